@@ -1,0 +1,20 @@
+// The subcommands of `lancer`.
+#pragma once
+
+#include <string>
+
+#include "app/cli/options.h"
+
+namespace lancer::cli {
+
+/// Load, build, render and write the outputs. Returns the process exit status.
+int runRender(const CommonOptions& o, const std::string& outPath, bool quiet);
+
+struct TraceOptions {
+    int x = 0, y = 0;
+    bool json = false;
+    bool shadows = false;  ///< also walk the primary hit's shadow rays
+};
+int runTrace(const CommonOptions& o, const TraceOptions& t);
+
+}  // namespace lancer::cli

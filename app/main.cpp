@@ -1,0 +1,54 @@
+// lancer: CSG ray tracing with the space subdivisions of Arnaldi, Priol and Bouatouch (1986).
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "app/cli/commands.h"
+#include "engine/scene/builtin_scenes.h"
+
+using namespace lancer;
+
+int main(int argc, char** argv) {
+    CLI::App app{"lancer: see and measure how space subdivision accelerates ray tracing of CSG solids"};
+    app.require_subcommand(0, 1);
+    std::string builtins = "Built-in scenes:";
+    for (const BuiltinInfo& b : builtinScenes())
+        builtins += std::string("\n  builtin:") + b.name + (b.maxSize > b.minSize ? "[:SIZE]" : "") + "  " + b.description;
+    app.footer(builtins);
+
+    cli::CommonOptions viewOpt, renderOpt, traceOpt;
+    std::string viewOut = "lancer-view.png";
+    CLI::App* view = app.add_subcommand("view", "Open the viewer (the default); without a display, render headless");
+    view->add_option("scene", viewOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]");
+    view->add_option("--headless-output", viewOut, "Where the headless render goes when there is no display");
+    cli::addCommonOptions(*view, viewOpt);
+
+    std::string out;
+    bool quiet = false;
+    CLI::App* render = app.add_subcommand("render", "Render a scene to a PNG");
+    render->add_option("scene", renderOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")->required();
+    render->add_option("-o,--output", out, "Output PNG")->required();
+    render->add_flag("-q,--quiet", quiet, "Print nothing on success");
+    cli::addCommonOptions(*render, renderOpt);
+
+    cli::TraceOptions topt;
+    CLI::App* trace = app.add_subcommand("trace", "Trace one primary ray and print its walk");
+    trace->add_option("scene", traceOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")->required();
+    std::vector<int> pixel;
+    trace->add_option("--pixel", pixel, "Pixel X Y (y = 0 on the top row)")->expected(2)->required();
+    trace->add_flag("--json", topt.json, "Machine-readable output");
+    cli::addCommonOptions(*trace, traceOpt);
+
+    CLI11_PARSE(app, argc, argv);
+
+    if (*render) return cli::runRender(renderOpt, out, quiet);
+    if (*trace) {
+        topt.x = pixel[0];
+        topt.y = pixel[1];
+        return cli::runTrace(traceOpt, topt);
+    }
+    // view (explicit or default). The interactive viewer is not part of this build yet, so the
+    // scene is rendered headless and the image's path printed.
+    std::cout << "lancer: the interactive viewer is not available in this build; rendering " << viewOpt.scene
+              << " headless.\n";
+    return cli::runRender(viewOpt, viewOut, false);
+}

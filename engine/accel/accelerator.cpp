@@ -1,0 +1,50 @@
+#include "engine/accel/accelerator.h"
+
+#include <chrono>
+#include <stdexcept>
+
+namespace lancer {
+
+const char* schemeName(SchemeKind k) {
+    switch (k) {
+        case SchemeKind::Brute: return "brute";
+        case SchemeKind::Regular: return "regular";
+        case SchemeKind::Irregular: return "irregular";
+    }
+    return "?";
+}
+
+const char* stepName(StepMethod s) { return s == StepMethod::Exact ? "exact" : "push"; }
+
+const char* heuristicName(BspHeuristic h) {
+    switch (h) {
+        case BspHeuristic::First: return "first";
+        case BspHeuristic::Balanced: return "balanced";
+        case BspHeuristic::FewestCuts: return "fewest-cuts";
+    }
+    return "?";
+}
+
+std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params) {
+    if (!scene.prepared) throw std::logic_error("buildAccelerator: scene not prepared");
+    auto start = std::chrono::steady_clock::now();
+    auto elapsedMs = [&] {
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count();
+    };
+    switch (params.scheme) {
+        case SchemeKind::Brute: {
+            BruteForce b(scene);
+            AccelInfo info;
+            info.regions = b.regionCount();
+            info.memoryBytes = b.memoryBytes();
+            info.buildMs = elapsedMs();
+            return std::make_unique<Accelerator>(std::move(b), params, std::move(info));
+        }
+        default:
+            throw std::invalid_argument(std::string("--scheme ") + schemeName(params.scheme) +
+                                        ": this scheme is not implemented yet");
+    }
+}
+
+}  // namespace lancer

@@ -1,0 +1,73 @@
+// The acceleration schemes as one closed set: brute force (the reference), the regular
+// subdivision and the irregular subdivision of Arnaldi, Priol and Bouatouch (1986).
+#pragma once
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <variant>
+
+#include "engine/accel/brute_force.h"
+
+namespace lancer {
+
+enum class SchemeKind : uint8_t { Brute, Regular, Irregular };
+enum class StepMethod : uint8_t { Exact, Push };
+enum class BspHeuristic : uint8_t { First, Balanced, FewestCuts };
+
+const char* schemeName(SchemeKind k);
+const char* stepName(StepMethod s);
+const char* heuristicName(BspHeuristic h);
+
+/// Builder parameters: a plain struct the command line, the viewer and the tests fill in.
+struct BuildParams {
+    SchemeKind scheme = SchemeKind::Brute;
+    int maxLevel = 18;          ///< deepest subdivision level (regular: total BSP depth)
+    int maxObjects = 2;         ///< stop subdividing a cell holding at most this many primitives
+    StepMethod step = StepMethod::Exact;
+    double delta = 1e-6;        ///< push distance, relative to the scene box's largest extent
+    BspHeuristic heuristic = BspHeuristic::Balanced;
+    bool mailboxes = true;      ///< --no-mailbox turns them off to measure their effect
+};
+
+/// What a built structure reports: `--stats` and the viewer show it.
+struct AccelInfo {
+    double buildMs = 0.0;
+    size_t regions = 1;
+    size_t memoryBytes = 0;
+    nlohmann::json extra = nlohmann::json::object();  ///< scheme-specific figures
+};
+
+class Accelerator {
+public:
+    using Impl = std::variant<BruteForce>;
+
+    Accelerator(Impl impl, BuildParams params, AccelInfo info)
+        : impl_(std::move(impl)), params_(params), info_(std::move(info)) {}
+
+    /// Nearest visible hit with t in (tmin, tmax]; reports the walk to `obs`.
+    template <class Obs>
+    bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                   Hit& hit) const {
+        return std::visit([&](const auto& s) { return s.intersect(ray, tmin, tmax, ctx, obs, hit); },
+                          impl_);
+    }
+    bool usesMailboxes() const {
+        return params_.mailboxes &&
+               std::visit([](const auto& s) { return s.usesMailboxes(); }, impl_);
+    }
+    const BuildParams& params() const { return params_; }
+    const AccelInfo& info() const { return info_; }
+    const Impl& impl() const { return impl_; }
+
+private:
+    Impl impl_;
+    BuildParams params_;
+    AccelInfo info_;
+};
+
+/// Build the scheme named in `params` over a prepared scene. Throws std::invalid_argument for
+/// parameters that are refused (for example a max level whose structure would not fit).
+std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params);
+
+}  // namespace lancer

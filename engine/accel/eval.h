@@ -1,0 +1,94 @@
+// Ray casting a CSG tree (Roth): primitive spans (through the mailboxes), combined by the
+// tree's operators; and the visible hit inside one region's ray interval. Every scheme uses
+// these two functions, so brute force and subdivisions differ only in which tree and interval.
+#pragma once
+
+#include <cassert>
+
+#include "engine/accel/observer.h"
+#include "engine/accel/trace_context.h"
+#include "engine/scene/scene.h"
+
+namespace lancer {
+
+/// The visible hit: a span boundary on primitive `prim`.
+struct Hit {
+    double t = kInf;
+    uint32_t prim = kNoPrim;
+    uint8_t part = 0;
+    bool flip = false;
+    bool valid() const { return prim != kNoPrim; }
+};
+
+/// Spans of the primitive for the current ray, from its mailbox when this ray already tested it.
+template <class Obs>
+inline int primitiveSpans(const Scene& scene, uint32_t p, const Ray& ray, TraceContext& ctx,
+                          Obs& obs, const Span*& out, Span* local) {
+    if (ctx.useMailboxes) {
+        Mailbox& m = ctx.mail[p];
+        if (m.ray == ctx.rayId) {
+            ++ctx.counters.mailboxHits;
+            obs.mailboxHit(p);
+            out = m.spans;
+            return m.count;
+        }
+        m.count = uint8_t(scene.prims[p].spans(ray, p, m.spans));
+        m.ray = ctx.rayId;
+        ++ctx.counters.primTests;
+        obs.primTest(p, m.spans, m.count);
+        out = m.spans;
+        return m.count;
+    }
+    int n = scene.prims[p].spans(ray, p, local);
+    ++ctx.counters.primTests;
+    obs.primTest(p, local, n);
+    out = local;
+    return n;
+}
+
+/// Spans of `tree` from `node` along the whole line of `ray`, into `out`.
+template <class Obs>
+void evalTree(const Scene& scene, const CsgTree& tree, int node, const Ray& ray, TraceContext& ctx,
+              Obs& obs, size_t level, SpanList& out) {
+    const CsgNode& x = tree.nodes[node];
+    if (x.op == Op::Primitive) {
+        Span local[2];
+        const Span* s;
+        int n = primitiveSpans(scene, x.prim, ray, ctx, obs, s, local);
+        out.assign(s, s + n);
+        return;
+    }
+    // Sized by TraceContext::reset from the tree depth: never resized here, since parents hold
+    // references into it.
+    assert(ctx.scratch.size() >= 2 * level + 2);
+    SpanList& a = ctx.scratch[2 * level];
+    SpanList& b = ctx.scratch[2 * level + 1];
+    evalTree(scene, tree, x.left, ray, ctx, obs, level + 1, a);
+    if (a.empty() && x.op != Op::Union) {  // nothing to intersect or to cut from
+        out.clear();
+        return;
+    }
+    evalTree(scene, tree, x.right, ray, ctx, obs, level + 1, b);
+    switch (x.op) {
+        case Op::Union: spanUnion(a, b, out); break;
+        case Op::Intersection: spanIntersection(a, b, out); break;
+        case Op::Difference: spanDifference(a, b, out); break;
+        case Op::Primitive: break;
+    }
+}
+
+/// The visible hit of `tree` inside a region the ray crosses on [t0, t1]: the first span
+/// boundary with t in [t0, t1] and t > tmin. The restricted tree agrees with the full tree only
+/// inside the region, so boundaries outside it are ignored.
+template <class Obs>
+bool hitInRegion(const Scene& scene, const CsgTree& tree, int root, const Ray& ray, double tmin,
+                 double t0, double t1, TraceContext& ctx, Obs& obs, Hit& hit) {
+    if (root < 0) return false;
+    evalTree(scene, tree, root, ray, ctx, obs, 0, ctx.result);
+    if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
+    const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
+    if (b) hit = {b->t, b->prim, b->part, b->flip};
+    return b != nullptr;
+}
+
+}  // namespace lancer

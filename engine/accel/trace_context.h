@@ -1,0 +1,54 @@
+// Per-thread state of ray tracing: mailboxes, span scratch buffers and counters.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "engine/model/span.h"
+
+namespace lancer {
+
+/// Counters every scheme reports; summed over threads for `--stats`, per pixel for heatmaps.
+struct RayCounters {
+    uint64_t rays = 0;          ///< all rays traced (primary, shadow, reflected, refracted)
+    uint64_t primaryRays = 0;
+    uint64_t shadowRays = 0;
+    uint64_t primTests = 0;     ///< ray-primitive intersection computations done
+    uint64_t mailboxHits = 0;   ///< computations saved by a mailbox
+    uint64_t regionVisits = 0;  ///< regions entered
+    uint64_t pointerSteps = 0;  ///< region changes by corner pointer (irregular scheme)
+    uint64_t walkErrors = 0;    ///< walks that could not advance and were ended
+
+    RayCounters& operator+=(const RayCounters& o);
+    RayCounters operator-(const RayCounters& o) const;
+};
+
+/// The report's "boîte aux lettres": the last ray tested against a primitive and its spans.
+/// Each thread owns its own array, so no mailbox is ever shared between threads.
+struct Mailbox {
+    uint64_t ray = 0;
+    uint8_t count = 0;
+    Span spans[2];
+};
+
+/// One per thread. Ray ids start at 1 and are unique within the context, so mailboxes never
+/// need clearing between rays.
+struct TraceContext {
+    std::vector<Mailbox> mail;
+    std::vector<SpanList> scratch;  ///< two buffers per tree level, reused without allocation
+    SpanList result;                ///< spans of the tree evaluated last
+    uint64_t rayId = 0;
+    bool useMailboxes = true;
+    RayCounters counters;
+
+    TraceContext() = default;
+    TraceContext(size_t primitives, int treeDepth) { reset(primitives, treeDepth); }
+    void reset(size_t primitives, int treeDepth);
+    /// Start a new ray: a fresh id for the mailboxes.
+    void beginRay() {
+        ++rayId;
+        ++counters.rays;
+    }
+};
+
+}  // namespace lancer

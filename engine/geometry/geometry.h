@@ -1,0 +1,112 @@
+// Rays, axis-aligned boxes and affine transforms, in double precision.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace lancer {
+
+using Vec3 = glm::dvec3;
+using Mat4 = glm::dmat4;
+using Mat3 = glm::dmat3;
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string toString(const Vec3& v);
+
+/// A ray o + t d. `d` need not be unit length; spans are measured in t.
+struct Ray {
+    Vec3 o{0.0};
+    Vec3 d{0.0, 0.0, 1.0};
+
+    Vec3 at(double t) const { return o + t * d; }
+    std::string toString() const;
+};
+
+/// A closed axis-aligned box. Empty when lo > hi on some axis; a flat box (lo == hi) is not empty.
+struct Box3 {
+    Vec3 lo{kInf};
+    Vec3 hi{-kInf};
+
+    static Box3 empty() { return {}; }
+    static Box3 everything() { return {Vec3(-kInf), Vec3(kInf)}; }
+
+    bool isEmpty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
+    bool isBounded() const;
+    Vec3 extent() const { return hi - lo; }
+    Vec3 center() const { return 0.5 * (lo + hi); }
+    bool contains(const Vec3& p) const {
+        return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z &&
+               p.z <= hi.z;
+    }
+    /// Closed overlap: boxes that only touch do overlap.
+    bool overlaps(const Box3& b) const {
+        return lo.x <= b.hi.x && b.lo.x <= hi.x && lo.y <= b.hi.y && b.lo.y <= hi.y &&
+               lo.z <= b.hi.z && b.lo.z <= hi.z;
+    }
+    void expand(const Vec3& p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    void expand(const Box3& b) {
+        lo = glm::min(lo, b.lo);
+        hi = glm::max(hi, b.hi);
+    }
+    bool operator==(const Box3& b) const = default;
+    std::string toString() const;
+};
+
+inline Box3 hull(const Box3& a, const Box3& b) {
+    if (a.isEmpty()) return b;
+    if (b.isEmpty()) return a;
+    return {glm::min(a.lo, b.lo), glm::max(a.hi, b.hi)};
+}
+
+/// Intersection of two boxes; stays empty if either is empty.
+inline Box3 overlap(const Box3& a, const Box3& b) {
+    Box3 r{glm::max(a.lo, b.lo), glm::min(a.hi, b.hi)};
+    return r.isEmpty() ? Box3::empty() : r;
+}
+
+/// Parametric interval [t0, t1] of the ray inside a closed box (over the whole line).
+/// Returns false when the line misses. Axis-parallel rays are handled without 0 * inf.
+bool clipLine(const Ray& r, const Box3& b, double& t0, double& t1);
+
+/// An affine transform with its inverse and the normal matrix (inverse transpose).
+struct Transform {
+    Mat4 m{1.0};
+    Mat4 inv{1.0};
+    Mat3 normal{1.0};
+
+    Transform() = default;
+    explicit Transform(const Mat4& matrix);
+
+    static Transform translate(const Vec3& t);
+    static Transform scale(const Vec3& s);
+    /// Rotation by `degrees` about `axis`.
+    static Transform rotate(double degrees, const Vec3& axis);
+
+    /// this ∘ other: apply `other` first.
+    Transform operator*(const Transform& o) const { return Transform(m * o.m); }
+
+    Vec3 point(const Vec3& p) const { return Vec3(m * glm::dvec4(p, 1.0)); }
+    Vec3 vector(const Vec3& v) const { return Mat3(m) * v; }
+    Vec3 normalOf(const Vec3& n) const { return glm::normalize(normal * n); }
+    Ray toLocal(const Ray& r) const {
+        return {Vec3(inv * glm::dvec4(r.o, 1.0)), Mat3(inv) * r.d};
+    }
+    /// World box of a local box (hull of its eight transformed corners).
+    Box3 box(const Box3& local) const;
+    bool isIdentity() const { return m == Mat4(1.0); }
+    /// True when the linear part is invertible with a finite inverse.
+    bool isInvertible() const;
+};
+
+/// An orthonormal frame whose third axis is `w` (unit).
+void orthonormalBasis(const Vec3& w, Vec3& u, Vec3& v);
+
+}  // namespace lancer

@@ -1,0 +1,61 @@
+// The primitives, each in its own local frame. `spans` returns the ray's spans over the whole
+// line (any t), sorted; solids give at most one span of positive length, surfaces give
+// zero-length spans. `normal` is the outward (solids) or geometric (surfaces) normal.
+#pragma once
+
+#include <variant>
+#include <vector>
+
+#include "engine/model/span.h"
+
+namespace lancer {
+
+/// Sphere of centre `c` and radius `r` > 0.
+struct Sphere {
+    Vec3 c{0.0};
+    double r = 1.0;
+};
+
+/// Axis-aligned box [lo, hi] with lo < hi on every axis. Parts 0..5: -x, +x, -y, +y, -z, +z.
+struct Block {
+    Vec3 lo{-1.0}, hi{1.0};
+};
+
+/// Capped (truncated) cone along +z: radius r1 at z = 0, r2 at z = h. r1 = r2 is a cylinder.
+/// Parts: 0 side, 1 bottom cap, 2 top cap. As a surface (`open`), no caps and no inside.
+struct Cone {
+    double r1 = 1.0, r2 = 1.0, h = 1.0;
+    bool open = false;
+};
+
+/// Triangle; with `smooth`, vertex normals are interpolated for shading (NFF `pp`).
+struct Triangle {
+    Vec3 p[3];
+    Vec3 n[3];
+    bool smooth = false;
+};
+
+/// Planar polygon, convex or not (even-odd rule), at least three vertices.
+struct Polygon {
+    std::vector<Vec3> p;
+    Vec3 n{0.0};       ///< unit plane normal (Newell)
+    double d = 0.0;    ///< plane: dot(n, x) = d
+    int drop = 2;      ///< axis dropped for the 2D inside test
+};
+
+using Shape = std::variant<Sphere, Block, Cone, Triangle, Polygon>;
+
+/// Spans of the line `r` (in the shape's frame) through the shape, written to `out` (capacity 2).
+int shapeSpans(const Shape& s, const Ray& r, uint32_t prim, Span* out);
+/// Normal at local point `p` on part `part` (not normalised for transformed shapes' sake).
+Vec3 shapeNormal(const Shape& s, const Vec3& p, uint8_t part);
+/// Local bounds.
+Box3 shapeBounds(const Shape& s);
+/// True for shapes with no inside (polygons, triangles, open cones).
+bool shapeIsSurface(const Shape& s);
+const char* shapeName(const Shape& s);
+
+/// Build a polygon (computes plane and projection axis). Returns false if degenerate.
+bool makePolygon(std::vector<Vec3> pts, Polygon& out);
+
+}  // namespace lancer

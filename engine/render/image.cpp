@@ -1,0 +1,112 @@
+#include "engine/render/image.h"
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "engine/model/span.h"
+
+// Implementations come from Debian's libstb.
+#include <stb_image.h>
+#include <stb_image_write.h>
+
+namespace lancer {
+
+void Image::resize(int w, int h) {
+    width = w;
+    height = h;
+    size_t n = size_t(w) * size_t(h);
+    color.assign(n, glm::vec3(0.0f));
+    depth.assign(n, std::numeric_limits<float>::infinity());
+    hitPrim.assign(n, kNoPrim);
+    primTests.assign(n, 0);
+    regionVisits.assign(n, 0);
+    timeUs.assign(n, 0.0f);
+}
+
+std::vector<uint8_t> Image::rgba8() const {
+    std::vector<uint8_t> out(color.size() * 4);
+    for (size_t i = 0; i < color.size(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+            float v = std::min(std::max(color[i][c], 0.0f), 1.0f);
+            out[4 * i + c] = uint8_t(v * 255.0f + 0.5f);
+        }
+        out[4 * i + 3] = 255;
+    }
+    return out;
+}
+
+void writeFileAtomic(const std::string& path, const std::string& data) {
+    std::string tmp = path + ".tmp";
+    {
+        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+        if (!f) throw std::runtime_error(path + ": cannot open for writing");
+        f.write(data.data(), std::streamsize(data.size()));
+        f.close();
+        if (!f) {
+            std::remove(tmp.c_str());
+            throw std::runtime_error(path + ": write failed");
+        }
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        throw std::runtime_error(path + ": cannot rename the temporary file into place");
+    }
+}
+
+void writePng(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba) {
+    std::string data;
+    auto sink = [](void* ctx, void* bytes, int n) {
+        static_cast<std::string*>(ctx)->append(static_cast<const char*>(bytes), size_t(n));
+    };
+    if (!stbi_write_png_to_func(sink, &data, w, h, 4, rgba.data(), w * 4))
+        throw std::runtime_error(path + ": PNG encoding failed");
+    writeFileAtomic(path, data);
+}
+
+void writePng(const std::string& path, const Image& img) {
+    writePng(path, img.width, img.height, img.rgba8());
+}
+
+void writeDepthPfm(const std::string& path, const Image& img) {
+    std::ostringstream os;
+    os << "Pf\n" << img.width << " " << img.height << "\n-1.0\n";
+    std::string data = os.str();
+    size_t header = data.size();
+    data.resize(header + img.depth.size() * 4);
+    char* p = data.data() + header;
+    for (int y = img.height - 1; y >= 0; --y) {  // PFM rows go bottom to top
+        std::memcpy(p, &img.depth[img.index(0, y)], size_t(img.width) * 4);  // x86: little endian
+        p += size_t(img.width) * 4;
+    }
+    writeFileAtomic(path, data);
+}
+
+std::vector<float> readPfm(const std::string& path, int& w, int& h) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) throw std::runtime_error(path + ": cannot open");
+    std::string magic;
+    double scale;
+    f >> magic >> w >> h >> scale;
+    f.get();
+    if (magic != "Pf" || w <= 0 || h <= 0 || scale >= 0) throw std::runtime_error(path + ": not a little-endian one-channel PFM");
+    std::vector<float> rows(size_t(w) * size_t(h)), out(rows.size());
+    f.read(reinterpret_cast<char*>(rows.data()), std::streamsize(rows.size() * 4));
+    if (!f) throw std::runtime_error(path + ": truncated");
+    for (int y = 0; y < h; ++y)
+        std::memcpy(&out[size_t(y) * size_t(w)], &rows[size_t(h - 1 - y) * size_t(w)], size_t(w) * 4);
+    return out;
+}
+
+std::vector<uint8_t> readPng(const std::string& path, int& w, int& h) {
+    int n;
+    unsigned char* px = stbi_load(path.c_str(), &w, &h, &n, 4);
+    if (!px) throw std::runtime_error(path + ": cannot read PNG: " + stbi_failure_reason());
+    std::vector<uint8_t> out(px, px + size_t(w) * size_t(h) * 4);
+    stbi_image_free(px);
+    return out;
+}
+
+}  // namespace lancer

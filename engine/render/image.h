@@ -1,0 +1,41 @@
+// Images the tracer fills: colour, depth and per-pixel counters, and their files.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "engine/geometry/geometry.h"
+
+namespace lancer {
+
+struct Image {
+    int width = 0, height = 0;
+    std::vector<glm::vec3> color;    ///< linear RGB, row 0 on top
+    std::vector<float> depth;        ///< primary hit distance along the unit direction; +inf: miss
+    std::vector<uint32_t> hitPrim;   ///< primitive of the primary hit; kNoPrim on a miss
+    std::vector<uint32_t> primTests; ///< per pixel, every ray of the pixel
+    std::vector<uint32_t> regionVisits;
+    std::vector<float> timeUs;       ///< per pixel wall time in microseconds
+
+    Image() = default;
+    Image(int w, int h) { resize(w, h); }
+    void resize(int w, int h);
+    size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
+    /// 8-bit sRGB-ish bytes (clamped, gamma 1/2.2 not applied: NFF colours are display values).
+    std::vector<uint8_t> rgba8() const;
+};
+
+/// Write a PNG atomically (a temporary file renamed into place). Throws std::runtime_error.
+void writePng(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba);
+void writePng(const std::string& path, const Image& img);
+/// Standard PFM ("Pf", little endian, rows bottom to top) of the depth channel.
+void writeDepthPfm(const std::string& path, const Image& img);
+/// Read a one-channel PFM. Throws std::runtime_error.
+std::vector<float> readPfm(const std::string& path, int& w, int& h);
+/// Read a PNG as RGBA8. Throws std::runtime_error.
+std::vector<uint8_t> readPng(const std::string& path, int& w, int& h);
+/// Write `data` to `path` atomically.
+void writeFileAtomic(const std::string& path, const std::string& data);
+
+}  // namespace lancer

@@ -1,0 +1,79 @@
+#include "engine/render/renderer.h"
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+
+namespace lancer {
+
+int effectiveThreads(int requested) {
+    int cores = tbb::info::default_concurrency();
+    return requested > 0 ? requested : cores;
+}
+
+RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOptions& opt,
+                   Image& img, PassLattice pass, const std::atomic<bool>* cancel,
+                   std::atomic<size_t>* progress) {
+    using Clock = std::chrono::steady_clock;
+    RenderStats stats;
+    stats.threads = effectiveThreads(opt.threads);
+    const Camera& cam = scene.camera;
+    const int w = img.width, h = img.height;
+    const Tracer tracer(scene, accel, opt.shading);
+    const int depth = scene.tree.depth();
+    const bool mailboxes = accel.usesMailboxes();
+    tbb::enumerable_thread_specific<TraceContext> contexts([&] {
+        TraceContext c(scene.prims.size(), depth);
+        c.useMailboxes = mailboxes;
+        return c;
+    });
+    auto start = Clock::now();
+    std::atomic<bool> stopped{false};
+    tbb::task_arena arena(stats.threads);
+    arena.execute([&] {
+        tbb::parallel_for(
+            tbb::blocked_range2d<int>(0, h, opt.tile, 0, w, opt.tile),
+            [&](const tbb::blocked_range2d<int>& r) {
+                if (stopped.load(std::memory_order_relaxed)) return;
+                if (cancel && cancel->load(std::memory_order_relaxed)) {
+                    stopped = true;
+                    return;
+                }
+                TraceContext& ctx = contexts.local();
+                NullObserver obs;
+                size_t done = 0;
+                for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
+                    for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
+                        if (!pass.contains(x, y)) continue;
+                        auto t0 = Clock::now();
+                        RayCounters before = ctx.counters;
+                        Ray ray = cam.primaryRay(x, y, w, h);
+                        ++ctx.counters.primaryRays;
+                        Hit hit;
+                        Vec3 c = tracer.radiance(ray, 0, ctx, obs, &hit);
+                        size_t i = img.index(x, y);
+                        img.color[i] = glm::vec3(c);
+                        img.depth[i] = hit.valid() ? float(hit.t) : std::numeric_limits<float>::infinity();
+                        img.hitPrim[i] = hit.prim;
+                        RayCounters d = ctx.counters - before;
+                        img.primTests[i] = uint32_t(d.primTests);
+                        img.regionVisits[i] = uint32_t(d.regionVisits);
+                        img.timeUs[i] = std::chrono::duration<float, std::micro>(Clock::now() - t0).count();
+                        ++done;
+                    }
+                }
+                if (progress) progress->fetch_add(done, std::memory_order_relaxed);
+            },
+            tbb::simple_partitioner());
+    });
+    stats.renderMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    stats.cancelled = stopped.load();
+    for (const TraceContext& c : contexts) stats.counters += c.counters;
+    return stats;
+}
+
+}  // namespace lancer

@@ -1,0 +1,45 @@
+// Multithreaded rendering over tiles (oneTBB), with per-pixel counters and cancellation.
+#pragma once
+
+#include <atomic>
+
+#include "engine/render/image.h"
+#include "engine/render/tracer.h"
+
+namespace lancer {
+
+struct RenderOptions {
+    int width = 512, height = 512;
+    int threads = 0;            ///< 0: all cores
+    int tile = 16;
+    ShadingOptions shading;
+};
+
+struct RenderStats {
+    RayCounters counters;
+    double renderMs = 0.0;
+    int threads = 1;
+    bool cancelled = false;
+};
+
+/// Pixels of one progressive pass: those on the `stride` lattice that were not on the
+/// `previousStride` lattice (0: none rendered before).
+struct PassLattice {
+    int stride = 1;
+    int previousStride = 0;
+    bool contains(int x, int y) const {
+        if (x % stride || y % stride) return false;
+        return previousStride == 0 || (x % previousStride) || (y % previousStride);
+    }
+};
+
+/// Render the pixels of `pass` into `img` (already sized). Stops early, with
+/// `cancelled` set, when `*cancel` becomes true. `progress` counts finished pixels.
+RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOptions& opt,
+                   Image& img, PassLattice pass = {}, const std::atomic<bool>* cancel = nullptr,
+                   std::atomic<size_t>* progress = nullptr);
+
+/// Threads a render with `requested` threads uses (0: all cores).
+int effectiveThreads(int requested);
+
+}  // namespace lancer

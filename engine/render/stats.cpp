@@ -1,0 +1,46 @@
+#include "engine/render/stats.h"
+
+namespace lancer {
+
+nlohmann::json statsJson(const Scene& scene, const Accelerator& accel, const RenderOptions& opt,
+                         const RenderStats& rs) {
+    const BuildParams& p = accel.params();
+    const AccelInfo& info = accel.info();
+    const RayCounters& c = rs.counters;
+    nlohmann::json j;
+    j["scene"] = scene.name;
+    j["scheme"] = schemeName(p.scheme);
+    j["width"] = opt.width;
+    j["height"] = opt.height;
+    j["threads"] = rs.threads;
+    j["build_ms"] = info.buildMs;
+    j["render_ms"] = rs.renderMs;
+    j["rays"] = c.rays;
+    j["primary_rays"] = c.primaryRays;
+    j["shadow_rays"] = c.shadowRays;
+    j["prim_tests"] = c.primTests;
+    j["mailbox_hits"] = c.mailboxHits;
+    j["region_visits"] = c.regionVisits;
+    j["pointer_steps"] = c.pointerSteps;
+    j["walk_errors"] = c.walkErrors;
+    j["regions"] = info.regions;
+    j["memory_bytes"] = info.memoryBytes;
+    j["max_level"] = p.maxLevel;
+    j["max_objects"] = p.maxObjects;
+    j["step"] = stepName(p.step);
+    j["delta"] = p.delta;
+    j["bsp_heuristic"] = heuristicName(p.heuristic);
+    j["mailboxes"] = accel.usesMailboxes();
+    j["bounces"] = opt.shading.bounces;
+    j["primitives"] = scene.prims.size();
+    j["live_primitives"] = scene.livePrimitives().size();
+    j["dropped_primitives"] = scene.droppedPrims;
+    double rays = c.rays ? double(c.rays) : 1.0;
+    j["prim_tests_per_ray"] = double(c.primTests) / rays;
+    j["region_visits_per_ray"] = double(c.regionVisits) / rays;
+    j["cancelled"] = rs.cancelled;
+    for (const auto& [k, v] : info.extra.items()) j[k] = v;
+    return j;
+}
+
+}  // namespace lancer

@@ -1,0 +1,41 @@
+#include "engine/scene/loader.h"
+
+#include <charconv>
+
+#include "engine/scene/builtin_scenes.h"
+#include "engine/scene/json_reader.h"
+#include "engine/scene/nff_reader.h"
+
+namespace lancer {
+
+namespace {
+std::string extension(const std::string& path) {
+    size_t dot = path.rfind('.');
+    size_t slash = path.rfind('/');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+    std::string e = path.substr(dot);
+    for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return e;
+}
+}  // namespace
+
+Scene loadScene(const std::string& spec) {
+    if (spec.rfind("builtin:", 0) == 0) {
+        std::string rest = spec.substr(8);
+        size_t colon = rest.find(':');
+        if (colon == std::string::npos) return makeBuiltin(rest);
+        std::string num = rest.substr(colon + 1);
+        int size = 0;
+        auto r = std::from_chars(num.data(), num.data() + num.size(), size);
+        if (r.ec != std::errc() || r.ptr != num.data() + num.size())
+            throw SceneError(spec + ": the size after the second ':' must be an integer");
+        return makeBuiltin(rest.substr(0, colon), size);
+    }
+    std::string ext = extension(spec);
+    if (ext == ".json") return readJsonScene(SourceText::fromFile(spec));
+    if (ext == ".nff") return readNff(SourceText::fromFile(spec));
+    throw SceneError(spec + ": unknown scene format '" + ext +
+                     "' (expected .json, .nff, or builtin:NAME[:SIZE])");
+}
+
+}  // namespace lancer

@@ -1,0 +1,185 @@
+#include "engine/scene/nff_reader.h"
+
+#include <cmath>
+
+#include "engine/scene/tokenizer.h"
+
+namespace lancer {
+
+namespace {
+constexpr int kMaxVertices = 1 << 20;  // refuses absurd counts before allocating
+}
+
+Scene readNff(const SourceText& src, NffCounts* countsOut) {
+    WordReader in(src);
+    Scene scene;
+    scene.name = src.path();
+    NffCounts counts;
+    std::vector<int> leaves;
+    int material = 0;
+    bool haveView = false;
+    double angle = 45.0;
+    int resH = 0;
+    std::vector<Vec3> lightPos;
+    std::vector<Vec3> lightColor;
+    std::vector<bool> lightHasColor;
+
+    auto addPrim = [&](Shape shape, const Transform& xf, size_t pos) {
+        Primitive p = makePrimitive(std::move(shape), xf, material);
+        p.origin = src.where(pos);
+        scene.prims.push_back(std::move(p));
+        leaves.push_back(scene.tree.leaf(uint32_t(scene.prims.size() - 1)));
+    };
+    auto nextIsNumber = [&] {
+        double v;
+        return parseFiniteDouble(in.peek().text, v);
+    };
+
+    while (true) {
+        Token t = in.next();
+        if (t.text.empty()) break;
+        std::string_view k = t.text;
+        if (k == "v") {
+            // from, at, up, angle, hither, resolution: keyword-led, in this order.
+            auto expect = [&](const char* word) {
+                Token w = in.next();
+                if (w.text != word)
+                    src.fail(w.pos, std::string("expected '") + word + "' in the viewpoint ('v') block, got '" + std::string(w.text) + "'");
+            };
+            expect("from");
+            scene.camera.from = in.vec3("the 'from' point");
+            expect("at");
+            scene.camera.at = in.vec3("the 'at' point");
+            expect("up");
+            scene.camera.up = in.vec3("the 'up' vector");
+            expect("angle");
+            size_t apos = in.peek().pos;
+            angle = in.number("the view angle");
+            if (!(angle > 0.0 && angle < 180.0)) src.fail(apos, "the view angle must be in (0, 180) degrees");
+            expect("hither");
+            in.number("the hither distance");
+            expect("resolution");
+            scene.width = in.count("the image width", 16384);
+            size_t rpos = in.peek().pos;
+            resH = in.count("the image height", 16384);
+            if (scene.width < 1 || resH < 1) src.fail(rpos, "the resolution must be at least 1 x 1");
+            scene.height = resH;
+            haveView = true;
+            if (std::string e = scene.camera.validate(); !e.empty()) src.fail(t.pos, e);
+        } else if (k == "b") {
+            scene.background = in.vec3("the background colour");
+        } else if (k == "l") {
+            lightPos.push_back(in.vec3("the light position"));
+            bool c = nextIsNumber();
+            lightColor.push_back(c ? in.vec3("the light colour") : Vec3(1.0));
+            lightHasColor.push_back(c);
+            ++counts.lights;
+        } else if (k == "f") {
+            Material m;
+            m.color = in.vec3("the fill colour");
+            m.diffuse = in.number("Kd");
+            m.specular = in.number("Ks");
+            m.shininess = in.number("Shine");
+            m.transmit = in.number("T");
+            size_t ipos = in.peek().pos;
+            m.ior = in.number("the index of refraction");
+            if (m.ior <= 0.0) src.fail(ipos, "the index of refraction must be positive");
+            m.reflect = m.specular;  // NFF: Ks also weights the mirror reflection
+            m.ambient = 0.1;
+            scene.materials.push_back(m);
+            material = int(scene.materials.size()) - 1;
+            ++counts.materials;
+        } else if (k == "s") {
+            Sphere s;
+            s.c = in.vec3("the sphere centre");
+            size_t rpos = in.peek().pos;
+            s.r = in.number("the sphere radius");
+            if (!(s.r > 0.0)) src.fail(rpos, "the sphere radius must be positive");
+            addPrim(s, Transform(), t.pos);
+            ++counts.spheres;
+        } else if (k == "p" || k == "pp") {
+            bool patch = k == "pp";
+            size_t cpos = in.peek().pos;
+            int n = in.count("the vertex count", kMaxVertices);
+            if (n < 3) src.fail(cpos, "a polygon needs at least 3 vertices");
+            std::vector<Vec3> pts, nrm;
+            for (int i = 0; i < n; ++i) {
+                pts.push_back(in.vec3("a vertex"));
+                if (patch) nrm.push_back(in.vec3("a vertex normal"));
+            }
+            (patch ? counts.patches : counts.polygons)++;
+            if (patch) {
+                // Fan of smooth triangles (exact for the convex patches SPD writes).
+                for (int i = 1; i + 1 < n; ++i) {
+                    Triangle tr;
+                    tr.p[0] = pts[0], tr.p[1] = pts[size_t(i)], tr.p[2] = pts[size_t(i + 1)];
+                    tr.n[0] = nrm[0], tr.n[1] = nrm[size_t(i)], tr.n[2] = nrm[size_t(i + 1)];
+                    tr.smooth = true;
+                    if (glm::length(glm::cross(tr.p[1] - tr.p[0], tr.p[2] - tr.p[0])) == 0.0) {
+                        ++counts.degenerate;
+                        continue;
+                    }
+                    addPrim(tr, Transform(), t.pos);
+                }
+            } else if (n == 3) {
+                Triangle tr;
+                for (int i = 0; i < 3; ++i) tr.p[i] = pts[size_t(i)];
+                if (glm::length(glm::cross(tr.p[1] - tr.p[0], tr.p[2] - tr.p[0])) == 0.0)
+                    ++counts.degenerate;
+                else
+                    addPrim(tr, Transform(), t.pos);
+            } else {
+                Polygon pg;
+                if (makePolygon(pts, pg))
+                    addPrim(std::move(pg), Transform(), t.pos);
+                else
+                    ++counts.degenerate;
+            }
+        } else if (k == "c") {
+            Vec3 base = in.vec3("the cone base point");
+            size_t r0pos = in.peek().pos;
+            double r0 = in.number("the cone base radius");
+            Vec3 apex = in.vec3("the cone apex point");
+            size_t r1pos = in.peek().pos;
+            double r1 = in.number("the cone apex radius");
+            if (r0 < 0.0) src.fail(r0pos, "a cone radius must not be negative");
+            if (r1 < 0.0) src.fail(r1pos, "a cone radius must not be negative");
+            if (r0 == 0.0 && r1 == 0.0) src.fail(r0pos, "a cone needs a positive radius at one end");
+            Vec3 axis = apex - base;
+            double h = glm::length(axis);
+            if (!(h > 0.0)) src.fail(t.pos, "the cone's base and apex are the same point");
+            Vec3 w = axis / h, u, v;
+            orthonormalBasis(w, u, v);
+            Mat4 m(1.0);
+            m[0] = glm::dvec4(u, 0.0);
+            m[1] = glm::dvec4(v, 0.0);
+            m[2] = glm::dvec4(w, 0.0);
+            m[3] = glm::dvec4(base, 1.0);
+            Cone c{r0, r1, h, true};
+            addPrim(c, Transform(m), t.pos);
+            ++counts.cones;
+        } else {
+            src.fail(t.pos, "unknown NFF entity '" + std::string(k) + "' (expected v, b, l, f, s, p, pp, c or #)");
+        }
+    }
+
+    // NFF lights have equal intensity; scale so several lights do not wash the image out.
+    double share = lightPos.empty() ? 1.0 : 1.0 / std::sqrt(double(lightPos.size()));
+    for (size_t i = 0; i < lightPos.size(); ++i)
+        scene.lights.push_back({lightPos[i], lightHasColor[i] ? lightColor[i] * share : Vec3(share)});
+    scene.tree.root = scene.tree.balanced(Op::Union, leaves);
+    scene.prepare();
+    if (haveView) {
+        // NFF's angle spans the centres of the top and bottom pixel rows: widen it to the edges.
+        double half = std::tan(glm::radians(angle) * 0.5);
+        if (resH > 1) half *= double(resH) / double(resH - 1);
+        scene.camera.fov = glm::degrees(2.0 * std::atan(half));
+    } else {
+        scene.frameCamera({-1.0, 2.0, -1.0}, {0, 0, 1});
+    }
+    if (scene.lights.empty()) scene.defaultLights();
+    if (countsOut) *countsOut = counts;
+    return scene;
+}
+
+}  // namespace lancer

@@ -1,0 +1,28 @@
+// Source text with line/column lookup, shared by every scene reader's error messages.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace lancer {
+
+class SourceText {
+public:
+    SourceText(std::string path, std::string text);
+    /// Read a whole file; throws SceneError naming the path when it cannot be read.
+    static SourceText fromFile(const std::string& path);
+    const std::string& path() const { return path_; }
+    const std::string& text() const { return text_; }
+    /// 1-based line and column of byte offset `pos`.
+    void lineColumn(size_t pos, int& line, int& col) const;
+    /// "path:line:col" of byte offset `pos`.
+    std::string where(size_t pos) const;
+    /// Throw SceneError("path:line:col: message").
+    [[noreturn]] void fail(size_t pos, const std::string& message) const;
+
+private:
+    std::string path_, text_;
+    std::vector<size_t> lineStarts_;
+};
+
+}  // namespace lancer
