@@ -1,0 +1,166 @@
+// Restriction rules (report, section 2), minimized boxes (Fig. 1), and the restricted tree's
+// agreement with the full tree inside a region.
+#include <gtest/gtest.h>
+
+#include "engine/accel/eval.h"
+#include "tests/support/differential.h"
+
+namespace lancer {
+namespace {
+
+// Tree "p0 op p1" over two unit spheres, restricted to the given membership.
+std::string restrictPair(Op op, bool keepA, bool keepB) {
+    CsgTree t;
+    t.root = t.combine(op, t.leaf(0), t.leaf(1));
+    CsgTree r;
+    r.root = restrictTree(t, t.root, {char(keepA), char(keepB)}, r);
+    return r.toString();
+}
+
+TEST(Restriction, PrimitiveInOrOut) {
+    CsgTree t;
+    t.root = t.leaf(0);
+    CsgTree in, out;
+    in.root = restrictTree(t, t.root, {1}, in);
+    out.root = restrictTree(t, t.root, {0}, out);
+    EXPECT_EQ(in.toString(), "p0");
+    EXPECT_EQ(out.toString(), "∅");
+}
+
+TEST(Restriction, EveryRuleOfTheReport) {
+    // Both non-empty: A op B.
+    EXPECT_EQ(restrictPair(Op::Union, true, true), "(p0 ∪ p1)");
+    EXPECT_EQ(restrictPair(Op::Intersection, true, true), "(p0 ∩ p1)");
+    EXPECT_EQ(restrictPair(Op::Difference, true, true), "(p0 − p1)");
+    // Both empty: empty.
+    for (Op op : {Op::Union, Op::Intersection, Op::Difference}) EXPECT_EQ(restrictPair(op, false, false), "∅");
+    // Only B: union gives B; difference and intersection give empty.
+    EXPECT_EQ(restrictPair(Op::Union, false, true), "p1");
+    EXPECT_EQ(restrictPair(Op::Difference, false, true), "∅");
+    EXPECT_EQ(restrictPair(Op::Intersection, false, true), "∅");
+    // Only A: union and difference give A; intersection gives empty.
+    EXPECT_EQ(restrictPair(Op::Union, true, false), "p0");
+    EXPECT_EQ(restrictPair(Op::Difference, true, false), "p0");
+    EXPECT_EQ(restrictPair(Op::Intersection, true, false), "∅");
+}
+
+TEST(Restriction, NestedTree) {
+    // ((p0 ∪ p1) − (p2 ∩ p3)) restricted to {p1, p2}: (p1) − ∅ = p1.
+    CsgTree t;
+    int u = t.combine(Op::Union, t.leaf(0), t.leaf(1));
+    int i = t.combine(Op::Intersection, t.leaf(2), t.leaf(3));
+    t.root = t.combine(Op::Difference, u, i);
+    CsgTree r;
+    r.root = restrictTree(t, t.root, {0, 1, 1, 0}, r);
+    EXPECT_EQ(r.toString(), "p1");
+    CsgTree r2;
+    r2.root = restrictTree(t, t.root, {1, 0, 1, 1}, r2);
+    EXPECT_EQ(r2.toString(), "(p0 − (p2 ∩ p3))");
+}
+
+TEST(MinimizedBoxes, IntersectionClipsBothSides) {
+    Scene s;
+    s.prims.push_back(makePrimitive(Block{{0, 0, 0}, {4, 4, 4}}, Transform()));
+    s.prims.push_back(makePrimitive(Sphere{{4, 4, 4}, 1.0}, Transform()));
+    s.tree.root = s.tree.combine(Op::Intersection, s.tree.leaf(0), s.tree.leaf(1));
+    s.prepare();
+    EXPECT_EQ(s.minBox[0], (Box3{{3, 3, 3}, {4, 4, 4}}));
+    EXPECT_EQ(s.minBox[1], (Box3{{3, 3, 3}, {4, 4, 4}}));
+    EXPECT_EQ(s.droppedPrims, 0);
+}
+
+TEST(MinimizedBoxes, DifferenceClipsTheSubtrahendAndDropsWhatLiesOutside) {
+    Scene s;
+    s.prims.push_back(makePrimitive(Block{{0, 0, 0}, {2, 2, 2}}, Transform()));
+    s.prims.push_back(makePrimitive(Sphere{{2, 1, 1}, 0.5}, Transform()));   // half inside
+    s.prims.push_back(makePrimitive(Sphere{{9, 9, 9}, 0.5}, Transform()));   // far outside
+    int cut = s.tree.combine(Op::Union, s.tree.leaf(1), s.tree.leaf(2));
+    s.tree.root = s.tree.combine(Op::Difference, s.tree.leaf(0), cut);
+    s.prepare();
+    EXPECT_EQ(s.minBox[0], (Box3{{0, 0, 0}, {2, 2, 2}}));
+    EXPECT_EQ(s.minBox[1], (Box3{{1.5, 0.5, 0.5}, {2, 1.5, 1.5}}));
+    EXPECT_TRUE(s.minBox[2].isEmpty());
+    EXPECT_EQ(s.droppedPrims, 1);
+    EXPECT_EQ(s.tree.toString(), "(p0 − p1)");
+}
+
+TEST(MinimizedBoxes, IteratesToAFixedPoint) {
+    // (A ∩ B) − C, then the clipped box of A ∩ B clips C further: needs more than one pass
+    // when boxes shrink through several operators.
+    Scene s;
+    s.prims.push_back(makePrimitive(Block{{0, 0, 0}, {10, 10, 10}}, Transform()));
+    s.prims.push_back(makePrimitive(Block{{5, 5, 5}, {20, 20, 20}}, Transform()));
+    s.prims.push_back(makePrimitive(Block{{-5, -5, -5}, {7, 7, 7}}, Transform()));
+    int i = s.tree.combine(Op::Intersection, s.tree.leaf(0), s.tree.leaf(1));
+    s.tree.root = s.tree.combine(Op::Difference, i, s.tree.leaf(2));
+    s.prepare();
+    EXPECT_EQ(s.minBox[0], (Box3{{5, 5, 5}, {10, 10, 10}}));
+    EXPECT_EQ(s.minBox[2], (Box3{{5, 5, 5}, {7, 7, 7}}));
+    EXPECT_GE(s.minimizeIterations, 2);
+}
+
+TEST(MinimizedBoxes, EveryVisibleHitLiesInItsPrimitivesBox) {
+    NullObserver obs;
+    for (uint64_t seed = 1; seed <= 40; ++seed) {
+        Scene s = test::randomCsgScene(seed);
+        BuildParams bp;
+        auto brute = buildAccelerator(s, bp);
+        TraceContext ctx(s.prims.size(), s.tree.depth());
+        ctx.useMailboxes = false;
+        for (const Ray& r : test::randomRays(s, seed * 7, 500)) {
+            Hit h;
+            ctx.beginRay();
+            if (!brute->intersect(r, 0.0, kInf, ctx, obs, h)) continue;
+            Vec3 p = r.at(h.t);
+            Box3 b = s.minBox[h.prim];
+            Vec3 slack = Vec3(1e-9 * std::max(1.0, glm::length(p)));
+            Box3 loose{b.lo - slack, b.hi + slack};
+            ASSERT_TRUE(loose.contains(p)) << "seed " << seed << " " << r.toString() << " hit p" << h.prim
+                                           << " at " << toString(p) << " outside " << b.toString();
+        }
+    }
+}
+
+// Within any box region, the tree restricted to the primitives whose minimized boxes overlap
+// the region gives the same span boundaries as the full tree.
+TEST(Restriction, RestrictedTreeAgreesInsideRandomRegions) {
+    NullObserver obs;
+    std::mt19937_64 rng(99);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int checkedHits = 0;
+    for (uint64_t seed = 1; seed <= 60; ++seed) {
+        Scene s = test::randomCsgScene(seed);
+        if (s.tree.empty()) continue;
+        TraceContext ctx(s.prims.size(), s.tree.depth());
+        ctx.useMailboxes = false;
+        for (int k = 0; k < 20; ++k) {
+            // A random sub-box of the scene bounds.
+            Vec3 a = s.bounds.lo + Vec3(u(rng), u(rng), u(rng)) * s.bounds.extent();
+            Vec3 b = s.bounds.lo + Vec3(u(rng), u(rng), u(rng)) * s.bounds.extent();
+            Box3 region{glm::min(a, b), glm::max(a, b)};
+            std::vector<char> keep(s.prims.size(), 0);
+            for (uint32_t p : s.livePrimitives()) keep[p] = s.minBox[p].overlaps(region);
+            CsgTree r;
+            r.root = restrictTree(s.tree, s.tree.root, keep, r);
+            for (const Ray& ray : test::randomRays(s, seed * 1000 + uint64_t(k), 60)) {
+                double t0, t1;
+                if (!clipLine(ray, region, t0, t1)) continue;
+                Hit full, part;
+                ctx.beginRay();
+                bool f = hitInRegion(s, s.tree, s.tree.root, ray, -kInf, t0, t1, ctx, obs, full);
+                ctx.beginRay();
+                bool p = hitInRegion(s, r, r.root, ray, -kInf, t0, t1, ctx, obs, part);
+                ASSERT_EQ(f, p) << "seed " << seed << " " << ray.toString() << " region " << region.toString()
+                                << "\nfull " << s.tree.toString() << "\nrestricted " << r.toString();
+                if (f) {
+                    ASSERT_EQ(full.t, part.t) << ray.toString();
+                    ++checkedHits;
+                }
+            }
+        }
+    }
+    EXPECT_GT(checkedHits, 1000);
+}
+
+}  // namespace
+}  // namespace lancer

@@ -1,0 +1,167 @@
+#include "tests/support/differential.h"
+
+#include <sstream>
+
+namespace lancer::test {
+
+Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.3, 1.5);
+    Scene s;
+    s.name = "random:" + std::to_string(seed);
+    std::vector<int> nodes;
+    for (int i = 0; i < opt.primitives; ++i) {
+        Vec3 c = opt.spread * Vec3(u(rng), u(rng), u(rng));
+        Shape shape;
+        Transform xf = Transform::translate(c + opt.offset);
+        switch (rng() % 4) {
+            case 0: shape = Sphere{Vec3(0.0), pos(rng)}; break;
+            case 1: shape = Block{-Vec3(pos(rng), pos(rng), pos(rng)), Vec3(pos(rng), pos(rng), pos(rng))}; break;
+            case 2: { double r = pos(rng); shape = Cone{r, r, 2.0 * pos(rng), false}; break; }
+            default: shape = Cone{pos(rng), (rng() % 3 == 0) ? 0.0 : pos(rng), 2.0 * pos(rng), false}; break;
+        }
+        if (opt.transforms && rng() % 2) {
+            xf = xf * Transform::rotate(180.0 * u(rng), {u(rng), u(rng), u(rng) + 1.5}) *
+                 Transform::scale({pos(rng), pos(rng), pos(rng)});
+        }
+        s.prims.push_back(makePrimitive(shape, xf, 0));
+        nodes.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
+    }
+    // Random binary tree: repeatedly combine two random nodes with a random operator.
+    while (nodes.size() > 1) {
+        size_t i = rng() % nodes.size();
+        int a = nodes[i];
+        nodes.erase(nodes.begin() + long(i));
+        size_t j = rng() % nodes.size();
+        int b = nodes[j];
+        Op op = std::array<Op, 4>{Op::Union, Op::Union, Op::Intersection, Op::Difference}[rng() % 4];
+        nodes[j] = s.tree.combine(op, a, b);
+    }
+    int root = nodes.empty() ? -1 : nodes[0];
+    if (opt.surfaces) {
+        std::vector<int> top{root};
+        for (int i = 0; i < 4; ++i) {
+            Vec3 c = opt.spread * Vec3(u(rng), u(rng), u(rng)) + opt.offset;
+            Triangle t;
+            for (auto& p : t.p) p = c + 2.0 * Vec3(u(rng), u(rng), u(rng));
+            s.prims.push_back(makePrimitive(t, Transform(), 0));
+            top.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
+            Cone open{pos(rng), pos(rng), 2.0 * pos(rng), true};
+            s.prims.push_back(makePrimitive(open, Transform::translate(c) * Transform::rotate(90.0 * u(rng), {1, 0, 0}), 0));
+            top.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
+        }
+        root = s.tree.balanced(Op::Union, top);
+    }
+    s.tree.root = root;
+    s.prepare();
+    s.frameCamera({-1.0, 2.0, -1.0}, {0, 0, 1});
+    s.defaultLights();
+    return s;
+}
+
+std::vector<Ray> randomRays(const Scene& scene, uint64_t seed, int count) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    Box3 b = scene.bounds.isEmpty() ? Box3{Vec3(-1.0), Vec3(1.0)} : scene.bounds;
+    Vec3 ext = b.extent();
+    double diag = std::max(glm::length(ext), 1e-9);
+    auto inside = [&] { return b.lo + Vec3(u(rng), u(rng), u(rng)) * ext; };
+    std::vector<Ray> rays;
+    rays.reserve(size_t(count));
+    for (int i = 0; i < count; ++i) {
+        Vec3 target = inside();
+        Vec3 origin;
+        switch (i % 4) {
+            case 0:  // from far outside
+            case 1: {
+                Vec3 d = glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) + 1e-3);
+                origin = b.center() + d * diag * 1.5;
+                break;
+            }
+            case 2: origin = inside(); break;  // from inside the scene
+            default: {  // axis-parallel
+                int axis = int(rng() % 3);
+                Vec3 d(0.0);
+                d[axis] = (rng() % 2) ? 1.0 : -1.0;
+                rays.push_back({target - d * diag * 1.5, d});
+                continue;
+            }
+        }
+        Vec3 d = target - origin;
+        if (glm::dot(d, d) == 0.0) d = Vec3(0, 0, 1);
+        rays.push_back({origin, glm::normalize(d)});
+    }
+    return rays;
+}
+
+std::vector<Ray> raysThroughPoints(const std::vector<Vec3>& points, const Box3& bounds, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    double diag = std::max(glm::length(bounds.extent()), 1e-9);
+    std::vector<Ray> rays;
+    for (const Vec3& p : points) {
+        Vec3 d = glm::normalize(Vec3(u(rng), u(rng), u(rng)) + 1e-3);
+        rays.push_back({p - d * diag, d});  // aimed exactly at p
+        rays.push_back({p, d});             // starting exactly on p
+        int axis = int(rng() % 3);
+        Vec3 a(0.0);
+        a[axis] = (rng() % 2) ? 1.0 : -1.0;
+        rays.push_back({p - a * diag, a});  // axis-parallel through p
+        // Diagonal through p in a coordinate plane (exits through edges and corners).
+        Vec3 diag2(0.0);
+        diag2[axis] = 1.0;
+        diag2[(axis + 1) % 3] = 1.0;
+        rays.push_back({p - diag2 * diag, glm::normalize(diag2)});
+    }
+    return rays;
+}
+
+std::string RayMismatch::toString(const Scene& scene) const {
+    std::ostringstream os;
+    os.precision(17);
+    os << ray.toString() << "\n  brute: ";
+    if (expectedFound) os << "t=" << expected.t << " p" << expected.prim << " " << scene.prims[expected.prim].toString();
+    else os << "miss";
+    os << "\n  got:   ";
+    if (gotFound) os << "t=" << got.t << " p" << got.prim << " " << scene.prims[got.prim].toString();
+    else os << "miss";
+    return os.str();
+}
+
+std::vector<RayMismatch> compareWithBrute(const Scene& scene, const Accelerator& accel,
+                                          const std::vector<Ray>& rays, double tmin, double relTol,
+                                          size_t maxReport) {
+    BuildParams bp;
+    bp.scheme = SchemeKind::Brute;
+    auto brute = buildAccelerator(scene, bp);
+    TraceContext cb(scene.prims.size(), scene.tree.depth()), ca(scene.prims.size(), scene.tree.depth());
+    cb.useMailboxes = brute->usesMailboxes();
+    ca.useMailboxes = accel.usesMailboxes();
+    NullObserver obs;
+    std::vector<RayMismatch> out;
+    for (const Ray& r : rays) {
+        Hit hb, ha;
+        cb.beginRay();
+        ca.beginRay();
+        bool fb = brute->intersect(r, tmin, kInf, cb, obs, hb);
+        bool fa = accel.intersect(r, tmin, kInf, ca, obs, ha);
+        bool same = fb == fa;
+        if (same && fb) {
+            double scale = std::max(1.0, std::abs(hb.t));
+            same = std::abs(hb.t - ha.t) <= relTol * scale &&
+                   (hb.prim == ha.prim || hb.t == ha.t);  // equal t on two primitives: a tie
+        }
+        if (!same && out.size() < maxReport) out.push_back({r, hb, ha, fb, fa});
+    }
+    return out;
+}
+
+std::vector<Ray> pixelRays(const Scene& scene, int w, int h) {
+    std::vector<Ray> rays;
+    rays.reserve(size_t(w) * size_t(h));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) rays.push_back(scene.camera.primaryRay(x, y, w, h));
+    return rays;
+}
+
+}  // namespace lancer::test

@@ -1,0 +1,51 @@
+// Shared test support: random CSG scenes, hard rays, and ray-for-ray comparison of a scheme
+// against the brute-force reference.
+#pragma once
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "engine/accel/accelerator.h"
+#include "engine/render/tracer.h"
+#include "engine/scene/scene.h"
+
+namespace lancer::test {
+
+struct RandomSceneOptions {
+    int primitives = 12;
+    bool transforms = true;     ///< rotated, non-uniformly scaled primitives
+    bool surfaces = false;      ///< add triangles/polygons/open cones under a top-level union
+    Vec3 offset{0.0};           ///< translate everything (far-from-origin scenes)
+    double spread = 4.0;        ///< primitives' centres in [-spread, spread]^3
+};
+
+/// A random binary CSG tree over random solids (spheres, boxes, cylinders, cones), prepared.
+Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt = {});
+
+/// Random rays aimed at the scene: through random points of the bounds, from outside and
+/// inside, plus axis-parallel rays. Directions are unit length.
+std::vector<Ray> randomRays(const Scene& scene, uint64_t seed, int count);
+
+/// Rays aimed exactly at the given points (cell corners, edge midpoints, face centres) from
+/// random origins, and axis-parallel rays through them.
+std::vector<Ray> raysThroughPoints(const std::vector<Vec3>& points, const Box3& bounds, uint64_t seed);
+
+struct RayMismatch {
+    Ray ray;
+    Hit expected, got;
+    bool expectedFound = false, gotFound = false;
+    std::string toString(const Scene& scene) const;
+};
+
+/// Nearest hits of `accel` and of brute force for each ray with t in (tmin, inf). Two hits
+/// agree when both miss, or both hit the same primitive at the same t within `relTol`.
+/// Returns the mismatches (at most `maxReport`).
+std::vector<RayMismatch> compareWithBrute(const Scene& scene, const Accelerator& accel,
+                                          const std::vector<Ray>& rays, double tmin = 0.0,
+                                          double relTol = 1e-9, size_t maxReport = 20);
+
+/// Primary rays of every pixel of a w x h image of the scene's camera.
+std::vector<Ray> pixelRays(const Scene& scene, int w, int h);
+
+}  // namespace lancer::test
