@@ -207,8 +207,8 @@ Vec3 shapeNormal(const Shape& s, const Vec3& p, uint8_t part) {
                 if (!x.smooth) return glm::normalize(g);
                 // Barycentric weights of p; shading normal oriented like the geometric one.
                 double area = glm::dot(g, g);
-                double w1 = glm::dot(glm::cross(x.p[0] - p, x.p[2] - p), g) / area;
-                double w2 = glm::dot(glm::cross(x.p[1] - p, x.p[0] - p), g) / area;
+                double w1 = glm::dot(glm::cross(x.p[2] - p, x.p[0] - p), g) / area;
+                double w2 = glm::dot(glm::cross(x.p[0] - p, x.p[1] - p), g) / area;
                 double w0 = 1.0 - w1 - w2;
                 Vec3 n = w0 * x.n[0] + w1 * x.n[1] + w2 * x.n[2];
                 if (glm::dot(n, n) == 0.0) return glm::normalize(g);
