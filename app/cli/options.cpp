@@ -14,7 +14,7 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
     app.add_option("--width", o.width, "Image width in pixels (default: the scene's)")->check(CLI::Range(1, 16384));
     app.add_option("--height", o.height, "Image height in pixels (default: the scene's)")->check(CLI::Range(1, 16384));
     app.add_option("--scheme", o.build.scheme, "Acceleration scheme: brute, regular or irregular")
-        ->transform(CLI::CheckedTransformer(schemes, CLI::ignore_case))
+        ->transform(CLI::CheckedTransformer(schemes, CLI::ignore_case).description("{brute, regular, irregular}"))
         ->default_str("brute");
     app.add_option("--max-level", o.build.maxLevel, "Deepest subdivision level")
         ->check(CLI::Range(0, 48))
@@ -23,13 +23,13 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
         ->check(CLI::Range(1, 1000000))
         ->default_val(o.build.maxObjects);
     app.add_option("--step", o.build.step, "Regular scheme's next-cell method: exact or push")
-        ->transform(CLI::CheckedTransformer(steps, CLI::ignore_case))
+        ->transform(CLI::CheckedTransformer(steps, CLI::ignore_case).description("{exact, push}"))
         ->default_str("exact");
     app.add_option("--delta", o.build.delta, "Push distance of --step push, relative to the scene size")
         ->check(CLI::Range(1e-15, 0.5))
         ->default_val(o.build.delta);
     app.add_option("--bsp-heuristic", o.build.heuristic, "Irregular scheme's choice of splitting segment: first, balanced, fewest-cuts")
-        ->transform(CLI::CheckedTransformer(heuristics, CLI::ignore_case))
+        ->transform(CLI::CheckedTransformer(heuristics, CLI::ignore_case).description("{first, balanced, fewest-cuts}"))
         ->default_str("balanced");
     app.add_flag("--no-mailbox{false}", o.build.mailboxes, "Turn the mailboxes off (to measure their effect)");
     app.add_option("--threads", o.render.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024))->default_val(0);

@@ -349,7 +349,10 @@ struct JsonSceneBuilder {
         return scene.tree.leaf(uint32_t(scene.prims.size() - 1));
     }
 
-    int node(const JsonAt& n, const Transform& parentXf, int parentMat) {
+    static constexpr int kMaxDepth = 2000;  // deeper nesting is refused, not recursed into
+
+    int node(const JsonAt& n, const Transform& parentXf, int parentMat, int depth = 0) {
+        if (depth > kMaxDepth) n.fail("nesting deeper than " + std::to_string(kMaxDepth) + " levels");
         static const char* kinds[] = {"sphere", "box", "cylinder", "cone", "triangle", "polygon", "union", "intersection", "difference"};
         n.object();
         std::string kind;
@@ -368,10 +371,20 @@ struct JsonSceneBuilder {
         JsonAt body = n[kind];
 
         if (kind == "union" || kind == "intersection" || kind == "difference") {
-            std::vector<int> kids;
-            for (size_t i = 0; i < body.array().size(); ++i) kids.push_back(node(body[i], xf, mat));
-            if (kids.empty()) return -1;  // an empty operator contributes nothing
             Op op = kind == "union" ? Op::Union : kind == "intersection" ? Op::Intersection : Op::Difference;
+            std::vector<int> kids;
+            for (size_t i = 0; i < body.array().size(); ++i) {
+                int k = node(body[i], xf, mat, depth + 1);
+                // An empty child (an empty operator) is the empty set: it vanishes from a union
+                // and from the subtracted part of a difference, and empties an intersection or
+                // a difference it starts.
+                if (k >= 0) {
+                    kids.push_back(k);
+                } else if (op == Op::Intersection || (op == Op::Difference && i == 0)) {
+                    return -1;
+                }
+            }
+            if (kids.empty()) return -1;  // an empty operator contributes nothing
             if (op != Op::Difference) return scene.tree.balanced(op, kids);
             // First child minus all the others.
             std::vector<int> rest(kids.begin() + 1, kids.end());

@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# `lancer render` and `lancer trace` as a user runs them: outputs, errors, exit statuses.
+set -u
+LANCER="$1"; SRC="$2"
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+# A render writes the PNG, the depth PFM and the stats JSON.
+"$LANCER" render builtin:default --width 64 --height 40 -o "$tmp/a.png" --depth "$tmp/a.pfm" --stats "$tmp/a.json" -q \
+  || fail "render exited non-zero"
+[ -s "$tmp/a.png" ] || fail "no PNG"
+head -c 8 "$tmp/a.png" | od -An -c | grep -q "P   N   G" || fail "not a PNG"
+head -c 11 "$tmp/a.pfm" | grep -q "^Pf" || fail "not a PFM"
+for key in scheme width height threads build_ms render_ms rays primary_rays prim_tests mailbox_hits \
+           region_visits regions memory_bytes max_level max_objects step; do
+  grep -q "\"$key\"" "$tmp/a.json" || fail "stats lack $key"
+done
+grep -q '"primary_rays": 2560' "$tmp/a.json" || fail "primary_rays is not 64*40"
+
+# --width alone keeps the scene's aspect (640x400 -> 80x50).
+"$LANCER" render builtin:default --width 80 -o "$tmp/b.png" --stats "$tmp/b.json" -q || fail "render --width"
+grep -q '"height": 50' "$tmp/b.json" || fail "--width did not keep the aspect"
+
+# Bad options: non-zero exit, the option named.
+out=$("$LANCER" render builtin:default -o "$tmp/c.png" --scheme nonsense 2>&1) && fail "bad --scheme accepted"
+echo "$out" | grep -q -- "--scheme" || fail "bad --scheme not named: $out"
+out=$("$LANCER" render builtin:default -o "$tmp/c.png" --width -3 2>&1) && fail "negative width accepted"
+echo "$out" | grep -q -- "--width" || fail "bad --width not named: $out"
+out=$("$LANCER" render builtin:default -o "$tmp/c.png" --max-level 100000 2>&1) && fail "huge max-level accepted"
+echo "$out" | grep -q -- "--max-level" || fail "huge --max-level not named: $out"
+[ ! -e "$tmp/c.png" ] || fail "an image was written despite the error"
+
+# A bad scene file: file:line:col, non-zero exit, no output written.
+printf '{\n  "scene": {"sphere": {"radius": -2}}\n}\n' > "$tmp/bad.json"
+out=$("$LANCER" render "$tmp/bad.json" -o "$tmp/d.png" 2>&1) && fail "bad scene accepted"
+echo "$out" | grep -q "bad.json:2:24: expected a positive number" || fail "bad scene message: $out"
+[ ! -e "$tmp/d.png" ] || fail "an image was written for a bad scene"
+out=$("$LANCER" render "$tmp/missing.json" -o "$tmp/d.png" 2>&1) && fail "missing scene accepted"
+echo "$out" | grep -q "missing.json: cannot open" || fail "missing file message: $out"
+out=$("$LANCER" render builtin:nosuch -o "$tmp/d.png" 2>&1) && fail "unknown builtin accepted"
+echo "$out" | grep -q "unknown built-in scene" || fail "unknown builtin message: $out"
+
+# An unwritable output: an error, and no partial file left behind.
+out=$("$LANCER" render builtin:default --width 16 -o "$tmp/no/such/dir/e.png" 2>&1) && fail "unwritable output accepted"
+echo "$out" | grep -q "e.png" || fail "unwritable output message: $out"
+
+# trace: the walk and the hit, as text and JSON.
+"$LANCER" trace builtin:default --width 64 --height 40 --pixel 32 20 > "$tmp/t.txt" || fail "trace"
+grep -q "hit t = " "$tmp/t.txt" || fail "trace shows no hit"
+"$LANCER" trace builtin:default --width 64 --height 40 --pixel 32 20 --json > "$tmp/t.json" || fail "trace --json"
+grep -q '"prim_test"' "$tmp/t.json" || fail "trace --json lacks events"
+out=$("$LANCER" trace builtin:default --width 64 --height 40 --pixel 64 0 2>&1) && fail "pixel outside accepted"
+echo "$out" | grep -q -- "--pixel" || fail "outside pixel message: $out"
+
+# --help lists every common option.
+help=$("$LANCER" render --help)
+for opt in --width --height --scheme --max-level --max-objects --step --delta --threads --bounces --stats --depth; do
+  echo "$help" | grep -q -- "$opt" || fail "render --help lacks $opt"
+done
+echo "ok"
