@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "app/bench/report.h"
 #include "app/cli/commands.h"
 #include "engine/scene/builtin_scenes.h"
 
@@ -38,7 +39,20 @@ int main(int argc, char** argv) {
     trace->add_flag("--json", topt.json, "Machine-readable output");
     cli::addCommonOptions(*trace, traceOpt);
 
+    bench::BenchOptions bopt;
+    CLI::App* benchCmd = app.add_subcommand("bench", "Write the speed-against-error report (CSV and plots)");
+    benchCmd->add_option("--scenes", bopt.scenes, "Scenes to measure")->capture_default_str();
+    benchCmd->add_option("--width", bopt.width, "Image width")->check(CLI::Range(1, 16384))->capture_default_str();
+    benchCmd->add_option("--height", bopt.height, "Image height")->check(CLI::Range(1, 16384))->capture_default_str();
+    benchCmd->add_option("--threads", bopt.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+    benchCmd->add_option("--bounces", bopt.bounces, "Reflection/refraction depth")->check(CLI::Range(0, 64))->capture_default_str();
+    benchCmd->add_option("--out", bopt.outDir, "Output directory")->capture_default_str();
+    benchCmd->add_flag("--quick", bopt.quick, "Fewer knob values (a smoke run)");
+    benchCmd->add_flag("--no-plots{false}", bopt.plots, "Write the CSV only");
+
     CLI11_PARSE(app, argc, argv);
+
+    if (*benchCmd) return bench::runBench(bopt);
 
     if (*render) return cli::runRender(renderOpt, out, quiet);
     if (*trace) {

@@ -1,0 +1,277 @@
+#include "app/bench/report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <sstream>
+
+#include "engine/render/renderer.h"
+#include "engine/scene/loader.h"
+
+namespace lancer::bench {
+
+namespace {
+
+/// One point of a sweep: a knob set to a value.
+struct Config {
+    std::string knob, value;
+    BuildParams build;
+    ShadingOptions shading;
+};
+
+/// Difference of an image against the reference.
+struct ImageError {
+    size_t hitDiff = 0;     ///< pixels whose primary hit (primitive or distance) differs
+    size_t colorDiff = 0;   ///< pixels whose colour differs by more than 2/255
+    double maxDepthDiff = 0.0;
+};
+
+ImageError compare(const Image& ref, const Image& img) {
+    ImageError e;
+    std::vector<uint8_t> a = ref.rgba8(), b = img.rgba8();
+    for (size_t i = 0; i < ref.depth.size(); ++i) {
+        float da = ref.depth[i], db = img.depth[i];
+        bool bothMiss = std::isinf(da) && std::isinf(db);
+        double dd = bothMiss ? 0.0 : (std::isinf(da) || std::isinf(db)) ? kInf : std::abs(double(da) - double(db));
+        if (ref.hitPrim[i] != img.hitPrim[i] || dd > 1e-6 * std::max(1.0, double(da))) ++e.hitDiff;
+        if (std::isfinite(dd)) e.maxDepthDiff = std::max(e.maxDepthDiff, dd);
+        else e.maxDepthDiff = kInf;
+        for (int c = 0; c < 3; ++c)
+            if (std::abs(int(a[4 * i + size_t(c)]) - int(b[4 * i + size_t(c)])) > 2) {
+                ++e.colorDiff;
+                break;
+            }
+    }
+    return e;
+}
+
+/// Fill the pixels a coarse pass skipped with the pass's sample of their block (what a
+/// progressive display shows).
+Image upsample(const Image& img, int stride) {
+    Image out = img;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            size_t src = img.index(x - x % stride, y - y % stride), dst = img.index(x, y);
+            out.color[dst] = img.color[src];
+            out.depth[dst] = img.depth[src];
+            out.hitPrim[dst] = img.hitPrim[src];
+        }
+    return out;
+}
+
+std::string num(double v) {
+    if (std::isinf(v)) return "inf";
+    std::ostringstream os;
+    os.precision(6);
+    os << v;
+    return os.str();
+}
+
+std::vector<Config> sweep(bool quick) {
+    std::vector<Config> out;
+    auto add = [&](const std::string& knob, const std::string& value, BuildParams b, ShadingOptions s = {}) {
+        out.push_back({knob, value, b, s});
+    };
+    BuildParams regular;
+    regular.scheme = SchemeKind::Regular;
+    BuildParams irregular;
+    irregular.scheme = SchemeKind::Irregular;
+    add("scheme", "regular", regular);
+    add("scheme", "irregular", irregular);
+    std::vector<int> levels = quick ? std::vector<int>{6, 12} : std::vector<int>{3, 6, 9, 12, 15, 18, 21, 24};
+    for (int l : levels) {
+        BuildParams b = regular;
+        b.maxLevel = l;
+        add("regular max-level", std::to_string(l), b);
+    }
+    std::vector<int> objects = quick ? std::vector<int>{1, 8} : std::vector<int>{1, 2, 4, 8, 16, 32};
+    for (int m : objects) {
+        BuildParams b = regular;
+        b.maxObjects = m;
+        add("regular max-objects", std::to_string(m), b);
+        BuildParams c = irregular;
+        c.maxObjects = m;
+        add("irregular max-objects", std::to_string(m), c);
+    }
+    std::vector<double> deltas = quick ? std::vector<double>{1e-12, 1e-2} : std::vector<double>{1e-15, 1e-12, 1e-9, 1e-6, 1e-4, 1e-3, 1e-2, 5e-2};
+    for (double d : deltas) {
+        BuildParams b = regular;
+        b.step = StepMethod::Push;
+        b.delta = d;
+        add("push delta", num(d), b);
+    }
+    for (BspHeuristic h : {BspHeuristic::First, BspHeuristic::Balanced, BspHeuristic::FewestCuts}) {
+        BuildParams b = irregular;
+        b.heuristic = h;
+        add("bsp-heuristic", heuristicName(h), b);
+    }
+    for (bool mail : {true, false}) {
+        BuildParams b = regular;
+        b.mailboxes = mail;
+        add("regular mailboxes", mail ? "on" : "off", b);
+    }
+    std::vector<double> offsets = quick ? std::vector<double>{0.0, 1e-9} : std::vector<double>{0.0, 1e-14, 1e-12, 1e-9, 1e-6, 1e-4, 1e-2};
+    for (double o : offsets) {
+        ShadingOptions s;
+        s.offsetScale = o;
+        add("offset", num(o), regular, s);
+    }
+    return out;
+}
+
+const char* kHeader =
+    "scene,scheme,knob,value,build_ms,memory_bytes,regions,render_ms,speedup,rays,prim_tests_per_ray,"
+    "region_visits_per_ray,mailbox_hits,walk_errors,hit_diff_pixels,color_diff_pixels,max_depth_diff\n";
+
+void writePlots(const std::string& dir, const std::vector<std::string>& scenes) {
+    // One gnuplot script per figure; each reads report.csv with awk-filtered rows.
+    auto script = [&](const std::string& name, const std::string& body) {
+        std::ofstream f(dir + "/" + name + ".gp");
+        f << "set datafile separator ','\nset terminal pngcairo size 1000,620 font 'sans,10'\n"
+          << "set output '" << name << ".png'\nset key outside right\nset grid\n"
+          << body;
+    };
+    auto rows = [](const std::string& scene, const std::string& knob) {
+        return "'< awk -F, \"\\$1==\\\"" + scene + "\\\" && \\$3==\\\"" + knob + "\\\"\" report.csv'";
+    };
+    std::string speedErr = "set title 'Speed against error (every configuration)'\nset xlabel 'speedup over brute force'\n"
+                           "set ylabel 'pixels whose primary hit differs from brute force'\nset logscale x\nset yrange [-1:*]\nplot ";
+    std::string level = "set title 'Regular scheme: max-level'\nset xlabel 'max-level'\nset ylabel 'speedup'\nset y2label 'memory (KiB)'\nset y2tics\nplot ";
+    std::string delta = "set title 'Push step: delta against error'\nset xlabel 'delta (relative to the scene size)'\nset logscale x\n"
+                        "set ylabel 'pixels whose hit differs'\nset yrange [-1:*]\nplot ";
+    std::string offset = "set title 'Secondary-ray offset against error'\nset xlabel 'offset (relative to the scene scale; 0 plotted at 1e-16)'\nset logscale x\n"
+                         "set ylabel 'pixels whose colour differs'\nset yrange [-1:*]\nplot ";
+    std::string prog = "set title 'Progressive passes: error and time'\nset xlabel 'pass stride'\nset logscale x 2\nset xrange [*:*] reverse\n"
+                       "set ylabel 'pixels differing from the final image'\nset y2label 'time since the start (ms)'\nset y2tics\nplot ";
+    for (size_t i = 0; i < scenes.size(); ++i) {
+        const std::string& s = scenes[i];
+        std::string sep = i + 1 < scenes.size() ? ", \\\n  " : "\n";
+        speedErr += "'< awk -F, \"\\$1==\\\"" + s + "\\\"\" report.csv' using 9:15 with points pt 7 title '" + s + "'" + sep;
+        level += rows(s, "regular max-level") + " using 4:9 with linespoints title '" + s + " speedup', " +
+                 rows(s, "regular max-level") + " using 4:($6/1024) axes x1y2 with linespoints dt 2 title '" + s + " memory'" + sep;
+        delta += rows(s, "push delta") + " using 4:15 with linespoints title '" + s + "'" + sep;
+        offset += rows(s, "offset") + " using ($4==0?1e-16:$4):16 with linespoints title '" + s + "'" + sep;
+        prog += rows(s, "progressive pass") + " using 4:16 with linespoints title '" + s + " error', " +
+                rows(s, "progressive pass") + " using 4:8 axes x1y2 with linespoints dt 2 title '" + s + " time'" + sep;
+    }
+    script("speed_vs_error", speedErr);
+    script("regular_max_level", level);
+    script("push_delta", delta);
+    script("offset", offset);
+    script("progressive", prog);
+}
+
+}  // namespace
+
+int runBench(const BenchOptions& opt) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::create_directories(opt.outDir, ec);
+    if (ec) {
+        std::cerr << "error: --out " << opt.outDir << ": " << ec.message() << "\n";
+        return 2;
+    }
+    std::ostringstream csv;
+    csv << kHeader;
+    std::vector<std::string> done;
+    for (const std::string& spec : opt.scenes) {
+        Scene scene;
+        try {
+            scene = loadScene(spec);
+        } catch (const std::exception& e) {
+            std::cerr << "error: " << e.what() << "\n";
+            return 2;
+        }
+        RenderOptions ro;
+        ro.width = opt.width;
+        ro.height = opt.height;
+        ro.threads = opt.threads;
+        ro.shading.bounces = opt.bounces;
+
+        // The reference of this run (after a small warm-up render that starts the thread pool).
+        BuildParams bruteParams;
+        auto brute = buildAccelerator(scene, bruteParams);
+        Image ref(ro.width, ro.height);
+        render(scene, *brute, ro, ref, PassLattice{16, 0});
+        RenderStats rs = render(scene, *brute, ro, ref);
+        double bruteMs = rs.renderMs;
+        auto row = [&](const char* scheme, const std::string& knob, const std::string& value, const AccelInfo& info,
+                       const RenderStats& s, const ImageError& e) {
+            const RayCounters& c = s.counters;
+            double rays = c.rays ? double(c.rays) : 1.0;
+            csv << spec << "," << scheme << "," << knob << "," << value << "," << num(info.buildMs) << ","
+                << info.memoryBytes << "," << info.regions << "," << num(s.renderMs) << "," << num(bruteMs / s.renderMs)
+                << "," << c.rays << "," << num(double(c.primTests) / rays) << "," << num(double(c.regionVisits) / rays)
+                << "," << c.mailboxHits << "," << c.walkErrors << "," << e.hitDiff << "," << e.colorDiff << ","
+                << num(e.maxDepthDiff) << "\n";
+        };
+        row("brute", "scheme", "brute", brute->info(), rs, {});
+        std::cerr << spec << ": brute force " << int(bruteMs) << " ms\n";
+
+        for (const Config& c : sweep(opt.quick)) {
+            std::unique_ptr<Accelerator> accel;
+            try {
+                accel = buildAccelerator(scene, c.build);
+            } catch (const std::invalid_argument& e) {
+                std::cerr << spec << ": " << c.knob << " = " << c.value << ": skipped: " << e.what() << "\n";
+                continue;
+            }
+            RenderOptions r = ro;
+            r.shading.offsetScale = c.shading.offsetScale;
+            Image img(ro.width, ro.height);
+            RenderStats s = render(scene, *accel, r, img);
+            row(schemeName(c.build.scheme), c.knob, c.value, accel->info(), s, compare(ref, img));
+            std::cerr << spec << ": " << c.knob << " = " << c.value << ": " << int(s.renderMs) << " ms\n";
+        }
+
+        // Progressive passes of the fastest default scheme available: error of each pass
+        // against the final image, and the time since the first pass started.
+        std::unique_ptr<Accelerator> best;
+        for (SchemeKind k : {SchemeKind::Irregular, SchemeKind::Regular, SchemeKind::Brute}) {
+            BuildParams b;
+            b.scheme = k;
+            try {
+                best = buildAccelerator(scene, b);
+                break;
+            } catch (const std::invalid_argument&) {
+            }
+        }
+        Image prog(ro.width, ro.height);
+        double elapsed = 0.0;
+        int prev = 0;
+        for (int stride : {16, 8, 4, 2, 1}) {
+            RenderStats s = render(scene, *best, ro, prog, PassLattice{stride, prev});
+            elapsed += s.renderMs;
+            s.renderMs = elapsed;
+            ImageError e = compare(ref, upsample(prog, stride));
+            row(schemeName(best->params().scheme), "progressive pass", std::to_string(stride), best->info(), s, e);
+            prev = stride;
+        }
+        done.push_back(spec);
+    }
+    std::ofstream(opt.outDir + "/report.csv") << csv.str();
+    std::cout << "wrote " << opt.outDir << "/report.csv\n";
+    if (opt.plots) {
+        writePlots(opt.outDir, done);
+        // A plot is drawn when the CSV has rows for its knob.
+        const std::pair<const char*, const char*> plots[] = {{"speed_vs_error", ",scheme,"},
+                                                             {"regular_max_level", ",regular max-level,"},
+                                                             {"push_delta", ",push delta,"},
+                                                             {"offset", ",offset,"},
+                                                             {"progressive", ",progressive pass,"}};
+        for (const auto& [name, knob] : plots) {
+            if (csv.str().find(knob) == std::string::npos) continue;
+            std::string cmd = "cd '" + opt.outDir + "' && gnuplot " + name + ".gp 2>/dev/null";
+            if (std::system(cmd.c_str()) != 0)
+                std::cerr << "warning: gnuplot failed on " << name << ".gp (is gnuplot installed?)\n";
+            else
+                std::cout << "wrote " << opt.outDir << "/" << name << ".png\n";
+        }
+    }
+    return 0;
+}
+
+}  // namespace lancer::bench

@@ -1,0 +1,24 @@
+// `lancer bench`: the speed-against-error report (DESIGN.md section 7). Every configuration is
+// rendered and compared with the brute-force image of the same run: build time, memory, render
+// time, speedup, work per ray, and error (pixels whose hit differs, largest depth difference).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace lancer::bench {
+
+struct BenchOptions {
+    std::vector<std::string> scenes{"builtin:balls:3", "builtin:drilled:6", "builtin:lattice:6"};
+    int width = 256, height = 256;
+    int threads = 0;
+    int bounces = 3;
+    std::string outDir = "bench-out";
+    bool quick = false;  ///< fewer knob values (used by the test suite)
+    bool plots = true;   ///< run gnuplot on the CSV
+};
+
+/// Run the sweeps, write OUT/report.csv, OUT/*.gp and OUT/*.png. Returns the exit status.
+int runBench(const BenchOptions& opt);
+
+}  // namespace lancer::bench

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# `lancer bench --quick`: the report's CSV has the reference, the sweeps and the progressive
+# passes, and the final pass equals the reference.
+set -u
+LANCER="$1"; SRC="$2"
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+"$LANCER" bench --quick --scenes builtin:default --width 40 --height 24 --threads 2 --out "$tmp/b" 2>"$tmp/log" \
+  || { cat "$tmp/log"; fail "bench exited non-zero"; }
+csv="$tmp/b/report.csv"
+head -1 "$csv" | grep -q "^scene,scheme,knob,value,build_ms,memory_bytes,regions,render_ms,speedup" || fail "CSV header"
+grep -q "^builtin:default,brute,scheme,brute," "$csv" || fail "no brute-force reference row"
+[ "$(grep -c ',progressive pass,' "$csv")" -eq 5 ] || fail "expected 5 progressive passes"
+# The last pass is the full image: no pixel differs from the reference.
+grep ',progressive pass,1,' "$csv" | awk -F, '{ if ($15 != 0 || $16 != 0) exit 1 }' || fail "final pass differs from brute force"
+# Every scheme row that was measured agrees with brute force at default settings.
+awk -F, '$3=="scheme" && $15 != 0 { exit 1 }' "$csv" || fail "a scheme differs from brute force at defaults"
+[ -s "$tmp/b/speed_vs_error.png" ] || fail "no speed_vs_error plot"
+out=$("$LANCER" bench --quick --scenes builtin:nosuch --out "$tmp/c" 2>&1) && fail "unknown scene accepted"
+echo "$out" | grep -q "unknown built-in scene" || fail "bench error message: $out"
+echo ok
