@@ -8,6 +8,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "app/bench/embree_peer.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
 
@@ -225,6 +226,37 @@ int runBench(const BenchOptions& opt) {
             RenderStats s = render(scene, *accel, r, img);
             row(schemeName(c.build.scheme), c.knob, c.value, accel->info(), s, compare(ref, img));
             std::cerr << spec << ": " << c.knob << " = " << c.value << ": " << int(s.renderMs) << " ms\n";
+        }
+
+        // Against a peer: Embree on union-only scenes, on primary and shadow rays
+        // (--bounces 0), with every scheme of ours on the same workload.
+        if (EmbreePeer::available() && EmbreePeer::supports(scene)) {
+            RenderOptions r0 = ro;
+            r0.shading.bounces = 0;
+            Image ref0(ro.width, ro.height);
+            RenderStats b0 = render(scene, *brute, r0, ref0);
+            double brute0 = b0.renderMs;
+            std::swap(bruteMs, brute0);  // speedups of these rows are over brute force at --bounces 0
+            row("brute", "peer (bounces 0)", "brute", brute->info(), b0, {});
+            for (SchemeKind k : {SchemeKind::Regular, SchemeKind::Irregular}) {
+                BuildParams b;
+                b.scheme = k;
+                try {
+                    auto a = buildAccelerator(scene, b);
+                    Image img(ro.width, ro.height);
+                    RenderStats s = render(scene, *a, r0, img);
+                    row(schemeName(k), "peer (bounces 0)", schemeName(k), a->info(), s, compare(ref0, img));
+                } catch (const std::invalid_argument&) {
+                }
+            }
+            EmbreePeer peer(scene);
+            Image img(ro.width, ro.height);
+            RenderStats s = peer.render(r0, img);
+            AccelInfo info;
+            info.buildMs = peer.buildMs();
+            row("embree", "peer (bounces 0)", "embree", info, s, compare(ref0, img));
+            std::swap(bruteMs, brute0);
+            std::cerr << spec << ": embree " << int(s.renderMs) << " ms (brute force at --bounces 0: " << int(b0.renderMs) << " ms)\n";
         }
 
         // Progressive passes of the fastest default scheme available: error of each pass
