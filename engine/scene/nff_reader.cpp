@@ -75,10 +75,12 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             size_t hpos = in.peek().pos;
             if (in.number("the hither distance") < 0.0) src.fail(hpos, "the hither distance must not be negative");
             expect("resolution");
+            size_t wpos = in.peek().pos;
             scene.width = in.count("the image width", 16384);
+            if (scene.width < 1) src.fail(wpos, "the resolution must be at least 1 x 1");
             size_t rpos = in.peek().pos;
             resH = in.count("the image height", 16384);
-            if (scene.width < 1 || resH < 1) src.fail(rpos, "the resolution must be at least 1 x 1");
+            if (resH < 1) src.fail(rpos, "the resolution must be at least 1 x 1");
             scene.height = resH;
             haveView = true;
             if (std::string e = scene.camera.validate(); !e.empty()) src.fail(t.pos, e);
@@ -105,7 +107,10 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             m.transmit = weight("T");
             size_t ipos = in.peek().pos;
             m.ior = in.number("the index of refraction");
-            if (m.ior <= 0.0) src.fail(ipos, "the index of refraction must be positive");
+            // SPD writes 0 for opaque materials (T = 0), where the index is unused.
+            if (m.ior < 0.0) src.fail(ipos, "the index of refraction must not be negative");
+            if (m.ior == 0.0 && m.transmit > 0.0) src.fail(ipos, "a transmitting material (T > 0) needs a positive index of refraction");
+            if (m.ior == 0.0) m.ior = 1.0;
             m.reflect = m.specular;  // NFF: Ks also weights the mirror reflection
             m.ambient = 0.1;
             scene.materials.push_back(m);
