@@ -625,7 +625,13 @@ private:
         }
         if (k == "multmatrix" || k == "translate" || k == "rotate" || k == "scale" || k == "mirror") {
             ++counts_.transforms;
-            return unionOf(n.children, xf * transform(n), mat);
+            Transform t = xf * transform(n);
+            // Each step is finite and invertible; their product may still overflow.
+            for (int c = 0; c < 4; ++c)
+                for (int r = 0; r < 4; ++r)
+                    if (!std::isfinite(t.m[c][r]) || !std::isfinite(t.inv[c][r]))
+                        src_.fail(n.pos, k + "() gives a transform with non-finite entries");
+            return unionOf(n.children, t, mat);
         }
         if (k == "color") {
             ++counts_.colors;
