@@ -9,6 +9,8 @@ template <class... Ts>
 struct Overloaded : Ts... {
     using Ts::operator()...;
 };
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;  // clang 14 lacks C++20 aggregate deduction
 
 int sphereSpans(const Sphere& s, const Ray& r, uint32_t prim, Span* out) {
     // Robust form (Haines et al., Ray Tracing Gems ch. 7): the discriminant from the distance

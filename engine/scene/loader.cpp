@@ -5,6 +5,7 @@
 #include "engine/scene/builtin_scenes.h"
 #include "engine/scene/json_reader.h"
 #include "engine/scene/nff_reader.h"
+#include "engine/scene/openscad_reader.h"
 
 namespace lancer {
 
@@ -34,8 +35,9 @@ Scene loadScene(const std::string& spec) {
     std::string ext = extension(spec);
     if (ext == ".json") return readJsonScene(SourceText::fromFile(spec));
     if (ext == ".nff") return readNff(SourceText::fromFile(spec));
+    if (ext == ".csg") return readOpenScadFile(spec);
     throw SceneError(spec + ": unknown scene format '" + ext +
-                     "' (expected .json, .nff, or builtin:NAME[:SIZE])");
+                     "' (expected .json, .nff, .csg, or builtin:NAME[:SIZE])");
 }
 
 }  // namespace lancer

@@ -8,6 +8,18 @@ namespace lancer {
 
 namespace {
 constexpr int kMaxVertices = 1 << 20;  // refuses absurd counts before allocating
+
+/// True when the polygon turns the same way at every vertex (and so a fan covers it exactly).
+bool isConvex(const std::vector<Vec3>& p) {
+    Vec3 n(0.0);  // Newell normal
+    size_t k = p.size();
+    for (size_t i = 0; i < k; ++i) n += glm::cross(p[i], p[(i + 1) % k]);
+    for (size_t i = 0; i < k; ++i) {
+        Vec3 turn = glm::cross(p[(i + 1) % k] - p[i], p[(i + 2) % k] - p[(i + 1) % k]);
+        if (glm::dot(turn, n) < 0.0) return false;
+    }
+    return true;
+}
 }
 
 Scene readNff(const SourceText& src, NffCounts* countsOut) {
@@ -43,6 +55,7 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             // from, at, up, angle, hither, resolution: keyword-led, in this order.
             auto expect = [&](const char* word) {
                 Token w = in.next();
+                if (w.text.empty()) src.fail(w.pos, std::string("unexpected end of file: expected '") + word + "' in the viewpoint ('v') block");
                 if (w.text != word)
                     src.fail(w.pos, std::string("expected '") + word + "' in the viewpoint ('v') block, got '" + std::string(w.text) + "'");
             };
@@ -57,12 +70,17 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             angle = in.number("the view angle");
             if (!(angle > 0.0 && angle < 180.0)) src.fail(apos, "the view angle must be in (0, 180) degrees");
             expect("hither");
-            in.number("the hither distance");
+            // Hither is the near clipping distance; primary rays start at the eye, as in SPD's
+            // reference tracers, so it is checked and otherwise unused.
+            size_t hpos = in.peek().pos;
+            if (in.number("the hither distance") < 0.0) src.fail(hpos, "the hither distance must not be negative");
             expect("resolution");
+            size_t wpos = in.peek().pos;
             scene.width = in.count("the image width", 16384);
+            if (scene.width < 1) src.fail(wpos, "the resolution must be at least 1 x 1");
             size_t rpos = in.peek().pos;
             resH = in.count("the image height", 16384);
-            if (scene.width < 1 || resH < 1) src.fail(rpos, "the resolution must be at least 1 x 1");
+            if (resH < 1) src.fail(rpos, "the resolution must be at least 1 x 1");
             scene.height = resH;
             haveView = true;
             if (std::string e = scene.camera.validate(); !e.empty()) src.fail(t.pos, e);
@@ -77,13 +95,22 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
         } else if (k == "f") {
             Material m;
             m.color = in.vec3("the fill colour");
-            m.diffuse = in.number("Kd");
-            m.specular = in.number("Ks");
-            m.shininess = in.number("Shine");
-            m.transmit = in.number("T");
+            auto weight = [&](const char* what) {
+                size_t wpos = in.peek().pos;
+                double v = in.number(what);
+                if (v < 0.0) src.fail(wpos, std::string(what) + " must not be negative");
+                return v;
+            };
+            m.diffuse = weight("Kd");
+            m.specular = weight("Ks");
+            m.shininess = weight("Shine");
+            m.transmit = weight("T");
             size_t ipos = in.peek().pos;
             m.ior = in.number("the index of refraction");
-            if (m.ior <= 0.0) src.fail(ipos, "the index of refraction must be positive");
+            // SPD writes 0 for opaque materials (T = 0), where the index is unused.
+            if (m.ior < 0.0) src.fail(ipos, "the index of refraction must not be negative");
+            if (m.ior == 0.0 && m.transmit > 0.0) src.fail(ipos, "a transmitting material (T > 0) needs a positive index of refraction");
+            if (m.ior == 0.0) m.ior = 1.0;
             m.reflect = m.specular;  // NFF: Ks also weights the mirror reflection
             m.ambient = 0.1;
             scene.materials.push_back(m);
@@ -108,8 +135,8 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
                 if (patch) nrm.push_back(in.vec3("a vertex normal"));
             }
             (patch ? counts.patches : counts.polygons)++;
-            if (patch) {
-                // Fan of smooth triangles (exact for the convex patches SPD writes).
+            if (patch && isConvex(pts)) {
+                // Fan of smooth triangles: exact for a convex patch (SPD writes triangles).
                 for (int i = 1; i + 1 < n; ++i) {
                     Triangle tr;
                     tr.p[0] = pts[0], tr.p[1] = pts[size_t(i)], tr.p[2] = pts[size_t(i + 1)];
@@ -121,6 +148,14 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
                     }
                     addPrim(tr, Transform(), t.pos);
                 }
+            } else if (patch) {
+                // A non-convex patch: its exact outline as a flat polygon (the vertex normals,
+                // shading only, are not interpolated over it).
+                Polygon pg;
+                if (makePolygon(pts, pg))
+                    addPrim(std::move(pg), Transform(), t.pos);
+                else
+                    ++counts.degenerate;
             } else if (n == 3) {
                 Triangle tr;
                 for (int i = 0; i < 3; ++i) tr.p[i] = pts[size_t(i)];
@@ -142,8 +177,11 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             Vec3 apex = in.vec3("the cone apex point");
             size_t r1pos = in.peek().pos;
             double r1 = in.number("the cone apex radius");
-            if (r0 < 0.0) src.fail(r0pos, "a cone radius must not be negative");
-            if (r1 < 0.0) src.fail(r1pos, "a cone radius must not be negative");
+            // NFF: both radii negative means only the inside is visible. Lancer's surfaces
+            // are seen from both sides, so that is the same open cone.
+            if (r0 < 0.0 && r1 < 0.0) r0 = -r0, r1 = -r1;
+            if (r0 < 0.0) src.fail(r0pos, "a cone radius must not be negative (unless both are, for an inside-visible cone)");
+            if (r1 < 0.0) src.fail(r1pos, "a cone radius must not be negative (unless both are, for an inside-visible cone)");
             if (r0 == 0.0 && r1 == 0.0) src.fail(r0pos, "a cone needs a positive radius at one end");
             Vec3 axis = apex - base;
             double h = glm::length(axis);

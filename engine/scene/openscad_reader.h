@@ -1,0 +1,38 @@
+// OpenSCAD's CSG export (`openscad -o model.csg model.scad`): the tree of group, boolean,
+// multmatrix, color and primitive nodes that OpenSCAD writes, in OpenSCAD syntax.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "engine/scene/scene.h"
+#include "engine/scene/source_text.h"
+
+namespace lancer {
+
+/// What a .csg file held, for tests and messages.
+struct OpenScadCounts {
+    int cubes = 0, spheres = 0, cylinders = 0, cones = 0;  ///< primitives modelled
+    int operators = 0;     ///< union/group/render, intersection, difference nodes read
+    int transforms = 0;    ///< multmatrix/translate/rotate/scale/mirror nodes read
+    int colors = 0;
+    int leftOut = 0;       ///< subtrees dropped by the `*` or `%` modifier (or outside a `!` root)
+    int empty = 0;         ///< zero-size primitives (OpenSCAD makes nothing of them)
+};
+
+/// Nodes the reader models exactly; every other node is refused naming the node and position.
+const std::vector<std::string>& openScadSupportedNodes();
+
+/// Read a .csg text. `camera` (optional) is the sidecar NAME.camera.json; without it the camera
+/// is framed on the bounds from OpenSCAD's default view direction, with the default light rig.
+/// Throws SceneError naming file, line and column.
+Scene readOpenScad(const SourceText& src, const SourceText* camera = nullptr,
+                   OpenScadCounts* counts = nullptr);
+
+/// Read `path` and, when it exists, its sidecar (path without ".csg" + ".camera.json").
+Scene readOpenScadFile(const std::string& path, OpenScadCounts* counts = nullptr);
+
+/// The sidecar path of a .csg path: "dir/NAME.csg" -> "dir/NAME.camera.json".
+std::string openScadCameraPath(const std::string& csgPath);
+
+}  // namespace lancer
