@@ -83,7 +83,9 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             m.transmit = in.number("T");
             size_t ipos = in.peek().pos;
             m.ior = in.number("the index of refraction");
-            if (m.ior <= 0.0) src.fail(ipos, "the index of refraction must be positive");
+            // SPD files write 0 for opaque surfaces (gears2.nff): the index matters only with T > 0.
+            if (m.ior <= 0.0 && m.transmit > 0.0) src.fail(ipos, "the index of refraction must be positive");
+            if (m.ior <= 0.0) m.ior = 1.0;
             m.reflect = m.specular;  // NFF: Ks also weights the mirror reflection
             m.ambient = 0.1;
             scene.materials.push_back(m);
