@@ -70,7 +70,7 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
             r.box.hi.z = cuts[i + 1];
             inSlab.clear();
             for (const uint32_t* p = first; p != last; ++p)
-                if (box[*p].lo.z <= cuts[i + 1] && box[*p].hi.z >= cuts[i]) inSlab.push_back(*p);
+                if (box[*p].lo.z < cuts[i + 1] && box[*p].hi.z > cuts[i]) inSlab.push_back(*p);
             if (inSlab.empty()) ++out.emptySlabs;
             share(inSlab, r);
             out.regions.push_back(r);

@@ -39,7 +39,6 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Build
     s.scene_ = &scene;
     s.frame_ = CameraFrame::of(scene.camera);
     std::vector<uint32_t> live = scene.livePrimitives();
-    extra["heuristic"] = heuristicName(params.heuristic);
     if (live.empty() || scene.bounds.isEmpty()) {
         extra["zones"] = 0;
         return s;

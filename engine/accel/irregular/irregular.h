@@ -169,6 +169,7 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
     if (!(t <= tend)) return false;
     uint32_t r = locate(glm::clamp(rc.at(t), bounds_.lo, bounds_.hi), rc.d);
     size_t budget = budget_;
+    int lastRoot = -1;
     for (;;) {
         const IrregularRegion& R = regions_[r];
         int axis, ties;
@@ -177,8 +178,20 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         double t1 = std::min(te, tend);
         ++ctx.counters.regionVisits;
         obs.region(r, t, t1);
-        if (R.root >= 0 && hitInRegion(*scene_, pool_, R.root, ray, tmin, t, t1, ctx, obs, hit))
-            return true;
+        if (R.root >= 0) {
+            if (R.root != lastRoot) {
+                if (hitInRegion(*scene_, pool_, R.root, ray, tmin, t, t1, ctx, obs, hit)) return true;
+                lastRoot = R.root;
+            } else {
+                // The same tree as the region before (a shared restriction): its spans along
+                // the whole line are still in ctx.result; only the interval changed.
+                if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
+                if (const Boundary* b = firstBoundary(ctx.result, tmin, t, t1)) {
+                    hit = {b->t, b->prim, b->part, b->flip};
+                    return true;
+                }
+            }
+        }
         if (te >= tend) return false;
         // Out through the structure's border (a face, or an edge or corner touching it).
         for (int a = 0; a < 3; ++a)

@@ -78,8 +78,11 @@ Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h) {
     return best;
 }
 
-bool touches(const Box3& r, glm::dvec2 lo, glm::dvec2 hi) {
-    return r.lo.x <= hi.x && lo.x <= r.hi.x && r.lo.y <= hi.y && lo.y <= r.hi.y;
+/// The rectangle's interior meets the cell's. A rectangle that only touches the cell is left
+/// out: boxes are padded far beyond rounding (irregular.cpp), so its primitive has no point
+/// and no hit within the cell; including it would add every neighbour across an edge.
+bool overlapsOpen(const Box3& r, glm::dvec2 lo, glm::dvec2 hi) {
+    return r.lo.x < hi.x && lo.x < r.hi.x && r.lo.y < hi.y && lo.y < r.hi.y;
 }
 
 }  // namespace
@@ -151,8 +154,8 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
             }
         }
         for (uint32_t p : cell.prims) {
-            if (touches(rect[p], below.lo, below.hi)) below.prims.push_back(p);
-            if (touches(rect[p], above.lo, above.hi)) above.prims.push_back(p);
+            if (overlapsOpen(rect[p], below.lo, below.hi)) below.prims.push_back(p);
+            if (overlapsOpen(rect[p], above.lo, above.hi)) above.prims.push_back(p);
         }
         cell = Cell{};  // free the parent's lists before descending
         if (below.segs.size() < above.segs.size()) std::swap(below, above);
