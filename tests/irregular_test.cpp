@@ -1,12 +1,14 @@
 // The irregular subdivision (report, section 2): same hits as brute force for every kind of ray,
 // walks by corner pointers that reach the region holding any point, pointers that land where
 // they should, and refused parameters.
+#include "engine/accel/irregular/irregular.h"
+#include "engine/accel/irregular/tree_restrictor.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <random>
 
-#include "engine/accel/irregular/irregular.h"
 #include "engine/scene/loader.h"
 #include "tests/support/differential.h"
 
@@ -91,7 +93,8 @@ std::vector<Ray> secondaryRays(const Scene& scene, const std::vector<Ray>& prima
         if (!brute->intersect(r, 0.0, kInf, ctx, obs, h)) continue;
         Vec3 p = r.at(h.t);
         rays.push_back({p, glm::normalize(Vec3(n(rng), n(rng), n(rng)))});
-        if (!scene.lights.empty()) rays.push_back({p, glm::normalize(scene.lights[0].position - p)});
+        if (!scene.lights.empty())
+            rays.push_back({p, glm::normalize(scene.lights[0].position - p)});
     }
     return rays;
 }
@@ -121,7 +124,8 @@ TEST(Irregular, SpdScenesPixelForPixel) {
         for (int ortho = 0; ortho < 2; ++ortho) {
             if (ortho) makeOrthographic(scene);
             auto accel = buildIrregular(scene);
-            std::string what = path.filename().string() + (ortho ? " orthographic" : " perspective");
+            std::string what =
+                path.filename().string() + (ortho ? " orthographic" : " perspective");
             std::vector<Ray> rays = test::pixelRays(scene, n, n);
             expectSame(scene, *accel, rays, what);
             std::vector<Ray> sec = secondaryRays(scene, rays, 7);
@@ -135,10 +139,11 @@ TEST(Irregular, BuiltinCsgScenesPixelForPixel) {
         Scene scene = loadScene(spec);
         for (int ortho = 0; ortho < 2; ++ortho) {
             if (ortho) makeOrthographic(scene);
-            for (BspHeuristic h : {BspHeuristic::First, BspHeuristic::Balanced, BspHeuristic::FewestCuts}) {
+            for (BspHeuristic h :
+                 {BspHeuristic::First, BspHeuristic::Balanced, BspHeuristic::FewestCuts}) {
                 auto accel = buildIrregular(scene, h);
-                std::string what = std::string(spec) + (ortho ? " orthographic " : " perspective ") +
-                                   heuristicName(h);
+                std::string what = std::string(spec) +
+                                   (ortho ? " orthographic " : " perspective ") + heuristicName(h);
                 std::vector<Ray> rays = test::pixelRays(scene, 48, 48);
                 expectSame(scene, *accel, rays, what);
                 expectSame(scene, *accel, secondaryRays(scene, rays, 3), what + " secondary",
@@ -219,7 +224,8 @@ TEST(Irregular, WalkReachesTheRegionHoldingAPoint) {
         std::vector<Vec3> pts;
         std::uniform_real_distribution<double> u(0.0, 1.0);
         const Box3& B = s.bounds();
-        for (int i = 0; i < 300; ++i) pts.push_back(B.lo + Vec3(u(rng), u(rng), u(rng)) * B.extent());
+        for (int i = 0; i < 300; ++i)
+            pts.push_back(B.lo + Vec3(u(rng), u(rng), u(rng)) * B.extent());
         // Corners, edge midpoints and face centres of regions, exactly (camera coordinates).
         for (int i = 0; i < 200; ++i) {
             const Box3& b = R[rng() % R.size()].box;
@@ -243,8 +249,8 @@ TEST(Irregular, WalkReachesTheRegionHoldingAPoint) {
             if (holding.size() == 1)
                 EXPECT_EQ(uint32_t(got), holding[0])
                     << "point " << toString(p) << " from " << from << " dir " << toString(d)
-                    << "\n  got " << R[got].box.toString() << "\n  want " << R[holding[0]].box.toString()
-                    << "\n  bounds " << B.toString();
+                    << "\n  got " << R[got].box.toString() << "\n  want "
+                    << R[holding[0]].box.toString() << "\n  bounds " << B.toString();
             else
                 EXPECT_TRUE(s.holds(uint32_t(got), p, d)) << toString(p);
         }
@@ -262,12 +268,15 @@ TEST(Irregular, WalkReachesTheRegionHoldingAPoint) {
                     }
                     ASSERT_GE(n, 0) << "region " << r << " axis " << a;
                     const Box3& nb = R[n].box;
-                    EXPECT_TRUE(nb.contains(c)) << "pointer " << r << " -> " << n << " misses its corner";
+                    EXPECT_TRUE(nb.contains(c))
+                        << "pointer " << r << " -> " << n << " misses its corner";
                     EXPECT_EQ(high ? nb.lo[a] : nb.hi[a], c[a]) << "not across the face";
                     for (int b = 0; b < 3; ++b) {
                         if (b == a) continue;
-                        if (high) EXPECT_LT(nb.lo[b], c[b]);  // holds the point just below the corner
-                        else EXPECT_GT(nb.hi[b], c[b]);
+                        if (high)
+                            EXPECT_LT(nb.lo[b], c[b]);  // holds the point just below the corner
+                        else
+                            EXPECT_GT(nb.hi[b], c[b]);
                     }
                 }
             }
@@ -324,7 +333,6 @@ TEST(Irregular, ObserverSeesRegionsPointersAndMailboxes) {
         uint64_t before = ctx.counters.pointerSteps;
         accel->intersect(ray, 0.0, kInf, ctx, obs, hit);
         double last = -kInf;
-        uint32_t lastRegion = 0;
         int regions = 0;
         uint64_t seen = 0;
         for (const WalkEvent& e : obs.events) {
@@ -334,7 +342,6 @@ TEST(Irregular, ObserverSeesRegionsPointersAndMailboxes) {
                 }
                 EXPECT_LE(e.t0, e.t1);
                 last = e.t1;
-                lastRegion = e.a;
                 ++regions;
             } else if (e.kind == WalkEvent::Pointer) {
                 ++seen;
@@ -343,13 +350,38 @@ TEST(Irregular, ObserverSeesRegionsPointersAndMailboxes) {
                 ++mailbox;
             }
         }
-        (void)lastRegion;
         EXPECT_EQ(seen, ctx.counters.pointerSteps - before);
         pointers += seen;
     }
     EXPECT_GT(pointers, 0u);
     EXPECT_GT(mailbox, 0u);
     EXPECT_EQ(ctx.counters.walkErrors, 0u);
+}
+
+// The sparse restriction used for thousands of slabs builds the same tree as restrictTree.
+TEST(Irregular, SparseRestrictionEqualsRestrictTree) {
+    std::mt19937_64 rng(17);
+    for (uint64_t seed = 50; seed < 70; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.primitives = 20;
+        opt.surfaces = seed % 2 == 0;
+        Scene scene = test::randomCsgScene(seed, opt);
+        TreeRestrictor restrictor(scene.tree);
+        for (int k = 0; k < 20; ++k) {
+            std::vector<char> keep(scene.prims.size(), 0);
+            std::vector<uint32_t> prims;
+            for (uint32_t p = 0; p < scene.prims.size(); ++p)
+                if (rng() % 3 == 0) {
+                    keep[p] = 1;
+                    prims.push_back(p);
+                }
+            CsgTree a, b;
+            a.root = restrictTree(scene.tree, scene.tree.root, keep, a);
+            b.root = restrictor.restrict(prims, b);
+            EXPECT_EQ(a.toString(), b.toString()) << "seed " << seed;
+            EXPECT_EQ(a.nodes.size(), b.nodes.size());
+        }
+    }
 }
 
 TEST(Irregular, RefusesBadParameters) {

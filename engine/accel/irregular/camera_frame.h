@@ -31,8 +31,8 @@ struct CameraFrame {
         Box3 out;
         if (b.isEmpty()) return out;
         for (int i = 0; i < 8; ++i)
-            out.expand(point({(i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y,
-                              (i & 4) ? b.hi.z : b.lo.z}));
+            out.expand(point(
+                {(i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z}));
         return out;
     }
 };

@@ -32,8 +32,9 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Build
     if (std::string err = scene.camera.validate(); !err.empty())
         throw std::invalid_argument("--scheme irregular: the camera is invalid: " + err);
     if (params.maxObjects < 0)
-        throw std::invalid_argument("--max-objects " + std::to_string(params.maxObjects) +
-                                    ": must be >= 0 (0: split the screen until no segment is left)");
+        throw std::invalid_argument(
+            "--max-objects " + std::to_string(params.maxObjects) +
+            ": must be >= 0 (0: split the screen until no segment is left)");
 
     IrregularSubdivision s;
     s.scene_ = &scene;
@@ -120,9 +121,12 @@ double IrregularSubdivision::exitOf(const IrregularRegion& r, const Ray& rc, dou
     double te = kInf;
     axis = 0;
     for (int a = 0; a < 3; ++a) {
-        if (rc.d[a] > 0.0) ta[a] = (r.box.hi[a] - rc.o[a]) / rc.d[a];
-        else if (rc.d[a] < 0.0) ta[a] = (r.box.lo[a] - rc.o[a]) / rc.d[a];
-        else ta[a] = kInf;
+        if (rc.d[a] > 0.0)
+            ta[a] = (r.box.hi[a] - rc.o[a]) / rc.d[a];
+        else if (rc.d[a] < 0.0)
+            ta[a] = (r.box.lo[a] - rc.o[a]) / rc.d[a];
+        else
+            ta[a] = kInf;
         if (ta[a] < te) {
             te = ta[a];
             axis = a;
@@ -132,8 +136,10 @@ double IrregularSubdivision::exitOf(const IrregularRegion& r, const Ray& rc, dou
     ties = 0;
     for (int a = 0; a < 3; ++a) {
         if (ta[a] == te) ties |= 1 << a;
-        if (ta[a] == te) p[a] = rc.d[a] > 0.0 ? r.box.hi[a] : r.box.lo[a];
-        else p[a] = std::clamp(rc.o[a] + tc * rc.d[a], r.box.lo[a], r.box.hi[a]);
+        if (ta[a] == te)
+            p[a] = rc.d[a] > 0.0 ? r.box.hi[a] : r.box.lo[a];
+        else
+            p[a] = std::clamp(rc.o[a] + tc * rc.d[a], r.box.lo[a], r.box.hi[a]);
     }
     return tc;
 }

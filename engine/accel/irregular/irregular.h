@@ -41,7 +41,7 @@ namespace lancer {
 struct BuildParams;  // accelerator.h
 
 class IrregularSubdivision {
-public:
+  public:
     /// Build over a prepared scene from scene.camera; scheme figures go to `extra`. Throws
     /// std::invalid_argument for refused parameters or a structure over its limits.
     static IrregularSubdivision build(const Scene& scene, const BuildParams& params,
@@ -79,7 +79,7 @@ public:
     /// (walking the segment from its centre to p); -1 after a walk error.
     int64_t walkTo(uint32_t from, const Vec3& p) const;
 
-private:
+  private:
     /// p is below region r on axis a (or on its low face, going down).
     bool below(uint32_t r, int a, const Vec3& p, const Vec3& d) const {
         const Box3& b = regions_[r].box;
@@ -180,7 +180,8 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         obs.region(r, t, t1);
         if (R.root >= 0) {
             if (R.root != lastRoot) {
-                if (hitInRegion(*scene_, pool_, R.root, ray, tmin, t, t1, ctx, obs, hit)) return true;
+                if (hitInRegion(*scene_, pool_, R.root, ray, tmin, t, t1, ctx, obs, hit))
+                    return true;
                 lastRoot = R.root;
             } else {
                 // The same tree as the region before (a shared restriction): its spans along
@@ -196,7 +197,8 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         // Out through the structure's border (a face, or an edge or corner touching it).
         for (int a = 0; a < 3; ++a)
             if ((ties >> a & 1) && onBorder(R, a, rc.d)) return false;
-        int64_t next = budget > 0 ? cross(r, axis, p, rc.d, obs, ctx.counters.pointerSteps, budget) : -1;
+        int64_t next =
+            budget > 0 ? cross(r, axis, p, rc.d, obs, ctx.counters.pointerSteps, budget) : -1;
         if (next < 0) {
             ++ctx.counters.walkErrors;
             obs.walkError(budget == 0 ? "irregular walk: step budget exhausted"

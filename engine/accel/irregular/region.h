@@ -16,12 +16,12 @@ namespace lancer {
 /// -1 where the face lies on the structure's border. This is Ousterhout's corner stitching
 /// (1984) in 3D; see irregular.h for why these six pointers reach every neighbour.
 struct IrregularRegion {
-    Box3 box;              ///< camera frame
+    Box3 box;  ///< camera frame
     int32_t lo[3] = {-1, -1, -1};
     int32_t hi[3] = {-1, -1, -1};
-    int32_t root = -1;     ///< restricted tree in the shared pool; -1: an empty region
-    uint32_t zone = 0;     ///< its screen zone
-    uint32_t list = 0;     ///< its primitive list (IrregularSubdivision::primitives)
+    int32_t root = -1;  ///< restricted tree in the shared pool; -1: an empty region
+    uint32_t zone = 0;  ///< its screen zone
+    uint32_t list = 0;  ///< its primitive list (IrregularSubdivision::primitives)
 };
 
 /// Corner numbers reported to the observer: bit 0 x, bit 1 y, bit 2 z set for the high side.

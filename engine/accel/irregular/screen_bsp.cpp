@@ -96,8 +96,10 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
     // nothing and is left out.
     for (uint32_t p : prims) {
         const Box3& r = rect[p];
-        Segment e[4] = {{r.lo.x, r.lo.y, r.hi.y, 0}, {r.hi.x, r.lo.y, r.hi.y, 0},
-                        {r.lo.y, r.lo.x, r.hi.x, 1}, {r.hi.y, r.lo.x, r.hi.x, 1}};
+        Segment e[4] = {{r.lo.x, r.lo.y, r.hi.y, 0},
+                        {r.hi.x, r.lo.y, r.hi.y, 0},
+                        {r.lo.y, r.lo.x, r.hi.x, 1},
+                        {r.hi.y, r.lo.x, r.hi.x, 1}};
         for (const Segment& s : e) {
             uint8_t o = 1 - s.axis;
             Segment c{s.c, std::max(s.lo, lo[o]), std::min(s.hi, hi[o]), s.axis};
@@ -119,9 +121,10 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
                     (params.stopObjects > 0 && cell.prims.size() <= size_t(params.stopObjects));
         if (stop) {
             if (params.maxZones && bsp.zoneLo.size() >= params.maxZones)
-                throw std::invalid_argument(
-                    "--scheme irregular: the screen BSP passes " + std::to_string(params.maxZones) +
-                    " zones; stop the 2D step earlier with --max-objects or try another --bsp-heuristic");
+                throw std::invalid_argument("--scheme irregular: the screen BSP passes " +
+                                            std::to_string(params.maxZones) +
+                                            " zones; stop the 2D step earlier with --max-objects "
+                                            "or try another --bsp-heuristic");
             slot = ~int32_t(bsp.zoneLo.size());
             bsp.zoneLo.push_back(cell.lo);
             bsp.zoneHi.push_back(cell.hi);
@@ -141,8 +144,10 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         above.lo[sp.axis] = sp.c;
         for (const Segment& s : cell.segs) {
             if (s.axis == sp.axis) {
-                if (s.c < sp.c) below.segs.push_back(s);
-                else if (s.c > sp.c) above.segs.push_back(s);
+                if (s.c < sp.c)
+                    below.segs.push_back(s);
+                else if (s.c > sp.c)
+                    above.segs.push_back(s);
             } else if (s.hi <= sp.c) {
                 below.segs.push_back(s);
             } else if (s.lo >= sp.c) {

@@ -15,25 +15,25 @@ enum class BspHeuristic : uint8_t;  // accelerator.h
 
 struct ScreenBspParams {
     BspHeuristic heuristic{};  ///< the choice of splitting line
-    int stopObjects = 0;     ///< a cell overlapping at most this many rectangles is a zone (0: never)
-    size_t maxZones = 0;     ///< refuse (throw std::invalid_argument) beyond this many zones
+    int stopObjects = 0;  ///< a cell overlapping at most this many rectangles is a zone (0: never)
+    size_t maxZones = 0;  ///< refuse (throw std::invalid_argument) beyond this many zones
 };
 
 /// The screen BSP and its leaves, the zones, each with the primitives whose rectangle it touches.
 struct ScreenBsp {
     struct Node {
-        uint8_t axis;       ///< 0: the line x = value, 1: the line y = value
+        uint8_t axis;  ///< 0: the line x = value, 1: the line y = value
         double value;
-        int32_t child[2];   ///< [0] below the line, [1] above; >= 0 a node, < 0 the zone ~child
+        int32_t child[2];  ///< [0] below the line, [1] above; >= 0 a node, < 0 the zone ~child
     };
     std::vector<Node> nodes;
-    int32_t root = ~0;                 ///< a node, or ~zone when the BSP is a single zone
+    int32_t root = ~0;  ///< a node, or ~zone when the BSP is a single zone
     std::vector<glm::dvec2> zoneLo, zoneHi;
-    std::vector<uint32_t> zoneFirst;   ///< zone z holds zonePrims[zoneFirst[z] .. zoneFirst[z + 1])
+    std::vector<uint32_t> zoneFirst;  ///< zone z holds zonePrims[zoneFirst[z] .. zoneFirst[z + 1])
     std::vector<uint32_t> zonePrims;
-    size_t segments = 0;               ///< rectangle edges fed to the BSP
-    size_t cuts = 0;                   ///< segments cut in two by a splitting line
-    int depth = 0;                     ///< deepest node
+    size_t segments = 0;  ///< rectangle edges fed to the BSP
+    size_t cuts = 0;      ///< segments cut in two by a splitting line
+    int depth = 0;        ///< deepest node
 
     size_t zoneCount() const { return zoneLo.size(); }
     /// The zone holding the point (x, y), or for a point on a line, the zone on the side given by

@@ -12,12 +12,12 @@
 namespace lancer {
 
 class TreeRestrictor {
-public:
+  public:
     explicit TreeRestrictor(const CsgTree& tree);
     /// Same result as restrictTree(tree, tree.root, keep, dst) with keep = `prims`.
     int restrict(const std::vector<uint32_t>& prims, CsgTree& dst);
 
-private:
+  private:
     int visit(int node, CsgTree& dst) const;
     void mark(const std::vector<uint32_t>& prims, char value);
 
