@@ -41,6 +41,14 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
             info.buildMs = elapsedMs();
             return std::make_unique<Accelerator>(std::move(b), params, std::move(info));
         }
+        case SchemeKind::Irregular: {
+            AccelInfo info;
+            IrregularSubdivision s = IrregularSubdivision::build(scene, params, info.extra);
+            info.regions = s.regionCount();
+            info.memoryBytes = s.memoryBytes();
+            info.buildMs = elapsedMs();
+            return std::make_unique<Accelerator>(std::move(s), params, std::move(info));
+        }
         default:
             throw std::invalid_argument(std::string("--scheme ") + schemeName(params.scheme) +
                                         ": this scheme is not implemented yet");

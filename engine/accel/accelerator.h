@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "engine/accel/brute_force.h"
+#include "engine/accel/irregular/irregular.h"
 
 namespace lancer {
 
@@ -40,7 +41,7 @@ struct AccelInfo {
 
 class Accelerator {
 public:
-    using Impl = std::variant<BruteForce>;
+    using Impl = std::variant<BruteForce, IrregularSubdivision>;
 
     Accelerator(Impl impl, BuildParams params, AccelInfo info)
         : impl_(std::move(impl)), params_(params), info_(std::move(info)) {}

@@ -1,0 +1,49 @@
+#include "engine/accel/irregular/corner_pointers.h"
+
+#include <algorithm>
+
+namespace lancer {
+
+uint32_t slabAt(const std::vector<IrregularRegion>& regions,
+                const std::vector<uint32_t>& zoneFirstRegion, uint32_t zone, double z, int s) {
+    uint32_t first = zoneFirstRegion[zone], last = zoneFirstRegion[zone + 1];
+    // The first slab whose top is above z (s > 0) or at or above z (s <= 0).
+    auto it = std::partition_point(
+        regions.begin() + first, regions.begin() + last,
+        [&](const IrregularRegion& r) { return s > 0 ? r.box.hi.z <= z : r.box.hi.z < z; });
+    uint32_t i = uint32_t(it - regions.begin());
+    return std::min(i, last - 1);
+}
+
+void linkCorners(const ScreenBsp& bsp, const Box3& bounds, DepthSlabs& slabs) {
+    for (uint32_t zone = 0; zone < bsp.zoneCount(); ++zone) {
+        glm::dvec2 lo = bsp.zoneLo[zone], hi = bsp.zoneHi[zone];
+        // The zones beyond this zone's corners, across each screen face (-1: the border).
+        int64_t hx = hi.x < bounds.hi.x ? int64_t(bsp.locate(hi.x, hi.y, +1, -1)) : -1;
+        int64_t hy = hi.y < bounds.hi.y ? int64_t(bsp.locate(hi.x, hi.y, -1, +1)) : -1;
+        int64_t lx = lo.x > bounds.lo.x ? int64_t(bsp.locate(lo.x, lo.y, -1, +1)) : -1;
+        int64_t ly = lo.y > bounds.lo.y ? int64_t(bsp.locate(lo.x, lo.y, +1, -1)) : -1;
+        uint32_t first = slabs.zoneFirstRegion[zone], last = slabs.zoneFirstRegion[zone + 1];
+        for (uint32_t i = first; i < last; ++i) {
+            IrregularRegion& r = slabs.regions[i];
+            // High corner: just below its zhi in the neighbour; low corner: just above its zlo.
+            r.hi[0] = hx < 0 ? -1
+                             : int32_t(slabAt(slabs.regions, slabs.zoneFirstRegion, uint32_t(hx),
+                                              r.box.hi.z, -1));
+            r.hi[1] = hy < 0 ? -1
+                             : int32_t(slabAt(slabs.regions, slabs.zoneFirstRegion, uint32_t(hy),
+                                              r.box.hi.z, -1));
+            r.lo[0] = lx < 0 ? -1
+                             : int32_t(slabAt(slabs.regions, slabs.zoneFirstRegion, uint32_t(lx),
+                                              r.box.lo.z, +1));
+            r.lo[1] = ly < 0 ? -1
+                             : int32_t(slabAt(slabs.regions, slabs.zoneFirstRegion, uint32_t(ly),
+                                              r.box.lo.z, +1));
+            // Along depth the neighbour is the next slab of the same zone: same footprint.
+            r.lo[2] = i > first ? int32_t(i - 1) : -1;
+            r.hi[2] = i + 1 < last ? int32_t(i + 1) : -1;
+        }
+    }
+}
+
+}  // namespace lancer

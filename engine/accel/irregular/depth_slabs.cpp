@@ -1,0 +1,84 @@
+#include "engine/accel/irregular/depth_slabs.h"
+
+#include <algorithm>
+#include <unordered_map>
+
+#include "engine/accel/irregular/tree_restrictor.h"
+
+namespace lancer {
+
+namespace {
+
+struct ListHash {
+    size_t operator()(const std::vector<uint32_t>& v) const {
+        uint64_t h = 1469598103934665603ull;
+        for (uint32_t x : v) h = (h ^ x) * 1099511628211ull;
+        return size_t(h);
+    }
+};
+
+}  // namespace
+
+DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
+                           double zlo, double zhi) {
+    DepthSlabs out;
+    TreeRestrictor restrictor(scene.tree);
+    // One tree and one list per distinct primitive set; list 0 is the empty set.
+    std::unordered_map<std::vector<uint32_t>, std::pair<uint32_t, int>, ListHash> shared;
+    out.listFirst = {0, 0};
+    shared[{}] = {0, -1};
+    auto share = [&](std::vector<uint32_t>& prims, IrregularRegion& r) {
+        std::sort(prims.begin(), prims.end());
+        auto it = shared.find(prims);
+        if (it == shared.end()) {
+            uint32_t list = uint32_t(out.listFirst.size() - 1);
+            int root = restrictor.restrict(prims, out.pool);
+            out.listPrims.insert(out.listPrims.end(), prims.begin(), prims.end());
+            out.listFirst.push_back(uint32_t(out.listPrims.size()));
+            it = shared.emplace(prims, std::make_pair(list, root)).first;
+        }
+        r.list = it->second.first;
+        r.root = it->second.second;
+    };
+
+    std::vector<double> cuts;
+    std::vector<uint32_t> inSlab;
+    out.zoneFirstRegion.push_back(0);
+    for (uint32_t z = 0; z < bsp.zoneCount(); ++z) {
+        const uint32_t* first = bsp.zonePrims.data() + bsp.zoneFirst[z];
+        const uint32_t* last = bsp.zonePrims.data() + bsp.zoneFirst[z + 1];
+        IrregularRegion r;
+        r.zone = z;
+        r.box.lo = Vec3(bsp.zoneLo[z], zlo);
+        r.box.hi = Vec3(bsp.zoneHi[z], zhi);
+        if (first == last) {  // an empty zone: one empty region through the whole depth
+            ++out.emptyZones;
+            out.regions.push_back(r);
+            out.zoneFirstRegion.push_back(uint32_t(out.regions.size()));
+            continue;
+        }
+        // Depth cuts: the structure's ends and every box's zmin and zmax.
+        cuts = {zlo, zhi};
+        for (const uint32_t* p = first; p != last; ++p) {
+            cuts.push_back(std::clamp(box[*p].lo.z, zlo, zhi));
+            cuts.push_back(std::clamp(box[*p].hi.z, zlo, zhi));
+        }
+        std::sort(cuts.begin(), cuts.end());
+        cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+        for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+            r.box.lo.z = cuts[i];
+            r.box.hi.z = cuts[i + 1];
+            inSlab.clear();
+            for (const uint32_t* p = first; p != last; ++p)
+                if (box[*p].lo.z < cuts[i + 1] && box[*p].hi.z > cuts[i]) inSlab.push_back(*p);
+            if (inSlab.empty()) ++out.emptySlabs;
+            share(inSlab, r);
+            out.regions.push_back(r);
+            ++out.slabs;
+        }
+        out.zoneFirstRegion.push_back(uint32_t(out.regions.size()));
+    }
+    return out;
+}
+
+}  // namespace lancer

@@ -1,0 +1,32 @@
+// The irregular scheme's 3D step: each zone of the screen BSP cut along depth at the zmin/zmax
+// of the boxes over it. Each slab is a region with the primitives whose box overlaps its
+// interior and their restricted tree; equal primitive sets share one tree in the pool. Boxes
+// that only touch a slab are left out: with the padding of irregular.cpp their primitives have
+// no hit there, and a closed overlap would add each box to the slabs on both sides of its own
+// zmin and zmax.
+#pragma once
+
+#include <vector>
+
+#include "engine/accel/irregular/region.h"
+#include "engine/accel/irregular/screen_bsp.h"
+#include "engine/scene/scene.h"
+
+namespace lancer {
+
+struct DepthSlabs {
+    std::vector<IrregularRegion> regions;   ///< zone by zone, slabs by increasing depth
+    std::vector<uint32_t> zoneFirstRegion;  ///< zone z: regions [zoneFirstRegion[z], [z + 1])
+    CsgTree pool;                           ///< the restricted trees
+    std::vector<uint32_t> listFirst;        ///< list l: listPrims[listFirst[l] .. [l + 1])
+    std::vector<uint32_t> listPrims;
+    size_t slabs = 0;       ///< regions cut in non-empty zones
+    size_t emptyZones = 0;  ///< zones no rectangle touches (one region each)
+    size_t emptySlabs = 0;  ///< slabs of non-empty zones that hold no primitive
+};
+
+/// Cut every zone of `bsp` along depth inside [zlo, zhi]; box[p] is primitive p's camera box.
+DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
+                           double zlo, double zhi);
+
+}  // namespace lancer

@@ -1,0 +1,186 @@
+#include "engine/accel/irregular/irregular.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "engine/accel/accelerator.h"
+#include "engine/accel/irregular/corner_pointers.h"
+#include "engine/accel/irregular/depth_slabs.h"
+
+namespace lancer {
+
+namespace {
+
+int sign(double v) { return v > 0.0 ? 1 : (v < 0.0 ? -1 : 0); }
+
+double maxAbs(const Vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
+
+/// Zones beyond this many are refused: a screen BSP that large means the 2D step should stop
+/// earlier (see README, "Irregular subdivision").
+constexpr size_t kMaxZones = 4'000'000;
+/// Regions beyond this many are refused: pointers are 32-bit and memory would run out first.
+constexpr size_t kMaxRegions = 50'000'000;
+
+}  // namespace
+
+IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const BuildParams& params,
+                                                 nlohmann::json& extra) {
+    using Clock = std::chrono::steady_clock;
+    auto ms = [](Clock::time_point a) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - a).count();
+    };
+    if (std::string err = scene.camera.validate(); !err.empty())
+        throw std::invalid_argument("--scheme irregular: the camera is invalid: " + err);
+    if (params.maxObjects < 0)
+        throw std::invalid_argument(
+            "--max-objects " + std::to_string(params.maxObjects) +
+            ": must be >= 0 (0: split the screen until no segment is left)");
+
+    IrregularSubdivision s;
+    s.scene_ = &scene;
+    s.frame_ = CameraFrame::of(scene.camera);
+    std::vector<uint32_t> live = scene.livePrimitives();
+    if (live.empty() || scene.bounds.isEmpty()) {
+        extra["zones"] = 0;
+        return s;
+    }
+
+    // Camera-frame boxes, padded by a few thousand rounding errors of the largest coordinate
+    // involved, so that a hit point and the ray's own camera-frame point never fall outside the
+    // box of the primitive they belong to; the structure's box is padded twice as much so every
+    // primitive box lies strictly inside it.
+    auto t0 = Clock::now();
+    Box3 cam = s.frame_.box(scene.bounds);
+    double scale = std::max({maxAbs(cam.lo), maxAbs(cam.hi), maxAbs(scene.bounds.lo),
+                             maxAbs(scene.bounds.hi), maxAbs(scene.camera.from), 1e-300});
+    double eps = 1e-9 * scale;
+    std::vector<Box3> box(scene.prims.size());
+    for (uint32_t p : live) {
+        box[p] = s.frame_.box(scene.minBox[p]);
+        box[p].lo -= eps;
+        box[p].hi += eps;
+    }
+    s.bounds_ = {cam.lo - 2.0 * eps, cam.hi + 2.0 * eps};
+
+    // 2D step.
+    ScreenBspParams sp;
+    sp.heuristic = params.heuristic;
+    sp.stopObjects = params.maxObjects;
+    sp.maxZones = kMaxZones;
+    s.bsp_ = ScreenBsp::build(box, live, {s.bounds_.lo.x, s.bounds_.lo.y},
+                              {s.bounds_.hi.x, s.bounds_.hi.y}, sp);
+    double bspMs = ms(t0);
+
+    // 3D step.
+    auto t1 = Clock::now();
+    DepthSlabs slabs = buildDepthSlabs(scene, s.bsp_, box, s.bounds_.lo.z, s.bounds_.hi.z);
+    if (slabs.regions.size() > kMaxRegions)
+        throw std::invalid_argument("--scheme irregular: " + std::to_string(slabs.regions.size()) +
+                                    " regions is over the limit of " + std::to_string(kMaxRegions) +
+                                    "; stop the 2D step earlier with --max-objects");
+    double slabMs = ms(t1);
+
+    auto t2 = Clock::now();
+    linkCorners(s.bsp_, s.bounds_, slabs);
+    double linkMs = ms(t2);
+
+    s.regions_ = std::move(slabs.regions);
+    s.zoneFirstRegion_ = std::move(slabs.zoneFirstRegion);
+    s.pool_ = std::move(slabs.pool);
+    s.listFirst_ = std::move(slabs.listFirst);
+    s.listPrims_ = std::move(slabs.listPrims);
+    s.budget_ = 16 * s.regions_.size() + 1024;
+
+    size_t refs = 0, most = 0;
+    for (uint32_t r = 0; r < s.regions_.size(); ++r) {
+        size_t n = s.primitives(r).size();
+        refs += n;
+        most = std::max(most, n);
+    }
+    extra["zones"] = s.bsp_.zoneCount();
+    extra["segments"] = s.bsp_.segments;
+    extra["cut_segments"] = s.bsp_.cuts;
+    extra["bsp_nodes"] = s.bsp_.nodes.size();
+    extra["bsp_depth"] = s.bsp_.depth;
+    extra["slabs"] = slabs.slabs;
+    extra["empty_zones"] = slabs.emptyZones;
+    extra["empty_slabs"] = slabs.emptySlabs;
+    extra["distinct_trees"] = s.listFirst_.size() - 1;
+    extra["pool_nodes"] = s.pool_.nodes.size();
+    extra["prims_per_region"] = double(refs) / double(s.regions_.size());
+    extra["max_prims_per_region"] = most;
+    extra["screen_bsp_ms"] = bspMs;
+    extra["slabs_ms"] = slabMs;
+    extra["pointers_ms"] = linkMs;
+    return s;
+}
+
+double IrregularSubdivision::exitOf(const IrregularRegion& r, const Ray& rc, double t, int& axis,
+                                    int& ties, Vec3& p) const {
+    double ta[3];
+    double te = kInf;
+    axis = 0;
+    for (int a = 0; a < 3; ++a) {
+        if (rc.d[a] > 0.0)
+            ta[a] = (r.box.hi[a] - rc.o[a]) / rc.d[a];
+        else if (rc.d[a] < 0.0)
+            ta[a] = (r.box.lo[a] - rc.o[a]) / rc.d[a];
+        else
+            ta[a] = kInf;
+        if (ta[a] < te) {
+            te = ta[a];
+            axis = a;
+        }
+    }
+    double tc = std::max(te, t);
+    ties = 0;
+    for (int a = 0; a < 3; ++a) {
+        if (ta[a] == te) ties |= 1 << a;
+        if (ta[a] == te)
+            p[a] = rc.d[a] > 0.0 ? r.box.hi[a] : r.box.lo[a];
+        else
+            p[a] = std::clamp(rc.o[a] + tc * rc.d[a], r.box.lo[a], r.box.hi[a]);
+    }
+    return tc;
+}
+
+uint32_t IrregularSubdivision::locate(const Vec3& p, const Vec3& d) const {
+    uint32_t zone = bsp_.locate(p.x, p.y, sign(d.x), sign(d.y));
+    return slabAt(regions_, zoneFirstRegion_, zone, p.z, sign(d.z));
+}
+
+int64_t IrregularSubdivision::walkTo(uint32_t from, const Vec3& p) const {
+    Ray rc{regions_[from].box.center(), p - regions_[from].box.center()};
+    uint32_t r = from;
+    double t = 0.0;
+    size_t budget = budget_;
+    uint64_t steps = 0;
+    NullObserver obs;
+    // Stop on the region that holds p (exact comparisons) or where the segment ends (a point
+    // a few ulps off a cut may round to the other side of it).
+    for (;;) {
+        if (holds(r, p, rc.d)) return r;
+        int axis, ties;
+        Vec3 q;
+        double te = exitOf(regions_[r], rc, t, axis, ties, q);
+        if (te > 1.0) return r;
+        // p on the structure's border: cross a tied face that is not on it.
+        axis = -1;
+        for (int a = 0; a < 3 && axis < 0; ++a)
+            if ((ties >> a & 1) && !onBorder(regions_[r], a, rc.d)) axis = a;
+        if (axis < 0) return r;
+        int64_t next = cross(r, axis, q, rc.d, obs, steps, budget);
+        if (next < 0 || budget == 0) return -1;
+        --budget;
+        r = uint32_t(next);
+        t = te;
+    }
+}
+
+size_t IrregularSubdivision::memoryBytes() const {
+    return sizeof(*this) + regions_.size() * sizeof(IrregularRegion) + bsp_.memoryBytes() +
+           zoneFirstRegion_.size() * sizeof(uint32_t) + pool_.nodes.size() * sizeof(CsgNode) +
+           (listFirst_.size() + listPrims_.size()) * sizeof(uint32_t);
+}
+
+}  // namespace lancer

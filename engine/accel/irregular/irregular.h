@@ -1,0 +1,214 @@
+// The irregular subdivision of Arnaldi, Priol and Bouatouch (report, section 2; DESIGN.md
+// section 4): a screen BSP of the primitives' projected boxes (screen_bsp.h), each zone cut in
+// depth slabs (depth_slabs.h), the slabs linked by corner pointers (corner_pointers.h), and a
+// walk that follows a ray from region to region by those pointers alone.
+//
+// Everything lives in the camera frame (camera_frame.h): screen x, screen y, depth z. The frame
+// is orthonormal and camera-relative, so every ray, primary (orthographic or perspective) or
+// secondary, from any origin, is walked the same way; t is the same in both frames.
+//
+// Why the six corner pointers of region.h are enough. Zones tile the screen rectangle and every
+// zone is a full-depth column of slabs, so:
+//  - across a depth face the neighbour is unique: the next slab of the same column (lo[2]/hi[2]);
+//  - across a screen face, say x = xhi, the neighbours form a column of zones stacked along y
+//    (a T-junction: several neighbours per face). hi[0] lands on the topmost of them (it holds
+//    the point just above xhi, just below yhi). From a neighbour N, N.lo[1] holds the point just
+//    right of N.xlo = xhi and just below N.ylo: while N.ylo is above the exit point that point is
+//    still on our face, so it is the next neighbour down. The walk down the face therefore
+//    visits only face neighbours and stops at the one holding the exit point's y. The other
+//    faces are symmetric: a low face starts at lo[a] (the lowest neighbour) and walks up by hi[b].
+//    The depth is then found in that zone's column by lo[2]/hi[2].
+//  - an exit through an edge or a corner: the walk crosses one of the tied faces; the exit point
+//    lies on a border of the face, where the face walk stops on a neighbour that only touches
+//    the point. The ray spends a zero-length interval there, and that region's own exit has the
+//    same t (its far plane is the same coordinate, so the same floating-point division), so the
+//    next crossing takes the next tied axis. At most three crossings per point.
+// Ties use the ray's direction: a point on a plane belongs to the side the ray goes to, so a walk
+// never steps back; t never decreases and the number of steps is bounded, beyond which the ray
+// ends with a counted walk error.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <span>
+
+#include "engine/accel/eval.h"
+#include "engine/accel/irregular/camera_frame.h"
+#include "engine/accel/irregular/region.h"
+#include "engine/accel/irregular/screen_bsp.h"
+
+namespace lancer {
+
+struct BuildParams;  // accelerator.h
+
+class IrregularSubdivision {
+  public:
+    /// Build over a prepared scene from scene.camera; scheme figures go to `extra`. Throws
+    /// std::invalid_argument for refused parameters or a structure over its limits.
+    static IrregularSubdivision build(const Scene& scene, const BuildParams& params,
+                                      nlohmann::json& extra);
+
+    template <class Obs>
+    bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                   Hit& hit) const;
+
+    size_t regionCount() const { return regions_.size(); }
+    size_t memoryBytes() const;
+    bool usesMailboxes() const { return true; }
+
+    // Inspection (tests, viewer).
+    const CameraFrame& frame() const { return frame_; }
+    /// The structure's box in the camera frame: the scene bounds' bound there, padded.
+    const Box3& bounds() const { return bounds_; }
+    const std::vector<IrregularRegion>& regions() const { return regions_; }
+    const ScreenBsp& screen() const { return bsp_; }
+    /// Primitives of a region.
+    std::span<const uint32_t> primitives(uint32_t region) const {
+        uint32_t l = regions_[region].list;
+        return {listPrims_.data() + listFirst_[l], listPrims_.data() + listFirst_[l + 1]};
+    }
+    /// Does region r hold camera point p, on the side of direction d where p lies on a cut?
+    bool holds(uint32_t r, const Vec3& p, const Vec3& d) const {
+        for (int a = 0; a < 3; ++a)
+            if (below(r, a, p, d) || above(r, a, p, d)) return false;
+        return true;
+    }
+    /// The region holding camera point p (side of d): screen BSP and binary search over the
+    /// zone's slabs. Only the start of a walk uses it.
+    uint32_t locate(const Vec3& p, const Vec3& d) const;
+    /// The region holding camera point p, reached from region `from` by corner pointers alone
+    /// (walking the segment from its centre to p); -1 after a walk error.
+    int64_t walkTo(uint32_t from, const Vec3& p) const;
+
+  private:
+    /// p is below region r on axis a (or on its low face, going down).
+    bool below(uint32_t r, int a, const Vec3& p, const Vec3& d) const {
+        const Box3& b = regions_[r].box;
+        return p[a] < b.lo[a] || (p[a] == b.lo[a] && d[a] < 0.0 && b.lo[a] > bounds_.lo[a]);
+    }
+    bool above(uint32_t r, int a, const Vec3& p, const Vec3& d) const {
+        const Box3& b = regions_[r].box;
+        return p[a] > b.hi[a] || (p[a] == b.hi[a] && d[a] > 0.0 && b.hi[a] < bounds_.hi[a]);
+    }
+    /// Where the ray leaves region r after t: the exit parameter, the axis crossed (the first
+    /// of the tied ones), the tied axes (a bit mask), and the exit point, exactly on every tied
+    /// plane.
+    double exitOf(const IrregularRegion& r, const Ray& rc, double t, int& axis, int& ties,
+                  Vec3& p) const;
+    /// The face of r that a ray going along d leaves through on axis a is the structure's border.
+    bool onBorder(const IrregularRegion& r, int a, const Vec3& d) const {
+        return d[a] > 0.0 ? r.box.hi[a] == bounds_.hi[a] : r.box.lo[a] == bounds_.lo[a];
+    }
+    /// The region beyond region r's face on `axis` that holds p, by corner pointers.
+    template <class Obs>
+    int64_t cross(uint32_t r, int axis, const Vec3& p, const Vec3& d, Obs& obs, uint64_t& steps,
+                  size_t& budget) const;
+
+    const Scene* scene_ = nullptr;
+    CameraFrame frame_;
+    Box3 bounds_;
+    ScreenBsp bsp_;
+    std::vector<IrregularRegion> regions_;
+    std::vector<uint32_t> zoneFirstRegion_;  ///< zone z: regions [zoneFirstRegion_[z], [z + 1])
+    CsgTree pool_;
+    std::vector<uint32_t> listFirst_, listPrims_;
+    size_t budget_ = 0;  ///< steps allowed to one walk
+};
+
+template <class Obs>
+int64_t IrregularSubdivision::cross(uint32_t r, int axis, const Vec3& p, const Vec3& d, Obs& obs,
+                                    uint64_t& steps, size_t& budget) const {
+    auto follow = [&](uint32_t from, int32_t to, int corner) -> bool {
+        if (to < 0 || budget == 0) return false;
+        --budget;
+        ++steps;
+        obs.pointer(from, uint32_t(to), corner);
+        return true;
+    };
+    bool up = d[axis] > 0.0;
+    int32_t n = up ? regions_[r].hi[axis] : regions_[r].lo[axis];
+    if (!follow(r, n, up ? kHighCorner : kLowCorner)) return -1;
+    if (axis < 2) {
+        // Along the face: down from the high corner's neighbour, up from the low corner's.
+        int b = 1 - axis;
+        if (up) {
+            while (below(uint32_t(n), b, p, d)) {
+                int32_t m = regions_[n].lo[b];
+                if (!follow(uint32_t(n), m, kLowCorner)) return -1;
+                n = m;
+            }
+        } else {
+            while (above(uint32_t(n), b, p, d)) {
+                int32_t m = regions_[n].hi[b];
+                if (!follow(uint32_t(n), m, kHighCorner)) return -1;
+                n = m;
+            }
+        }
+    }
+    // In depth, inside the zone's column: its slabs share its footprint, so both ways are open.
+    while (below(uint32_t(n), 2, p, d)) {
+        int32_t m = regions_[n].lo[2];
+        if (!follow(uint32_t(n), m, kLowCorner)) return -1;
+        n = m;
+    }
+    while (above(uint32_t(n), 2, p, d)) {
+        int32_t m = regions_[n].hi[2];
+        if (!follow(uint32_t(n), m, kHighCorner)) return -1;
+        n = m;
+    }
+    return n;
+}
+
+template <class Obs>
+bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx,
+                                     Obs& obs, Hit& hit) const {
+    if (regions_.empty()) return false;
+    Ray rc = frame_.ray(ray);
+    double tw0, tw1;
+    if (!clipLine(rc, bounds_, tw0, tw1)) return false;
+    double t = std::max(tw0, tmin), tend = std::min(tw1, tmax);
+    if (!(t <= tend)) return false;
+    uint32_t r = locate(glm::clamp(rc.at(t), bounds_.lo, bounds_.hi), rc.d);
+    size_t budget = budget_;
+    int lastRoot = -1;
+    for (;;) {
+        const IrregularRegion& R = regions_[r];
+        int axis, ties;
+        Vec3 p;
+        double te = exitOf(R, rc, t, axis, ties, p);
+        double t1 = std::min(te, tend);
+        ++ctx.counters.regionVisits;
+        obs.region(r, t, t1);
+        if (R.root >= 0) {
+            if (R.root != lastRoot) {
+                if (hitInRegion(*scene_, pool_, R.root, ray, tmin, t, t1, ctx, obs, hit))
+                    return true;
+                lastRoot = R.root;
+            } else {
+                // The same tree as the region before (a shared restriction): its spans along
+                // the whole line are still in ctx.result; only the interval changed.
+                if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
+                if (const Boundary* b = firstBoundary(ctx.result, tmin, t, t1)) {
+                    hit = {b->t, b->prim, b->part, b->flip};
+                    return true;
+                }
+            }
+        }
+        if (te >= tend) return false;
+        // Out through the structure's border (a face, or an edge or corner touching it).
+        for (int a = 0; a < 3; ++a)
+            if ((ties >> a & 1) && onBorder(R, a, rc.d)) return false;
+        int64_t next =
+            budget > 0 ? cross(r, axis, p, rc.d, obs, ctx.counters.pointerSteps, budget) : -1;
+        if (next < 0) {
+            ++ctx.counters.walkErrors;
+            obs.walkError(budget == 0 ? "irregular walk: step budget exhausted"
+                                      : "irregular walk: no corner pointer toward the exit point");
+            return false;
+        }
+        if (budget > 0) --budget;
+        r = uint32_t(next);
+        t = te;
+    }
+}
+
+}  // namespace lancer

@@ -1,0 +1,189 @@
+#include "engine/accel/irregular/screen_bsp.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "engine/accel/accelerator.h"
+
+namespace lancer {
+
+namespace {
+
+/// A piece of a rectangle edge: the line p[axis] == c, from lo to hi along the other axis.
+struct Segment {
+    double c, lo, hi;
+    uint8_t axis;
+};
+
+/// A cell still to be split: its rectangle, the segments strictly inside it and the primitives
+/// whose rectangle touches it.
+struct Cell {
+    glm::dvec2 lo, hi;
+    std::vector<Segment> segs;
+    std::vector<uint32_t> prims;
+    int32_t parent;  ///< node whose child this cell becomes (-1: the root); nodes may reallocate
+    int side;
+    int depth;
+};
+
+struct Split {
+    uint8_t axis;
+    double c;
+};
+
+/// The line to split on. `first`: the first segment's line (the report's "on choisit un
+/// segment", read literally). `balanced`: the line that minimizes the larger side (segments on
+/// it plus the pieces cut), then the cuts. `fewest-cuts`: the line that cuts fewest segments,
+/// then the larger side. Each axis is scored in O(n log n) from sorted endpoints.
+Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h) {
+    if (h == BspHeuristic::First) return {segs[0].axis, segs[0].c};
+    Split best{segs[0].axis, segs[0].c};
+    size_t bestMain = SIZE_MAX, bestTie = SIZE_MAX;
+    std::vector<double> lines, lo, hi;
+    for (uint8_t a = 0; a < 2; ++a) {
+        lines.clear();
+        lo.clear();
+        hi.clear();
+        for (const Segment& s : segs) {
+            if (s.axis == a) {
+                lines.push_back(s.c);
+            } else {
+                lo.push_back(s.lo);
+                hi.push_back(s.hi);
+            }
+        }
+        if (lines.empty()) continue;
+        std::sort(lines.begin(), lines.end());
+        std::sort(lo.begin(), lo.end());
+        std::sort(hi.begin(), hi.end());
+        for (size_t i = 0; i < lines.size(); ++i) {
+            if (i > 0 && lines[i] == lines[i - 1]) continue;
+            double c = lines[i];
+            size_t below = i;
+            size_t above = size_t(lines.end() - std::upper_bound(lines.begin(), lines.end(), c));
+            size_t crossLow = size_t(std::upper_bound(hi.begin(), hi.end(), c) - hi.begin());
+            size_t crossHigh = size_t(lo.end() - std::lower_bound(lo.begin(), lo.end(), c));
+            size_t cut = lo.size() - crossLow - crossHigh;
+            size_t larger = std::max(below + crossLow, above + crossHigh) + cut;
+            size_t mainCost = h == BspHeuristic::Balanced ? larger : cut;
+            size_t tieCost = h == BspHeuristic::Balanced ? cut : larger;
+            if (mainCost < bestMain || (mainCost == bestMain && tieCost < bestTie)) {
+                bestMain = mainCost;
+                bestTie = tieCost;
+                best = {a, c};
+            }
+        }
+    }
+    return best;
+}
+
+/// The rectangle's interior meets the cell's. A rectangle that only touches the cell is left
+/// out: boxes are padded far beyond rounding (irregular.cpp), so its primitive has no point
+/// and no hit within the cell; including it would add every neighbour across an edge.
+bool overlapsOpen(const Box3& r, glm::dvec2 lo, glm::dvec2 hi) {
+    return r.lo.x < hi.x && lo.x < r.hi.x && r.lo.y < hi.y && lo.y < r.hi.y;
+}
+
+}  // namespace
+
+ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint32_t>& prims,
+                           glm::dvec2 lo, glm::dvec2 hi, const ScreenBspParams& params) {
+    ScreenBsp bsp;
+    bsp.zoneFirst.push_back(0);
+    Cell top{lo, hi, {}, {}, -1, 0, 0};
+    // The four edges of each rectangle, in primitive order; an edge on the cell's border splits
+    // nothing and is left out.
+    for (uint32_t p : prims) {
+        const Box3& r = rect[p];
+        Segment e[4] = {{r.lo.x, r.lo.y, r.hi.y, 0},
+                        {r.hi.x, r.lo.y, r.hi.y, 0},
+                        {r.lo.y, r.lo.x, r.hi.x, 1},
+                        {r.hi.y, r.lo.x, r.hi.x, 1}};
+        for (const Segment& s : e) {
+            uint8_t o = 1 - s.axis;
+            Segment c{s.c, std::max(s.lo, lo[o]), std::min(s.hi, hi[o]), s.axis};
+            if (c.c > lo[s.axis] && c.c < hi[s.axis] && c.lo < c.hi) top.segs.push_back(c);
+        }
+        top.prims.push_back(p);
+    }
+    bsp.segments = top.segs.size();
+
+    // Depth first, smaller child first, so at most O(log n) large cells wait on the stack.
+    std::vector<Cell> stack;
+    stack.push_back(std::move(top));
+    while (!stack.empty()) {
+        Cell cell = std::move(stack.back());
+        stack.pop_back();
+        int32_t& slot = cell.parent < 0 ? bsp.root : bsp.nodes[cell.parent].child[cell.side];
+        bsp.depth = std::max(bsp.depth, cell.depth);
+        bool stop = cell.segs.empty() ||
+                    (params.stopObjects > 0 && cell.prims.size() <= size_t(params.stopObjects));
+        if (stop) {
+            if (params.maxZones && bsp.zoneLo.size() >= params.maxZones)
+                throw std::invalid_argument("--scheme irregular: the screen BSP passes " +
+                                            std::to_string(params.maxZones) +
+                                            " zones; stop the 2D step earlier with --max-objects "
+                                            "or try another --bsp-heuristic");
+            slot = ~int32_t(bsp.zoneLo.size());
+            bsp.zoneLo.push_back(cell.lo);
+            bsp.zoneHi.push_back(cell.hi);
+            bsp.zonePrims.insert(bsp.zonePrims.end(), cell.prims.begin(), cell.prims.end());
+            bsp.zoneFirst.push_back(uint32_t(bsp.zonePrims.size()));
+            continue;
+        }
+        Split sp = chooseSplit(cell.segs, params.heuristic);
+        int32_t node = int32_t(bsp.nodes.size());
+        slot = node;
+        bsp.nodes.push_back({sp.axis, sp.c, {0, 0}});
+
+        // Children: segments on the line are used up, segments across it are cut in two.
+        Cell below{cell.lo, cell.hi, {}, {}, node, 0, cell.depth + 1};
+        Cell above{cell.lo, cell.hi, {}, {}, node, 1, cell.depth + 1};
+        below.hi[sp.axis] = sp.c;
+        above.lo[sp.axis] = sp.c;
+        for (const Segment& s : cell.segs) {
+            if (s.axis == sp.axis) {
+                if (s.c < sp.c)
+                    below.segs.push_back(s);
+                else if (s.c > sp.c)
+                    above.segs.push_back(s);
+            } else if (s.hi <= sp.c) {
+                below.segs.push_back(s);
+            } else if (s.lo >= sp.c) {
+                above.segs.push_back(s);
+            } else {
+                ++bsp.cuts;
+                below.segs.push_back({s.c, s.lo, sp.c, s.axis});
+                above.segs.push_back({s.c, sp.c, s.hi, s.axis});
+            }
+        }
+        for (uint32_t p : cell.prims) {
+            if (overlapsOpen(rect[p], below.lo, below.hi)) below.prims.push_back(p);
+            if (overlapsOpen(rect[p], above.lo, above.hi)) above.prims.push_back(p);
+        }
+        cell = Cell{};  // free the parent's lists before descending
+        if (below.segs.size() < above.segs.size()) std::swap(below, above);
+        stack.push_back(std::move(below));  // the larger one waits
+        stack.push_back(std::move(above));
+    }
+    return bsp;
+}
+
+uint32_t ScreenBsp::locate(double x, double y, int sx, int sy) const {
+    int32_t n = root;
+    while (n >= 0) {
+        const Node& node = nodes[n];
+        double q = node.axis == 0 ? x : y;
+        int s = node.axis == 0 ? sx : sy;
+        n = node.child[q > node.value || (q == node.value && s > 0)];
+    }
+    return uint32_t(~n);
+}
+
+size_t ScreenBsp::memoryBytes() const {
+    return nodes.size() * sizeof(Node) + zoneLo.size() * 2 * sizeof(glm::dvec2) +
+           zoneFirst.size() * sizeof(uint32_t) + zonePrims.size() * sizeof(uint32_t);
+}
+
+}  // namespace lancer

@@ -1,0 +1,49 @@
+// The irregular scheme's 2D step: a Fuchs BSP of the screen plane, fed with the edges of the
+// primitives' rectangles (their camera-frame boxes projected along depth). Every edge is
+// horizontal or vertical, so every splitting line is too and every zone is an axis-aligned
+// rectangle inside the structure's screen rectangle.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "engine/geometry/geometry.h"
+
+namespace lancer {
+
+enum class BspHeuristic : uint8_t;  // accelerator.h
+
+struct ScreenBspParams {
+    BspHeuristic heuristic{};  ///< the choice of splitting line
+    int stopObjects = 0;  ///< a cell overlapping at most this many rectangles is a zone (0: never)
+    size_t maxZones = 0;  ///< refuse (throw std::invalid_argument) beyond this many zones
+};
+
+/// The screen BSP and its leaves, the zones, each with the primitives whose rectangle it touches.
+struct ScreenBsp {
+    struct Node {
+        uint8_t axis;  ///< 0: the line x = value, 1: the line y = value
+        double value;
+        int32_t child[2];  ///< [0] below the line, [1] above; >= 0 a node, < 0 the zone ~child
+    };
+    std::vector<Node> nodes;
+    int32_t root = ~0;  ///< a node, or ~zone when the BSP is a single zone
+    std::vector<glm::dvec2> zoneLo, zoneHi;
+    std::vector<uint32_t> zoneFirst;  ///< zone z holds zonePrims[zoneFirst[z] .. zoneFirst[z + 1])
+    std::vector<uint32_t> zonePrims;
+    size_t segments = 0;  ///< rectangle edges fed to the BSP
+    size_t cuts = 0;      ///< segments cut in two by a splitting line
+    int depth = 0;        ///< deepest node
+
+    size_t zoneCount() const { return zoneLo.size(); }
+    /// The zone holding the point (x, y), or for a point on a line, the zone on the side given by
+    /// (sx, sy) (+1 above the line, -1 below, 0 either).
+    uint32_t locate(double x, double y, int sx, int sy) const;
+    size_t memoryBytes() const;
+
+    /// Build over the rectangles rect[p].xy of the primitives `prims`, inside [lo, hi].
+    static ScreenBsp build(const std::vector<Box3>& rect, const std::vector<uint32_t>& prims,
+                           glm::dvec2 lo, glm::dvec2 hi, const ScreenBspParams& params);
+};
+
+}  // namespace lancer

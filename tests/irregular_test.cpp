@@ -1,0 +1,404 @@
+// The irregular subdivision (report, section 2): same hits as brute force for every kind of ray,
+// walks by corner pointers that reach the region holding any point, pointers that land where
+// they should, and refused parameters.
+#include "engine/accel/irregular/irregular.h"
+#include "engine/accel/irregular/tree_restrictor.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+
+#include "engine/scene/loader.h"
+#include "tests/support/differential.h"
+
+namespace lancer {
+namespace {
+
+const IrregularSubdivision& irregularOf(const Accelerator& a) {
+    return std::get<IrregularSubdivision>(a.impl());
+}
+
+std::unique_ptr<Accelerator> buildIrregular(const Scene& scene,
+                                            BspHeuristic h = BspHeuristic::Balanced,
+                                            int maxObjects = 0) {
+    BuildParams p;
+    p.scheme = SchemeKind::Irregular;
+    p.heuristic = h;
+    p.maxObjects = maxObjects;
+    return buildAccelerator(scene, p);
+}
+
+void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
+                const std::string& what, double tmin = 0.0) {
+    auto bad = test::compareWithBrute(scene, accel, rays, tmin);
+    EXPECT_TRUE(bad.empty()) << what << ": " << bad.size() << " mismatches, first:\n"
+                             << (bad.empty() ? "" : bad[0].toString(scene));
+}
+
+/// An orthographic camera on the same eye and axes, framing the scene's bounds.
+void makeOrthographic(Scene& scene) {
+    CameraFrame f = CameraFrame::of(scene.camera);
+    Box3 b = f.box(scene.bounds);
+    scene.camera.projection = Projection::Orthographic;
+    scene.camera.orthoHeight = 1.1 * std::max(b.extent().x, b.extent().y);
+    // The orthographic eye plane must stand in front of the scene for primary rays to see it all.
+    scene.camera.from = f.toWorld({0.5 * (b.lo.x + b.hi.x), 0.5 * (b.lo.y + b.hi.y), b.lo.z - 1.0});
+    scene.camera.at = scene.camera.from + f.z;
+}
+
+/// World points at the corners, edge midpoints and face centres of some regions.
+std::vector<Vec3> regionPoints(const IrregularSubdivision& s, size_t maxRegions, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::vector<Vec3> pts;
+    const auto& regions = s.regions();
+    for (size_t k = 0; k < maxRegions && !regions.empty(); ++k) {
+        const Box3& b = regions[rng() % regions.size()].box;
+        for (int i = 0; i < 27; i += 2) {  // corners, edge midpoints, face centres, centre
+            Vec3 c;
+            for (int a = 0, j = i; a < 3; ++a, j /= 3)
+                c[a] = j % 3 == 0 ? b.lo[a] : (j % 3 == 1 ? 0.5 * (b.lo[a] + b.hi[a]) : b.hi[a]);
+            pts.push_back(s.frame().toWorld(c));
+        }
+    }
+    return pts;
+}
+
+/// Rays along the camera frame's axes through the given world points, both ways.
+std::vector<Ray> cameraAxisRays(const IrregularSubdivision& s, const std::vector<Vec3>& pts,
+                                double reach) {
+    std::vector<Ray> rays;
+    const Vec3 axes[3] = {s.frame().x, s.frame().y, s.frame().z};
+    for (size_t i = 0; i < pts.size(); ++i) {
+        const Vec3& d = axes[i % 3];
+        double sgn = (i / 3) % 2 ? 1.0 : -1.0;
+        rays.push_back({pts[i] - sgn * reach * d, sgn * d});
+        rays.push_back({pts[i], sgn * d});  // starting on a region boundary
+    }
+    return rays;
+}
+
+/// Secondary rays from the brute-force hits of `primary`: mirror and random directions.
+std::vector<Ray> secondaryRays(const Scene& scene, const std::vector<Ray>& primary, uint64_t seed) {
+    BuildParams bp;
+    auto brute = buildAccelerator(scene, bp);
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    NullObserver obs;
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> n;
+    std::vector<Ray> rays;
+    for (const Ray& r : primary) {
+        Hit h;
+        ctx.beginRay();
+        if (!brute->intersect(r, 0.0, kInf, ctx, obs, h)) continue;
+        Vec3 p = r.at(h.t);
+        rays.push_back({p, glm::normalize(Vec3(n(rng), n(rng), n(rng)))});
+        if (!scene.lights.empty())
+            rays.push_back({p, glm::normalize(scene.lights[0].position - p)});
+    }
+    return rays;
+}
+
+/// A random camera: outside or inside the scene, perspective or orthographic.
+void randomCamera(Scene& scene, std::mt19937_64& rng) {
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Vec3 c = scene.bounds.center(), e = scene.bounds.extent();
+    double far = (rng() % 3) ? 2.0 : 0.3;  // a third of the cameras stand inside the bounds
+    scene.camera.from = c + far * e * Vec3(u(rng), u(rng), u(rng));
+    scene.camera.at = c + 0.2 * e * Vec3(u(rng), u(rng), u(rng));
+    scene.camera.up = glm::normalize(Vec3(u(rng), u(rng), u(rng)));
+    scene.camera.projection = rng() % 2 ? Projection::Orthographic : Projection::Perspective;
+    scene.camera.orthoHeight = glm::length(e);
+}
+
+// Every pixel of every SPD scene, perspective and orthographic, against brute force.
+TEST(Irregular, SpdScenesPixelForPixel) {
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(LANCER_SPD_DIR))
+        if (e.path().extension() == ".nff") files.push_back(e.path());
+    ASSERT_GE(files.size(), 10u);
+    std::sort(files.begin(), files.end());
+    for (const auto& path : files) {
+        Scene scene = loadScene(path.string());
+        int n = path.filename() == "balls4.nff" ? 24 : 40;
+        for (int ortho = 0; ortho < 2; ++ortho) {
+            if (ortho) makeOrthographic(scene);
+            auto accel = buildIrregular(scene);
+            std::string what =
+                path.filename().string() + (ortho ? " orthographic" : " perspective");
+            std::vector<Ray> rays = test::pixelRays(scene, n, n);
+            expectSame(scene, *accel, rays, what);
+            std::vector<Ray> sec = secondaryRays(scene, rays, 7);
+            expectSame(scene, *accel, sec, what + " secondary", 1e-9 * scene.scale());
+        }
+    }
+}
+
+TEST(Irregular, BuiltinCsgScenesPixelForPixel) {
+    for (const char* spec : {"builtin:default", "builtin:drilled:4", "builtin:lattice:4"}) {
+        Scene scene = loadScene(spec);
+        for (int ortho = 0; ortho < 2; ++ortho) {
+            if (ortho) makeOrthographic(scene);
+            for (BspHeuristic h :
+                 {BspHeuristic::First, BspHeuristic::Balanced, BspHeuristic::FewestCuts}) {
+                auto accel = buildIrregular(scene, h);
+                std::string what = std::string(spec) +
+                                   (ortho ? " orthographic " : " perspective ") + heuristicName(h);
+                std::vector<Ray> rays = test::pixelRays(scene, 48, 48);
+                expectSame(scene, *accel, rays, what);
+                expectSame(scene, *accel, secondaryRays(scene, rays, 3), what + " secondary",
+                           1e-9 * scene.scale());
+            }
+        }
+    }
+}
+
+// 20 random scenes x (3000 random + region-corner + camera-axis rays): over 10^5 rays.
+TEST(Irregular, RandomScenesAndHardRays) {
+    size_t total = 0;
+    for (uint64_t seed = 1; seed <= 20; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.transforms = seed % 2 == 0;
+        opt.surfaces = seed % 3 == 0;
+        opt.primitives = 8 + int(seed % 4) * 6;
+        if (seed % 5 == 0) opt.offset = Vec3(1e6, -1e6, 5e5);
+        Scene scene = test::randomCsgScene(seed, opt);
+        if (scene.bounds.isEmpty()) continue;
+        std::mt19937_64 rng(seed * 977);
+        randomCamera(scene, rng);
+        BspHeuristic h = BspHeuristic(seed % 3);
+        auto accel = buildIrregular(scene, h, seed % 4 == 0 ? 2 : 0);
+        const IrregularSubdivision& irr = irregularOf(*accel);
+        std::string what = "seed " + std::to_string(seed) + " " + heuristicName(h);
+
+        std::vector<Ray> rays = test::randomRays(scene, seed, 3000);
+        std::vector<Vec3> pts = regionPoints(irr, 60, seed);
+        std::vector<Ray> corner = test::raysThroughPoints(pts, scene.bounds, seed);
+        rays.insert(rays.end(), corner.begin(), corner.end());
+        std::vector<Ray> axis = cameraAxisRays(irr, pts, 2.0 * glm::length(scene.bounds.extent()));
+        rays.insert(rays.end(), axis.begin(), axis.end());
+        std::vector<Ray> pix = test::pixelRays(scene, 16, 16);
+        rays.insert(rays.end(), pix.begin(), pix.end());
+        expectSame(scene, *accel, rays, what);
+        // Secondary rays that start on region boundaries, with a tmin as the tracer uses.
+        std::vector<Ray> onBoundary;
+        for (size_t i = 0; i < corner.size(); i += 4) onBoundary.push_back(corner[i + 1]);
+        expectSame(scene, *accel, onBoundary, what + " tmin", 1e-9 * scene.scale());
+        total += rays.size() + onBoundary.size();
+
+        TraceContext ctx(scene.prims.size(), scene.tree.depth());
+        NullObserver obs;
+        for (const Ray& r : rays) {
+            Hit hit;
+            ctx.beginRay();
+            accel->intersect(r, 0.0, kInf, ctx, obs, hit);
+        }
+        EXPECT_EQ(ctx.counters.walkErrors, 0u) << what;
+    }
+    EXPECT_GE(total, 100000u);
+}
+
+// For random points: the region reached by pointers from a random region is the one a search
+// over all regions finds; every pointer lands on a region touching its corner.
+TEST(Irregular, WalkReachesTheRegionHoldingAPoint) {
+    std::vector<Scene> scenes;
+    for (uint64_t seed = 31; seed <= 36; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.primitives = 16;
+        opt.surfaces = seed % 2 == 0;
+        scenes.push_back(test::randomCsgScene(seed, opt));
+        if (scenes.back().bounds.isEmpty()) {
+            scenes.pop_back();
+            continue;
+        }
+        std::mt19937_64 rng(seed);
+        randomCamera(scenes.back(), rng);
+    }
+    scenes.push_back(loadScene(std::string(LANCER_SPD_DIR) + "/gears1.nff"));
+    std::mt19937_64 rng(5);
+    for (const Scene& scene : scenes) {
+        auto accel = buildIrregular(scene);
+        const IrregularSubdivision& s = irregularOf(*accel);
+        const auto& R = s.regions();
+        ASSERT_FALSE(R.empty());
+        std::vector<Vec3> pts;
+        std::uniform_real_distribution<double> u(0.0, 1.0);
+        const Box3& B = s.bounds();
+        for (int i = 0; i < 300; ++i)
+            pts.push_back(B.lo + Vec3(u(rng), u(rng), u(rng)) * B.extent());
+        // Corners, edge midpoints and face centres of regions, exactly (camera coordinates).
+        for (int i = 0; i < 200; ++i) {
+            const Box3& b = R[rng() % R.size()].box;
+            Vec3 c;
+            for (int a = 0; a < 3; ++a) {
+                int k = int(rng() % 3);
+                c[a] = k == 0 ? b.lo[a] : (k == 1 ? b.hi[a] : 0.5 * (b.lo[a] + b.hi[a]));
+            }
+            pts.push_back(c);
+        }
+        for (Vec3 p : pts) {
+            p = glm::clamp(p, B.lo, B.hi);  // corners mapped to the world and back may round out
+            uint32_t from = uint32_t(rng() % R.size());
+            Vec3 d = p - R[from].box.center();
+            int64_t got = s.walkTo(from, p);
+            ASSERT_GE(got, 0) << "walk error from region " << from << " to " << toString(p);
+            std::vector<uint32_t> holding;
+            for (uint32_t r = 0; r < R.size(); ++r)
+                if (s.holds(r, p, d)) holding.push_back(r);
+            ASSERT_FALSE(holding.empty()) << toString(p);
+            if (holding.size() == 1)
+                EXPECT_EQ(uint32_t(got), holding[0])
+                    << "point " << toString(p) << " from " << from << " dir " << toString(d)
+                    << "\n  got " << R[got].box.toString() << "\n  want "
+                    << R[holding[0]].box.toString() << "\n  bounds " << B.toString();
+            else
+                EXPECT_TRUE(s.holds(uint32_t(got), p, d)) << toString(p);
+        }
+        // Pointers: hi[a] holds the point just beyond the high corner across face a, just inside
+        // on the other axes; lo[a] likewise at the low corner.
+        for (uint32_t r = 0; r < R.size(); ++r) {
+            for (int a = 0; a < 3; ++a) {
+                for (int high = 0; high < 2; ++high) {
+                    int32_t n = high ? R[r].hi[a] : R[r].lo[a];
+                    Vec3 c = high ? R[r].box.hi : R[r].box.lo;
+                    bool border = high ? c[a] == B.hi[a] : c[a] == B.lo[a];
+                    if (border) {
+                        EXPECT_EQ(n, -1);
+                        continue;
+                    }
+                    ASSERT_GE(n, 0) << "region " << r << " axis " << a;
+                    const Box3& nb = R[n].box;
+                    EXPECT_TRUE(nb.contains(c))
+                        << "pointer " << r << " -> " << n << " misses its corner";
+                    EXPECT_EQ(high ? nb.lo[a] : nb.hi[a], c[a]) << "not across the face";
+                    for (int b = 0; b < 3; ++b) {
+                        if (b == a) continue;
+                        if (high)
+                            EXPECT_LT(nb.lo[b], c[b]);  // holds the point just below the corner
+                        else
+                            EXPECT_GT(nb.hi[b], c[b]);
+                    }
+                }
+            }
+        }
+    }
+}
+
+// Zones tile the structure's screen rectangle; slabs tile each zone's depth; every primitive
+// touching a region is listed in it.
+TEST(Irregular, RegionsTileTheBoundsAndListTheirPrimitives) {
+    Scene scene = loadScene("builtin:drilled:4");
+    auto accel = buildIrregular(scene);
+    const IrregularSubdivision& s = irregularOf(*accel);
+    const Box3& B = s.bounds();
+    double volume = 0.0;
+    for (uint32_t r = 0; r < s.regions().size(); ++r) {
+        const Box3& b = s.regions()[r].box;
+        Vec3 e = b.extent();
+        EXPECT_GT(e.x, 0.0);
+        EXPECT_GT(e.y, 0.0);
+        EXPECT_GT(e.z, 0.0);
+        volume += e.x * e.y * e.z;
+        auto prims = s.primitives(r);
+        for (uint32_t p : scene.livePrimitives()) {
+            Box3 pb = s.frame().box(scene.minBox[p]);
+            bool listed = std::find(prims.begin(), prims.end(), p) != prims.end();
+            // Strictly overlapping boxes must be listed (touching ones may be, by the padding).
+            bool strict = pb.lo.x < b.hi.x && b.lo.x < pb.hi.x && pb.lo.y < b.hi.y &&
+                          b.lo.y < pb.hi.y && pb.lo.z < b.hi.z && b.lo.z < pb.hi.z;
+            if (strict) EXPECT_TRUE(listed) << "p" << p << " missing from region " << r;
+        }
+    }
+    Vec3 e = B.extent();
+    EXPECT_NEAR(volume, e.x * e.y * e.z, 1e-9 * e.x * e.y * e.z);
+    const nlohmann::json& x = accel->info().extra;
+    EXPECT_GT(x["zones"].get<size_t>(), 1u);
+    EXPECT_EQ(x["zones"].get<size_t>(), s.screen().zoneCount());
+    EXPECT_EQ(accel->info().regions, s.regions().size());
+    EXPECT_TRUE(accel->usesMailboxes());
+}
+
+// The walk reported to the observer: regions in ray order with contiguous intervals, the
+// corner pointers followed between them, mailbox hits for primitives shared by regions.
+TEST(Irregular, ObserverSeesRegionsPointersAndMailboxes) {
+    Scene scene = loadScene("builtin:lattice:4");
+    auto accel = buildIrregular(scene);
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    ctx.useMailboxes = accel->usesMailboxes();
+    uint64_t pointers = 0, mailbox = 0;
+    for (const Ray& ray : test::pixelRays(scene, 12, 12)) {
+        RecordingObserver obs;
+        Hit hit;
+        ctx.beginRay();
+        uint64_t before = ctx.counters.pointerSteps;
+        accel->intersect(ray, 0.0, kInf, ctx, obs, hit);
+        double last = -kInf;
+        int regions = 0;
+        uint64_t seen = 0;
+        for (const WalkEvent& e : obs.events) {
+            if (e.kind == WalkEvent::Region) {
+                if (regions > 0) {
+                    EXPECT_EQ(e.t0, last) << "intervals not contiguous";
+                }
+                EXPECT_LE(e.t0, e.t1);
+                last = e.t1;
+                ++regions;
+            } else if (e.kind == WalkEvent::Pointer) {
+                ++seen;
+                EXPECT_GE(e.corner, 0);
+            } else if (e.kind == WalkEvent::MailboxHit) {
+                ++mailbox;
+            }
+        }
+        EXPECT_EQ(seen, ctx.counters.pointerSteps - before);
+        pointers += seen;
+    }
+    EXPECT_GT(pointers, 0u);
+    EXPECT_GT(mailbox, 0u);
+    EXPECT_EQ(ctx.counters.walkErrors, 0u);
+}
+
+// The sparse restriction used for thousands of slabs builds the same tree as restrictTree.
+TEST(Irregular, SparseRestrictionEqualsRestrictTree) {
+    std::mt19937_64 rng(17);
+    for (uint64_t seed = 50; seed < 70; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.primitives = 20;
+        opt.surfaces = seed % 2 == 0;
+        Scene scene = test::randomCsgScene(seed, opt);
+        TreeRestrictor restrictor(scene.tree);
+        for (int k = 0; k < 20; ++k) {
+            std::vector<char> keep(scene.prims.size(), 0);
+            std::vector<uint32_t> prims;
+            for (uint32_t p = 0; p < scene.prims.size(); ++p)
+                if (rng() % 3 == 0) {
+                    keep[p] = 1;
+                    prims.push_back(p);
+                }
+            CsgTree a, b;
+            a.root = restrictTree(scene.tree, scene.tree.root, keep, a);
+            b.root = restrictor.restrict(prims, b);
+            EXPECT_EQ(a.toString(), b.toString()) << "seed " << seed;
+            EXPECT_EQ(a.nodes.size(), b.nodes.size());
+        }
+    }
+}
+
+TEST(Irregular, RefusesBadParameters) {
+    Scene scene = loadScene("builtin:default");
+    BuildParams p;
+    p.scheme = SchemeKind::Irregular;
+    p.maxObjects = -1;
+    try {
+        buildAccelerator(scene, p);
+        ADD_FAILURE() << "negative --max-objects accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("--max-objects"), std::string::npos) << e.what();
+    }
+    p.maxObjects = 0;
+    scene.camera.at = scene.camera.from;  // no viewing direction
+    EXPECT_THROW(buildAccelerator(scene, p), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace lancer
