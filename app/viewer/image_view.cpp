@@ -82,7 +82,9 @@ void ImageView::upload(const Image& img, ViewMode mode) {
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
     glBindTexture(GL_TEXTURE_2D, colorTex_);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, width_, height_, 0, GL_RGB, GL_FLOAT, img.color.data());
+    // 8 bits per channel, quantised as the PNG writer does: the screen shows what `render` saves.
+    std::vector<uint8_t> rgba = img.rgba8();
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
     if (mode != ViewMode::Color) {
         std::vector<float> heat = heatChannel(img, mode);
         glBindTexture(GL_TEXTURE_2D, heatTex_);

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "engine/render/progressive.h"
 #include "engine/scene/loader.h"
 
 namespace lancer::viewer {
@@ -38,7 +39,12 @@ BuildResult buildStructure(const BuildRequest& r) {
     return out;
 }
 
-StructureBuilder::StructureBuilder() { worker_ = std::thread([this] { run(); }); }
+StructureBuilder::StructureBuilder() {
+    worker_ = std::thread([this] {
+        lowerThreadPriority();
+        run();
+    });
+}
 
 StructureBuilder::~StructureBuilder() {
     {

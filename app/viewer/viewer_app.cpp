@@ -546,6 +546,7 @@ void ViewerApp::startSpeedup() {
     std::shared_ptr<const Structure> st = structure_;
     // Both timed on the same pixels, one after the other, on the current view.
     speedupThread_ = std::thread([sp, st, opt] {
+        lowerThreadPriority();
         try {
             PassLattice lattice{sp->stride, 0};
             Image img(opt.width, opt.height);

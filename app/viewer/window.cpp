@@ -6,6 +6,7 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -103,11 +104,22 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
     int status = 0;
     {
         ViewerApp app(settings, v.logTimings);
-        int frames = 0;
+        using Clock = std::chrono::steady_clock;
+        int frames = 0, statFrames = 0;
+        double statWorkMs = 0.0, statSwapMs = 0.0;
+        Clock::time_point frameStart = Clock::now(), statStart = frameStart;
         while (!glfwWindowShouldClose(window)) {
-            // Idle (nothing rendering or building): sleep until an event instead of spinning.
-            if (app.settled() && v.frames == 0) glfwWaitEventsTimeout(0.25);
-            else glfwPollEvents();
+            // At most 60 frames per second, waiting for events in between (no swap interval
+            // is guaranteed, e.g. under Xvfb); idle (nothing rendering or building): sleep
+            // until an event.
+            if (app.settled() && v.frames == 0) {
+                glfwWaitEventsTimeout(0.25);
+            } else {
+                double left = 1.0 / 60.0 - std::chrono::duration<double>(Clock::now() - frameStart).count();
+                if (left > 0.0) glfwWaitEventsTimeout(left);
+                else glfwPollEvents();
+            }
+            frameStart = Clock::now();
             if (!dropped.empty()) {
                 app.openScene(dropped.back());
                 dropped.clear();
@@ -135,7 +147,20 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 }
                 break;
             }
+            auto beforeSwap = Clock::now();
             glfwSwapBuffers(window);
+            statSwapMs += std::chrono::duration<double, std::milli>(Clock::now() - beforeSwap).count();
+            // The UI thread's own cost per frame (the render runs on other threads).
+            statWorkMs += std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
+            ++statFrames;
+            if (v.logTimings && Clock::now() - statStart > std::chrono::seconds(2)) {
+                double secs = std::chrono::duration<double>(Clock::now() - statStart).count();
+                std::cerr << "timing: ui " << statFrames / secs << " fps, " << statWorkMs / statFrames
+                          << " ms of work per frame (" << statSwapMs / statFrames << " ms in the swap)\n";
+                statFrames = 0;
+                statWorkMs = statSwapMs = 0.0;
+                statStart = Clock::now();
+            }
         }
     }
     ImGui_ImplOpenGL3_Shutdown();

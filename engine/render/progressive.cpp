@@ -1,6 +1,17 @@
 #include "engine/render/progressive.h"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 namespace lancer {
+
+void lowerThreadPriority() {
+#ifdef __linux__
+    // On Linux the nice value is per thread: this leaves the caller's other threads alone.
+    setpriority(PRIO_PROCESS, id_t(syscall(SYS_gettid)), 5);
+#endif
+}
 
 void fillBlocks(const Image& src, int stride, Image& dst) {
     if (dst.width != src.width || dst.height != src.height) dst.resize(src.width, src.height);
@@ -20,7 +31,10 @@ void fillBlocks(const Image& src, int stride, Image& dst) {
 
 ProgressiveRenderer::ProgressiveRenderer(std::vector<int> strides) : strides_(std::move(strides)) {
     if (strides_.empty() || strides_.back() != 1) strides_.push_back(1);
-    worker_ = std::thread([this] { run(); });
+    worker_ = std::thread([this] {
+        lowerThreadPriority();
+        run();
+    });
 }
 
 ProgressiveRenderer::~ProgressiveRenderer() {
@@ -51,10 +65,11 @@ void ProgressiveRenderer::cancel() {
     cancel_ = true;
 }
 
-bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out) const {
+bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, int* stride) const {
     std::lock_guard lock(mutex_);
     if (version == displayVersion_) return false;
     out = display_;
+    if (stride) *stride = displayStride_;
     version = displayVersion_;
     return true;
 }
@@ -121,6 +136,7 @@ void ProgressiveRenderer::run() {
             }
             std::swap(display_, shown);
             ++displayVersion_;
+            displayStride_ = stride;
             PassRecord rec;
             rec.stride = stride;
             rec.renderMs = rs.renderMs;

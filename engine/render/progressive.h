@@ -30,6 +30,10 @@ struct PassRecord {
     RayCounters counters;
 };
 
+/// Lower the calling thread's scheduling priority (nice 5 on Linux), so an interactive thread
+/// stays responsive beside it; threads it starts (oneTBB's workers, on first use) inherit it.
+void lowerThreadPriority();
+
 /// Copy `src` into `dst`, each pixel taking the values of the pixel at the corner of its
 /// stride x stride block: how a pass that rendered only that lattice is shown.
 void fillBlocks(const Image& src, int stride, Image& dst);
@@ -52,8 +56,8 @@ public:
     void cancel();
 
     /// If a pass finished since `version`, copy the displayable image into `out`, update
-    /// `version` and return true.
-    bool snapshot(uint64_t& version, Image& out) const;
+    /// `version` and return true; `stride` (if given) receives the stride of that pass.
+    bool snapshot(uint64_t& version, Image& out, int* stride = nullptr) const;
     /// Passes of the current job finished so far.
     std::vector<PassRecord> passes() const;
     /// The current job has rendered every pass.
@@ -79,6 +83,7 @@ private:
     std::atomic<size_t> progressTotal_{0};
     Image display_;
     uint64_t displayVersion_ = 0;
+    int displayStride_ = 0;
     std::vector<PassRecord> passes_;
     std::thread worker_;
 };
