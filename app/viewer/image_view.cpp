@@ -59,18 +59,22 @@ ImageView::ImageView() {
     locColor_ = glGetUniformLocation(program_, "colorTex");
     locHeat_ = glGetUniformLocation(program_, "heatTex");
     glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even an empty one
-    GLuint tex[2];
-    glGenTextures(2, tex);
+    GLuint tex[3];
+    glGenTextures(3, tex);
     colorTex_ = tex[0];
     heatTex_ = tex[1];
+    shadedTex_ = tex[2];
     setupTexture(colorTex_);
     setupTexture(heatTex_);
+    setupTexture(shadedTex_);
     glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, &fbo_);
 }
 
 ImageView::~ImageView() {
-    GLuint tex[2] = {colorTex_, heatTex_};
-    glDeleteTextures(2, tex);
+    GLuint tex[3] = {colorTex_, heatTex_, shadedTex_};
+    glDeleteTextures(3, tex);
+    glDeleteFramebuffers(1, &fbo_);
     glDeleteVertexArrays(1, &vao_);
     glDeleteProgram(program_);
 }
@@ -90,12 +94,30 @@ void ImageView::upload(const Image& img, ViewMode mode) {
         glBindTexture(GL_TEXTURE_2D, heatTex_);
         glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, width_, height_, 0, GL_RED, GL_FLOAT, heat.data());
     }
+    glBindTexture(GL_TEXTURE_2D, shadedTex_);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
     glBindTexture(GL_TEXTURE_2D, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, shadedTex_, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    shadedValid_ = false;
 }
 
 void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) const {
     if (width_ == 0) return;
+    scale = scale > 0.0f ? scale : 1.0f;
+    if (!shadedValid_ || mode != shadedMode_ || (mode != ViewMode::Color && scale != shadedScale_)) shade(mode, scale);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glDisable(GL_SCISSOR_TEST);
+    glBlitFramebuffer(0, 0, width_, height_, 0, 0, fbWidth, fbHeight, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
+}
+
+void ImageView::shade(ViewMode mode, float scale) const {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glViewport(0, 0, width_, height_);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_SCISSOR_TEST);
@@ -108,7 +130,7 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) cons
     glUniform1i(locColor_, 0);
     glUniform1i(locHeat_, 1);
     glUniform1i(locMode_, mode == ViewMode::Color ? 0 : 1);
-    glUniform1f(locScale_, scale > 0.0f ? scale : 1.0f);
+    glUniform1f(locScale_, scale);
     const auto& stops = colormapStops();
     glUniform3fv(locStops_, GLsizei(stops.size()), &stops[0].x);
     glUniform1i(locStopCount_, GLint(stops.size()));
@@ -120,6 +142,10 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) cons
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, 0);
     glUseProgram(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    shadedValid_ = true;
+    shadedMode_ = mode;
+    shadedScale_ = scale;
 }
 
 std::vector<uint8_t> readFramebuffer(int width, int height) {
