@@ -92,9 +92,12 @@ void StructureBuilder::run() {
         }
         BuildResult result = buildStructure(r);
         result.request = id;
-        std::lock_guard lock(mutex_);
-        running_ = false;
-        if (id == requested_) ready_ = std::move(result);  // a newer request supersedes this one
+        {
+            std::lock_guard lock(mutex_);
+            running_ = false;
+            if (id == requested_) ready_ = std::move(result);  // a newer request supersedes this one
+        }
+        if (onReady_) onReady_();
     }
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <condition_variable>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -49,6 +50,8 @@ public:
     std::optional<BuildResult> poll();
     /// A request is queued or running.
     bool busy() const;
+    /// Called on the builder's thread when a result is ready. Set it before the first request.
+    void setOnReady(std::function<void()> f) { onReady_ = std::move(f); }
 
 private:
     void run();
@@ -60,6 +63,7 @@ private:
     uint64_t requested_ = 0;
     bool running_ = false;
     bool quit_ = false;
+    std::function<void()> onReady_;
     std::thread worker_;
 };
 

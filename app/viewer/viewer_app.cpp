@@ -80,8 +80,12 @@ bool enumCombo(const char* label, E& value, int count, const char* (*name)(E)) {
 
 }  // namespace
 
-ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings)
+ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<void()> wake)
     : s_(settings), logTimings_(logTimings), view_(std::make_unique<ImageView>()) {
+    if (wake) {
+        renderer_.setOnPass(wake);
+        builder_.setOnReady(wake);
+    }
     pathInput_ = s_.scene.rfind("builtin:", 0) == 0 ? "" : s_.scene;
     requestBuild(true, "open scene");
 }
@@ -407,7 +411,7 @@ void ViewerApp::parametersPanel() {
 
 void ViewerApp::cameraPanel() {
     ImGui::SetNextWindowPos(ImVec2(8, 468), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(330, 240), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(330, 215), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Camera", &s_.showCamera)) {
         ImGui::End();
         return;
@@ -461,7 +465,7 @@ void ViewerApp::cameraPanel() {
 void ViewerApp::statisticsPanel() {
     ImGuiIO& io = ImGui::GetIO();
     ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 348, 28), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(340, 330), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(340, 265), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Statistics", &s_.showStatistics)) {
         ImGui::End();
         return;
@@ -569,8 +573,8 @@ void ViewerApp::startSpeedup() {
 
 void ViewerApp::viewPanel() {
     ImGuiIO& io = ImGui::GetIO();
-    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 348, 366), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(340, 250), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 348, 301), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(340, 175), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("View", &s_.showView)) {
         ImGui::End();
         return;

@@ -22,7 +22,8 @@ public:
     /// Needs a current OpenGL 3.3 core context and an ImGui context whose OpenGL3 renderer
     /// backend is initialised. Starts loading `settings.scene` at once. `settings` is the
     /// object the ini handler reads and writes; it must outlive the app.
-    ViewerApp(ViewerSettings& settings, bool logTimings);
+    /// `wake` (optional) is called from worker threads when there is something new to show.
+    ViewerApp(ViewerSettings& settings, bool logTimings, std::function<void()> wake = {});
     ~ViewerApp();
 
     /// One frame: ImGui::NewFrame (the platform backend, if any, has set io.DisplaySize and the

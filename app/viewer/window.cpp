@@ -7,6 +7,7 @@
 #include <imgui_impl_opengl3.h>
 
 #include <chrono>
+#include <thread>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -103,22 +104,20 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
 
     int status = 0;
     {
-        ViewerApp app(settings, v.logTimings);
+        // Worker threads wake the loop when a pass or a structure is ready (thread-safe in GLFW).
+        ViewerApp app(settings, v.logTimings, [] { glfwPostEmptyEvent(); });
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
         double statWorkMs = 0.0, statSwapMs = 0.0;
         Clock::time_point frameStart = Clock::now(), statStart = frameStart;
         while (!glfwWindowShouldClose(window)) {
-            // At most 60 frames per second, waiting for events in between (no swap interval
-            // is guaranteed, e.g. under Xvfb); idle (nothing rendering or building): sleep
-            // until an event.
-            if (app.settled() && v.frames == 0) {
-                glfwWaitEventsTimeout(0.25);
-            } else {
-                double left = 1.0 / 60.0 - std::chrono::duration<double>(Clock::now() - frameStart).count();
-                if (left > 0.0) glfwWaitEventsTimeout(left);
-                else glfwPollEvents();
-            }
+            // At most 60 frames per second (no swap interval is guaranteed, e.g. under Xvfb).
+            // Interactive: draw on input, on a new pass or structure (the workers post an empty
+            // event), and at 10 Hz for the progress bar while working; idle otherwise.
+            double left = 1.0 / 60.0 - std::chrono::duration<double>(Clock::now() - frameStart).count();
+            if (left > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(left));
+            if (v.frames > 0) glfwPollEvents();
+            else glfwWaitEventsTimeout(app.settled() ? 1.0 : 0.1);
             frameStart = Clock::now();
             if (!dropped.empty()) {
                 app.openScene(dropped.back());

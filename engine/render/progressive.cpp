@@ -129,7 +129,7 @@ void ProgressiveRenderer::run() {
                 break;
             }
             fillBlocks(work, stride, shown);
-            std::lock_guard lock(mutex_);
+            std::unique_lock lock(mutex_);
             if (cancel_) {  // a newer job arrived while the pass finished: do not show this one
                 complete = false;
                 break;
@@ -144,6 +144,8 @@ void ProgressiveRenderer::run() {
             rec.counters = rs.counters;
             passes_.push_back(rec);
             previous = stride;
+            lock.unlock();
+            if (onPass_) onPass_();
         }
         std::lock_guard lock(mutex_);
         if (complete && !pending_) finished_ = true;

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -54,6 +55,9 @@ public:
     void start(ProgressiveJob job, Clock::time_point requested = Clock::now());
     /// Cancel the job in flight without starting another.
     void cancel();
+    /// Called on the worker thread after each pass becomes available (e.g. to wake a UI loop
+    /// waiting for events). Set it before the first start().
+    void setOnPass(std::function<void()> f) { onPass_ = std::move(f); }
 
     /// If a pass finished since `version`, copy the displayable image into `out`, update
     /// `version` and return true; `stride` (if given) receives the stride of that pass.
@@ -85,6 +89,7 @@ private:
     uint64_t displayVersion_ = 0;
     int displayStride_ = 0;
     std::vector<PassRecord> passes_;
+    std::function<void()> onPass_;
     std::thread worker_;
 };
 
