@@ -30,6 +30,8 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 1000000));
     view->add_option("--screenshot", vopt.screenshot, "With --frames: save the window as a PNG before exiting");
     view->add_flag("--log-timings", vopt.logTimings, "Print the latency of each pass after a change to stderr");
+    view->add_flag("--replay-change", vopt.replayChange,
+                   "After the first complete image, rebuild the structure once, as a parameter change does (to time it)");
     view->add_option("--ini", vopt.ini, "Settings file (default: ~/.config/lancer/imgui.ini; \"none\": none)");
 #endif
 

@@ -2,7 +2,7 @@
 // The rendered image, or one of its per-pixel counters through the heat colour map.
 in vec2 uv;
 out vec4 fragColor;
-uniform sampler2D colorTex;  // linear RGB as the tracer wrote it
+uniform sampler2D colorTex;  // the image as 8-bit RGBA, as the PNG writer quantises it
 uniform sampler2D heatTex;   // one counter per pixel
 uniform int mode;            // 0: colour, 1: heat map
 uniform float scale;         // counter value shown at the top of the colour map

@@ -1,11 +1,12 @@
 // The progressive renderer: its passes add up to the full render, coarse passes show as blocks,
 // and a new job cancels the one in flight.
+#include "engine/render/progressive.h"
+
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <thread>
 
-#include "engine/render/progressive.h"
 #include "engine/scene/loader.h"
 
 namespace lancer {
@@ -14,7 +15,8 @@ namespace {
 bool waitFor(const std::function<bool()>& done, double seconds = 30.0) {
     auto start = std::chrono::steady_clock::now();
     while (!done()) {
-        if (std::chrono::steady_clock::now() - start > std::chrono::duration<double>(seconds)) return false;
+        if (std::chrono::steady_clock::now() - start > std::chrono::duration<double>(seconds))
+            return false;
         std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     return true;
@@ -45,7 +47,8 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
             for (int y = 0; y < opt.height; ++y)
                 for (int x = 0; x < opt.width; ++x) {
                     size_t s = direct.index(x - x % stride, y - y % stride), d = shown.index(x, y);
-                    ASSERT_EQ(shown.color[d], direct.color[s]) << x << "," << y << " stride " << stride;
+                    ASSERT_EQ(shown.color[d], direct.color[s])
+                        << x << "," << y << " stride " << stride;
                     ASSERT_EQ(shown.primTests[d], direct.primTests[s]);
                 }
         }
@@ -58,7 +61,8 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
     ASSERT_EQ(passes.size(), 4u);
     uint64_t primary = 0;
     for (const PassRecord& p : passes) primary += p.counters.primaryRays;
-    EXPECT_EQ(primary, uint64_t(opt.width) * uint64_t(opt.height)) << "each pixel is traced once over the passes";
+    EXPECT_EQ(primary, uint64_t(opt.width) * uint64_t(opt.height))
+        << "each pixel is traced once over the passes";
     EXPECT_EQ(shown.color, direct.color);
 }
 
@@ -79,7 +83,8 @@ TEST(Progressive, ANewJobCancelsTheOneInFlight) {
     Image shown;
     uint64_t version = 0;
     ASSERT_TRUE(waitFor([&] { return pr.finished(); }, 20.0)) << "the big job was not cancelled";
-    double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     EXPECT_LT(ms, 10000.0);
     ASSERT_TRUE(pr.snapshot(version, shown));
     EXPECT_EQ(shown.width, 24);

@@ -36,10 +36,10 @@ void orbit(Camera& c, double yaw, double pitch) {
 void pan(Camera& c, double dx, double dy, int viewportHeight) {
     Vec3 f, r, u;
     c.basis(f, r, u);
-    double unitsPerPixel =
-        c.projection == Projection::Orthographic
-            ? c.orthoHeight / viewportHeight
-            : 2.0 * glm::length(c.at - c.from) * std::tan(glm::radians(c.fov) * 0.5) / viewportHeight;
+    double unitsPerPixel = c.projection == Projection::Orthographic
+                               ? c.orthoHeight / viewportHeight
+                               : 2.0 * glm::length(c.at - c.from) *
+                                     std::tan(glm::radians(c.fov) * 0.5) / viewportHeight;
     Vec3 move = (-dx * r + dy * u) * unitsPerPixel;
     c.from += move;
     c.at += move;
@@ -72,7 +72,8 @@ Camera cameraFromJson(const std::string& text, const Camera& base) {
     SourceText src("camera JSON", text);
     LocatedJson doc(src);
     JsonAt root{doc, doc.root(), ""};
-    if (!root.value.is_object()) root.fail("expected a JSON object with \"from\", \"at\", \"up\", \"fov\"");
+    if (!root.value.is_object())
+        root.fail("expected a JSON object with \"from\", \"at\", \"up\", \"fov\"");
     // The sidecar's reader; lights, background and size land in a scratch scene, ignored here.
     // As in a sidecar, a camera without "projection" is a perspective one.
     Scene holder;

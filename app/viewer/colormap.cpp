@@ -7,20 +7,24 @@ namespace lancer::viewer {
 
 const char* viewModeName(ViewMode m) {
     switch (m) {
-        case ViewMode::Color: return "colour";
-        case ViewMode::PrimTests: return "primitive tests";
-        case ViewMode::RegionVisits: return "region visits";
-        case ViewMode::TimeUs: return "time (us)";
+        case ViewMode::Color:
+            return "colour";
+        case ViewMode::PrimTests:
+            return "primitive tests";
+        case ViewMode::RegionVisits:
+            return "region visits";
+        case ViewMode::TimeUs:
+            return "time (us)";
     }
     return "?";
 }
 
 const std::array<glm::vec3, 8>& colormapStops() {
     static const std::array<glm::vec3, 8> stops = {
-        glm::vec3(0, 0, 4) / 255.0f,       glm::vec3(40, 11, 84) / 255.0f,
-        glm::vec3(101, 21, 110) / 255.0f,  glm::vec3(159, 42, 99) / 255.0f,
-        glm::vec3(212, 72, 66) / 255.0f,   glm::vec3(245, 125, 21) / 255.0f,
-        glm::vec3(250, 193, 39) / 255.0f,  glm::vec3(252, 255, 164) / 255.0f};
+        glm::vec3(0, 0, 4) / 255.0f,      glm::vec3(40, 11, 84) / 255.0f,
+        glm::vec3(101, 21, 110) / 255.0f, glm::vec3(159, 42, 99) / 255.0f,
+        glm::vec3(212, 72, 66) / 255.0f,  glm::vec3(245, 125, 21) / 255.0f,
+        glm::vec3(250, 193, 39) / 255.0f, glm::vec3(252, 255, 164) / 255.0f};
     return stops;
 }
 
@@ -35,10 +39,17 @@ glm::vec3 colormap(float v) {
 std::vector<float> heatChannel(const Image& img, ViewMode mode) {
     std::vector<float> out;
     switch (mode) {
-        case ViewMode::Color: break;
-        case ViewMode::PrimTests: out.assign(img.primTests.begin(), img.primTests.end()); break;
-        case ViewMode::RegionVisits: out.assign(img.regionVisits.begin(), img.regionVisits.end()); break;
-        case ViewMode::TimeUs: out = img.timeUs; break;
+        case ViewMode::Color:
+            break;
+        case ViewMode::PrimTests:
+            out.assign(img.primTests.begin(), img.primTests.end());
+            break;
+        case ViewMode::RegionVisits:
+            out.assign(img.regionVisits.begin(), img.regionVisits.end());
+            break;
+        case ViewMode::TimeUs:
+            out = img.timeUs;
+            break;
     }
     return out;
 }

@@ -3,9 +3,8 @@
 
 #include <array>
 #include <cstdint>
-#include <vector>
-
 #include <glm/vec3.hpp>
+#include <vector>
 
 #include "engine/render/image.h"
 

@@ -88,14 +88,16 @@ void ImageView::upload(const Image& img, ViewMode mode) {
     glBindTexture(GL_TEXTURE_2D, colorTex_);
     // 8 bits per channel, quantised as the PNG writer does: the screen shows what `render` saves.
     std::vector<uint8_t> rgba = img.rgba8();
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                 rgba.data());
     if (mode != ViewMode::Color) {
         std::vector<float> heat = heatChannel(img, mode);
         glBindTexture(GL_TEXTURE_2D, heatTex_);
         glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, width_, height_, 0, GL_RED, GL_FLOAT, heat.data());
     }
     glBindTexture(GL_TEXTURE_2D, shadedTex_);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                 nullptr);
     glBindTexture(GL_TEXTURE_2D, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, shadedTex_, 0);
@@ -106,11 +108,13 @@ void ImageView::upload(const Image& img, ViewMode mode) {
 void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) const {
     if (width_ == 0) return;
     scale = scale > 0.0f ? scale : 1.0f;
-    if (!shadedValid_ || mode != shadedMode_ || (mode != ViewMode::Color && scale != shadedScale_)) shade(mode, scale);
+    if (!shadedValid_ || mode != shadedMode_ || (mode != ViewMode::Color && scale != shadedScale_))
+        shade(mode, scale);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
-    glBlitFramebuffer(0, 0, width_, height_, 0, 0, fbWidth, fbHeight, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBlitFramebuffer(0, 0, width_, height_, 0, 0, fbWidth, fbHeight, GL_COLOR_BUFFER_BIT,
+                      GL_NEAREST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
 }
@@ -154,7 +158,8 @@ std::vector<uint8_t> readFramebuffer(int width, int height) {
     glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
     const size_t stride = size_t(width) * 4;
     for (int y = 0; y < height; ++y)  // GL's row 0 is the bottom one
-        std::copy_n(rows.data() + size_t(height - 1 - y) * stride, stride, out.data() + size_t(y) * stride);
+        std::copy_n(rows.data() + size_t(height - 1 - y) * stride, stride,
+                    out.data() + size_t(y) * stride);
     for (size_t i = 3; i < out.size(); i += 4) out[i] = 255;  // the window is opaque
     return out;
 }

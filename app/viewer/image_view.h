@@ -8,7 +8,7 @@
 namespace lancer::viewer {
 
 class ImageView {
-public:
+  public:
     /// Needs a current OpenGL 3.3 core context. Throws std::runtime_error if a shader fails.
     ImageView();
     ~ImageView();
@@ -26,7 +26,7 @@ public:
     int width() const { return width_; }
     int height() const { return height_; }
 
-private:
+  private:
     void shade(ViewMode mode, float scale) const;
 
     unsigned program_ = 0, vao_ = 0, colorTex_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
@@ -34,7 +34,8 @@ private:
     mutable ViewMode shadedMode_ = ViewMode::Color;
     mutable float shadedScale_ = 0.0f;
     int width_ = 0, height_ = 0;
-    int locMode_ = -1, locScale_ = -1, locStops_ = -1, locStopCount_ = -1, locColor_ = -1, locHeat_ = -1;
+    int locMode_ = -1, locScale_ = -1, locStops_ = -1, locStopCount_ = -1, locColor_ = -1,
+        locHeat_ = -1;
 };
 
 /// Read the current framebuffer's pixels as RGBA8, row 0 on top (as PNG files want).

@@ -21,9 +21,12 @@ BuildResult buildStructure(const BuildRequest& r) {
             out.sceneFailed = true;
             return out;
         }
-        s->loadMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        s->loadMs =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
     }
-    if (r.camera) {  // the structure is built for this view; the scene's own camera stays the home view
+    if (r.camera) {  // the structure is built for this view; the scene's own camera stays the home
+                     // view
         auto viewed = std::make_shared<Scene>(*scene);
         viewed->camera = *r.camera;
         scene = viewed;
@@ -95,7 +98,8 @@ void StructureBuilder::run() {
         {
             std::lock_guard lock(mutex_);
             running_ = false;
-            if (id == requested_) ready_ = std::move(result);  // a newer request supersedes this one
+            if (id == requested_)
+                ready_ = std::move(result);  // a newer request supersedes this one
         }
         if (onReady_) onReady_();
     }

@@ -17,28 +17,29 @@ namespace lancer::viewer {
 /// A scene and a structure built over it; the structure refers to the scene, so they travel
 /// together (members are destroyed in reverse order: the structure first).
 struct Structure {
-    std::string spec;                          ///< the SCENE argument it was loaded from
+    std::string spec;  ///< the SCENE argument it was loaded from
     std::shared_ptr<const Scene> scene;
     std::shared_ptr<const Accelerator> accel;
-    double loadMs = 0.0;                       ///< reading and preparing the scene
+    double loadMs = 0.0;  ///< reading and preparing the scene
 };
 
 struct BuildRequest {
     std::string spec;
-    std::shared_ptr<const Scene> loaded;  ///< the scene of `spec` when already loaded; else it is read
+    std::shared_ptr<const Scene>
+        loaded;  ///< the scene of `spec` when already loaded; else it is read
     BuildParams params;
-    std::optional<Camera> camera;         ///< the view the structure is built for (irregular scheme)
+    std::optional<Camera> camera;  ///< the view the structure is built for (irregular scheme)
 };
 
 struct BuildResult {
     std::shared_ptr<const Structure> structure;  ///< null on failure
     std::string error;                           ///< why it failed
-    bool sceneFailed = false;                    ///< the scene could not be loaded (else: the build)
+    bool sceneFailed = false;  ///< the scene could not be loaded (else: the build)
     uint64_t request = 0;
 };
 
 class StructureBuilder {
-public:
+  public:
     StructureBuilder();
     ~StructureBuilder();  ///< waits for a build in progress (builds cannot be interrupted)
     StructureBuilder(const StructureBuilder&) = delete;
@@ -53,7 +54,7 @@ public:
     /// Called on the builder's thread when a result is ready. Set it before the first request.
     void setOnReady(std::function<void()> f) { onReady_ = std::move(f); }
 
-private:
+  private:
     void run();
 
     mutable std::mutex mutex_;

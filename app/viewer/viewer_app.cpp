@@ -1,8 +1,8 @@
 #include "app/viewer/viewer_app.h"
 
 #include <imgui.h>
-#include <imgui_internal.h>  // MarkIniSettingsDirty
 #include <imgui_impl_opengl3.h>
+#include <imgui_internal.h>  // MarkIniSettingsDirty
 #include <imgui_stdlib.h>
 
 #include <algorithm>
@@ -32,9 +32,12 @@ double msSince(ViewerApp::Clock::time_point t) {
 
 std::string humanBytes(size_t b) {
     char buf[64];
-    if (b < 10 * 1024) std::snprintf(buf, sizeof buf, "%zu B", b);
-    else if (b < 10 * 1024 * 1024) std::snprintf(buf, sizeof buf, "%.1f KiB", double(b) / 1024.0);
-    else std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / (1024.0 * 1024.0));
+    if (b < 10 * 1024)
+        std::snprintf(buf, sizeof buf, "%zu B", b);
+    else if (b < 10 * 1024 * 1024)
+        std::snprintf(buf, sizeof buf, "%.1f KiB", double(b) / 1024.0);
+    else
+        std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / (1024.0 * 1024.0));
     return buf;
 }
 
@@ -109,6 +112,11 @@ void ViewerApp::openScene(const std::string& spec) {
 void ViewerApp::setViewMode(ViewMode mode) {
     s_.mode = mode;
     view_->upload(shown_, s_.mode);
+    updateAutoScale();
+}
+
+void ViewerApp::updateAutoScale() {
+    if (s_.mode != ViewMode::Color) autoScale_ = autoScale(heatChannel(shown_, s_.mode));
 }
 
 void ViewerApp::setHeatScale(float scale) {
@@ -166,8 +174,8 @@ void ViewerApp::pollBackground() {
         if (r->structure) {
             const bool newScene = !structure_ || structure_->spec != r->structure->spec;
             logTiming(buildWhy_ + ": structure ready " + std::to_string(msSince(buildChangeAt_)) +
-                      " ms after the change (load " + std::to_string(r->structure->loadMs) + " ms, build " +
-                      std::to_string(r->structure->accel->info().buildMs) + " ms)");
+                      " ms after the change (load " + std::to_string(r->structure->loadMs) +
+                      " ms, build " + std::to_string(r->structure->accel->info().buildMs) + " ms)");
             structure_ = r->structure;
             if (newScene) {
                 home_ = structure_->scene->camera;
@@ -185,8 +193,10 @@ void ViewerApp::pollBackground() {
             std::cerr << "lancer view: " << error_ << "\n";
             if (structure_) {
                 // Keep what is on screen, and the settings that describe it.
-                if (r->sceneFailed) s_.scene = structure_->spec;
-                else s_.build = structure_->accel->params();
+                if (r->sceneFailed)
+                    s_.scene = structure_->spec;
+                else
+                    s_.build = structure_->accel->params();
             } else if (!r->sceneFailed && s_.build.scheme != SchemeKind::Brute) {
                 // Nothing on screen yet: show the scene with the reference scheme meanwhile.
                 s_.build.scheme = SchemeKind::Brute;
@@ -242,6 +252,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     pollBackground();
     if (renderer_.snapshot(shownVersion_, shown_)) {
         view_->upload(shown_, s_.mode);
+        updateAutoScale();
         std::vector<PassRecord> passes = renderer_.passes();
         for (; passesLogged_ < passes.size(); ++passesLogged_) {
             const PassRecord& p = passes[passesLogged_];
@@ -251,10 +262,10 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
                       std::to_string(shown_.height) + ")");
         }
         if (!passes.empty() && passes.back().stride == 1)
-            logTiming(changeWhy_ + ": full image " + std::to_string(msSince(changeAt_)) + " ms after the change");
+            logTiming(changeWhy_ + ": full image " + std::to_string(msSince(changeAt_)) +
+                      " ms after the change");
     }
-    if (s_.mode != ViewMode::Color)
-        scale_ = s_.autoScale ? autoScale(heatChannel(shown_, s_.mode)) : s_.heatScale;
+    if (s_.mode != ViewMode::Color) scale_ = s_.autoScale ? autoScale_ : s_.heatScale;
 
     ImGui_ImplOpenGL3_NewFrame();
     ImGui::NewFrame();
@@ -264,12 +275,13 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     if (fbWidth > 0 && fbHeight > 0 && (fbWidth != jobWidth_ || fbHeight != jobHeight_)) {
         jobWidth_ = fbWidth;
         jobHeight_ = fbHeight;
-        markRender("window size");
+        if (!renderDirty_) markRender("window size");  // else keep the pending change's time
     }
     // The irregular scheme's regions live in the camera frame: rebuild once the drag ends.
     if (cameraMovedForBuild_ && !ImGui::IsAnyMouseDown()) {
         cameraMovedForBuild_ = false;
-        if (s_.build.scheme == SchemeKind::Irregular) requestBuild(false, "camera (irregular frame)");
+        if (s_.build.scheme == SchemeKind::Irregular)
+            requestBuild(false, "camera (irregular frame)");
     }
     if (renderDirty_ && structure_) restartRender(renderWhy_.c_str());
     ImGui::Render();
@@ -289,8 +301,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         pendingScreenshot_.clear();
     }
 
-    settled_ = !builder_.busy() && !renderDirty_ &&
-               (!structure_ || (finishedBefore && renderer_.finished()));
+    settled_ = !builder_.busy() &&
+               (!structure_ || (!renderDirty_ && finishedBefore && renderer_.finished()));
 }
 
 void ViewerApp::saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const {
@@ -308,7 +320,8 @@ void ViewerApp::panels() {
         }
         ImGui::TextDisabled("%s", s_.scene.c_str());
         if (builder_.busy()) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "building...");
-        if (!error_.empty()) ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "error (see Parameters)");
+        if (!error_.empty())
+            ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "error (see Parameters)");
         ImGui::EndMainMenuBar();
     }
     if (s_.showParameters) parametersPanel();
@@ -340,7 +353,8 @@ void ViewerApp::parametersPanel() {
     }
     if (info && info->maxSize > info->minSize) {
         if (builtinSize_ < 0) builtinSize_ = bsize >= 0 ? bsize : info->defaultSize;
-        ImGui::SliderInt("size", &builtinSize_, info->minSize, std::min(info->maxSize, info->minSize + 64));
+        ImGui::SliderInt("size", &builtinSize_, info->minSize,
+                         std::min(info->maxSize, info->minSize + 64));
         if (ImGui::IsItemDeactivatedAfterEdit())
             openScene("builtin:" + std::string(info->name) + ":" + std::to_string(builtinSize_));
     }
@@ -370,7 +384,8 @@ void ViewerApp::parametersPanel() {
     rebuild |= enumCombo("step", s_.build.step, 2, stepName);
     if (s_.build.step == StepMethod::Push) {
         double d = s_.build.delta;
-        if (ImGui::InputDouble("delta", &d, 0.0, 0.0, "%.3e", ImGuiInputTextFlags_EnterReturnsTrue) &&
+        if (ImGui::InputDouble("delta", &d, 0.0, 0.0, "%.3e",
+                               ImGuiInputTextFlags_EnterReturnsTrue) &&
             d >= 1e-15 && d <= 0.5) {
             s_.build.delta = d;
             rebuild = true;
@@ -380,17 +395,20 @@ void ViewerApp::parametersPanel() {
     rebuild |= ImGui::Checkbox("mailboxes", &s_.build.mailboxes);
     if (structure_) {
         const AccelInfo& ai = structure_->accel->info();
-        ImGui::Text("on screen: %s, built in %.1f ms", schemeName(structure_->accel->params().scheme), ai.buildMs);
+        ImGui::Text("on screen: %s, built in %.1f ms",
+                    schemeName(structure_->accel->params().scheme), ai.buildMs);
         ImGui::Text("regions %zu, memory %s", ai.regions, humanBytes(ai.memoryBytes).c_str());
         ImGui::Text("%zu primitives (%d dropped by minimization)", structure_->scene->prims.size(),
                     structure_->scene->droppedPrims);
     }
-    if (builder_.busy()) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "building in the background...");
+    if (builder_.busy())
+        ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "building in the background...");
 
     ImGui::Separator();
     ImGui::TextUnformatted("Rendering");
     int maxThreads = effectiveThreads(0);
-    rerender |= ImGui::SliderInt("threads", &s_.threads, 0, std::max(maxThreads, 1), s_.threads ? "%d" : "all");
+    rerender |= ImGui::SliderInt("threads", &s_.threads, 0, std::max(maxThreads, 1),
+                                 s_.threads ? "%d" : "all");
     rerender |= ImGui::Checkbox("shadows", &s_.shading.shadows);
     ImGui::SameLine();
     rerender |= ImGui::Checkbox("reflection", &s_.shading.reflections);
@@ -430,10 +448,11 @@ void ViewerApp::cameraPanel() {
         double lo = 1.0, hi = 170.0;
         changed |= ImGui::SliderScalar("fov", ImGuiDataType_Double, &c.fov, &lo, &hi, "%.1f deg");
     } else {
-        changed |= ImGui::InputDouble("height", &c.orthoHeight, 0.0, 0.0, "%.4g") && c.orthoHeight > 0.0;
+        changed |=
+            ImGui::InputDouble("height", &c.orthoHeight, 0.0, 0.0, "%.4g") && c.orthoHeight > 0.0;
     }
-    changed |= ImGui::InputScalarN("from", ImGuiDataType_Double, &c.from.x, 3, nullptr, nullptr, "%.4g",
-                                   ImGuiInputTextFlags_EnterReturnsTrue);
+    changed |= ImGui::InputScalarN("from", ImGuiDataType_Double, &c.from.x, 3, nullptr, nullptr,
+                                   "%.4g", ImGuiInputTextFlags_EnterReturnsTrue);
     changed |= ImGui::InputScalarN("at", ImGuiDataType_Double, &c.at.x, 3, nullptr, nullptr, "%.4g",
                                    ImGuiInputTextFlags_EnterReturnsTrue);
     if (changed && c.validate().empty()) setCamera(c);
@@ -457,7 +476,9 @@ void ViewerApp::cameraPanel() {
         ImGui::PopStyleColor();
     }
     ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
-    ImGui::TextWrapped("Left drag: orbit. Middle drag: pan. Right drag or wheel: zoom. R: reset. O: perspective/orthographic.");
+    ImGui::TextWrapped(
+        "Left drag: orbit. Middle drag: pan. Right drag or wheel: zoom. R: reset. O: "
+        "perspective/orthographic.");
     ImGui::PopStyleColor();
     ImGui::End();
 }
@@ -470,11 +491,13 @@ void ViewerApp::statisticsPanel() {
         ImGui::End();
         return;
     }
-    ImGui::Text("%d x %d, %d threads, %.0f fps", jobWidth_, jobHeight_, effectiveThreads(s_.threads), io.Framerate);
+    ImGui::Text("%d x %d, %d threads, %.0f fps", jobWidth_, jobHeight_,
+                effectiveThreads(s_.threads), io.Framerate);
     std::vector<PassRecord> passes = renderer_.passes();
     RayCounters total;
     double renderMs = 0.0;
-    if (ImGui::BeginTable("passes", 4, ImGuiTableFlags_Borders | ImGuiTableFlags_SizingStretchProp)) {
+    if (ImGui::BeginTable("passes", 4,
+                          ImGuiTableFlags_Borders | ImGuiTableFlags_SizingStretchProp)) {
         ImGui::TableSetupColumn("pass");
         ImGui::TableSetupColumn("render ms");
         ImGui::TableSetupColumn("since change");
@@ -498,7 +521,8 @@ void ViewerApp::statisticsPanel() {
     if (!renderer_.finished()) {
         size_t done = 0, count = 0;
         renderer_.progress(done, count);
-        ImGui::ProgressBar(count ? float(done) / float(count) : 0.0f, ImVec2(-1, 0), "rendering next pass");
+        ImGui::ProgressBar(count ? float(done) / float(count) : 0.0f, ImVec2(-1, 0),
+                           "rendering next pass");
     }
     if (total.rays) {
         const double rays = double(total.rays);
@@ -508,9 +532,11 @@ void ViewerApp::statisticsPanel() {
         ImGui::Text("prim tests / ray    %.2f", double(total.primTests) / rays);
         ImGui::Text("region visits / ray %.2f", double(total.regionVisits) / rays);
         const double asked = double(total.primTests + total.mailboxHits);
-        ImGui::Text("mailbox hit rate    %.1f %%", asked > 0 ? 100.0 * double(total.mailboxHits) / asked : 0.0);
+        ImGui::Text("mailbox hit rate    %.1f %%",
+                    asked > 0 ? 100.0 * double(total.mailboxHits) / asked : 0.0);
         if (total.walkErrors)
-            ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "walk errors %llu", (unsigned long long)total.walkErrors);
+            ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "walk errors %llu",
+                               (unsigned long long)total.walkErrors);
     }
 
     ImGui::Separator();
@@ -526,11 +552,13 @@ void ViewerApp::statisticsPanel() {
         startSpeedup();
     }
     if (speedup_ && speedup_->done) {
-        if (!speedup_->error.empty()) ImGui::TextWrapped("%s", speedup_->error.c_str());
+        if (!speedup_->error.empty())
+            ImGui::TextWrapped("%s", speedup_->error.c_str());
         else
-            ImGui::TextWrapped("%s %.1f ms, brute %.1f ms on %zu pixels: speedup x%.2f", speedup_->scheme.c_str(),
-                               speedup_->schemeMs, speedup_->bruteMs, speedup_->pixels,
-                               speedup_->schemeMs > 0 ? speedup_->bruteMs / speedup_->schemeMs : 0.0);
+            ImGui::TextWrapped(
+                "%s %.1f ms, brute %.1f ms on %zu pixels: speedup x%.2f", speedup_->scheme.c_str(),
+                speedup_->schemeMs, speedup_->bruteMs, speedup_->pixels,
+                speedup_->schemeMs > 0 ? speedup_->bruteMs / speedup_->schemeMs : 0.0);
     }
     ImGui::End();
 }
@@ -582,47 +610,58 @@ void ViewerApp::viewPanel() {
     int mode = int(s_.mode);
     for (int i = 0; i < kViewModeCount; ++i) {
         if (i) ImGui::SameLine();
-        ImGui::RadioButton(i == 0 ? "colour" : i == 1 ? "prim tests" : i == 2 ? "regions" : "time", &mode, i);
+        ImGui::RadioButton(i == 0   ? "colour"
+                           : i == 1 ? "prim tests"
+                           : i == 2 ? "regions"
+                                    : "time",
+                           &mode, i);
     }
     if (mode != int(s_.mode)) {
         setViewMode(ViewMode(mode));
         ImGui::MarkIniSettingsDirty();
-        if (s_.mode != ViewMode::Color && s_.autoScale) scale_ = autoScale(heatChannel(shown_, s_.mode));
+        if (s_.mode != ViewMode::Color && s_.autoScale) scale_ = autoScale_;
     }
     if (s_.mode != ViewMode::Color) {
         if (ImGui::Checkbox("auto scale", &s_.autoScale)) ImGui::MarkIniSettingsDirty();
         ImGui::SameLine();
         if (s_.autoScale) s_.heatScale = scale_;
-        if (ImGui::SliderFloat("##scale", &s_.heatScale, 1.0f, 1e6f, "%.0f", ImGuiSliderFlags_Logarithmic)) {
+        if (ImGui::SliderFloat("##scale", &s_.heatScale, 1.0f, 1e6f, "%.0f",
+                               ImGuiSliderFlags_Logarithmic)) {
             s_.autoScale = false;
             ImGui::MarkIniSettingsDirty();
         }
-        // The colour bar: the stops of the shader's map, value 0 on the left, the scale on the right.
+        // The colour bar: the stops of the shader's map, value 0 on the left, the scale on the
+        // right.
         ImVec2 p = ImGui::GetCursorScreenPos();
         const float w = ImGui::GetContentRegionAvail().x, h = 16.0f;
         const auto& stops = colormapStops();
         ImDrawList* dl = ImGui::GetWindowDrawList();
         const int segs = int(stops.size()) - 1;
         for (int i = 0; i < segs; ++i) {
-            auto col = [](const glm::vec3& c) { return ImGui::ColorConvertFloat4ToU32(ImVec4(c.x, c.y, c.z, 1.0f)); };
+            auto col = [](const glm::vec3& c) {
+                return ImGui::ColorConvertFloat4ToU32(ImVec4(c.x, c.y, c.z, 1.0f));
+            };
             float x0 = p.x + w * float(i) / float(segs), x1 = p.x + w * float(i + 1) / float(segs);
             dl->AddRectFilledMultiColor(ImVec2(x0, p.y), ImVec2(x1, p.y + h), col(stops[size_t(i)]),
-                                        col(stops[size_t(i) + 1]), col(stops[size_t(i) + 1]), col(stops[size_t(i)]));
+                                        col(stops[size_t(i) + 1]), col(stops[size_t(i) + 1]),
+                                        col(stops[size_t(i)]));
         }
         ImGui::Dummy(ImVec2(w, h));
         ImGui::Text("0");
         char right[32];
-        std::snprintf(right, sizeof right, "%.6g %s", double(scale_), s_.mode == ViewMode::TimeUs ? "us" : "");
+        std::snprintf(right, sizeof right, "%.6g %s", double(scale_),
+                      s_.mode == ViewMode::TimeUs ? "us" : "");
         ImGui::SameLine(std::max(0.0f, w - ImGui::CalcTextSize(right).x));
         ImGui::TextUnformatted(right);
     }
     // The pixel under the cursor, from the same per-pixel counters as --stats.
     if (!io.WantCaptureMouse && shown_.width > 0) {
-        int x = int(io.MousePos.x * io.DisplayFramebufferScale.x), y = int(io.MousePos.y * io.DisplayFramebufferScale.y);
+        int x = int(io.MousePos.x * io.DisplayFramebufferScale.x),
+            y = int(io.MousePos.y * io.DisplayFramebufferScale.y);
         if (x >= 0 && y >= 0 && x < shown_.width && y < shown_.height) {
             size_t i = shown_.index(x, y);
-            ImGui::Text("pixel %d %d: %u prim tests, %u regions, %.1f us", x, y, shown_.primTests[i],
-                        shown_.regionVisits[i], double(shown_.timeUs[i]));
+            ImGui::Text("pixel %d %d: %u prim tests, %u regions, %.1f us", x, y,
+                        shown_.primTests[i], shown_.regionVisits[i], double(shown_.timeUs[i]));
         }
     }
     ImGui::Separator();

@@ -16,7 +16,7 @@
 namespace lancer::viewer {
 
 class ViewerApp {
-public:
+  public:
     using Clock = std::chrono::steady_clock;
 
     /// Needs a current OpenGL 3.3 core context and an ImGui context whose OpenGL3 renderer
@@ -33,6 +33,8 @@ public:
     /// Open a scene (file dropped on the window, or typed): loaded in the background; on failure
     /// the error shows in the panel and the previous scene stays.
     void openScene(const std::string& spec);
+    /// Rebuild the structure with the current parameters, as a parameter change does.
+    void rebuild(const char* why) { requestBuild(false, why); }
     /// Everything asked for is built and the last frame drew the complete image.
     bool settled() const { return settled_; }
     /// Write the framebuffer as drawn by the last frame() to a PNG. Throws std::runtime_error.
@@ -51,7 +53,7 @@ public:
     /// The heat scale in use this frame.
     float heatScale() const { return scale_; }
 
-private:
+  private:
     void pollBackground();
     void handleInput(int fbWidth, int fbHeight);
     void handleKeys();
@@ -65,6 +67,7 @@ private:
     void markRender(const char* why);
     void startSpeedup();
     void logTiming(const std::string& line) const;
+    void updateAutoScale();
 
     ViewerSettings& s_;
     bool logTimings_;
@@ -73,7 +76,7 @@ private:
     ProgressiveRenderer renderer_;
     std::shared_ptr<const Structure> structure_;
     Camera camera_, home_;
-    bool cameraSet_ = false;           ///< camera_ chosen (else it follows the next scene)
+    bool cameraSet_ = false;  ///< camera_ chosen (else it follows the next scene)
     std::string error_;
     Image shown_;
     uint64_t shownVersion_ = 0;
@@ -81,6 +84,7 @@ private:
     bool renderDirty_ = false, buildDirty_ = false, cameraMovedForBuild_ = false;
     std::string renderWhy_;
     float scale_ = 1.0f;
+    float autoScale_ = 1.0f;  ///< largest value of the shown counter
     bool settled_ = false;
 
     // Latency of the last change: when it happened, what it was, what was logged.

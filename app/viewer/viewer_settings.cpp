@@ -65,21 +65,33 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
         int v;
         if (in >> v) out = v != 0;
     };
-    if (key == "scene" && !value.empty()) s.scene = value;
-    else if (key == "scheme") parseEnum(value, SchemeKind(3), schemeName, s.build.scheme);
-    else if (key == "max_level") integer(s.build.maxLevel, 0, 48);
-    else if (key == "max_objects") integer(s.build.maxObjects, 1, 1000000);
-    else if (key == "step") parseEnum(value, StepMethod(2), stepName, s.build.step);
+    if (key == "scene" && !value.empty())
+        s.scene = value;
+    else if (key == "scheme")
+        parseEnum(value, SchemeKind(3), schemeName, s.build.scheme);
+    else if (key == "max_level")
+        integer(s.build.maxLevel, 0, 48);
+    else if (key == "max_objects")
+        integer(s.build.maxObjects, 1, 1000000);
+    else if (key == "step")
+        parseEnum(value, StepMethod(2), stepName, s.build.step);
     else if (key == "delta") {
         double d;
         if (in >> d && d >= 1e-15 && d <= 0.5) s.build.delta = d;
-    } else if (key == "bsp_heuristic") parseEnum(value, BspHeuristic(3), heuristicName, s.build.heuristic);
-    else if (key == "mailboxes") flag(s.build.mailboxes);
-    else if (key == "threads") integer(s.threads, 0, 1024);
-    else if (key == "bounces") integer(s.shading.bounces, 0, 64);
-    else if (key == "shadows") flag(s.shading.shadows);
-    else if (key == "reflections") flag(s.shading.reflections);
-    else if (key == "refractions") flag(s.shading.refractions);
+    } else if (key == "bsp_heuristic")
+        parseEnum(value, BspHeuristic(3), heuristicName, s.build.heuristic);
+    else if (key == "mailboxes")
+        flag(s.build.mailboxes);
+    else if (key == "threads")
+        integer(s.threads, 0, 1024);
+    else if (key == "bounces")
+        integer(s.shading.bounces, 0, 64);
+    else if (key == "shadows")
+        flag(s.shading.shadows);
+    else if (key == "reflections")
+        flag(s.shading.reflections);
+    else if (key == "refractions")
+        flag(s.shading.refractions);
     else if (key == "window") {
         int w, h;
         if (in >> w >> h && w >= 64 && h >= 64 && w <= 16384 && h <= 16384) {
@@ -97,7 +109,8 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
     } else if (key == "view") {
         for (int i = 0; i < kViewModeCount; ++i)
             if (value == viewModeKey(ViewMode(i))) s.mode = ViewMode(i);
-    } else if (key == "auto_scale") flag(s.autoScale);
+    } else if (key == "auto_scale")
+        flag(s.autoScale);
     else if (key == "heat_scale") {
         float v;
         if (in >> v && v > 0.0f && v < 1e12f) s.heatScale = v;

@@ -10,15 +10,15 @@
 namespace lancer::viewer {
 
 struct ViewerSettings {
-    std::string scene = "builtin:default";   ///< last scene opened
+    std::string scene = "builtin:default";  ///< last scene opened
     BuildParams build;
     ShadingOptions shading;
-    int threads = 0;                         ///< render threads (0: all cores)
+    int threads = 0;  ///< render threads (0: all cores)
     int windowWidth = 1280, windowHeight = 720;
     bool showParameters = true, showStatistics = true, showCamera = true, showView = true;
     ViewMode mode = ViewMode::Color;
-    bool autoScale = true;                   ///< heat scale follows the image's largest value
-    float heatScale = 100.0f;                ///< counter value at the top of the colour map
+    bool autoScale = true;     ///< heat scale follows the image's largest value
+    float heatScale = 100.0f;  ///< counter value at the top of the colour map
 };
 
 /// Register the [Lancer][Settings] ini handler of the current ImGui context, reading into and

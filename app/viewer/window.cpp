@@ -2,15 +2,15 @@
 
 #include <GLFW/glfw3.h>
 #include <imgui.h>
-#include <imgui_internal.h>  // MarkIniSettingsDirty
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
+#include <imgui_internal.h>  // MarkIniSettingsDirty
 
 #include <chrono>
-#include <thread>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <thread>
 #include <vector>
 
 #include "app/viewer/viewer_app.h"
@@ -22,17 +22,20 @@ namespace {
 std::string defaultIniPath() {
     namespace fs = std::filesystem;
     fs::path dir;
-    if (const char* x = std::getenv("XDG_CONFIG_HOME"); x && *x) dir = fs::path(x) / "lancer";
-    else if (const char* h = std::getenv("HOME"); h && *h) dir = fs::path(h) / ".config" / "lancer";
-    else return "lancer-imgui.ini";
+    if (const char* x = std::getenv("XDG_CONFIG_HOME"); x && *x)
+        dir = fs::path(x) / "lancer";
+    else if (const char* h = std::getenv("HOME"); h && *h)
+        dir = fs::path(h) / ".config" / "lancer";
+    else
+        return "lancer-imgui.ini";
     std::error_code ec;
     fs::create_directories(dir, ec);
     return (dir / "imgui.ini").string();
 }
 
 /// Settings explicitly given on the command line win over those saved in the ini.
-void applyCommandLine(const cli::CommonOptions& o, const std::function<bool(const std::string&)>& given,
-                      ViewerSettings& s) {
+void applyCommandLine(const cli::CommonOptions& o,
+                      const std::function<bool(const std::string&)>& given, ViewerSettings& s) {
     if (given("scene")) s.scene = o.scene;
     if (given("--scheme")) s.build.scheme = o.build.scheme;
     if (given("--max-level")) s.build.maxLevel = o.build.maxLevel;
@@ -59,7 +62,8 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
         why = "no display (DISPLAY is not set)";
         return kNoDisplay;
     }
-    glfwSetErrorCallback([](int code, const char* text) { std::cerr << "glfw: " << text << " (" << code << ")\n"; });
+    glfwSetErrorCallback(
+        [](int code, const char* text) { std::cerr << "glfw: " << text << " (" << code << ")\n"; });
     if (!glfwInit()) {
         why = "no display (GLFW could not initialise)";
         return kNoDisplay;
@@ -84,7 +88,8 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-    GLFWwindow* window = glfwCreateWindow(settings.windowWidth, settings.windowHeight, "lancer", nullptr, nullptr);
+    GLFWwindow* window =
+        glfwCreateWindow(settings.windowWidth, settings.windowHeight, "lancer", nullptr, nullptr);
     if (!window) {
         ImGui::DestroyContext();
         glfwTerminate();
@@ -103,21 +108,25 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
     ImGui_ImplOpenGL3_Init("#version 330 core");
 
     int status = 0;
-    {
+    try {
         // Worker threads wake the loop when a pass or a structure is ready (thread-safe in GLFW).
         ViewerApp app(settings, v.logTimings, [] { glfwPostEmptyEvent(); });
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
+        bool replayed = false;
         double statWorkMs = 0.0, statSwapMs = 0.0;
         Clock::time_point frameStart = Clock::now(), statStart = frameStart;
         while (!glfwWindowShouldClose(window)) {
             // At most 60 frames per second (no swap interval is guaranteed, e.g. under Xvfb).
             // Interactive: draw on input, on a new pass or structure (the workers post an empty
             // event), and at 10 Hz for the progress bar while working; idle otherwise.
-            double left = 1.0 / 60.0 - std::chrono::duration<double>(Clock::now() - frameStart).count();
+            double left =
+                1.0 / 60.0 - std::chrono::duration<double>(Clock::now() - frameStart).count();
             if (left > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(left));
-            if (v.frames > 0) glfwPollEvents();
-            else glfwWaitEventsTimeout(app.settled() ? 1.0 : 0.1);
+            if (v.frames > 0)
+                glfwPollEvents();
+            else
+                glfwWaitEventsTimeout(app.settled() ? 1.0 : 0.1);
             frameStart = Clock::now();
             if (!dropped.empty()) {
                 app.openScene(dropped.back());
@@ -134,11 +143,19 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             ImGui_ImplGlfw_NewFrame();
             app.frame(fbw, fbh);
             ++frames;
-            if (v.frames > 0 && frames >= v.frames && app.settled()) {
+            if (v.replayChange && !replayed && app.settled() && app.structure()) {
+                app.rebuild("replayed parameter change");
+                replayed = true;
+            } else if (v.frames > 0 && frames >= v.frames && app.settled()) {
+                if (!app.structure()) {  // a scripted run on a scene that cannot be shown fails
+                    std::cerr << "error: lancer view: the scene could not be shown (see above)\n";
+                    status = 2;
+                }
                 if (!v.screenshot.empty()) {
                     try {
                         app.saveScreenshot(v.screenshot, fbw, fbh);
-                        std::cout << "lancer view: " << frames << " frames, screenshot " << v.screenshot << "\n";
+                        std::cout << "lancer view: " << frames << " frames, screenshot "
+                                  << v.screenshot << "\n";
                     } catch (const std::exception& e) {
                         std::cerr << "error: --screenshot: " << e.what() << "\n";
                         status = 2;
@@ -148,19 +165,25 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             }
             auto beforeSwap = Clock::now();
             glfwSwapBuffers(window);
-            statSwapMs += std::chrono::duration<double, std::milli>(Clock::now() - beforeSwap).count();
+            statSwapMs +=
+                std::chrono::duration<double, std::milli>(Clock::now() - beforeSwap).count();
             // The UI thread's own cost per frame (the render runs on other threads).
-            statWorkMs += std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
+            statWorkMs +=
+                std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
             ++statFrames;
             if (v.logTimings && Clock::now() - statStart > std::chrono::seconds(2)) {
                 double secs = std::chrono::duration<double>(Clock::now() - statStart).count();
-                std::cerr << "timing: ui " << statFrames / secs << " fps, " << statWorkMs / statFrames
-                          << " ms of work per frame (" << statSwapMs / statFrames << " ms in the swap)\n";
+                std::cerr << "timing: ui " << statFrames / secs << " fps, "
+                          << statWorkMs / statFrames << " ms of work per frame ("
+                          << statSwapMs / statFrames << " ms in the swap)\n";
                 statFrames = 0;
                 statWorkMs = statSwapMs = 0.0;
                 statStart = Clock::now();
             }
         }
+    } catch (const std::exception& e) {  // e.g. a shader the driver refuses
+        std::cerr << "error: the viewer failed: " << e.what() << "\n";
+        status = 2;
     }
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();

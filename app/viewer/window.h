@@ -12,7 +12,9 @@ struct ViewOptions {
     int frames = 0;           ///< > 0: run this many frames, wait for the render, then exit
     std::string screenshot;   ///< with frames: save the window here before exiting
     bool logTimings = false;  ///< print pass latencies to stderr
-    std::string ini;          ///< settings file; empty: the default one ("none": no file)
+    bool replayChange =
+        false;  ///< after the first complete image, rebuild once (timed like a parameter change)
+    std::string ini;  ///< settings file; empty: the default one ("none": no file)
 };
 
 /// What runViewer returns when no window can be opened (no display, no OpenGL 3.3).

@@ -140,7 +140,8 @@ void ProgressiveRenderer::run() {
             PassRecord rec;
             rec.stride = stride;
             rec.renderMs = rs.renderMs;
-            rec.sinceStartMs = std::chrono::duration<double, std::milli>(Clock::now() - requested).count();
+            rec.sinceStartMs =
+                std::chrono::duration<double, std::milli>(Clock::now() - requested).count();
             rec.counters = rs.counters;
             passes_.push_back(rec);
             previous = stride;

@@ -26,8 +26,8 @@ struct ProgressiveJob {
 /// One finished pass of a job.
 struct PassRecord {
     int stride = 1;
-    double renderMs = 0.0;     ///< the pass alone
-    double sinceStartMs = 0.0; ///< from start() to the pass being available
+    double renderMs = 0.0;      ///< the pass alone
+    double sinceStartMs = 0.0;  ///< from start() to the pass being available
     RayCounters counters;
 };
 
@@ -40,7 +40,7 @@ void lowerThreadPriority();
 void fillBlocks(const Image& src, int stride, Image& dst);
 
 class ProgressiveRenderer {
-public:
+  public:
     using Clock = std::chrono::steady_clock;
 
     /// Passes from coarse to fine; the last must be 1.
@@ -71,7 +71,7 @@ public:
     /// Pixels finished by the pass in flight (for a progress bar), and that pass's pixel count.
     void progress(size_t& done, size_t& total) const;
 
-private:
+  private:
     void run();
 
     std::vector<int> strides_;

@@ -19,3 +19,11 @@ test -s "$tmp/out.png"
 "$lancer" render builtin:default -o "$tmp/cpu.png" --width 900 --height 560 -q
 # Centre: between the default Parameters (x < 340) and Statistics/View (x > 550) panels.
 python3 "$src/tests/support/png_compare.py" "$tmp/out.png" "$tmp/cpu.png" 350 40 540 550 20 60 320 400
+# A scripted run on a scene that cannot be loaded fails with the file's error, without hanging.
+status=0
+timeout 120 xvfb-run -a "$lancer" view "$tmp/missing.nff" --frames 2 --ini none 2>"$tmp/err.txt" || status=$?
+if [ "$status" != 2 ]; then
+  echo "a missing scene must end with status 2, got $status" >&2
+  exit 1
+fi
+grep -q "missing.nff" "$tmp/err.txt"

@@ -1,6 +1,8 @@
 // The viewer drawn into an OSMesa context: the image quad must carry the traced image pixel for
 // pixel, a heat map must show the counters through the colour map, and the panels must be drawn.
+// GL prototypes first (GL_GLEXT_PROTOTYPES), then OSMesa, which includes GL/gl.h too.
 #include "app/viewer/gl.h"
+// (kept apart so the include sorter leaves this order)
 #include <GL/osmesa.h>
 #include <gtest/gtest.h>
 #include <imgui.h>
@@ -18,11 +20,19 @@ namespace {
 
 /// An OpenGL 3.3 core context drawing into memory.
 class OffscreenGl {
-public:
+  public:
     OffscreenGl(int w, int h) : w_(w), h_(h), buffer_(size_t(w) * size_t(h) * 4) {
-        const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_PROFILE,
-                               OSMESA_CORE_PROFILE, OSMESA_CONTEXT_MAJOR_VERSION, 3,
-                               OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
+        const int attribs[] = {OSMESA_FORMAT,
+                               OSMESA_RGBA,
+                               OSMESA_DEPTH_BITS,
+                               0,
+                               OSMESA_PROFILE,
+                               OSMESA_CORE_PROFILE,
+                               OSMESA_CONTEXT_MAJOR_VERSION,
+                               3,
+                               OSMESA_CONTEXT_MINOR_VERSION,
+                               3,
+                               0};
         ctx_ = OSMesaCreateContextAttribs(attribs, nullptr);
         if (ctx_ && !OSMesaMakeCurrent(ctx_, buffer_.data(), GL_UNSIGNED_BYTE, w, h)) {
             OSMesaDestroyContext(ctx_);
@@ -38,7 +48,7 @@ public:
         return readFramebuffer(w_, h_);
     }
 
-private:
+  private:
     int w_, h_;
     std::vector<uint8_t> buffer_;
     OSMesaContext ctx_ = nullptr;
@@ -64,7 +74,8 @@ Traced traceCpu(const std::string& spec, const Camera* camera, int w, int h) {
 
 int maxDiff(const uint8_t* a, const glm::vec3& expected) {
     int d = 0;
-    for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(a[c]) - int(std::lround(expected[c] * 255.0f))));
+    for (int c = 0; c < 3; ++c)
+        d = std::max(d, std::abs(int(a[c]) - int(std::lround(expected[c] * 255.0f))));
     return d;
 }
 
@@ -79,7 +90,8 @@ TEST(ViewerGl, ImageQuadCarriesTheTracedImageAndHeatMapsItsCounters) {
     std::vector<uint8_t> shown = gl.read(), expected = t.img.rgba8();
     ASSERT_EQ(shown.size(), expected.size());
     size_t differing = 0;
-    for (size_t i = 0; i < shown.size(); ++i) differing += std::abs(int(shown[i]) - int(expected[i])) > 1;
+    for (size_t i = 0; i < shown.size(); ++i)
+        differing += std::abs(int(shown[i]) - int(expected[i])) > 1;
     EXPECT_EQ(differing, 0u) << "the quad must show every pixel of the image, row 0 on top";
 
     // Heat map of primitive tests: each pixel is the colour map of its count over the scale.
@@ -112,7 +124,7 @@ TEST(ViewerGl, ImageQuadCarriesTheTracedImageAndHeatMapsItsCounters) {
 
 /// Run the whole viewer (panels, progressive render, drawing) until it has settled.
 class ViewerFrames : public ::testing::Test {
-protected:
+  protected:
     static constexpr int kW = 900, kH = 560;
     void SetUp() override {
         gl_ = std::make_unique<OffscreenGl>(kW, kH);
@@ -139,11 +151,14 @@ protected:
             app_->frame(kW, kH);
             ++frames;
             if (!app_->settled()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        } while ((!app_->settled() || frames < 3) && std::chrono::steady_clock::now() - start < std::chrono::seconds(30));
+        } while ((!app_->settled() || frames < 3) &&
+                 std::chrono::steady_clock::now() - start < std::chrono::seconds(30));
         return frames;
     }
     // The middle of the window, between the default panels (left 8..338, right kW-348..).
-    static bool inCentre(int x, int y) { return x >= 350 && x < kW - 360 && y >= 40 && y < kH - 10; }
+    static bool inCentre(int x, int y) {
+        return x >= 350 && x < kW - 360 && y >= 40 && y < kH - 10;
+    }
 
     std::unique_ptr<OffscreenGl> gl_;
     ViewerSettings settings_;
@@ -164,7 +179,8 @@ TEST_F(ViewerFrames, ShowsTheRenderedSceneAndThePanels) {
         for (int x = 0; x < kW; ++x) {
             size_t i = 4 * (size_t(y) * kW + size_t(x));
             bool differs = false;
-            for (int c = 0; c < 3; ++c) differs |= std::abs(int(shown[i + c]) - int(cpu[i + c])) > 1;
+            for (int c = 0; c < 3; ++c)
+                differs |= std::abs(int(shown[i + c]) - int(cpu[i + c])) > 1;
             if (inCentre(x, y)) {
                 ++centre;
                 centreDiff += differs;
@@ -194,7 +210,8 @@ TEST_F(ViewerFrames, HeatMapModeShowsPrimitiveTests) {
         for (int x = 0; x < kW; ++x) {
             if (!inCentre(x, y)) continue;
             size_t i = size_t(y) * kW + size_t(x);
-            worst = std::max(worst, maxDiff(&hot[4 * i], colormap(float(img.primTests[i]) / scale)));
+            worst =
+                std::max(worst, maxDiff(&hot[4 * i], colormap(float(img.primTests[i]) / scale)));
             changed += std::abs(int(hot[4 * i]) - int(colour[4 * i])) > 8;
             ++n;
         }

@@ -40,7 +40,8 @@ TEST(CameraControl, PanMovesEyeAndTargetTogetherInTheImagePlane) {
     Vec3 move = c.at - sample().at;
     EXPECT_NEAR(glm::length((c.from - sample().from) - move), 0.0, 1e-12);
     EXPECT_NEAR(glm::dot(move, f), 0.0, 1e-12);
-    EXPECT_LT(glm::dot(move, r), 0.0) << "dragging right moves the camera left: the scene follows the mouse";
+    EXPECT_LT(glm::dot(move, r), 0.0)
+        << "dragging right moves the camera left: the scene follows the mouse";
     // A drag the height of the viewport moves by the visible height at the target.
     Camera d = sample();
     pan(d, 0.0, 500.0, 500);
@@ -113,7 +114,8 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     }
     EXPECT_EQ(settingsLines(r), lines);
     ViewerSettings bad = r;
-    for (const char* line : {"max_level=999", "scheme=octree", "window=5 5", "delta=-1", "threads=x", "garbage"})
+    for (const char* line :
+         {"max_level=999", "scheme=octree", "window=5 5", "delta=-1", "threads=x", "garbage"})
         readSettingsLine(bad, line);
     EXPECT_EQ(settingsLines(bad), lines);
 }
