@@ -219,6 +219,51 @@ TEST_F(ViewerFrames, HeatMapModeShowsPrimitiveTests) {
     EXPECT_GT(changed, n / 2);
 }
 
+TEST_F(ViewerFrames, DragsMoveTheCameraExceptWhenImGuiWantsTheMouse) {
+    runUntilSettled();
+    ImGuiIO& io = ImGui::GetIO();
+    auto frame = [&] {
+        io.DeltaTime = 1.0f / 60.0f;
+        app_->frame(kW, kH);
+    };
+    auto drag = [&](float x0, float y0, float x1, float y1) {
+        io.MousePos = ImVec2(x0, y0);
+        frame();
+        io.MouseDown[0] = true;
+        frame();
+        for (int i = 1; i <= 5; ++i) {
+            io.MousePos = ImVec2(x0 + (x1 - x0) * float(i) / 5.0f, y0 + (y1 - y0) * float(i) / 5.0f);
+            frame();
+        }
+        io.MouseDown[0] = false;
+        frame();
+    };
+    const Camera home = app_->camera();
+    drag(150.0f, 200.0f, 250.0f, 260.0f);  // starts on the Parameters panel: ImGui's
+    EXPECT_EQ(app_->camera().from, home.from);
+    drag(600.0f, 300.0f, 680.0f, 300.0f);  // starts on the image: orbits about the target
+    EXPECT_NE(app_->camera().from, home.from);
+    EXPECT_EQ(app_->camera().at, home.at);
+    EXPECT_NEAR(glm::length(app_->camera().from - home.at), glm::length(home.from - home.at), 1e-9);
+    const Camera orbited = app_->camera();
+    io.MousePos = ImVec2(600.0f, 300.0f);
+    io.MouseWheel = 1.0f;  // zoom in
+    frame();
+    io.MouseWheel = 0.0f;
+    EXPECT_LT(glm::length(app_->camera().from - home.at), glm::length(orbited.from - home.at));
+    io.AddInputCharacter('r');  // reset
+    frame();
+    EXPECT_EQ(app_->camera().from, home.from);
+    io.AddInputCharacter('o');  // orthographic
+    frame();
+    EXPECT_EQ(app_->camera().projection, Projection::Orthographic);
+    // The new view is rendered: once settled, the screen shows the orthographic CPU render.
+    runUntilSettled();
+    Camera cam = app_->camera();
+    Traced t = traceCpu("builtin:default", &cam, kW, kH);
+    EXPECT_EQ(app_->displayed().color, t.img.color);
+}
+
 TEST_F(ViewerFrames, ASceneThatFailsToLoadKeepsThePreviousOne) {
     runUntilSettled();
     auto before = app_->structure();
