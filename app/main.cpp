@@ -26,9 +26,11 @@ int main(int argc, char** argv) {
     cli::addCommonOptions(*view, viewOpt);
 #ifdef LANCER_WITH_VIEWER
     viewer::ViewOptions vopt;
-    view->add_option("--frames", vopt.frames, "Run this many frames, wait for the render to finish, then exit")
-        ->check(CLI::Range(1, 1000000));
-    view->add_option("--screenshot", vopt.screenshot, "With --frames: save the window as a PNG before exiting");
+    CLI::Option* frames =
+        view->add_option("--frames", vopt.frames, "Run this many frames, wait for the render to finish, then exit")
+            ->check(CLI::Range(1, 1000000));
+    view->add_option("--screenshot", vopt.screenshot, "With --frames: save the window as a PNG before exiting")
+        ->needs(frames);
     view->add_flag("--log-timings", vopt.logTimings, "Print the latency of each pass after a change to stderr");
     view->add_flag("--replay-change", vopt.replayChange,
                    "After the first complete image, rebuild the structure once, as a parameter change does (to time it)");
