@@ -5,6 +5,9 @@
 #include "app/bench/report.h"
 #include "app/cli/commands.h"
 #include "engine/scene/builtin_scenes.h"
+#ifdef LANCER_WITH_VIEWER
+#include "app/viewer/window.h"
+#endif
 
 using namespace lancer;
 
@@ -22,6 +25,18 @@ int main(int argc, char** argv) {
     view->add_option("scene", viewOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]");
     view->add_option("--headless-output", viewOut, "Where the headless render goes when there is no display");
     cli::addCommonOptions(*view, viewOpt);
+#ifdef LANCER_WITH_VIEWER
+    viewer::ViewOptions vopt;
+    CLI::Option* frames =
+        view->add_option("--frames", vopt.frames, "Run this many frames, wait for the render to finish, then exit")
+            ->check(CLI::Range(1, 1000000));
+    view->add_option("--screenshot", vopt.screenshot, "With --frames: save the window as a PNG before exiting")
+        ->needs(frames);
+    view->add_flag("--log-timings", vopt.logTimings, "Print the latency of each pass after a change to stderr");
+    view->add_flag("--replay-change", vopt.replayChange,
+                   "After the first complete image, rebuild the structure once, as a parameter change does (to time it)");
+    view->add_option("--ini", vopt.ini, "Settings file (default: ~/.config/lancer/imgui.ini; \"none\": none)");
+#endif
 
     std::string out;
     bool quiet = false;
@@ -60,9 +75,12 @@ int main(int argc, char** argv) {
         topt.y = pixel[1];
         return cli::runTrace(traceOpt, topt);
     }
-    // view (explicit or default). The interactive viewer is not part of this build yet, so the
-    // scene is rendered headless and the image's path printed.
-    std::cout << "lancer: the interactive viewer is not available in this build; rendering " << viewOpt.scene
-              << " headless.\n";
+    // view (explicit or default): the window when there is a display, else a headless render.
+    std::string why = "the interactive viewer is not available in this build";
+#ifdef LANCER_WITH_VIEWER
+    auto given = [&](const std::string& name) { return view->count(name) > 0; };
+    if (int status = viewer::runViewer(viewOpt, vopt, given, why); status != viewer::kNoDisplay) return status;
+#endif
+    std::cout << "lancer: " << why << "; rendering " << viewOpt.scene << " headless.\n";
     return cli::runRender(viewOpt, viewOut, false);
 }

@@ -21,7 +21,7 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     using Clock = std::chrono::steady_clock;
     RenderStats stats;
     stats.threads = effectiveThreads(opt.threads);
-    const Camera& cam = scene.camera;
+    const Camera& cam = opt.camera ? *opt.camera : scene.camera;
     const int w = img.width, h = img.height;
     const Tracer tracer(scene, accel, opt.shading);
     const int depth = scene.tree.depth();
@@ -47,6 +47,11 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                 NullObserver obs;
                 size_t done = 0;
                 for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
+                    // Checked per row too, so a cancel lands within a row of slow pixels.
+                    if (cancel && cancel->load(std::memory_order_relaxed)) {
+                        stopped = true;
+                        break;
+                    }
                     for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
                         if (!pass.contains(x, y)) continue;
                         auto t0 = Clock::now();

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <atomic>
+#include <optional>
 
 #include "engine/render/image.h"
 #include "engine/render/tracer.h"
@@ -13,6 +14,7 @@ struct RenderOptions {
     int threads = 0;            ///< 0: all cores
     int tile = 16;
     ShadingOptions shading;
+    std::optional<Camera> camera;  ///< overrides scene.camera (the viewer moves its own camera)
 };
 
 struct RenderStats {

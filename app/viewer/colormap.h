@@ -1,0 +1,28 @@
+// The heat-map colour map, shared by the shader (as uniforms), the colour bar and the tests.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <glm/vec3.hpp>
+#include <vector>
+
+#include "engine/render/image.h"
+
+namespace lancer::viewer {
+
+/// What the image area shows: the colour image or one per-pixel counter (those of --stats).
+enum class ViewMode : uint8_t { Color, PrimTests, RegionVisits, TimeUs };
+inline constexpr int kViewModeCount = 4;
+const char* viewModeName(ViewMode m);
+
+/// Evenly spaced stops of the colour map (black through purple and orange to pale yellow,
+/// like matplotlib's "inferno": monotonic in lightness, so the order of values reads at a glance).
+const std::array<glm::vec3, 8>& colormapStops();
+/// The colour of `v` in [0, 1] (clamped), interpolated linearly between stops as the shader does.
+glm::vec3 colormap(float v);
+/// The per-pixel counter `mode` shows, as floats (empty for ViewMode::Color).
+std::vector<float> heatChannel(const Image& img, ViewMode mode);
+/// A scale that fits the counter: its largest value (at least 1).
+float autoScale(const std::vector<float>& heat);
+
+}  // namespace lancer::viewer

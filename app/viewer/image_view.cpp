@@ -1,0 +1,167 @@
+#include "app/viewer/image_view.h"
+
+#include <stdexcept>
+#include <string>
+
+#include "app/viewer/gl.h"
+#include "lancer_shaders.h"  // generated from shaders/*.{vert,frag} at configure time
+
+namespace lancer::viewer {
+
+namespace {
+
+GLuint compile(GLenum type, const char* source, const char* name) {
+    GLuint s = glCreateShader(type);
+    glShaderSource(s, 1, &source, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[2048] = {};
+        glGetShaderInfoLog(s, sizeof log, nullptr, log);
+        glDeleteShader(s);
+        throw std::runtime_error(std::string("shader ") + name + ": " + log);
+    }
+    return s;
+}
+
+void setupTexture(GLuint tex) {
+    glBindTexture(GL_TEXTURE_2D, tex);
+    // Nearest: the texture has one texel per framebuffer pixel, and heat values must not blend.
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+}  // namespace
+
+ImageView::ImageView() {
+    GLuint vs = compile(GL_VERTEX_SHADER, shaders::kImageVert, "image.vert");
+    GLuint fs = compile(GL_FRAGMENT_SHADER, shaders::kImageFrag, "image.frag");
+    program_ = glCreateProgram();
+    glAttachShader(program_, vs);
+    glAttachShader(program_, fs);
+    glLinkProgram(program_);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(program_, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[2048] = {};
+        glGetProgramInfoLog(program_, sizeof log, nullptr, log);
+        throw std::runtime_error(std::string("image shader link: ") + log);
+    }
+    locMode_ = glGetUniformLocation(program_, "mode");
+    locScale_ = glGetUniformLocation(program_, "scale");
+    locStops_ = glGetUniformLocation(program_, "stops");
+    locStopCount_ = glGetUniformLocation(program_, "stopCount");
+    locColor_ = glGetUniformLocation(program_, "colorTex");
+    locHeat_ = glGetUniformLocation(program_, "heatTex");
+    glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even an empty one
+    GLuint tex[3];
+    glGenTextures(3, tex);
+    colorTex_ = tex[0];
+    heatTex_ = tex[1];
+    shadedTex_ = tex[2];
+    setupTexture(colorTex_);
+    setupTexture(heatTex_);
+    setupTexture(shadedTex_);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenFramebuffers(1, &fbo_);
+}
+
+ImageView::~ImageView() {
+    GLuint tex[3] = {colorTex_, heatTex_, shadedTex_};
+    glDeleteTextures(3, tex);
+    glDeleteFramebuffers(1, &fbo_);
+    glDeleteVertexArrays(1, &vao_);
+    glDeleteProgram(program_);
+}
+
+void ImageView::upload(const Image& img, ViewMode mode) {
+    if (img.width <= 0 || img.height <= 0) return;
+    width_ = img.width;
+    height_ = img.height;
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glBindTexture(GL_TEXTURE_2D, colorTex_);
+    // 8 bits per channel, quantised as the PNG writer does: the screen shows what `render` saves.
+    std::vector<uint8_t> rgba = img.rgba8();
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                 rgba.data());
+    if (mode != ViewMode::Color) {
+        std::vector<float> heat = heatChannel(img, mode);
+        glBindTexture(GL_TEXTURE_2D, heatTex_);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, width_, height_, 0, GL_RED, GL_FLOAT, heat.data());
+    }
+    glBindTexture(GL_TEXTURE_2D, shadedTex_);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                 nullptr);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, shadedTex_, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    shadedValid_ = false;
+}
+
+void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) const {
+    if (width_ == 0) return;
+    scale = scale > 0.0f ? scale : 1.0f;
+    if (!shadedValid_ || mode != shadedMode_ || (mode != ViewMode::Color && scale != shadedScale_))
+        shade(mode, scale);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glDisable(GL_SCISSOR_TEST);
+    glBlitFramebuffer(0, 0, width_, height_, 0, 0, fbWidth, fbHeight, GL_COLOR_BUFFER_BIT,
+                      GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, fbWidth, fbHeight);
+}
+
+void ImageView::shade(ViewMode mode, float scale) const {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glViewport(0, 0, width_, height_);
+    glDisable(GL_BLEND);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_SCISSOR_TEST);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(program_);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, colorTex_);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, heatTex_);
+    glUniform1i(locColor_, 0);
+    glUniform1i(locHeat_, 1);
+    glUniform1i(locMode_, mode == ViewMode::Color ? 0 : 1);
+    glUniform1f(locScale_, scale);
+    const auto& stops = colormapStops();
+    glUniform3fv(locStops_, GLsizei(stops.size()), &stops[0].x);
+    glUniform1i(locStopCount_, GLint(stops.size()));
+    glBindVertexArray(vao_);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    glBindVertexArray(0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glUseProgram(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    shadedValid_ = true;
+    shadedMode_ = mode;
+    shadedScale_ = scale;
+}
+
+std::vector<uint8_t> readFramebuffer(int width, int height) {
+    std::vector<uint8_t> rows(size_t(width) * size_t(height) * 4), out(rows.size());
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rows.data());
+    const size_t stride = size_t(width) * 4;
+    for (int y = 0; y < height; ++y)  // GL's row 0 is the bottom one
+        std::copy_n(rows.data() + size_t(height - 1 - y) * stride, stride,
+                    out.data() + size_t(y) * stride);
+    for (size_t i = 3; i < out.size(); i += 4) out[i] = 255;  // the window is opaque
+    return out;
+}
+
+}  // namespace lancer::viewer

@@ -1,0 +1,44 @@
+// Draws the traced image (or a heat map of its counters) into the current GL context, given
+// the framebuffer size: no window involved, so the OSMesa test drives exactly this code.
+#pragma once
+
+#include "app/viewer/colormap.h"
+#include "engine/render/image.h"
+
+namespace lancer::viewer {
+
+class ImageView {
+  public:
+    /// Needs a current OpenGL 3.3 core context. Throws std::runtime_error if a shader fails.
+    ImageView();
+    ~ImageView();
+    ImageView(const ImageView&) = delete;
+    ImageView& operator=(const ImageView&) = delete;
+
+    /// Upload the colour and the counter `mode` shows (textures sized like the image).
+    void upload(const Image& img, ViewMode mode);
+    /// Draw the uploaded image over the whole viewport of a fbWidth x fbHeight framebuffer
+    /// (framebuffer 0); heat maps divide the counter by `scale`. Nothing is drawn before the
+    /// first upload. The shader runs once per upload, mode or scale, into a texture; each frame
+    /// then only copies that texture (a blit), which software GL does far faster than shading.
+    void draw(int fbWidth, int fbHeight, ViewMode mode, float scale) const;
+    /// Size of the uploaded image (0 x 0 before the first upload).
+    int width() const { return width_; }
+    int height() const { return height_; }
+
+  private:
+    void shade(ViewMode mode, float scale) const;
+
+    unsigned program_ = 0, vao_ = 0, colorTex_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
+    mutable bool shadedValid_ = false;
+    mutable ViewMode shadedMode_ = ViewMode::Color;
+    mutable float shadedScale_ = 0.0f;
+    int width_ = 0, height_ = 0;
+    int locMode_ = -1, locScale_ = -1, locStops_ = -1, locStopCount_ = -1, locColor_ = -1,
+        locHeat_ = -1;
+};
+
+/// Read the current framebuffer's pixels as RGBA8, row 0 on top (as PNG files want).
+std::vector<uint8_t> readFramebuffer(int width, int height);
+
+}  // namespace lancer::viewer

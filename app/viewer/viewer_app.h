@@ -1,0 +1,107 @@
+// The viewer's body, independent of the window: state, ImGui panels, camera input, the
+// progressive render and structure builds in the background, and the GL drawing of each frame.
+// A GLFW shell (window.cpp) or a test (an OSMesa context) calls frame() once per frame.
+#pragma once
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "app/viewer/image_view.h"
+#include "app/viewer/structure_builder.h"
+#include "app/viewer/viewer_settings.h"
+#include "engine/render/progressive.h"
+
+namespace lancer::viewer {
+
+class ViewerApp {
+  public:
+    using Clock = std::chrono::steady_clock;
+
+    /// Needs a current OpenGL 3.3 core context and an ImGui context whose OpenGL3 renderer
+    /// backend is initialised. Starts loading `settings.scene` at once. `settings` is the
+    /// object the ini handler reads and writes; it must outlive the app.
+    /// `wake` (optional) is called from worker threads when there is something new to show.
+    ViewerApp(ViewerSettings& settings, bool logTimings, std::function<void()> wake = {});
+    ~ViewerApp();
+
+    /// One frame: ImGui::NewFrame (the platform backend, if any, has set io.DisplaySize and the
+    /// input), panels and camera input, then draws the image and the UI into the current
+    /// framebuffer of fbWidth x fbHeight pixels.
+    void frame(int fbWidth, int fbHeight);
+    /// Open a scene (file dropped on the window, or typed): loaded in the background; on failure
+    /// the error shows in the panel and the previous scene stays.
+    void openScene(const std::string& spec);
+    /// Rebuild the structure with the current parameters, as a parameter change does.
+    void rebuild(const char* why) { requestBuild(false, why); }
+    /// Everything asked for is built and the last frame drew the complete image.
+    bool settled() const { return settled_; }
+    /// Write the framebuffer as drawn by the last frame() to a PNG. Throws std::runtime_error.
+    void saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const;
+
+    /// What the image area shows, and its heat scale (turns automatic scaling off).
+    void setViewMode(ViewMode mode);
+    void setHeatScale(float scale);
+    /// The image on screen (the last snapshot uploaded), the current error, the camera.
+    const Image& displayed() const { return shown_; }
+    const std::string& error() const { return error_; }
+    const Camera& camera() const { return camera_; }
+    void setCamera(const Camera& c);
+    /// The scene and structure on screen (null until the first build succeeds).
+    const std::shared_ptr<const Structure>& structure() const { return structure_; }
+    /// The heat scale in use this frame.
+    float heatScale() const { return scale_; }
+
+  private:
+    void pollBackground();
+    void handleInput(int fbWidth, int fbHeight);
+    void handleKeys();
+    void panels();
+    void parametersPanel();
+    void cameraPanel();
+    void statisticsPanel();
+    void viewPanel();
+    void requestBuild(bool reloadScene, const char* why);
+    void restartRender(const char* why);
+    void markRender(const char* why);
+    void startSpeedup();
+    void logTiming(const std::string& line) const;
+    void updateAutoScale();
+
+    ViewerSettings& s_;
+    bool logTimings_;
+    std::unique_ptr<ImageView> view_;
+    StructureBuilder builder_;
+    ProgressiveRenderer renderer_;
+    std::shared_ptr<const Structure> structure_;
+    Camera camera_, home_;
+    bool cameraSet_ = false;  ///< camera_ chosen (else it follows the next scene)
+    std::string error_;
+    Image shown_;
+    uint64_t shownVersion_ = 0;
+    int jobWidth_ = 0, jobHeight_ = 0;
+    bool renderDirty_ = false, buildDirty_ = false, cameraMovedForBuild_ = false;
+    std::string renderWhy_;
+    float scale_ = 1.0f;
+    float autoScale_ = 1.0f;  ///< largest value of the shown counter
+    bool settled_ = false;
+
+    // Latency of the last change: when it happened, what it was, what was logged.
+    Clock::time_point changeAt_ = Clock::now(), buildChangeAt_ = Clock::now();
+    std::string changeWhy_, buildWhy_;
+    size_t passesLogged_ = 0;
+
+    // UI scratch.
+    std::string pathInput_, cameraJson_, cameraError_, screenshotNote_, pendingScreenshot_;
+    int builtinSize_ = -1;
+    int screenshotCount_ = 0;
+
+    // Speedup over brute force, measured on demand on a worker thread.
+    struct Speedup;
+    std::shared_ptr<Speedup> speedup_;
+    std::thread speedupThread_;
+    int speedupStride_ = 4;
+};
+
+}  // namespace lancer::viewer

@@ -1,0 +1,196 @@
+#include "app/viewer/window.h"
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+#include <imgui_internal.h>  // MarkIniSettingsDirty
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <thread>
+#include <vector>
+
+#include "app/viewer/viewer_app.h"
+
+namespace lancer::viewer {
+
+namespace {
+
+std::string defaultIniPath() {
+    namespace fs = std::filesystem;
+    fs::path dir;
+    if (const char* x = std::getenv("XDG_CONFIG_HOME"); x && *x)
+        dir = fs::path(x) / "lancer";
+    else if (const char* h = std::getenv("HOME"); h && *h)
+        dir = fs::path(h) / ".config" / "lancer";
+    else
+        return "lancer-imgui.ini";
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    return (dir / "imgui.ini").string();
+}
+
+/// Settings explicitly given on the command line win over those saved in the ini.
+void applyCommandLine(const cli::CommonOptions& o,
+                      const std::function<bool(const std::string&)>& given, ViewerSettings& s) {
+    if (given("scene")) s.scene = o.scene;
+    if (given("--scheme")) s.build.scheme = o.build.scheme;
+    if (given("--max-level")) s.build.maxLevel = o.build.maxLevel;
+    if (given("--max-objects")) s.build.maxObjects = o.build.maxObjects;
+    if (given("--step")) s.build.step = o.build.step;
+    if (given("--delta")) s.build.delta = o.build.delta;
+    if (given("--bsp-heuristic")) s.build.heuristic = o.build.heuristic;
+    if (given("--no-mailbox")) s.build.mailboxes = o.build.mailboxes;
+    if (given("--threads")) s.threads = o.render.threads;
+    if (given("--bounces")) s.shading.bounces = o.render.shading.bounces;
+    if (given("--no-shadows")) s.shading.shadows = o.render.shading.shadows;
+    if (given("--offset")) s.shading.offsetScale = o.render.shading.offsetScale;
+    if (given("--width")) s.windowWidth = o.width;
+    if (given("--height")) s.windowHeight = o.height;
+}
+
+}  // namespace
+
+int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
+              const std::function<bool(const std::string&)>& given, std::string& why) {
+    const char* display = std::getenv("DISPLAY");
+    const char* wayland = std::getenv("WAYLAND_DISPLAY");
+    if (!(display && *display) && !(wayland && *wayland)) {
+        why = "no display (DISPLAY is not set)";
+        return kNoDisplay;
+    }
+    glfwSetErrorCallback(
+        [](int code, const char* text) { std::cerr << "glfw: " << text << " (" << code << ")\n"; });
+    if (!glfwInit()) {
+        why = "no display (GLFW could not initialise)";
+        return kNoDisplay;
+    }
+
+    // Settings: defaults, then the ini, then the command line.
+    ViewerSettings settings;
+    ImGui::CreateContext();
+    ImGuiIO& io = ImGui::GetIO();
+    registerSettingsHandler(&settings);
+    // A scripted run (--frames) neither reads nor writes the user's settings unless told to.
+    std::string ini = v.ini.empty() ? (v.frames > 0 ? "none" : defaultIniPath()) : v.ini;
+    if (ini == "none") {
+        io.IniFilename = nullptr;
+    } else {
+        io.IniFilename = ini.c_str();
+        ImGui::LoadIniSettingsFromDisk(ini.c_str());
+    }
+    applyCommandLine(o, given, settings);
+
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    GLFWwindow* window =
+        glfwCreateWindow(settings.windowWidth, settings.windowHeight, "lancer", nullptr, nullptr);
+    if (!window) {
+        ImGui::DestroyContext();
+        glfwTerminate();
+        why = "no OpenGL 3.3 core window could be opened";
+        return kNoDisplay;
+    }
+    glfwMakeContextCurrent(window);
+    glfwSwapInterval(1);
+
+    // Dropped files open as scenes; chained before ImGui installs its own callbacks.
+    static std::vector<std::string> dropped;
+    glfwSetDropCallback(window, [](GLFWwindow*, int count, const char** paths) {
+        for (int i = 0; i < count; ++i) dropped.emplace_back(paths[i]);
+    });
+    ImGui_ImplGlfw_InitForOpenGL(window, true);
+    ImGui_ImplOpenGL3_Init("#version 330 core");
+
+    int status = 0;
+    try {
+        // Worker threads wake the loop when a pass or a structure is ready (thread-safe in GLFW).
+        ViewerApp app(settings, v.logTimings, [] { glfwPostEmptyEvent(); });
+        using Clock = std::chrono::steady_clock;
+        int frames = 0, statFrames = 0;
+        bool replayed = false;
+        double statWorkMs = 0.0, statSwapMs = 0.0;
+        Clock::time_point frameStart = Clock::now(), statStart = frameStart;
+        while (!glfwWindowShouldClose(window)) {
+            // At most 60 frames per second (no swap interval is guaranteed, e.g. under Xvfb).
+            // Interactive: draw on input, on a new pass or structure (the workers post an empty
+            // event), and at 10 Hz for the progress bar while working; idle otherwise.
+            double left =
+                1.0 / 60.0 - std::chrono::duration<double>(Clock::now() - frameStart).count();
+            if (left > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(left));
+            if (v.frames > 0)
+                glfwPollEvents();
+            else
+                glfwWaitEventsTimeout(app.settled() ? 1.0 : 0.1);
+            frameStart = Clock::now();
+            if (!dropped.empty()) {
+                app.openScene(dropped.back());
+                dropped.clear();
+            }
+            int fbw = 0, fbh = 0, ww = 0, wh = 0;
+            glfwGetFramebufferSize(window, &fbw, &fbh);
+            glfwGetWindowSize(window, &ww, &wh);
+            if (ww > 0 && wh > 0 && (ww != settings.windowWidth || wh != settings.windowHeight)) {
+                settings.windowWidth = ww;
+                settings.windowHeight = wh;
+                ImGui::MarkIniSettingsDirty();
+            }
+            ImGui_ImplGlfw_NewFrame();
+            app.frame(fbw, fbh);
+            ++frames;
+            if (v.replayChange && !replayed && app.settled() && app.structure()) {
+                app.rebuild("replayed parameter change");
+                replayed = true;
+            } else if (v.frames > 0 && frames >= v.frames && app.settled()) {
+                if (!app.structure()) {  // a scripted run on a scene that cannot be shown fails
+                    std::cerr << "error: lancer view: the scene could not be shown (see above)\n";
+                    status = 2;
+                }
+                if (!v.screenshot.empty()) {
+                    try {
+                        app.saveScreenshot(v.screenshot, fbw, fbh);
+                        std::cout << "lancer view: " << frames << " frames, screenshot "
+                                  << v.screenshot << "\n";
+                    } catch (const std::exception& e) {
+                        std::cerr << "error: --screenshot: " << e.what() << "\n";
+                        status = 2;
+                    }
+                }
+                break;
+            }
+            auto beforeSwap = Clock::now();
+            glfwSwapBuffers(window);
+            statSwapMs +=
+                std::chrono::duration<double, std::milli>(Clock::now() - beforeSwap).count();
+            // The UI thread's own cost per frame (the render runs on other threads).
+            statWorkMs +=
+                std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
+            ++statFrames;
+            if (v.logTimings && Clock::now() - statStart > std::chrono::seconds(2)) {
+                double secs = std::chrono::duration<double>(Clock::now() - statStart).count();
+                std::cerr << "timing: ui " << statFrames / secs << " fps, "
+                          << statWorkMs / statFrames << " ms of work per frame ("
+                          << statSwapMs / statFrames << " ms in the swap)\n";
+                statFrames = 0;
+                statWorkMs = statSwapMs = 0.0;
+                statStart = Clock::now();
+            }
+        }
+    } catch (const std::exception& e) {  // e.g. a shader the driver refuses
+        std::cerr << "error: the viewer failed: " << e.what() << "\n";
+        status = 2;
+    }
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();  // writes the ini
+    glfwDestroyWindow(window);
+    glfwTerminate();
+    return status;
+}
+
+}  // namespace lancer::viewer

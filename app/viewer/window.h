@@ -1,0 +1,28 @@
+// `lancer view`: the GLFW window around ViewerApp.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "app/cli/options.h"
+
+namespace lancer::viewer {
+
+struct ViewOptions {
+    int frames = 0;           ///< > 0: run this many frames, wait for the render, then exit
+    std::string screenshot;   ///< with frames: save the window here before exiting
+    bool logTimings = false;  ///< print pass latencies to stderr
+    bool replayChange =
+        false;  ///< after the first complete image, rebuild once (timed like a parameter change)
+    std::string ini;  ///< settings file; empty: the default one ("none": no file)
+};
+
+/// What runViewer returns when no window can be opened (no display, no OpenGL 3.3).
+inline constexpr int kNoDisplay = -1;
+
+/// Open the viewer on the options; `given(name)` tells which options the user set explicitly
+/// (they override the saved settings). Returns the exit status, or kNoDisplay with `why` set.
+int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
+              const std::function<bool(const std::string&)>& given, std::string& why);
+
+}  // namespace lancer::viewer

@@ -1,0 +1,96 @@
+// Progressive rendering on a worker thread: coarse passes first (one pixel in stride x stride,
+// shown as blocks), refined to every pixel; a new job cancels the one in flight at once.
+// No GL here: the viewer displays the snapshots, the benchmark can time the passes.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "engine/render/renderer.h"
+
+namespace lancer {
+
+/// What a progressive job renders: a scene, a structure built over it, and the options.
+/// `accel` must have been built over `*scene`; both are kept alive by the job.
+struct ProgressiveJob {
+    std::shared_ptr<const Scene> scene;
+    std::shared_ptr<const Accelerator> accel;
+    RenderOptions options;
+};
+
+/// One finished pass of a job.
+struct PassRecord {
+    int stride = 1;
+    double renderMs = 0.0;      ///< the pass alone
+    double sinceStartMs = 0.0;  ///< from start() to the pass being available
+    RayCounters counters;
+};
+
+/// Lower the calling thread's scheduling priority (nice 5 on Linux), so an interactive thread
+/// stays responsive beside it; threads it starts (oneTBB's workers, on first use) inherit it.
+void lowerThreadPriority();
+
+/// Copy `src` into `dst`, each pixel taking the values of the pixel at the corner of its
+/// stride x stride block: how a pass that rendered only that lattice is shown.
+void fillBlocks(const Image& src, int stride, Image& dst);
+
+class ProgressiveRenderer {
+  public:
+    using Clock = std::chrono::steady_clock;
+
+    /// Passes from coarse to fine; the last must be 1.
+    explicit ProgressiveRenderer(std::vector<int> strides = {8, 4, 2, 1});
+    /// Cancels the job in flight and joins the worker.
+    ~ProgressiveRenderer();
+    ProgressiveRenderer(const ProgressiveRenderer&) = delete;
+    ProgressiveRenderer& operator=(const ProgressiveRenderer&) = delete;
+
+    /// Cancel the job in flight and render `job` from the coarsest pass. Returns at once.
+    /// `requested` is when the change that caused the job happened (for the latencies).
+    void start(ProgressiveJob job, Clock::time_point requested = Clock::now());
+    /// Cancel the job in flight without starting another.
+    void cancel();
+    /// Called on the worker thread after each pass becomes available (e.g. to wake a UI loop
+    /// waiting for events). Set it before the first start().
+    void setOnPass(std::function<void()> f) { onPass_ = std::move(f); }
+
+    /// If a pass finished since `version`, copy the displayable image into `out`, update
+    /// `version` and return true; `stride` (if given) receives the stride of that pass.
+    bool snapshot(uint64_t& version, Image& out, int* stride = nullptr) const;
+    /// Passes of the current job finished so far.
+    std::vector<PassRecord> passes() const;
+    /// The current job has rendered every pass.
+    bool finished() const;
+    /// No job is queued or running.
+    bool idle() const;
+    /// Pixels finished by the pass in flight (for a progress bar), and that pass's pixel count.
+    void progress(size_t& done, size_t& total) const;
+
+  private:
+    void run();
+
+    std::vector<int> strides_;
+    mutable std::mutex mutex_;
+    std::condition_variable wake_;
+    std::unique_ptr<ProgressiveJob> pending_;
+    Clock::time_point pendingRequested_;
+    bool quit_ = false;
+    bool running_ = false;
+    bool finished_ = false;
+    std::atomic<bool> cancel_{false};
+    std::atomic<size_t> progressDone_{0};
+    std::atomic<size_t> progressTotal_{0};
+    Image display_;
+    uint64_t displayVersion_ = 0;
+    int displayStride_ = 0;
+    std::vector<PassRecord> passes_;
+    std::function<void()> onPass_;
+    std::thread worker_;
+};
+
+}  // namespace lancer

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# The viewer in a virtual X server: run 30 frames, wait for the render, save the window, and
+# check the screenshot is the rendered scene (equal to `lancer render` between the panels) plus
+# the UI, not a blank window. Usage: viewer_xvfb.sh LANCER SOURCE_DIR
+set -euo pipefail
+lancer=$1
+src=$2
+if ! command -v xvfb-run >/dev/null; then
+  echo "xvfb-run is not installed (apt-get install xvfb)" >&2
+  exit 1
+fi
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp"
+# The window and the CPU render have the same size and the scene's own camera.
+timeout 240 xvfb-run -a -s "-screen 0 1280x1024x24" \
+  "$lancer" view builtin:default --frames 30 --screenshot "$tmp/out.png" --width 900 --height 560 --ini none
+test -s "$tmp/out.png"
+"$lancer" render builtin:default -o "$tmp/cpu.png" --width 900 --height 560 -q
+# Centre: between the default Parameters (x < 340) and Statistics/View (x > 550) panels.
+python3 "$src/tests/support/png_compare.py" "$tmp/out.png" "$tmp/cpu.png" 350 40 540 550 20 60 320 400
+# A scripted run on a scene that cannot be loaded fails with the file's error, without hanging.
+status=0
+timeout 120 xvfb-run -a "$lancer" view "$tmp/missing.nff" --frames 2 --ini none 2>"$tmp/err.txt" || status=$?
+if [ "$status" != 2 ]; then
+  echo "a missing scene must end with status 2, got $status" >&2
+  exit 1
+fi
+grep -q "missing.nff" "$tmp/err.txt"

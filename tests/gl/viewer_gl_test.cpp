@@ -1,0 +1,285 @@
+// The viewer drawn into an OSMesa context: the image quad must carry the traced image pixel for
+// pixel, a heat map must show the counters through the colour map, and the panels must be drawn.
+// GL prototypes first (GL_GLEXT_PROTOTYPES), then OSMesa, which includes GL/gl.h too.
+#include "app/viewer/gl.h"
+// (kept apart so the include sorter leaves this order)
+#include <GL/osmesa.h>
+#include <gtest/gtest.h>
+#include <imgui.h>
+#include <imgui_impl_opengl3.h>
+
+#include <chrono>
+#include <thread>
+
+#include "app/viewer/image_view.h"
+#include "app/viewer/viewer_app.h"
+#include "engine/scene/loader.h"
+
+namespace lancer::viewer {
+namespace {
+
+/// An OpenGL 3.3 core context drawing into memory.
+class OffscreenGl {
+  public:
+    OffscreenGl(int w, int h) : w_(w), h_(h), buffer_(size_t(w) * size_t(h) * 4) {
+        const int attribs[] = {OSMESA_FORMAT,
+                               OSMESA_RGBA,
+                               OSMESA_DEPTH_BITS,
+                               0,
+                               OSMESA_PROFILE,
+                               OSMESA_CORE_PROFILE,
+                               OSMESA_CONTEXT_MAJOR_VERSION,
+                               3,
+                               OSMESA_CONTEXT_MINOR_VERSION,
+                               3,
+                               0};
+        ctx_ = OSMesaCreateContextAttribs(attribs, nullptr);
+        if (ctx_ && !OSMesaMakeCurrent(ctx_, buffer_.data(), GL_UNSIGNED_BYTE, w, h)) {
+            OSMesaDestroyContext(ctx_);
+            ctx_ = nullptr;
+        }
+    }
+    ~OffscreenGl() {
+        if (ctx_) OSMesaDestroyContext(ctx_);
+    }
+    bool ok() const { return ctx_ != nullptr; }
+    std::vector<uint8_t> read() const {
+        glFinish();
+        return readFramebuffer(w_, h_);
+    }
+
+  private:
+    int w_, h_;
+    std::vector<uint8_t> buffer_;
+    OSMesaContext ctx_ = nullptr;
+};
+
+struct Traced {
+    Scene scene;
+    std::unique_ptr<Accelerator> accel;
+    Image img;
+};
+
+/// The CPU render the viewer must show: same scene, camera and size.
+Traced traceCpu(const std::string& spec, const Camera* camera, int w, int h) {
+    Traced t{loadScene(spec), nullptr, Image(w, h)};
+    t.accel = buildAccelerator(t.scene, BuildParams{});
+    RenderOptions opt;
+    opt.width = w;
+    opt.height = h;
+    if (camera) opt.camera = *camera;
+    render(t.scene, *t.accel, opt, t.img);
+    return t;
+}
+
+int maxDiff(const uint8_t* a, const glm::vec3& expected) {
+    int d = 0;
+    for (int c = 0; c < 3; ++c)
+        d = std::max(d, std::abs(int(a[c]) - int(std::lround(expected[c] * 255.0f))));
+    return d;
+}
+
+TEST(ViewerGl, ImageQuadCarriesTheTracedImageAndHeatMapsItsCounters) {
+    const int w = 160, h = 100;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    Traced t = traceCpu("builtin:default", nullptr, w, h);
+    ImageView view;
+    view.upload(t.img, ViewMode::Color);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    std::vector<uint8_t> shown = gl.read(), expected = t.img.rgba8();
+    ASSERT_EQ(shown.size(), expected.size());
+    size_t differing = 0;
+    for (size_t i = 0; i < shown.size(); ++i)
+        differing += std::abs(int(shown[i]) - int(expected[i])) > 1;
+    EXPECT_EQ(differing, 0u) << "the quad must show every pixel of the image, row 0 on top";
+
+    // Heat map of primitive tests: each pixel is the colour map of its count over the scale.
+    std::vector<float> heat = heatChannel(t.img, ViewMode::PrimTests);
+    const float scale = autoScale(heat);
+    ASSERT_GT(scale, 1.0f);
+    view.upload(t.img, ViewMode::PrimTests);
+    view.draw(w, h, ViewMode::PrimTests, scale);
+    std::vector<uint8_t> hot = gl.read();
+    int worst = 0;
+    size_t changed = 0;
+    for (size_t i = 0; i < heat.size(); ++i) {
+        worst = std::max(worst, maxDiff(&hot[4 * i], colormap(heat[i] / scale)));
+        changed += std::abs(int(hot[4 * i]) - int(shown[4 * i])) > 8;
+    }
+    EXPECT_LE(worst, 2);
+    EXPECT_GT(changed, heat.size() / 2) << "the heat map must replace the colour image";
+    // The busiest pixel is drawn at the top of the map, an empty one at its bottom.
+    size_t top = size_t(std::max_element(heat.begin(), heat.end()) - heat.begin());
+    EXPECT_LE(maxDiff(&hot[4 * top], colormapStops().back()), 2);
+
+    // Halving the scale saturates more pixels: the scale is applied.
+    view.draw(w, h, ViewMode::PrimTests, scale * 0.5f);
+    std::vector<uint8_t> hotter = gl.read();
+    worst = 0;
+    for (size_t i = 0; i < heat.size(); ++i)
+        worst = std::max(worst, maxDiff(&hotter[4 * i], colormap(heat[i] / (scale * 0.5f))));
+    EXPECT_LE(worst, 2);
+}
+
+/// Run the whole viewer (panels, progressive render, drawing) until it has settled.
+class ViewerFrames : public ::testing::Test {
+  protected:
+    static constexpr int kW = 900, kH = 560;
+    void SetUp() override {
+        gl_ = std::make_unique<OffscreenGl>(kW, kH);
+        ASSERT_TRUE(gl_->ok());
+        ImGui::CreateContext();
+        ImGui::GetIO().IniFilename = nullptr;
+        ImGui::GetIO().DisplaySize = ImVec2(float(kW), float(kH));
+        ASSERT_TRUE(ImGui_ImplOpenGL3_Init("#version 330 core"));
+        settings_.scene = "builtin:default";
+        app_ = std::make_unique<ViewerApp>(settings_, false);
+    }
+    void TearDown() override {
+        app_.reset();
+        ImGui_ImplOpenGL3_Shutdown();
+        ImGui::DestroyContext();
+        gl_.reset();
+    }
+    /// Frames until the render has finished (at most ~30 s, so a bug fails instead of hanging).
+    int runUntilSettled() {
+        int frames = 0;
+        auto start = std::chrono::steady_clock::now();
+        do {
+            ImGui::GetIO().DeltaTime = 1.0f / 60.0f;
+            app_->frame(kW, kH);
+            ++frames;
+            if (!app_->settled()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        } while ((!app_->settled() || frames < 3) &&
+                 std::chrono::steady_clock::now() - start < std::chrono::seconds(30));
+        return frames;
+    }
+    // The middle of the window, between the default panels (left 8..338, right kW-348..).
+    static bool inCentre(int x, int y) {
+        return x >= 350 && x < kW - 360 && y >= 40 && y < kH - 10;
+    }
+
+    std::unique_ptr<OffscreenGl> gl_;
+    ViewerSettings settings_;
+    std::unique_ptr<ViewerApp> app_;
+};
+
+TEST_F(ViewerFrames, ShowsTheRenderedSceneAndThePanels) {
+    runUntilSettled();
+    ASSERT_TRUE(app_->settled());
+    ASSERT_TRUE(app_->error().empty()) << app_->error();
+    ASSERT_EQ(app_->displayed().width, kW);
+    std::vector<uint8_t> shown = gl_->read();
+    Camera cam = app_->camera();
+    Traced t = traceCpu("builtin:default", &cam, kW, kH);
+    std::vector<uint8_t> cpu = t.img.rgba8();
+    size_t centre = 0, centreDiff = 0, outside = 0, outsideDiff = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            size_t i = 4 * (size_t(y) * kW + size_t(x));
+            bool differs = false;
+            for (int c = 0; c < 3; ++c)
+                differs |= std::abs(int(shown[i + c]) - int(cpu[i + c])) > 1;
+            if (inCentre(x, y)) {
+                ++centre;
+                centreDiff += differs;
+            } else if (x < 330 && y > 40 && y < 400) {  // the Parameters panel
+                ++outside;
+                outsideDiff += differs;
+            }
+        }
+    EXPECT_EQ(centreDiff, 0u) << "between the panels the window shows the CPU render exactly";
+    EXPECT_GT(outsideDiff, outside / 2) << "the Parameters panel is drawn over the image";
+}
+
+TEST_F(ViewerFrames, HeatMapModeShowsPrimitiveTests) {
+    runUntilSettled();
+    ASSERT_TRUE(app_->settled());
+    std::vector<uint8_t> colour = gl_->read();
+    app_->setViewMode(ViewMode::RegionVisits);
+    app_->setViewMode(ViewMode::PrimTests);
+    runUntilSettled();
+    std::vector<uint8_t> hot = gl_->read();
+    const Image& img = app_->displayed();
+    const float scale = app_->heatScale();
+    EXPECT_EQ(scale, autoScale(heatChannel(img, ViewMode::PrimTests)));
+    int worst = 0;
+    size_t changed = 0, n = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            if (!inCentre(x, y)) continue;
+            size_t i = size_t(y) * kW + size_t(x);
+            worst =
+                std::max(worst, maxDiff(&hot[4 * i], colormap(float(img.primTests[i]) / scale)));
+            changed += std::abs(int(hot[4 * i]) - int(colour[4 * i])) > 8;
+            ++n;
+        }
+    EXPECT_LE(worst, 2);
+    EXPECT_GT(changed, n / 2);
+}
+
+TEST_F(ViewerFrames, DragsMoveTheCameraExceptWhenImGuiWantsTheMouse) {
+    runUntilSettled();
+    ImGuiIO& io = ImGui::GetIO();
+    auto frame = [&] {
+        io.DeltaTime = 1.0f / 60.0f;
+        app_->frame(kW, kH);
+    };
+    auto drag = [&](float x0, float y0, float x1, float y1) {
+        io.MousePos = ImVec2(x0, y0);
+        frame();
+        io.MouseDown[0] = true;
+        frame();
+        for (int i = 1; i <= 5; ++i) {
+            io.MousePos = ImVec2(x0 + (x1 - x0) * float(i) / 5.0f, y0 + (y1 - y0) * float(i) / 5.0f);
+            frame();
+        }
+        io.MouseDown[0] = false;
+        frame();
+    };
+    const Camera home = app_->camera();
+    drag(150.0f, 200.0f, 250.0f, 260.0f);  // starts on the Parameters panel: ImGui's
+    EXPECT_EQ(app_->camera().from, home.from);
+    drag(600.0f, 300.0f, 680.0f, 300.0f);  // starts on the image: orbits about the target
+    EXPECT_NE(app_->camera().from, home.from);
+    EXPECT_EQ(app_->camera().at, home.at);
+    EXPECT_NEAR(glm::length(app_->camera().from - home.at), glm::length(home.from - home.at), 1e-9);
+    const Camera orbited = app_->camera();
+    io.MousePos = ImVec2(600.0f, 300.0f);
+    io.MouseWheel = 1.0f;  // zoom in
+    frame();
+    io.MouseWheel = 0.0f;
+    EXPECT_LT(glm::length(app_->camera().from - home.at), glm::length(orbited.from - home.at));
+    io.AddInputCharacter('r');  // reset
+    frame();
+    EXPECT_EQ(app_->camera().from, home.from);
+    io.AddInputCharacter('o');  // orthographic
+    frame();
+    EXPECT_EQ(app_->camera().projection, Projection::Orthographic);
+    // The new view is rendered: once settled, the screen shows the orthographic CPU render.
+    runUntilSettled();
+    Camera cam = app_->camera();
+    Traced t = traceCpu("builtin:default", &cam, kW, kH);
+    EXPECT_EQ(app_->displayed().color, t.img.color);
+}
+
+TEST_F(ViewerFrames, ASceneThatFailsToLoadKeepsThePreviousOne) {
+    runUntilSettled();
+    auto before = app_->structure();
+    ASSERT_TRUE(before);
+    app_->openScene("/nonexistent/scene.nff");
+    runUntilSettled();
+    EXPECT_NE(app_->error().find("/nonexistent/scene.nff"), std::string::npos) << app_->error();
+    EXPECT_EQ(app_->structure(), before);
+    EXPECT_EQ(settings_.scene, "builtin:default");
+    // A scheme that cannot be built (or an invalid parameter) keeps the structure too.
+    settings_.build.maxLevel = 18;
+    app_->openScene("builtin:balls:1");
+    runUntilSettled();
+    EXPECT_TRUE(app_->error().empty()) << app_->error();
+    EXPECT_EQ(settings_.scene, "builtin:balls:1");
+}
+
+}  // namespace
+}  // namespace lancer::viewer

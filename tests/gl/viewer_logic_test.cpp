@@ -1,0 +1,124 @@
+// The viewer's camera controls, camera JSON and saved settings (no GL needed, but they live in
+// the viewer library this binary links).
+#include <gtest/gtest.h>
+
+#include "app/viewer/camera_control.h"
+#include "app/viewer/viewer_settings.h"
+#include "engine/scene/scene.h"
+
+namespace lancer::viewer {
+namespace {
+
+Camera sample() {
+    Camera c;
+    c.from = {1.5, -10.0, 4.5};
+    c.at = {0.0, 0.0, -0.2};
+    c.up = {0.0, 0.0, 1.0};
+    c.fov = 38.0;
+    return c;
+}
+
+TEST(CameraControl, OrbitKeepsTheDistanceAndTheTarget) {
+    Camera c = sample();
+    double d = glm::length(c.from - c.at);
+    orbit(c, 0.7, 0.3);
+    EXPECT_NEAR(glm::length(c.from - c.at), d, 1e-9);
+    EXPECT_EQ(c.at, sample().at);
+    EXPECT_TRUE(c.validate().empty());
+    // Pitching far past the pole stops short of it: the view never looks along `up`.
+    orbit(c, 0.0, 10.0);
+    Vec3 f = glm::normalize(c.at - c.from);
+    EXPECT_LT(std::abs(glm::dot(f, c.up)), std::cos(glm::radians(0.5)));
+    EXPECT_TRUE(c.validate().empty());
+}
+
+TEST(CameraControl, PanMovesEyeAndTargetTogetherInTheImagePlane) {
+    Camera c = sample();
+    Vec3 f, r, u;
+    c.basis(f, r, u);
+    pan(c, 100.0, 0.0, 500);
+    Vec3 move = c.at - sample().at;
+    EXPECT_NEAR(glm::length((c.from - sample().from) - move), 0.0, 1e-12);
+    EXPECT_NEAR(glm::dot(move, f), 0.0, 1e-12);
+    EXPECT_LT(glm::dot(move, r), 0.0)
+        << "dragging right moves the camera left: the scene follows the mouse";
+    // A drag the height of the viewport moves by the visible height at the target.
+    Camera d = sample();
+    pan(d, 0.0, 500.0, 500);
+    double visible = 2.0 * glm::length(sample().at - sample().from) * std::tan(glm::radians(19.0));
+    EXPECT_NEAR(glm::length(d.at - sample().at), visible, 1e-9);
+}
+
+TEST(CameraControl, ZoomAndProjectionToggleKeepTheFraming) {
+    Camera c = sample();
+    double d = glm::length(c.from - c.at);
+    zoom(c, 0.5);
+    EXPECT_NEAR(glm::length(c.from - c.at), 0.5 * d, 1e-9);
+    toggleProjection(c);
+    EXPECT_EQ(c.projection, Projection::Orthographic);
+    EXPECT_NEAR(c.orthoHeight, 2.0 * 0.5 * d * std::tan(glm::radians(19.0)), 1e-9);
+    zoom(c, 2.0);
+    EXPECT_NEAR(c.orthoHeight, 2.0 * d * std::tan(glm::radians(19.0)), 1e-9);
+    toggleProjection(c);
+    EXPECT_EQ(c.projection, Projection::Perspective);
+    EXPECT_NEAR(glm::length(c.from - c.at), d, 1e-9);
+}
+
+TEST(CameraControl, JsonRoundTripAndErrors) {
+    Camera c = sample();
+    Camera back = cameraFromJson(c.toJson(), Camera{});
+    EXPECT_EQ(back.from, c.from);
+    EXPECT_EQ(back.at, c.at);
+    EXPECT_EQ(back.up, c.up);
+    EXPECT_EQ(back.fov, c.fov);
+    toggleProjection(c);
+    back = cameraFromJson(c.toJson(), sample());
+    EXPECT_EQ(back.projection, Projection::Orthographic);
+    EXPECT_EQ(back.orthoHeight, c.orthoHeight);
+    try {
+        cameraFromJson("{\"from\": [0, 0, 0],\n \"at\": [0, 0, 0]}", sample());
+        FAIL() << "a camera looking at its own eye must be refused";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("camera JSON:1:1"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(cameraFromJson("{\"fov\": 200}", sample()), SceneError);
+    EXPECT_THROW(cameraFromJson("not json", sample()), SceneError);
+}
+
+TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
+    ViewerSettings s;
+    s.scene = "assets/spd/balls4.nff";
+    s.build.scheme = SchemeKind::Irregular;
+    s.build.maxLevel = 7;
+    s.build.maxObjects = 5;
+    s.build.step = StepMethod::Push;
+    s.build.delta = 3.5e-7;
+    s.build.heuristic = BspHeuristic::FewestCuts;
+    s.build.mailboxes = false;
+    s.threads = 1;
+    s.shading.bounces = 2;
+    s.shading.shadows = false;
+    s.windowWidth = 800;
+    s.windowHeight = 600;
+    s.showStatistics = false;
+    s.mode = ViewMode::TimeUs;
+    s.autoScale = false;
+    s.heatScale = 42.0f;
+    ViewerSettings r;
+    std::string lines = settingsLines(s);
+    size_t start = 0;
+    while (start < lines.size()) {
+        size_t end = lines.find('\n', start);
+        readSettingsLine(r, lines.substr(start, end - start));
+        start = end + 1;
+    }
+    EXPECT_EQ(settingsLines(r), lines);
+    ViewerSettings bad = r;
+    for (const char* line :
+         {"max_level=999", "scheme=octree", "window=5 5", "delta=-1", "threads=x", "garbage"})
+        readSettingsLine(bad, line);
+    EXPECT_EQ(settingsLines(bad), lines);
+}
+
+}  // namespace
+}  // namespace lancer::viewer

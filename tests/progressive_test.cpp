@@ -1,0 +1,97 @@
+// The progressive renderer: its passes add up to the full render, coarse passes show as blocks,
+// and a new job cancels the one in flight.
+#include "engine/render/progressive.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
+
+#include "engine/scene/loader.h"
+
+namespace lancer {
+namespace {
+
+bool waitFor(const std::function<bool()>& done, double seconds = 30.0) {
+    auto start = std::chrono::steady_clock::now();
+    while (!done()) {
+        if (std::chrono::steady_clock::now() - start > std::chrono::duration<double>(seconds))
+            return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return true;
+}
+
+TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
+    auto scene = std::make_shared<const Scene>(loadScene("builtin:default"));
+    std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
+    RenderOptions opt;
+    opt.width = 97;  // not a multiple of the strides: partial blocks at the edges
+    opt.height = 61;
+    Image direct(opt.width, opt.height);
+    render(*scene, *accel, opt, direct);
+
+    ProgressiveRenderer pr({8, 4, 2, 1});
+    pr.start({scene, accel, opt});
+    Image shown;
+    uint64_t version = 0;
+    std::vector<int> seenStrides;
+    auto start = std::chrono::steady_clock::now();
+    for (;;) {
+        ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
+        const bool finished = pr.finished();  // read first: then the snapshot below is the last
+        int stride = 0;
+        if (pr.snapshot(version, shown, &stride)) {
+            seenStrides.push_back(stride);
+            // Every pixel shows its block's corner pixel of the direct render.
+            for (int y = 0; y < opt.height; ++y)
+                for (int x = 0; x < opt.width; ++x) {
+                    size_t s = direct.index(x - x % stride, y - y % stride), d = shown.index(x, y);
+                    ASSERT_EQ(shown.color[d], direct.color[s])
+                        << x << "," << y << " stride " << stride;
+                    ASSERT_EQ(shown.primTests[d], direct.primTests[s]);
+                }
+        }
+        if (finished) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    ASSERT_FALSE(seenStrides.empty());
+    EXPECT_EQ(seenStrides.back(), 1);
+    std::vector<PassRecord> passes = pr.passes();
+    ASSERT_EQ(passes.size(), 4u);
+    uint64_t primary = 0;
+    for (const PassRecord& p : passes) primary += p.counters.primaryRays;
+    EXPECT_EQ(primary, uint64_t(opt.width) * uint64_t(opt.height))
+        << "each pixel is traced once over the passes";
+    EXPECT_EQ(shown.color, direct.color);
+}
+
+TEST(Progressive, ANewJobCancelsTheOneInFlight) {
+    auto scene = std::make_shared<const Scene>(loadScene("builtin:balls:3"));
+    std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
+    RenderOptions big;
+    big.width = 1600;  // brute force on 800 spheres: minutes if it were not cancelled
+    big.height = 1200;
+    ProgressiveRenderer pr;
+    pr.start({scene, accel, big});
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    RenderOptions small;
+    small.width = 24;
+    small.height = 16;
+    auto t0 = std::chrono::steady_clock::now();
+    pr.start({scene, accel, small});
+    Image shown;
+    uint64_t version = 0;
+    ASSERT_TRUE(waitFor([&] { return pr.finished(); }, 20.0)) << "the big job was not cancelled";
+    double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_LT(ms, 10000.0);
+    ASSERT_TRUE(pr.snapshot(version, shown));
+    EXPECT_EQ(shown.width, 24);
+    EXPECT_EQ(shown.height, 16);
+    pr.cancel();
+    EXPECT_TRUE(waitFor([&] { return pr.idle(); }, 20.0));
+}
+
+}  // namespace
+}  // namespace lancer
