@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "engine/accel/brute_force.h"
+#include "engine/accel/regular/regular_grid.h"
 
 namespace lancer {
 
@@ -28,6 +29,7 @@ struct BuildParams {
     double delta = 1e-6;        ///< push distance, relative to the scene box's largest extent
     BspHeuristic heuristic = BspHeuristic::Balanced;
     bool mailboxes = true;      ///< --no-mailbox turns them off to measure their effect
+    bool fullTable = false;     ///< regular: one full directory table instead of sub-tables
 };
 
 /// What a built structure reports: `--stats` and the viewer show it.
@@ -40,7 +42,7 @@ struct AccelInfo {
 
 class Accelerator {
 public:
-    using Impl = std::variant<BruteForce>;
+    using Impl = std::variant<BruteForce, RegularGrid>;
 
     Accelerator(Impl impl, BuildParams params, AccelInfo info)
         : impl_(std::move(impl)), params_(params), info_(std::move(info)) {}
