@@ -27,8 +27,8 @@ struct BspNodes {
 /// The directory: full table or sub-tables, one lookup path for both.
 class Directory {
 public:
-    /// Levels a sub-table covers at most (6: 4x4x4 entries). Measured on balls4 and drilled:
-    /// 3 and 9 gave the same render time within noise; 6 keeps tables small (256 bytes).
+    /// Levels a sub-table covers at most (6: 4x4x4 entries, 256 bytes): fewer levels mean
+    /// more hops per lookup, more mean larger tables for partly uniform blocks.
     static constexpr int kSubTableLevels = 6;
     /// Levels the top table covers at most in sub-table mode (12: 16x16x16 entries, 16 KiB).
     static constexpr int kTopLevels = 12;
@@ -44,9 +44,9 @@ public:
     uint32_t lookup(uint32_t i, uint32_t j, uint32_t k) const {
         const Table* t = &tables_[0];
         for (;;) {
-            uint32_t e = entries_[t->offset + (((i >> t->shift[0]) & t->mask[0]) << t->lowBits) +
-                                  (((j >> t->shift[1]) & t->mask[1]) << t->bits[2]) +
-                                  ((k >> t->shift[2]) & t->mask[2])];
+            uint32_t e = entries_[t->offset + (((i >> t->shift[0]) & t->mask(0)) << t->lowBits) +
+                                  (((j >> t->shift[1]) & t->mask(1)) << t->bits[2]) +
+                                  ((k >> t->shift[2]) & t->mask(2))];
             if (!(e & kSubTable)) return e;
             t = &tables_[e & ~kSubTable];
         }
@@ -63,12 +63,14 @@ private:
     static constexpr uint32_t kSubTable = 0x80000000u;
 
     /// One table: a block of the grid at BSP level `level`, subdivided `levels` more levels.
+    /// 12 bytes: many sub-tables are small (a node two levels deep has 4 entries).
     struct Table {
-        uint32_t offset = 0;     ///< first entry in entries_
-        uint32_t shift[3] = {};  ///< finest index >> shift = index at the table's finest level
-        uint32_t mask[3] = {};   ///< low bits: position inside the block
-        uint32_t bits[3] = {};   ///< entries per axis = 2^bits
-        uint32_t lowBits = 0;    ///< bits[1] + bits[2]
+        uint32_t offset = 0;    ///< first entry in entries_
+        uint8_t shift[3] = {};  ///< finest index >> shift = index at the table's finest level
+        uint8_t bits[3] = {};   ///< entries per axis = 2^bits
+        uint8_t lowBits = 0;    ///< bits[1] + bits[2]
+        /// Low bits of an index at the table's finest level: the position inside the block.
+        uint32_t mask(int a) const { return (1u << bits[a]) - 1u; }
     };
 
     /// Levels a table rooted at a node of `height` at `level` covers.
