@@ -90,7 +90,8 @@ void expectPixelsMatch(const std::string& spec, int size, StepMethod step) {
     auto accel = buildAccelerator(s, regular(step));
     auto rays = test::pixelRays(s, size, size);
     auto bad = test::compareWithBrute(s, *accel, rays);
-    EXPECT_TRUE(bad.empty()) << spec << ": " << bad.size() << " pixels differ\n" << describe(s, bad);
+    EXPECT_TRUE(bad.empty()) << spec << ": " << bad.size() << " pixels differ\n"
+                             << describe(s, bad);
     EXPECT_EQ(walkErrors(s, *accel, rays), 0u) << spec;
 }
 
@@ -169,7 +170,9 @@ void randomScenesMatchBrute(StepMethod step, int seeds) {
 }
 
 TEST(RegularExact, RandomCsgScenesRayForRay) { randomScenesMatchBrute(StepMethod::Exact, 6); }
-TEST(RegularPush, RandomCsgScenesRayForRayAtDefaultDelta) { randomScenesMatchBrute(StepMethod::Push, 6); }
+TEST(RegularPush, RandomCsgScenesRayForRayAtDefaultDelta) {
+    randomScenesMatchBrute(StepMethod::Push, 6);
+}
 
 // The report's push has an error: a delta larger than a thin cell jumps over it (wrong hits);
 // a delta below the coordinates' rounding does not leave the cell (stalls, counted errors).
@@ -198,8 +201,10 @@ TEST(RegularPush, WrongForDeltaTooLargeOrTooSmallWhereExactIsRight) {
         stalledOrWrong += walkErrors(s, *tiny, rays) +
                           test::compareWithBrute(s, *tiny, rays, 0.0, 1e-9, SIZE_MAX).size();
     }
-    std::printf("push, delta 0.05: %zu wrong hits; delta 1e-19: %zu walk errors + wrong hits "
-                "(exact: none)\n", skipped, stalledOrWrong);
+    std::printf(
+        "push, delta 0.05: %zu wrong hits; delta 1e-19: %zu walk errors + wrong hits "
+        "(exact: none)\n",
+        skipped, stalledOrWrong);
     EXPECT_GT(skipped, 0u) << "a push larger than the cells should skip some";
     EXPECT_GT(stalledOrWrong, 0u) << "a push below rounding should stall";
 }
@@ -283,14 +288,16 @@ TEST(RegularRender, ImageWithBouncesEqualsBrute) {
     EXPECT_GT(sr.counters.rays, sr.counters.primaryRays);
     EXPECT_EQ(sr.counters.walkErrors, 0u);
     EXPECT_EQ(ib.hitPrim, ir.hitPrim);
-    for (size_t i = 0; i < ib.color.size(); ++i) ASSERT_EQ(ib.color[i], ir.color[i]) << "pixel " << i;
+    for (size_t i = 0; i < ib.color.size(); ++i)
+        ASSERT_EQ(ib.color[i], ir.color[i]) << "pixel " << i;
 }
 
 // Sub-tables name the same leaf as the full table for every point, in less memory.
 TEST(RegularSubTables, SameLeafAsFullTableInLessMemory) {
     // Scenes whose subdivision is deep in places and shallow elsewhere (in a uniformly deep
     // one, such as drilled:4 at max-objects 1, sub-tables cost about as much as the full table).
-    for (std::string spec : {std::string(LANCER_SPD_DIR) + "/balls2.nff", std::string("builtin:default")}) {
+    for (std::string spec :
+         {std::string(LANCER_SPD_DIR) + "/balls2.nff", std::string("builtin:default")}) {
         Scene s = loadScene(spec);
         BuildParams pf = regular();
         pf.maxLevel = 18;  // deeper than the top table, so sub-tables appear
@@ -314,9 +321,11 @@ TEST(RegularSubTables, SameLeafAsFullTableInLessMemory) {
             uint32_t i = uint32_t(c % gf.cells(0)), j = uint32_t(c / gf.cells(0) % gf.cells(1)),
                      k = uint32_t(c / gf.cells(0) / gf.cells(1));
             uint32_t leaf = gf.directory().lookup(i, j, k);
-            ASSERT_EQ(leaf, gs.directory().lookup(i, j, k)) << spec << " cell " << i << " " << j << " " << k;
+            ASSERT_EQ(leaf, gs.directory().lookup(i, j, k))
+                << spec << " cell " << i << " " << j << " " << k;
             const RegularLeaf& L = gf.leaves()[leaf];
-            ASSERT_TRUE(L.lo[0] <= i && i < L.hi[0] && L.lo[1] <= j && j < L.hi[1] && L.lo[2] <= k && k < L.hi[2]);
+            ASSERT_TRUE(L.lo[0] <= i && i < L.hi[0] && L.lo[1] <= j && j < L.hi[1] &&
+                        L.lo[2] <= k && k < L.hi[2]);
         }
     }
 }
@@ -390,7 +399,8 @@ TEST(RegularBuild, LeavesHoldTheirOverlappingPrimitivesAndShareTrees) {
     CsgTree t = g.treePool();
     for (const RegularLeaf& L : g.leaves()) {
         Box3 cell;
-        for (int a = 0; a < 3; ++a) cell.lo[a] = g.plane(a, L.lo[a]), cell.hi[a] = g.plane(a, L.hi[a]);
+        for (int a = 0; a < 3; ++a)
+            cell.lo[a] = g.plane(a, L.lo[a]), cell.hi[a] = g.plane(a, L.hi[a]);
         t.root = L.root;
         std::vector<uint32_t> ps = L.root < 0 ? std::vector<uint32_t>{} : t.primitives();
         EXPECT_EQ(ps.size(), L.prims);

@@ -72,7 +72,8 @@ void Directory::fill(const BspNodes& bsp, uint32_t table, int tableLevel, int le
     if (n.first < 0 || level == bottom) {
         // A leaf owns every entry of its block; an inner node at the table's bottom level gets
         // one entry naming its own sub-table.
-        uint32_t value = n.first < 0 ? n.leaf : kSubTable | addTable(bsp, node, level, finestLevel, full);
+        uint32_t value =
+            n.first < 0 ? n.leaf : kSubTable | addTable(bsp, node, level, finestLevel, full);
         const Table t = tables_[table];  // copy: addTable may have grown tables_
         uint32_t lo[3], hi[3];
         for (int a = 0; a < 3; ++a) {

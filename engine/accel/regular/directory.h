@@ -26,9 +26,11 @@ struct BspNodes {
 
 /// The directory: full table or sub-tables, one lookup path for both.
 class Directory {
-public:
-    /// Levels a sub-table covers at most (6: 4x4x4 entries, 256 bytes): fewer levels mean
-    /// more hops per lookup, more mean larger tables for partly uniform blocks.
+  public:
+    /// Levels a sub-table covers at most (6: 4x4x4 entries, 256 bytes). Fewer levels mean more
+    /// hops per lookup, more mean larger tables for partly uniform blocks. Directory bytes
+    /// measured on balls4 / drilled:20 at the defaults: 3 levels 149 / 442 KB, 6 levels
+    /// 194 / 585 KB, 9 levels 226 / 813 KB; render times differed within noise.
     static constexpr int kSubTableLevels = 6;
     /// Levels the top table covers at most in sub-table mode (12: 16x16x16 entries, 16 KiB).
     static constexpr int kTopLevels = 12;
@@ -58,7 +60,7 @@ public:
     size_t tableCount() const { return tables_.size(); }
     size_t entryCount() const { return entries_.size(); }
 
-private:
+  private:
     /// Tag of an entry that names a sub-table rather than a leaf.
     static constexpr uint32_t kSubTable = 0x80000000u;
 

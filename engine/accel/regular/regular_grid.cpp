@@ -44,13 +44,15 @@ struct RegularBuilder {
     /// Plane `i` of `level`-cut grid on `axis` (i in 0..2^cuts); equal to grid.plane() at the
     /// finest level, since i / 2^c == (i 2^(n-c)) / 2^n exactly in floating point.
     double planeAt(int axis, uint32_t i, int cuts) const {
-        return i == (1u << cuts) ? grid.box_.hi[axis]
-                                 : grid.box_.lo[axis] + grid.ext_[axis] * std::ldexp(double(i), -cuts);
+        return i == (1u << cuts)
+                   ? grid.box_.hi[axis]
+                   : grid.box_.lo[axis] + grid.ext_[axis] * std::ldexp(double(i), -cuts);
     }
 
     std::string refusal() const {
         return "--max-level " + std::to_string(params.maxLevel) + " --max-objects " +
-               std::to_string(params.maxObjects) + ": the regular subdivision would need more than " +
+               std::to_string(params.maxObjects) +
+               ": the regular subdivision would need more than " +
                std::to_string(RegularGrid::kMaxBspNodes) + " BSP nodes (memory budget " +
                megabytes(RegularGrid::kMemoryBudget) +
                "); lower --max-level or raise --max-objects";
@@ -103,7 +105,8 @@ struct RegularBuilder {
             makeLeaf(id, level, pos, treeFor(tree, prims), uint32_t(prims.size()));
             return;
         }
-        if (bsp.nodes.size() + 2 > RegularGrid::kMaxBspNodes) throw std::invalid_argument(refusal());
+        if (bsp.nodes.size() + 2 > RegularGrid::kMaxBspNodes)
+            throw std::invalid_argument(refusal());
         // A cell inside every one of its primitives' boxes: every sub-cell has the same
         // primitives, so the same restricted tree, and the subtree is complete down to
         // max-level. This is how absurd parameters explode (cells inside the overlap of more
@@ -186,7 +189,8 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
     // Build the BSP.
     RegularBuilder b{scene, params, *this, {}, std::vector<char>(scene.prims.size(), 0), {}, {}};
     b.bsp.nodes.resize(1);
-    std::vector<uint32_t> live = scene.tree.empty() ? std::vector<uint32_t>{} : scene.tree.primitives();
+    std::vector<uint32_t> live =
+        scene.tree.empty() ? std::vector<uint32_t>{} : scene.tree.primitives();
     sortedUnique(live);
     const uint32_t origin[3] = {0, 0, 0};
     b.build(0, 0, origin, box_, scene.tree, live);
@@ -214,20 +218,24 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
     const bool full = params.fullTable;
     const size_t fullBytes = Directory::estimateBytes(b.bsp, finest, true);
     const size_t dirBytes = full ? fullBytes : Directory::estimateBytes(b.bsp, finest, false);
-    const size_t otherBytes = leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode);
+    const size_t otherBytes =
+        leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode);
     if (dirBytes > kMemoryBudget || dirBytes + otherBytes > kMemoryBudget) {
         std::string what = full ? "--full-table" : "--max-level " + std::to_string(params.maxLevel);
-        throw std::invalid_argument(what + ": the regular directory at level " + std::to_string(finest) +
-                                    " would take " + (dirBytes == SIZE_MAX ? std::string("2^") + std::to_string(finest + 2) + " bytes" : megabytes(dirBytes)) +
-                                    ", over the memory budget of " + megabytes(kMemoryBudget) +
-                                    (full ? "; use sub-tables (drop --full-table)" : "; lower --max-level"));
+        throw std::invalid_argument(
+            what + ": the regular directory at level " + std::to_string(finest) + " would take " +
+            (dirBytes == SIZE_MAX ? std::string("2^") + std::to_string(finest + 2) + " bytes"
+                                  : megabytes(dirBytes)) +
+            ", over the memory budget of " + megabytes(kMemoryBudget) +
+            (full ? "; use sub-tables (drop --full-table)" : "; lower --max-level"));
     }
     dir_.build(b.bsp, finest, full);
 
     extra_ = {
         {"directory", full ? "full" : "sub-tables"},
         {"directory_bytes", dir_.memoryBytes()},
-        {"full_table_bytes", fullBytes == SIZE_MAX ? nlohmann::json(nullptr) : nlohmann::json(fullBytes)},
+        {"full_table_bytes",
+         fullBytes == SIZE_MAX ? nlohmann::json(nullptr) : nlohmann::json(fullBytes)},
         {"sub_tables", dir_.tableCount()},
         {"leaves", leaves_.size()},
         {"empty_leaves", b.emptyLeaves},

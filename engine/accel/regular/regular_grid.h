@@ -20,12 +20,12 @@ struct BuildParams;  // engine/accel/accelerator.h, which includes this header
 /// A BSP leaf: its block of the finest grid, [lo, hi) per axis, and its restricted tree.
 struct RegularLeaf {
     uint32_t lo[3] = {}, hi[3] = {};
-    int32_t root = -1;     ///< restricted tree in the shared pool; -1: empty
-    uint32_t prims = 0;    ///< primitives in the restricted tree
+    int32_t root = -1;   ///< restricted tree in the shared pool; -1: empty
+    uint32_t prims = 0;  ///< primitives in the restricted tree
 };
 
 class RegularGrid {
-public:
+  public:
     /// Whole structure (BSP while building, leaves, trees, directory) must fit in this.
     static constexpr size_t kMemoryBudget = size_t(512) << 20;
     /// BSP nodes allowed while building (4M: about 200 MiB of nodes, leaves and tables). An
@@ -61,7 +61,8 @@ public:
     uint32_t cells(int axis) const { return n_[axis]; }
     /// Coordinate of grid plane k (0..2^n) on `axis`; plane 2^n is exactly box().hi.
     double plane(int axis, uint32_t k) const {
-        return k == n_[axis] ? box_.hi[axis] : box_.lo[axis] + ext_[axis] * (double(k) * inv_[axis]);
+        return k == n_[axis] ? box_.hi[axis]
+                             : box_.lo[axis] + ext_[axis] * (double(k) * inv_[axis]);
     }
     /// The report's point location, 0-based: floor((x - min) / (max - min) * 2^n), clamped.
     uint32_t locate(int axis, double x) const {
@@ -70,9 +71,11 @@ public:
         return f >= double(n_[axis]) ? n_[axis] - 1 : uint32_t(f);
     }
     /// Leaf holding a point (clamped into the grid).
-    uint32_t leafAt(const Vec3& p) const { return dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z)); }
+    uint32_t leafAt(const Vec3& p) const {
+        return dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
+    }
 
-private:
+  private:
     const Scene* scene_;
     bool exact_ = true;   ///< --step exact (else push)
     double delta_ = 0.0;  ///< absolute push distance
@@ -115,9 +118,12 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
         double tExit = kInf;
         int exitAxis = -1;
         for (int a = 0; a < 3; ++a) {
-            if (ray.d[a] > 0.0) tAxis[a] = (plane(a, L.hi[a]) - ray.o[a]) / ray.d[a];
-            else if (ray.d[a] < 0.0) tAxis[a] = (plane(a, L.lo[a]) - ray.o[a]) / ray.d[a];
-            else tAxis[a] = kInf;
+            if (ray.d[a] > 0.0)
+                tAxis[a] = (plane(a, L.hi[a]) - ray.o[a]) / ray.d[a];
+            else if (ray.d[a] < 0.0)
+                tAxis[a] = (plane(a, L.lo[a]) - ray.o[a]) / ray.d[a];
+            else
+                tAxis[a] = kInf;
             if (tAxis[a] < tExit) tExit = tAxis[a], exitAxis = a;
         }
         bool last = !(tExit < tEnd);
@@ -131,11 +137,15 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
                 // is exact; the other indices are the exit point's, kept on the face.
                 const int a = exitAxis;
                 if (ray.d[a] > 0.0) {
-                    if (L.hi[a] == n_[a]) last = true;
-                    else next[a] = L.hi[a];
+                    if (L.hi[a] == n_[a])
+                        last = true;
+                    else
+                        next[a] = L.hi[a];
                 } else {
-                    if (L.lo[a] == 0) last = true;
-                    else next[a] = L.lo[a] - 1;
+                    if (L.lo[a] == 0)
+                        last = true;
+                    else
+                        next[a] = L.lo[a] - 1;
                 }
                 for (int b = 0; b < 3; ++b)
                     if (b != a) next[b] = std::clamp(locate(b, q[b]), L.lo[b], L.hi[b] - 1);
