@@ -40,6 +40,7 @@ struct RegularBuilder {
     uint64_t primRefs = 0;
     uint32_t maxPrims = 0;
     size_t emptyLeaves = 0;
+    size_t coveredLeaves = 0;  ///< leaves stopped because every box holds the whole cell
 
     /// Plane `i` of `level`-cut grid on `axis` (i in 0..2^cuts); equal to grid.plane() at the
     /// finest level, since i / 2^c == (i 2^(n-c)) / 2^n exactly in floating point.
@@ -82,21 +83,6 @@ struct RegularBuilder {
         maxPrims = std::max(maxPrims, nprims);
     }
 
-    /// The complete subtree of a covered cell: every leaf at max-level, all with one tree.
-    void complete(int id, int level, const uint32_t pos[3], int32_t root, uint32_t nprims) {
-        if (level >= params.maxLevel) return makeLeaf(id, level, pos, root, nprims);
-        int axis = level % 3;
-        int first = int(bsp.nodes.size());
-        bsp.nodes.resize(bsp.nodes.size() + 2);
-        bsp.nodes[size_t(id)].first = first;
-        bsp.nodes[size_t(id)].height = uint8_t(params.maxLevel - level);
-        for (int side = 0; side < 2; ++side) {
-            uint32_t cpos[3] = {pos[0], pos[1], pos[2]};
-            cpos[axis] = 2 * pos[axis] + uint32_t(side);
-            complete(first + side, level + 1, cpos, root, nprims);
-        }
-    }
-
     /// Node `id` at `level`, at index pos[a] of its level's grid on each axis, covering `box`;
     /// `tree` is the scene's tree restricted to `prims` (sorted), the primitives that matter here.
     void build(int id, int level, const uint32_t pos[3], const Box3& box, const CsgTree& tree,
@@ -107,11 +93,10 @@ struct RegularBuilder {
         }
         if (bsp.nodes.size() + 2 > RegularGrid::kMaxBspNodes)
             throw std::invalid_argument(refusal());
-        // A cell inside every one of its primitives' boxes: every sub-cell has the same
-        // primitives, so the same restricted tree, and the subtree is complete down to
-        // max-level. This is how absurd parameters explode (cells inside the overlap of more
-        // than max-objects boxes); its size is known, so it is refused before it is built, or
-        // else built without overlap tests or restrictions.
+        // A cell inside every one of its primitives' boxes is not split: every sub-cell would
+        // hold the same primitives, hence the same tree, so splitting only adds leaves. (The
+        // report stops at max-objects or max-level only; cells inside the overlap of more than
+        // max-objects boxes would then split down to max-level: millions of identical leaves.)
         bool covered = true;
         for (uint32_t p : prims) {
             const Box3& b = scene.minBox[p];
@@ -122,11 +107,8 @@ struct RegularBuilder {
             }
         }
         if (covered) {
-            int below = params.maxLevel - level;
-            if (below >= 40 || (size_t(2) << below) > RegularGrid::kMaxBspNodes - bsp.nodes.size())
-                throw std::invalid_argument(refusal());
-            int32_t root = treeFor(tree, prims);
-            complete(id, level, pos, root, uint32_t(prims.size()));
+            ++coveredLeaves;
+            makeLeaf(id, level, pos, treeFor(tree, prims), uint32_t(prims.size()));
             return;
         }
         // Middle cut on axis level % 3, in the grid's own plane coordinates.
@@ -239,6 +221,7 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
         {"sub_tables", dir_.tableCount()},
         {"leaves", leaves_.size()},
         {"empty_leaves", b.emptyLeaves},
+        {"covered_leaves", b.coveredLeaves},
         {"bsp_nodes", b.bsp.nodes.size()},
         {"finest_level", finest},
         {"depth_xyz", {depth[0], depth[1], depth[2]}},
