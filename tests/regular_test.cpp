@@ -232,8 +232,10 @@ TEST(RegularWalk, RegionsAreContiguousAndInRayOrder) {
             Vec3 mid = r.at(0.5 * (e.t0 + e.t1));
             for (int a = 0; a < 3; ++a) {
                 double slack = 1e-9 * g.box().extent()[a];
-                ASSERT_GE(mid[a], g.plane(a, L.lo[a]) - slack) << r.toString();
-                ASSERT_LE(mid[a], g.plane(a, L.hi[a]) + slack) << r.toString();
+                ASSERT_GE(mid[a], g.plane(a, L.lo[a]) - slack)
+                    << r.toString() << g.describeLeaf(e.a);
+                ASSERT_LE(mid[a], g.plane(a, L.hi[a]) + slack)
+                    << r.toString() << g.describeLeaf(e.a);
             }
             prev = e.t1;
             first = false;
@@ -241,6 +243,7 @@ TEST(RegularWalk, RegionsAreContiguousAndInRayOrder) {
         walks += !first;
     }
     EXPECT_GT(walks, 100);
+    EXPECT_NE(g.describeLeaf(0).find("leaf 0 cells ["), std::string::npos) << g.describeLeaf(0);
 }
 
 TEST(RegularMailbox, SameHitsFewerTestsThanWithout) {

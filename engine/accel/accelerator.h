@@ -25,8 +25,8 @@ struct BuildParams {
     SchemeKind scheme = SchemeKind::Brute;
     /// Deepest subdivision level (regular: total BSP depth, cuts x, y, z in turn). 24 and 4
     /// measured best for the regular scheme (README, "Regular subdivision"): balls4 11.7
-    /// primitive tests per ray (18: 65), and CSG scenes never explode (max-objects 2 does on
-    /// lattice, where bars overlap in threes).
+    /// primitive tests per ray (at 18 / 2: 65), and no built-in CSG scene explodes (at 24 / 2
+    /// lattice does, where box faces run through other boxes). Were 18 and 2.
     int maxLevel = 24;
     int maxObjects = 4;         ///< stop subdividing a cell holding at most this many primitives
     StepMethod step = StepMethod::Exact;

@@ -232,4 +232,19 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
     };
 }
 
+std::string RegularGrid::describeLeaf(uint32_t id) const {
+    const RegularLeaf& L = leaves_.at(id);
+    std::string out = "leaf " + std::to_string(id) + " cells ";
+    Box3 box;
+    for (int a = 0; a < 3; ++a) {
+        out += (a ? "x[" : "[") + std::to_string(L.lo[a]) + "," + std::to_string(L.hi[a]) + ")";
+        box.lo[a] = plane(a, L.lo[a]);
+        box.hi[a] = plane(a, L.hi[a]);
+    }
+    CsgTree tree;
+    tree.nodes = pool_.nodes;  // toString walks from root: a copy keeps this const
+    tree.root = L.root;
+    return out + " " + box.toString() + " " + std::to_string(L.prims) + " prims " + tree.toString();
+}
+
 }  // namespace lancer

@@ -70,6 +70,8 @@ class RegularGrid {
         if (!(f >= 0.0)) return 0;  // also NaN
         return f >= double(n_[axis]) ? n_[axis] - 1 : uint32_t(f);
     }
+    /// "leaf 12 cells [8,12)x[0,8)x[8,16) Box3{..} 2 prims (p1 − p11)": for messages and traces.
+    std::string describeLeaf(uint32_t id) const;
     /// Leaf holding a point (clamped into the grid).
     uint32_t leafAt(const Vec3& p) const {
         return dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
