@@ -41,6 +41,15 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
             info.buildMs = elapsedMs();
             return std::make_unique<Accelerator>(std::move(b), params, std::move(info));
         }
+        case SchemeKind::Regular: {
+            RegularGrid g(scene, params);
+            AccelInfo info;
+            info.regions = g.regionCount();
+            info.memoryBytes = g.memoryBytes();
+            info.extra = g.extra();
+            info.buildMs = elapsedMs();
+            return std::make_unique<Accelerator>(std::move(g), params, std::move(info));
+        }
         case SchemeKind::Irregular: {
             AccelInfo info;
             IrregularSubdivision s = IrregularSubdivision::build(scene, params, info.extra);
@@ -49,10 +58,8 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
             info.buildMs = elapsedMs();
             return std::make_unique<Accelerator>(std::move(s), params, std::move(info));
         }
-        default:
-            throw std::invalid_argument(std::string("--scheme ") + schemeName(params.scheme) +
-                                        ": this scheme is not implemented yet");
     }
+    throw std::logic_error("buildAccelerator: unknown scheme");
 }
 
 }  // namespace lancer

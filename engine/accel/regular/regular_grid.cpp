@@ -1,0 +1,250 @@
+#include "engine/accel/regular/regular_grid.h"
+
+#include <map>
+#include <stdexcept>
+
+#include "engine/accel/accelerator.h"
+
+namespace lancer {
+
+namespace {
+
+std::string megabytes(size_t bytes) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / double(1 << 20));
+    return buf;
+}
+
+void sortedUnique(std::vector<uint32_t>& v) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+}  // namespace
+
+/// Builds the BSP depth first. Each node's restricted tree is restricted again for its children
+/// (restriction composes: restricting to P then to Q ⊆ P equals restricting to Q), so a node
+/// costs the size of its parent's small tree, not of the scene's tree.
+struct RegularBuilder {
+    const Scene& scene;
+    const BuildParams& params;
+    RegularGrid& grid;
+    BspNodes bsp;
+    std::vector<char> keep;                          ///< membership marks, all 0 between uses
+    std::map<std::vector<uint32_t>, int32_t> trees;  ///< leaf primitive set -> pool root
+    struct LeafPlace {
+        int level;
+        uint32_t pos[3];
+    };
+    std::vector<LeafPlace> places;
+    uint64_t primRefs = 0;
+    uint32_t maxPrims = 0;
+    size_t emptyLeaves = 0;
+    size_t coveredLeaves = 0;  ///< leaves stopped because every box holds the whole cell
+
+    /// Plane `i` of `level`-cut grid on `axis` (i in 0..2^cuts); equal to grid.plane() at the
+    /// finest level, since i / 2^c == (i 2^(n-c)) / 2^n exactly in floating point.
+    double planeAt(int axis, uint32_t i, int cuts) const {
+        return i == (1u << cuts)
+                   ? grid.box_.hi[axis]
+                   : grid.box_.lo[axis] + grid.ext_[axis] * std::ldexp(double(i), -cuts);
+    }
+
+    std::string refusal() const {
+        return "--max-level " + std::to_string(params.maxLevel) + " --max-objects " +
+               std::to_string(params.maxObjects) +
+               ": the regular subdivision would need more than " +
+               std::to_string(RegularGrid::kMaxBspNodes) + " BSP nodes (memory budget " +
+               megabytes(RegularGrid::kMemoryBudget) +
+               "); lower --max-level or raise --max-objects";
+    }
+
+    /// Root in the shared pool of the tree restricted to `prims`, added once per set.
+    int32_t treeFor(const CsgTree& tree, const std::vector<uint32_t>& prims) {
+        if (prims.empty()) return -1;
+        auto [it, fresh] = trees.try_emplace(prims, -1);
+        if (fresh) {
+            for (uint32_t p : prims) keep[p] = 1;
+            it->second = restrictTree(tree, tree.root, keep, grid.pool_);
+            for (uint32_t p : prims) keep[p] = 0;
+        }
+        return it->second;
+    }
+
+    void makeLeaf(int id, int level, const uint32_t pos[3], int32_t root, uint32_t nprims) {
+        emptyLeaves += nprims == 0;
+        bsp.nodes[size_t(id)].leaf = uint32_t(grid.leaves_.size());
+        RegularLeaf leaf;
+        leaf.root = root;
+        leaf.prims = nprims;
+        grid.leaves_.push_back(leaf);
+        places.push_back({level, {pos[0], pos[1], pos[2]}});
+        primRefs += nprims;
+        maxPrims = std::max(maxPrims, nprims);
+    }
+
+    /// Node `id` at `level`, at index pos[a] of its level's grid on each axis, covering `box`;
+    /// `tree` is the scene's tree restricted to `prims` (sorted), the primitives that matter here.
+    void build(int id, int level, const uint32_t pos[3], const Box3& box, const CsgTree& tree,
+               const std::vector<uint32_t>& prims) {
+        if (prims.size() <= size_t(params.maxObjects) || level >= params.maxLevel) {
+            makeLeaf(id, level, pos, treeFor(tree, prims), uint32_t(prims.size()));
+            return;
+        }
+        if (bsp.nodes.size() + 2 > RegularGrid::kMaxBspNodes)
+            throw std::invalid_argument(refusal());
+        // A cell inside every one of its primitives' boxes is not split: every sub-cell would
+        // hold the same primitives, hence the same tree, so splitting only adds leaves. (The
+        // report stops at max-objects or max-level only; cells inside the overlap of more than
+        // max-objects boxes would then split down to max-level: millions of identical leaves.)
+        bool covered = true;
+        for (uint32_t p : prims) {
+            const Box3& b = scene.minBox[p];
+            if (!(b.lo.x <= box.lo.x && b.lo.y <= box.lo.y && b.lo.z <= box.lo.z &&
+                  b.hi.x >= box.hi.x && b.hi.y >= box.hi.y && b.hi.z >= box.hi.z)) {
+                covered = false;
+                break;
+            }
+        }
+        if (covered) {
+            ++coveredLeaves;
+            makeLeaf(id, level, pos, treeFor(tree, prims), uint32_t(prims.size()));
+            return;
+        }
+        // Middle cut on axis level % 3, in the grid's own plane coordinates.
+        int axis = level % 3;
+        int cuts = cutsOnAxis(level, axis);
+        double mid = planeAt(axis, 2 * pos[axis] + 1, cuts + 1);
+        int first = int(bsp.nodes.size());
+        bsp.nodes.resize(bsp.nodes.size() + 2);
+        bsp.nodes[size_t(id)].first = first;
+        uint8_t height = 0;
+        for (int side = 0; side < 2; ++side) {
+            Box3 child = box;
+            (side ? child.lo : child.hi)[axis] = mid;
+            // Primitives whose minimized boxes overlap the closed child box, then the tree
+            // restricted to them; a primitive the restriction drops cannot contribute here.
+            std::vector<uint32_t> in;
+            for (uint32_t p : prims)
+                if (scene.minBox[p].overlaps(child)) in.push_back(p);
+            CsgTree sub;
+            for (uint32_t p : in) keep[p] = 1;
+            sub.root = restrictTree(tree, tree.root, keep, sub);
+            for (uint32_t p : in) keep[p] = 0;
+            std::vector<uint32_t> live = sub.primitives();
+            sortedUnique(live);
+            uint32_t cpos[3] = {pos[0], pos[1], pos[2]};
+            cpos[axis] = 2 * pos[axis] + uint32_t(side);
+            build(first + side, level + 1, cpos, child, sub, live);
+            height = std::max<uint8_t>(height, bsp.nodes[size_t(first + side)].height + 1);
+        }
+        bsp.nodes[size_t(id)].height = height;
+    }
+};
+
+RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
+    : scene_(&scene), exact_(params.step == StepMethod::Exact) {
+    if (params.maxLevel < 0 || params.maxLevel > 48)
+        throw std::invalid_argument("--max-level " + std::to_string(params.maxLevel) +
+                                    ": must be in 0..48 for the regular scheme");
+    if (params.maxObjects < 1)
+        throw std::invalid_argument("--max-objects " + std::to_string(params.maxObjects) +
+                                    ": must be at least 1");
+    if (!exact_ && !(params.delta > 0.0 && params.delta < 1.0))
+        throw std::invalid_argument("--delta " + std::to_string(params.delta) +
+                                    ": must be in (0, 1) (relative to the scene size)");
+
+    // The grid box: the scene bounds, widened where they are flat so every axis can be cut.
+    box_ = scene.bounds.isEmpty() ? Box3{Vec3(-1.0), Vec3(1.0)} : scene.bounds;
+    Vec3 e = box_.extent();
+    double largest = std::max({e.x, e.y, e.z});
+    double pad = largest > 0.0 ? 1e-3 * largest
+                               : 1e-6 * std::max({1.0, glm::length(box_.lo), glm::length(box_.hi)});
+    for (int a = 0; a < 3; ++a)
+        if (!(e[a] > 0.0)) box_.lo[a] -= pad, box_.hi[a] += pad;
+    ext_ = box_.extent();
+    double hair = 1e-9 * (std::max({ext_.x, ext_.y, ext_.z}) +
+                          std::max(glm::length(box_.lo), glm::length(box_.hi)));
+    clipBox_ = {box_.lo - Vec3(hair), box_.hi + Vec3(hair)};
+    delta_ = params.delta * std::max({ext_.x, ext_.y, ext_.z});
+
+    // Build the BSP.
+    RegularBuilder b{scene, params, *this, {}, std::vector<char>(scene.prims.size(), 0), {}, {}};
+    b.bsp.nodes.resize(1);
+    std::vector<uint32_t> live =
+        scene.tree.empty() ? std::vector<uint32_t>{} : scene.tree.primitives();
+    sortedUnique(live);
+    const uint32_t origin[3] = {0, 0, 0};
+    b.build(0, 0, origin, box_, scene.tree, live);
+
+    // The finest level reached fixes the directory's resolution, 2^n per axis.
+    const int finest = b.bsp.nodes[0].height;
+    int depth[3];
+    for (int a = 0; a < 3; ++a) {
+        depth[a] = cutsOnAxis(finest, a);
+        n_[a] = 1u << depth[a];
+        inv_[a] = std::ldexp(1.0, -depth[a]);
+    }
+    for (size_t i = 0; i < leaves_.size(); ++i) {
+        const RegularBuilder::LeafPlace& pl = b.places[i];
+        for (int a = 0; a < 3; ++a) {
+            int shift = depth[a] - cutsOnAxis(pl.level, a);
+            leaves_[i].lo[a] = pl.pos[a] << shift;
+            leaves_[i].hi[a] = (pl.pos[a] + 1) << shift;
+        }
+    }
+    // Longest exact walk: one step per grid plane crossed, plus degenerate steps at edges.
+    maxSteps_ = 4 * (size_t(n_[0]) + n_[1] + n_[2]) + 16;
+
+    // The directory: estimated before it is allocated.
+    const bool full = params.fullTable;
+    const size_t fullBytes = Directory::estimateBytes(b.bsp, finest, true);
+    const size_t dirBytes = full ? fullBytes : Directory::estimateBytes(b.bsp, finest, false);
+    const size_t otherBytes =
+        leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode);
+    if (dirBytes > kMemoryBudget || dirBytes + otherBytes > kMemoryBudget) {
+        std::string what = full ? "--full-table" : "--max-level " + std::to_string(params.maxLevel);
+        throw std::invalid_argument(
+            what + ": the regular directory at level " + std::to_string(finest) + " would take " +
+            (dirBytes == SIZE_MAX ? std::string("2^") + std::to_string(finest + 2) + " bytes"
+                                  : megabytes(dirBytes)) +
+            ", over the memory budget of " + megabytes(kMemoryBudget) +
+            (full ? "; use sub-tables (drop --full-table)" : "; lower --max-level"));
+    }
+    dir_.build(b.bsp, finest, full);
+
+    extra_ = {
+        {"directory", full ? "full" : "sub-tables"},
+        {"directory_bytes", dir_.memoryBytes()},
+        {"full_table_bytes",
+         fullBytes == SIZE_MAX ? nlohmann::json(nullptr) : nlohmann::json(fullBytes)},
+        {"sub_tables", dir_.tableCount()},
+        {"leaves", leaves_.size()},
+        {"empty_leaves", b.emptyLeaves},
+        {"covered_leaves", b.coveredLeaves},
+        {"bsp_nodes", b.bsp.nodes.size()},
+        {"finest_level", finest},
+        {"depth_xyz", {depth[0], depth[1], depth[2]}},
+        {"distinct_trees", b.trees.size()},
+        {"tree_pool_nodes", pool_.nodes.size()},
+        {"prims_per_leaf", leaves_.empty() ? 0.0 : double(b.primRefs) / double(leaves_.size())},
+        {"max_prims_per_leaf", b.maxPrims},
+    };
+}
+
+std::string RegularGrid::describeLeaf(uint32_t id) const {
+    const RegularLeaf& L = leaves_.at(id);
+    std::string out = "leaf " + std::to_string(id) + " cells ";
+    Box3 box;
+    for (int a = 0; a < 3; ++a) {
+        out += (a ? "x[" : "[") + std::to_string(L.lo[a]) + "," + std::to_string(L.hi[a]) + ")";
+        box.lo[a] = plane(a, L.lo[a]);
+        box.hi[a] = plane(a, L.hi[a]);
+    }
+    CsgTree tree;
+    tree.nodes = pool_.nodes;  // toString walks from root: a copy keeps this const
+    tree.root = L.root;
+    return out + " " + box.toString() + " " + std::to_string(L.prims) + " prims " + tree.toString();
+}
+
+}  // namespace lancer

@@ -1,0 +1,191 @@
+// The regular subdivision (report, section 3): a BSP over the scene box cut at the middle on x,
+// y, z in turn, its leaves reached through a directory at the finest level (full table or
+// Tamminen sub-tables), and a ray walk from leaf to leaf by one of two methods:
+//  - push (the report's): push the exit point by `delta` across the exit face, edge or corner
+//    and locate it; a delta too large skips thin cells, a delta too small stalls;
+//  - exact: leaves are aligned on the directory's integer grid, so the next cell's index on the
+//    exit axis is known exactly and the other indices come from the exit point clamped into
+//    the exit face's range. No epsilon: no skipped cell, no stall.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "engine/accel/eval.h"
+#include "engine/accel/regular/directory.h"
+
+namespace lancer {
+
+struct BuildParams;  // engine/accel/accelerator.h, which includes this header
+
+/// A BSP leaf: its block of the finest grid, [lo, hi) per axis, and its restricted tree.
+struct RegularLeaf {
+    uint32_t lo[3] = {}, hi[3] = {};
+    int32_t root = -1;   ///< restricted tree in the shared pool; -1: empty
+    uint32_t prims = 0;  ///< primitives in the restricted tree
+};
+
+class RegularGrid {
+  public:
+    /// Whole structure (BSP while building, leaves, trees, directory) must fit in this.
+    static constexpr size_t kMemoryBudget = size_t(512) << 20;
+    /// BSP nodes allowed while building (4M: about 200 MiB of nodes, leaves and tables). An
+    /// absurd max-level / max-objects pair is refused after bounded work (a few seconds at
+    /// most) instead of exhausting memory; the largest useful builds measured (lattice at
+    /// level 21, max-objects 1) need 2.7M.
+    static constexpr size_t kMaxBspNodes = size_t(1) << 22;
+
+    /// Build over a prepared scene. Throws std::invalid_argument naming the option when the
+    /// parameters are invalid or the structure would not fit in kMemoryBudget.
+    RegularGrid(const Scene& scene, const BuildParams& params);
+
+    /// Nearest visible hit with t in (tmin, tmax], walking the leaves in ray order.
+    template <class Obs>
+    bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                   Hit& hit) const;
+
+    size_t regionCount() const { return leaves_.size(); }
+    size_t memoryBytes() const {
+        return leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode) +
+               dir_.memoryBytes();
+    }
+    bool usesMailboxes() const { return true; }
+
+    /// Scheme-specific figures for `--stats` (full-table size, leaves, depth per axis...).
+    nlohmann::json extra() const { return extra_; }
+    const std::vector<RegularLeaf>& leaves() const { return leaves_; }
+    const CsgTree& treePool() const { return pool_; }
+    const Directory& directory() const { return dir_; }
+    /// The grid's box: the scene bounds, widened on an axis where they are flat.
+    const Box3& box() const { return box_; }
+    /// Directory cells per axis, 2^n.
+    uint32_t cells(int axis) const { return n_[axis]; }
+    /// Coordinate of grid plane k (0..2^n) on `axis`; plane 2^n is exactly box().hi.
+    double plane(int axis, uint32_t k) const {
+        return k == n_[axis] ? box_.hi[axis]
+                             : box_.lo[axis] + ext_[axis] * (double(k) * inv_[axis]);
+    }
+    /// The report's point location, 0-based: floor((x - min) / (max - min) * 2^n), clamped.
+    uint32_t locate(int axis, double x) const {
+        double f = std::floor((x - box_.lo[axis]) / ext_[axis] * double(n_[axis]));
+        if (!(f >= 0.0)) return 0;  // also NaN
+        return f >= double(n_[axis]) ? n_[axis] - 1 : uint32_t(f);
+    }
+    /// "leaf 12 cells [8,12)x[0,8)x[8,16) Box3{..} 2 prims (p1 − p11)": for messages and traces.
+    std::string describeLeaf(uint32_t id) const;
+    /// Leaf holding a point (clamped into the grid).
+    uint32_t leafAt(const Vec3& p) const {
+        return dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
+    }
+
+  private:
+    const Scene* scene_;
+    bool exact_ = true;   ///< --step exact (else push)
+    double delta_ = 0.0;  ///< absolute push distance
+    Box3 box_;
+    Box3 clipBox_;  ///< box_ grown by a hair: a grazing ray whose hit rounds outside still enters
+    Vec3 ext_{0.0};
+    uint32_t n_[3] = {1, 1, 1};
+    double inv_[3] = {1.0, 1.0, 1.0};
+    size_t maxSteps_ = 16;
+    std::vector<RegularLeaf> leaves_;
+    CsgTree pool_;  ///< restricted trees of all leaves, shared between equal primitive sets
+    Directory dir_;
+    nlohmann::json extra_;
+
+    friend struct RegularBuilder;
+};
+
+template <class Obs>
+bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                            Hit& hit) const {
+    double tA, tB;
+    if (!clipLine(ray, clipBox_, tA, tB)) return false;
+    const double tStart = std::max(tmin, tA), tEnd = std::min(tmax, tB);
+    if (!(tStart <= tEnd)) return false;
+    Vec3 p = std::isfinite(tStart) ? ray.at(tStart) : ray.o;
+    uint32_t idx[3] = {locate(0, p.x), locate(1, p.y), locate(2, p.z)};
+    uint32_t leaf = dir_.lookup(idx[0], idx[1], idx[2]);
+    // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
+    // inside the grid, so this only admits hits that rounding puts a hair outside the box.
+    double t0 = tmin, tIn = tStart;
+    for (size_t step = 0;; ++step) {
+        if (step > maxSteps_) {
+            ++ctx.counters.walkErrors;
+            obs.walkError("regular: step bound exceeded");
+            return false;
+        }
+        const RegularLeaf& L = leaves_[leaf];
+        // Exit: the nearest of the cell's exit planes; ties are edges and corners.
+        double tAxis[3];
+        double tExit = kInf;
+        int exitAxis = -1;
+        for (int a = 0; a < 3; ++a) {
+            if (ray.d[a] > 0.0)
+                tAxis[a] = (plane(a, L.hi[a]) - ray.o[a]) / ray.d[a];
+            else if (ray.d[a] < 0.0)
+                tAxis[a] = (plane(a, L.lo[a]) - ray.o[a]) / ray.d[a];
+            else
+                tAxis[a] = kInf;
+            if (tAxis[a] < tExit) tExit = tAxis[a], exitAxis = a;
+        }
+        bool last = !(tExit < tEnd);
+        bool stalled = false;
+        uint32_t next[3] = {idx[0], idx[1], idx[2]};
+        uint32_t nextLeaf = leaf;
+        if (!last) {
+            const Vec3 q = ray.at(tExit);
+            if (exact_) {
+                // The exit face lies on grid plane L.hi or L.lo of exitAxis: the next index there
+                // is exact; the other indices are the exit point's, kept on the face.
+                const int a = exitAxis;
+                if (ray.d[a] > 0.0) {
+                    if (L.hi[a] == n_[a])
+                        last = true;
+                    else
+                        next[a] = L.hi[a];
+                } else {
+                    if (L.lo[a] == 0)
+                        last = true;
+                    else
+                        next[a] = L.lo[a] - 1;
+                }
+                for (int b = 0; b < 3; ++b)
+                    if (b != a) next[b] = std::clamp(locate(b, q[b]), L.lo[b], L.hi[b] - 1);
+            } else {
+                // The report's method: the exit point, taken on the cell's box (rounding can put
+                // ray.at(tExit) a hair outside it), is pushed by delta across every face it
+                // leaves through, then located. Off the pushed axes it stays in the cell's range,
+                // so the walk cannot bounce back into the previous cell.
+                for (int a = 0; a < 3; ++a) {
+                    double x = std::clamp(q[a], plane(a, L.lo[a]), plane(a, L.hi[a]));
+                    if (tAxis[a] == tExit) {
+                        x += ray.d[a] > 0.0 ? delta_ : -delta_;
+                        if (x < box_.lo[a] || x > box_.hi[a]) last = true;  // left the grid
+                        next[a] = locate(a, x);
+                    } else {
+                        next[a] = std::clamp(locate(a, x), L.lo[a], L.hi[a] - 1);
+                    }
+                }
+            }
+            if (!last) {
+                nextLeaf = dir_.lookup(next[0], next[1], next[2]);
+                stalled = nextLeaf == leaf;
+            }
+        }
+        const double t1 = last ? tmax : std::max(tExit, tIn);
+        ++ctx.counters.regionVisits;
+        obs.region(leaf, tIn, last ? tEnd : t1);
+        if (hitInRegion(*scene_, pool_, L.root, ray, tmin, t0, t1, ctx, obs, hit)) return true;
+        if (last) return false;
+        if (stalled) {
+            ++ctx.counters.walkErrors;
+            obs.walkError("regular push: the pushed exit point is still in the same leaf");
+            return false;
+        }
+        t0 = tIn = t1;
+        leaf = nextLeaf;
+        idx[0] = next[0], idx[1] = next[1], idx[2] = next[2];
+    }
+}
+
+}  // namespace lancer

@@ -1,0 +1,415 @@
+// The regular subdivision (report, section 3) against brute force, ray for ray: SPD and built-in
+// scenes pixel by pixel, random CSG scenes with rays aimed at the grid's corners, edges and faces;
+// both walks (exact and push), push's failure modes, sub-tables, mailboxes and refusals.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "engine/render/renderer.h"
+#include "engine/scene/loader.h"
+#include "tests/support/differential.h"
+
+namespace lancer {
+namespace {
+
+BuildParams regular(StepMethod step = StepMethod::Exact) {
+    BuildParams p;
+    p.scheme = SchemeKind::Regular;
+    p.step = step;
+    return p;
+}
+
+const RegularGrid& gridOf(const Accelerator& a) { return std::get<RegularGrid>(a.impl()); }
+
+/// Walk errors of `accel` over `rays` (compareWithBrute checks the hits, this the walks).
+uint64_t walkErrors(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
+                    double tmin = 0.0) {
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    ctx.useMailboxes = accel.usesMailboxes();
+    NullObserver obs;
+    for (const Ray& r : rays) {
+        Hit h;
+        ctx.beginRay();
+        accel.intersect(r, tmin, kInf, ctx, obs, h);
+    }
+    return ctx.counters.walkErrors;
+}
+
+std::string describe(const Scene& s, const std::vector<test::RayMismatch>& m) {
+    std::string out;
+    for (size_t i = 0; i < std::min<size_t>(m.size(), 3); ++i) out += m[i].toString(s) + "\n";
+    return out;
+}
+
+/// Points where walks go wrong: corners, edge midpoints and face centres of leaves spread over
+/// the grid, plus random points of the finest grid's planes.
+std::vector<Vec3> gridPoints(const RegularGrid& g, uint64_t seed, size_t leavesWanted = 150) {
+    std::vector<Vec3> pts;
+    const auto& leaves = g.leaves();
+    size_t stride = std::max<size_t>(1, leaves.size() / leavesWanted);
+    for (size_t i = 0; i < leaves.size(); i += stride) {
+        const RegularLeaf& L = leaves[i];
+        double c[3][3];  // per axis: lo plane, middle, hi plane
+        for (int a = 0; a < 3; ++a) {
+            c[a][0] = g.plane(a, L.lo[a]);
+            c[a][2] = g.plane(a, L.hi[a]);
+            c[a][1] = 0.5 * (c[a][0] + c[a][2]);
+        }
+        for (int x = 0; x < 3; ++x)
+            for (int y = 0; y < 3; ++y)
+                for (int z = 0; z < 3; ++z)
+                    if (x != 1 || y != 1 || z != 1) pts.push_back({c[0][x], c[1][y], c[2][z]});
+    }
+    std::mt19937_64 rng(seed);
+    for (int k = 0; k < 400; ++k) {
+        Vec3 p;
+        for (int a = 0; a < 3; ++a) p[a] = g.plane(a, uint32_t(rng() % (g.cells(a) + 1)));
+        pts.push_back(p);
+    }
+    return pts;
+}
+
+/// Random rays plus rays through the grid's hard points, for one built scheme.
+std::vector<Ray> hardRays(const Scene& s, const RegularGrid& g, uint64_t seed, int random) {
+    std::vector<Ray> rays = test::randomRays(s, seed, random);
+    std::vector<Ray> grid = test::raysThroughPoints(gridPoints(g, seed), g.box(), seed + 1);
+    rays.insert(rays.end(), grid.begin(), grid.end());
+    return rays;
+}
+
+std::vector<std::string> spdScenes() {
+    std::vector<std::string> files;
+    for (const auto& e : std::filesystem::directory_iterator(LANCER_SPD_DIR))
+        if (e.path().extension() == ".nff") files.push_back(e.path().string());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+void expectPixelsMatch(const std::string& spec, int size, StepMethod step) {
+    Scene s = loadScene(spec);
+    auto accel = buildAccelerator(s, regular(step));
+    auto rays = test::pixelRays(s, size, size);
+    auto bad = test::compareWithBrute(s, *accel, rays);
+    EXPECT_TRUE(bad.empty()) << spec << ": " << bad.size() << " pixels differ\n"
+                             << describe(s, bad);
+    EXPECT_EQ(walkErrors(s, *accel, rays), 0u) << spec;
+}
+
+/// Runs `check` on every SPD scene the NFF reader loads; a scene it rejects is reported (the
+/// reader is tested elsewhere), but the balls scenes must load.
+template <class F>
+void forEachSpd(F check) {
+    int loaded = 0;
+    for (const std::string& f : spdScenes()) {
+        try {
+            loadScene(f);
+        } catch (const SceneError& e) {
+            std::printf("note: not tested, the reader rejects it: %s\n", e.what());
+            EXPECT_EQ(f.find("balls"), std::string::npos) << e.what();
+            continue;
+        }
+        check(f);
+        ++loaded;
+    }
+    EXPECT_GE(loaded, 4);
+}
+
+TEST(RegularExact, EverySpdScenePixelMatchesBrute) {
+    forEachSpd([](const std::string& f) {
+        expectPixelsMatch(f, f.find("balls4") != std::string::npos ? 32 : 48, StepMethod::Exact);
+    });
+}
+
+TEST(RegularExact, BuiltinCsgScenesPixelMatchBrute) {
+    for (const char* spec : {"builtin:default", "builtin:drilled:4", "builtin:lattice:4"})
+        expectPixelsMatch(spec, 48, StepMethod::Exact);
+}
+
+TEST(RegularPush, DefaultDeltaPixelMatchesBrute) {
+    forEachSpd([](const std::string& f) {
+        if (f.find("balls4") == std::string::npos) expectPixelsMatch(f, 40, StepMethod::Push);
+    });
+    for (const char* spec : {"builtin:default", "builtin:drilled:4", "builtin:lattice:4"})
+        expectPixelsMatch(spec, 40, StepMethod::Push);
+}
+
+/// Random CSG scenes: plain, with transforms, with surfaces, far from the origin.
+std::vector<test::RandomSceneOptions> sceneVariants() {
+    std::vector<test::RandomSceneOptions> v(4);
+    v[0].transforms = false;
+    v[1].transforms = true;
+    v[2].surfaces = true;
+    v[3].offset = Vec3(1e6, -1e6, 1e6);
+    for (auto& o : v) o.primitives = 16;
+    return v;
+}
+
+// >= 10^5 rays in all: random, from inside and outside, axis-parallel, aimed at and starting on
+// cell corners, edge midpoints and face centres; also with tmin > 0 as secondary rays have.
+void randomScenesMatchBrute(StepMethod step, int seeds) {
+    size_t total = 0;
+    for (const auto& opt : sceneVariants()) {
+        for (uint64_t seed = 1; seed <= uint64_t(seeds); ++seed) {
+            Scene s = test::randomCsgScene(seed * 31 + 7, opt);
+            BuildParams p = regular(step);
+            p.maxObjects = 1 + int(seed % 3);
+            p.maxLevel = 9 + int(seed % 10);
+            auto accel = buildAccelerator(s, p);
+            auto rays = hardRays(s, gridOf(*accel), seed, 1500);
+            total += rays.size();
+            auto bad = test::compareWithBrute(s, *accel, rays);
+            ASSERT_TRUE(bad.empty()) << s.name << " offset " << toString(opt.offset) << " level "
+                                     << p.maxLevel << ": " << bad.size() << " rays differ\n"
+                                     << describe(s, bad);
+            ASSERT_EQ(walkErrors(s, *accel, rays), 0u) << s.name;
+            auto secondary = test::compareWithBrute(s, *accel, rays, 1e-3 * s.scale());
+            ASSERT_TRUE(secondary.empty()) << s.name << " tmin > 0\n" << describe(s, secondary);
+        }
+    }
+    EXPECT_GE(total, 100000u);
+}
+
+TEST(RegularExact, RandomCsgScenesRayForRay) { randomScenesMatchBrute(StepMethod::Exact, 6); }
+TEST(RegularPush, RandomCsgScenesRayForRayAtDefaultDelta) {
+    randomScenesMatchBrute(StepMethod::Push, 6);
+}
+
+// The report's push has an error: a delta larger than a thin cell jumps over it (wrong hits);
+// a delta below the coordinates' rounding does not leave the cell (stalls, counted errors).
+// Exact stepping is right on the same rays.
+TEST(RegularPush, WrongForDeltaTooLargeOrTooSmallWhereExactIsRight) {
+    size_t skipped = 0, stalledOrWrong = 0;
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.primitives = 20;
+        Scene s = test::randomCsgScene(seed * 11, opt);
+        BuildParams p = regular(StepMethod::Exact);
+        p.maxLevel = 18;  // cells 1/64 of the box
+        p.maxObjects = 1;
+        auto exact = buildAccelerator(s, p);
+        auto rays = hardRays(s, gridOf(*exact), seed, 3000);
+        ASSERT_TRUE(test::compareWithBrute(s, *exact, rays).empty());
+        ASSERT_EQ(walkErrors(s, *exact, rays), 0u);
+
+        p.step = StepMethod::Push;
+        p.delta = 0.05;  // wider than the finest cells
+        auto large = buildAccelerator(s, p);
+        skipped += test::compareWithBrute(s, *large, rays, 0.0, 1e-9, SIZE_MAX).size();
+
+        p.delta = 1e-19;  // below the rounding of the coordinates
+        auto tiny = buildAccelerator(s, p);
+        stalledOrWrong += walkErrors(s, *tiny, rays) +
+                          test::compareWithBrute(s, *tiny, rays, 0.0, 1e-9, SIZE_MAX).size();
+    }
+    std::printf(
+        "push, delta 0.05: %zu wrong hits; delta 1e-19: %zu walk errors + wrong hits "
+        "(exact: none)\n",
+        skipped, stalledOrWrong);
+    EXPECT_GT(skipped, 0u) << "a push larger than the cells should skip some";
+    EXPECT_GT(stalledOrWrong, 0u) << "a push below rounding should stall";
+}
+
+TEST(RegularWalk, RegionsAreContiguousAndInRayOrder) {
+    Scene s = test::randomCsgScene(5);
+    auto accel = buildAccelerator(s, regular());
+    const RegularGrid& g = gridOf(*accel);
+    TraceContext ctx(s.prims.size(), s.tree.depth());
+    int walks = 0;
+    for (const Ray& r : test::randomRays(s, 3, 400)) {
+        RecordingObserver obs;
+        Hit h;
+        ctx.beginRay();
+        accel->intersect(r, 0.0, kInf, ctx, obs, h);
+        double prev = -kInf;
+        bool first = true;
+        for (const WalkEvent& e : obs.events) {
+            if (e.kind != WalkEvent::Region) continue;
+            ASSERT_LT(e.a, g.regionCount());
+            ASSERT_LE(e.t0, e.t1);
+            if (!first) ASSERT_EQ(e.t0, prev) << r.toString();
+            // The cell contains the ray's points of its interval (up to rounding).
+            const RegularLeaf& L = g.leaves()[e.a];
+            Vec3 mid = r.at(0.5 * (e.t0 + e.t1));
+            for (int a = 0; a < 3; ++a) {
+                double slack = 1e-9 * g.box().extent()[a];
+                ASSERT_GE(mid[a], g.plane(a, L.lo[a]) - slack)
+                    << r.toString() << g.describeLeaf(e.a);
+                ASSERT_LE(mid[a], g.plane(a, L.hi[a]) + slack)
+                    << r.toString() << g.describeLeaf(e.a);
+            }
+            prev = e.t1;
+            first = false;
+        }
+        walks += !first;
+    }
+    EXPECT_GT(walks, 100);
+    EXPECT_NE(g.describeLeaf(0).find("leaf 0 cells ["), std::string::npos) << g.describeLeaf(0);
+}
+
+TEST(RegularMailbox, SameHitsFewerTestsThanWithout) {
+    Scene s = loadScene("builtin:lattice:4");
+    BuildParams with = regular(), without = regular();
+    without.mailboxes = false;
+    auto a = buildAccelerator(s, with), b = buildAccelerator(s, without);
+    EXPECT_TRUE(a->usesMailboxes());
+    EXPECT_FALSE(b->usesMailboxes());
+    auto rays = test::pixelRays(s, 40, 40);
+    EXPECT_TRUE(test::compareWithBrute(s, *b, rays).empty());
+    auto count = [&](const Accelerator& acc) {
+        TraceContext ctx(s.prims.size(), s.tree.depth());
+        ctx.useMailboxes = acc.usesMailboxes();
+        NullObserver obs;
+        for (const Ray& r : rays) {
+            Hit h;
+            ctx.beginRay();
+            acc.intersect(r, 0.0, kInf, ctx, obs, h);
+        }
+        return ctx.counters;
+    };
+    RayCounters ca = count(*a), cb = count(*b);
+    EXPECT_GT(ca.mailboxHits, 0u);
+    EXPECT_EQ(cb.mailboxHits, 0u);
+    EXPECT_LT(ca.primTests, cb.primTests);
+    EXPECT_EQ(ca.primTests + ca.mailboxHits, cb.primTests);  // every saved test is a mailbox hit
+}
+
+// Shadow, reflection and refraction rays go through the subdivision: whole renders with bounces
+// give the same image as brute force.
+TEST(RegularRender, ImageWithBouncesEqualsBrute) {
+    Scene s = loadScene("builtin:default");
+    RenderOptions opt;
+    opt.width = opt.height = 40;
+    opt.threads = 2;
+    opt.shading.bounces = 4;
+    BuildParams bp;
+    auto brute = buildAccelerator(s, bp);
+    auto reg = buildAccelerator(s, regular());
+    Image ib(40, 40), ir(40, 40);
+    RenderStats sb = render(s, *brute, opt, ib);
+    RenderStats sr = render(s, *reg, opt, ir);
+    EXPECT_EQ(sb.counters.rays, sr.counters.rays);
+    EXPECT_GT(sr.counters.rays, sr.counters.primaryRays);
+    EXPECT_EQ(sr.counters.walkErrors, 0u);
+    EXPECT_EQ(ib.hitPrim, ir.hitPrim);
+    for (size_t i = 0; i < ib.color.size(); ++i)
+        ASSERT_EQ(ib.color[i], ir.color[i]) << "pixel " << i;
+}
+
+// Sub-tables name the same leaf as the full table for every point, in less memory.
+TEST(RegularSubTables, SameLeafAsFullTableInLessMemory) {
+    // Scenes whose subdivision is deep in places and shallow elsewhere (in a uniformly deep
+    // one, such as drilled:4 at max-objects 1, sub-tables cost about as much as the full table).
+    for (std::string spec :
+         {std::string(LANCER_SPD_DIR) + "/balls2.nff", std::string("builtin:default")}) {
+        Scene s = loadScene(spec);
+        BuildParams pf = regular();
+        pf.maxLevel = 18;  // deeper than the top table, so sub-tables appear
+        pf.maxObjects = 1;
+        BuildParams ps = pf;
+        pf.fullTable = true;
+        auto full = buildAccelerator(s, pf), sub = buildAccelerator(s, ps);
+        const RegularGrid &gf = gridOf(*full), &gs = gridOf(*sub);
+        ASSERT_EQ(gf.regionCount(), gs.regionCount());
+        EXPECT_EQ(full->info().extra["directory"], "full");
+        EXPECT_EQ(sub->info().extra["directory"], "sub-tables");
+        EXPECT_EQ(size_t(sub->info().extra["full_table_bytes"]), gf.directory().memoryBytes());
+        EXPECT_LT(gs.directory().memoryBytes(), gf.directory().memoryBytes()) << spec;
+        EXPECT_LT(sub->info().memoryBytes, full->info().memoryBytes) << spec;
+        // Every finest cell when the grid is small, else a dense random sample.
+        uint64_t cells = uint64_t(gf.cells(0)) * gf.cells(1) * gf.cells(2);
+        std::mt19937_64 rng(1);
+        uint64_t samples = std::min<uint64_t>(cells, 1u << 20);
+        for (uint64_t n = 0; n < samples; ++n) {
+            uint64_t c = cells == samples ? n : rng() % cells;
+            uint32_t i = uint32_t(c % gf.cells(0)), j = uint32_t(c / gf.cells(0) % gf.cells(1)),
+                     k = uint32_t(c / gf.cells(0) / gf.cells(1));
+            uint32_t leaf = gf.directory().lookup(i, j, k);
+            ASSERT_EQ(leaf, gs.directory().lookup(i, j, k))
+                << spec << " cell " << i << " " << j << " " << k;
+            const RegularLeaf& L = gf.leaves()[leaf];
+            ASSERT_TRUE(L.lo[0] <= i && i < L.hi[0] && L.lo[1] <= j && j < L.hi[1] &&
+                        L.lo[2] <= k && k < L.hi[2]);
+        }
+    }
+}
+
+// A BSP deep in one spot only: the full table (2^level entries) would not fit, sub-tables do,
+// and the walk is still exact.
+TEST(RegularSubTables, DeepLevelBuiltWhereTheFullTableWouldNotFit) {
+    Scene s;
+    s.prims.push_back(makePrimitive(Sphere{{0, 0, 0}, 1.0}, Transform()));
+    s.prims.push_back(makePrimitive(Sphere{{2.0 + 1e-7, 0, 0}, 1.0}, Transform()));  // near touch
+    s.prims.push_back(makePrimitive(Sphere{{100, 100, 100}, 1.0}, Transform()));
+    std::vector<int> leaves{s.tree.leaf(0), s.tree.leaf(1), s.tree.leaf(2)};
+    s.tree.root = s.tree.balanced(Op::Union, leaves);
+    s.prepare();
+    s.frameCamera({-1.0, 2.0, -1.0}, {0, 0, 1});
+    BuildParams p = regular();
+    p.maxLevel = 40;
+    p.maxObjects = 1;
+    auto accel = buildAccelerator(s, p);
+    const RegularGrid& g = gridOf(*accel);
+    int finest = accel->info().extra["finest_level"];
+    EXPECT_GE(finest, 36);
+    EXPECT_GT(double(std::ldexp(4.0, finest)), double(RegularGrid::kMemoryBudget));
+    // The cells along the near-touching pair's gap: tens of thousands of leaves, a few MiB.
+    EXPECT_LT(accel->info().memoryBytes, size_t(16) << 20);
+    p.fullTable = true;
+    EXPECT_THROW(buildAccelerator(s, p), std::invalid_argument);
+    // Rays at the near-touching pair and through its grid points.
+    std::vector<Ray> rays = test::raysThroughPoints(gridPoints(g, 3, 400), g.box(), 9);
+    for (int k = 0; k < 2000; ++k) {
+        double y = (k % 100 - 50) * 2e-3, z = (k / 100 - 10) * 5e-2;
+        rays.push_back({{1.0 + 5e-8, y - 5, z}, glm::normalize(Vec3(1e-9 * (k % 7), 1, 0.01))});
+    }
+    auto bad = test::compareWithBrute(s, *accel, rays);
+    EXPECT_TRUE(bad.empty()) << describe(s, bad);
+    EXPECT_EQ(walkErrors(s, *accel, rays), 0u);
+}
+
+TEST(RegularRefusal, AbsurdLevelAndObjectsAreRefusedWithAMessage) {
+    // Overlapping boxes: with max-objects 1 every cell of the overlap splits down to max-level.
+    Scene s;
+    s.prims.push_back(makePrimitive(Sphere{{0, 0, 0}, 1.0}, Transform()));
+    s.prims.push_back(makePrimitive(Sphere{{0.5, 0, 0}, 1.0}, Transform()));
+    s.tree.root = s.tree.combine(Op::Union, s.tree.leaf(0), s.tree.leaf(1));
+    s.prepare();
+    BuildParams p = regular();
+    p.maxLevel = 48;
+    p.maxObjects = 1;
+    try {
+        buildAccelerator(s, p);
+        FAIL() << "not refused";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("--max-level 48"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("--max-objects 1"), std::string::npos) << e.what();
+    }
+    p.maxLevel = 49;
+    EXPECT_THROW(buildAccelerator(s, p), std::invalid_argument);
+    p.maxLevel = 10;
+    p.maxObjects = 0;
+    EXPECT_THROW(buildAccelerator(s, p), std::invalid_argument);
+}
+
+TEST(RegularBuild, LeavesHoldTheirOverlappingPrimitivesAndShareTrees) {
+    Scene s = loadScene("builtin:lattice:4");
+    auto accel = buildAccelerator(s, regular());
+    const RegularGrid& g = gridOf(*accel);
+    const auto& x = accel->info().extra;
+    EXPECT_EQ(size_t(x["leaves"]), g.regionCount());
+    EXPECT_LT(size_t(x["distinct_trees"]), g.regionCount());  // shared, not copied
+    EXPECT_LE(int(x["finest_level"]), BuildParams{}.maxLevel);
+    CsgTree t = g.treePool();
+    for (const RegularLeaf& L : g.leaves()) {
+        Box3 cell;
+        for (int a = 0; a < 3; ++a)
+            cell.lo[a] = g.plane(a, L.lo[a]), cell.hi[a] = g.plane(a, L.hi[a]);
+        t.root = L.root;
+        std::vector<uint32_t> ps = L.root < 0 ? std::vector<uint32_t>{} : t.primitives();
+        EXPECT_EQ(ps.size(), L.prims);
+        for (uint32_t p : ps) ASSERT_TRUE(s.minBox[p].overlaps(cell));
+    }
+}
+
+}  // namespace
+}  // namespace lancer
