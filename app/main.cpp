@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
     benchCmd->add_option("--out", bopt.outDir, "Output directory")->capture_default_str();
     benchCmd->add_flag("--quick", bopt.quick, "Fewer knob values (a smoke run)");
     benchCmd->add_flag("--no-plots{false}", bopt.plots, "Write the CSV only");
+    benchCmd->add_flag("--schemes-only", bopt.schemesOnly, "Each scheme at its defaults, and the peer: the comparison table");
 
     CLI11_PARSE(app, argc, argv);
 

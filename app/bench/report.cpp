@@ -71,7 +71,7 @@ std::string num(double v) {
     return os.str();
 }
 
-std::vector<Config> sweep(bool quick) {
+std::vector<Config> sweep(bool quick, bool schemesOnly) {
     std::vector<Config> out;
     auto add = [&](const std::string& knob, const std::string& value, BuildParams b, ShadingOptions s = {}) {
         out.push_back({knob, value, b, s});
@@ -82,6 +82,7 @@ std::vector<Config> sweep(bool quick) {
     irregular.scheme = SchemeKind::Irregular;
     add("scheme", "regular", regular);
     add("scheme", "irregular", irregular);
+    if (schemesOnly) return out;
     std::vector<int> levels = quick ? std::vector<int>{6, 12} : std::vector<int>{3, 6, 9, 12, 15, 18, 21, 24};
     for (int l : levels) {
         BuildParams b = regular;
@@ -175,8 +176,10 @@ int runBench(const BenchOptions& opt) {
         std::cerr << "error: --out " << opt.outDir << ": " << ec.message() << "\n";
         return 2;
     }
-    std::ostringstream csv;
+    std::ostringstream csv, table;
     csv << kHeader;
+    table << "| scene | scheme | build ms | regions | memory | render ms | us/ray | prim tests/ray | region visits/ray | speedup | hits differing |\n"
+          << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     std::vector<std::string> done;
     for (const std::string& spec : opt.scenes) {
         Scene scene;
@@ -203,6 +206,14 @@ int runBench(const BenchOptions& opt) {
                        const RenderStats& s, const ImageError& e) {
             const RayCounters& c = s.counters;
             double rays = c.rays ? double(c.rays) : 1.0;
+            if (knob == "scheme" || knob == "peer (bounces 0)") {
+                char line[512];
+                std::snprintf(line, sizeof line, "| %s | %s%s | %.0f | %zu | %.1f MiB | %.0f | %.2f | %.1f | %.1f | %.1fx | %zu |\n",
+                              spec.c_str(), scheme, knob == "scheme" ? "" : " (bounces 0)", info.buildMs, info.regions,
+                              double(info.memoryBytes) / 1048576.0, s.renderMs, 1000.0 * s.renderMs / rays,
+                              double(c.primTests) / rays, double(c.regionVisits) / rays, bruteMs / s.renderMs, e.hitDiff);
+                table << line;
+            }
             csv << spec << "," << scheme << "," << knob << "," << value << "," << num(info.buildMs) << ","
                 << info.memoryBytes << "," << info.regions << "," << num(s.renderMs) << "," << num(bruteMs / s.renderMs)
                 << "," << c.rays << "," << num(double(c.primTests) / rays) << "," << num(double(c.regionVisits) / rays)
@@ -212,7 +223,7 @@ int runBench(const BenchOptions& opt) {
         row("brute", "scheme", "brute", brute->info(), rs, {});
         std::cerr << spec << ": brute force " << int(bruteMs) << " ms\n";
 
-        for (const Config& c : sweep(opt.quick)) {
+        for (const Config& c : sweep(opt.quick, opt.schemesOnly)) {
             std::unique_ptr<Accelerator> accel;
             try {
                 accel = buildAccelerator(scene, c.build);
@@ -254,11 +265,16 @@ int runBench(const BenchOptions& opt) {
             RenderStats s = peer.render(r0, img);
             AccelInfo info;
             info.buildMs = peer.buildMs();
+            info.regions = 0;
             row("embree", "peer (bounces 0)", "embree", info, s, compare(ref0, img));
             std::swap(bruteMs, brute0);
             std::cerr << spec << ": embree " << int(s.renderMs) << " ms (brute force at --bounces 0: " << int(b0.renderMs) << " ms)\n";
         }
 
+        if (opt.schemesOnly) {
+            done.push_back(spec);
+            continue;
+        }
         // Progressive passes of the fastest default scheme available: error of each pass
         // against the final image, and the time since the first pass started.
         std::unique_ptr<Accelerator> best;
@@ -285,7 +301,8 @@ int runBench(const BenchOptions& opt) {
         done.push_back(spec);
     }
     std::ofstream(opt.outDir + "/report.csv") << csv.str();
-    std::cout << "wrote " << opt.outDir << "/report.csv\n";
+    std::ofstream(opt.outDir + "/schemes.md") << table.str();
+    std::cout << table.str() << "wrote " << opt.outDir << "/report.csv and schemes.md\n";
     if (opt.plots) {
         writePlots(opt.outDir, done);
         // A plot is drawn when the CSV has rows for its knob.

@@ -16,6 +16,7 @@ struct BenchOptions {
     std::string outDir = "bench-out";
     bool quick = false;  ///< fewer knob values (used by the test suite)
     bool plots = true;   ///< run gnuplot on the CSV
+    bool schemesOnly = false;  ///< default settings of each scheme (and the peer) only: the table
 };
 
 /// Run the sweeps, write OUT/report.csv, OUT/*.gp and OUT/*.png. Returns the exit status.
