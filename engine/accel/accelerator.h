@@ -15,10 +15,13 @@ namespace lancer {
 enum class SchemeKind : uint8_t { Brute, Regular, Irregular };
 enum class StepMethod : uint8_t { Exact, Push };
 enum class BspHeuristic : uint8_t { First, Balanced, FewestCuts };
+/// Irregular scheme: primary rays walk the camera-frame structure, or the projective zones.
+enum class IrregularFrame : uint8_t { Camera, Projective };
 
 const char* schemeName(SchemeKind k);
 const char* stepName(StepMethod s);
 const char* heuristicName(BspHeuristic h);
+const char* irregularFrameName(IrregularFrame f);
 
 /// Builder parameters: a plain struct the command line, the viewer and the tests fill in.
 struct BuildParams {
@@ -29,6 +32,7 @@ struct BuildParams {
     double delta = 1e-6;        ///< push distance, relative to the scene box's largest extent
     BspHeuristic heuristic = BspHeuristic::Balanced;
     bool mailboxes = true;      ///< --no-mailbox turns them off to measure their effect
+    IrregularFrame irregularFrame = IrregularFrame::Projective;  ///< --irregular-frame
 };
 
 /// What a built structure reports: `--stats` and the viewer show it.
