@@ -66,7 +66,12 @@ int main(int argc, char** argv) {
     benchCmd->add_flag("--no-plots{false}", bopt.plots, "Write the CSV only");
     benchCmd->add_flag("--schemes-only", bopt.schemesOnly, "Each scheme at its defaults, and the peer: the comparison table");
 
-    CLI11_PARSE(app, argc, argv);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        // --help prints and succeeds; every other parse error names the option and exits 2.
+        return app.exit(e) == 0 ? 0 : 2;
+    }
 
     if (*benchCmd) return bench::runBench(bopt);
 

@@ -21,9 +21,11 @@ const IrregularSubdivision& irregularOf(const Accelerator& a) {
 
 std::unique_ptr<Accelerator> buildIrregular(const Scene& scene,
                                             BspHeuristic h = BspHeuristic::Balanced,
-                                            int maxObjects = 0) {
+                                            int maxObjects = 0,
+                                            IrregularFrame frame = IrregularFrame::Projective) {
     BuildParams p;
     p.scheme = SchemeKind::Irregular;
+    p.irregularFrame = frame;
     p.heuristic = h;
     p.maxObjects = maxObjects;
     return buildAccelerator(scene, p);
@@ -99,6 +101,28 @@ std::vector<Ray> secondaryRays(const Scene& scene, const std::vector<Ray>& prima
     return rays;
 }
 
+/// Rays from the eye through the corners, edge midpoints and centres of projective zones, and
+/// random ones: they run along zone borders, where (u, v) ties.
+std::vector<Ray> eyeRaysOnZoneCorners(const Scene& scene, const IrregularSubdivision& s,
+                                      size_t maxZones, uint64_t seed) {
+    std::vector<Ray> rays;
+    const ScreenBsp& z = s.projective().screen();
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (size_t k = 0; k < maxZones && z.zoneCount() > 0; ++k) {
+        uint32_t i = uint32_t(rng() % z.zoneCount());
+        for (int j = 0; j < 9; ++j) {
+            double a = j % 3 == 0 ? z.zoneLo[i].x : (j % 3 == 1 ? 0.5 * (z.zoneLo[i].x + z.zoneHi[i].x) : z.zoneHi[i].x);
+            double b = j / 3 == 0 ? z.zoneLo[i].y : (j / 3 == 1 ? 0.5 * (z.zoneLo[i].y + z.zoneHi[i].y) : z.zoneHi[i].y);
+            Vec3 d = a * s.frame().x + b * s.frame().y + s.frame().z;
+            rays.push_back({scene.camera.from, glm::normalize(d)});
+        }
+        Vec3 d = u(rng) * s.frame().x + u(rng) * s.frame().y + (1.0 + u(rng)) * s.frame().z;
+        if (glm::dot(d, d) > 0.0) rays.push_back({scene.camera.from, glm::normalize(d)});
+    }
+    return rays;
+}
+
 /// A random camera: outside or inside the scene, perspective or orthographic.
 void randomCamera(Scene& scene, std::mt19937_64& rng) {
     std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -111,8 +135,9 @@ void randomCamera(Scene& scene, std::mt19937_64& rng) {
     scene.camera.orthoHeight = glm::length(e);
 }
 
-// Every pixel of every SPD scene, perspective and orthographic, against brute force.
-TEST(Irregular, SpdScenesPixelForPixel) {
+// Every pixel of every SPD scene, perspective and orthographic, against brute force; primary
+// rays walk the given structure, secondary rays the camera-frame one.
+void spdPixelForPixel(IrregularFrame frame) {
     std::vector<std::filesystem::path> files;
     for (const auto& e : std::filesystem::directory_iterator(LANCER_SPD_DIR))
         if (e.path().extension() == ".nff") files.push_back(e.path());
@@ -123,16 +148,22 @@ TEST(Irregular, SpdScenesPixelForPixel) {
         int n = path.filename() == "balls4.nff" ? 24 : 40;
         for (int ortho = 0; ortho < 2; ++ortho) {
             if (ortho) makeOrthographic(scene);
-            auto accel = buildIrregular(scene);
-            std::string what =
-                path.filename().string() + (ortho ? " orthographic" : " perspective");
+            auto accel = buildIrregular(scene, BspHeuristic::Balanced, 0, frame);
+            std::string what = path.filename().string() +
+                               (ortho ? " orthographic " : " perspective ") +
+                               irregularFrameName(frame);
             std::vector<Ray> rays = test::pixelRays(scene, n, n);
             expectSame(scene, *accel, rays, what);
-            std::vector<Ray> sec = secondaryRays(scene, rays, 7);
-            expectSame(scene, *accel, sec, what + " secondary", 1e-9 * scene.scale());
+            if (frame == IrregularFrame::Camera) {  // the same structure either way
+                std::vector<Ray> sec = secondaryRays(scene, rays, 7);
+                expectSame(scene, *accel, sec, what + " secondary", 1e-9 * scene.scale());
+            }
         }
     }
 }
+
+TEST(Irregular, SpdScenesPixelForPixelCameraFrame) { spdPixelForPixel(IrregularFrame::Camera); }
+TEST(Irregular, SpdScenesPixelForPixelProjective) { spdPixelForPixel(IrregularFrame::Projective); }
 
 TEST(Irregular, BuiltinCsgScenesPixelForPixel) {
     for (const char* spec : {"builtin:default", "builtin:drilled:4", "builtin:lattice:4"}) {
@@ -141,9 +172,13 @@ TEST(Irregular, BuiltinCsgScenesPixelForPixel) {
             if (ortho) makeOrthographic(scene);
             for (BspHeuristic h :
                  {BspHeuristic::First, BspHeuristic::Balanced, BspHeuristic::FewestCuts}) {
-                auto accel = buildIrregular(scene, h);
+                // Primary rays on the projective zones with one heuristic in two.
+                IrregularFrame f = h == BspHeuristic::Balanced ? IrregularFrame::Camera
+                                                               : IrregularFrame::Projective;
+                auto accel = buildIrregular(scene, h, 0, f);
                 std::string what = std::string(spec) +
-                                   (ortho ? " orthographic " : " perspective ") + heuristicName(h);
+                                   (ortho ? " orthographic " : " perspective ") + heuristicName(h) +
+                                   " " + irregularFrameName(f);
                 std::vector<Ray> rays = test::pixelRays(scene, 48, 48);
                 expectSame(scene, *accel, rays, what);
                 expectSame(scene, *accel, secondaryRays(scene, rays, 3), what + " secondary",
@@ -179,6 +214,8 @@ TEST(Irregular, RandomScenesAndHardRays) {
         rays.insert(rays.end(), axis.begin(), axis.end());
         std::vector<Ray> pix = test::pixelRays(scene, 16, 16);
         rays.insert(rays.end(), pix.begin(), pix.end());
+        std::vector<Ray> eye = eyeRaysOnZoneCorners(scene, irr, 200, seed);
+        rays.insert(rays.end(), eye.begin(), eye.end());
         expectSame(scene, *accel, rays, what);
         // Secondary rays that start on region boundaries, with a tmin as the tracer uses.
         std::vector<Ray> onBoundary;
@@ -314,7 +351,8 @@ TEST(Irregular, RegionsTileTheBoundsAndListTheirPrimitives) {
     const nlohmann::json& x = accel->info().extra;
     EXPECT_GT(x["zones"].get<size_t>(), 1u);
     EXPECT_EQ(x["zones"].get<size_t>(), s.screen().zoneCount());
-    EXPECT_EQ(accel->info().regions, s.regions().size());
+    EXPECT_EQ(accel->info().regions, s.regions().size() + s.projective().regionCount());
+    EXPECT_GT(s.projective().regionCount(), 0u);
     EXPECT_TRUE(accel->usesMailboxes());
 }
 
@@ -322,7 +360,7 @@ TEST(Irregular, RegionsTileTheBoundsAndListTheirPrimitives) {
 // corner pointers followed between them, mailbox hits for primitives shared by regions.
 TEST(Irregular, ObserverSeesRegionsPointersAndMailboxes) {
     Scene scene = loadScene("builtin:lattice:4");
-    auto accel = buildIrregular(scene);
+    auto accel = buildIrregular(scene, BspHeuristic::Balanced, 0, IrregularFrame::Camera);
     TraceContext ctx(scene.prims.size(), scene.tree.depth());
     ctx.useMailboxes = accel->usesMailboxes();
     uint64_t pointers = 0, mailbox = 0;
@@ -355,6 +393,39 @@ TEST(Irregular, ObserverSeesRegionsPointersAndMailboxes) {
     }
     EXPECT_GT(pointers, 0u);
     EXPECT_GT(mailbox, 0u);
+    EXPECT_EQ(ctx.counters.walkErrors, 0u);
+}
+
+// Primary rays on the projective zones: regions in depth order with contiguous intervals, no
+// corner pointer, the near region first when the eye stands among the boxes.
+TEST(Irregular, ProjectiveWalkIsADepthRun) {
+    Scene scene = loadScene(std::string(LANCER_SPD_DIR) + "/balls2.nff");
+    auto accel = buildIrregular(scene);
+    const IrregularSubdivision& s = irregularOf(*accel);
+    ASSERT_GT(s.projective().zoneCount(), 1u);
+    EXPECT_TRUE(s.projective().hasNearRegion());  // the floor reaches behind the eye
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    ctx.useMailboxes = accel->usesMailboxes();
+    uint64_t visits = 0;
+    for (const Ray& ray : test::pixelRays(scene, 16, 16)) {
+        RecordingObserver obs;
+        Hit hit;
+        ctx.beginRay();
+        accel->intersect(ray, 0.0, kInf, ctx, obs, hit);
+        double last = 0.0;
+        for (const WalkEvent& e : obs.events) {
+            EXPECT_NE(e.kind, WalkEvent::Pointer);
+            if (e.kind != WalkEvent::Region) continue;
+            EXPECT_EQ(e.t0, last) << "intervals not contiguous";
+            EXPECT_LE(e.t0, e.t1);
+            EXPECT_GE(e.a, s.regions().size());  // ids after the camera-frame regions
+            EXPECT_LT(e.a, accel->info().regions);
+            last = e.t1;
+            ++visits;
+        }
+    }
+    EXPECT_EQ(visits, ctx.counters.regionVisits);
+    EXPECT_EQ(ctx.counters.pointerSteps, 0u);
     EXPECT_EQ(ctx.counters.walkErrors, 0u);
 }
 

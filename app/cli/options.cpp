@@ -32,6 +32,12 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
         ->transform(CLI::CheckedTransformer(heuristics, CLI::ignore_case).description("{first, balanced, fewest-cuts}"))
         ->default_str("balanced");
     app.add_flag("--full-table", o.build.fullTable, "Regular scheme: one full directory table instead of sub-tables");
+    static const std::map<std::string, IrregularFrame> frames = {
+        {"camera", IrregularFrame::Camera}, {"projective", IrregularFrame::Projective}};
+    app.add_option("--irregular-frame", o.build.irregularFrame,
+                   "Irregular scheme's structure for primary rays: camera (the camera-frame walk) or projective (zones in screen x/z, y/z)")
+        ->transform(CLI::CheckedTransformer(frames, CLI::ignore_case).description("{camera, projective}"))
+        ->default_str(irregularFrameName(o.build.irregularFrame));
     app.add_flag("--no-mailbox{false}", o.build.mailboxes, "Turn the mailboxes off (to measure their effect)");
     app.add_option("--threads", o.render.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024))->default_val(0);
     app.add_option("--bounces", o.render.shading.bounces, "Reflection/refraction depth; 0 = primary and shadow rays only")

@@ -25,6 +25,10 @@ const char* heuristicName(BspHeuristic h) {
     return "?";
 }
 
+const char* irregularFrameName(IrregularFrame f) {
+    return f == IrregularFrame::Camera ? "camera" : "projective";
+}
+
 std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params) {
     if (!scene.prepared) throw std::logic_error("buildAccelerator: scene not prepared");
     auto start = std::chrono::steady_clock::now();

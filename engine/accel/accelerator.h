@@ -16,10 +16,13 @@ namespace lancer {
 enum class SchemeKind : uint8_t { Brute, Regular, Irregular };
 enum class StepMethod : uint8_t { Exact, Push };
 enum class BspHeuristic : uint8_t { First, Balanced, FewestCuts };
+/// Irregular scheme: primary rays walk the camera-frame structure, or the projective zones.
+enum class IrregularFrame : uint8_t { Camera, Projective };
 
 const char* schemeName(SchemeKind k);
 const char* stepName(StepMethod s);
 const char* heuristicName(BspHeuristic h);
+const char* irregularFrameName(IrregularFrame f);
 
 /// Builder parameters: a plain struct the command line, the viewer and the tests fill in.
 struct BuildParams {
@@ -35,6 +38,7 @@ struct BuildParams {
     BspHeuristic heuristic = BspHeuristic::Balanced;
     bool mailboxes = true;      ///< --no-mailbox turns them off to measure their effect
     bool fullTable = false;     ///< regular: one full directory table instead of sub-tables
+    IrregularFrame irregularFrame = IrregularFrame::Projective;  ///< --irregular-frame
 };
 
 /// What a built structure reports: `--stats` and the viewer show it.

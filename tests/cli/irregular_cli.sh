@@ -6,12 +6,12 @@ LANCER="$1"; SRC="$2"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
-out=$("$LANCER" trace builtin:default --scheme irregular --pixel 40 30 --width 64 --height 64) \
+out=$("$LANCER" trace builtin:default --scheme irregular --irregular-frame camera --pixel 40 30 --width 64 --height 64) \
   || fail "trace exited non-zero"
 echo "$out" | grep -q "^  pointer [0-9]* -> [0-9]* (corner [0-9])" || fail "no corner pointer in the walk: $out"
 echo "$out" | grep -q "^  region [0-9]*  t = \[" || fail "no region in the walk"
 echo "$out" | grep -q "^hit t = " || fail "no hit"
-"$LANCER" trace builtin:default --scheme irregular --pixel 40 30 --width 64 --height 64 --json \
+"$LANCER" trace builtin:default --scheme irregular --irregular-frame camera --pixel 40 30 --width 64 --height 64 --json \
   | grep -q '"event": "pointer"' || fail "no pointer event in --json"
 
 for h in first balanced fewest-cuts; do
@@ -29,6 +29,22 @@ for h in first balanced fewest-cuts; do
   cmp -s "$tmp/b.pfm" "$tmp/i_$h.pfm" || fail "depth image of $h differs from brute force"
 done
 
+# Projective zones (the default): a primary ray walks in depth without corner pointers, and both
+# frames render the same depth image.
+out=$("$LANCER" trace builtin:default --scheme irregular --pixel 40 30 --width 64 --height 64) \
+  || fail "projective trace exited non-zero"
+echo "$out" | grep -q "^  region [0-9]*  t = \[" || fail "no region in the projective walk"
+echo "$out" | grep -q "^  pointer" && fail "a corner pointer in a projective primary walk: $out"
+for f in camera projective; do
+  "$LANCER" render builtin:lattice:3 --scheme irregular --irregular-frame $f --width 48 --height 40 \
+    --threads 2 -o "$tmp/f.png" --depth "$tmp/f_$f.pfm" --stats "$tmp/f.json" >/dev/null \
+    || fail "render --irregular-frame $f"
+  grep -q "\"frame\": *\"$f\"" "$tmp/f.json" || fail "--stats has no frame $f"
+done
+cmp -s "$tmp/f_camera.pfm" "$tmp/f_projective.pfm" || fail "camera and projective frames differ"
+msg=$("$LANCER" render builtin:default --scheme irregular --irregular-frame nosuch -o "$tmp/x.png" 2>&1) \
+  && fail "unknown frame accepted"
+echo "$msg" | grep -q -- "--irregular-frame" || fail "message does not name the option: $msg"
 msg=$("$LANCER" render builtin:default --scheme irregular --bsp-heuristic nosuch -o "$tmp/x.png" 2>&1) \
   && fail "unknown heuristic accepted"
 echo "$msg" | grep -q -- "--bsp-heuristic" || fail "message does not name the option: $msg"

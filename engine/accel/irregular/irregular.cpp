@@ -91,6 +91,14 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Build
     s.listPrims_ = std::move(slabs.listPrims);
     s.budget_ = 16 * s.regions_.size() + 1024;
 
+    double eyeMs = 0.0;
+    extra["frame"] = irregularFrameName(params.irregularFrame);
+    if (params.irregularFrame == IrregularFrame::Projective) {
+        auto t3 = Clock::now();
+        s.eye_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, extra);
+        eyeMs = ms(t3);
+    }
+
     size_t refs = 0, most = 0;
     for (uint32_t r = 0; r < s.regions_.size(); ++r) {
         size_t n = s.primitives(r).size();
@@ -112,6 +120,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Build
     extra["screen_bsp_ms"] = bspMs;
     extra["slabs_ms"] = slabMs;
     extra["pointers_ms"] = linkMs;
+    extra["projective_ms"] = eyeMs;
     return s;
 }
 
@@ -180,7 +189,7 @@ int64_t IrregularSubdivision::walkTo(uint32_t from, const Vec3& p) const {
 size_t IrregularSubdivision::memoryBytes() const {
     return sizeof(*this) + regions_.size() * sizeof(IrregularRegion) + bsp_.memoryBytes() +
            zoneFirstRegion_.size() * sizeof(uint32_t) + pool_.nodes.size() * sizeof(CsgNode) +
-           (listFirst_.size() + listPrims_.size()) * sizeof(uint32_t);
+           (listFirst_.size() + listPrims_.size()) * sizeof(uint32_t) + eye_.memoryBytes();
 }
 
 }  // namespace lancer

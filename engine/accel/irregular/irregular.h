@@ -33,6 +33,7 @@
 
 #include "engine/accel/eval.h"
 #include "engine/accel/irregular/camera_frame.h"
+#include "engine/accel/irregular/projective_zones.h"
 #include "engine/accel/irregular/region.h"
 #include "engine/accel/irregular/screen_bsp.h"
 
@@ -51,7 +52,7 @@ class IrregularSubdivision {
     bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                    Hit& hit) const;
 
-    size_t regionCount() const { return regions_.size(); }
+    size_t regionCount() const { return regions_.size() + eye_.regionCount(); }
     size_t memoryBytes() const;
     bool usesMailboxes() const { return true; }
 
@@ -61,6 +62,8 @@ class IrregularSubdivision {
     const Box3& bounds() const { return bounds_; }
     const std::vector<IrregularRegion>& regions() const { return regions_; }
     const ScreenBsp& screen() const { return bsp_; }
+    /// The projective zones that primary rays walk (empty with --irregular-frame camera).
+    const ProjectiveZones& projective() const { return eye_; }
     /// Primitives of a region.
     std::span<const uint32_t> primitives(uint32_t region) const {
         uint32_t l = regions_[region].list;
@@ -107,6 +110,7 @@ class IrregularSubdivision {
     CameraFrame frame_;
     Box3 bounds_;
     ScreenBsp bsp_;
+    ProjectiveZones eye_;  ///< primary rays (region ids from regions_.size() on)
     std::vector<IrregularRegion> regions_;
     std::vector<uint32_t> zoneFirstRegion_;  ///< zone z: regions [zoneFirstRegion_[z], [z + 1])
     CsgTree pool_;
@@ -163,6 +167,8 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
                                      Obs& obs, Hit& hit) const {
     if (regions_.empty()) return false;
     Ray rc = frame_.ray(ray);
+    if (double u, v; eye_.covers(ray, rc, u, v))
+        return eye_.intersect(ray, rc, u, v, tmin, tmax, uint32_t(regions_.size()), ctx, obs, hit);
     double tw0, tw1;
     if (!clipLine(rc, bounds_, tw0, tw1)) return false;
     double t = std::max(tw0, tmin), tend = std::min(tw1, tmax);

@@ -1,0 +1,96 @@
+#include "engine/accel/irregular/projective_zones.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/accel/irregular/depth_slabs.h"
+#include "engine/accel/irregular/tree_restrictor.h"
+
+namespace lancer {
+
+ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& frame,
+                                       const std::vector<Box3>& box,
+                                       const std::vector<uint32_t>& live,
+                                       const ScreenBspParams& sp, nlohmann::json& extra) {
+    ProjectiveZones s;
+    s.scene_ = &scene;
+    s.eye_ = frame.origin;
+    const Camera& cam = scene.camera;
+    if (cam.projection != Projection::Perspective) return s;
+
+    // zNear: the nearest box wholly in front of the eye.
+    double zNear = kInf, zFar = 0.0;
+    for (uint32_t p : live) {
+        if (box[p].lo.z > 0.0) zNear = std::min(zNear, box[p].lo.z);
+        zFar = std::max(zFar, box[p].hi.z);
+    }
+    if (!(zFar > 0.0)) return s;  // nothing in front of the eye
+    if (zNear == kInf) zNear = 1e-3 * zFar;
+    // The screen rectangle: every pixel of the scene's camera for any aspect ratio up to 4:1
+    // (wider images, and rays outside it, take the camera-frame walk).
+    double half = std::tan(glm::radians(cam.fov) * 0.5);
+    double aspect = std::max(4.0, double(scene.width) / double(std::max(scene.height, 1)));
+    glm::dvec2 limLo(-half * aspect, -half * (1.0 + 1e-6)), limHi(half * aspect, half * (1.0 + 1e-6));
+
+    // Projected boxes: x/z over a box in front of the eye is extreme at its corners. A relative
+    // pad of 1e-12 covers the rounding of these divisions (the camera-frame padding gives the
+    // hit points a margin above 1e-9).
+    std::vector<Box3> pbox(scene.prims.size());
+    std::vector<uint32_t> inside, nearPrims;
+    glm::dvec2 lo(kInf), hi(-kInf);
+    for (uint32_t p : live) {
+        const Box3& b = box[p];
+        if (b.lo.z < zNear) nearPrims.push_back(p);
+        if (!(b.hi.z > zNear)) continue;
+        double z0 = std::max(b.lo.z, zNear), z1 = b.hi.z;
+        Box3 q;
+        q.lo.z = z0;
+        q.hi.z = z1;
+        for (int a = 0; a < 2; ++a) {
+            double c[4] = {b.lo[a] / z0, b.lo[a] / z1, b.hi[a] / z0, b.hi[a] / z1};
+            double mn = std::min({c[0], c[1], c[2], c[3]}), mx = std::max({c[0], c[1], c[2], c[3]});
+            mn -= 1e-12 * std::max(1.0, std::abs(mn));
+            mx += 1e-12 * std::max(1.0, std::abs(mx));
+            q.lo[a] = std::max(mn, limLo[a]);
+            q.hi[a] = std::min(mx, limHi[a]);
+        }
+        if (!(q.lo.x < q.hi.x && q.lo.y < q.hi.y)) continue;  // outside the screen rectangle
+        pbox[p] = q;
+        inside.push_back(p);
+        lo = glm::min(lo, glm::dvec2(q.lo));
+        hi = glm::max(hi, glm::dvec2(q.hi));
+    }
+    if (inside.empty()) return s;
+    s.lo_ = lo;
+    s.hi_ = hi;
+    s.zNear_ = zNear;
+    s.zFar_ = zFar;
+    s.bsp_ = ScreenBsp::build(pbox, inside, lo, hi, sp);
+    DepthSlabs slabs = buildDepthSlabs(scene, s.bsp_, pbox, zNear, zFar);
+    s.zones_ = s.bsp_.zoneCount();
+    s.zoneFirst_ = std::move(slabs.zoneFirstRegion);
+    s.slabLo_.reserve(slabs.regions.size());
+    s.slabRoot_.reserve(slabs.regions.size());
+    for (const IrregularRegion& r : slabs.regions) {
+        s.slabLo_.push_back(r.box.lo.z);
+        s.slabRoot_.push_back(r.root);
+    }
+    s.pool_ = std::move(slabs.pool);
+    std::sort(nearPrims.begin(), nearPrims.end());
+    if (!nearPrims.empty()) s.nearRoot_ = TreeRestrictor(scene.tree).restrict(nearPrims, s.pool_);
+
+    extra["projective_zones"] = s.zones_;
+    extra["projective_slabs"] = s.slabRoot_.size();
+    extra["projective_empty_slabs"] = slabs.emptySlabs + slabs.emptyZones;
+    extra["projective_near_primitives"] = nearPrims.size();
+    extra["projective_znear"] = zNear;
+    return s;
+}
+
+size_t ProjectiveZones::memoryBytes() const {
+    return bsp_.memoryBytes() + zoneFirst_.size() * sizeof(uint32_t) +
+           slabLo_.size() * sizeof(double) + slabRoot_.size() * sizeof(int32_t) +
+           pool_.nodes.size() * sizeof(CsgNode);
+}
+
+}  // namespace lancer

@@ -1,0 +1,118 @@
+// The report's perspective reading of the irregular scheme, for primary rays: zones and depth
+// slabs in the camera's projective space (u = x/z, v = y/z, depth z; DESIGN.md section 4).
+// Every ray from the eye has constant (u, v), so it stays in the zone of its pixel and only walks
+// in depth: no corner pointer, no exit computation, the next slab is the next array entry.
+//
+// Boxes must lie in front of the eye: each camera-frame box is clipped to z >= zNear, and every
+// primitive whose box reaches in front of zNear (for example a floor under the eye) is listed in
+// one near region covering the depth [0, zNear] of every pixel. zNear is the smallest zmin of the
+// boxes wholly in front of the eye, so scenes seen from outside have an empty near region.
+//
+// Why the lists are exact. A visible hit lies in its primitive's box, which the camera-frame box
+// holds with a margin of 1e-9 of the scene scale (irregular.cpp). Along a ray from the eye a
+// point at depth z has (u, v) = (dx/dz, dy/dz), and x/z over a box in front of the eye is
+// extreme at its corners, so the hit's (u, v) lies strictly inside the projected rectangle (the
+// margin, divided by a depth at most the scene scale, is over 1e-9, far beyond the rounding of
+// the divisions), and its depth strictly inside the box's depth range. Region intervals are
+// t = z / dz for the slab boundaries z, computed the same way for both neighbours, so they tile
+// the ray without gap.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "engine/accel/eval.h"
+#include "engine/accel/irregular/camera_frame.h"
+#include "engine/accel/irregular/screen_bsp.h"
+
+namespace lancer {
+
+class ProjectiveZones {
+  public:
+    /// Build over the camera-frame boxes `box` (padded) of the primitives `live`; empty when no
+    /// box reaches in front of the eye. Figures go to `extra`.
+    static ProjectiveZones build(const Scene& scene, const CameraFrame& frame,
+                                 const std::vector<Box3>& box, const std::vector<uint32_t>& live,
+                                 const ScreenBspParams& sp, nlohmann::json& extra);
+
+    /// This structure answers the ray: it starts exactly at the eye and its (u, v) is inside the
+    /// screen rectangle. `rc` is the ray in the camera frame.
+    bool covers(const Ray& world, const Ray& rc, double& u, double& v) const {
+        if (zones_ == 0 || world.o != eye_ || !(rc.d.z > 0.0)) return false;
+        u = rc.d.x / rc.d.z;
+        v = rc.d.y / rc.d.z;
+        return u >= lo_.x && u <= hi_.x && v >= lo_.y && v <= hi_.y;
+    }
+
+    /// Walk a covered ray: the near region, then the slabs of its zone in depth. Region ids
+    /// reported to the observer start at `firstId`.
+    template <class Obs>
+    bool intersect(const Ray& ray, const Ray& rc, double u, double v, double tmin, double tmax,
+                   uint32_t firstId, TraceContext& ctx, Obs& obs, Hit& hit) const;
+
+    size_t regionCount() const { return zones_ == 0 ? 0 : slabRoot_.size() + 1; }
+    size_t memoryBytes() const;
+    size_t zoneCount() const { return zones_; }
+    double zNear() const { return zNear_; }
+    /// The zones, in (u, v).
+    const ScreenBsp& screen() const { return bsp_; }
+    /// Primitives listed in the near region [0, zNear].
+    bool hasNearRegion() const { return nearRoot_ >= 0; }
+
+  private:
+    const Scene* scene_ = nullptr;
+    Vec3 eye_{0.0};
+    glm::dvec2 lo_{0.0}, hi_{0.0};  ///< the screen rectangle in (u, v)
+    double zNear_ = 0.0, zFar_ = 0.0;  ///< depth range of the slabs
+    int nearRoot_ = -1;  ///< restricted tree of the primitives reaching in front of zNear
+    size_t zones_ = 0;
+    ScreenBsp bsp_;
+    std::vector<uint32_t> zoneFirst_;  ///< zone z: slabs [zoneFirst_[z], zoneFirst_[z + 1])
+    std::vector<double> slabLo_;       ///< depth where each slab starts; the last one ends at zFar_
+    std::vector<int32_t> slabRoot_;    ///< restricted tree of each slab (-1: empty)
+    CsgTree pool_;
+};
+
+template <class Obs>
+bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double v, double tmin,
+                                double tmax, uint32_t firstId, TraceContext& ctx, Obs& obs,
+                                Hit& hit) const {
+    const Scene& scene = *scene_;
+    const double dz = rc.d.z;
+    double t = tmin;
+    if (nearRoot_ >= 0) {
+        double t1 = std::min(zNear_ / dz, tmax);
+        if (t <= t1) {
+            ++ctx.counters.regionVisits;
+            obs.region(firstId + uint32_t(slabRoot_.size()), t, t1);
+            if (hitInRegion(scene, pool_, nearRoot_, ray, tmin, t, t1, ctx, obs, hit)) return true;
+        }
+    }
+    uint32_t zone = bsp_.locate(u, v, 0, 0);
+    uint32_t i = zoneFirst_[zone], last = zoneFirst_[zone + 1];
+    // Skip the slabs wholly before tmin (a primary ray has tmin = 0: none).
+    while (i + 1 < last && slabLo_[i + 1] / dz < t) ++i;
+    int lastRoot = -1;
+    for (; i < last; ++i) {
+        double t0 = std::max(slabLo_[i] / dz, t);
+        double z1 = i + 1 < last ? slabLo_[i + 1] : zFar_;
+        double t1 = std::min(z1 / dz, tmax);
+        if (t0 > tmax) return false;
+        int root = slabRoot_[i];
+        ++ctx.counters.regionVisits;
+        obs.region(firstId + i, t0, t1);
+        if (root < 0) continue;
+        if (root != lastRoot) {
+            if (hitInRegion(scene, pool_, root, ray, tmin, t0, t1, ctx, obs, hit)) return true;
+            lastRoot = root;
+        } else {
+            if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
+            if (const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1)) {
+                hit = {b->t, b->prim, b->part, b->flip};
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+}  // namespace lancer
