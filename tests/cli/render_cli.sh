@@ -22,7 +22,8 @@ grep -q '"primary_rays": 2560' "$tmp/a.json" || fail "primary_rays is not 64*40"
 grep -q '"height": 50' "$tmp/b.json" || fail "--width did not keep the aspect"
 
 # Bad options: non-zero exit, the option named.
-out=$("$LANCER" render builtin:default -o "$tmp/c.png" --scheme nonsense 2>&1) && fail "bad --scheme accepted"
+out=$("$LANCER" render builtin:default -o "$tmp/c.png" --scheme nonsense 2>&1); status=$?
+[ "$status" -eq 2 ] || fail "bad --scheme: exit status $status, expected 2"
 echo "$out" | grep -q -- "--scheme" || fail "bad --scheme not named: $out"
 out=$("$LANCER" render builtin:default -o "$tmp/c.png" --width -3 2>&1) && fail "negative width accepted"
 echo "$out" | grep -q -- "--width" || fail "bad --width not named: $out"
@@ -32,7 +33,8 @@ echo "$out" | grep -q -- "--max-level" || fail "huge --max-level not named: $out
 
 # A bad scene file: file:line:col, non-zero exit, no output written.
 printf '{\n  "scene": {"sphere": {"radius": -2}}\n}\n' > "$tmp/bad.json"
-out=$("$LANCER" render "$tmp/bad.json" -o "$tmp/d.png" 2>&1) && fail "bad scene accepted"
+out=$("$LANCER" render "$tmp/bad.json" -o "$tmp/d.png" 2>&1); status=$?
+[ "$status" -eq 2 ] || fail "bad scene: exit status $status, expected 2"
 echo "$out" | grep -q "bad.json:2:24: expected a positive number" || fail "bad scene message: $out"
 [ ! -e "$tmp/d.png" ] || fail "an image was written for a bad scene"
 out=$("$LANCER" render "$tmp/missing.json" -o "$tmp/d.png" 2>&1) && fail "missing scene accepted"
