@@ -1,5 +1,6 @@
 #include "engine/scene/builtin_scenes.h"
 
+#include <array>
 #include <cmath>
 #include <functional>
 
@@ -170,6 +171,80 @@ Scene latticeScene(int n) {
     return s;
 }
 
+// SPD-style "tetra": a Sierpinski tetrahedron of 4^SIZE triangles (surfaces in one union).
+Scene tetraScene(int size) {
+    SceneBuilder b;
+    int m = b.material(mat({1.0, 0.2, 0.2}, 0.7, 0.3, 20.0));
+    std::vector<int> leaves;
+    std::function<void(const std::array<Vec3, 4>&, int)> split = [&](const std::array<Vec3, 4>& v, int depth) {
+        if (depth == 0) {
+            static const int faces[4][3] = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};
+            for (const auto& f : faces) {
+                Triangle t;
+                for (int i = 0; i < 3; ++i) t.p[i] = v[size_t(f[i])];
+                leaves.push_back(b.prim(t, m));
+            }
+            return;
+        }
+        for (int corner = 0; corner < 4; ++corner) {
+            std::array<Vec3, 4> w;
+            for (int i = 0; i < 4; ++i) w[size_t(i)] = 0.5 * (v[size_t(corner)] + v[size_t(i)]);
+            split(w, depth - 1);
+        }
+    };
+    double r = 1.0;
+    split({Vec3(r, r, r), Vec3(-r, -r, r), Vec3(-r, r, -r), Vec3(r, -r, -r)}, size - 1);
+    Scene s = b.finish(b.all(Op::Union, leaves), "tetra:" + std::to_string(size));
+    s.background = {0.078, 0.361, 0.753};
+    s.frameCamera({-0.45, 1.0, 0.35}, {0, 0, 1});
+    s.defaultLights();
+    return s;
+}
+
+// SPD-style "rings": SIZE x SIZE rings, each a chain of spheres joined by open cylinders
+// (surfaces), over a floor polygon: solids and surfaces in one union.
+Scene ringsScene(int size) {
+    SceneBuilder b;
+    int ballM = b.material(mat({1.0, 0.9, 0.7}, 0.5, 0.5, 3.0827, 0.5));
+    int rodM = b.material(mat({0.7, 0.7, 0.9}, 0.7, 0.3, 20.0));
+    int floorM = b.material(mat({1.0, 0.75, 0.33}, 0.8, 0.0, 1.0));
+    std::vector<int> leaves;
+    const int beads = 10;
+    const double ringR = 1.0, bead = 0.12, rod = 0.045;
+    for (int i = 0; i < size; ++i)
+        for (int j = 0; j < size; ++j) {
+            Vec3 c(2.6 * (i - 0.5 * (size - 1)), 2.6 * (j - 0.5 * (size - 1)), 0.4 * ((i + j) % 2));
+            // Tilt alternate rings so the chains interleave.
+            Transform tilt = Transform::translate(c) * Transform::rotate(20.0 * ((i * 3 + j) % 4), {1, 1, 0});
+            std::vector<Vec3> pts;
+            for (int k = 0; k < beads; ++k) {
+                double a = 2.0 * M_PI * k / beads;
+                pts.push_back(tilt.point({ringR * std::cos(a), ringR * std::sin(a), 0.0}));
+            }
+            for (int k = 0; k < beads; ++k) {
+                leaves.push_back(b.prim(Sphere{pts[size_t(k)], bead}, ballM));
+                Vec3 p = pts[size_t(k)], q = pts[size_t((k + 1) % beads)];
+                Vec3 w = glm::normalize(q - p), u, v;
+                orthonormalBasis(w, u, v);
+                Mat4 frame(1.0);
+                frame[0] = glm::dvec4(u, 0.0);
+                frame[1] = glm::dvec4(v, 0.0);
+                frame[2] = glm::dvec4(w, 0.0);
+                frame[3] = glm::dvec4(p, 1.0);
+                leaves.push_back(b.prim(Cone{rod, rod, glm::length(q - p), true}, rodM, Transform(frame)));
+            }
+        }
+    double half = 1.3 * size + 1.5;
+    Polygon floor;
+    makePolygon({{half, half, -1.2}, {-half, half, -1.2}, {-half, -half, -1.2}, {half, -half, -1.2}}, floor);
+    leaves.push_back(b.prim(floor, floorM));
+    Scene s = b.finish(b.all(Op::Union, leaves), "rings:" + std::to_string(size));
+    s.background = {0.078, 0.361, 0.753};
+    s.frameCamera({-1.0, 1.6, -1.1}, {0, 0, 1});
+    s.defaultLights();
+    return s;
+}
+
 }  // namespace
 
 const std::vector<BuiltinInfo>& builtinScenes() {
@@ -178,6 +253,8 @@ const std::vector<BuiltinInfo>& builtinScenes() {
         {"balls", 3, 0, 5, "SPD sphereflake: 1 + 9 + ... + 9^SIZE spheres and a floor polygon"},
         {"drilled", 6, 1, 40, "a block minus SIZE^3 spheres (CSG stress)"},
         {"lattice", 6, 1, 30, "SIZE^3 cells of (cube ∩ sphere) − cylinder, cut by a slab (CSG stress)"},
+        {"tetra", 3, 1, 7, "SPD-style Sierpinski tetrahedron: 4^SIZE triangles"},
+        {"rings", 3, 1, 20, "SPD-style rings: SIZE^2 chains of 10 spheres and 10 open cylinders, a floor"},
     };
     return list;
 }
@@ -193,6 +270,8 @@ Scene makeBuiltin(const std::string& name, int size) {
         if (name == "balls") return ballsScene(size);
         if (name == "drilled") return drilledScene(size);
         if (name == "lattice") return latticeScene(size);
+        if (name == "tetra") return tetraScene(size);
+        if (name == "rings") return ringsScene(size);
     }
     std::string names;
     for (const BuiltinInfo& info : builtinScenes()) names += std::string(names.empty() ? "" : ", ") + info.name;

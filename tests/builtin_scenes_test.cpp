@@ -1,0 +1,38 @@
+// Every built-in scene loads, renders, and gives the brute-force hit on every pixel with both
+// subdivision schemes at their defaults.
+#include <gtest/gtest.h>
+
+#include "engine/scene/builtin_scenes.h"
+#include "tests/support/differential.h"
+
+namespace lancer {
+namespace {
+
+TEST(BuiltinScenes, EverySchemeAgreesWithBruteForceOnEveryPixel) {
+    for (const BuiltinInfo& info : builtinScenes()) {
+        int size = std::min(info.defaultSize, 3);
+        Scene s = makeBuiltin(info.name, std::max(size, info.minSize));
+        ASSERT_FALSE(s.tree.empty()) << info.name;
+        std::vector<Ray> rays = test::pixelRays(s, 32, 24);
+        for (SchemeKind k : {SchemeKind::Regular, SchemeKind::Irregular}) {
+            BuildParams bp;
+            bp.scheme = k;
+            auto accel = buildAccelerator(s, bp);
+            auto bad = test::compareWithBrute(s, *accel, rays);
+            EXPECT_TRUE(bad.empty()) << info.name << " " << schemeName(k) << ": " << bad.size()
+                                     << " mismatches, first:\n" << (bad.empty() ? "" : bad[0].toString(s));
+        }
+    }
+}
+
+TEST(BuiltinScenes, SizesFollowTheirDefinition) {
+    EXPECT_EQ(makeBuiltin("tetra", 3).prims.size(), 64u);   // 4^SIZE triangles, as SPD tetra3
+    EXPECT_EQ(makeBuiltin("tetra", 4).prims.size(), 256u);
+    EXPECT_EQ(makeBuiltin("rings", 2).prims.size(), 2u * 2u * 20u + 1u);
+    EXPECT_EQ(makeBuiltin("balls", 3).prims.size(), 821u);  // 820 spheres and the floor
+    EXPECT_EQ(makeBuiltin("drilled", 4).prims.size(), 65u);
+    EXPECT_THROW(makeBuiltin("tetra", 99), SceneError);
+}
+
+}  // namespace
+}  // namespace lancer
