@@ -15,7 +15,7 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
     app.add_option("--height", o.height, "Image height in pixels (default: the scene's)")->check(CLI::Range(1, 16384));
     app.add_option("--scheme", o.build.scheme, "Acceleration scheme: brute, regular or irregular")
         ->transform(CLI::CheckedTransformer(schemes, CLI::ignore_case).description("{brute, regular, irregular}"))
-        ->default_str("brute");
+        ->default_str(schemeName(o.build.scheme));
     app.add_option("--max-level", o.build.maxLevel, "Deepest subdivision level")
         ->check(CLI::Range(0, 48))
         ->default_val(o.build.maxLevel);

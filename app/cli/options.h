@@ -11,9 +11,16 @@
 namespace lancer::cli {
 
 struct CommonOptions {
+    /// The command line's default scheme is the fastest one measured (README, "Speed against
+    /// error"); BuildParams itself defaults to brute force, the reference.
+    static BuildParams defaultBuild() {
+        BuildParams b;
+        b.scheme = SchemeKind::Regular;
+        return b;
+    }
     std::string scene = "builtin:default";
     int width = 0, height = 0;  ///< 0: the scene's own size (the other follows its aspect)
-    BuildParams build;
+    BuildParams build = defaultBuild();
     RenderOptions render;
     std::string statsPath, depthPath;
 };
