@@ -343,7 +343,9 @@ TEST(Irregular, RegionsTileTheBoundsAndListTheirPrimitives) {
             // Strictly overlapping boxes must be listed (touching ones may be, by the padding).
             bool strict = pb.lo.x < b.hi.x && b.lo.x < pb.hi.x && pb.lo.y < b.hi.y &&
                           b.lo.y < pb.hi.y && pb.lo.z < b.hi.z && b.lo.z < pb.hi.z;
-            if (strict) EXPECT_TRUE(listed) << "p" << p << " missing from region " << r;
+            if (strict) {
+                EXPECT_TRUE(listed) << "p" << p << " missing from region " << r;
+            }
         }
     }
     Vec3 e = B.extent();

@@ -226,7 +226,9 @@ TEST(RegularWalk, RegionsAreContiguousAndInRayOrder) {
             if (e.kind != WalkEvent::Region) continue;
             ASSERT_LT(e.a, g.regionCount());
             ASSERT_LE(e.t0, e.t1);
-            if (!first) ASSERT_EQ(e.t0, prev) << r.toString();
+            if (!first) {
+                ASSERT_EQ(e.t0, prev) << r.toString();
+            }
             // The cell contains the ray's points of its interval (up to rounding).
             const RegularLeaf& L = g.leaves()[e.a];
             Vec3 mid = r.at(0.5 * (e.t0 + e.t1));

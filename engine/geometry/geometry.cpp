@@ -55,6 +55,17 @@ Transform Transform::rotate(double degrees, const Vec3& axis) {
     return Transform(glm::rotate(Mat4(1.0), glm::radians(degrees), glm::normalize(axis)));
 }
 
+Transform Transform::alongAxis(const Vec3& origin, const Vec3& w) {
+    Vec3 u, v;
+    orthonormalBasis(w, u, v);
+    Mat4 m(1.0);
+    m[0] = glm::dvec4(u, 0.0);
+    m[1] = glm::dvec4(v, 0.0);
+    m[2] = glm::dvec4(w, 0.0);
+    m[3] = glm::dvec4(origin, 1.0);
+    return Transform(m);
+}
+
 Box3 Transform::box(const Box3& local) const {
     if (local.isEmpty()) return local;
     Box3 out;

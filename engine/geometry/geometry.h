@@ -89,6 +89,8 @@ struct Transform {
     static Transform scale(const Vec3& s);
     /// Rotation by `degrees` about `axis`.
     static Transform rotate(double degrees, const Vec3& axis);
+    /// Rigid frame with origin `origin` whose local +z is the unit vector `w`.
+    static Transform alongAxis(const Vec3& origin, const Vec3& w);
 
     /// this ∘ other: apply `other` first.
     Transform operator*(const Transform& o) const { return Transform(m * o.m); }

@@ -224,14 +224,8 @@ Scene ringsScene(int size) {
             for (int k = 0; k < beads; ++k) {
                 leaves.push_back(b.prim(Sphere{pts[size_t(k)], bead}, ballM));
                 Vec3 p = pts[size_t(k)], q = pts[size_t((k + 1) % beads)];
-                Vec3 w = glm::normalize(q - p), u, v;
-                orthonormalBasis(w, u, v);
-                Mat4 frame(1.0);
-                frame[0] = glm::dvec4(u, 0.0);
-                frame[1] = glm::dvec4(v, 0.0);
-                frame[2] = glm::dvec4(w, 0.0);
-                frame[3] = glm::dvec4(p, 1.0);
-                leaves.push_back(b.prim(Cone{rod, rod, glm::length(q - p), true}, rodM, Transform(frame)));
+                leaves.push_back(b.prim(Cone{rod, rod, glm::length(q - p), true}, rodM,
+                                        Transform::alongAxis(p, glm::normalize(q - p))));
             }
         }
     double half = 1.3 * size + 1.5;

@@ -186,15 +186,8 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             Vec3 axis = apex - base;
             double h = glm::length(axis);
             if (!(h > 0.0)) src.fail(t.pos, "the cone's base and apex are the same point");
-            Vec3 w = axis / h, u, v;
-            orthonormalBasis(w, u, v);
-            Mat4 m(1.0);
-            m[0] = glm::dvec4(u, 0.0);
-            m[1] = glm::dvec4(v, 0.0);
-            m[2] = glm::dvec4(w, 0.0);
-            m[3] = glm::dvec4(base, 1.0);
             Cone c{r0, r1, h, true};
-            addPrim(c, Transform(m), t.pos);
+            addPrim(c, Transform::alongAxis(base, axis / h), t.pos);
             ++counts.cones;
         } else {
             src.fail(t.pos, "unknown NFF entity '" + std::string(k) + "' (expected v, b, l, f, s, p, pp, c or #)");
