@@ -46,16 +46,26 @@ inline int primitiveSpans(const Scene& scene, uint32_t p, const Ray& ray, TraceC
     return n;
 }
 
+/// How evalTree fetches a primitive's spans: through primitiveSpans (tested or taken from the
+/// mailbox, counted), or straight from the mailbox that hitInLeaf has just filled (not counted).
+enum class Fetch : uint8_t { Counted, Fresh };
+
 /// Spans of `tree` from `node` along the whole line of `ray`, into `out`.
-template <class Obs>
+template <class Obs, Fetch F = Fetch::Counted>
 void evalTree(const Scene& scene, const CsgTree& tree, int node, const Ray& ray, TraceContext& ctx,
               Obs& obs, size_t level, SpanList& out) {
     const CsgNode& x = tree.nodes[node];
     if (x.op == Op::Primitive) {
-        Span local[2];
-        const Span* s;
-        int n = primitiveSpans(scene, x.prim, ray, ctx, obs, s, local);
-        out.assign(s, s + n);
+        if constexpr (F == Fetch::Fresh) {
+            const Mailbox& m = ctx.mail[x.prim];
+            assert(m.ray == ctx.rayId);
+            out.assign(m.spans, m.spans + m.count);
+        } else {
+            Span local[2];
+            const Span* s;
+            int n = primitiveSpans(scene, x.prim, ray, ctx, obs, s, local);
+            out.assign(s, s + n);
+        }
         return;
     }
     // Sized by TraceContext::reset from the tree depth: never resized here, since parents hold
@@ -63,12 +73,12 @@ void evalTree(const Scene& scene, const CsgTree& tree, int node, const Ray& ray,
     assert(ctx.scratch.size() >= 2 * level + 2);
     SpanList& a = ctx.scratch[2 * level];
     SpanList& b = ctx.scratch[2 * level + 1];
-    evalTree(scene, tree, x.left, ray, ctx, obs, level + 1, a);
+    evalTree<Obs, F>(scene, tree, x.left, ray, ctx, obs, level + 1, a);
     if (a.empty() && x.op != Op::Union) {  // nothing to intersect or to cut from
         out.clear();
         return;
     }
-    evalTree(scene, tree, x.right, ray, ctx, obs, level + 1, b);
+    evalTree<Obs, F>(scene, tree, x.right, ray, ctx, obs, level + 1, b);
     switch (x.op) {
         case Op::Union: spanUnion(a, b, out); break;
         case Op::Intersection: spanIntersection(a, b, out); break;
@@ -85,6 +95,47 @@ bool hitInRegion(const Scene& scene, const CsgTree& tree, int root, const Ray& r
                  double t0, double t1, TraceContext& ctx, Obs& obs, Hit& hit) {
     if (root < 0) return false;
     evalTree(scene, tree, root, ray, ctx, obs, 0, ctx.result);
+    if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
+    const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
+    if (b) hit = {b->t, b->prim, b->part, b->flip};
+    return b != nullptr;
+}
+
+/// hitInRegion for a region that lists its tree's primitives (`prims`, `count`). Every boundary
+/// of a CSG result is a boundary of one of its primitives, with the same t; so when no primitive
+/// boundary lies in [t0, t1] after tmin, the region holds no hit and its tree is not evaluated.
+/// Most regions a ray crosses are like that: their primitives are hit elsewhere or not at all.
+/// The spans are fetched once into the mailboxes (counted as tests or mailbox hits); the tree
+/// then reads them there. Without mailboxes, each region gets a fresh stamp, so nothing carries
+/// over from one region to the next and every region tests its primitives again.
+/// Unlike hitInRegion, ctx.result is left unspecified.
+template <class Obs>
+bool hitInLeaf(const Scene& scene, const CsgTree& tree, int root, const uint32_t* prims,
+               uint32_t count, const Ray& ray, double tmin, double t0, double t1,
+               TraceContext& ctx, Obs& obs, Hit& hit) {
+    if (root < 0) return false;
+    if (!ctx.useMailboxes) ++ctx.rayId;
+    bool candidate = false;
+    for (uint32_t i = 0; i < count; ++i) {
+        const uint32_t p = prims[i];
+        Mailbox& m = ctx.mail[p];
+        if (m.ray == ctx.rayId) {
+            ++ctx.counters.mailboxHits;
+            obs.mailboxHit(p);
+        } else {
+            m.count = uint8_t(scene.prims[p].spans(ray, p, m.spans));
+            m.ray = ctx.rayId;
+            ++ctx.counters.primTests;
+            obs.primTest(p, m.spans, m.count);
+        }
+        for (int k = 0; k < m.count; ++k) {
+            const Span& s = m.spans[k];
+            candidate |= (s.in.t >= t0 && s.in.t > tmin && s.in.t <= t1) |
+                         (s.out.t >= t0 && s.out.t > tmin && s.out.t <= t1);
+        }
+    }
+    if (!candidate && !Obs::kActive) return false;  // the observer is shown the spans anyway
+    evalTree<Obs, Fetch::Fresh>(scene, tree, root, ray, ctx, obs, 0, ctx.result);
     if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
     const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
     if (b) hit = {b->t, b->prim, b->part, b->flip};

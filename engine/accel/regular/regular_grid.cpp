@@ -31,7 +31,11 @@ struct RegularBuilder {
     RegularGrid& grid;
     BspNodes bsp;
     std::vector<char> keep;                          ///< membership marks, all 0 between uses
-    std::map<std::vector<uint32_t>, int32_t> trees;  ///< leaf primitive set -> pool root
+    struct SharedTree {
+        int32_t root = -1;
+        uint32_t first = 0;  ///< in grid.primList_
+    };
+    std::map<std::vector<uint32_t>, SharedTree> trees;  ///< leaf primitive set -> its tree
     struct LeafPlace {
         int level;
         uint32_t pos[3];
@@ -59,24 +63,27 @@ struct RegularBuilder {
                "); lower --max-level or raise --max-objects";
     }
 
-    /// Root in the shared pool of the tree restricted to `prims`, added once per set.
-    int32_t treeFor(const CsgTree& tree, const std::vector<uint32_t>& prims) {
-        if (prims.empty()) return -1;
-        auto [it, fresh] = trees.try_emplace(prims, -1);
+    /// The tree restricted to `prims` in the shared pool, and their list, added once per set.
+    SharedTree treeFor(const CsgTree& tree, const std::vector<uint32_t>& prims) {
+        if (prims.empty()) return {};
+        auto [it, fresh] = trees.try_emplace(prims);
         if (fresh) {
             for (uint32_t p : prims) keep[p] = 1;
-            it->second = restrictTree(tree, tree.root, keep, grid.pool_);
+            it->second.root = restrictTree(tree, tree.root, keep, grid.pool_);
             for (uint32_t p : prims) keep[p] = 0;
+            it->second.first = uint32_t(grid.primList_.size());
+            grid.primList_.insert(grid.primList_.end(), prims.begin(), prims.end());
         }
         return it->second;
     }
 
-    void makeLeaf(int id, int level, const uint32_t pos[3], int32_t root, uint32_t nprims) {
+    void makeLeaf(int id, int level, const uint32_t pos[3], SharedTree tree, uint32_t nprims) {
         emptyLeaves += nprims == 0;
         bsp.nodes[size_t(id)].leaf = uint32_t(grid.leaves_.size());
         RegularLeaf leaf;
-        leaf.root = root;
+        leaf.root = tree.root;
         leaf.prims = nprims;
+        leaf.first = tree.first;
         grid.leaves_.push_back(leaf);
         places.push_back({level, {pos[0], pos[1], pos[2]}});
         primRefs += nprims;
@@ -183,7 +190,12 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
     for (int a = 0; a < 3; ++a) {
         depth[a] = cutsOnAxis(finest, a);
         n_[a] = 1u << depth[a];
-        inv_[a] = std::ldexp(1.0, -depth[a]);
+        scale_[a] = double(n_[a]) / ext_[a];
+        // Plane k: min + extent * k / 2^n, the last one exactly max.
+        planes_[a].resize(size_t(n_[a]) + 1);
+        for (uint32_t k = 0; k < n_[a]; ++k)
+            planes_[a][k] = box_.lo[a] + ext_[a] * std::ldexp(double(k), -depth[a]);
+        planes_[a][n_[a]] = box_.hi[a];
     }
     for (size_t i = 0; i < leaves_.size(); ++i) {
         const RegularBuilder::LeafPlace& pl = b.places[i];
@@ -201,7 +213,8 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
     const size_t fullBytes = Directory::estimateBytes(b.bsp, finest, true);
     const size_t dirBytes = full ? fullBytes : Directory::estimateBytes(b.bsp, finest, false);
     const size_t otherBytes =
-        leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode);
+        leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode) +
+        primList_.size() * sizeof(uint32_t) + (size_t(n_[0]) + n_[1] + n_[2] + 3) * sizeof(double);
     if (dirBytes > kMemoryBudget || dirBytes + otherBytes > kMemoryBudget) {
         std::string what = full ? "--full-table" : "--max-level " + std::to_string(params.maxLevel);
         throw std::invalid_argument(

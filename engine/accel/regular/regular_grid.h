@@ -22,6 +22,7 @@ struct RegularLeaf {
     uint32_t lo[3] = {}, hi[3] = {};
     int32_t root = -1;   ///< restricted tree in the shared pool; -1: empty
     uint32_t prims = 0;  ///< primitives in the restricted tree
+    uint32_t first = 0;  ///< where they are listed in RegularGrid::primList(), shared like trees
 };
 
 class RegularGrid {
@@ -46,6 +47,8 @@ class RegularGrid {
     size_t regionCount() const { return leaves_.size(); }
     size_t memoryBytes() const {
         return leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode) +
+               primList_.size() * sizeof(uint32_t) +
+               (planes_[0].size() + planes_[1].size() + planes_[2].size()) * sizeof(double) +
                dir_.memoryBytes();
     }
     bool usesMailboxes() const { return true; }
@@ -54,19 +57,20 @@ class RegularGrid {
     nlohmann::json extra() const { return extra_; }
     const std::vector<RegularLeaf>& leaves() const { return leaves_; }
     const CsgTree& treePool() const { return pool_; }
+    /// Primitives of the leaves' trees: leaf L's are primList()[L.first, L.first + L.prims).
+    const std::vector<uint32_t>& primList() const { return primList_; }
     const Directory& directory() const { return dir_; }
     /// The grid's box: the scene bounds, widened on an axis where they are flat.
     const Box3& box() const { return box_; }
     /// Directory cells per axis, 2^n.
     uint32_t cells(int axis) const { return n_[axis]; }
     /// Coordinate of grid plane k (0..2^n) on `axis`; plane 2^n is exactly box().hi.
-    double plane(int axis, uint32_t k) const {
-        return k == n_[axis] ? box_.hi[axis]
-                             : box_.lo[axis] + ext_[axis] * (double(k) * inv_[axis]);
-    }
-    /// The report's point location, 0-based: floor((x - min) / (max - min) * 2^n), clamped.
+    double plane(int axis, uint32_t k) const { return planes_[axis][k]; }
+    /// The report's point location, 0-based: floor((x - min) / (max - min) * 2^n), clamped; the
+    /// quotient is a product by the precomputed 2^n / (max - min). Truncation is the floor here,
+    /// the quotient being positive.
     uint32_t locate(int axis, double x) const {
-        double f = std::floor((x - box_.lo[axis]) / ext_[axis] * double(n_[axis]));
+        const double f = (x - box_.lo[axis]) * scale_[axis];
         if (!(f >= 0.0)) return 0;  // also NaN
         return f >= double(n_[axis]) ? n_[axis] - 1 : uint32_t(f);
     }
@@ -85,10 +89,12 @@ class RegularGrid {
     Box3 clipBox_;  ///< box_ grown by a hair: a grazing ray whose hit rounds outside still enters
     Vec3 ext_{0.0};
     uint32_t n_[3] = {1, 1, 1};
-    double inv_[3] = {1.0, 1.0, 1.0};
+    double scale_[3] = {1.0, 1.0, 1.0};   ///< 2^n / extent, for locate
+    std::vector<double> planes_[3];       ///< grid plane coordinates, 2^n + 1 per axis
     size_t maxSteps_ = 16;
     std::vector<RegularLeaf> leaves_;
     CsgTree pool_;  ///< restricted trees of all leaves, shared between equal primitive sets
+    std::vector<uint32_t> primList_;  ///< each distinct primitive set once, as leaves list it
     Directory dir_;
     nlohmann::json extra_;
 
@@ -105,6 +111,9 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
     Vec3 p = std::isfinite(tStart) ? ray.at(tStart) : ray.o;
     uint32_t idx[3] = {locate(0, p.x), locate(1, p.y), locate(2, p.z)};
     uint32_t leaf = dir_.lookup(idx[0], idx[1], idx[2]);
+    // Per ray: 1/d, so each exit plane costs a product, not a division (an axis the ray runs
+    // parallel to is never an exit).
+    const double inv[3] = {1.0 / ray.d.x, 1.0 / ray.d.y, 1.0 / ray.d.z};
     // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
     // inside the grid, so this only admits hits that rounding puts a hair outside the box.
     double t0 = tmin, tIn = tStart;
@@ -121,9 +130,9 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
         int exitAxis = -1;
         for (int a = 0; a < 3; ++a) {
             if (ray.d[a] > 0.0)
-                tAxis[a] = (plane(a, L.hi[a]) - ray.o[a]) / ray.d[a];
+                tAxis[a] = (planes_[a][L.hi[a]] - ray.o[a]) * inv[a];
             else if (ray.d[a] < 0.0)
-                tAxis[a] = (plane(a, L.lo[a]) - ray.o[a]) / ray.d[a];
+                tAxis[a] = (planes_[a][L.lo[a]] - ray.o[a]) * inv[a];
             else
                 tAxis[a] = kInf;
             if (tAxis[a] < tExit) tExit = tAxis[a], exitAxis = a;
@@ -175,7 +184,9 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
         const double t1 = last ? tmax : std::max(tExit, tIn);
         ++ctx.counters.regionVisits;
         obs.region(leaf, tIn, last ? tEnd : t1);
-        if (hitInRegion(*scene_, pool_, L.root, ray, tmin, t0, t1, ctx, obs, hit)) return true;
+        if (hitInLeaf(*scene_, pool_, L.root, primList_.data() + L.first, L.prims, ray, tmin, t0,
+                      t1, ctx, obs, hit))
+            return true;
         if (last) return false;
         if (stalled) {
             ++ctx.counters.walkErrors;
