@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <set>
 
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
@@ -332,6 +333,53 @@ TEST(RegularSubTables, SameLeafAsFullTableInLessMemory) {
             ASSERT_TRUE(L.lo[0] <= i && i < L.hi[0] && L.lo[1] <= j && j < L.hi[1] &&
                         L.lo[2] <= k && k < L.hi[2]);
         }
+    }
+}
+
+// A rope is a cached directory lookup: for every face of every leaf, each finest cell just
+// across it lies in the rope's leaf; a face marked split really has several leaves across it.
+TEST(RegularRopes, EveryRopeIsTheLeafTheDirectoryGivesAcrossTheFace) {
+    for (std::string spec : {std::string(LANCER_SPD_DIR) + "/balls2.nff",
+                             std::string("builtin:drilled:3"), std::string("builtin:default")}) {
+        Scene s = loadScene(spec);
+        BuildParams p = regular();
+        p.maxLevel = 15;
+        p.maxObjects = 1;
+        auto accel = buildAccelerator(s, p);
+        const RegularGrid& g = gridOf(*accel);
+        size_t roped = 0, split = 0, border = 0;
+        for (uint32_t id = 0; id < g.regionCount(); ++id) {
+            const RegularLeaf& L = g.leaves()[id];
+            for (int a = 0; a < 3; ++a)
+                for (int side = 0; side < 2; ++side) {
+                    const uint32_t rope = L.rope[2 * a + side];
+                    if (side ? L.hi[a] == g.cells(a) : L.lo[a] == 0) {
+                        ASSERT_EQ(rope, kBorder) << spec << " leaf " << id;
+                        ++border;
+                        continue;
+                    }
+                    const int b = (a + 1) % 3, c = (a + 2) % 3;
+                    std::set<uint32_t> across;
+                    for (uint32_t i = L.lo[b]; i < L.hi[b]; ++i)
+                        for (uint32_t j = L.lo[c]; j < L.hi[c]; ++j) {
+                            uint32_t cell[3];
+                            cell[a] = side ? L.hi[a] : L.lo[a] - 1;
+                            cell[b] = i;
+                            cell[c] = j;
+                            across.insert(g.directory().lookup(cell[0], cell[1], cell[2]));
+                        }
+                    if (rope == kSplitFace) {
+                        EXPECT_GT(across.size(), 1u) << spec << " leaf " << id;
+                        ++split;
+                    } else {
+                        ASSERT_EQ(across, std::set<uint32_t>{rope}) << spec << " leaf " << id;
+                        ++roped;
+                    }
+                }
+        }
+        EXPECT_GT(roped, 0u) << spec;
+        EXPECT_GT(split, 0u) << spec;
+        EXPECT_GT(border, 0u) << spec;
     }
 }
 

@@ -226,6 +226,28 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
     }
     dir_.build(b.bsp, finest, full);
 
+    // Ropes: across each face, the cell at the face's low corner names the neighbour leaf; it is
+    // the only one when it covers the face on the other two axes.
+    for (RegularLeaf& L : leaves_) {
+        for (int a = 0; a < 3; ++a) {
+            for (int side = 0; side < 2; ++side) {
+                uint32_t& rope = L.rope[2 * a + side];
+                if (side ? L.hi[a] == n_[a] : L.lo[a] == 0) {
+                    rope = kBorder;
+                    continue;
+                }
+                uint32_t c[3] = {L.lo[0], L.lo[1], L.lo[2]};
+                c[a] = side ? L.hi[a] : L.lo[a] - 1;
+                const uint32_t nb = dir_.lookup(c[0], c[1], c[2]);
+                const RegularLeaf& N = leaves_[nb];
+                bool covers = true;
+                for (int o = 0; o < 3; ++o)
+                    if (o != a && (N.lo[o] > L.lo[o] || N.hi[o] < L.hi[o])) covers = false;
+                rope = covers ? nb : kSplitFace;
+            }
+        }
+    }
+
     extra_ = {
         {"directory", full ? "full" : "sub-tables"},
         {"directory_bytes", dir_.memoryBytes()},

@@ -23,7 +23,13 @@ struct RegularLeaf {
     int32_t root = -1;   ///< restricted tree in the shared pool; -1: empty
     uint32_t prims = 0;  ///< primitives in the restricted tree
     uint32_t first = 0;  ///< where they are listed in RegularGrid::primList(), shared like trees
+    /// Ropes (Havran): the leaf across each face, 2 * axis + (1 for the hi face), when one leaf
+    /// covers the whole face; kSplitFace when several do (the directory finds which one);
+    /// kBorder on the grid's border. A rope is a cached directory lookup: the same leaf.
+    uint32_t rope[6] = {};
 };
+inline constexpr uint32_t kSplitFace = 0xffffffffu;
+inline constexpr uint32_t kBorder = 0xfffffffeu;
 
 class RegularGrid {
   public:
@@ -109,8 +115,7 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
     const double tStart = std::max(tmin, tA), tEnd = std::min(tmax, tB);
     if (!(tStart <= tEnd)) return false;
     Vec3 p = std::isfinite(tStart) ? ray.at(tStart) : ray.o;
-    uint32_t idx[3] = {locate(0, p.x), locate(1, p.y), locate(2, p.z)};
-    uint32_t leaf = dir_.lookup(idx[0], idx[1], idx[2]);
+    uint32_t leaf = dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
     // Per ray: 1/d, so each exit plane costs a product, not a division (an axis the ray runs
     // parallel to is never an exit).
     const double inv[3] = {1.0 / ray.d.x, 1.0 / ray.d.y, 1.0 / ray.d.z};
@@ -139,27 +144,26 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
         }
         bool last = !(tExit < tEnd);
         bool stalled = false;
-        uint32_t next[3] = {idx[0], idx[1], idx[2]};
+        uint32_t next[3];
         uint32_t nextLeaf = leaf;
         if (!last) {
             const Vec3 q = ray.at(tExit);
             if (exact_) {
                 // The exit face lies on grid plane L.hi or L.lo of exitAxis: the next index there
-                // is exact; the other indices are the exit point's, kept on the face.
+                // is exact; the other indices are the exit point's, kept on the face. When one
+                // leaf covers the whole face, the leaf's rope names it and no lookup is needed.
                 const int a = exitAxis;
-                if (ray.d[a] > 0.0) {
-                    if (L.hi[a] == n_[a])
-                        last = true;
-                    else
-                        next[a] = L.hi[a];
+                const uint32_t rope = L.rope[2 * a + (ray.d[a] > 0.0)];
+                if (rope == kBorder) {
+                    last = true;
+                } else if (rope != kSplitFace) {
+                    nextLeaf = rope;
                 } else {
-                    if (L.lo[a] == 0)
-                        last = true;
-                    else
-                        next[a] = L.lo[a] - 1;
+                    next[a] = ray.d[a] > 0.0 ? L.hi[a] : L.lo[a] - 1;
+                    for (int b = 0; b < 3; ++b)
+                        if (b != a) next[b] = std::clamp(locate(b, q[b]), L.lo[b], L.hi[b] - 1);
+                    nextLeaf = dir_.lookup(next[0], next[1], next[2]);
                 }
-                for (int b = 0; b < 3; ++b)
-                    if (b != a) next[b] = std::clamp(locate(b, q[b]), L.lo[b], L.hi[b] - 1);
             } else {
                 // The report's method: the exit point, taken on the cell's box (rounding can put
                 // ray.at(tExit) a hair outside it), is pushed by delta across every face it
@@ -175,10 +179,10 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
                         next[a] = std::clamp(locate(a, x), L.lo[a], L.hi[a] - 1);
                     }
                 }
-            }
-            if (!last) {
-                nextLeaf = dir_.lookup(next[0], next[1], next[2]);
-                stalled = nextLeaf == leaf;
+                if (!last) {
+                    nextLeaf = dir_.lookup(next[0], next[1], next[2]);
+                    stalled = nextLeaf == leaf;
+                }
             }
         }
         const double t1 = last ? tmax : std::max(tExit, tIn);
@@ -195,7 +199,6 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
         }
         t0 = tIn = t1;
         leaf = nextLeaf;
-        idx[0] = next[0], idx[1] = next[1], idx[2] = next[2];
     }
 }
 
