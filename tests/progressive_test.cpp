@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <thread>
 
@@ -32,6 +33,8 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
     render(*scene, *accel, opt, direct);
 
     ProgressiveRenderer pr({8, 4, 2, 1});
+    std::atomic<int> shownTimes{0};
+    pr.setOnPass([&] { ++shownTimes; });
     pr.start({scene, accel, opt});
     Image shown;
     uint64_t version = 0;
@@ -40,12 +43,16 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
     for (;;) {
         ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
         const bool finished = pr.finished();  // read first: then the snapshot below is the last
-        int stride = 0;
-        if (pr.snapshot(version, shown, &stride)) {
-            seenStrides.push_back(stride);
-            // Every pixel shows its block's corner pixel of the direct render.
+        ProgressiveRenderer::Shown what;
+        if (pr.snapshot(version, shown, &what)) {
+            seenStrides.push_back(what.stride);
+            ASSERT_GT(what.rows, 0);
+            // Every pixel shows its block's corner pixel of the direct render: at the stride of
+            // the pass above its band's end, of the pass before below it.
             for (int y = 0; y < opt.height; ++y)
                 for (int x = 0; x < opt.width; ++x) {
+                    const int stride = y < what.rows ? what.stride : what.previousStride;
+                    ASSERT_GT(stride, 0) << "row " << y << " shown before it was rendered";
                     size_t s = direct.index(x - x % stride, y - y % stride), d = shown.index(x, y);
                     ASSERT_EQ(shown.color[d], direct.color[s])
                         << x << "," << y << " stride " << stride;
@@ -57,6 +64,8 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
     }
     ASSERT_FALSE(seenStrides.empty());
     EXPECT_EQ(seenStrides.back(), 1);
+    // Shown one band at a time: passes 8 and 4 whole, passes 2 and 1 in bands of 8 rows.
+    EXPECT_EQ(shownTimes.load(), 1 + 1 + 8 + 8);
     std::vector<PassRecord> passes = pr.passes();
     ASSERT_EQ(passes.size(), 4u);
     uint64_t primary = 0;

@@ -13,9 +13,14 @@ void lowerThreadPriority() {
 #endif
 }
 
-void fillBlocks(const Image& src, int stride, Image& dst) {
-    if (dst.width != src.width || dst.height != src.height) dst.resize(src.width, src.height);
-    for (int y = 0; y < src.height; ++y) {
+void fillBlocks(const Image& src, int stride, Image& dst, int rowBegin, int rowEnd) {
+    if (dst.width != src.width || dst.height != src.height) {
+        dst.resize(src.width, src.height);
+        rowBegin = 0;
+        rowEnd = -1;
+    }
+    const int end = rowEnd < 0 ? src.height : std::min(rowEnd, src.height);
+    for (int y = std::max(rowBegin, 0); y < end; ++y) {
         const int sy = y - y % stride;
         for (int x = 0; x < src.width; ++x) {
             const size_t s = src.index(x - x % stride, sy), d = dst.index(x, y);
@@ -65,11 +70,11 @@ void ProgressiveRenderer::cancel() {
     cancel_ = true;
 }
 
-bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, int* stride) const {
+bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown) const {
     std::lock_guard lock(mutex_);
     if (version == displayVersion_) return false;
     out = display_;
-    if (stride) *stride = displayStride_;
+    if (shown) *shown = displayShown_;
     version = displayVersion_;
     return true;
 }
@@ -122,31 +127,45 @@ void ProgressiveRenderer::run() {
                 for (int x = 0; x < w; x += stride) count += lattice.contains(x, y);
             progressDone_ = 0;
             progressTotal_ = count;
-            RenderStats rs = render(*job.scene, *job.accel, job.options, work, lattice, &cancel_,
-                                    &progressDone_);
-            if (rs.cancelled) {
-                complete = false;
-                break;
-            }
-            fillBlocks(work, stride, shown);
-            std::unique_lock lock(mutex_);
-            if (cancel_) {  // a newer job arrived while the pass finished: do not show this one
-                complete = false;
-                break;
-            }
-            std::swap(display_, shown);
-            ++displayVersion_;
-            displayStride_ = stride;
+            // The long passes in bands of rows (a multiple of the coarsest stride, so a band's
+            // blocks come from its own rows), each shown when done; the rest of the image keeps
+            // the previous pass meanwhile.
+            const int bands = stride <= 2 ? kBands : 1;
+            const int bandRows = std::max(8, (h / bands + 7) / 8 * 8);
             PassRecord rec;
             rec.stride = stride;
-            rec.renderMs = rs.renderMs;
-            rec.sinceStartMs =
-                std::chrono::duration<double, std::milli>(Clock::now() - requested).count();
-            rec.counters = rs.counters;
-            passes_.push_back(rec);
+            for (int y0 = 0; y0 < h && complete; y0 += bandRows) {
+                lattice.rowBegin = y0;
+                lattice.rowEnd = std::min(h, y0 + bandRows);
+                RenderStats rs = render(*job.scene, *job.accel, job.options, work, lattice,
+                                        &cancel_, &progressDone_);
+                if (rs.cancelled) {
+                    complete = false;
+                    break;
+                }
+                rec.renderMs += rs.renderMs;
+                rec.counters += rs.counters;
+                fillBlocks(work, stride, shown, y0, lattice.rowEnd);
+                const bool passDone = lattice.rowEnd == h;
+                std::unique_lock lock(mutex_);
+                if (cancel_) {  // a newer job arrived while the band finished: do not show it
+                    complete = false;
+                    break;
+                }
+                display_ = shown;
+                ++displayVersion_;
+                displayShown_ = {stride, lattice.rowEnd, previous};
+                if (passDone) {
+                    rec.sinceStartMs =
+                        std::chrono::duration<double, std::milli>(Clock::now() - requested)
+                            .count();
+                    passes_.push_back(rec);
+                }
+                lock.unlock();
+                if (onPass_) onPass_();
+            }
+            if (!complete) break;
             previous = stride;
-            lock.unlock();
-            if (onPass_) onPass_();
         }
         std::lock_guard lock(mutex_);
         if (complete && !pending_) finished_ = true;

@@ -35,9 +35,10 @@ struct PassRecord {
 /// stays responsive beside it; threads it starts (oneTBB's workers, on first use) inherit it.
 void lowerThreadPriority();
 
-/// Copy `src` into `dst`, each pixel taking the values of the pixel at the corner of its
-/// stride x stride block: how a pass that rendered only that lattice is shown.
-void fillBlocks(const Image& src, int stride, Image& dst);
+/// Copy rows [rowBegin, rowEnd) (-1: to the last) of `src` into `dst`, each pixel taking the
+/// values of the pixel at the corner of its stride x stride block: how a pass that rendered only
+/// that lattice is shown. `dst` is resized (and then wholly filled) if its size differs.
+void fillBlocks(const Image& src, int stride, Image& dst, int rowBegin = 0, int rowEnd = -1);
 
 class ProgressiveRenderer {
   public:
@@ -45,6 +46,8 @@ class ProgressiveRenderer {
 
     /// Passes from coarse to fine; the last must be 1.
     explicit ProgressiveRenderer(std::vector<int> strides = {8, 4, 2, 1});
+    /// Bands the passes of stride 2 and 1 are cut into (each band becomes visible when done).
+    static constexpr int kBands = 8;
     /// Cancels the job in flight and joins the worker.
     ~ProgressiveRenderer();
     ProgressiveRenderer(const ProgressiveRenderer&) = delete;
@@ -55,13 +58,20 @@ class ProgressiveRenderer {
     void start(ProgressiveJob job, Clock::time_point requested = Clock::now());
     /// Cancel the job in flight without starting another.
     void cancel();
-    /// Called on the worker thread after each pass becomes available (e.g. to wake a UI loop
+    /// Called on the worker thread after each band or pass becomes available (e.g. to wake a UI loop
     /// waiting for events). Set it before the first start().
     void setOnPass(std::function<void()> f) { onPass_ = std::move(f); }
 
-    /// If a pass finished since `version`, copy the displayable image into `out`, update
-    /// `version` and return true; `stride` (if given) receives the stride of that pass.
-    bool snapshot(uint64_t& version, Image& out, int* stride = nullptr) const;
+    /// What a snapshot shows: rows [0, rows) the pass of `stride`, the rows below it the pass
+    /// before, of `previousStride` (0: none).
+    struct Shown {
+        int stride = 0;
+        int rows = 0;
+        int previousStride = 0;
+    };
+    /// If a band or pass finished since `version`, copy the displayable image into `out`,
+    /// update `version` and return true; `shown` (if given) tells what the image holds.
+    bool snapshot(uint64_t& version, Image& out, Shown* shown = nullptr) const;
     /// Passes of the current job finished so far.
     std::vector<PassRecord> passes() const;
     /// The current job has rendered every pass.
@@ -87,7 +97,7 @@ class ProgressiveRenderer {
     std::atomic<size_t> progressTotal_{0};
     Image display_;
     uint64_t displayVersion_ = 0;
-    int displayStride_ = 0;
+    Shown displayShown_;
     std::vector<PassRecord> passes_;
     std::function<void()> onPass_;
     std::thread worker_;

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 
 namespace lancer {
@@ -36,7 +37,9 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     tbb::task_arena arena(stats.threads);
     arena.execute([&] {
         tbb::parallel_for(
-            tbb::blocked_range2d<int>(0, h, opt.tile, 0, w, opt.tile),
+            tbb::blocked_range2d<int>(std::clamp(pass.rowBegin, 0, h),
+                                      pass.rowEnd < 0 ? h : std::clamp(pass.rowEnd, 0, h), opt.tile,
+                                      0, w, opt.tile),
             [&](const tbb::blocked_range2d<int>& r) {
                 if (stopped.load(std::memory_order_relaxed)) return;
                 if (cancel && cancel->load(std::memory_order_relaxed)) {

@@ -25,10 +25,12 @@ struct RenderStats {
 };
 
 /// Pixels of one progressive pass: those on the `stride` lattice that were not on the
-/// `previousStride` lattice (0: none rendered before).
+/// `previousStride` lattice (0: none rendered before), in rows [rowBegin, rowEnd) (rowEnd -1:
+/// to the last row), so a long pass can be rendered, and shown, band by band.
 struct PassLattice {
     int stride = 1;
     int previousStride = 0;
+    int rowBegin = 0, rowEnd = -1;
     bool contains(int x, int y) const {
         if (x % stride || y % stride) return false;
         return previousStride == 0 || (x % previousStride) || (y % previousStride);
