@@ -73,7 +73,8 @@ void ProgressiveRenderer::cancel() {
 bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown) const {
     std::lock_guard lock(mutex_);
     if (version == displayVersion_) return false;
-    out = display_;
+    // A swap, not a copy: the worker writes the whole of display_ before the next version.
+    std::swap(out, display_);
     if (shown) *shown = displayShown_;
     version = displayVersion_;
     return true;
@@ -115,7 +116,12 @@ void ProgressiveRenderer::run() {
             running_ = true;
         }
         const int w = job.options.width, h = job.options.height;
-        Image work(w, h), shown;
+        // Kept between jobs: no allocation (and page faults) before the first pass. `work` need
+        // not be cleared: each pass writes its lattice before any pixel of it is shown.
+        Image& work = work_;
+        Image& shown = shown_;
+        if (work.width != w || work.height != h) work = Image(w, h);
+        if (shown.width != w || shown.height != h) shown = Image();  // filled whole by pass 1
         int previous = 0;
         bool complete = true;
         for (int stride : strides_) {
@@ -130,7 +136,8 @@ void ProgressiveRenderer::run() {
             // The long passes in bands of rows (a multiple of the coarsest stride, so a band's
             // blocks come from its own rows), each shown when done; the rest of the image keeps
             // the previous pass meanwhile.
-            const int bands = stride <= 2 ? kBands : 1;
+            // The first pass is shown whole: nothing older is there to fill the rows below.
+            const int bands = stride <= 2 && previous > 0 ? kBands : 1;
             const int bandRows = std::max(8, (h / bands + 7) / 8 * 8);
             PassRecord rec;
             rec.stride = stride;
