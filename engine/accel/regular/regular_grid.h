@@ -5,7 +5,9 @@
 //    and locate it; a delta too large skips thin cells, a delta too small stalls;
 //  - exact: leaves are aligned on the directory's integer grid, so the next cell's index on the
 //    exit axis is known exactly and the other indices come from the exit point clamped into
-//    the exit face's range. No epsilon: no skipped cell, no stall.
+//    the exit face's range. No epsilon: no skipped cell, no stall. Across a face that one leaf
+//    covers, the leaf's rope names it and the directory is not consulted.
+// In each leaf, the tree is evaluated only when a primitive boundary lies in the leaf's interval.
 #pragma once
 
 #include <nlohmann/json.hpp>
