@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
     view->add_flag("--log-timings", vopt.logTimings, "Print the latency of each pass after a change to stderr");
     view->add_flag("--replay-change", vopt.replayChange,
                    "After the first complete image, rebuild the structure once, as a parameter change does (to time it)");
+    view->add_flag("--continuous", vopt.continuous,
+                   "Redraw every frame, as while the user interacts (to measure the UI's frame rate under load)");
     view->add_option("--ini", vopt.ini, "Settings file (default: ~/.config/lancer/imgui.ini; \"none\": none)");
 #endif
 

@@ -7,9 +7,11 @@
 #include <imgui_internal.h>  // MarkIniSettingsDirty
 
 #include <chrono>
+#include <condition_variable>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -109,21 +111,42 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
 
     int status = 0;
     try {
-        // Worker threads wake the loop when a pass or a structure is ready (thread-safe in GLFW).
-        ViewerApp app(settings, v.logTimings, [] { glfwPostEmptyEvent(); });
+        // Worker threads wake the loop when a band, pass or structure is ready: through the
+        // condition variable if it is pacing frames, else through GLFW's event queue.
+        std::mutex wakeMutex;
+        std::condition_variable wakeCv;
+        bool woken = false;
+        ViewerApp app(settings, v.logTimings, [&] {
+            {
+                std::lock_guard lock(wakeMutex);
+                woken = true;
+            }
+            wakeCv.notify_one();
+            glfwPostEmptyEvent();  // thread-safe in GLFW
+        });
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
         bool replayed = false;
         double statWorkMs = 0.0, statSwapMs = 0.0;
         Clock::time_point frameStart = Clock::now(), statStart = frameStart;
         while (!glfwWindowShouldClose(window)) {
-            // At most 60 frames per second (no swap interval is guaranteed, e.g. under Xvfb).
-            // Interactive: draw on input, on a new pass or structure (the workers post an empty
-            // event), and at 10 Hz for the progress bar while working; idle otherwise.
+            // At most 60 frames per second for input (no swap interval is guaranteed, e.g.
+            // under Xvfb); a worker's result ends the wait at once, so a new pass or structure
+            // is shown (or a render started on it) without waiting out the frame.
             double left =
                 1.0 / 60.0 - std::chrono::duration<double>(Clock::now() - frameStart).count();
-            if (left > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(left));
-            if (v.frames > 0)
+            if (left > 0.0) {
+                std::unique_lock lock(wakeMutex);
+                wakeCv.wait_for(lock, std::chrono::duration<double>(left), [&] { return woken; });
+            }
+            {
+                std::lock_guard lock(wakeMutex);
+                woken = false;
+            }
+            // Interactive: draw on input, on a new band, pass or structure (the workers post an
+            // empty event), and at 10 Hz for the progress bar while working; idle otherwise. A
+            // scripted run (--frames) counts its frames quickly once the image is complete.
+            if (v.continuous || (v.frames > 0 && app.settled()))
                 glfwPollEvents();
             else
                 glfwWaitEventsTimeout(app.settled() ? 1.0 : 0.1);

@@ -15,6 +15,9 @@ struct ViewOptions {
     bool replayChange =
         false;  ///< after the first complete image, rebuild once (timed like a parameter change)
     std::string ini;  ///< settings file; empty: the default one ("none": no file)
+    /// Redraw every frame (at most 60 per second), as while the user keeps interacting; else
+    /// only on input, on a worker's result and at 10 Hz while rendering.
+    bool continuous = false;
 };
 
 /// What runViewer returns when no window can be opened (no display, no OpenGL 3.3).

@@ -19,6 +19,14 @@ test -s "$tmp/out.png"
 "$lancer" render builtin:default -o "$tmp/cpu.png" --width 900 --height 560 -q
 # Centre: between the default Parameters (x < 340) and Statistics/View (x > 550) panels.
 python3 "$src/tests/support/png_compare.py" "$tmp/out.png" "$tmp/cpu.png" 350 40 540 550 20 60 320 400
+# Redrawing every frame (--continuous) the viewer still completes the image, and --log-timings
+# reports each pass's latency and the UI's frame rate.
+timeout 240 xvfb-run -a -s "-screen 0 1280x1024x24" \
+  "$lancer" view builtin:default --frames 150 --continuous --log-timings --width 320 --height 200 \
+  --ini none 2>"$tmp/timings.txt"
+grep -q "pass stride 16 visible" "$tmp/timings.txt" || { cat "$tmp/timings.txt" >&2; exit 1; }
+grep -q "full image" "$tmp/timings.txt" || { cat "$tmp/timings.txt" >&2; exit 1; }
+grep -q "timing: ui .* fps" "$tmp/timings.txt" || { cat "$tmp/timings.txt" >&2; exit 1; }
 # A scripted run on a scene that cannot be loaded fails with the file's error, without hanging.
 status=0
 timeout 120 xvfb-run -a "$lancer" view "$tmp/missing.nff" --frames 2 --ini none 2>"$tmp/err.txt" || status=$?
