@@ -132,17 +132,25 @@ struct RegularBuilder {
             // Primitives whose minimized boxes overlap the closed child box, then the tree
             // restricted to them; a primitive the restriction drops cannot contribute here.
             std::vector<uint32_t> in;
+            in.reserve(prims.size());
             for (uint32_t p : prims)
                 if (scene.minBox[p].overlaps(child)) in.push_back(p);
-            CsgTree sub;
-            for (uint32_t p : in) keep[p] = 1;
-            sub.root = restrictTree(tree, tree.root, keep, sub);
-            for (uint32_t p : in) keep[p] = 0;
-            std::vector<uint32_t> live = sub.primitives();
-            sortedUnique(live);
             uint32_t cpos[3] = {pos[0], pos[1], pos[2]};
             cpos[axis] = 2 * pos[axis] + uint32_t(side);
-            build(first + side, level + 1, cpos, child, sub, live);
+            if (in.size() == prims.size()) {
+                // Every primitive overlaps the child: the restriction is this tree, whose
+                // primitives all count (`prims` are the live ones).
+                build(first + side, level + 1, cpos, child, tree, prims);
+            } else {
+                CsgTree sub;
+                sub.nodes.reserve(2 * in.size());
+                for (uint32_t p : in) keep[p] = 1;
+                sub.root = restrictTree(tree, tree.root, keep, sub);
+                for (uint32_t p : in) keep[p] = 0;
+                std::vector<uint32_t> live = sub.primitives();
+                sortedUnique(live);
+                build(first + side, level + 1, cpos, child, sub, live);
+            }
             height = std::max<uint8_t>(height, bsp.nodes[size_t(first + side)].height + 1);
         }
         bsp.nodes[size_t(id)].height = height;
