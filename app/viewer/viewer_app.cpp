@@ -287,8 +287,12 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     ImGui::Render();
 
     glViewport(0, 0, fbWidth, fbHeight);
-    glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT);
+    // The image is drawn over the whole framebuffer: clear only while there is none (one
+    // full-screen fill less per frame, which software GL feels).
+    if (view_->width() == 0) {
+        glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+    }
     view_->draw(fbWidth, fbHeight, s_.mode, scale_);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     if (!pendingScreenshot_.empty()) {
