@@ -18,10 +18,8 @@ namespace lancer::viewer {
 
 struct ViewerApp::Speedup {
     std::atomic<bool> cancel{false}, done{false};
-    std::string scheme, error;
+    SpeedupResult result;
     int stride = 4;
-    size_t pixels = 0;
-    double schemeMs = 0.0, bruteMs = 0.0;
 };
 
 namespace {
@@ -556,22 +554,37 @@ void ViewerApp::statisticsPanel() {
         startSpeedup();
     }
     if (speedup_ && speedup_->done) {
-        if (!speedup_->error.empty())
-            ImGui::TextWrapped("%s", speedup_->error.c_str());
+        const SpeedupResult& r = speedup_->result;
+        if (!r.error.empty())
+            ImGui::TextWrapped("%s", r.error.c_str());
         else
             ImGui::TextWrapped(
-                "%s %.1f ms, brute %.1f ms on %zu pixels: speedup x%.2f", speedup_->scheme.c_str(),
-                speedup_->schemeMs, speedup_->bruteMs, speedup_->pixels,
-                speedup_->schemeMs > 0 ? speedup_->bruteMs / speedup_->schemeMs : 0.0);
+                "%s %.1f ms, brute %.1f ms on %zu pixels: speedup x%.2f; primitive tests per "
+                "ray %.1f against %.1f",
+                r.scheme.c_str(), r.schemeMs, r.bruteMs, r.pixels,
+                r.schemeMs > 0 ? r.bruteMs / r.schemeMs : 0.0,
+                r.schemeRays ? double(r.schemeTests) / double(r.schemeRays) : 0.0,
+                r.bruteRays ? double(r.bruteTests) / double(r.bruteRays) : 0.0);
     }
     ImGui::End();
+}
+
+void ViewerApp::measureSpeedup(int stride) {
+    if (!structure_) return;
+    speedupStride_ = stride;
+    startSpeedup();
+}
+
+std::optional<ViewerApp::SpeedupResult> ViewerApp::speedupResult() const {
+    if (!speedup_ || !speedup_->done) return std::nullopt;
+    return speedup_->result;
 }
 
 void ViewerApp::startSpeedup() {
     if (speedupThread_.joinable()) speedupThread_.join();
     auto sp = std::make_shared<Speedup>();
     sp->stride = speedupStride_;
-    sp->scheme = schemeName(structure_->accel->params().scheme);
+    sp->result.scheme = schemeName(structure_->accel->params().scheme);
     speedup_ = sp;
     RenderOptions opt;
     opt.width = jobWidth_;
@@ -587,17 +600,22 @@ void ViewerApp::startSpeedup() {
             PassLattice lattice{sp->stride, 0};
             Image img(opt.width, opt.height);
             for (int y = 0; y < opt.height; y += sp->stride)
-                for (int x = 0; x < opt.width; x += sp->stride) ++sp->pixels;
+                for (int x = 0; x < opt.width; x += sp->stride) ++sp->result.pixels;
             RenderStats a = render(*st->scene, *st->accel, opt, img, lattice, &sp->cancel);
             BuildParams bp = st->accel->params();
             bp.scheme = SchemeKind::Brute;
             auto brute = buildAccelerator(*st->scene, bp);
             RenderStats b = render(*st->scene, *brute, opt, img, lattice, &sp->cancel);
-            if (a.cancelled || b.cancelled) sp->error = "cancelled: the view changed";
-            sp->schemeMs = a.renderMs;
-            sp->bruteMs = b.renderMs;
+            SpeedupResult& r = sp->result;
+            if (a.cancelled || b.cancelled) r.error = "cancelled: the view changed";
+            r.schemeMs = a.renderMs;
+            r.bruteMs = b.renderMs;
+            r.schemeRays = a.counters.rays;
+            r.bruteRays = b.counters.rays;
+            r.schemeTests = a.counters.primTests;
+            r.bruteTests = b.counters.primTests;
         } catch (const std::exception& e) {
-            sp->error = e.what();
+            sp->result.error = e.what();
         }
         sp->done = true;
     });

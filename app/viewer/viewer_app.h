@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -52,6 +53,19 @@ class ViewerApp {
     const std::shared_ptr<const Structure>& structure() const { return structure_; }
     /// The heat scale in use this frame.
     float heatScale() const { return scale_; }
+
+    /// The speedup over brute force on the current view (the Statistics panel's button): the
+    /// pixels of one in `stride` x `stride` traced with the scheme, then with brute force, on
+    /// a worker thread. Nothing happens before the first structure.
+    void measureSpeedup(int stride);
+    struct SpeedupResult {
+        std::string scheme, error;
+        size_t pixels = 0;
+        double schemeMs = 0.0, bruteMs = 0.0;
+        uint64_t schemeRays = 0, bruteRays = 0, schemeTests = 0, bruteTests = 0;
+    };
+    /// The last measurement, once it is done.
+    std::optional<SpeedupResult> speedupResult() const;
 
   private:
     void pollBackground();

@@ -281,5 +281,37 @@ TEST_F(ViewerFrames, ASceneThatFailsToLoadKeepsThePreviousOne) {
     EXPECT_EQ(settings_.scene, "builtin:balls:1");
 }
 
+// The Statistics panel's speedup: both runs trace the same pixels and, giving the same hits,
+// the same rays; brute force tests the live primitives for every ray (fewer where a
+// difference or intersection has nothing on its left), the scheme far fewer.
+TEST_F(ViewerFrames, SpeedupTracesTheSamePixelsAndRaysWithBothSchemes) {
+    settings_.build.scheme = SchemeKind::Regular;
+    app_->rebuild("scheme");
+    runUntilSettled();
+    ASSERT_TRUE(app_->structure());
+    ASSERT_EQ(app_->structure()->accel->params().scheme, SchemeKind::Regular);
+    EXPECT_FALSE(app_->speedupResult()) << "nothing measured before it is asked for";
+    app_->measureSpeedup(4);
+    std::optional<ViewerApp::SpeedupResult> r;
+    auto start = std::chrono::steady_clock::now();
+    while (!(r = app_->speedupResult()) &&
+           std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
+        app_->frame(kW, kH);  // the panel shows the result once done
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_TRUE(r) << "the measurement did not finish";
+    ASSERT_TRUE(r->error.empty()) << r->error;
+    EXPECT_EQ(r->scheme, "regular");
+    EXPECT_EQ(r->pixels, size_t((kW + 3) / 4) * size_t((kH + 3) / 4));
+    EXPECT_GE(r->schemeRays, r->pixels);
+    EXPECT_EQ(r->schemeRays, r->bruteRays);
+    const Scene& scene = *app_->structure()->scene;
+    EXPECT_LE(r->bruteTests, r->bruteRays * scene.livePrimitives().size());
+    EXPECT_GT(r->bruteTests, r->bruteRays);
+    EXPECT_LT(r->schemeTests, r->bruteTests);
+    EXPECT_GT(r->schemeMs, 0.0);
+    EXPECT_GT(r->bruteMs, 0.0);
+}
+
 }  // namespace
 }  // namespace lancer::viewer
