@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "app/cli/options.h"
 #include "app/viewer/colormap.h"
 #include "engine/accel/accelerator.h"
 #include "engine/render/tracer.h"
@@ -11,7 +12,7 @@ namespace lancer::viewer {
 
 struct ViewerSettings {
     std::string scene = "builtin:default";  ///< last scene opened
-    BuildParams build;
+    BuildParams build = cli::CommonOptions::defaultBuild();  ///< the command line's default
     ShadingOptions shading;
     int threads = 0;  ///< render threads (0: all cores)
     int windowWidth = 1280, windowHeight = 720;

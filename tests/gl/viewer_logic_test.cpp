@@ -85,6 +85,16 @@ TEST(CameraControl, JsonRoundTripAndErrors) {
     EXPECT_THROW(cameraFromJson("not json", sample()), SceneError);
 }
 
+// With no ini and no option, the viewer builds what `lancer render` would: the regular scheme
+// (a viewer that silently fell back to brute force took minutes on balls4).
+TEST(ViewerSettingsIni, DefaultsAreTheCommandLineDefaults) {
+    ViewerSettings s;
+    EXPECT_EQ(s.build.scheme, SchemeKind::Regular);
+    EXPECT_EQ(s.build.scheme, cli::CommonOptions{}.build.scheme);
+    EXPECT_EQ(s.build.maxLevel, cli::CommonOptions{}.build.maxLevel);
+    EXPECT_EQ(s.build.maxObjects, cli::CommonOptions{}.build.maxObjects);
+}
+
 TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     ViewerSettings s;
     s.scene = "assets/spd/balls4.nff";
