@@ -149,7 +149,6 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
         uint32_t next[3];
         uint32_t nextLeaf = leaf;
         if (!last) {
-            const Vec3 q = ray.at(tExit);
             if (exact_) {
                 // The exit face lies on grid plane L.hi or L.lo of exitAxis: the next index there
                 // is exact; the other indices are the exit point's, kept on the face. When one
@@ -161,6 +160,7 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
                 } else if (rope != kSplitFace) {
                     nextLeaf = rope;
                 } else {
+                    const Vec3 q = ray.at(tExit);
                     next[a] = ray.d[a] > 0.0 ? L.hi[a] : L.lo[a] - 1;
                     for (int b = 0; b < 3; ++b)
                         if (b != a) next[b] = std::clamp(locate(b, q[b]), L.lo[b], L.hi[b] - 1);
@@ -171,6 +171,7 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
                 // ray.at(tExit) a hair outside it), is pushed by delta across every face it
                 // leaves through, then located. Off the pushed axes it stays in the cell's range,
                 // so the walk cannot bounce back into the previous cell.
+                const Vec3 q = ray.at(tExit);
                 for (int a = 0; a < 3; ++a) {
                     double x = std::clamp(q[a], plane(a, L.lo[a]), plane(a, L.hi[a]));
                     if (tAxis[a] == tExit) {
