@@ -223,14 +223,7 @@ TEST(Irregular, RandomScenesAndHardRays) {
         expectSame(scene, *accel, onBoundary, what + " tmin", 1e-9 * scene.scale());
         total += rays.size() + onBoundary.size();
 
-        TraceContext ctx(scene.prims.size(), scene.tree.depth());
-        NullObserver obs;
-        for (const Ray& r : rays) {
-            Hit hit;
-            ctx.beginRay();
-            accel->intersect(r, 0.0, kInf, ctx, obs, hit);
-        }
-        EXPECT_EQ(ctx.counters.walkErrors, 0u) << what;
+        EXPECT_EQ(test::traceCounters(scene, *accel, rays).walkErrors, 0u) << what;
     }
     EXPECT_GE(total, 100000u);
 }

@@ -25,15 +25,7 @@ const RegularGrid& gridOf(const Accelerator& a) { return std::get<RegularGrid>(a
 /// Walk errors of `accel` over `rays` (compareWithBrute checks the hits, this the walks).
 uint64_t walkErrors(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
                     double tmin = 0.0) {
-    TraceContext ctx(scene.prims.size(), scene.tree.depth());
-    ctx.useMailboxes = accel.usesMailboxes();
-    NullObserver obs;
-    for (const Ray& r : rays) {
-        Hit h;
-        ctx.beginRay();
-        accel.intersect(r, tmin, kInf, ctx, obs, h);
-    }
-    return ctx.counters.walkErrors;
+    return test::traceCounters(scene, accel, rays, tmin).walkErrors;
 }
 
 std::string describe(const Scene& s, const std::vector<test::RayMismatch>& m) {
@@ -258,18 +250,7 @@ TEST(RegularMailbox, SameHitsFewerTestsThanWithout) {
     EXPECT_FALSE(b->usesMailboxes());
     auto rays = test::pixelRays(s, 40, 40);
     EXPECT_TRUE(test::compareWithBrute(s, *b, rays).empty());
-    auto count = [&](const Accelerator& acc) {
-        TraceContext ctx(s.prims.size(), s.tree.depth());
-        ctx.useMailboxes = acc.usesMailboxes();
-        NullObserver obs;
-        for (const Ray& r : rays) {
-            Hit h;
-            ctx.beginRay();
-            acc.intersect(r, 0.0, kInf, ctx, obs, h);
-        }
-        return ctx.counters;
-    };
-    RayCounters ca = count(*a), cb = count(*b);
+    RayCounters ca = test::traceCounters(s, *a, rays), cb = test::traceCounters(s, *b, rays);
     EXPECT_GT(ca.mailboxHits, 0u);
     EXPECT_EQ(cb.mailboxHits, 0u);
     EXPECT_LT(ca.primTests, cb.primTests);

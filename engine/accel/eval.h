@@ -20,22 +20,30 @@ struct Hit {
     bool valid() const { return prim != kNoPrim; }
 };
 
+/// The primitive's mailbox holding its spans for the current ray id: filled by a test (counted
+/// as one) unless this ray id already filled it (counted as a mailbox hit).
+template <class Obs>
+inline const Mailbox& mailboxSpans(const Scene& scene, uint32_t p, const Ray& ray,
+                                   TraceContext& ctx, Obs& obs) {
+    Mailbox& m = ctx.mail[p];
+    if (m.ray == ctx.rayId) {
+        ++ctx.counters.mailboxHits;
+        obs.mailboxHit(p);
+        return m;
+    }
+    m.count = uint8_t(scene.prims[p].spans(ray, p, m.spans));
+    m.ray = ctx.rayId;
+    ++ctx.counters.primTests;
+    obs.primTest(p, m.spans, m.count);
+    return m;
+}
+
 /// Spans of the primitive for the current ray, from its mailbox when this ray already tested it.
 template <class Obs>
 inline int primitiveSpans(const Scene& scene, uint32_t p, const Ray& ray, TraceContext& ctx,
                           Obs& obs, const Span*& out, Span* local) {
     if (ctx.useMailboxes) {
-        Mailbox& m = ctx.mail[p];
-        if (m.ray == ctx.rayId) {
-            ++ctx.counters.mailboxHits;
-            obs.mailboxHit(p);
-            out = m.spans;
-            return m.count;
-        }
-        m.count = uint8_t(scene.prims[p].spans(ray, p, m.spans));
-        m.ray = ctx.rayId;
-        ++ctx.counters.primTests;
-        obs.primTest(p, m.spans, m.count);
+        const Mailbox& m = mailboxSpans(scene, p, ray, ctx, obs);
         out = m.spans;
         return m.count;
     }
@@ -117,17 +125,7 @@ bool hitInLeaf(const Scene& scene, const CsgTree& tree, int root, const uint32_t
     if (!ctx.useMailboxes) ++ctx.rayId;
     bool candidate = false;
     for (uint32_t i = 0; i < count; ++i) {
-        const uint32_t p = prims[i];
-        Mailbox& m = ctx.mail[p];
-        if (m.ray == ctx.rayId) {
-            ++ctx.counters.mailboxHits;
-            obs.mailboxHit(p);
-        } else {
-            m.count = uint8_t(scene.prims[p].spans(ray, p, m.spans));
-            m.ray = ctx.rayId;
-            ++ctx.counters.primTests;
-            obs.primTest(p, m.spans, m.count);
-        }
+        const Mailbox& m = mailboxSpans(scene, prims[i], ray, ctx, obs);
         for (int k = 0; k < m.count; ++k) {
             const Span& s = m.spans[k];
             candidate |= (s.in.t >= t0 && s.in.t > tmin && s.in.t <= t1) |

@@ -70,7 +70,7 @@ void ProgressiveRenderer::cancel() {
     cancel_ = true;
 }
 
-bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown) const {
+bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown) {
     std::lock_guard lock(mutex_);
     if (version == displayVersion_) return false;
     // A swap, not a copy: the worker writes the whole of display_ before the next version.

@@ -74,7 +74,7 @@ class ProgressiveRenderer {
     /// If a band or pass finished since `version`, move the displayable image into `out` (the
     /// previous contents of `out` are recycled), update `version` and return true; `shown`
     /// (if given) tells what the image holds.
-    bool snapshot(uint64_t& version, Image& out, Shown* shown = nullptr) const;
+    bool snapshot(uint64_t& version, Image& out, Shown* shown = nullptr);
     /// Passes of the current job finished so far.
     std::vector<PassRecord> passes() const;
     /// The current job has rendered every pass.
@@ -98,7 +98,7 @@ class ProgressiveRenderer {
     std::atomic<bool> cancel_{false};
     std::atomic<size_t> progressDone_{0};
     std::atomic<size_t> progressTotal_{0};
-    mutable Image display_;  ///< swapped out by snapshot()
+    Image display_;  ///< swapped out by snapshot()
     uint64_t displayVersion_ = 0;
     Shown displayShown_;
     Image work_, shown_;  ///< the worker's buffers, kept between jobs of the same size

@@ -156,6 +156,19 @@ std::vector<RayMismatch> compareWithBrute(const Scene& scene, const Accelerator&
     return out;
 }
 
+RayCounters traceCounters(const Scene& scene, const Accelerator& accel,
+                          const std::vector<Ray>& rays, double tmin) {
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    ctx.useMailboxes = accel.usesMailboxes();
+    NullObserver obs;
+    for (const Ray& r : rays) {
+        Hit h;
+        ctx.beginRay();
+        accel.intersect(r, tmin, kInf, ctx, obs, h);
+    }
+    return ctx.counters;
+}
+
 std::vector<Ray> pixelRays(const Scene& scene, int w, int h) {
     std::vector<Ray> rays;
     rays.reserve(size_t(w) * size_t(h));

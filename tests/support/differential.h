@@ -45,6 +45,11 @@ std::vector<RayMismatch> compareWithBrute(const Scene& scene, const Accelerator&
                                           const std::vector<Ray>& rays, double tmin = 0.0,
                                           double relTol = 1e-9, size_t maxReport = 20);
 
+/// Counters of `accel` tracing every ray with t in (tmin, inf), one context, mailboxes as the
+/// structure uses them (compareWithBrute checks the hits, this the walks and the tests).
+RayCounters traceCounters(const Scene& scene, const Accelerator& accel,
+                          const std::vector<Ray>& rays, double tmin = 0.0);
+
 /// Primary rays of every pixel of a w x h image of the scene's camera.
 std::vector<Ray> pixelRays(const Scene& scene, int w, int h);
 

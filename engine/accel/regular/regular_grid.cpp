@@ -199,11 +199,9 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
         depth[a] = cutsOnAxis(finest, a);
         n_[a] = 1u << depth[a];
         scale_[a] = double(n_[a]) / ext_[a];
-        // Plane k: min + extent * k / 2^n, the last one exactly max.
+        // The builder's cut planes at the finest level (the last one exactly max).
         planes_[a].resize(size_t(n_[a]) + 1);
-        for (uint32_t k = 0; k < n_[a]; ++k)
-            planes_[a][k] = box_.lo[a] + ext_[a] * std::ldexp(double(k), -depth[a]);
-        planes_[a][n_[a]] = box_.hi[a];
+        for (uint32_t k = 0; k <= n_[a]; ++k) planes_[a][k] = b.planeAt(a, k, depth[a]);
     }
     for (size_t i = 0; i < leaves_.size(); ++i) {
         const RegularBuilder::LeafPlace& pl = b.places[i];
@@ -220,9 +218,7 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
     const bool full = params.fullTable;
     const size_t fullBytes = Directory::estimateBytes(b.bsp, finest, true);
     const size_t dirBytes = full ? fullBytes : Directory::estimateBytes(b.bsp, finest, false);
-    const size_t otherBytes =
-        leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode) +
-        primList_.size() * sizeof(uint32_t) + (size_t(n_[0]) + n_[1] + n_[2] + 3) * sizeof(double);
+    const size_t otherBytes = memoryBytes();  // everything but the directory, not built yet
     if (dirBytes > kMemoryBudget || dirBytes + otherBytes > kMemoryBudget) {
         std::string what = full ? "--full-table" : "--max-level " + std::to_string(params.maxLevel);
         throw std::invalid_argument(
