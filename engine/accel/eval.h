@@ -3,6 +3,7 @@
 // these two functions, so brute force and subdivisions differ only in which tree and interval.
 #pragma once
 
+#include <algorithm>
 #include <cassert>
 
 #include "engine/accel/observer.h"
@@ -21,20 +22,22 @@ struct Hit {
 };
 
 /// The primitive's mailbox holding its spans for the current ray id: filled by a test (counted
-/// as one) unless this ray id already filled it (counted as a mailbox hit).
+/// as one) unless this ray id already filled it (counted as a mailbox hit). `fresh` says which.
 template <class Obs>
 inline const Mailbox& mailboxSpans(const Scene& scene, uint32_t p, const Ray& ray,
-                                   TraceContext& ctx, Obs& obs) {
+                                   TraceContext& ctx, Obs& obs, bool* fresh = nullptr) {
     Mailbox& m = ctx.mail[p];
-    if (m.ray == ctx.rayId) {
+    if (ctx.stamp[p] == ctx.rayId) {
         ++ctx.counters.mailboxHits;
         obs.mailboxHit(p);
+        if (fresh) *fresh = false;
         return m;
     }
     m.count = uint8_t(scene.prims[p].spans(ray, p, m.spans));
-    m.ray = ctx.rayId;
+    ctx.stamp[p] = ctx.rayId;
     ++ctx.counters.primTests;
     obs.primTest(p, m.spans, m.count);
+    if (fresh) *fresh = true;
     return m;
 }
 
@@ -66,7 +69,7 @@ void evalTree(const Scene& scene, const CsgTree& tree, int node, const Ray& ray,
     if (x.op == Op::Primitive) {
         if constexpr (F == Fetch::Fresh) {
             const Mailbox& m = ctx.mail[x.prim];
-            assert(m.ray == ctx.rayId);
+            assert(ctx.stamp[x.prim] == ctx.rayId);
             out.assign(m.spans, m.spans + m.count);
         } else {
             Span local[2];
@@ -109,30 +112,42 @@ bool hitInRegion(const Scene& scene, const CsgTree& tree, int root, const Ray& r
     return b != nullptr;
 }
 
-/// hitInRegion for a region that lists its tree's primitives (`prims`, `count`). Every boundary
-/// of a CSG result is a boundary of one of its primitives, with the same t; so when no primitive
-/// boundary lies in [t0, t1] after tmin, the region holds no hit and its tree is not evaluated.
-/// Most regions a ray crosses are like that: their primitives are hit elsewhere or not at all.
-/// The spans are fetched once into the mailboxes (counted as tests or mailbox hits); the tree
-/// then reads them there. Without mailboxes, each region gets a fresh stamp, so nothing carries
-/// over from one region to the next and every region tests its primitives again.
-/// Unlike hitInRegion, ctx.result is left unspecified.
+/// hitInRegion for a region that lists its tree's primitives (`prims`, `count`), walked in ray
+/// order from the ray's first region, ctx.pending cleared for it. Every boundary of a CSG result
+/// is a boundary of one of its primitives, with the same t; so when no primitive boundary lies
+/// in [t0, t1] after tmin, the region holds no hit and its tree is not evaluated. Most regions a
+/// ray crosses are like that: their primitives are hit elsewhere or not at all. The check costs
+/// one comparison: ctx.pending keeps the boundaries after tmin of every primitive this ray has
+/// tested, so a primitive taken from its mailbox adds nothing new. (A tested primitive outside
+/// this region cannot have a boundary inside it unless its box was trimmed by the CSG; then the
+/// tree is evaluated for nothing, never wrongly.) The spans are fetched once into the mailboxes
+/// (counted as tests or mailbox hits); the tree then reads them there. Without mailboxes, each
+/// region gets a fresh stamp and an empty pending list, so every region tests its primitives
+/// again. Unlike hitInRegion, ctx.result is left unspecified.
 template <class Obs>
-bool hitInLeaf(const Scene& scene, const CsgTree& tree, int root, const uint32_t* prims,
+[[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree& tree, int root, const uint32_t* prims,
                uint32_t count, const Ray& ray, double tmin, double t0, double t1,
                TraceContext& ctx, Obs& obs, Hit& hit) {
     if (root < 0) return false;
-    if (!ctx.useMailboxes) ++ctx.rayId;
-    bool candidate = false;
+    PendingBoundaries& pend = ctx.pending;
+    if (!ctx.useMailboxes) {
+        ++ctx.rayId;
+        pend.clear();
+    } else if (pend.next < t0) {
+        pend.advance(t0);
+    }
+    const double from = std::max(t0, tmin);  // boundaries must be >= t0 and > tmin
     for (uint32_t i = 0; i < count; ++i) {
-        const Mailbox& m = mailboxSpans(scene, prims[i], ray, ctx, obs);
+        bool fresh;
+        const Mailbox& m = mailboxSpans(scene, prims[i], ray, ctx, obs, &fresh);
+        if (!fresh) continue;
         for (int k = 0; k < m.count; ++k) {
             const Span& s = m.spans[k];
-            candidate |= (s.in.t >= t0 && s.in.t > tmin && s.in.t <= t1) |
-                         (s.out.t >= t0 && s.out.t > tmin && s.out.t <= t1);
+            if (s.in.t >= from && s.in.t > tmin) pend.add(s.in.t);
+            if (s.out.t >= from && s.out.t > tmin) pend.add(s.out.t);
         }
     }
-    if (!candidate && !Obs::kActive) return false;  // the observer is shown the spans anyway
+    if (!(pend.next <= t1) && !Obs::kActive) return false;  // the observer is shown the spans anyway
     evalTree<Obs, Fetch::Fresh>(scene, tree, root, ray, ctx, obs, 0, ctx.result);
     if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
     const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);

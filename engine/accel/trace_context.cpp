@@ -28,6 +28,7 @@ RayCounters RayCounters::operator-(const RayCounters& o) const {
 }
 
 void TraceContext::reset(size_t primitives, int treeDepth) {
+    stamp.assign(primitives, 0);
     mail.assign(primitives, Mailbox{});
     scratch.resize(size_t(2 * treeDepth + 4));
     rayId = 0;

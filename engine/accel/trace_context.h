@@ -23,18 +23,47 @@ struct RayCounters {
     RayCounters operator-(const RayCounters& o) const;
 };
 
-/// The report's "boîte aux lettres": the last ray tested against a primitive and its spans.
-/// Each thread owns its own array, so no mailbox is ever shared between threads.
+/// The report's "boîte aux lettres": the spans of the last ray tested against a primitive, the
+/// ray's id being TraceContext::stamp. Each thread owns its own arrays, so no mailbox is ever
+/// shared between threads.
 struct Mailbox {
-    uint64_t ray = 0;
     uint8_t count = 0;
     Span spans[2];
+};
+
+/// Span boundaries of the primitives the current ray has tested that lie ahead of its walk: the
+/// regular walk evaluates a leaf's tree only when the nearest of them falls inside the leaf.
+struct PendingBoundaries {
+    std::vector<double> t;  ///< unordered; those behind the walk are dropped lazily
+    double next = kInf;     ///< the least of t
+
+    void clear() {
+        t.clear();
+        next = kInf;
+    }
+    void add(double x) {
+        t.push_back(x);
+        if (x < next) next = x;
+    }
+    /// Drop the boundaries before `t0` and find the least of the rest.
+    void advance(double t0) {
+        size_t k = 0;
+        next = kInf;
+        for (double x : t)
+            if (x >= t0) {
+                t[k++] = x;
+                if (x < next) next = x;
+            }
+        t.resize(k);
+    }
 };
 
 /// One per thread. Ray ids start at 1 and are unique within the context, so mailboxes never
 /// need clearing between rays.
 struct TraceContext {
+    std::vector<uint64_t> stamp;  ///< per primitive: the ray id its mailbox holds spans for
     std::vector<Mailbox> mail;
+    PendingBoundaries pending;    ///< of the ray the regular walk is on
     std::vector<SpanList> scratch;  ///< two buffers per tree level, reused without allocation
     SpanList result;                ///< spans of the tree evaluated last
     uint64_t rayId = 0;

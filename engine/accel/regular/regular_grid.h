@@ -90,6 +90,11 @@ class RegularGrid {
     }
 
   private:
+    /// intersect() for one step method.
+    template <bool kExact, class Obs>
+    bool walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+              Hit& hit) const;
+
     const Scene* scene_;
     bool exact_ = true;   ///< --step exact (else push)
     double delta_ = 0.0;  ///< absolute push distance
@@ -112,6 +117,13 @@ class RegularGrid {
 template <class Obs>
 bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                             Hit& hit) const {
+    return exact_ ? walk<true>(ray, tmin, tmax, ctx, obs, hit)
+                  : walk<false>(ray, tmin, tmax, ctx, obs, hit);
+}
+
+template <bool kExact, class Obs>
+bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                       Hit& hit) const {
     double tA, tB;
     if (!clipLine(ray, clipBox_, tA, tB)) return false;
     const double tStart = std::max(tmin, tA), tEnd = std::min(tmax, tB);
@@ -119,27 +131,40 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
     Vec3 p = std::isfinite(tStart) ? ray.at(tStart) : ray.o;
     uint32_t leaf = dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
     // Per ray: 1/d, so each exit plane costs a product, not a division (an axis the ray runs
-    // parallel to is never an exit).
+    // parallel to is never an exit), and the side of a cell the ray leaves by on each axis.
     const double inv[3] = {1.0 / ray.d.x, 1.0 / ray.d.y, 1.0 / ray.d.z};
+    const bool up[3] = {ray.d.x > 0.0, ray.d.y > 0.0, ray.d.z > 0.0};
+    // The arrays the loop reads, held locally: the loop's stores (mailboxes, counters) could
+    // otherwise alias them, and each step would reload them.
+    const RegularLeaf* const leaves = leaves_.data();
+    const uint32_t* const primList = primList_.data();
+    const double* const planes[3] = {planes_[0].data(), planes_[1].data(), planes_[2].data()};
+    uint64_t visits = 0;
+    struct CountVisits {  // on every way out
+        uint64_t& total;
+        const uint64_t& visits;
+        ~CountVisits() { total += visits; }
+    } countVisits{ctx.counters.regionVisits, visits};
     // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
     // inside the grid, so this only admits hits that rounding puts a hair outside the box.
     double t0 = tmin, tIn = tStart;
+    ctx.pending.clear();
     for (size_t step = 0;; ++step) {
         if (step > maxSteps_) {
             ++ctx.counters.walkErrors;
             obs.walkError("regular: step bound exceeded");
             return false;
         }
-        const RegularLeaf& L = leaves_[leaf];
+        const RegularLeaf& L = leaves[leaf];
         // Exit: the nearest of the cell's exit planes; ties are edges and corners.
         double tAxis[3];
         double tExit = kInf;
-        int exitAxis = -1;
+        int exitAxis = 0;
         for (int a = 0; a < 3; ++a) {
             if (ray.d[a] > 0.0)
-                tAxis[a] = (planes_[a][L.hi[a]] - ray.o[a]) * inv[a];
+                tAxis[a] = (planes[a][L.hi[a]] - ray.o[a]) * inv[a];
             else if (ray.d[a] < 0.0)
-                tAxis[a] = (planes_[a][L.lo[a]] - ray.o[a]) * inv[a];
+                tAxis[a] = (planes[a][L.lo[a]] - ray.o[a]) * inv[a];
             else
                 tAxis[a] = kInf;
             if (tAxis[a] < tExit) tExit = tAxis[a], exitAxis = a;
@@ -149,19 +174,19 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
         uint32_t next[3];
         uint32_t nextLeaf = leaf;
         if (!last) {
-            if (exact_) {
+            if constexpr (kExact) {
                 // The exit face lies on grid plane L.hi or L.lo of exitAxis: the next index there
                 // is exact; the other indices are the exit point's, kept on the face. When one
                 // leaf covers the whole face, the leaf's rope names it and no lookup is needed.
                 const int a = exitAxis;
-                const uint32_t rope = L.rope[2 * a + (ray.d[a] > 0.0)];
+                const uint32_t rope = L.rope[2 * a + up[a]];
                 if (rope == kBorder) {
                     last = true;
                 } else if (rope != kSplitFace) {
                     nextLeaf = rope;
                 } else {
                     const Vec3 q = ray.at(tExit);
-                    next[a] = ray.d[a] > 0.0 ? L.hi[a] : L.lo[a] - 1;
+                    next[a] = up[a] ? L.hi[a] : L.lo[a] - 1;
                     for (int b = 0; b < 3; ++b)
                         if (b != a) next[b] = std::clamp(locate(b, q[b]), L.lo[b], L.hi[b] - 1);
                     nextLeaf = dir_.lookup(next[0], next[1], next[2]);
@@ -173,9 +198,9 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
                 // so the walk cannot bounce back into the previous cell.
                 const Vec3 q = ray.at(tExit);
                 for (int a = 0; a < 3; ++a) {
-                    double x = std::clamp(q[a], plane(a, L.lo[a]), plane(a, L.hi[a]));
+                    double x = std::clamp(q[a], planes[a][L.lo[a]], planes[a][L.hi[a]]);
                     if (tAxis[a] == tExit) {
-                        x += ray.d[a] > 0.0 ? delta_ : -delta_;
+                        x += up[a] ? delta_ : -delta_;
                         if (x < box_.lo[a] || x > box_.hi[a]) last = true;  // left the grid
                         next[a] = locate(a, x);
                     } else {
@@ -189,10 +214,10 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
             }
         }
         const double t1 = last ? tmax : std::max(tExit, tIn);
-        ++ctx.counters.regionVisits;
+        ++visits;
         obs.region(leaf, tIn, last ? tEnd : t1);
-        if (hitInLeaf(*scene_, pool_, L.root, primList_.data() + L.first, L.prims, ray, tmin, t0,
-                      t1, ctx, obs, hit))
+        if (hitInLeaf(*scene_, pool_, L.root, primList + L.first, L.prims, ray, tmin, t0, t1, ctx,
+                      obs, hit))
             return true;
         if (last) return false;
         if (stalled) {
