@@ -182,6 +182,7 @@ RenderStats EmbreePeer::render(const RenderOptions& opt, Image& img) const {
     stats.threads = effectiveThreads(opt.threads);
     const int w = img.width, h = img.height;
     double scale = scene.scale();
+    const PrimaryRays primary(scene.camera, w, h);
     std::atomic<uint64_t> rays{0}, shadows{0};
     auto start = Clock::now();
     tbb::task_arena arena(stats.threads);
@@ -192,7 +193,7 @@ RenderStats EmbreePeer::render(const RenderOptions& opt, Image& img) const {
             uint64_t nRays = 0, nShadow = 0;
             for (int y = r.rows().begin(); y < r.rows().end(); ++y)
                 for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-                    Ray ray = scene.camera.primaryRay(x, y, w, h);
+                    Ray ray = primary(x, y);
                     RTCRayHit rh{};
                     rh.ray = {float(ray.o.x), float(ray.o.y), float(ray.o.z), 0.0f, float(ray.d.x), float(ray.d.y),
                               float(ray.d.z), 0.0f, float(kInf), 0xffffffffu, 0, 0};

@@ -25,6 +25,7 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     const Camera& cam = opt.camera ? *opt.camera : scene.camera;
     const int w = img.width, h = img.height;
     const Tracer tracer(scene, accel, opt.shading);
+    const PrimaryRays primary(cam, w, h);
     const int depth = scene.tree.depth();
     const bool mailboxes = accel.usesMailboxes();
     tbb::enumerable_thread_specific<TraceContext> contexts([&] {
@@ -59,7 +60,7 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                         if (!pass.contains(x, y)) continue;
                         auto t0 = Clock::now();
                         RayCounters before = ctx.counters;
-                        Ray ray = cam.primaryRay(x, y, w, h);
+                        Ray ray = primary(x, y);
                         ++ctx.counters.primaryRays;
                         Hit hit;
                         Vec3 c = tracer.radiance(ray, 0, ctx, obs, &hit);

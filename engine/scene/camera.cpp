@@ -12,17 +12,21 @@ void Camera::basis(Vec3& f, Vec3& r, Vec3& u) const {
 }
 
 Ray Camera::primaryRay(double x, double y, int w, int h) const {
-    Vec3 f, r, u;
-    basis(f, r, u);
+    return PrimaryRays(*this, w, h)(x, y);
+}
+
+PrimaryRays::PrimaryRays(const Camera& cam, int w, int h)
+    : from_(cam.from), w_(w), h_(h), ortho_(cam.projection == Projection::Orthographic) {
+    cam.basis(f_, r_, u_);
+    half_ = ortho_ ? 0.5 * cam.orthoHeight : std::tan(glm::radians(cam.fov) * 0.5);
+}
+
+Ray PrimaryRays::operator()(double x, double y) const {
     // Offsets of the pixel centre on the image plane, in units of the half height.
-    double sx = ((x + 0.5) / w * 2.0 - 1.0) * double(w) / double(h);
-    double sy = 1.0 - (y + 0.5) / h * 2.0;
-    if (projection == Projection::Orthographic) {
-        double half = 0.5 * orthoHeight;
-        return {from + (sx * half) * r + (sy * half) * u, f};
-    }
-    double half = std::tan(glm::radians(fov) * 0.5);
-    return {from, glm::normalize(f + (sx * half) * r + (sy * half) * u)};
+    double sx = ((x + 0.5) / w_ * 2.0 - 1.0) * w_ / h_;
+    double sy = 1.0 - (y + 0.5) / h_ * 2.0;
+    if (ortho_) return {from_ + (sx * half_) * r_ + (sy * half_) * u_, f_};
+    return {from_, glm::normalize(f_ + (sx * half_) * r_ + (sy * half_) * u_)};
 }
 
 std::string Camera::validate() const {

@@ -27,4 +27,18 @@ struct Camera {
     std::string toJson() const;
 };
 
+/// Camera::primaryRay with the basis and the lens factor computed once for a whole image.
+class PrimaryRays {
+  public:
+    PrimaryRays(const Camera& cam, int w, int h);
+    /// The ray Camera::primaryRay(x, y, w, h) gives, bit for bit.
+    Ray operator()(double x, double y) const;
+
+  private:
+    Vec3 from_, f_, r_, u_;
+    double half_;  ///< half the image height on the image plane (perspective: at distance 1)
+    double w_, h_;
+    bool ortho_;
+};
+
 }  // namespace lancer
