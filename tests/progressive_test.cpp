@@ -44,9 +44,21 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
         ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
         const bool finished = pr.finished();  // read first: then the snapshot below is the last
         ProgressiveRenderer::Shown what;
+        const Image before = shown;
         if (pr.snapshot(version, shown, &what)) {
             seenStrides.push_back(what.stride);
             ASSERT_GT(what.rows, 0);
+            // Only the rows said to have changed are copied; they reach the last band's end
+            // (further when an earlier pass, whole, was not taken yet).
+            ASSERT_LT(what.changedBegin, what.changedEnd);
+            ASSERT_GE(what.changedEnd, what.rows);
+            if (before.width == shown.width)
+                for (int y = 0; y < opt.height; ++y)
+                    if (y < what.changedBegin || y >= what.changedEnd)
+                        for (int x = 0; x < opt.width; ++x)
+                            ASSERT_EQ(shown.color[shown.index(x, y)],
+                                      before.color[before.index(x, y)])
+                                << "row " << y << " outside the changed rows changed";
             // Every pixel shows its block's corner pixel of the direct render: at the stride of
             // the pass above its band's end, of the pass before below it.
             for (int y = 0; y < opt.height; ++y)
@@ -73,6 +85,15 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
     EXPECT_EQ(primary, uint64_t(opt.width) * uint64_t(opt.height))
         << "each pixel is traced once over the passes";
     EXPECT_EQ(shown.color, direct.color);
+    // An image of another size (here a new one) is given the whole display.
+    Image fresh;
+    uint64_t freshVersion = 0;
+    ProgressiveRenderer::Shown what;
+    ASSERT_TRUE(pr.snapshot(freshVersion, fresh, &what));
+    EXPECT_EQ(what.changedBegin, 0);
+    EXPECT_EQ(what.changedEnd, opt.height);
+    EXPECT_EQ(fresh.color, direct.color);
+    EXPECT_EQ(fresh.timeUs, shown.timeUs);
 }
 
 TEST(Progressive, ANewJobCancelsTheOneInFlight) {

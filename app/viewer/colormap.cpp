@@ -36,22 +36,20 @@ glm::vec3 colormap(float v) {
     return s[size_t(i)] * (1.0f - f) + s[size_t(i) + 1] * f;
 }
 
-std::vector<float> heatChannel(const Image& img, ViewMode mode) {
-    std::vector<float> out;
+std::vector<float> heatChannel(const Image& img, ViewMode mode, int rowBegin, int rowEnd) {
+    size_t first, last;
+    img.pixelRange(rowBegin, rowEnd, first, last);
+    auto rows = [&](const auto& channel) {
+        return std::vector<float>(channel.begin() + std::ptrdiff_t(first),
+                                  channel.begin() + std::ptrdiff_t(last));
+    };
     switch (mode) {
-        case ViewMode::Color:
-            break;
-        case ViewMode::PrimTests:
-            out.assign(img.primTests.begin(), img.primTests.end());
-            break;
-        case ViewMode::RegionVisits:
-            out.assign(img.regionVisits.begin(), img.regionVisits.end());
-            break;
-        case ViewMode::TimeUs:
-            out = img.timeUs;
-            break;
+        case ViewMode::Color: break;
+        case ViewMode::PrimTests: return rows(img.primTests);
+        case ViewMode::RegionVisits: return rows(img.regionVisits);
+        case ViewMode::TimeUs: return rows(img.timeUs);
     }
-    return out;
+    return {};
 }
 
 float autoScale(const std::vector<float>& heat) {

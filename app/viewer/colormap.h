@@ -20,8 +20,9 @@ const char* viewModeName(ViewMode m);
 const std::array<glm::vec3, 8>& colormapStops();
 /// The colour of `v` in [0, 1] (clamped), interpolated linearly between stops as the shader does.
 glm::vec3 colormap(float v);
-/// The per-pixel counter `mode` shows, as floats (empty for ViewMode::Color).
-std::vector<float> heatChannel(const Image& img, ViewMode mode);
+/// The per-pixel counter `mode` shows, as floats, of rows [rowBegin, rowEnd) (-1: to the last);
+/// empty for ViewMode::Color.
+std::vector<float> heatChannel(const Image& img, ViewMode mode, int rowBegin = 0, int rowEnd = -1);
 /// A scale that fits the counter: its largest value (at least 1).
 float autoScale(const std::vector<float>& heat);
 

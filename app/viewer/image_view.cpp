@@ -79,29 +79,45 @@ ImageView::~ImageView() {
     glDeleteProgram(program_);
 }
 
-void ImageView::upload(const Image& img, ViewMode mode) {
+void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd) {
     if (img.width <= 0 || img.height <= 0) return;
+    const bool resized = img.width != width_ || img.height != height_;
+    if (resized) rowBegin = 0, rowEnd = img.height;
+    if (rowEnd < 0 || rowEnd > img.height) rowEnd = img.height;
+    rowBegin = std::clamp(rowBegin, 0, rowEnd);
+    const int rows = rowEnd - rowBegin;
     width_ = img.width;
     height_ = img.height;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    glBindTexture(GL_TEXTURE_2D, colorTex_);
-    // 8 bits per channel, quantised as the PNG writer does: the screen shows what `render` saves.
-    std::vector<uint8_t> rgba = img.rgba8();
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                 rgba.data());
-    if (mode != ViewMode::Color) {
-        std::vector<float> heat = heatChannel(img, mode);
+    if (resized) {  // storage for every texture at the new size, the FBO on the shaded one
+        glBindTexture(GL_TEXTURE_2D, colorTex_);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                     nullptr);
         glBindTexture(GL_TEXTURE_2D, heatTex_);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, width_, height_, 0, GL_RED, GL_FLOAT, heat.data());
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, width_, height_, 0, GL_RED, GL_FLOAT, nullptr);
+        glBindTexture(GL_TEXTURE_2D, shadedTex_);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                     nullptr);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, shadedTex_, 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
     }
-    glBindTexture(GL_TEXTURE_2D, shadedTex_);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                 nullptr);
+    if (rows > 0) {
+        // 8 bits per channel, quantised as the PNG writer does: the screen shows what `render`
+        // saves. Texture row y is image row y, as in the first upload.
+        glBindTexture(GL_TEXTURE_2D, colorTex_);
+        std::vector<uint8_t> rgba = img.rgba8(rowBegin, rowEnd);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, rowBegin, width_, rows, GL_RGBA, GL_UNSIGNED_BYTE,
+                        rgba.data());
+        if (mode != ViewMode::Color) {
+            std::vector<float> heat = heatChannel(img, mode, rowBegin, rowEnd);
+            glBindTexture(GL_TEXTURE_2D, heatTex_);
+            glTexSubImage2D(GL_TEXTURE_2D, 0, 0, rowBegin, width_, rows, GL_RED, GL_FLOAT,
+                            heat.data());
+        }
+    }
     glBindTexture(GL_TEXTURE_2D, 0);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, shadedTex_, 0);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     shadedValid_ = false;
 }
 

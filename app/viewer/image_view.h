@@ -15,8 +15,10 @@ class ImageView {
     ImageView(const ImageView&) = delete;
     ImageView& operator=(const ImageView&) = delete;
 
-    /// Upload the colour and the counter `mode` shows (textures sized like the image).
-    void upload(const Image& img, ViewMode mode);
+    /// Upload rows [rowBegin, rowEnd) (-1: to the last) of the colour and of the counter `mode`
+    /// shows; the whole image when its size differs from the last upload's. The other rows keep
+    /// what earlier uploads put there, so after a change of mode upload the whole image.
+    void upload(const Image& img, ViewMode mode, int rowBegin = 0, int rowEnd = -1);
     /// Draw the uploaded image over the whole viewport of a fbWidth x fbHeight framebuffer
     /// (framebuffer 0); heat maps divide the counter by `scale`. Nothing is drawn before the
     /// first upload. The shader runs once per upload, mode or scale, into a texture; each frame

@@ -248,8 +248,9 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // Read before taking the snapshot: if the job was finished then, the snapshot below is final.
     const bool finishedBefore = renderer_.finished();
     pollBackground();
-    if (renderer_.snapshot(shownVersion_, shown_)) {
-        view_->upload(shown_, s_.mode);
+    ProgressiveRenderer::Shown what;
+    if (renderer_.snapshot(shownVersion_, shown_, &what)) {
+        view_->upload(shown_, s_.mode, what.changedBegin, what.changedEnd);
         updateAutoScale();
         std::vector<PassRecord> passes = renderer_.passes();
         for (; passesLogged_ < passes.size(); ++passesLogged_) {

@@ -1,5 +1,6 @@
 #include "engine/render/image.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -26,16 +27,45 @@ void Image::resize(int w, int h) {
     timeUs.assign(n, 0.0f);
 }
 
-std::vector<uint8_t> Image::rgba8() const {
-    std::vector<uint8_t> out(color.size() * 4);
-    for (size_t i = 0; i < color.size(); ++i) {
+void Image::pixelRange(int rowBegin, int rowEnd, size_t& first, size_t& last) const {
+    const int end = rowEnd < 0 ? height : std::min(rowEnd, height);
+    const int begin = std::clamp(rowBegin, 0, std::max(end, 0));
+    first = size_t(begin) * size_t(width);
+    last = size_t(std::max(end, begin)) * size_t(width);
+}
+
+std::vector<uint8_t> Image::rgba8(int rowBegin, int rowEnd) const {
+    size_t first, last;
+    pixelRange(rowBegin, rowEnd, first, last);
+    std::vector<uint8_t> out((last - first) * 4);
+    for (size_t i = first; i < last; ++i) {
+        uint8_t* o = &out[4 * (i - first)];
         for (int c = 0; c < 3; ++c) {
             float v = std::min(std::max(color[i][c], 0.0f), 1.0f);
-            out[4 * i + c] = uint8_t(v * 255.0f + 0.5f);
+            o[c] = uint8_t(v * 255.0f + 0.5f);
         }
-        out[4 * i + 3] = 255;
+        o[3] = 255;
     }
     return out;
+}
+
+void copyRows(const Image& src, Image& dst, int rowBegin, int rowEnd) {
+    if (dst.width != src.width || dst.height != src.height) {
+        dst = src;
+        return;
+    }
+    size_t first, last;
+    src.pixelRange(rowBegin, rowEnd, first, last);
+    auto rows = [&](const auto& from, auto& to) {
+        std::copy(from.begin() + std::ptrdiff_t(first), from.begin() + std::ptrdiff_t(last),
+                  to.begin() + std::ptrdiff_t(first));
+    };
+    rows(src.color, dst.color);
+    rows(src.depth, dst.depth);
+    rows(src.hitPrim, dst.hitPrim);
+    rows(src.primTests, dst.primTests);
+    rows(src.regionVisits, dst.regionVisits);
+    rows(src.timeUs, dst.timeUs);
 }
 
 void writeFileAtomic(const std::string& path, const std::string& data) {

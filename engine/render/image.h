@@ -22,9 +22,16 @@ struct Image {
     Image(int w, int h) { resize(w, h); }
     void resize(int w, int h);
     size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
-    /// 8-bit sRGB-ish bytes (clamped, gamma 1/2.2 not applied: NFF colours are display values).
-    std::vector<uint8_t> rgba8() const;
+    /// 8-bit sRGB-ish bytes (clamped, gamma 1/2.2 not applied: NFF colours are display values)
+    /// of rows [rowBegin, rowEnd) (-1: to the last).
+    std::vector<uint8_t> rgba8(int rowBegin = 0, int rowEnd = -1) const;
+    /// Rows [rowBegin, rowEnd) clamped to the image, as a pixel index range [first, last).
+    void pixelRange(int rowBegin, int rowEnd, size_t& first, size_t& last) const;
 };
+
+/// Copy rows [rowBegin, rowEnd) (-1: to the last) of every channel of `src` into `dst`, which
+/// is first made a whole copy of `src` if its size differs.
+void copyRows(const Image& src, Image& dst, int rowBegin = 0, int rowEnd = -1);
 
 /// Write a PNG atomically (a temporary file renamed into place). Throws std::runtime_error.
 void writePng(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba);

@@ -73,9 +73,19 @@ void ProgressiveRenderer::cancel() {
 bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown) {
     std::lock_guard lock(mutex_);
     if (version == displayVersion_) return false;
-    // A swap, not a copy: the worker writes the whole of display_ before the next version.
-    std::swap(out, display_);
-    if (shown) *shown = displayShown_;
+    // Only the rows written since the last snapshot, unless `out` is new or of another size.
+    Shown s = displayShown_;
+    if (out.width != display_.width || out.height != display_.height) {
+        out = display_;
+        s.changedBegin = 0;
+        s.changedEnd = display_.height;
+    } else {
+        copyRows(display_, out, changedBegin_, changedEnd_);
+        s.changedBegin = changedBegin_;
+        s.changedEnd = changedEnd_;
+    }
+    changedBegin_ = changedEnd_ = 0;
+    if (shown) *shown = s;
     version = displayVersion_;
     return true;
 }
@@ -119,9 +129,7 @@ void ProgressiveRenderer::run() {
         // Kept between jobs: no allocation (and page faults) before the first pass. `work` need
         // not be cleared: each pass writes its lattice before any pixel of it is shown.
         Image& work = work_;
-        Image& shown = shown_;
         if (work.width != w || work.height != h) work = Image(w, h);
-        if (shown.width != w || shown.height != h) shown = Image();  // filled whole by pass 1
         int previous = 0;
         bool complete = true;
         for (int stride : strides_) {
@@ -152,14 +160,20 @@ void ProgressiveRenderer::run() {
                 }
                 rec.renderMs += rs.renderMs;
                 rec.counters += rs.counters;
-                fillBlocks(work, stride, shown, y0, lattice.rowEnd);
                 const bool passDone = lattice.rowEnd == h;
                 std::unique_lock lock(mutex_);
                 if (cancel_) {  // a newer job arrived while the band finished: do not show it
                     complete = false;
                     break;
                 }
-                display_ = shown;
+                // The band's rows, as blocks of the pass, straight into the displayed image (the
+                // first pass of a job fills it whole; another size is refilled whole).
+                const bool whole = display_.width != w || display_.height != h;
+                fillBlocks(work, stride, display_, y0, lattice.rowEnd);
+                const int b = whole ? 0 : y0, e = whole ? h : lattice.rowEnd;
+                if (changedBegin_ == changedEnd_) changedBegin_ = b, changedEnd_ = e;
+                changedBegin_ = std::min(changedBegin_, b);
+                changedEnd_ = std::max(changedEnd_, e);
                 ++displayVersion_;
                 displayShown_ = {stride, lattice.rowEnd, previous};
                 if (passDone) {

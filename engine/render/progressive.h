@@ -65,15 +65,19 @@ class ProgressiveRenderer {
     void setOnPass(std::function<void()> f) { onPass_ = std::move(f); }
 
     /// What a snapshot shows: rows [0, rows) the pass of `stride`, the rows below it the pass
-    /// before, of `previousStride` (0: none).
+    /// before, of `previousStride` (0: none); rows [changedBegin, changedEnd) are the ones this
+    /// snapshot wrote.
     struct Shown {
         int stride = 0;
         int rows = 0;
         int previousStride = 0;
+        int changedBegin = 0, changedEnd = 0;
     };
-    /// If a band or pass finished since `version`, move the displayable image into `out` (the
-    /// previous contents of `out` are recycled), update `version` and return true; `shown`
-    /// (if given) tells what the image holds.
+    /// If a band or pass finished since `version`, bring `out` up to date with the displayable
+    /// image, update `version` and return true; `shown` (if given) tells what the image holds
+    /// and which rows changed. Only the rows written since the last snapshot are copied, so
+    /// `out` must be the image the previous snapshots were taken into (any other is made a
+    /// whole copy when its size differs; keep one `out` per caller).
     bool snapshot(uint64_t& version, Image& out, Shown* shown = nullptr);
     /// Passes of the current job finished so far.
     std::vector<PassRecord> passes() const;
@@ -98,10 +102,11 @@ class ProgressiveRenderer {
     std::atomic<bool> cancel_{false};
     std::atomic<size_t> progressDone_{0};
     std::atomic<size_t> progressTotal_{0};
-    Image display_;  ///< swapped out by snapshot()
+    Image display_;  ///< what snapshot() copies from: the passes' blocks, band by band
+    int changedBegin_ = 0, changedEnd_ = 0;  ///< rows of display_ written since the last snapshot
     uint64_t displayVersion_ = 0;
     Shown displayShown_;
-    Image work_, shown_;  ///< the worker's buffers, kept between jobs of the same size
+    Image work_;  ///< the worker's lattice buffer, kept between jobs of the same size
     std::vector<PassRecord> passes_;
     std::function<void()> onPass_;
     std::thread worker_;

@@ -122,6 +122,40 @@ TEST(ViewerGl, ImageQuadCarriesTheTracedImageAndHeatMapsItsCounters) {
     EXPECT_LE(worst, 2);
 }
 
+TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnly) {
+    const int w = 120, h = 80;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    Image a(w, h), b(w, h);
+    for (size_t i = 0; i < a.color.size(); ++i) {
+        a.color[i] = glm::vec3(0.2f, 0.4f, 0.6f);
+        b.color[i] = glm::vec3(0.9f, 0.1f, 0.3f);
+        a.primTests[i] = 1;
+        b.primTests[i] = 7;
+    }
+    ImageView view;
+    view.upload(a, ViewMode::Color);
+    const int rowBegin = 30, rowEnd = 45;
+    view.upload(b, ViewMode::Color, rowBegin, rowEnd);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    std::vector<uint8_t> shown = gl.read();
+    for (int y = 0; y < h; ++y) {
+        const Image& expected = y >= rowBegin && y < rowEnd ? b : a;
+        for (int x = 0; x < w; ++x)
+            ASSERT_LE(maxDiff(&shown[4 * a.index(x, y)], expected.color[a.index(x, y)]), 1)
+                << x << "," << y;
+    }
+    // A heat map uploaded whole, then a band of it: the band's counters, the rest unchanged.
+    view.upload(a, ViewMode::PrimTests);
+    view.upload(b, ViewMode::PrimTests, rowBegin, rowEnd);
+    view.draw(w, h, ViewMode::PrimTests, 8.0f);
+    std::vector<uint8_t> hot = gl.read();
+    for (int y = 0; y < h; ++y) {
+        const float v = (y >= rowBegin && y < rowEnd ? 7.0f : 1.0f) / 8.0f;
+        ASSERT_LE(maxDiff(&hot[4 * a.index(0, y)], colormap(v)), 2) << "row " << y;
+    }
+}
+
 /// Run the whole viewer (panels, progressive render, drawing) until it has settled.
 class ViewerFrames : public ::testing::Test {
   protected:
