@@ -37,6 +37,10 @@ int main(int argc, char** argv) {
                    "After the first complete image, rebuild the structure once, as a parameter change does (to time it)");
     view->add_flag("--continuous", vopt.continuous,
                    "Redraw every frame, as while the user interacts (to measure the UI's frame rate under load)");
+    view->add_option("--drop", vopt.drop,
+                     "After the first complete image, hand FILE to the window's drop handler, as the desktop does "
+                     "when a file is dropped on the window")
+        ->needs(frames);
     view->add_option("--ini", vopt.ini, "Settings file (default: ~/.config/lancer/imgui.ini; \"none\": none)");
 #endif
 

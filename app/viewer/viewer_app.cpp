@@ -103,6 +103,7 @@ void ViewerApp::logTiming(const std::string& line) const {
 
 void ViewerApp::openScene(const std::string& spec) {
     s_.scene = spec;
+    if (spec.rfind("builtin:", 0) != 0) pathInput_ = spec;  // a dropped file shows in the field
     ImGui::MarkIniSettingsDirty();
     requestBuild(true, "open scene");
 }
@@ -247,6 +248,8 @@ void ViewerApp::handleKeys() {
 void ViewerApp::frame(int fbWidth, int fbHeight) {
     // Read before taking the snapshot: if the job was finished then, the snapshot below is final.
     const bool finishedBefore = renderer_.finished();
+    // Likewise: a builder idle before the poll has nothing left that this frame has not taken.
+    const bool builtBefore = !builder_.busy();
     pollBackground();
     ProgressiveRenderer::Shown what;
     if (renderer_.snapshot(shownVersion_, shown_, &what)) {
@@ -304,7 +307,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         pendingScreenshot_.clear();
     }
 
-    settled_ = !builder_.busy() &&
+    settled_ = builtBefore && !builder_.busy() &&
                (!structure_ || (!renderDirty_ && finishedBefore && renderer_.finished()));
 }
 

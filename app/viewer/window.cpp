@@ -126,7 +126,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
         });
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
-        bool replayed = false;
+        bool replayed = false, droppedScripted = false;
         double statWorkMs = 0.0, statSwapMs = 0.0;
         Clock::time_point frameStart = Clock::now(), statStart = frameStart;
         while (!glfwWindowShouldClose(window)) {
@@ -169,6 +169,13 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             if (v.replayChange && !replayed && app.settled() && app.structure()) {
                 app.rebuild("replayed parameter change");
                 replayed = true;
+            } else if (!v.drop.empty() && !droppedScripted && app.settled() && app.structure()) {
+                // Through the callback the window has installed, as a drop from the desktop.
+                GLFWdropfun onDrop = glfwSetDropCallback(window, nullptr);
+                glfwSetDropCallback(window, onDrop);
+                const char* paths[] = {v.drop.c_str()};
+                if (onDrop) onDrop(window, 1, paths);
+                droppedScripted = true;
             } else if (v.frames > 0 && frames >= v.frames && app.settled()) {
                 if (!app.structure()) {  // a scripted run on a scene that cannot be shown fails
                     std::cerr << "error: lancer view: the scene could not be shown (see above)\n";

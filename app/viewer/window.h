@@ -14,6 +14,9 @@ struct ViewOptions {
     bool logTimings = false;  ///< print pass latencies to stderr
     bool replayChange =
         false;  ///< after the first complete image, rebuild once (timed like a parameter change)
+    /// With frames: after the first complete image, call the window's drop callback with this
+    /// path, as GLFW does when a file is dropped on the window (a scripted drop).
+    std::string drop;
     std::string ini;  ///< settings file; empty: the default one ("none": no file)
     /// Redraw every frame (at most 60 per second), as while the user keeps interacting; else
     /// only on input, on a worker's result and at 10 Hz while rendering.

@@ -35,3 +35,18 @@ if [ "$status" != 2 ]; then
   exit 1
 fi
 grep -q "missing.nff" "$tmp/err.txt"
+# A file dropped on the window opens: the window's own drop callback is handed the path after
+# the first image (--drop), and the screenshot is then the dropped scene as `lancer render`
+# draws it, with its path in the file field.
+timeout 240 xvfb-run -a -s "-screen 0 1280x1024x24" \
+  "$lancer" view builtin:default --frames 5 --drop "$src/assets/spd/gears2.nff" \
+  --screenshot "$tmp/dropped.png" --width 900 --height 560 --ini none
+"$lancer" render "$src/assets/spd/gears2.nff" -o "$tmp/gears.png" --width 900 --height 560 -q
+python3 "$src/tests/support/png_compare.py" "$tmp/dropped.png" "$tmp/gears.png" 350 40 540 550 20 60 320 400
+# A dropped file that does not load keeps the previous scene on screen and says why.
+printf 'v\nfrom 0 0 0\nbogus line\n' >"$tmp/broken.nff"
+timeout 240 xvfb-run -a -s "-screen 0 1280x1024x24" \
+  "$lancer" view builtin:default --frames 5 --drop "$tmp/broken.nff" \
+  --screenshot "$tmp/kept.png" --width 900 --height 560 --ini none 2>"$tmp/drop-err.txt"
+grep -q "broken.nff" "$tmp/drop-err.txt" || { cat "$tmp/drop-err.txt" >&2; exit 1; }
+python3 "$src/tests/support/png_compare.py" "$tmp/kept.png" "$tmp/cpu.png" 350 40 540 550 20 60 320 400
