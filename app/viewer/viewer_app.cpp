@@ -130,6 +130,21 @@ void ViewerApp::setCamera(const Camera& c) {
     if (s_.build.scheme == SchemeKind::Irregular) cameraMovedForBuild_ = true;
 }
 
+void ViewerApp::copyCameraJson() { ImGui::SetClipboardText(camera_.toJson().c_str()); }
+
+bool ViewerApp::pasteCameraJson() {
+    const char* clip = ImGui::GetClipboardText();
+    cameraJson_ = clip ? clip : "";
+    try {
+        setCamera(cameraFromJson(cameraJson_, camera_));
+        cameraError_.clear();
+        return true;
+    } catch (const std::exception& e) {
+        cameraError_ = e.what();
+        return false;
+    }
+}
+
 void ViewerApp::requestBuild(bool reloadScene, const char* why) {
     BuildRequest r;
     r.params = s_.build;
@@ -464,18 +479,9 @@ void ViewerApp::cameraPanel() {
     if (changed && c.validate().empty()) setCamera(c);
     if (ImGui::Button("Reset (R)")) setCamera(home_);
     ImGui::SameLine();
-    if (ImGui::Button("Copy JSON")) ImGui::SetClipboardText(camera_.toJson().c_str());
+    if (ImGui::Button("Copy JSON")) copyCameraJson();
     ImGui::SameLine();
-    if (ImGui::Button("Paste JSON")) {
-        const char* clip = ImGui::GetClipboardText();
-        cameraJson_ = clip ? clip : "";
-        try {
-            setCamera(cameraFromJson(cameraJson_, camera_));
-            cameraError_.clear();
-        } catch (const std::exception& e) {
-            cameraError_ = e.what();
-        }
-    }
+    if (ImGui::Button("Paste JSON")) pasteCameraJson();
     if (!cameraError_.empty()) {
         ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.45f, 1.0f));
         ImGui::TextWrapped("%s", cameraError_.c_str());

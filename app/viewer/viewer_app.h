@@ -49,6 +49,12 @@ class ViewerApp {
     const std::string& error() const { return error_; }
     const Camera& camera() const { return camera_; }
     void setCamera(const Camera& c);
+    /// The Camera panel's buttons: the camera as JSON to the clipboard (ImGui's, which the GLFW
+    /// backend makes the desktop's), and back. A paste that is not a valid camera leaves the
+    /// camera as it is and returns false; cameraError() says why.
+    void copyCameraJson();
+    bool pasteCameraJson();
+    const std::string& cameraError() const { return cameraError_; }
     /// The scene and structure on screen (null until the first build succeeds).
     const std::shared_ptr<const Structure>& structure() const { return structure_; }
     /// The heat scale in use this frame.

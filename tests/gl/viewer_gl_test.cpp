@@ -347,5 +347,34 @@ TEST_F(ViewerFrames, SpeedupTracesTheSamePixelsAndRaysWithBothSchemes) {
     EXPECT_GT(r->bruteMs, 0.0);
 }
 
+TEST_F(ViewerFrames, CameraCopiedAsJsonPastesBackAndABadPasteKeepsTheCamera) {
+    runUntilSettled();
+    // ImGui's clipboard: the app's GLFW backend routes the same calls to the desktop's.
+    app_->copyCameraJson();
+    const char* clip = ImGui::GetClipboardText();
+    ASSERT_NE(clip, nullptr);
+    const Camera copied = app_->camera();
+    EXPECT_EQ(std::string(clip), copied.toJson());
+    ImGui::GetIO().AddInputCharacter('o');  // orthographic: another camera
+    ImGui::GetIO().DeltaTime = 1.0f / 60.0f;
+    app_->frame(kW, kH);
+    ASSERT_EQ(app_->camera().projection, Projection::Orthographic);
+    ASSERT_TRUE(app_->pasteCameraJson()) << app_->cameraError();
+    EXPECT_EQ(app_->camera().projection, copied.projection);
+    EXPECT_EQ(app_->camera().from, copied.from);
+    EXPECT_EQ(app_->camera().at, copied.at);
+    EXPECT_EQ(app_->camera().fov, copied.fov);
+    // Not a camera: refused with the reason, the camera unchanged.
+    ImGui::SetClipboardText("{\"fov\": 200}");
+    EXPECT_FALSE(app_->pasteCameraJson());
+    EXPECT_FALSE(app_->cameraError().empty());
+    EXPECT_EQ(app_->camera().fov, copied.fov);
+    // The pasted view is the one rendered.
+    runUntilSettled();
+    Camera cam = app_->camera();
+    Traced t = traceCpu("builtin:default", &cam, kW, kH);
+    EXPECT_EQ(app_->displayed().color, t.img.color);
+}
+
 }  // namespace
 }  // namespace lancer::viewer
