@@ -360,11 +360,8 @@ TEST(Irregular, ObserverSeesRegionsPointersAndMailboxes) {
     ctx.useMailboxes = accel->usesMailboxes();
     uint64_t pointers = 0, mailbox = 0;
     for (const Ray& ray : test::pixelRays(scene, 12, 12)) {
-        RecordingObserver obs;
-        Hit hit;
-        ctx.beginRay();
         uint64_t before = ctx.counters.pointerSteps;
-        accel->intersect(ray, 0.0, kInf, ctx, obs, hit);
+        RecordingObserver obs = test::recordWalk(*accel, ray, ctx);
         double last = -kInf;
         int regions = 0;
         uint64_t seen = 0;
@@ -403,10 +400,7 @@ TEST(Irregular, ProjectiveWalkIsADepthRun) {
     ctx.useMailboxes = accel->usesMailboxes();
     uint64_t visits = 0;
     for (const Ray& ray : test::pixelRays(scene, 16, 16)) {
-        RecordingObserver obs;
-        Hit hit;
-        ctx.beginRay();
-        accel->intersect(ray, 0.0, kInf, ctx, obs, hit);
+        RecordingObserver obs = test::recordWalk(*accel, ray, ctx);
         double last = 0.0;
         for (const WalkEvent& e : obs.events) {
             EXPECT_NE(e.kind, WalkEvent::Pointer);

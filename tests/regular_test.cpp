@@ -209,10 +209,7 @@ TEST(RegularWalk, RegionsAreContiguousAndInRayOrder) {
     TraceContext ctx(s.prims.size(), s.tree.depth());
     int walks = 0;
     for (const Ray& r : test::randomRays(s, 3, 400)) {
-        RecordingObserver obs;
-        Hit h;
-        ctx.beginRay();
-        accel->intersect(r, 0.0, kInf, ctx, obs, h);
+        RecordingObserver obs = test::recordWalk(*accel, r, ctx);
         double prev = -kInf;
         bool first = true;
         for (const WalkEvent& e : obs.events) {

@@ -125,9 +125,10 @@ bool hitInRegion(const Scene& scene, const CsgTree& tree, int root, const Ray& r
 /// region gets a fresh stamp and an empty pending list, so every region tests its primitives
 /// again. Unlike hitInRegion, ctx.result is left unspecified.
 template <class Obs>
-[[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree& tree, int root, const uint32_t* prims,
-               uint32_t count, const Ray& ray, double tmin, double t0, double t1,
-               TraceContext& ctx, Obs& obs, Hit& hit) {
+[[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree& tree, int root,
+                                             const uint32_t* prims, uint32_t count, const Ray& ray,
+                                             double tmin, double t0, double t1, TraceContext& ctx,
+                                             Obs& obs, Hit& hit) {
     if (root < 0) return false;
     PendingBoundaries& pend = ctx.pending;
     if (!ctx.useMailboxes) {

@@ -75,15 +75,10 @@ bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown) 
     if (version == displayVersion_) return false;
     // Only the rows written since the last snapshot, unless `out` is new or of another size.
     Shown s = displayShown_;
-    if (out.width != display_.width || out.height != display_.height) {
-        out = display_;
-        s.changedBegin = 0;
-        s.changedEnd = display_.height;
-    } else {
-        copyRows(display_, out, changedBegin_, changedEnd_);
-        s.changedBegin = changedBegin_;
-        s.changedEnd = changedEnd_;
-    }
+    const bool whole = out.width != display_.width || out.height != display_.height;
+    copyRows(display_, out, changedBegin_, changedEnd_);  // whole when the size differs
+    s.changedBegin = whole ? 0 : changedBegin_;
+    s.changedEnd = whole ? display_.height : changedEnd_;
     changedBegin_ = changedEnd_ = 0;
     if (shown) *shown = s;
     version = displayVersion_;
@@ -171,9 +166,9 @@ void ProgressiveRenderer::run() {
                 const bool whole = display_.width != w || display_.height != h;
                 fillBlocks(work, stride, display_, y0, lattice.rowEnd);
                 const int b = whole ? 0 : y0, e = whole ? h : lattice.rowEnd;
-                if (changedBegin_ == changedEnd_) changedBegin_ = b, changedEnd_ = e;
-                changedBegin_ = std::min(changedBegin_, b);
-                changedEnd_ = std::max(changedEnd_, e);
+                const bool none = changedBegin_ == changedEnd_;  // nothing waiting to be taken
+                changedBegin_ = none ? b : std::min(changedBegin_, b);
+                changedEnd_ = none ? e : std::max(changedEnd_, e);
                 ++displayVersion_;
                 displayShown_ = {stride, lattice.rowEnd, previous};
                 if (passDone) {

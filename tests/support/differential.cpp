@@ -169,6 +169,14 @@ RayCounters traceCounters(const Scene& scene, const Accelerator& accel,
     return ctx.counters;
 }
 
+RecordingObserver recordWalk(const Accelerator& accel, const Ray& ray, TraceContext& ctx) {
+    RecordingObserver obs;
+    Hit hit;
+    ctx.beginRay();
+    accel.intersect(ray, 0.0, kInf, ctx, obs, hit);
+    return obs;
+}
+
 std::vector<Ray> pixelRays(const Scene& scene, int w, int h) {
     std::vector<Ray> rays;
     rays.reserve(size_t(w) * size_t(h));

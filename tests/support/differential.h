@@ -50,6 +50,9 @@ std::vector<RayMismatch> compareWithBrute(const Scene& scene, const Accelerator&
 RayCounters traceCounters(const Scene& scene, const Accelerator& accel,
                           const std::vector<Ray>& rays, double tmin = 0.0);
 
+/// One ray's walk through `accel` with t in (0, inf), as an observer records it (a new ray id).
+RecordingObserver recordWalk(const Accelerator& accel, const Ray& ray, TraceContext& ctx);
+
 /// Primary rays of every pixel of a w x h image of the scene's camera.
 std::vector<Ray> pixelRays(const Scene& scene, int w, int h);
 

@@ -139,12 +139,6 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     const RegularLeaf* const leaves = leaves_.data();
     const uint32_t* const primList = primList_.data();
     const double* const planes[3] = {planes_[0].data(), planes_[1].data(), planes_[2].data()};
-    uint64_t visits = 0;
-    struct CountVisits {  // on every way out
-        uint64_t& total;
-        const uint64_t& visits;
-        ~CountVisits() { total += visits; }
-    } countVisits{ctx.counters.regionVisits, visits};
     // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
     // inside the grid, so this only admits hits that rounding puts a hair outside the box.
     double t0 = tmin, tIn = tStart;
@@ -214,7 +208,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
             }
         }
         const double t1 = last ? tmax : std::max(tExit, tIn);
-        ++visits;
+        ++ctx.counters.regionVisits;
         obs.region(leaf, tIn, last ? tEnd : t1);
         if (hitInLeaf(*scene_, pool_, L.root, primList + L.first, L.prims, ray, tmin, t0, t1, ctx,
                       obs, hit))
