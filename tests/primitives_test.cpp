@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include "engine/model/csg.h"
+#include "engine/scene/builtin_scenes.h"
+#include "engine/scene/scene.h"
+#include "tests/support/differential.h"
 
 namespace lancer {
 namespace {
@@ -236,6 +239,41 @@ TEST(Box3, ClipLineHandlesZeroDirections) {
     EXPECT_FALSE(clipLine({{1.5, 0.5, -1}, {0, 0, 1}}, b, t0, t1));
     EXPECT_TRUE(b.overlaps(Box3{{1, 1, 1}, {2, 2, 2}}));  // touching boxes overlap
     EXPECT_TRUE(overlap(b, Box3{{2, 2, 2}, {3, 3, 3}}).isEmpty());
+}
+
+
+// The walks test spheres from the scene's packed table: the same spans, bit for bit, as the
+// primitive's own test, for world spheres (packed) and transformed ones (not packed).
+TEST(PackedSpheres, SameSpansAsThePrimitivesBitForBit) {
+    test::RandomSceneOptions opt;
+    opt.primitives = 40;
+    for (bool transforms : {false, true}) {
+        opt.transforms = transforms;
+        // SPD spheres are in world coordinates; the random scene's are placed by transforms.
+        Scene scene = transforms ? test::randomCsgScene(11, opt) : makeBuiltin("balls", 2);
+        if (!scene.prepared) scene.prepare();
+        ASSERT_EQ(scene.packedSpheres.size(), scene.prims.size());
+        int packed = 0;
+        for (size_t p = 0; p < scene.prims.size(); ++p) {
+            const bool worldSphere =
+                std::holds_alternative<Sphere>(scene.prims[p].shape) && !scene.prims[p].hasXf;
+            EXPECT_EQ(scene.packedSpheres[p].r >= 0.0, worldSphere) << "primitive " << p;
+            packed += worldSphere;
+        }
+        if (!transforms) EXPECT_GT(packed, 0);
+        int hits = 0;
+        for (const Ray& ray : test::randomRays(scene, 5, 300)) {
+            for (uint32_t p = 0; p < scene.prims.size(); ++p) {
+                Span a[2] = {}, b[2] = {};
+                const int na = scene.primSpans(p, ray, a);
+                const int nb = scene.prims[p].spans(ray, p, b);
+                ASSERT_EQ(na, nb) << "primitive " << p << " ray " << ray.toString();
+                for (int k = 0; k < na; ++k) EXPECT_EQ(a[k], b[k]);
+                hits += na;
+            }
+        }
+        EXPECT_GT(hits, 100);
+    }
 }
 
 }  // namespace

@@ -33,7 +33,7 @@ inline const Mailbox& mailboxSpans(const Scene& scene, uint32_t p, const Ray& ra
         if (fresh) *fresh = false;
         return m;
     }
-    m.count = uint8_t(scene.prims[p].spans(ray, p, m.spans));
+    m.count = uint8_t(scene.primSpans(p, ray, m.spans));
     ctx.stamp[p] = ctx.rayId;
     ++ctx.counters.primTests;
     obs.primTest(p, m.spans, m.count);
@@ -50,7 +50,7 @@ inline int primitiveSpans(const Scene& scene, uint32_t p, const Ray& ray, TraceC
         out = m.spans;
         return m.count;
     }
-    int n = scene.prims[p].spans(ray, p, local);
+    int n = scene.primSpans(p, ray, local);
     ++ctx.counters.primTests;
     obs.primTest(p, local, n);
     out = local;

@@ -12,30 +12,6 @@ struct Overloaded : Ts... {
 template <class... Ts>
 Overloaded(Ts...) -> Overloaded<Ts...>;  // clang 14 lacks C++20 aggregate deduction
 
-int sphereSpans(const Sphere& s, const Ray& r, uint32_t prim, Span* out) {
-    // Robust form (Haines et al., Ray Tracing Gems ch. 7): the discriminant from the distance
-    // between the centre and the line, which keeps precision for far or grazing rays.
-    Vec3 f = r.o - s.c;
-    double a = glm::dot(r.d, r.d);
-    double b = -glm::dot(f, r.d);
-    Vec3 l = f + (b / a) * r.d;
-    double disc = a * (s.r * s.r - glm::dot(l, l));
-    if (!(disc > 0.0)) return 0;
-    double c = glm::dot(f, f) - s.r * s.r;
-    double q = b + std::copysign(std::sqrt(disc), b);
-    double t0, t1;
-    if (q == 0.0) {
-        t0 = t1 = b / a;
-    } else {
-        t0 = c / q;
-        t1 = q / a;
-    }
-    if (t0 > t1) std::swap(t0, t1);
-    if (!(t0 < t1)) return 0;
-    out[0] = {{t0, prim, 0, false}, {t1, prim, 0, false}};
-    return 1;
-}
-
 int blockSpans(const Block& b, const Ray& r, uint32_t prim, Span* out) {
     double t0 = -kInf, t1 = kInf;
     uint8_t p0 = 0, p1 = 0;
@@ -178,7 +154,7 @@ int polygonSpans(const Polygon& pg, const Ray& r, uint32_t prim, Span* out) {
 
 int shapeSpans(const Shape& s, const Ray& r, uint32_t prim, Span* out) {
     return std::visit(
-        Overloaded{[&](const Sphere& x) { return sphereSpans(x, r, prim, out); },
+        Overloaded{[&](const Sphere& x) { return sphereSpans(x.c, x.r, r, prim, out); },
                    [&](const Block& x) { return blockSpans(x, r, prim, out); },
                    [&](const Cone& x) { return coneSpans(x, r, prim, out); },
                    [&](const Triangle& x) { return triangleSpans(x, r, prim, out); },

@@ -3,6 +3,8 @@
 // zero-length spans. `normal` is the outward (solids) or geometric (surfaces) normal.
 #pragma once
 
+#include <cmath>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -15,6 +17,32 @@ struct Sphere {
     Vec3 c{0.0};
     double r = 1.0;
 };
+
+/// Spans of the sphere (c, r) along `ray`: inline, for shapeSpans and for the scene's packed
+/// sphere table (Scene::primSpans), which must give the same bits.
+inline int sphereSpans(const Vec3& c, double r, const Ray& ray, uint32_t prim, Span* out) {
+    // Robust form (Haines et al., Ray Tracing Gems ch. 7): the discriminant from the distance
+    // between the centre and the line, which keeps precision for far or grazing rays.
+    const Vec3 f = ray.o - c;
+    const double a = glm::dot(ray.d, ray.d);
+    const double b = -glm::dot(f, ray.d);
+    const Vec3 l = f + (b / a) * ray.d;
+    const double disc = a * (r * r - glm::dot(l, l));
+    if (!(disc > 0.0)) return 0;
+    const double cc = glm::dot(f, f) - r * r;
+    const double q = b + std::copysign(std::sqrt(disc), b);
+    double t0, t1;
+    if (q == 0.0) {
+        t0 = t1 = b / a;
+    } else {
+        t0 = cc / q;
+        t1 = q / a;
+    }
+    if (t0 > t1) std::swap(t0, t1);
+    if (!(t0 < t1)) return 0;
+    out[0] = {{t0, prim, 0, false}, {t1, prim, 0, false}};
+    return 1;
+}
 
 /// Axis-aligned box [lo, hi] with lo < hi on every axis. Parts 0..5: -x, +x, -y, +y, -z, +z.
 struct Block {

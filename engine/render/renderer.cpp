@@ -56,9 +56,10 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                         stopped = true;
                         break;
                     }
+                    // One clock read per pixel: a pixel's time runs from the previous one's end.
+                    auto t0 = Clock::now();
                     for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
                         if (!pass.contains(x, y)) continue;
-                        auto t0 = Clock::now();
                         RayCounters before = ctx.counters;
                         Ray ray = primary(x, y);
                         ++ctx.counters.primaryRays;
@@ -71,7 +72,9 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                         RayCounters d = ctx.counters - before;
                         img.primTests[i] = uint32_t(d.primTests);
                         img.regionVisits[i] = uint32_t(d.regionVisits);
-                        img.timeUs[i] = std::chrono::duration<float, std::micro>(Clock::now() - t0).count();
+                        const auto t1 = Clock::now();
+                        img.timeUs[i] = std::chrono::duration<float, std::micro>(t1 - t0).count();
+                        t0 = t1;
                         ++done;
                     }
                 }

@@ -20,6 +20,10 @@ void Scene::prepare() {
     }
     bounds = Box3::empty();
     for (uint32_t p : tree.primitives()) bounds.expand(minBox[p]);
+    packedSpheres.assign(prims.size(), PackedSphere{});
+    for (size_t i = 0; i < prims.size(); ++i)
+        if (const Sphere* sp = std::get_if<Sphere>(&prims[i].shape); sp && !prims[i].hasXf)
+            packedSpheres[i] = {sp->c, sp->r};
     prepared = true;
 }
 

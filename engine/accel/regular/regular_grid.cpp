@@ -211,6 +211,12 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
             leaves_[i].hi[a] = (pl.pos[a] + 1) << shift;
         }
     }
+    leafPlanes_.resize(6 * leaves_.size());
+    for (size_t i = 0; i < leaves_.size(); ++i)
+        for (int a = 0; a < 3; ++a) {
+            leafPlanes_[6 * i + a] = planes_[a][leaves_[i].lo[a]];
+            leafPlanes_[6 * i + 3 + a] = planes_[a][leaves_[i].hi[a]];
+        }
     // Longest exact walk: one step per grid plane crossed, plus degenerate steps at edges.
     maxSteps_ = 4 * (size_t(n_[0]) + n_[1] + n_[2]) + 16;
 

@@ -56,7 +56,8 @@ class RegularGrid {
     size_t memoryBytes() const {
         return leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode) +
                primList_.size() * sizeof(uint32_t) +
-               (planes_[0].size() + planes_[1].size() + planes_[2].size()) * sizeof(double) +
+               (planes_[0].size() + planes_[1].size() + planes_[2].size() + leafPlanes_.size()) *
+                   sizeof(double) +
                dir_.memoryBytes();
     }
     bool usesMailboxes() const { return true; }
@@ -104,6 +105,9 @@ class RegularGrid {
     uint32_t n_[3] = {1, 1, 1};
     double scale_[3] = {1.0, 1.0, 1.0};   ///< 2^n / extent, for locate
     std::vector<double> planes_[3];       ///< grid plane coordinates, 2^n + 1 per axis
+    /// Per leaf, its planes lo x, y, z then hi x, y, z (planes_ at RegularLeaf::lo, hi): the walk
+    /// reads a leaf's exit planes from one place instead of through its indices.
+    std::vector<double> leafPlanes_;
     size_t maxSteps_ = 16;
     std::vector<RegularLeaf> leaves_;
     CsgTree pool_;  ///< restricted trees of all leaves, shared between equal primitive sets
@@ -130,15 +134,24 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     if (!(tStart <= tEnd)) return false;
     Vec3 p = std::isfinite(tStart) ? ray.at(tStart) : ray.o;
     uint32_t leaf = dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
-    // Per ray: 1/d, so each exit plane costs a product, not a division (an axis the ray runs
-    // parallel to is never an exit), and the side of a cell the ray leaves by on each axis.
-    const double inv[3] = {1.0 / ray.d.x, 1.0 / ray.d.y, 1.0 / ray.d.z};
+    // Per ray, held locally (the loop's stores to mailboxes and counters could otherwise alias
+    // the ray and the arrays, and each step would reload them): the origin, 1/d, so each exit
+    // plane costs a product, not a division, and the side a cell is left by on each axis. An axis
+    // the ray runs parallel to is never an exit: its plane gets a factor 0 and a bias of +inf;
+    // on the others the bias is 0, which leaves the product bit for bit unchanged.
+    const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
     const bool up[3] = {ray.d.x > 0.0, ray.d.y > 0.0, ray.d.z > 0.0};
-    // The arrays the loop reads, held locally: the loop's stores (mailboxes, counters) could
-    // otherwise alias them, and each step would reload them.
+    double inv[3], bias[3];
+    uint32_t side[3];  ///< where a leaf's exit plane on each axis is in leafPlanes_: lo a, hi 3 + a
+    for (int a = 0; a < 3; ++a) {
+        const bool parallel = ray.d[a] == 0.0;
+        inv[a] = parallel ? 0.0 : 1.0 / ray.d[a];
+        bias[a] = parallel ? kInf : 0.0;
+        side[a] = up[a] ? 3 + a : a;
+    }
     const RegularLeaf* const leaves = leaves_.data();
     const uint32_t* const primList = primList_.data();
-    const double* const planes[3] = {planes_[0].data(), planes_[1].data(), planes_[2].data()};
+    const double* const leafPlanes = leafPlanes_.data();
     // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
     // inside the grid, so this only admits hits that rounding puts a hair outside the box.
     double t0 = tmin, tIn = tStart;
@@ -151,16 +164,12 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         }
         const RegularLeaf& L = leaves[leaf];
         // Exit: the nearest of the cell's exit planes; ties are edges and corners.
+        const double* const P = leafPlanes + 6 * size_t(leaf);
         double tAxis[3];
         double tExit = kInf;
         int exitAxis = 0;
         for (int a = 0; a < 3; ++a) {
-            if (ray.d[a] > 0.0)
-                tAxis[a] = (planes[a][L.hi[a]] - ray.o[a]) * inv[a];
-            else if (ray.d[a] < 0.0)
-                tAxis[a] = (planes[a][L.lo[a]] - ray.o[a]) * inv[a];
-            else
-                tAxis[a] = kInf;
+            tAxis[a] = (P[side[a]] - o[a]) * inv[a] + bias[a];
             if (tAxis[a] < tExit) tExit = tAxis[a], exitAxis = a;
         }
         bool last = !(tExit < tEnd);
@@ -192,7 +201,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
                 // so the walk cannot bounce back into the previous cell.
                 const Vec3 q = ray.at(tExit);
                 for (int a = 0; a < 3; ++a) {
-                    double x = std::clamp(q[a], planes[a][L.lo[a]], planes[a][L.hi[a]]);
+                    double x = std::clamp(q[a], P[a], P[3 + a]);
                     if (tAxis[a] == tExit) {
                         x += up[a] ? delta_ : -delta_;
                         if (x < box_.lo[a] || x > box_.hi[a]) last = true;  // left the grid
