@@ -55,6 +55,7 @@ uint32_t Directory::addTable(const BspNodes& bsp, int node, int level, int fines
     for (int a = 0; a < 3; ++a) {
         t.bits[a] = uint8_t(cutsOnAxis(level + m, a) - cutsOnAxis(level, a));
         t.shift[a] = uint8_t(cutsOnAxis(finestLevel, a) - cutsOnAxis(level + m, a));
+        t.mask[a] = (1u << t.bits[a]) - 1u;
     }
     t.lowBits = uint8_t(t.bits[1] + t.bits[2]);
     uint32_t id = uint32_t(tables_.size());

@@ -46,9 +46,9 @@ class Directory {
     uint32_t lookup(uint32_t i, uint32_t j, uint32_t k) const {
         const Table* t = &tables_[0];
         for (;;) {
-            uint32_t e = entries_[t->offset + (((i >> t->shift[0]) & t->mask(0)) << t->lowBits) +
-                                  (((j >> t->shift[1]) & t->mask(1)) << t->bits[2]) +
-                                  ((k >> t->shift[2]) & t->mask(2))];
+            uint32_t e = entries_[t->offset + (((i >> t->shift[0]) & t->mask[0]) << t->lowBits) +
+                                  (((j >> t->shift[1]) & t->mask[1]) << t->bits[2]) +
+                                  ((k >> t->shift[2]) & t->mask[2])];
             if (!(e & kSubTable)) return e;
             t = &tables_[e & ~kSubTable];
         }
@@ -65,14 +65,15 @@ class Directory {
     static constexpr uint32_t kSubTable = 0x80000000u;
 
     /// One table: a block of the grid at BSP level `level`, subdivided `levels` more levels.
-    /// 12 bytes: many sub-tables are small (a node two levels deep has 4 entries).
+    /// 24 bytes, the masks stored rather than computed on each lookup.
     struct Table {
         uint32_t offset = 0;    ///< first entry in entries_
         uint8_t shift[3] = {};  ///< finest index >> shift = index at the table's finest level
         uint8_t bits[3] = {};   ///< entries per axis = 2^bits
         uint8_t lowBits = 0;    ///< bits[1] + bits[2]
-        /// Low bits of an index at the table's finest level: the position inside the block.
-        uint32_t mask(int a) const { return (1u << bits[a]) - 1u; }
+        /// Low bits of an index at the table's finest level, 2^bits - 1: the position inside
+        /// the block.
+        uint32_t mask[3] = {};
     };
 
     /// Levels a table rooted at a node of `height` at `level` covers.

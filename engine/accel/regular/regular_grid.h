@@ -143,11 +143,13 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     const bool up[3] = {ray.d.x > 0.0, ray.d.y > 0.0, ray.d.z > 0.0};
     double inv[3], bias[3];
     uint32_t side[3];  ///< where a leaf's exit plane on each axis is in leafPlanes_: lo a, hi 3 + a
+    uint32_t rope[3];  ///< the rope across that plane
     for (int a = 0; a < 3; ++a) {
         const bool parallel = ray.d[a] == 0.0;
         inv[a] = parallel ? 0.0 : 1.0 / ray.d[a];
         bias[a] = parallel ? kInf : 0.0;
         side[a] = up[a] ? 3 + a : a;
+        rope[a] = 2 * a + up[a];
     }
     const RegularLeaf* const leaves = leaves_.data();
     const uint32_t* const primList = primList_.data();
@@ -156,8 +158,9 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     // inside the grid, so this only admits hits that rounding puts a hair outside the box.
     double t0 = tmin, tIn = tStart;
     ctx.pending.clear();
+    const size_t maxSteps = maxSteps_;
     for (size_t step = 0;; ++step) {
-        if (step > maxSteps_) {
+        if (step > maxSteps) {
             ++ctx.counters.walkErrors;
             obs.walkError("regular: step bound exceeded");
             return false;
@@ -182,11 +185,11 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
                 // is exact; the other indices are the exit point's, kept on the face. When one
                 // leaf covers the whole face, the leaf's rope names it and no lookup is needed.
                 const int a = exitAxis;
-                const uint32_t rope = L.rope[2 * a + up[a]];
-                if (rope == kBorder) {
+                const uint32_t across = L.rope[rope[a]];
+                if (across == kBorder) {
                     last = true;
-                } else if (rope != kSplitFace) {
-                    nextLeaf = rope;
+                } else if (across != kSplitFace) {
+                    nextLeaf = across;
                 } else {
                     const Vec3 q = ray.at(tExit);
                     next[a] = up[a] ? L.hi[a] : L.lo[a] - 1;
