@@ -118,14 +118,22 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
         }
     }
     glBindTexture(GL_TEXTURE_2D, 0);
-    shadedValid_ = false;
+    if (resized) {
+        shadedValid_ = false;
+    } else if (rows > 0) {
+        const bool none = dirtyBegin_ == dirtyEnd_;
+        dirtyBegin_ = none ? rowBegin : std::min(dirtyBegin_, rowBegin);
+        dirtyEnd_ = none ? rowEnd : std::max(dirtyEnd_, rowEnd);
+    }
 }
 
 void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) const {
     if (width_ == 0) return;
     scale = scale > 0.0f ? scale : 1.0f;
     if (!shadedValid_ || mode != shadedMode_ || (mode != ViewMode::Color && scale != shadedScale_))
-        shade(mode, scale);
+        shade(mode, scale, 0, height_);
+    else if (dirtyBegin_ < dirtyEnd_)
+        shade(mode, scale, dirtyBegin_, dirtyEnd_);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
@@ -135,13 +143,15 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) cons
     glViewport(0, 0, fbWidth, fbHeight);
 }
 
-void ImageView::shade(ViewMode mode, float scale) const {
+void ImageView::shade(ViewMode mode, float scale, int rowBegin, int rowEnd) const {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, width_, height_);
     glDisable(GL_BLEND);
     glDisable(GL_DEPTH_TEST);
-    glDisable(GL_SCISSOR_TEST);
     glDisable(GL_CULL_FACE);
+    // Image row r is FBO row height - 1 - r (the shader flips): rows [b, e) are [h - e, h - b).
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, height_ - rowEnd, width_, rowEnd - rowBegin);
     glUseProgram(program_);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, colorTex_);
@@ -162,7 +172,9 @@ void ImageView::shade(ViewMode mode, float scale) const {
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, 0);
     glUseProgram(0);
+    glDisable(GL_SCISSOR_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    dirtyBegin_ = dirtyEnd_ = 0;
     shadedValid_ = true;
     shadedMode_ = mode;
     shadedScale_ = scale;

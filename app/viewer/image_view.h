@@ -29,12 +29,17 @@ class ImageView {
     int height() const { return height_; }
 
   private:
-    void shade(ViewMode mode, float scale) const;
+    /// Shade image rows [rowBegin, rowEnd) into the FBO (the rest keeps its pixels).
+    void shade(ViewMode mode, float scale, int rowBegin, int rowEnd) const;
 
     unsigned program_ = 0, vao_ = 0, colorTex_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
     mutable bool shadedValid_ = false;
     mutable ViewMode shadedMode_ = ViewMode::Color;
     mutable float shadedScale_ = 0.0f;
+    /// Image rows uploaded since the FBO was last shaded: only they are shaded again (a band of
+    /// a progressive pass is a few rows; shading all of them per band cost llvmpipe a full-image
+    /// pass each time).
+    mutable int dirtyBegin_ = 0, dirtyEnd_ = 0;
     int width_ = 0, height_ = 0;
     int locMode_ = -1, locScale_ = -1, locStops_ = -1, locStopCount_ = -1, locColor_ = -1,
         locHeat_ = -1;

@@ -135,6 +135,9 @@ TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnly) {
     }
     ImageView view;
     view.upload(a, ViewMode::Color);
+    view.draw(w, h, ViewMode::Color, 1.0f);  // shades every row
+    ASSERT_LE(maxDiff(&gl.read()[4 * a.index(5, 70)], a.color[0]), 1);
+    // Then only the band's rows are shaded again; the others must keep their pixels.
     const int rowBegin = 30, rowEnd = 45;
     view.upload(b, ViewMode::Color, rowBegin, rowEnd);
     view.draw(w, h, ViewMode::Color, 1.0f);
@@ -147,6 +150,7 @@ TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnly) {
     }
     // A heat map uploaded whole, then a band of it: the band's counters, the rest unchanged.
     view.upload(a, ViewMode::PrimTests);
+    view.draw(w, h, ViewMode::PrimTests, 8.0f);
     view.upload(b, ViewMode::PrimTests, rowBegin, rowEnd);
     view.draw(w, h, ViewMode::PrimTests, 8.0f);
     std::vector<uint8_t> hot = gl.read();
