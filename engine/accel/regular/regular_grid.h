@@ -142,8 +142,8 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
     const bool up[3] = {ray.d.x > 0.0, ray.d.y > 0.0, ray.d.z > 0.0};
     double inv[3], bias[3];
-    uint32_t side[3];  ///< where a leaf's exit plane on each axis is in leafPlanes_: lo a, hi 3 + a
-    uint32_t rope[3];  ///< the rope across that plane
+    uint32_t side[3];  // where a leaf's exit plane on each axis is in leafPlanes_: lo a, hi 3 + a
+    uint32_t rope[3];  // the rope across that plane
     for (int a = 0; a < 3; ++a) {
         const bool parallel = ray.d[a] == 0.0;
         inv[a] = parallel ? 0.0 : 1.0 / ray.d[a];
