@@ -118,13 +118,10 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
         }
     }
     glBindTexture(GL_TEXTURE_2D, 0);
-    if (resized) {
+    if (resized)
         shadedValid_ = false;
-    } else if (rows > 0) {
-        const bool none = dirtyBegin_ == dirtyEnd_;
-        dirtyBegin_ = none ? rowBegin : std::min(dirtyBegin_, rowBegin);
-        dirtyEnd_ = none ? rowEnd : std::max(dirtyEnd_, rowEnd);
-    }
+    else
+        dirty_.add(rowBegin, rowEnd);
 }
 
 void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) const {
@@ -132,8 +129,8 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) cons
     scale = scale > 0.0f ? scale : 1.0f;
     if (!shadedValid_ || mode != shadedMode_ || (mode != ViewMode::Color && scale != shadedScale_))
         shade(mode, scale, 0, height_);
-    else if (dirtyBegin_ < dirtyEnd_)
-        shade(mode, scale, dirtyBegin_, dirtyEnd_);
+    else if (!dirty_.empty())
+        shade(mode, scale, dirty_.begin, dirty_.end);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
@@ -174,7 +171,7 @@ void ImageView::shade(ViewMode mode, float scale, int rowBegin, int rowEnd) cons
     glUseProgram(0);
     glDisable(GL_SCISSOR_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    dirtyBegin_ = dirtyEnd_ = 0;
+    dirty_.clear();
     shadedValid_ = true;
     shadedMode_ = mode;
     shadedScale_ = scale;

@@ -39,7 +39,7 @@ class ImageView {
     /// Image rows uploaded since the FBO was last shaded: only they are shaded again (a band of
     /// a progressive pass is a few rows; shading all of them per band cost llvmpipe a full-image
     /// pass each time).
-    mutable int dirtyBegin_ = 0, dirtyEnd_ = 0;
+    mutable RowRange dirty_;
     int width_ = 0, height_ = 0;
     int locMode_ = -1, locScale_ = -1, locStops_ = -1, locStopCount_ = -1, locColor_ = -1,
         locHeat_ = -1;

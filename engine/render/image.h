@@ -1,6 +1,7 @@
 // Images the tracer fills: colour, depth and per-pixel counters, and their files.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -27,6 +28,19 @@ struct Image {
     std::vector<uint8_t> rgba8(int rowBegin = 0, int rowEnd = -1) const;
     /// Rows [rowBegin, rowEnd) clamped to the image, as a pixel index range [first, last).
     void pixelRange(int rowBegin, int rowEnd, size_t& first, size_t& last) const;
+};
+
+/// Rows [begin, end) of an image written since someone last took them; empty when begin == end.
+struct RowRange {
+    int begin = 0, end = 0;
+    bool empty() const { return begin >= end; }
+    /// Grow to cover rows [b, e) too (nothing for an empty one).
+    void add(int b, int e) {
+        if (b >= e) return;
+        begin = empty() ? b : std::min(begin, b);
+        end = empty() ? e : std::max(end, e);
+    }
+    void clear() { begin = end = 0; }
 };
 
 /// Copy rows [rowBegin, rowEnd) (-1: to the last) of every channel of `src` into `dst`, which

@@ -76,10 +76,10 @@ bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown) 
     // Only the rows written since the last snapshot, unless `out` is new or of another size.
     Shown s = displayShown_;
     const bool whole = out.width != display_.width || out.height != display_.height;
-    copyRows(display_, out, changedBegin_, changedEnd_);  // whole when the size differs
-    s.changedBegin = whole ? 0 : changedBegin_;
-    s.changedEnd = whole ? display_.height : changedEnd_;
-    changedBegin_ = changedEnd_ = 0;
+    copyRows(display_, out, changed_.begin, changed_.end);  // whole when the size differs
+    s.changedBegin = whole ? 0 : changed_.begin;
+    s.changedEnd = whole ? display_.height : changed_.end;
+    changed_.clear();
     if (shown) *shown = s;
     version = displayVersion_;
     return true;
@@ -165,10 +165,7 @@ void ProgressiveRenderer::run() {
                 // first pass of a job fills it whole; another size is refilled whole).
                 const bool whole = display_.width != w || display_.height != h;
                 fillBlocks(work, stride, display_, y0, lattice.rowEnd);
-                const int b = whole ? 0 : y0, e = whole ? h : lattice.rowEnd;
-                const bool none = changedBegin_ == changedEnd_;  // nothing waiting to be taken
-                changedBegin_ = none ? b : std::min(changedBegin_, b);
-                changedEnd_ = none ? e : std::max(changedEnd_, e);
+                changed_.add(whole ? 0 : y0, whole ? h : lattice.rowEnd);
                 ++displayVersion_;
                 displayShown_ = {stride, lattice.rowEnd, previous};
                 if (passDone) {

@@ -103,7 +103,7 @@ class ProgressiveRenderer {
     std::atomic<size_t> progressDone_{0};
     std::atomic<size_t> progressTotal_{0};
     Image display_;  ///< what snapshot() copies from: the passes' blocks, band by band
-    int changedBegin_ = 0, changedEnd_ = 0;  ///< rows of display_ written since the last snapshot
+    RowRange changed_;  ///< rows of display_ written since the last snapshot
     uint64_t displayVersion_ = 0;
     Shown displayShown_;
     Image work_;  ///< the worker's lattice buffer, kept between jobs of the same size
