@@ -39,6 +39,8 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
         ->transform(CLI::CheckedTransformer(frames, CLI::ignore_case).description("{camera, projective}"))
         ->default_str(irregularFrameName(o.build.irregularFrame));
     app.add_flag("--no-mailbox{false}", o.build.mailboxes, "Turn the mailboxes off (to measure their effect)");
+    app.add_flag("--no-light-buffer{false}", o.build.lightBuffer,
+                 "Accelerated schemes: trace shadow rays without the light buffer (to measure its effect)");
     app.add_option("--threads", o.render.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024))->default_val(0);
     app.add_option("--bounces", o.render.shading.bounces, "Reflection/refraction depth; 0 = primary and shadow rays only")
         ->check(CLI::Range(0, 64))

@@ -414,6 +414,10 @@ void ViewerApp::parametersPanel() {
     }
     rebuild |= enumCombo("BSP heuristic", s_.build.heuristic, 3, heuristicName);
     rebuild |= ImGui::Checkbox("mailboxes", &s_.build.mailboxes);
+    ImGui::SameLine();
+    rebuild |= ImGui::Checkbox("light buffer", &s_.build.lightBuffer);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("Shadow rays stop where the light's depth map says nothing is left");
     if (structure_) {
         const AccelInfo& ai = structure_->accel->info();
         ImGui::Text("on screen: %s, built in %.1f ms",
@@ -546,6 +550,9 @@ void ViewerApp::statisticsPanel() {
         const double asked = double(total.primTests + total.mailboxHits);
         ImGui::Text("mailbox hit rate    %.1f %%",
                     asked > 0 ? 100.0 * double(total.mailboxHits) / asked : 0.0);
+        if (total.shadowRays)
+            ImGui::Text("shadow rays with no walk %.1f %% (light buffer)",
+                        100.0 * double(total.lightBufferSkips) / double(total.shadowRays));
         if (total.walkErrors)
             ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "walk errors %llu",
                                (unsigned long long)total.walkErrors);

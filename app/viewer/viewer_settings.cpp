@@ -38,6 +38,7 @@ std::string settingsLines(const ViewerSettings& s) {
       << "delta=" << s.build.delta << "\n"
       << "bsp_heuristic=" << heuristicName(s.build.heuristic) << "\n"
       << "mailboxes=" << s.build.mailboxes << "\n"
+      << "light_buffer=" << s.build.lightBuffer << "\n"
       << "threads=" << s.threads << "\n"
       << "bounces=" << s.shading.bounces << "\n"
       << "shadows=" << s.shading.shadows << "\n"
@@ -82,6 +83,8 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
         parseEnum(value, BspHeuristic(3), heuristicName, s.build.heuristic);
     else if (key == "mailboxes")
         flag(s.build.mailboxes);
+    else if (key == "light_buffer")
+        flag(s.build.lightBuffer);
     else if (key == "threads")
         integer(s.threads, 0, 1024);
     else if (key == "bounces")

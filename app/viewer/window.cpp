@@ -46,6 +46,7 @@ void applyCommandLine(const cli::CommonOptions& o,
     if (given("--delta")) s.build.delta = o.build.delta;
     if (given("--bsp-heuristic")) s.build.heuristic = o.build.heuristic;
     if (given("--no-mailbox")) s.build.mailboxes = o.build.mailboxes;
+    if (given("--no-light-buffer")) s.build.lightBuffer = o.build.lightBuffer;
     if (given("--threads")) s.threads = o.render.threads;
     if (given("--bounces")) s.shading.bounces = o.render.shading.bounces;
     if (given("--no-shadows")) s.shading.shadows = o.render.shading.shadows;

@@ -29,6 +29,20 @@ const char* irregularFrameName(IrregularFrame f) {
     return f == IrregularFrame::Camera ? "camera" : "projective";
 }
 
+namespace {
+
+/// The light buffer of an accelerated scheme, counted in its memory and reported in `extra`.
+LightBuffer lightBufferFor(const Scene& scene, const BuildParams& params, AccelInfo& info) {
+    if (!params.lightBuffer) return {};
+    LightBuffer lb(scene);
+    info.memoryBytes += lb.memoryBytes();
+    info.extra["light_buffer_bytes"] = lb.memoryBytes();
+    info.extra["light_buffer_lights"] = lb.mappedLights();
+    return lb;
+}
+
+}  // namespace
+
 std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params) {
     if (!scene.prepared) throw std::logic_error("buildAccelerator: scene not prepared");
     auto start = std::chrono::steady_clock::now();
@@ -51,16 +65,18 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
             info.regions = g.regionCount();
             info.memoryBytes = g.memoryBytes();
             info.extra = g.extra();
+            LightBuffer lb = lightBufferFor(scene, params, info);
             info.buildMs = elapsedMs();
-            return std::make_unique<Accelerator>(std::move(g), params, std::move(info));
+            return std::make_unique<Accelerator>(std::move(g), params, std::move(info), std::move(lb));
         }
         case SchemeKind::Irregular: {
             AccelInfo info;
             IrregularSubdivision s = IrregularSubdivision::build(scene, params, info.extra);
             info.regions = s.regionCount();
             info.memoryBytes = s.memoryBytes();
+            LightBuffer lb = lightBufferFor(scene, params, info);
             info.buildMs = elapsedMs();
-            return std::make_unique<Accelerator>(std::move(s), params, std::move(info));
+            return std::make_unique<Accelerator>(std::move(s), params, std::move(info), std::move(lb));
         }
     }
     throw std::logic_error("buildAccelerator: unknown scheme");

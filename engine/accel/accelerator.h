@@ -9,6 +9,7 @@
 
 #include "engine/accel/brute_force.h"
 #include "engine/accel/irregular/irregular.h"
+#include "engine/accel/light_buffer.h"
 #include "engine/accel/regular/regular_grid.h"
 
 namespace lancer {
@@ -37,6 +38,9 @@ struct BuildParams {
     double delta = 1e-6;        ///< push distance, relative to the scene box's largest extent
     BspHeuristic heuristic = BspHeuristic::Balanced;
     bool mailboxes = true;      ///< --no-mailbox turns them off to measure their effect
+    /// Accelerated schemes: shorten shadow rays with the light buffer (light_buffer.h);
+    /// --no-light-buffer turns it off to measure its effect. Brute force never uses it.
+    bool lightBuffer = true;
     bool fullTable = false;     ///< regular: one full directory table instead of sub-tables
     IrregularFrame irregularFrame = IrregularFrame::Projective;  ///< --irregular-frame
 };
@@ -53,8 +57,11 @@ class Accelerator {
 public:
     using Impl = std::variant<BruteForce, RegularGrid, IrregularSubdivision>;
 
-    Accelerator(Impl impl, BuildParams params, AccelInfo info)
-        : impl_(std::move(impl)), params_(params), info_(std::move(info)) {}
+    Accelerator(Impl impl, BuildParams params, AccelInfo info, LightBuffer lightBuffer = {})
+        : impl_(std::move(impl)),
+          params_(params),
+          info_(std::move(info)),
+          lightBuffer_(std::move(lightBuffer)) {}
 
     /// Nearest visible hit with t in (tmin, tmax]; reports the walk to `obs`.
     template <class Obs>
@@ -62,6 +69,22 @@ public:
                    Hit& hit) const {
         return std::visit([&](const auto& s) { return s.intersect(ray, tmin, tmax, ctx, obs, hit); },
                           impl_);
+    }
+    /// Whether the shadow ray toward scene light `light` (its direction points at the light)
+    /// meets anything with t in (0, tmax]: the answer intersect() gives. The accelerated schemes
+    /// first ask the light buffer how far the ray can meet anything at all (light_buffer.h).
+    template <class Obs>
+    bool occluded(const Ray& ray, double tmax, uint32_t light, TraceContext& ctx, Obs& obs) const {
+        if (!lightBuffer_.empty()) {
+            const double free = lightBuffer_.freeFrom(ray.o, ray.d, light);
+            if (!(free > 0.0)) {
+                ++ctx.counters.lightBufferSkips;
+                return false;
+            }
+            tmax = std::min(tmax, free);
+        }
+        Hit hit;
+        return intersect(ray, 0.0, tmax, ctx, obs, hit);
     }
     bool usesMailboxes() const {
         return params_.mailboxes &&
@@ -75,6 +98,7 @@ private:
     Impl impl_;
     BuildParams params_;
     AccelInfo info_;
+    LightBuffer lightBuffer_;  ///< empty for brute force and with --no-light-buffer
 };
 
 /// Build the scheme named in `params` over a prepared scene. Throws std::invalid_argument for

@@ -11,6 +11,7 @@ RayCounters& RayCounters::operator+=(const RayCounters& o) {
     regionVisits += o.regionVisits;
     pointerSteps += o.pointerSteps;
     walkErrors += o.walkErrors;
+    lightBufferSkips += o.lightBufferSkips;
     return *this;
 }
 
@@ -24,6 +25,7 @@ RayCounters RayCounters::operator-(const RayCounters& o) const {
     r.regionVisits -= o.regionVisits;
     r.pointerSteps -= o.pointerSteps;
     r.walkErrors -= o.walkErrors;
+    r.lightBufferSkips -= o.lightBufferSkips;
     return r;
 }
 

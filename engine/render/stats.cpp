@@ -23,6 +23,7 @@ nlohmann::json statsJson(const Scene& scene, const Accelerator& accel, const Ren
     j["region_visits"] = c.regionVisits;
     j["pointer_steps"] = c.pointerSteps;
     j["walk_errors"] = c.walkErrors;
+    j["light_buffer_skips"] = c.lightBufferSkips;
     j["regions"] = info.regions;
     j["memory_bytes"] = info.memoryBytes;
     j["max_level"] = p.maxLevel;

@@ -41,6 +41,13 @@ public:
         return accel_.intersect(ray, tmin, tmax, ctx, obs, hit);
     }
 
+    /// Whether the shadow ray toward scene light `light` is blocked before tmax. One new ray id.
+    template <class Obs>
+    bool occluded(const Ray& ray, double tmax, uint32_t light, TraceContext& ctx, Obs& obs) const {
+        ctx.beginRay();
+        return accel_.occluded(ray, tmax, light, ctx, obs);
+    }
+
     SurfacePoint surface(const Ray& ray, const Hit& hit) const {
         SurfacePoint s;
         const Primitive& prim = scene_.prims[hit.prim];
@@ -79,7 +86,8 @@ public:
         Vec3 above = s.p + eps * s.facing;
 
         // Direct light, with one shadow ray per light the surface faces.
-        for (const Light& light : scene_.lights) {
+        for (uint32_t li = 0; li < scene_.lights.size(); ++li) {
+            const Light& light = scene_.lights[li];
             Vec3 L = light.position - s.p;
             double dist = glm::length(L);
             if (!(dist > 0.0)) continue;
@@ -89,9 +97,7 @@ public:
             if (opt_.shadows) {
                 ++ctx.counters.shadowRays;
                 Ray shadow{above, glm::normalize(light.position - above)};
-                Hit blocker;
-                if (nearest(shadow, 0.0, glm::length(light.position - above), ctx, obs, blocker))
-                    continue;
+                if (occluded(shadow, glm::length(light.position - above), li, ctx, obs)) continue;
             }
             color += light.color * (m.diffuse * ndl) * m.color;
             if (m.specular > 0.0) {

@@ -17,6 +17,20 @@ for key in scheme width height threads build_ms render_ms rays primary_rays prim
 done
 grep -q '"primary_rays": 2560' "$tmp/a.json" || fail "primary_rays is not 64*40"
 
+# The light buffer: on by default for the accelerated schemes, --no-light-buffer turns it off;
+# the image is the same either way, and brute force never uses it.
+"$LANCER" render "$SRC/assets/spd/balls1.nff" --width 48 --height 48 -o "$tmp/lb.png" --stats "$tmp/lb.json" -q \
+  || fail "render balls1"
+"$LANCER" render "$SRC/assets/spd/balls1.nff" --width 48 --height 48 -o "$tmp/nolb.png" --stats "$tmp/nolb.json" -q \
+  --no-light-buffer || fail "render --no-light-buffer"
+cmp -s "$tmp/lb.png" "$tmp/nolb.png" || fail "the light buffer changed the image"
+grep -q '"light_buffer_skips": [1-9]' "$tmp/lb.json" || fail "the light buffer skipped no shadow ray"
+grep -q '"light_buffer_skips": 0' "$tmp/nolb.json" || fail "--no-light-buffer still used it"
+"$LANCER" render "$SRC/assets/spd/balls1.nff" --width 48 --height 48 -o "$tmp/bf.png" --stats "$tmp/bf.json" -q \
+  --scheme brute || fail "render brute"
+grep -q '"light_buffer_skips": 0' "$tmp/bf.json" || fail "brute force used the light buffer"
+cmp -s "$tmp/lb.png" "$tmp/bf.png" || fail "regular with the light buffer differs from brute force"
+
 # --width alone keeps the scene's aspect (640x400 -> 80x50).
 "$LANCER" render builtin:default --width 80 -o "$tmp/b.png" --stats "$tmp/b.json" -q || fail "render --width"
 grep -q '"height": 50' "$tmp/b.json" || fail "--width did not keep the aspect"

@@ -1,0 +1,174 @@
+// The light buffer (engine/accel/light_buffer.h): nothing meets a shadow ray past the point it
+// names, so every accelerated scheme answers each shadow ray as brute force does, on SPD, built-in
+// and random CSG scenes, far from the origin too; and it does shorten them.
+#include <gtest/gtest.h>
+
+#include "engine/render/renderer.h"
+#include "engine/scene/loader.h"
+#include "tests/support/differential.h"
+
+namespace lancer {
+namespace {
+
+struct ShadowRay {
+    Ray ray;
+    double tmax;
+    uint32_t light;
+};
+
+/// The tracer's shadow rays from the first hits of `rays` (origin offset off the surface, one per
+/// light the surface faces), plus rays from random points of the bounds to each light.
+std::vector<ShadowRay> shadowRays(const Scene& s, const std::vector<Ray>& rays, uint64_t seed) {
+    auto brute = buildAccelerator(s, BuildParams{});
+    Tracer tracer(s, *brute, ShadingOptions{});
+    TraceContext ctx(s.prims.size(), s.tree.depth());
+    NullObserver obs;
+    std::vector<ShadowRay> out;
+    auto toLight = [&](const Vec3& from, uint32_t l) {
+        const Vec3 L = s.lights[l].position;
+        out.push_back({Ray{from, glm::normalize(L - from)}, glm::length(L - from), l});
+    };
+    for (const Ray& r : rays) {
+        Hit hit;
+        if (!tracer.nearest(r, 0.0, kInf, ctx, obs, hit)) continue;
+        SurfacePoint p = tracer.surface(r, hit);
+        const Vec3 above = p.p + tracer.offset(p.p) * p.facing;
+        for (uint32_t l = 0; l < s.lights.size(); ++l)
+            if (glm::dot(p.facing, s.lights[l].position - p.p) > 0.0) toLight(above, l);
+    }
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int k = 0; k < 300; ++k) {
+        const Vec3 p = s.bounds.lo + Vec3(u(rng), u(rng), u(rng)) * s.bounds.extent();
+        toLight(p, uint32_t(k % s.lights.size()));
+    }
+    return out;
+}
+
+struct Tally {
+    size_t rays = 0, blocked = 0, skipped = 0, shortened = 0;
+};
+
+/// Checks every shadow ray against brute force: the light buffer's free point lies beyond the
+/// nearest blocker, and each accelerated scheme answers as brute force does.
+Tally checkShadowRays(const std::string& name, const Scene& s, const std::vector<ShadowRay>& rays) {
+    auto brute = buildAccelerator(s, BuildParams{});
+    TraceContext ctx(s.prims.size(), s.tree.depth());
+    NullObserver obs;
+    LightBuffer lb(s);
+    Tally tally;
+    std::vector<std::unique_ptr<Accelerator>> schemes;
+    for (StepMethod step : {StepMethod::Exact, StepMethod::Push}) {
+        BuildParams p;
+        p.scheme = SchemeKind::Regular;
+        p.step = step;
+        schemes.push_back(buildAccelerator(s, p));
+    }
+    BuildParams irr;
+    irr.scheme = SchemeKind::Irregular;
+    schemes.push_back(buildAccelerator(s, irr));
+    size_t failures = 0;
+    for (const ShadowRay& sr : rays) {
+        ++tally.rays;
+        Hit hit;
+        ctx.beginRay();
+        const bool blocked = brute->intersect(sr.ray, 0.0, sr.tmax, ctx, obs, hit);
+        const double free = lb.freeFrom(sr.ray.o, sr.ray.d, sr.light);
+        tally.blocked += blocked;
+        tally.skipped += !(free > 0.0);
+        tally.shortened += free > 0.0 && free < sr.tmax;
+        if (blocked && !(hit.t <= free) && failures++ < 5)
+            ADD_FAILURE() << name << ": " << sr.ray.toString() << " toward light " << sr.light
+                          << " is blocked at t = " << hit.t << " by p" << hit.prim
+                          << ", past the light buffer's free point " << free;
+        for (const auto& a : schemes) {
+            ctx.beginRay();
+            const bool got = a->occluded(sr.ray, sr.tmax, sr.light, ctx, obs);
+            if (got != blocked && failures++ < 5)
+                ADD_FAILURE() << name << " " << schemeName(a->params().scheme) << " "
+                              << stepName(a->params().step) << ": " << sr.ray.toString()
+                              << " toward light " << sr.light << ": occluded " << got
+                              << ", brute force " << blocked;
+        }
+    }
+    EXPECT_EQ(failures, 0u) << name;
+    return tally;
+}
+
+TEST(LightBuffer, SpdScenesShadowRaysAsBruteForceAndShortened) {
+    for (const char* f : {"balls1.nff", "gears1.nff", "tetra3.nff", "rings2.nff"}) {
+        Scene s = loadScene(std::string(LANCER_SPD_DIR) + "/" + f);
+        Tally t = checkShadowRays(f, s, shadowRays(s, test::pixelRays(s, 48, 48), 7));
+        std::printf("%s: %zu shadow rays, %zu blocked, %zu answered with no walk, %zu shortened\n",
+                    f, t.rays, t.blocked, t.skipped, t.shortened);
+        EXPECT_GT(t.blocked, 0u) << f;
+        EXPECT_GT(t.skipped, 0u) << f;
+        EXPECT_GT(t.shortened, 0u) << f;
+        // Balls: the lit floor's shadow rays, most of the unblocked ones, need no walk at all.
+        if (std::string(f) == "balls1.nff") EXPECT_GT(t.skipped, (t.rays - t.blocked) / 2);
+    }
+}
+
+TEST(LightBuffer, RandomCsgScenesShadowRaysAsBruteForce) {
+    Tally all;
+    for (uint64_t seed = 1; seed <= 12; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.surfaces = seed % 2 == 0;
+        if (seed >= 10) opt.offset = Vec3(3e5, -2e5, 1e5);  // far from the origin
+        Scene s = test::randomCsgScene(seed, opt);
+        Tally t = checkShadowRays("random " + std::to_string(seed), s,
+                                  shadowRays(s, test::randomRays(s, seed, 1500), seed));
+        all.rays += t.rays, all.blocked += t.blocked, all.skipped += t.skipped;
+        all.shortened += t.shortened;
+    }
+    EXPECT_GT(all.blocked, 0u);
+    EXPECT_GT(all.skipped, 0u);
+    EXPECT_GT(all.shortened, 0u);
+}
+
+TEST(LightBuffer, BuiltinCsgScenesShadowRaysAsBruteForce) {
+    for (const char* spec : {"builtin:default", "builtin:lattice:3", "builtin:drilled:3"}) {
+        Scene s = loadScene(spec);
+        Tally t = checkShadowRays(spec, s, shadowRays(s, test::pixelRays(s, 40, 40), 3));
+        EXPECT_GT(t.rays, 100u) << spec;
+    }
+}
+
+// A light inside the bounds gets no map: the buffer does not know, and the walk runs whole.
+TEST(LightBuffer, LightInsideTheBoundsHasNoMap) {
+    Scene s = loadScene(std::string(LANCER_SPD_DIR) + "/balls1.nff");
+    ASSERT_GE(s.lights.size(), 1u);
+    s.lights[0].position = s.bounds.center();
+    LightBuffer lb(s);
+    EXPECT_EQ(lb.mappedLights(), s.lights.size() - 1);
+    const Vec3 o = s.bounds.lo + 0.25 * s.bounds.extent();
+    EXPECT_EQ(lb.freeFrom(o, glm::normalize(s.lights[0].position - o), 0), kInf);
+    Tally t = checkShadowRays("balls1, light 0 inside", s,
+                              shadowRays(s, test::pixelRays(s, 24, 24), 5));
+    EXPECT_GT(t.skipped, 0u);  // the other lights still have theirs
+}
+
+// Rendering with and without the buffer: the same image, fewer regions visited with it.
+TEST(LightBuffer, SameImageFewerRegionVisits) {
+    Scene s = loadScene(std::string(LANCER_SPD_DIR) + "/balls1.nff");
+    RenderOptions opt;
+    opt.width = opt.height = 64;
+    opt.threads = 2;
+    BuildParams with;
+    with.scheme = SchemeKind::Regular;
+    BuildParams without = with;
+    without.lightBuffer = false;
+    auto a = buildAccelerator(s, with), b = buildAccelerator(s, without);
+    Image ia(64, 64), ib(64, 64);
+    RenderStats sa = render(s, *a, opt, ia), sb = render(s, *b, opt, ib);
+    EXPECT_EQ(ia.color, ib.color);
+    EXPECT_EQ(sa.counters.shadowRays, sb.counters.shadowRays);
+    EXPECT_GT(sa.counters.lightBufferSkips, sa.counters.shadowRays / 4);
+    EXPECT_EQ(sb.counters.lightBufferSkips, 0u);
+    EXPECT_LT(sa.counters.regionVisits, sb.counters.regionVisits);
+    EXPECT_TRUE(a->info().extra.contains("light_buffer_bytes"));
+    EXPECT_FALSE(b->info().extra.contains("light_buffer_bytes"));
+}
+
+}  // namespace
+}  // namespace lancer
