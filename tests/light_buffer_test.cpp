@@ -148,6 +148,72 @@ TEST(LightBuffer, LightInsideTheBoundsHasNoMap) {
     EXPECT_GT(t.skipped, 0u);  // the other lights still have theirs
 }
 
+/// Checks primary rays from the eye against brute force: nothing is met before nearFrom().
+size_t checkEyeRays(const std::string& name, const Scene& s, const std::vector<Ray>& rays) {
+    auto brute = buildAccelerator(s, BuildParams{});
+    TraceContext ctx(s.prims.size(), s.tree.depth());
+    NullObserver obs;
+    LightBuffer eye(s.bounds, s.minBox, {s.camera.from});
+    EXPECT_EQ(eye.mappedLights(), 1u) << name << ": the camera should be outside the bounds";
+    size_t failures = 0, skipped = 0;
+    for (const Ray& r : rays) {
+        EXPECT_EQ(r.o, s.camera.from);
+        Hit hit;
+        ctx.beginRay();
+        const double near = eye.nearFrom(r.d, 0);
+        skipped += near > 0.0;
+        if (brute->intersect(r, 0.0, kInf, ctx, obs, hit) && !(hit.t > near) && failures++ < 5)
+            ADD_FAILURE() << name << ": " << r.toString() << " hits p" << hit.prim << " at t = "
+                          << hit.t << ", before the eye buffer's " << near;
+    }
+    EXPECT_EQ(failures, 0u) << name;
+    return skipped;
+}
+
+TEST(EyeBuffer, NothingIsMetBeforeItsNearPoint) {
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (const char* f : {"balls1.nff", "gears1.nff", "rings2.nff", "tetra3.nff"}) {
+        Scene s = loadScene(std::string(LANCER_SPD_DIR) + "/" + f);
+        std::vector<Ray> rays = test::pixelRays(s, 64, 64);
+        for (int k = 0; k < 2000; ++k)  // any direction, grazing ones too
+            rays.push_back({s.camera.from, glm::normalize(Vec3(u(rng), u(rng), u(rng)) + 1e-9)});
+        EXPECT_GT(checkEyeRays(f, s, rays), rays.size() / 4) << f;
+    }
+    for (uint64_t seed = 1; seed <= 8; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.surfaces = seed % 2 == 0;
+        if (seed >= 7) opt.offset = Vec3(3e5, -2e5, 1e5);
+        Scene s = test::randomCsgScene(seed, opt);
+        if (s.bounds.isEmpty()) continue;  // the random tree came out empty
+        s.camera.at = s.bounds.center();
+        s.camera.from = s.bounds.center() + 1.5 * s.bounds.extent();  // outside
+        checkEyeRays("random " + std::to_string(seed), s, test::pixelRays(s, 48, 48));
+    }
+}
+
+// Whole renders with every bounce, lights and eye buffers on: brute force's image, bit for bit.
+TEST(LightBuffer, RegularRendersEqualBruteForce) {
+    uint64_t skips = 0;
+    for (const char* f : {"balls1.nff", "gears1.nff", "rings2.nff", "tetra3.nff"}) {
+        Scene s = loadScene(std::string(LANCER_SPD_DIR) + "/" + f);
+        RenderOptions opt;
+        opt.width = opt.height = 48;
+        opt.threads = 2;
+        BuildParams reg;
+        reg.scheme = SchemeKind::Regular;
+        auto a = buildAccelerator(s, reg), b = buildAccelerator(s, BuildParams{});
+        Image ia(48, 48), ib(48, 48);
+        RenderStats sa = render(s, *a, opt, ia), sb = render(s, *b, opt, ib);
+        EXPECT_EQ(ia.color, ib.color) << f;
+        EXPECT_EQ(ia.depth, ib.depth) << f;
+        EXPECT_EQ(ia.hitPrim, ib.hitPrim) << f;
+        skips += sa.counters.lightBufferSkips;
+        EXPECT_EQ(sb.counters.lightBufferSkips, 0u) << f;
+    }
+    EXPECT_GT(skips, 0u);
+}
+
 // Rendering with and without the buffer: the same image, fewer regions visited with it.
 TEST(LightBuffer, SameImageFewerRegionVisits) {
     Scene s = loadScene(std::string(LANCER_SPD_DIR) + "/balls1.nff");

@@ -23,9 +23,22 @@ void LightBuffer::Map::project(const Box3& x, double& dNear, double& uLo, double
         }
 }
 
-LightBuffer::LightBuffer(const Scene& scene, int bins) {
-    const Box3& bounds = scene.bounds;
-    if (bounds.isEmpty() || !bounds.isBounded() || scene.lights.empty()) return;
+namespace {
+
+std::vector<Vec3> positions(const std::vector<Light>& lights) {
+    std::vector<Vec3> out;
+    for (const Light& l : lights) out.push_back(l.position);
+    return out;
+}
+
+}  // namespace
+
+LightBuffer::LightBuffer(const Scene& scene, int bins)
+    : LightBuffer(scene.bounds, scene.minBox, positions(scene.lights), bins) {}
+
+LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
+                         const std::vector<Vec3>& points, int bins) {
+    if (bounds.isEmpty() || !bounds.isBounded() || points.empty()) return;
     const Vec3 e = bounds.extent();
     const double size = std::max({e.x, e.y, e.z}) +
                         std::max(glm::length(bounds.lo), glm::length(bounds.hi));
@@ -35,10 +48,10 @@ LightBuffer::LightBuffer(const Scene& scene, int bins) {
     hair_ = 1e-12 * size;
     const double side = 1e-9 * size;
     box_ = {bounds.lo - Vec3(hair_), bounds.hi + Vec3(hair_)};
-    maps_.resize(scene.lights.size());
-    for (size_t l = 0; l < scene.lights.size(); ++l) {
+    maps_.resize(points.size());
+    for (size_t l = 0; l < points.size(); ++l) {
         Map& m = maps_[l];
-        m.L = scene.lights[l].position;
+        m.L = points[l];
         // The face of the box the light is farthest beyond; a light inside gets no map.
         double gap = 0.0;
         for (int a = 0; a < 3; ++a)
@@ -46,7 +59,9 @@ LightBuffer::LightBuffer(const Scene& scene, int bins) {
                 const double x = s > 0.0 ? m.L[a] - box_.hi[a] : box_.lo[a] - m.L[a];
                 if (x > gap) gap = x, m.a = a, m.s = s;
             }
-        if (!(gap > 1e-6 * size) || !std::isfinite(gap)) continue;
+        // Well outside: a ray from the point that meets the box then runs steeply enough along the
+        // axis that rounding of a grazing hit stays inside its box's depth range.
+        if (!(gap > 1e-3 * std::max({e.x, e.y, e.z})) || !std::isfinite(gap)) continue;
         m.b = (m.a + 1) % 3;
         m.c = (m.a + 2) % 3;
         m.n = std::max(1, bins);
@@ -58,7 +73,7 @@ LightBuffer::LightBuffer(const Scene& scene, int bins) {
         m.sv = double(m.n) / (v1 - v0);
         const double pad = 1e-9 * std::max(u1 - u0, v1 - v0);
         m.near.assign(size_t(m.n) * size_t(m.n), kInf);
-        for (const Box3& mb : scene.minBox) {
+        for (const Box3& mb : boxes) {
             if (mb.isEmpty()) continue;  // a dropped primitive
             Box3 x{mb.lo - Vec3(side), mb.hi + Vec3(side)};  // widened across the view axis only
             x.lo[m.a] = mb.lo[m.a], x.hi[m.a] = mb.hi[m.a];

@@ -18,6 +18,7 @@
 // checked against.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -35,6 +36,10 @@ class LightBuffer {
     LightBuffer() = default;
     /// One depth map per light of the (prepared) scene that lies outside its bounds.
     explicit LightBuffer(const Scene& scene, int bins = kBins);
+    /// One depth map per point outside `bounds`, of `boxes` (those inside `bounds`; empty
+    /// ones are skipped): the scene's lights, or the eye of a perspective camera.
+    LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes, const std::vector<Vec3>& points,
+                int bins = kBins);
 
     /// For the shadow ray from `o` along `dir` toward light `light`: the t beyond which nothing
     /// can block it. <= 0: nothing can; +inf: the buffer does not know (the light is inside the
@@ -52,6 +57,19 @@ class LightBuffer {
                                       size_t(m.index(u, m.u0, m.su))];
         // Past the depth `nearest` (widened by the box's rounding hair, in t units).
         return (d - nearest + hair_) / rate;
+    }
+
+    /// For a ray leaving point `point` itself along `dir` (a primary ray from the eye): a t
+    /// before which it can meet nothing. 0 when the buffer does not know.
+    double nearFrom(const Vec3& dir, uint32_t point) const {
+        if (point >= maps_.size()) return 0.0;
+        const Map& m = maps_[point];
+        const double rate = -m.s * dir[m.a];  // depth gained per unit of t
+        if (m.near.empty() || !(rate > 0.0)) return 0.0;
+        const double u = dir[m.b] / rate, v = dir[m.c] / rate;
+        const double nearest = m.near[size_t(m.index(v, m.v0, m.sv)) * size_t(m.n) +
+                                      size_t(m.index(u, m.u0, m.su))];
+        return std::max(0.0, (nearest - hair_) / rate);
     }
 
     bool empty() const { return maps_.empty(); }

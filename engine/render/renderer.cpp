@@ -26,6 +26,13 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     const int w = img.width, h = img.height;
     const Tracer tracer(scene, accel, opt.shading);
     const PrimaryRays primary(cam, w, h);
+    // The eye's buffer (light_buffer.h, the eye in the lights' place): where each primary ray
+    // can meet its first box. Regular scheme only; perspective only (rays from one point).
+    const bool eyeBuffer = accel.params().lightBuffer &&
+                           accel.params().scheme == SchemeKind::Regular &&
+                           cam.projection == Projection::Perspective;
+    const LightBuffer eye = eyeBuffer ? LightBuffer(scene.bounds, scene.minBox, {cam.from})
+                                      : LightBuffer();
     const int depth = scene.tree.depth();
     const bool mailboxes = accel.usesMailboxes();
     tbb::enumerable_thread_specific<TraceContext> contexts([&] {
@@ -64,7 +71,7 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                         Ray ray = primary(x, y);
                         ++ctx.counters.primaryRays;
                         Hit hit;
-                        Vec3 c = tracer.radiance(ray, 0, ctx, obs, &hit);
+                        Vec3 c = tracer.radiance(ray, 0, ctx, obs, &hit, eye.nearFrom(ray.d, 0));
                         size_t i = img.index(x, y);
                         img.color[i] = glm::vec3(c);
                         img.depth[i] = hit.valid() ? float(hit.t) : std::numeric_limits<float>::infinity();

@@ -70,10 +70,12 @@ public:
     }
 
     /// Colour seen along `ray`; depth counts reflection/refraction bounces already taken.
+    /// `tmin`: the ray meets nothing before it (for a primary ray, the eye's buffer says so).
     template <class Obs>
-    Vec3 radiance(const Ray& ray, int depth, TraceContext& ctx, Obs& obs, Hit* first = nullptr) const {
+    Vec3 radiance(const Ray& ray, int depth, TraceContext& ctx, Obs& obs, Hit* first = nullptr,
+                  double tmin = 0.0) const {
         Hit hit;
-        if (!nearest(ray, 0.0, kInf, ctx, obs, hit)) {
+        if (!nearest(ray, tmin, kInf, ctx, obs, hit)) {
             if (first) *first = hit;
             return scene_.background;
         }
