@@ -260,7 +260,9 @@ TEST(PackedSpheres, SameSpansAsThePrimitivesBitForBit) {
             EXPECT_EQ(scene.packedSpheres[p].r >= 0.0, worldSphere) << "primitive " << p;
             packed += worldSphere;
         }
-        if (!transforms) EXPECT_GT(packed, 0);
+        if (!transforms) {
+            EXPECT_GT(packed, 0);
+        }
         int hits = 0;
         for (const Ray& ray : test::randomRays(scene, 5, 300)) {
             for (uint32_t p = 0; p < scene.prims.size(); ++p) {
