@@ -105,7 +105,9 @@ TEST(LightBuffer, SpdScenesShadowRaysAsBruteForceAndShortened) {
         EXPECT_GT(t.skipped, 0u) << f;
         EXPECT_GT(t.shortened, 0u) << f;
         // Balls: the lit floor's shadow rays, most of the unblocked ones, need no walk at all.
-        if (std::string(f) == "balls1.nff") EXPECT_GT(t.skipped, (t.rays - t.blocked) / 2);
+        if (std::string(f) == "balls1.nff") {
+            EXPECT_GT(t.skipped, (t.rays - t.blocked) / 2);
+        }
     }
 }
 

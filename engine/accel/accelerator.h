@@ -86,6 +86,16 @@ public:
         Hit hit;
         return intersect(ray, 0.0, tmax, ctx, obs, hit);
     }
+    /// The light buffer built from a perspective camera's eye (light_buffer.h), for primary
+    /// rays: the regular scheme's, when it uses a light buffer; empty otherwise (brute force is
+    /// the reference, and the irregular scheme's projective zones already start primary rays
+    /// where they meet their first region).
+    LightBuffer eyeBuffer(const Scene& scene, const Camera& cam) const {
+        if (!params_.lightBuffer || params_.scheme != SchemeKind::Regular ||
+            cam.projection != Projection::Perspective)
+            return {};
+        return LightBuffer(scene.bounds, scene.minBox, {cam.from});
+    }
     bool usesMailboxes() const {
         return params_.mailboxes &&
                std::visit([](const auto& s) { return s.usesMailboxes(); }, impl_);

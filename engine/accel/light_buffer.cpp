@@ -40,8 +40,8 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
                          const std::vector<Vec3>& points, int bins) {
     if (bounds.isEmpty() || !bounds.isBounded() || points.empty()) return;
     const Vec3 e = bounds.extent();
-    const double size = std::max({e.x, e.y, e.z}) +
-                        std::max(glm::length(bounds.lo), glm::length(bounds.hi));
+    const double largest = std::max({e.x, e.y, e.z});
+    const double size = largest + std::max(glm::length(bounds.lo), glm::length(bounds.hi));
     // Depths are compared with an allowance far above their rounding (a few ulps) and far below
     // the tracer's offset of shadow-ray origins (1e-9 of the scene scale), so a lit surface's
     // shadow ray is found unblocked at its origin; boxes are widened sideways by more.
@@ -61,7 +61,7 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
             }
         // Well outside: a ray from the point that meets the box then runs steeply enough along the
         // axis that rounding of a grazing hit stays inside its box's depth range.
-        if (!(gap > 1e-3 * std::max({e.x, e.y, e.z})) || !std::isfinite(gap)) continue;
+        if (!(gap > 1e-3 * largest) || !std::isfinite(gap)) continue;
         m.b = (m.a + 1) % 3;
         m.c = (m.a + 2) % 3;
         m.n = std::max(1, bins);

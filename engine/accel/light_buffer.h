@@ -53,10 +53,8 @@ class LightBuffer {
         const double rate = s * dir[m.a];             // fall of the depth per unit of t
         if (!(rate > 0.0)) return kInf;
         const double u = (o[m.b] - m.L[m.b]) / d, v = (o[m.c] - m.L[m.c]) / d;
-        const double nearest = m.near[size_t(m.index(v, m.v0, m.sv)) * size_t(m.n) +
-                                      size_t(m.index(u, m.u0, m.su))];
-        // Past the depth `nearest` (widened by the box's rounding hair, in t units).
-        return (d - nearest + hair_) / rate;
+        // Past its bin's least depth (widened by the rounding allowance, in t units).
+        return (d - m.least(u, v) + hair_) / rate;
     }
 
     /// For a ray leaving point `point` itself along `dir` (a primary ray from the eye): a t
@@ -67,9 +65,7 @@ class LightBuffer {
         const double rate = -m.s * dir[m.a];  // depth gained per unit of t
         if (m.near.empty() || !(rate > 0.0)) return 0.0;
         const double u = dir[m.b] / rate, v = dir[m.c] / rate;
-        const double nearest = m.near[size_t(m.index(v, m.v0, m.sv)) * size_t(m.n) +
-                                      size_t(m.index(u, m.u0, m.su))];
-        return std::max(0.0, (nearest - hair_) / rate);
+        return std::max(0.0, (m.least(u, v) - hair_) / rate);
     }
 
     bool empty() const { return maps_.empty(); }
@@ -90,6 +86,10 @@ class LightBuffer {
         int index(double x, double origin, double scale) const {
             const double f = (x - origin) * scale;
             return !(f >= 0.0) ? 0 : f >= double(n) ? n - 1 : int(f);
+        }
+        /// The least depth of the bin holding image point (u, v).
+        double least(double u, double v) const {
+            return near[size_t(index(v, v0, sv)) * size_t(n) + size_t(index(u, u0, su))];
         }
         void project(const Box3& x, double& dNear, double& u0, double& u1, double& v0,
                      double& v1) const;

@@ -18,7 +18,7 @@ struct RayCounters {
     uint64_t regionVisits = 0;  ///< regions entered
     uint64_t pointerSteps = 0;  ///< region changes by corner pointer (irregular scheme)
     uint64_t walkErrors = 0;    ///< walks that could not advance and were ended
-    uint64_t lightBufferSkips = 0;      ///< shadow rays the light buffer found unblocked, with no walk
+    uint64_t lightBufferSkips = 0;  ///< shadow rays the light buffer found unblocked, no walk
 
     RayCounters& operator+=(const RayCounters& o);
     RayCounters operator-(const RayCounters& o) const;

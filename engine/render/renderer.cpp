@@ -26,13 +26,8 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     const int w = img.width, h = img.height;
     const Tracer tracer(scene, accel, opt.shading);
     const PrimaryRays primary(cam, w, h);
-    // The eye's buffer (light_buffer.h, the eye in the lights' place): where each primary ray
-    // can meet its first box. Regular scheme only; perspective only (rays from one point).
-    const bool eyeBuffer = accel.params().lightBuffer &&
-                           accel.params().scheme == SchemeKind::Regular &&
-                           cam.projection == Projection::Perspective;
-    const LightBuffer eye = eyeBuffer ? LightBuffer(scene.bounds, scene.minBox, {cam.from})
-                                      : LightBuffer();
+    // Where each primary ray can first meet a box (empty unless the scheme uses one).
+    const LightBuffer eye = accel.eyeBuffer(scene, cam);
     const int depth = scene.tree.depth();
     const bool mailboxes = accel.usesMailboxes();
     tbb::enumerable_thread_specific<TraceContext> contexts([&] {
