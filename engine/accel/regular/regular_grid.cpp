@@ -211,12 +211,7 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
             leaves_[i].hi[a] = (pl.pos[a] + 1) << shift;
         }
     }
-    leafPlanes_.resize(6 * leaves_.size());
-    for (size_t i = 0; i < leaves_.size(); ++i)
-        for (int a = 0; a < 3; ++a) {
-            leafPlanes_[6 * i + a] = planes_[a][leaves_[i].lo[a]];
-            leafPlanes_[6 * i + 3 + a] = planes_[a][leaves_[i].hi[a]];
-        }
+    walk_.resize(leaves_.size());  // filled once the ropes are known
     // Longest exact walk: one step per grid plane crossed, plus degenerate steps at edges.
     maxSteps_ = 4 * (size_t(n_[0]) + n_[1] + n_[2]) + 16;
 
@@ -256,6 +251,24 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
                 rope = covers ? nb : kSplitFace;
             }
         }
+    }
+
+    for (size_t i = 0; i < leaves_.size(); ++i) {
+        const RegularLeaf& L = leaves_[i];
+        WalkLeaf& W = walk_[i];
+        W = WalkLeaf{};
+        for (int a = 0; a < 3; ++a) {
+            W.plane[a] = planes_[a][L.lo[a]];
+            W.plane[3 + a] = planes_[a][L.hi[a]];
+            W.lo[a] = L.lo[a];
+            W.hi[a] = L.hi[a];
+        }
+        std::copy(std::begin(L.rope), std::end(L.rope), W.rope);
+        W.root = L.root;
+        W.prims = L.prims;
+        W.first = L.first;
+        if (L.prims <= WalkLeaf::kInline)
+            std::copy_n(primList_.begin() + L.first, L.prims, W.inlined);
     }
 
     extra_ = {

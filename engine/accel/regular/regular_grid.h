@@ -30,6 +30,21 @@ struct RegularLeaf {
     /// kBorder on the grid's border. A rope is a cached directory lookup: the same leaf.
     uint32_t rope[6] = {};
 };
+/// What the walk reads of a leaf, in one 128-byte block (two cache lines the hardware fetches
+/// together) instead of three places: its exit planes, ropes, tree, block of the grid, and up
+/// to kInline of its primitives (3.9 on average on balls4), so most leaves need no primList.
+struct alignas(128) WalkLeaf {
+    static constexpr uint32_t kInline = 5;
+    double plane[6];  ///< lo x, y, z then hi x, y, z: the grid planes at lo and hi
+    uint32_t rope[6];
+    int32_t root;
+    uint32_t prims;
+    uint32_t first;
+    uint32_t lo[3], hi[3];
+    uint32_t inlined[kInline];  ///< the primitives when prims <= kInline
+};
+static_assert(sizeof(WalkLeaf) == 128);
+
 inline constexpr uint32_t kSplitFace = 0xffffffffu;
 inline constexpr uint32_t kBorder = 0xfffffffeu;
 
@@ -56,8 +71,8 @@ class RegularGrid {
     size_t memoryBytes() const {
         return leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode) +
                primList_.size() * sizeof(uint32_t) +
-               (planes_[0].size() + planes_[1].size() + planes_[2].size() + leafPlanes_.size()) *
-                   sizeof(double) +
+               walk_.size() * sizeof(WalkLeaf) +
+               (planes_[0].size() + planes_[1].size() + planes_[2].size()) * sizeof(double) +
                dir_.memoryBytes();
     }
     bool usesMailboxes() const { return true; }
@@ -105,9 +120,7 @@ class RegularGrid {
     uint32_t n_[3] = {1, 1, 1};
     double scale_[3] = {1.0, 1.0, 1.0};   ///< 2^n / extent, for locate
     std::vector<double> planes_[3];       ///< grid plane coordinates, 2^n + 1 per axis
-    /// Per leaf, its planes lo x, y, z then hi x, y, z (planes_ at RegularLeaf::lo, hi): the walk
-    /// reads a leaf's exit planes from one place instead of through its indices.
-    std::vector<double> leafPlanes_;
+    std::vector<WalkLeaf> walk_;  ///< leaves_ as the walk reads them, same indices
     size_t maxSteps_ = 16;
     std::vector<RegularLeaf> leaves_;
     CsgTree pool_;  ///< restricted trees of all leaves, shared between equal primitive sets
@@ -142,7 +155,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
     const bool up[3] = {ray.d.x > 0.0, ray.d.y > 0.0, ray.d.z > 0.0};
     double inv[3], bias[3];
-    uint32_t side[3];  // where a leaf's exit plane on each axis is in leafPlanes_: lo a, hi 3 + a
+    uint32_t side[3];  // where a leaf's exit plane on each axis is in WalkLeaf::plane: lo a, hi 3 + a
     uint32_t rope[3];  // the rope across that plane
     for (int a = 0; a < 3; ++a) {
         const bool parallel = ray.d[a] == 0.0;
@@ -151,9 +164,8 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         side[a] = up[a] ? 3 + a : a;
         rope[a] = 2 * a + up[a];
     }
-    const RegularLeaf* const leaves = leaves_.data();
+    const WalkLeaf* const leaves = walk_.data();
     const uint32_t* const primList = primList_.data();
-    const double* const leafPlanes = leafPlanes_.data();
     // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
     // inside the grid, so this only admits hits that rounding puts a hair outside the box.
     double t0 = tmin, tIn = tStart;
@@ -165,9 +177,9 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
             obs.walkError("regular: step bound exceeded");
             return false;
         }
-        const RegularLeaf& L = leaves[leaf];
+        const WalkLeaf& L = leaves[leaf];
         // Exit: the nearest of the cell's exit planes; ties are edges and corners.
-        const double* const P = leafPlanes + 6 * size_t(leaf);
+        const double* const P = L.plane;
         double tAxis[3];
         double tExit = kInf;
         int exitAxis = 0;
@@ -222,8 +234,8 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         const double t1 = last ? tmax : std::max(tExit, tIn);
         ++ctx.counters.regionVisits;
         obs.region(leaf, tIn, last ? tEnd : t1);
-        if (hitInLeaf(*scene_, pool_, L.root, primList + L.first, L.prims, ray, tmin, t0, t1, ctx,
-                      obs, hit))
+        const uint32_t* const ids = L.prims <= WalkLeaf::kInline ? L.inlined : primList + L.first;
+        if (hitInLeaf(*scene_, pool_, L.root, ids, L.prims, ray, tmin, t0, t1, ctx, obs, hit))
             return true;
         if (last) return false;
         if (stalled) {
