@@ -47,6 +47,7 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
         const Image before = shown;
         if (pr.snapshot(version, shown, &what)) {
             seenStrides.push_back(what.stride);
+            ASSERT_EQ(what.job, 1u) << "the only job started is number 1";
             ASSERT_GT(what.rows, 0);
             // Only the rows said to have changed are copied; they reach the last band's end
             // (further when an earlier pass, whole, was not taken yet).
@@ -103,7 +104,9 @@ TEST(Progressive, ANewJobCancelsTheOneInFlight) {
     big.width = 1600;  // brute force on 800 spheres: minutes if it were not cancelled
     big.height = 1200;
     ProgressiveRenderer pr;
+    EXPECT_EQ(pr.job(), 0u);
     pr.start({scene, accel, big});
+    EXPECT_EQ(pr.job(), 1u);
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     RenderOptions small;
     small.width = 24;
@@ -116,7 +119,10 @@ TEST(Progressive, ANewJobCancelsTheOneInFlight) {
     double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     EXPECT_LT(ms, 10000.0);
-    ASSERT_TRUE(pr.snapshot(version, shown));
+    EXPECT_EQ(pr.job(), 2u);
+    ProgressiveRenderer::Shown what;
+    ASSERT_TRUE(pr.snapshot(version, shown, &what));
+    EXPECT_EQ(what.job, 2u) << "the display comes from the second job";
     EXPECT_EQ(shown.width, 24);
     EXPECT_EQ(shown.height, 16);
     pr.cancel();

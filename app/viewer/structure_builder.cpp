@@ -80,6 +80,11 @@ bool StructureBuilder::busy() const {
     return pending_.has_value() || running_;
 }
 
+bool StructureBuilder::ready() const {
+    std::lock_guard lock(mutex_);
+    return ready_.has_value();
+}
+
 void StructureBuilder::run() {
     for (;;) {
         BuildRequest r;

@@ -51,6 +51,8 @@ class StructureBuilder {
     std::optional<BuildResult> poll();
     /// A request is queued or running.
     bool busy() const;
+    /// A result is waiting for poll().
+    bool ready() const;
     /// Called on the builder's thread when a result is ready. Set it before the first request.
     void setOnReady(std::function<void()> f) { onReady_ = std::move(f); }
 

@@ -269,6 +269,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     ProgressiveRenderer::Shown what;
     if (renderer_.snapshot(shownVersion_, shown_, &what)) {
         view_->upload(shown_, s_.mode, what.changedBegin, what.changedEnd);
+        shownJob_ = what.job;
         updateAutoScale();
         std::vector<PassRecord> passes = renderer_.passes();
         for (; passesLogged_ < passes.size(); ++passesLogged_) {
@@ -324,6 +325,11 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
 
     settled_ = builtBefore && !builder_.busy() &&
                (!structure_ || (!renderDirty_ && finishedBefore && renderer_.finished()));
+}
+
+bool ViewerApp::eager() const {
+    return builder_.busy() || builder_.ready() || renderDirty_ || shownJob_ != renderer_.job() ||
+           (renderer_.finished() && !settled_);
 }
 
 void ViewerApp::saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const {

@@ -38,6 +38,11 @@ class ViewerApp {
     void rebuild(const char* why) { requestBuild(false, why); }
     /// Everything asked for is built and the last frame drew the complete image.
     bool settled() const { return settled_; }
+    /// What the workers produce next should be drawn at once: a build is under way or ready,
+    /// the render of the latest change has shown nothing yet, or it is complete. Otherwise the
+    /// render is only refining what is on screen, and a window may show its bands at a lower
+    /// rate.
+    bool eager() const;
     /// Write the framebuffer as drawn by the last frame() to a PNG. Throws std::runtime_error.
     void saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const;
 
@@ -100,6 +105,7 @@ class ViewerApp {
     std::string error_;
     Image shown_;
     uint64_t shownVersion_ = 0;
+    uint64_t shownJob_ = 0;  ///< the render job the image on screen comes from
     int jobWidth_ = 0, jobHeight_ = 0;
     bool renderDirty_ = false, buildDirty_ = false, cameraMovedForBuild_ = false;
     std::string renderWhy_;

@@ -56,6 +56,7 @@ void ProgressiveRenderer::start(ProgressiveJob job, Clock::time_point requested)
     {
         std::lock_guard lock(mutex_);
         pending_ = std::make_unique<ProgressiveJob>(std::move(job));
+        ++jobs_;
         pendingRequested_ = requested;
         cancel_ = true;
         finished_ = false;
@@ -85,6 +86,11 @@ bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown) 
     return true;
 }
 
+uint64_t ProgressiveRenderer::job() const {
+    std::lock_guard lock(mutex_);
+    return jobs_;
+}
+
 std::vector<PassRecord> ProgressiveRenderer::passes() const {
     std::lock_guard lock(mutex_);
     return passes_;
@@ -108,6 +114,7 @@ void ProgressiveRenderer::progress(size_t& done, size_t& total) const {
 void ProgressiveRenderer::run() {
     for (;;) {
         ProgressiveJob job;
+        uint64_t jobNumber = 0;
         Clock::time_point requested;
         {
             std::unique_lock lock(mutex_);
@@ -116,6 +123,7 @@ void ProgressiveRenderer::run() {
             if (quit_) return;
             job = std::move(*pending_);
             pending_.reset();
+            jobNumber = jobs_;
             requested = pendingRequested_;
             cancel_ = false;
             running_ = true;
@@ -167,7 +175,7 @@ void ProgressiveRenderer::run() {
                 fillBlocks(work, stride, display_, y0, lattice.rowEnd);
                 changed_.add(whole ? 0 : y0, whole ? h : lattice.rowEnd);
                 ++displayVersion_;
-                displayShown_ = {stride, lattice.rowEnd, previous};
+                displayShown_ = {stride, lattice.rowEnd, previous, 0, 0, jobNumber};
                 if (passDone) {
                     rec.sinceStartMs =
                         std::chrono::duration<double, std::milli>(Clock::now() - requested)

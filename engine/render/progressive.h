@@ -66,13 +66,17 @@ class ProgressiveRenderer {
 
     /// What a snapshot shows: rows [0, rows) the pass of `stride`, the rows below it the pass
     /// before, of `previousStride` (0: none); rows [changedBegin, changedEnd) are the ones this
-    /// snapshot wrote.
+    /// snapshot wrote; `job` is the number of the job it comes from (see job()).
     struct Shown {
         int stride = 0;
         int rows = 0;
         int previousStride = 0;
         int changedBegin = 0, changedEnd = 0;
+        uint64_t job = 0;
     };
+    /// The number of the last job started (1 for the first; 0: none yet). A caller whose last
+    /// snapshot has another number has not yet seen anything of the current job.
+    uint64_t job() const;
     /// If a band or pass finished since `version`, bring `out` up to date with the displayable
     /// image, update `version` and return true; `shown` (if given) tells what the image holds
     /// and which rows changed. Only the rows written since the last snapshot are copied, so
@@ -95,6 +99,7 @@ class ProgressiveRenderer {
     mutable std::mutex mutex_;
     std::condition_variable wake_;
     std::unique_ptr<ProgressiveJob> pending_;
+    uint64_t jobs_ = 0;  ///< jobs started
     Clock::time_point pendingRequested_;
     bool quit_ = false;
     bool running_ = false;

@@ -231,6 +231,43 @@ TEST_F(ViewerFrames, ShowsTheRenderedSceneAndThePanels) {
     EXPECT_GT(outsideDiff, outside / 2) << "the Parameters panel is drawn over the image";
 }
 
+TEST_F(ViewerFrames, EagerUntilAChangeIsOnScreenThenRefinesAtTheWindowsPace) {
+    // What the window's loop reads to pace frames: eager while a build runs or waits and until
+    // the new render's first pass is drawn; then, while the passes only refine the image, not;
+    // eager again once the render is complete (its last band is drawn at once).
+    settings_.threads = 1;  // a render long enough to be seen refining
+    app_->openScene("builtin:balls:3");
+    runUntilSettled();
+    ASSERT_TRUE(app_->settled());
+    ASSERT_TRUE(app_->error().empty()) << app_->error();
+    EXPECT_FALSE(app_->eager()) << "settled: nothing more to draw";
+    app_->rebuild("test");
+    EXPECT_TRUE(app_->eager()) << "a build is under way";
+    int refiningFrames = 0, eagerWhileRefining = 0;
+    bool newJobShown = false;
+    const Image before = app_->displayed();
+    auto start = std::chrono::steady_clock::now();
+    do {  // settled() still describes the frame before the rebuild
+        ImGui::GetIO().DeltaTime = 1.0f / 60.0f;
+        app_->frame(kW, kH);
+        // Until the first pass of the rebuilt structure's render is drawn, the display is the
+        // old complete image (the same pixels: only the structure changed).
+        if (!newJobShown && app_->displayed().color != before.color) newJobShown = true;
+        if (newJobShown && !app_->settled()) {
+            ++refiningFrames;
+            eagerWhileRefining += app_->eager();
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    } while (!app_->settled() &&
+             std::chrono::steady_clock::now() - start < std::chrono::seconds(60));
+    ASSERT_TRUE(app_->settled());
+    EXPECT_TRUE(newJobShown) << "the coarse passes show as blocks, unlike the full image";
+    ASSERT_GT(refiningFrames, 3);
+    // Eager only at the end (the render finished between two frames) or never.
+    EXPECT_LE(eagerWhileRefining, 1) << refiningFrames << " frames while refining";
+    EXPECT_FALSE(app_->eager());
+}
+
 TEST_F(ViewerFrames, HeatMapModeShowsPrimitiveTests) {
     runUntilSettled();
     ASSERT_TRUE(app_->settled());
