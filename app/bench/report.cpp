@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "app/bench/embree_peer.h"
+#include "engine/render/progressive.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
 
@@ -290,7 +291,7 @@ int runBench(const BenchOptions& opt) {
         Image prog(ro.width, ro.height);
         double elapsed = 0.0;
         int prev = 0;
-        for (int stride : {16, 8, 4, 2, 1}) {
+        for (int stride : ProgressiveRenderer::kDefaultStrides) {  // the viewer's passes
             RenderStats s = render(scene, *best, ro, prog, PassLattice{stride, prev});
             elapsed += s.renderMs;
             s.renderMs = elapsed;

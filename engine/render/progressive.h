@@ -3,6 +3,7 @@
 // No GL here: the viewer displays the snapshots, the benchmark can time the passes.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <condition_variable>
 #include <functional>
@@ -44,10 +45,15 @@ class ProgressiveRenderer {
   public:
     using Clock = std::chrono::steady_clock;
 
+    /// The default passes. The first, 1 pixel in 256, is 3,600 pixels at 1280x720: on screen
+    /// within a few tens of milliseconds even on a slow scene; then 1 in 16, then every pixel.
+    /// Each pass costs more per pixel than the next (its pixels are far apart: less coherent
+    /// memory access), so few passes reach the full image sooner: on balls4 at 1280x720 on 2
+    /// cores, 16, 4, 1 was 6% faster to the full image than 16, 8, 4, 2, 1 (medians of 9).
+    static constexpr std::array<int, 3> kDefaultStrides = {16, 4, 1};
     /// Passes from coarse to fine; the last must be 1.
-    /// The default's first pass, 1 pixel in 256, is 3,600 pixels at 1280x720: on screen within
-    /// a few tens of milliseconds even on a slow scene.
-    explicit ProgressiveRenderer(std::vector<int> strides = {16, 8, 4, 2, 1});
+    explicit ProgressiveRenderer(
+        std::vector<int> strides = {kDefaultStrides.begin(), kDefaultStrides.end()});
     /// Bands the passes of stride 2 and 1 are cut into (each band becomes visible when done).
     static constexpr int kBands = 8;
     /// Cancels the job in flight and joins the worker.

@@ -37,12 +37,14 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     });
     auto start = Clock::now();
     std::atomic<bool> stopped{false};
+    // A tile holds about tile x tile pixels of the pass's lattice, however sparse it is.
+    const int tile = std::max(1, opt.tile) * std::max(1, pass.stride);
     tbb::task_arena arena(stats.threads);
     arena.execute([&] {
         tbb::parallel_for(
             tbb::blocked_range2d<int>(std::clamp(pass.rowBegin, 0, h),
-                                      pass.rowEnd < 0 ? h : std::clamp(pass.rowEnd, 0, h), opt.tile,
-                                      0, w, opt.tile),
+                                      pass.rowEnd < 0 ? h : std::clamp(pass.rowEnd, 0, h), tile,
+                                      0, w, tile),
             [&](const tbb::blocked_range2d<int>& r) {
                 if (stopped.load(std::memory_order_relaxed)) return;
                 if (cancel && cancel->load(std::memory_order_relaxed)) {
