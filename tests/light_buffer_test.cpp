@@ -46,7 +46,7 @@ std::vector<ShadowRay> shadowRays(const Scene& s, const std::vector<Ray>& rays, 
 }
 
 struct Tally {
-    size_t rays = 0, blocked = 0, skipped = 0, shortened = 0;
+    size_t rays = 0, blocked = 0, skipped = 0, shortened = 0, segments = 0;
 };
 
 /// Checks every shadow ray against brute force: the light buffer's free point lies beyond the
@@ -81,6 +81,16 @@ Tally checkShadowRays(const std::string& name, const Scene& s, const std::vector
             ADD_FAILURE() << name << ": " << sr.ray.toString() << " toward light " << sr.light
                           << " is blocked at t = " << hit.t << " by p" << hit.prim
                           << ", past the light buffer's free point " << free;
+        // The nearest blocker lies in one of the stretches the accelerators walk.
+        LightBuffer::Segment seg[LightBuffer::kSlots];
+        const int n = lb.shadowSegments(sr.ray.o, sr.ray.d, sr.light, sr.tmax, seg);
+        bool inside = n < 0;
+        for (int i = 0; i < n; ++i) inside |= seg[i].t0 < hit.t && hit.t <= seg[i].t1;
+        tally.segments += n > 0 ? size_t(n) : 0;
+        if (blocked && !inside && failures++ < 5)
+            ADD_FAILURE() << name << ": " << sr.ray.toString() << " toward light " << sr.light
+                          << " is blocked at t = " << hit.t << " by p" << hit.prim
+                          << ", outside the light buffer's " << n << " stretches";
         for (const auto& a : schemes) {
             ctx.beginRay();
             const bool got = a->occluded(sr.ray, sr.tmax, sr.light, ctx, obs);
@@ -134,6 +144,80 @@ TEST(LightBuffer, BuiltinCsgScenesShadowRaysAsBruteForce) {
         Tally t = checkShadowRays(spec, s, shadowRays(s, test::pixelRays(s, 40, 40), 3));
         EXPECT_GT(t.rays, 100u) << spec;
     }
+}
+
+// The stretches of a shadow ray cover every box it passes through (between its origin and the
+// light), whichever bin its origin falls in: boxes small and large (floors, whose images take
+// the whole view and are kept apart from the fine bins), origins on box faces and anywhere.
+TEST(LightBuffer, EveryBoxAlongAShadowRayLiesInItsStretches) {
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    size_t checked = 0, walked = 0, none = 0, two = 0;
+    for (int scene = 0; scene < 40; ++scene) {
+        const double scale = scene % 5 == 4 ? 1e4 : 1.0;
+        const Vec3 offset = scene % 7 == 6 ? Vec3(3e5, -2e5, 1e5) : Vec3(0.0);
+        std::vector<Box3> boxes;
+        Box3 bounds;
+        auto add = [&](Vec3 lo, Vec3 hi) {
+            boxes.push_back({offset + scale * lo, offset + scale * hi});
+            bounds.expand(boxes.back());
+        };
+        add({-10.0, -10.0, -0.5}, {10.0, 10.0, -0.5});  // a floor: flat, its image the view's
+        if (scene % 3 == 0) add({-10.0, -10.0, -1.5}, {-9.0, 10.0, 3.0});  // a wall
+        const int count = 1 + scene % 30;
+        for (int k = 0; k < count; ++k) {  // an object of small boxes over the floor
+            const Vec3 c(u(rng) * 2.0 - 1.0, u(rng) * 2.0 - 1.0, u(rng) * 1.5 - 0.3);
+            const Vec3 h(0.01 + 0.3 * u(rng), 0.01 + 0.3 * u(rng), k % 4 == 0 ? 0.0 : 0.01 + 0.3 * u(rng));
+            add(c - h, c + h);
+        }
+        std::vector<Vec3> lights;
+        for (int l = 0; l < 4; ++l) {  // beyond the top, or a side
+            Vec3 p = bounds.lo + Vec3(u(rng), u(rng), u(rng)) * bounds.extent();
+            const int a = l == 0 ? 2 : int(u(rng) * 3.0) % 3;
+            p[a] = bounds.hi[a] + (0.01 + u(rng)) * bounds.extent()[a] + scale;
+            lights.push_back(p);
+        }
+        for (int bins : {LightBuffer::kBins, 5}) {
+            LightBuffer lb(bounds, boxes, lights, bins);
+            ASSERT_EQ(lb.mappedLights(), lights.size());
+            for (int k = 0; k < 1500; ++k) {
+                // Anywhere in the bounds, on the floor, or on a face of an object's box.
+                Vec3 o = bounds.lo + Vec3(u(rng), u(rng), u(rng)) * bounds.extent();
+                const Box3& on = boxes[size_t(k) % boxes.size()];
+                if (k % 3 == 1) o = on.lo + Vec3(u(rng), u(rng), 1.0) * on.extent();
+                const uint32_t light = uint32_t(k) % uint32_t(lights.size());
+                const Vec3 L = lights[light];
+                const Ray ray{o, glm::normalize(L - o)};
+                const double tmax = glm::length(L - o);
+                LightBuffer::Segment seg[LightBuffer::kSlots];
+                const int n = lb.shadowSegments(ray.o, ray.d, light, tmax, seg);
+                ASSERT_GE(n, 0) << "the origin is in the bounds, the light outside";
+                none += n == 0;
+                two += n == 2;
+                walked += n > 0;
+                for (int i = 0; i + 1 < n; ++i) ASSERT_LT(seg[i].t1, seg[i + 1].t0);
+                for (const Box3& b : boxes) {
+                    double ta, tb;
+                    if (!clipLine(ray, b, ta, tb)) continue;
+                    ta = std::max(ta, 0.0), tb = std::min(tb, tmax);
+                    if (!(ta < tb) || tb <= 0.0) continue;
+                    ++checked;
+                    bool covered = false;
+                    for (int i = 0; i < n; ++i) covered |= seg[i].t0 <= ta && tb <= seg[i].t1;
+                    ASSERT_TRUE(covered) << "scene " << scene << ", " << bins << " bins: "
+                                         << ray.toString() << " toward light " << light
+                                         << " passes through " << b.toString() << " on ["
+                                         << ta << ", " << tb << "], outside its " << n
+                                         << " stretches";
+                }
+            }
+        }
+    }
+    std::printf("%zu boxes on shadow rays checked; %zu rays walked, %zu with two stretches, "
+                "%zu with none\n", checked, walked, two, none);
+    EXPECT_GT(checked, 10000u);
+    EXPECT_GT(two, 1000u) << "a floor's stretch apart from the object's";
+    EXPECT_GT(none, 1000u);
 }
 
 // A light inside the bounds gets no map: the buffer does not know, and the walk runs whole.

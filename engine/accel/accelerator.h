@@ -72,18 +72,26 @@ public:
     }
     /// Whether the shadow ray toward scene light `light` (its direction points at the light)
     /// meets anything with t in (0, tmax]: the answer intersect() gives. The accelerated schemes
-    /// first ask the light buffer how far the ray can meet anything at all (light_buffer.h).
+    /// first ask the light buffer which stretches of the ray can meet anything at all, and walk
+    /// only those (light_buffer.h).
     template <class Obs>
     bool occluded(const Ray& ray, double tmax, uint32_t light, TraceContext& ctx, Obs& obs) const {
+        Hit hit;
         if (!lightBuffer_.empty()) {
-            const double free = lightBuffer_.freeFrom(ray.o, ray.d, light);
-            if (!(free > 0.0)) {
+            LightBuffer::Segment seg[LightBuffer::kSlots];
+            const int n = lightBuffer_.shadowSegments(ray.o, ray.d, light, tmax, seg);
+            if (n == 0) {
                 ++ctx.counters.lightBufferSkips;
                 return false;
             }
-            tmax = std::min(tmax, free);
+            for (int i = 0; i < n; ++i) {
+                // Each stretch is a walk of its own: a fresh mailbox id, so the primitives a
+                // stretch tests are fresh to it (a walk's boundary check relies on that).
+                if (i > 0) ctx.newStamp();
+                if (intersect(ray, seg[i].t0, seg[i].t1, ctx, obs, hit)) return true;
+            }
+            if (n > 0) return false;
         }
-        Hit hit;
         return intersect(ray, 0.0, tmax, ctx, obs, hit);
     }
     /// The light buffer built from a perspective camera's eye (light_buffer.h), for primary
@@ -94,7 +102,7 @@ public:
         if (!params_.lightBuffer || params_.scheme != SchemeKind::Regular ||
             cam.projection != Projection::Perspective)
             return {};
-        return LightBuffer(scene.bounds, scene.minBox, {cam.from});
+        return LightBuffer(scene.bounds, scene.minBox, {cam.from}, LightBuffer::kBins, 1);
     }
     bool usesMailboxes() const {
         return params_.mailboxes &&

@@ -36,8 +36,43 @@ std::vector<Vec3> positions(const std::vector<Light>& lights) {
 LightBuffer::LightBuffer(const Scene& scene, int bins)
     : LightBuffer(scene.bounds, scene.minBox, positions(scene.lights), bins) {}
 
+/// Add depth interval x to a bin of k intervals (sorted, disjoint, unused ones last): merged
+/// with those it overlaps; then, if k + 1 remain, the two with the smallest gap are joined.
+void LightBuffer::insert(Slot* bin, int k, Slot x) {
+    if (k == 1 || !(bin[0].near <= bin[0].far)) {  // one slot, or an empty bin
+        bin[0].near = std::min(bin[0].near, x.near);
+        bin[0].far = std::max(bin[0].far, x.far);
+        return;
+    }
+    Slot t[kSlots + 1];
+    int m = 0;
+    bool placed = false;
+    for (int i = 0; i < k && bin[i].near <= bin[i].far; ++i) {
+        if (!placed && x.near < bin[i].near) t[m++] = x, placed = true;
+        t[m++] = bin[i];
+    }
+    if (!placed) t[m++] = x;
+    int w = 0;
+    for (int i = 1; i < m; ++i) {
+        if (t[i].near <= t[w].far)
+            t[w].far = std::max(t[w].far, t[i].far);
+        else
+            t[++w] = t[i];
+    }
+    m = w + 1;
+    if (m > k) {
+        int j = 0;
+        for (int i = 1; i + 1 < m; ++i)
+            if (t[i + 1].near - t[i].far < t[j + 1].near - t[j].far) j = i;
+        t[j].far = std::max(t[j].far, t[j + 1].far);
+        for (int i = j + 1; i + 1 < m; ++i) t[i] = t[i + 1];
+        --m;
+    }
+    for (int i = 0; i < k; ++i) bin[i] = i < m ? t[i] : Slot{};
+}
+
 LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
-                         const std::vector<Vec3>& points, int bins) {
+                         const std::vector<Vec3>& points, int bins, int slots) {
     if (bounds.isEmpty() || !bounds.isBounded() || points.empty()) return;
     const Vec3 e = bounds.extent();
     const double largest = std::max({e.x, e.y, e.z});
@@ -64,38 +99,129 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
         if (!(gap > 1e-3 * largest) || !std::isfinite(gap)) continue;
         m.b = (m.a + 1) % 3;
         m.c = (m.a + 2) % 3;
-        m.n = std::max(1, bins);
+        const int n = std::max(1, bins), k = std::clamp(slots, 1, kSlots);
         double dn, u0, u1, v0, v1;
         m.project(box_, dn, u0, u1, v0, v1);
         if (!(u1 > u0) || !(v1 > v0)) continue;
-        m.u0 = u0, m.v0 = v0;
-        m.su = double(m.n) / (u1 - u0);
-        m.sv = double(m.n) / (v1 - v0);
-        const double pad = 1e-9 * std::max(u1 - u0, v1 - v0);
-        m.near.assign(size_t(m.n) * size_t(m.n), kInf);
+        // The boxes' images. The fine bins cover the rectangle of the small ones (whose image
+        // is at most kLargeShare of the scene's): a floor under an object would otherwise
+        // stretch the bins over its whole image, the object getting few of them. Outside it,
+        // coarse bins over the whole image hold the large boxes.
+        const double largeArea = kLargeShare * (u1 - u0) * (v1 - v0);
+        std::vector<BoxImage> images;
+        images.reserve(boxes.size());
+        double wu0 = kInf, wu1 = -kInf, wv0 = kInf, wv1 = -kInf;
+        bool anyLarge = false;
         for (const Box3& mb : boxes) {
             if (mb.isEmpty()) continue;  // a dropped primitive
             Box3 x{mb.lo - Vec3(side), mb.hi + Vec3(side)};  // widened across the view axis only
             x.lo[m.a] = mb.lo[m.a], x.hi[m.a] = mb.hi[m.a];
-            m.project(x, dn, u0, u1, v0, v1);
-            const int i0 = m.index(u0 - pad, m.u0, m.su), i1 = m.index(u1 + pad, m.u0, m.su);
-            const int j0 = m.index(v0 - pad, m.v0, m.sv), j1 = m.index(v1 + pad, m.v0, m.sv);
-            for (int j = j0; j <= j1; ++j) {
-                double* row = m.near.data() + size_t(j) * size_t(m.n);
-                for (int i = i0; i <= i1; ++i) row[i] = std::min(row[i], dn);
+            BoxImage im;
+            m.project(x, im.dn, im.u0, im.u1, im.v0, im.v1);
+            im.df = m.s > 0.0 ? m.L[m.a] - x.lo[m.a] : x.hi[m.a] - m.L[m.a];
+            im.b0 = x.lo[m.b] - m.L[m.b], im.b1 = x.hi[m.b] - m.L[m.b];
+            im.c0 = x.lo[m.c] - m.L[m.c], im.c1 = x.hi[m.c] - m.L[m.c];
+            im.large = (im.u1 - im.u0) * (im.v1 - im.v0) > largeArea;
+            images.push_back(im);
+            anyLarge |= im.large;
+            if (!im.large) {
+                wu0 = std::min(wu0, im.u0), wu1 = std::max(wu1, im.u1);
+                wv0 = std::min(wv0, im.v0), wv1 = std::max(wv1, im.v1);
             }
+        }
+        const bool window = anyLarge && wu1 > wu0 && wv1 > wv0;
+        if (window) {
+            m.fine.cover(wu0, wu1, wv0, wv1, n, k);
+            m.coarse.cover(u0, u1, v0, v1, std::max(1, n / 4), k);
+        } else {
+            m.fine.cover(u0, u1, v0, v1, n, k);
+        }
+        for (const BoxImage& im : images) {
+            m.fine.add(im);
+            if (window && im.large) m.coarse.add(im);
+        }
+    }
+}
+
+void LightBuffer::Grid::cover(double uLo, double uHi, double vLo, double vHi, int bins,
+                              int slotsPerBin) {
+    n = bins;
+    k = slotsPerBin;
+    // Padded, so each small image lies strictly inside: no point of it is found outside.
+    pad = 1e-9 * std::max(uHi - uLo, vHi - vLo);
+    u0 = uLo - 2.0 * pad, v0 = vLo - 2.0 * pad;
+    su = double(n) / (uHi - uLo + 4.0 * pad);
+    sv = double(n) / (vHi - vLo + 4.0 * pad);
+    slots.assign(size_t(n) * size_t(n) * size_t(k), Slot{});
+}
+
+namespace {
+
+/// Narrow [lo, hi] to the depths d > 0 at which some u in [ua, ub] has u d in [w0, w1]: where
+/// a cone of sight spanning [ua, ub] on one image axis meets a box spanning [w0, w1] on that
+/// axis (relative to the point), up to the rounding of a division. False when the cone cannot
+/// meet the box at any depth (exact tests); lo > hi may result otherwise.
+bool coneDepths(double ua, double ub, double w0, double w1, double& lo, double& hi) {
+    if (ua > 0.0)
+        hi = std::min(hi, w1 / ua);  // ua d <= w1
+    else if (ua < 0.0)
+        lo = std::max(lo, w1 / ua);
+    else if (w1 < 0.0)
+        return false;
+    if (ub > 0.0)
+        lo = std::max(lo, w0 / ub);  // ub d >= w0
+    else if (ub < 0.0)
+        hi = std::min(hi, w0 / ub);
+    else if (w0 > 0.0)
+        return false;
+    return true;
+}
+
+}  // namespace
+
+void LightBuffer::Grid::add(const BoxImage& im) {
+    const int i0 = index(im.u0 - pad, u0, su), i1 = index(im.u1 + pad, u0, su);
+    const int j0 = index(im.v0 - pad, v0, sv), j1 = index(im.v1 + pad, v0, sv);
+    // A bin's cone: its image rectangle widened by pad (far above the rounding of the bin a
+    // point falls in), the cone's depths widened by 1e-12 of themselves (far above that of the
+    // divisions). A bin at the grid's edge also holds the points clamped into it: its cone is
+    // unbounded on that side. The constraint of a column of bins is the same on every row.
+    const double rel = 1e-12;
+    const double du = 1.0 / su, dv = 1.0 / sv;
+    thread_local std::vector<double> colLo, colHi;
+    colLo.resize(size_t(i1 - i0 + 1));
+    colHi.resize(size_t(i1 - i0 + 1));
+    for (int i = i0; i <= i1; ++i) {
+        const double ua = i == 0 ? -kInf : u0 + i * du - pad;
+        const double ub = i == n - 1 ? kInf : u0 + (i + 1) * du + pad;
+        double lo = im.dn, hi = im.df;
+        if (!coneDepths(ua, ub, im.b0, im.b1, lo, hi)) lo = kInf, hi = -kInf;
+        colLo[size_t(i - i0)] = lo * (1.0 - rel);
+        colHi[size_t(i - i0)] = hi * (1.0 + rel);
+    }
+    for (int j = j0; j <= j1; ++j) {
+        const double va = j == 0 ? -kInf : v0 + j * dv - pad;
+        const double vb = j == n - 1 ? kInf : v0 + (j + 1) * dv + pad;
+        double lo = im.dn, hi = im.df;
+        if (!coneDepths(va, vb, im.c0, im.c1, lo, hi)) continue;
+        lo = std::max(im.dn, lo * (1.0 - rel));
+        hi = std::min(im.df, hi * (1.0 + rel));
+        Slot* row = at(0, j);
+        for (int i = i0; i <= i1; ++i) {
+            const Slot depths{std::max(lo, colLo[size_t(i - i0)]), std::min(hi, colHi[size_t(i - i0)])};
+            if (depths.near <= depths.far) insert(row + size_t(i) * size_t(k), k, depths);
         }
     }
 }
 
 size_t LightBuffer::memoryBytes() const {
     size_t bytes = maps_.size() * sizeof(Map);
-    for (const Map& m : maps_) bytes += m.near.size() * sizeof(double);
+    for (const Map& m : maps_) bytes += (m.fine.slots.size() + m.coarse.slots.size()) * sizeof(Slot);
     return bytes;
 }
 
 size_t LightBuffer::mappedLights() const {
-    return size_t(std::count_if(maps_.begin(), maps_.end(), [](const Map& m) { return !m.near.empty(); }));
+    return size_t(std::count_if(maps_.begin(), maps_.end(), [](const Map& m) { return !m.fine.slots.empty(); }));
 }
 
 }  // namespace lancer

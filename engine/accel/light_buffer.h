@@ -4,15 +4,18 @@
 // Each light outside the scene's box looks at it along the axis it lies farthest beyond: depth
 // d(p) = s (L[a] - p[a]) > 0, image point (u, v) = the other two coordinates relative to the
 // light, over d. Every point of a ray from the light has the same image point. The image is cut
-// into bins; a bin keeps the least depth of any primitive's (CSG-minimized) box whose image
-// meets it (a box's image lies inside the rectangle of its corners' images).
+// into bins; a bin keeps the depth ranges [near, far] of the primitives' (CSG-minimized) boxes
+// whose images meet it (a box's image lies inside the rectangle of its corners' images), merged
+// into at most kSlots intervals (overlapping ranges join; then the two closest ones).
 //
 // A shadow ray heads for its light, so its depth falls as t grows, and its image point is that
-// of its origin o. A blocker at t > 0 lies nearer the light than o, and its box's least depth is
-// at most its own depth. So once the ray is nearer the light than its bin's least depth, nothing
-// is left to meet: the ray is unblocked from there on, and when o itself is that near, the ray
-// is unblocked without a walk. Each approximation (rectangles for images, bins, least depths)
-// can only make that point come later, never earlier.
+// of its origin o. A blocker at t > 0 lies nearer the light than o, inside a box whose image
+// meets o's bin, so at a depth inside one of the bin's intervals. The ray is walked only over
+// those intervals (from o's side, the nearest first); when none lies between o and the light,
+// it is unblocked without a walk. Each approximation (rectangles for images, bins, merged
+// intervals) can only widen the intervals, never narrow them.
+// On balls4, a shadow ray from the floor otherwise crawls along the cells that hold the floor
+// polygon until it reaches the spheres: the floor's interval is a single depth, far from theirs.
 //
 // Only the accelerated schemes use it: brute force stays the unaided reference the others are
 // checked against.
@@ -31,15 +34,52 @@ struct Scene;
 class LightBuffer {
   public:
     /// Bins per image axis.
-    static constexpr int kBins = 256;
+    static constexpr int kBins = 128;
+    /// Depth intervals per bin of a light's map.
+    static constexpr int kSlots = 2;
+    /// A box whose image covers more than this share of the scene's is large (a floor): the
+    /// bins cover the others' images only.
+    static constexpr double kLargeShare = 1.0 / 16.0;
 
     LightBuffer() = default;
-    /// One depth map per light of the (prepared) scene that lies outside its bounds.
+    /// One depth map per light of the (prepared) scene that lies outside its bounds, kSlots
+    /// intervals per bin.
     explicit LightBuffer(const Scene& scene, int bins = kBins);
     /// One depth map per point outside `bounds`, of `boxes` (those inside `bounds`; empty
-    /// ones are skipped): the scene's lights, or the eye of a perspective camera.
+    /// ones are skipped), `slots` intervals per bin (1 to kSlots): the scene's lights, or the
+    /// eye of a perspective camera (which needs only the least depth: 1).
     LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes, const std::vector<Vec3>& points,
-                int bins = kBins);
+                int bins = kBins, int slots = kSlots);
+
+    /// A stretch [t0, t1] of a shadow ray that boxes may occupy.
+    struct Segment {
+        double t0, t1;
+    };
+    /// The stretches of the shadow ray from `o` along `dir` toward light `light`, within
+    /// [0, tmax], outside which nothing can block it, in order of t, into `out` (kSlots at
+    /// most). Returns how many (0: nothing can block it), or -1 when the buffer does not know
+    /// (the light is inside the bounds, or `o` outside them): then the whole ray is to walk.
+    int shadowSegments(const Vec3& o, const Vec3& dir, uint32_t light, double tmax,
+                       Segment* out) const {
+        if (light >= maps_.size()) return -1;
+        const Map& m = maps_[light];
+        if (m.fine.slots.empty() || !box_.contains(o)) return -1;
+        const double s = m.s;
+        const double d = s * (m.L[m.a] - o[m.a]);  // > 0: o is in the box, the light beyond
+        const double rate = s * dir[m.a];           // fall of the depth per unit of t
+        if (!(rate > 0.0)) return -1;
+        const double u = (o[m.b] - m.L[m.b]) / d, v = (o[m.c] - m.L[m.c]) / d;
+        const Slot* bin = m.bin(u, v);
+        int count = 0;
+        for (int i = m.fine.k - 1; i >= 0; --i) {  // deepest first: the one nearest o
+            if (!(bin[i].near <= bin[i].far)) continue;  // unused
+            // Widened by the rounding allowance, in t units.
+            const double t0 = std::max(0.0, (d - bin[i].far - hair_) / rate);
+            const double t1 = std::min(tmax, (d - bin[i].near + hair_) / rate);
+            if (t0 < t1) out[count++] = {t0, t1};
+        }
+        return count;
+    }
 
     /// For the shadow ray from `o` along `dir` toward light `light`: the t beyond which nothing
     /// can block it. <= 0: nothing can; +inf: the buffer does not know (the light is inside the
@@ -47,14 +87,14 @@ class LightBuffer {
     double freeFrom(const Vec3& o, const Vec3& dir, uint32_t light) const {
         if (light >= maps_.size()) return kInf;
         const Map& m = maps_[light];
-        if (m.near.empty() || !box_.contains(o)) return kInf;
+        if (m.fine.slots.empty() || !box_.contains(o)) return kInf;
         const double s = m.s;
         const double d = s * (m.L[m.a] - o[m.a]);    // > 0: o is in the box, the light beyond
         const double rate = s * dir[m.a];             // fall of the depth per unit of t
         if (!(rate > 0.0)) return kInf;
         const double u = (o[m.b] - m.L[m.b]) / d, v = (o[m.c] - m.L[m.c]) / d;
         // Past its bin's least depth (widened by the rounding allowance, in t units).
-        return (d - m.least(u, v) + hair_) / rate;
+        return (d - m.bin(u, v)[0].near + hair_) / rate;
     }
 
     /// For a ray leaving point `point` itself along `dir` (a primary ray from the eye): a t
@@ -63,9 +103,9 @@ class LightBuffer {
         if (point >= maps_.size()) return 0.0;
         const Map& m = maps_[point];
         const double rate = -m.s * dir[m.a];  // depth gained per unit of t
-        if (m.near.empty() || !(rate > 0.0)) return 0.0;
+        if (m.fine.slots.empty() || !(rate > 0.0)) return 0.0;
         const double u = dir[m.b] / rate, v = dir[m.c] / rate;
-        return std::max(0.0, (m.least(u, v) - hair_) / rate);
+        return std::max(0.0, (m.bin(u, v)[0].near - hair_) / rate);
     }
 
     bool empty() const { return maps_.empty(); }
@@ -74,26 +114,66 @@ class LightBuffer {
     size_t mappedLights() const;
 
   private:
-    struct Map {
-        Vec3 L{0.0};
-        int a = 2, b = 0, c = 1;
-        double s = 1.0;
-        int n = 0;
+    /// A depth interval; unused: near > far. Doubles: a lit floor's shadow ray starts a hair
+    /// (1e-9 of the scene) above the floor's depth, which a float could not tell apart.
+    struct Slot {
+        double near = kInf, far = -kInf;
+    };
+    /// A box seen from the map's point: the rectangle holding its image, its extent on the two
+    /// image axes relative to the point, and its depth range.
+    struct BoxImage {
+        double u0, u1, v0, v1;
+        double b0, b1, c0, c1;
+        double dn, df;
+        bool large;
+    };
+    /// Bins over a rectangle of the image, k intervals each, row by row.
+    struct Grid {
+        int n = 0, k = 1;
         double u0 = 0.0, v0 = 0.0, su = 0.0, sv = 0.0;
-        std::vector<double> near;  ///< per bin, row by row: the least depth; empty: no map
+        double pad = 0.0;  ///< added around each image, far above rounding
+        /// Per bin, k intervals by increasing depth, disjoint, the unused ones last (the first
+        /// holds the bin's least depth); empty: no grid.
+        std::vector<Slot> slots;
+        void cover(double uLo, double uHi, double vLo, double vHi, int bins, int slotsPerBin);
         // Monotone in x (a difference and a product by a positive constant round monotonically):
         // a point inside a rectangle is in one of the rectangle's bins.
         int index(double x, double origin, double scale) const {
             const double f = (x - origin) * scale;
             return !(f >= 0.0) ? 0 : f >= double(n) ? n - 1 : int(f);
         }
-        /// The least depth of the bin holding image point (u, v).
-        double least(double u, double v) const {
-            return near[size_t(index(v, v0, sv)) * size_t(n) + size_t(index(u, u0, su))];
+        Slot* at(int i, int j) { return slots.data() + (size_t(j) * size_t(n) + size_t(i)) * size_t(k); }
+        /// The bin of (u, v), clamped into the rectangle.
+        const Slot* clamped(double u, double v) const {
+            return slots.data() +
+                   (size_t(index(v, v0, sv)) * size_t(n) + size_t(index(u, u0, su))) * size_t(k);
+        }
+        /// Add a box to the bins its image meets (clamped into the grid), each with the depths
+        /// at which the bin's cone of sight meets the box.
+        void add(const struct BoxImage& im);
+    };
+    struct Map {
+        Vec3 L{0.0};
+        int a = 2, b = 0, c = 1;
+        double s = 1.0;
+        /// Bins over the images of the small boxes, which hold every box meeting them.
+        Grid fine;
+        /// Bins over the whole image holding the large boxes (the only ones outside `fine`);
+        /// empty when `fine` covers the whole image.
+        Grid coarse;
+        /// The intervals of the bin holding image point (u, v).
+        const Slot* bin(double u, double v) const {
+            const double fu = (u - fine.u0) * fine.su, fv = (v - fine.v0) * fine.sv;
+            const double n = double(fine.n);
+            if (fu >= 0.0 && fu < n && fv >= 0.0 && fv < n)
+                return fine.slots.data() +
+                       (size_t(fv) * size_t(fine.n) + size_t(fu)) * size_t(fine.k);
+            return coarse.slots.empty() ? fine.clamped(u, v) : coarse.clamped(u, v);
         }
         void project(const Box3& x, double& dNear, double& u0, double& u1, double& v0,
                      double& v1) const;
     };
+    static void insert(Slot* bin, int k, Slot x);
     Box3 box_;           ///< the scene bounds, widened by hair_
     double hair_ = 0.0;  ///< rounding allowance, in scene units
     std::vector<Map> maps_;  ///< per scene light

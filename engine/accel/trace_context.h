@@ -79,6 +79,8 @@ struct TraceContext {
         ++rayId;
         ++counters.rays;
     }
+    /// A fresh mailbox id for the same ray (a walk over another stretch of it).
+    void newStamp() { ++rayId; }
 };
 
 }  // namespace lancer

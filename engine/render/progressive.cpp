@@ -133,6 +133,9 @@ void ProgressiveRenderer::run() {
         // not be cleared: each pass writes its lattice before any pixel of it is shown.
         Image& work = work_;
         if (work.width != w || work.height != h) work = Image(w, h);
+        // Where primary rays can first meet a box: once for all the passes of the view.
+        const LightBuffer eye = job.accel->eyeBuffer(
+            *job.scene, job.options.camera ? *job.options.camera : job.scene->camera);
         int previous = 0;
         bool complete = true;
         for (int stride : strides_) {
@@ -156,7 +159,7 @@ void ProgressiveRenderer::run() {
                 lattice.rowBegin = y0;
                 lattice.rowEnd = std::min(h, y0 + bandRows);
                 RenderStats rs = render(*job.scene, *job.accel, job.options, work, lattice,
-                                        &cancel_, &progressDone_);
+                                        &cancel_, &progressDone_, &eye);
                 if (rs.cancelled) {
                     complete = false;
                     break;

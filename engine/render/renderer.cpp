@@ -18,7 +18,7 @@ int effectiveThreads(int requested) {
 
 RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOptions& opt,
                    Image& img, PassLattice pass, const std::atomic<bool>* cancel,
-                   std::atomic<size_t>* progress) {
+                   std::atomic<size_t>* progress, const LightBuffer* eyeGiven) {
     using Clock = std::chrono::steady_clock;
     RenderStats stats;
     stats.threads = effectiveThreads(opt.threads);
@@ -27,7 +27,8 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     const Tracer tracer(scene, accel, opt.shading);
     const PrimaryRays primary(cam, w, h);
     // Where each primary ray can first meet a box (empty unless the scheme uses one).
-    const LightBuffer eye = accel.eyeBuffer(scene, cam);
+    const LightBuffer eyeBuilt = eyeGiven ? LightBuffer() : accel.eyeBuffer(scene, cam);
+    const LightBuffer& eye = eyeGiven ? *eyeGiven : eyeBuilt;
     const int depth = scene.tree.depth();
     const bool mailboxes = accel.usesMailboxes();
     tbb::enumerable_thread_specific<TraceContext> contexts([&] {

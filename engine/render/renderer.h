@@ -38,10 +38,12 @@ struct PassLattice {
 };
 
 /// Render the pixels of `pass` into `img` (already sized). Stops early, with
-/// `cancelled` set, when `*cancel` becomes true. `progress` counts finished pixels.
+/// `cancelled` set, when `*cancel` becomes true. `progress` counts finished pixels. `eye`: the
+/// accelerator's eye buffer for this camera (Accelerator::eyeBuffer), when the caller renders
+/// several passes of one view and builds it once; null: built here.
 RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOptions& opt,
                    Image& img, PassLattice pass = {}, const std::atomic<bool>* cancel = nullptr,
-                   std::atomic<size_t>* progress = nullptr);
+                   std::atomic<size_t>* progress = nullptr, const LightBuffer* eye = nullptr);
 
 /// Threads a render with `requested` threads uses (0: all cores).
 int effectiveThreads(int requested);
