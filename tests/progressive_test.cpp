@@ -113,6 +113,9 @@ TEST(Progressive, ANewJobCancelsTheOneInFlight) {
     small.height = 16;
     auto t0 = std::chrono::steady_clock::now();
     pr.start({scene, accel, small});
+    // Waiting for the first pass of the new job: it comes, and a job never started does not.
+    ASSERT_TRUE(pr.waitForJob(2, std::chrono::seconds(20)));
+    EXPECT_FALSE(pr.waitForJob(3, std::chrono::milliseconds(20)));
     Image shown;
     uint64_t version = 0;
     ASSERT_TRUE(waitFor([&] { return pr.finished(); }, 20.0)) << "the big job was not cancelled";

@@ -260,29 +260,32 @@ void ViewerApp::handleKeys() {
     }
 }
 
+void ViewerApp::takeSnapshot() {
+    ProgressiveRenderer::Shown what;
+    if (!renderer_.snapshot(shownVersion_, shown_, &what)) return;
+    view_->upload(shown_, s_.mode, what.changedBegin, what.changedEnd);
+    shownJob_ = what.job;
+    updateAutoScale();
+    std::vector<PassRecord> passes = renderer_.passes();
+    for (; passesLogged_ < passes.size(); ++passesLogged_) {
+        const PassRecord& p = passes[passesLogged_];
+        logTiming(changeWhy_ + ": pass stride " + std::to_string(p.stride) + " visible " +
+                  std::to_string(msSince(changeAt_)) + " ms after the change (pass render " +
+                  std::to_string(p.renderMs) + " ms, " + std::to_string(shown_.width) + "x" +
+                  std::to_string(shown_.height) + ")");
+    }
+    if (!passes.empty() && passes.back().stride == 1)
+        logTiming(changeWhy_ + ": full image " + std::to_string(msSince(changeAt_)) +
+                  " ms after the change");
+}
+
 void ViewerApp::frame(int fbWidth, int fbHeight) {
     // Read before taking the snapshot: if the job was finished then, the snapshot below is final.
-    const bool finishedBefore = renderer_.finished();
+    bool finishedBefore = renderer_.finished();
     // Likewise: a builder idle before the poll has nothing left that this frame has not taken.
     const bool builtBefore = !builder_.busy();
     pollBackground();
-    ProgressiveRenderer::Shown what;
-    if (renderer_.snapshot(shownVersion_, shown_, &what)) {
-        view_->upload(shown_, s_.mode, what.changedBegin, what.changedEnd);
-        shownJob_ = what.job;
-        updateAutoScale();
-        std::vector<PassRecord> passes = renderer_.passes();
-        for (; passesLogged_ < passes.size(); ++passesLogged_) {
-            const PassRecord& p = passes[passesLogged_];
-            logTiming(changeWhy_ + ": pass stride " + std::to_string(p.stride) + " visible " +
-                      std::to_string(msSince(changeAt_)) + " ms after the change (pass render " +
-                      std::to_string(p.renderMs) + " ms, " + std::to_string(shown_.width) + "x" +
-                      std::to_string(shown_.height) + ")");
-        }
-        if (!passes.empty() && passes.back().stride == 1)
-            logTiming(changeWhy_ + ": full image " + std::to_string(msSince(changeAt_)) +
-                      " ms after the change");
-    }
+    takeSnapshot();
     if (s_.mode != ViewMode::Color) scale_ = s_.autoScale ? autoScale_ : s_.heatScale;
 
     ImGui_ImplOpenGL3_NewFrame();
@@ -301,8 +304,21 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         if (s_.build.scheme == SchemeKind::Irregular)
             requestBuild(false, "camera (irregular frame)");
     }
-    if (renderDirty_ && structure_) restartRender(renderWhy_.c_str());
+    if (renderDirty_ && structure_) {
+        restartRender(renderWhy_.c_str());
+        finishedBefore = false;  // the snapshot above is of the job just cancelled
+        // A change made without dragging (a new structure, a parameter, a key): the first pass
+        // usually takes a few tens of milliseconds, so this frame waits that long for it and
+        // shows it, instead of drawing the old image and showing the pass a frame later. A drag
+        // draws at once: the next movement will replace this render anyway.
+        if (!ImGui::IsAnyMouseDown() && renderer_.waitForJob(renderer_.job(), kFirstPassWait)) {
+            finishedBefore = renderer_.finished();
+            takeSnapshot();
+            if (s_.mode != ViewMode::Color) scale_ = s_.autoScale ? autoScale_ : s_.heatScale;
+        }
+    }
     ImGui::Render();
+
 
     glViewport(0, 0, fbWidth, fbHeight);
     // The image is drawn over the whole framebuffer: clear only while there is none (one

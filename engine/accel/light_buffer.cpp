@@ -136,9 +136,10 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
         } else {
             m.fine.cover(u0, u1, v0, v1, n, k);
         }
+        std::vector<double> colLo, colHi;  // scratch of Grid::add
         for (const BoxImage& im : images) {
-            m.fine.add(im);
-            if (window && im.large) m.coarse.add(im);
+            m.fine.add(im, colLo, colHi);
+            if (window && im.large) m.coarse.add(im, colLo, colHi);
         }
     }
 }
@@ -179,7 +180,8 @@ bool coneDepths(double ua, double ub, double w0, double w1, double& lo, double& 
 
 }  // namespace
 
-void LightBuffer::Grid::add(const BoxImage& im) {
+void LightBuffer::Grid::add(const BoxImage& im, std::vector<double>& colLo,
+                            std::vector<double>& colHi) {
     const int i0 = index(im.u0 - pad, u0, su), i1 = index(im.u1 + pad, u0, su);
     const int j0 = index(im.v0 - pad, v0, sv), j1 = index(im.v1 + pad, v0, sv);
     // A bin's cone: its image rectangle widened by pad (far above the rounding of the bin a
@@ -188,7 +190,6 @@ void LightBuffer::Grid::add(const BoxImage& im) {
     // unbounded on that side. The constraint of a column of bins is the same on every row.
     const double rel = 1e-12;
     const double du = 1.0 / su, dv = 1.0 / sv;
-    thread_local std::vector<double> colLo, colHi;
     colLo.resize(size_t(i1 - i0 + 1));
     colHi.resize(size_t(i1 - i0 + 1));
     for (int i = i0; i <= i1; ++i) {

@@ -149,8 +149,8 @@ class LightBuffer {
                    (size_t(index(v, v0, sv)) * size_t(n) + size_t(index(u, u0, su))) * size_t(k);
         }
         /// Add a box to the bins its image meets (clamped into the grid), each with the depths
-        /// at which the bin's cone of sight meets the box.
-        void add(const struct BoxImage& im);
+        /// at which the bin's cone of sight meets the box. colLo, colHi: scratch.
+        void add(const struct BoxImage& im, std::vector<double>& colLo, std::vector<double>& colHi);
     };
     struct Map {
         Vec3 L{0.0};

@@ -91,6 +91,11 @@ uint64_t ProgressiveRenderer::job() const {
     return jobs_;
 }
 
+bool ProgressiveRenderer::waitForJob(uint64_t job, std::chrono::microseconds timeout) const {
+    std::unique_lock lock(mutex_);
+    return shown_.wait_for(lock, timeout, [&] { return displayShown_.job == job; });
+}
+
 std::vector<PassRecord> ProgressiveRenderer::passes() const {
     std::lock_guard lock(mutex_);
     return passes_;
@@ -186,6 +191,7 @@ void ProgressiveRenderer::run() {
                     passes_.push_back(rec);
                 }
                 lock.unlock();
+                shown_.notify_all();
                 if (onPass_) onPass_();
             }
             if (!complete) break;
