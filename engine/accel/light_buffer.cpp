@@ -44,6 +44,45 @@ void LightBuffer::insert(Slot* bin, int k, Slot x) {
         bin[0].far = std::max(bin[0].far, x.far);
         return;
     }
+    if (k == 2) {  // the lights' case, unrolled: the same result as the general one below
+        Slot& a = bin[0];
+        Slot& b = bin[1];
+        const bool meetsA = x.near <= a.far && a.near <= x.far;
+        if (!(b.near <= b.far)) {  // one interval so far
+            if (meetsA)
+                a = {std::min(a.near, x.near), std::max(a.far, x.far)};
+            else if (x.far < a.near)
+                b = a, a = x;
+            else
+                b = x;
+            return;
+        }
+        const bool meetsB = x.near <= b.far && b.near <= x.far;
+        if (meetsA && meetsB) {
+            a = {std::min(a.near, x.near), std::max(b.far, x.far)};
+            b = Slot{};
+        } else if (meetsA) {
+            a = {std::min(a.near, x.near), std::max(a.far, x.far)};
+        } else if (meetsB) {
+            b = {std::min(b.near, x.near), std::max(b.far, x.far)};
+        } else if (x.far < a.near) {  // x, a, b: join the closer pair (the first on a tie)
+            if (a.near - x.far <= b.near - a.far)
+                a.near = x.near;
+            else
+                b = {a.near, b.far}, a = x;
+        } else if (x.near > b.far) {  // a, b, x
+            if (b.near - a.far <= x.near - b.far)
+                a.far = b.far, b = x;
+            else
+                b.far = x.far;
+        } else {  // a, x, b
+            if (x.near - a.far <= b.near - x.far)
+                a.far = x.far;
+            else
+                b.near = x.near;
+        }
+        return;
+    }
     Slot t[kSlots + 1];
     int m = 0;
     bool placed = false;
