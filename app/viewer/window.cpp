@@ -70,6 +70,12 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
         why = "no display (DISPLAY is not set)";
         return kNoDisplay;
     }
+    // Under Mesa's software rasterizer (llvmpipe: no GPU, a VM, Xvfb), draw on the UI thread:
+    // with llvmpipe's worker threads, ThreadSanitizer finds a frame destroying a fence's mutex
+    // while a worker still signals it (tests/gl/CMakeLists.txt). The render's own threads are
+    // the ones that matter for speed; other drivers ignore the variable. A value the user set
+    // stays.
+    setenv("LP_NUM_THREADS", "0", 0);
     glfwSetErrorCallback(
         [](int code, const char* text) { std::cerr << "glfw: " << text << " (" << code << ")\n"; });
     if (!glfwInit()) {
