@@ -118,6 +118,10 @@ void ViewerApp::updateAutoScale() {
     if (s_.mode != ViewMode::Color) autoScale_ = autoScale(heatChannel(shown_, s_.mode));
 }
 
+void ViewerApp::updateScale() {
+    if (s_.mode != ViewMode::Color) scale_ = s_.autoScale ? autoScale_ : s_.heatScale;
+}
+
 void ViewerApp::setHeatScale(float scale) {
     s_.autoScale = false;
     s_.heatScale = scale;
@@ -286,7 +290,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     const bool builtBefore = !builder_.busy();
     pollBackground();
     takeSnapshot();
-    if (s_.mode != ViewMode::Color) scale_ = s_.autoScale ? autoScale_ : s_.heatScale;
+    updateScale();
 
     ImGui_ImplOpenGL3_NewFrame();
     ImGui::NewFrame();
@@ -314,11 +318,10 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         if (!ImGui::IsAnyMouseDown() && renderer_.waitForJob(renderer_.job(), kFirstPassWait)) {
             finishedBefore = renderer_.finished();
             takeSnapshot();
-            if (s_.mode != ViewMode::Color) scale_ = s_.autoScale ? autoScale_ : s_.heatScale;
+            updateScale();
         }
     }
     ImGui::Render();
-
 
     glViewport(0, 0, fbWidth, fbHeight);
     // The image is drawn over the whole framebuffer: clear only while there is none (one

@@ -97,6 +97,8 @@ class ViewerApp {
     void startSpeedup();
     void logTiming(const std::string& line) const;
     void updateAutoScale();
+    /// The heat scale this frame draws with: the automatic one or the user's.
+    void updateScale();
 
     ViewerSettings& s_;
     bool logTimings_;

@@ -80,17 +80,16 @@ public:
         if (!lightBuffer_.empty()) {
             LightBuffer::Segment seg[LightBuffer::kSlots];
             const int n = lightBuffer_.shadowSegments(ray.o, ray.d, light, tmax, seg);
-            if (n == 0) {
-                ++ctx.counters.lightBufferSkips;
+            if (n >= 0) {  // else the buffer does not know: the whole ray below
+                ctx.counters.lightBufferSkips += n == 0;
+                for (int i = 0; i < n; ++i) {
+                    // Each stretch is a walk of its own: a fresh mailbox id, so the primitives a
+                    // stretch tests are fresh to it (a walk's boundary check relies on that).
+                    if (i > 0) ctx.newStamp();
+                    if (intersect(ray, seg[i].t0, seg[i].t1, ctx, obs, hit)) return true;
+                }
                 return false;
             }
-            for (int i = 0; i < n; ++i) {
-                // Each stretch is a walk of its own: a fresh mailbox id, so the primitives a
-                // stretch tests are fresh to it (a walk's boundary check relies on that).
-                if (i > 0) ctx.newStamp();
-                if (intersect(ray, seg[i].t0, seg[i].t1, ctx, obs, hit)) return true;
-            }
-            if (n > 0) return false;
         }
         return intersect(ray, 0.0, tmax, ctx, obs, hit);
     }

@@ -37,77 +37,51 @@ LightBuffer::LightBuffer(const Scene& scene, int bins)
     : LightBuffer(scene.bounds, scene.minBox, positions(scene.lights), bins) {}
 
 /// Add depth interval x to a bin of k intervals (sorted, disjoint, unused ones last): merged
-/// with those it overlaps; then, if k + 1 remain, the two with the smallest gap are joined.
+/// with those it overlaps; then, if three remain, the two with the smaller gap are joined (the
+/// first pair on a tie).
 void LightBuffer::insert(Slot* bin, int k, Slot x) {
+    static_assert(kSlots == 2, "insert() merges into one or two intervals");
     if (k == 1 || !(bin[0].near <= bin[0].far)) {  // one slot, or an empty bin
         bin[0].near = std::min(bin[0].near, x.near);
         bin[0].far = std::max(bin[0].far, x.far);
         return;
     }
-    if (k == 2) {  // the lights' case, unrolled: the same result as the general one below
-        Slot& a = bin[0];
-        Slot& b = bin[1];
-        const bool meetsA = x.near <= a.far && a.near <= x.far;
-        if (!(b.near <= b.far)) {  // one interval so far
-            if (meetsA)
-                a = {std::min(a.near, x.near), std::max(a.far, x.far)};
-            else if (x.far < a.near)
-                b = a, a = x;
-            else
-                b = x;
-            return;
-        }
-        const bool meetsB = x.near <= b.far && b.near <= x.far;
-        if (meetsA && meetsB) {
-            a = {std::min(a.near, x.near), std::max(b.far, x.far)};
-            b = Slot{};
-        } else if (meetsA) {
+    Slot& a = bin[0];
+    Slot& b = bin[1];
+    const bool meetsA = x.near <= a.far && a.near <= x.far;
+    if (!(b.near <= b.far)) {  // one interval so far
+        if (meetsA)
             a = {std::min(a.near, x.near), std::max(a.far, x.far)};
-        } else if (meetsB) {
-            b = {std::min(b.near, x.near), std::max(b.far, x.far)};
-        } else if (x.far < a.near) {  // x, a, b: join the closer pair (the first on a tie)
-            if (a.near - x.far <= b.near - a.far)
-                a.near = x.near;
-            else
-                b = {a.near, b.far}, a = x;
-        } else if (x.near > b.far) {  // a, b, x
-            if (b.near - a.far <= x.near - b.far)
-                a.far = b.far, b = x;
-            else
-                b.far = x.far;
-        } else {  // a, x, b
-            if (x.near - a.far <= b.near - x.far)
-                a.far = x.far;
-            else
-                b.near = x.near;
-        }
+        else if (x.far < a.near)
+            b = a, a = x;
+        else
+            b = x;
         return;
     }
-    Slot t[kSlots + 1];
-    int m = 0;
-    bool placed = false;
-    for (int i = 0; i < k && bin[i].near <= bin[i].far; ++i) {
-        if (!placed && x.near < bin[i].near) t[m++] = x, placed = true;
-        t[m++] = bin[i];
-    }
-    if (!placed) t[m++] = x;
-    int w = 0;
-    for (int i = 1; i < m; ++i) {
-        if (t[i].near <= t[w].far)
-            t[w].far = std::max(t[w].far, t[i].far);
+    const bool meetsB = x.near <= b.far && b.near <= x.far;
+    if (meetsA && meetsB) {
+        a = {std::min(a.near, x.near), std::max(b.far, x.far)};
+        b = Slot{};
+    } else if (meetsA) {
+        a = {std::min(a.near, x.near), std::max(a.far, x.far)};
+    } else if (meetsB) {
+        b = {std::min(b.near, x.near), std::max(b.far, x.far)};
+    } else if (x.far < a.near) {  // x, a, b
+        if (a.near - x.far <= b.near - a.far)
+            a.near = x.near;
         else
-            t[++w] = t[i];
+            b = {a.near, b.far}, a = x;
+    } else if (x.near > b.far) {  // a, b, x
+        if (b.near - a.far <= x.near - b.far)
+            a.far = b.far, b = x;
+        else
+            b.far = x.far;
+    } else {  // a, x, b
+        if (x.near - a.far <= b.near - x.far)
+            a.far = x.far;
+        else
+            b.near = x.near;
     }
-    m = w + 1;
-    if (m > k) {
-        int j = 0;
-        for (int i = 1; i + 1 < m; ++i)
-            if (t[i + 1].near - t[i].far < t[j + 1].near - t[j].far) j = i;
-        t[j].far = std::max(t[j].far, t[j + 1].far);
-        for (int i = j + 1; i + 1 < m; ++i) t[i] = t[i + 1];
-        --m;
-    }
-    for (int i = 0; i < k; ++i) bin[i] = i < m ? t[i] : Slot{};
 }
 
 LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,

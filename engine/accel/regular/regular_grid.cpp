@@ -84,6 +84,8 @@ struct RegularBuilder {
         leaf.root = tree.root;
         leaf.prims = nprims;
         leaf.first = tree.first;
+        if (nprims <= RegularLeaf::kInline)
+            std::copy_n(grid.primList_.begin() + tree.first, nprims, leaf.inlined);
         grid.leaves_.push_back(leaf);
         places.push_back({level, {pos[0], pos[1], pos[2]}});
         primRefs += nprims;
@@ -207,11 +209,13 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
         const RegularBuilder::LeafPlace& pl = b.places[i];
         for (int a = 0; a < 3; ++a) {
             int shift = depth[a] - cutsOnAxis(pl.level, a);
-            leaves_[i].lo[a] = pl.pos[a] << shift;
-            leaves_[i].hi[a] = (pl.pos[a] + 1) << shift;
+            RegularLeaf& L = leaves_[i];
+            L.lo[a] = pl.pos[a] << shift;
+            L.hi[a] = (pl.pos[a] + 1) << shift;
+            L.plane[a] = planes_[a][L.lo[a]];
+            L.plane[3 + a] = planes_[a][L.hi[a]];
         }
     }
-    walk_.resize(leaves_.size());  // filled once the ropes are known
     // Longest exact walk: one step per grid plane crossed, plus degenerate steps at edges.
     maxSteps_ = 4 * (size_t(n_[0]) + n_[1] + n_[2]) + 16;
 
@@ -251,24 +255,6 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
                 rope = covers ? nb : kSplitFace;
             }
         }
-    }
-
-    for (size_t i = 0; i < leaves_.size(); ++i) {
-        const RegularLeaf& L = leaves_[i];
-        WalkLeaf& W = walk_[i];
-        W = WalkLeaf{};
-        for (int a = 0; a < 3; ++a) {
-            W.plane[a] = planes_[a][L.lo[a]];
-            W.plane[3 + a] = planes_[a][L.hi[a]];
-            W.lo[a] = L.lo[a];
-            W.hi[a] = L.hi[a];
-        }
-        std::copy(std::begin(L.rope), std::end(L.rope), W.rope);
-        W.root = L.root;
-        W.prims = L.prims;
-        W.first = L.first;
-        if (L.prims <= WalkLeaf::kInline)
-            std::copy_n(primList_.begin() + L.first, L.prims, W.inlined);
     }
 
     extra_ = {

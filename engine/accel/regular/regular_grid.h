@@ -19,8 +19,13 @@ namespace lancer {
 
 struct BuildParams;  // engine/accel/accelerator.h, which includes this header
 
-/// A BSP leaf: its block of the finest grid, [lo, hi) per axis, and its restricted tree.
-struct RegularLeaf {
+/// A BSP leaf: its block of the finest grid, [lo, hi) per axis, and its restricted tree; with
+/// everything the walk reads of it in one 128-byte block (two cache lines the hardware fetches
+/// together): its exit planes, ropes, tree, and up to kInline of its primitives (3.9 on average
+/// on balls4), so most leaves need no primList.
+struct alignas(128) RegularLeaf {
+    static constexpr uint32_t kInline = 5;
+    double plane[6] = {};  ///< lo x, y, z then hi x, y, z: the grid planes at lo and hi
     uint32_t lo[3] = {}, hi[3] = {};
     int32_t root = -1;   ///< restricted tree in the shared pool; -1: empty
     uint32_t prims = 0;  ///< primitives in the restricted tree
@@ -29,21 +34,13 @@ struct RegularLeaf {
     /// covers the whole face; kSplitFace when several do (the directory finds which one);
     /// kBorder on the grid's border. A rope is a cached directory lookup: the same leaf.
     uint32_t rope[6] = {};
+    uint32_t inlined[kInline] = {};  ///< the primitives when prims <= kInline
+    /// The leaf's primitives, `prims` of them.
+    const uint32_t* primitives(const uint32_t* primList) const {
+        return prims <= kInline ? inlined : primList + first;
+    }
 };
-/// What the walk reads of a leaf, in one 128-byte block (two cache lines the hardware fetches
-/// together) instead of three places: its exit planes, ropes, tree, block of the grid, and up
-/// to kInline of its primitives (3.9 on average on balls4), so most leaves need no primList.
-struct alignas(128) WalkLeaf {
-    static constexpr uint32_t kInline = 5;
-    double plane[6];  ///< lo x, y, z then hi x, y, z: the grid planes at lo and hi
-    uint32_t rope[6];
-    int32_t root;
-    uint32_t prims;
-    uint32_t first;
-    uint32_t lo[3], hi[3];
-    uint32_t inlined[kInline];  ///< the primitives when prims <= kInline
-};
-static_assert(sizeof(WalkLeaf) == 128);
+static_assert(sizeof(RegularLeaf) == 128);
 
 inline constexpr uint32_t kSplitFace = 0xffffffffu;
 inline constexpr uint32_t kBorder = 0xfffffffeu;
@@ -71,7 +68,6 @@ class RegularGrid {
     size_t memoryBytes() const {
         return leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode) +
                primList_.size() * sizeof(uint32_t) +
-               walk_.size() * sizeof(WalkLeaf) +
                (planes_[0].size() + planes_[1].size() + planes_[2].size()) * sizeof(double) +
                dir_.memoryBytes();
     }
@@ -120,7 +116,6 @@ class RegularGrid {
     uint32_t n_[3] = {1, 1, 1};
     double scale_[3] = {1.0, 1.0, 1.0};   ///< 2^n / extent, for locate
     std::vector<double> planes_[3];       ///< grid plane coordinates, 2^n + 1 per axis
-    std::vector<WalkLeaf> walk_;  ///< leaves_ as the walk reads them, same indices
     size_t maxSteps_ = 16;
     std::vector<RegularLeaf> leaves_;
     CsgTree pool_;  ///< restricted trees of all leaves, shared between equal primitive sets
@@ -155,7 +150,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
     const bool up[3] = {ray.d.x > 0.0, ray.d.y > 0.0, ray.d.z > 0.0};
     double inv[3], bias[3];
-    uint32_t side[3];  // where a leaf's exit plane on each axis is in WalkLeaf::plane: lo a, hi 3 + a
+    uint32_t side[3];  // where a leaf's exit plane on each axis is in RegularLeaf::plane: lo a, hi 3 + a
     uint32_t rope[3];  // the rope across that plane
     for (int a = 0; a < 3; ++a) {
         const bool parallel = ray.d[a] == 0.0;
@@ -164,7 +159,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         side[a] = up[a] ? 3 + a : a;
         rope[a] = 2 * a + up[a];
     }
-    const WalkLeaf* const leaves = walk_.data();
+    const RegularLeaf* const leaves = leaves_.data();
     const uint32_t* const primList = primList_.data();
     // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
     // inside the grid, so this only admits hits that rounding puts a hair outside the box.
@@ -177,7 +172,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
             obs.walkError("regular: step bound exceeded");
             return false;
         }
-        const WalkLeaf& L = leaves[leaf];
+        const RegularLeaf& L = leaves[leaf];
         // Exit: the nearest of the cell's exit planes; ties are edges and corners.
         const double* const P = L.plane;
         double tAxis[3];
@@ -234,8 +229,8 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         const double t1 = last ? tmax : std::max(tExit, tIn);
         ++ctx.counters.regionVisits;
         obs.region(leaf, tIn, last ? tEnd : t1);
-        const uint32_t* const ids = L.prims <= WalkLeaf::kInline ? L.inlined : primList + L.first;
-        if (hitInLeaf(*scene_, pool_, L.root, ids, L.prims, ray, tmin, t0, t1, ctx, obs, hit))
+        if (hitInLeaf(*scene_, pool_, L.root, L.primitives(primList), L.prims, ray, tmin, t0, t1,
+                      ctx, obs, hit))
             return true;
         if (last) return false;
         if (stalled) {
