@@ -269,6 +269,7 @@ void ViewerApp::takeSnapshot() {
     if (!renderer_.snapshot(shownVersion_, shown_, &what)) return;
     view_->upload(shown_, s_.mode, what.changedBegin, what.changedEnd);
     shownJob_ = what.job;
+    shownStride_ = what.stride;
     updateAutoScale();
     std::vector<PassRecord> passes = renderer_.passes();
     for (; passesLogged_ < passes.size(); ++passesLogged_) {
@@ -347,8 +348,10 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
 }
 
 bool ViewerApp::eager() const {
-    return builder_.busy() || builder_.ready() || renderDirty_ || shownJob_ != renderer_.job() ||
-           (renderer_.finished() && !settled_);
+    if (builder_.busy() || builder_.ready() || renderDirty_ || shownJob_ != renderer_.job())
+        return true;
+    const ProgressiveRenderer::Shown next = renderer_.latest();
+    return next.stride != shownStride_ || (renderer_.finished() && !settled_);
 }
 
 void ViewerApp::saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const {

@@ -39,8 +39,9 @@ class ViewerApp {
     /// Everything asked for is built and the last frame drew the complete image.
     bool settled() const { return settled_; }
     /// What the workers produce next should be drawn at once: a build is under way or ready,
-    /// the render of the latest change has shown nothing yet, or it is complete. Otherwise the
-    /// render is only refining what is on screen, and a window may show its bands at a lower
+    /// the render of the latest change has shown nothing yet, a pass finer than the one on
+    /// screen has begun to show, or the render is complete. Otherwise the render is only
+    /// refining the pass on screen band by band, and a window may show its bands at a lower
     /// rate.
     bool eager() const;
     /// Write the framebuffer as drawn by the last frame() to a PNG. Throws std::runtime_error.
@@ -112,6 +113,7 @@ class ViewerApp {
     Image shown_;
     uint64_t shownVersion_ = 0;
     uint64_t shownJob_ = 0;  ///< the render job the image on screen comes from
+    int shownStride_ = 0;    ///< and the pass it shows (some of its rows, at least)
     int jobWidth_ = 0, jobHeight_ = 0;
     bool renderDirty_ = false, buildDirty_ = false, cameraMovedForBuild_ = false;
     std::string renderWhy_;

@@ -96,6 +96,11 @@ bool ProgressiveRenderer::waitForJob(uint64_t job, std::chrono::microseconds tim
     return shown_.wait_for(lock, timeout, [&] { return displayShown_.job == job; });
 }
 
+ProgressiveRenderer::Shown ProgressiveRenderer::latest() const {
+    std::lock_guard lock(mutex_);
+    return displayShown_;
+}
+
 std::vector<PassRecord> ProgressiveRenderer::passes() const {
     std::lock_guard lock(mutex_);
     return passes_;

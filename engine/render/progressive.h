@@ -92,6 +92,9 @@ class ProgressiveRenderer {
     /// `out` must be the image the previous snapshots were taken into (any other is made a
     /// whole copy when its size differs; keep one `out` per caller).
     bool snapshot(uint64_t& version, Image& out, Shown* shown = nullptr);
+    /// What a snapshot taken now would show (its changed rows left at 0): a caller that has
+    /// shown another job or stride is behind by a pass.
+    Shown latest() const;
     /// Passes of the current job finished so far.
     std::vector<PassRecord> passes() const;
     /// The current job has rendered every pass.

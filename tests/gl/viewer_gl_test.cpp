@@ -262,10 +262,42 @@ TEST_F(ViewerFrames, EagerUntilAChangeIsOnScreenThenRefinesAtTheWindowsPace) {
              std::chrono::steady_clock::now() - start < std::chrono::seconds(60));
     ASSERT_TRUE(app_->settled());
     EXPECT_TRUE(newJobShown) << "the coarse passes show as blocks, unlike the full image";
-    ASSERT_GT(refiningFrames, 3);
-    // Eager only at the end (the render finished between two frames) or never.
-    EXPECT_LE(eagerWhileRefining, 1) << refiningFrames << " frames while refining";
+    ASSERT_GT(refiningFrames, 10);
+    // Eager only when a finer pass (of stride 4, then 1) or the end arrived between the frame's
+    // snapshot and the question: at most 3 times.
+    EXPECT_LE(eagerWhileRefining, 3) << refiningFrames << " frames while refining";
     EXPECT_FALSE(app_->eager());
+}
+
+TEST_F(ViewerFrames, EagerAsSoonAsAFinerPassIsReady) {
+    // A new pass is drawn at once, not at the window's refining pace: once the first pass of a
+    // change is on screen, the next one (of stride 4) makes the app eager before the render is
+    // complete.
+    settings_.threads = 1;
+    app_->openScene("builtin:balls:3");
+    runUntilSettled();
+    ASSERT_TRUE(app_->settled());
+    const Image before = app_->displayed();
+    app_->rebuild("test");
+    auto start = std::chrono::steady_clock::now();
+    const auto within = [&] {
+        return std::chrono::steady_clock::now() - start < std::chrono::seconds(60);
+    };
+    while (app_->displayed().color == before.color && within()) {
+        ImGui::GetIO().DeltaTime = 1.0f / 60.0f;
+        app_->frame(kW, kH);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    const Image coarse = app_->displayed();
+    ASSERT_NE(coarse.color, before.color) << "the first pass shows as blocks";
+    ASSERT_FALSE(app_->settled());
+    while (!app_->eager() && within()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ASSERT_TRUE(app_->eager());
+    ImGui::GetIO().DeltaTime = 1.0f / 60.0f;
+    app_->frame(kW, kH);
+    EXPECT_NE(app_->displayed().color, coarse.color) << "the finer pass is drawn";
+    EXPECT_FALSE(app_->settled()) << "eager before the render was complete";
+    runUntilSettled();
 }
 
 TEST_F(ViewerFrames, HeatMapModeShowsPrimitiveTests) {
