@@ -147,12 +147,14 @@ void randomScenesMatchBrute(StepMethod step, int seeds) {
             BuildParams p = regular(step);
             p.maxObjects = 1 + int(seed % 3);
             p.maxLevel = 9 + int(seed % 10);
+            p.splitAxes = seed % 2 ? SplitAxes::Cycle : SplitAxes::Cost;  // both orders
             auto accel = buildAccelerator(s, p);
             auto rays = hardRays(s, gridOf(*accel), seed, 1500);
             total += rays.size();
             auto bad = test::compareWithBrute(s, *accel, rays);
             ASSERT_TRUE(bad.empty()) << s.name << " offset " << toString(opt.offset) << " level "
-                                     << p.maxLevel << ": " << bad.size() << " rays differ\n"
+                                     << p.maxLevel << " " << splitAxesName(p.splitAxes) << ": "
+                                     << bad.size() << " rays differ\n"
                                      << describe(s, bad);
             ASSERT_EQ(walkErrors(s, *accel, rays), 0u) << s.name;
             auto secondary = test::compareWithBrute(s, *accel, rays, 1e-3 * s.scale());
@@ -417,6 +419,73 @@ TEST(RegularRefusal, AbsurdLevelAndObjectsAreRefusedWithAMessage) {
     p.maxLevel = 10;
     p.maxObjects = 0;
     EXPECT_THROW(buildAccelerator(s, p), std::invalid_argument);
+}
+
+TEST(RegularAxes, ScheduleCountsTheCutsOfEachAxis) {
+    const AxisSchedule report;  // x, y, z in turn
+    for (int level = 0; level < 48; ++level) {
+        EXPECT_EQ(report.axis(level), level % 3);
+        for (int a = 0; a < 3; ++a) ASSERT_EQ(report.cuts(level, a), (level - a + 2) / 3);
+    }
+    const AxisSchedule flat({0, 1, 0, 1, 2});
+    EXPECT_EQ(flat.toString(8), "xyxyzzxy");  // then axis level % 3 from level 5
+    EXPECT_EQ(flat.cuts(5, 0), 2);
+    EXPECT_EQ(flat.cuts(5, 1), 2);
+    EXPECT_EQ(flat.cuts(5, 2), 1);
+    EXPECT_EQ(flat.cuts(8, 0), 3);
+    EXPECT_EQ(flat.cuts(8, 2), 2);
+    EXPECT_THROW(AxisSchedule({0, 3}), std::invalid_argument);
+}
+
+/// `n` x `n` x `layers` spheres on a lattice of spacing 1 (flat when layers < n), in a union.
+Scene sphereLattice(int n, int layers) {
+    Scene s;
+    int root = -1;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+            for (int k = 0; k < layers; ++k) {
+                s.prims.push_back(makePrimitive(Sphere{{i + 0.5, j + 0.5, k + 0.5}, 0.3}, {}));
+                int leaf = s.tree.leaf(uint32_t(s.prims.size() - 1));
+                root = root < 0 ? leaf : s.tree.combine(Op::Union, root, leaf);
+            }
+    s.tree.root = root;
+    s.prepare();
+    return s;
+}
+
+TEST(RegularAxes, CostOrderIsTheReportsOnACubeAndCubicCellsOnAFlatScene) {
+    BuildParams cost = regular(), cycle = regular();
+    cycle.splitAxes = SplitAxes::Cycle;
+    cost.maxObjects = cycle.maxObjects = 1;
+    {  // a cube of evenly spread spheres: the planner's ties give the report's order
+        Scene s = sphereLattice(8, 8);
+        auto a = buildAccelerator(s, cost);
+        const RegularGrid& g = gridOf(*a);
+        EXPECT_EQ(g.schedule().toString(12), AxisSchedule().toString(12));
+        EXPECT_EQ(a->info().extra["split_axes"], "cost");
+    }
+    // 16 x 16 x 1 spheres: cutting x and y first keeps the cells about cubic; the report's order
+    // cuts z (the short axis) every third level, and rays walk through more, flatter cells.
+    Scene s = sphereLattice(16, 1);
+    auto byCost = buildAccelerator(s, cost), byCycle = buildAccelerator(s, cycle);
+    const RegularGrid &gc = gridOf(*byCost), &gr = gridOf(*byCycle);
+    EXPECT_EQ(gc.schedule().toString(8).find('z'), std::string::npos) << gc.schedule().toString(8);
+    EXPECT_EQ(byCycle->info().extra["axis_schedule"], gr.schedule().toString(64).substr(
+                                                          0, size_t(byCycle->info().extra["finest_level"])));
+    EXPECT_LT(gc.cells(2), gr.cells(2)) << "fewer cuts across the flat axis";
+    std::vector<Ray> rays = test::randomRays(s, 5, 4000);
+    const auto pts = gridPoints(gc, 5);
+    const auto more = test::raysThroughPoints(pts, s.bounds, 6);
+    rays.insert(rays.end(), more.begin(), more.end());
+    for (const Accelerator* a : {byCost.get(), byCycle.get()}) {
+        auto bad = test::compareWithBrute(s, *a, rays);
+        ASSERT_TRUE(bad.empty()) << describe(s, bad);
+        EXPECT_EQ(walkErrors(s, *a, rays), 0u);
+    }
+    const RayCounters c = test::traceCounters(s, *byCost, rays),
+                      r = test::traceCounters(s, *byCycle, rays);
+    EXPECT_LT(double(c.regionVisits), 0.8 * double(r.regionVisits));
+    EXPECT_LE(c.primTests, r.primTests);
 }
 
 TEST(RegularBuild, LeavesHoldTheirOverlappingPrimitivesAndShareTrees) {

@@ -111,6 +111,11 @@ std::vector<Config> sweep(bool quick, bool schemesOnly) {
         b.heuristic = h;
         add("bsp-heuristic", heuristicName(h), b);
     }
+    for (SplitAxes a : {SplitAxes::Cycle, SplitAxes::Cost}) {
+        BuildParams b = regular;
+        b.splitAxes = a;
+        add("split-axes", splitAxesName(a), b);
+    }
     for (bool mail : {true, false}) {
         BuildParams b = regular;
         b.mailboxes = mail;

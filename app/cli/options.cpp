@@ -31,6 +31,11 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
     app.add_option("--bsp-heuristic", o.build.heuristic, "Irregular scheme's choice of splitting segment: first, balanced, fewest-cuts")
         ->transform(CLI::CheckedTransformer(heuristics, CLI::ignore_case).description("{first, balanced, fewest-cuts}"))
         ->default_str("balanced");
+    static const std::map<std::string, SplitAxes> splitAxes = {{"cycle", SplitAxes::Cycle}, {"cost", SplitAxes::Cost}};
+    app.add_option("--split-axes", o.build.splitAxes,
+                   "Regular scheme's axis per BSP level: cycle (x, y, z in turn, the report's) or cost (per level, the axis of least estimated cost)")
+        ->transform(CLI::CheckedTransformer(splitAxes, CLI::ignore_case).description("{cycle, cost}"))
+        ->default_str(splitAxesName(o.build.splitAxes));
     app.add_flag("--full-table", o.build.fullTable, "Regular scheme: one full directory table instead of sub-tables");
     static const std::map<std::string, IrregularFrame> frames = {
         {"camera", IrregularFrame::Camera}, {"projective", IrregularFrame::Projective}};

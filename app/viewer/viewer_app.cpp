@@ -430,6 +430,10 @@ void ViewerApp::parametersPanel() {
         s_.build.maxObjects = std::clamp(s_.build.maxObjects, 1, 1000000);
         rebuild = true;
     }
+    rebuild |= enumCombo("split axes", s_.build.splitAxes, 2, splitAxesName);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("Regular: cycle cuts x, y, z in turn (the report's); cost picks each\n"
+                          "level's axis by an area estimate (cells stay about cubic)");
     rebuild |= enumCombo("step", s_.build.step, 2, stepName);
     if (s_.build.step == StepMethod::Push) {
         double d = s_.build.delta;

@@ -34,6 +34,7 @@ std::string settingsLines(const ViewerSettings& s) {
       << "scheme=" << schemeName(s.build.scheme) << "\n"
       << "max_level=" << s.build.maxLevel << "\n"
       << "max_objects=" << s.build.maxObjects << "\n"
+      << "split_axes=" << splitAxesName(s.build.splitAxes) << "\n"
       << "step=" << stepName(s.build.step) << "\n"
       << "delta=" << s.build.delta << "\n"
       << "bsp_heuristic=" << heuristicName(s.build.heuristic) << "\n"
@@ -74,6 +75,8 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
         integer(s.build.maxLevel, 0, 48);
     else if (key == "max_objects")
         integer(s.build.maxObjects, 1, 1000000);
+    else if (key == "split_axes")
+        parseEnum(value, SplitAxes(2), splitAxesName, s.build.splitAxes);
     else if (key == "step")
         parseEnum(value, StepMethod(2), stepName, s.build.step);
     else if (key == "delta") {

@@ -47,6 +47,7 @@ void applyCommandLine(const cli::CommonOptions& o,
     if (given("--scheme")) s.build.scheme = o.build.scheme;
     if (given("--max-level")) s.build.maxLevel = o.build.maxLevel;
     if (given("--max-objects")) s.build.maxObjects = o.build.maxObjects;
+    if (given("--split-axes")) s.build.splitAxes = o.build.splitAxes;
     if (given("--step")) s.build.step = o.build.step;
     if (given("--delta")) s.build.delta = o.build.delta;
     if (given("--bsp-heuristic")) s.build.heuristic = o.build.heuristic;

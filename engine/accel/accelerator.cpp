@@ -25,6 +25,8 @@ const char* heuristicName(BspHeuristic h) {
     return "?";
 }
 
+const char* splitAxesName(SplitAxes s) { return s == SplitAxes::Cycle ? "cycle" : "cost"; }
+
 const char* irregularFrameName(IrregularFrame f) {
     return f == IrregularFrame::Camera ? "camera" : "projective";
 }

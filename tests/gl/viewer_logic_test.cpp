@@ -104,6 +104,7 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     s.build.step = StepMethod::Push;
     s.build.delta = 3.5e-7;
     s.build.heuristic = BspHeuristic::FewestCuts;
+    s.build.splitAxes = SplitAxes::Cycle;  // not the default: the line must carry it
     s.build.mailboxes = false;
     s.threads = 1;
     s.shading.bounces = 2;
@@ -125,7 +126,8 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     EXPECT_EQ(settingsLines(r), lines);
     ViewerSettings bad = r;
     for (const char* line :
-         {"max_level=999", "scheme=octree", "window=5 5", "delta=-1", "threads=x", "garbage"})
+         {"max_level=999", "scheme=octree", "split_axes=diagonal", "window=5 5", "delta=-1",
+          "threads=x", "garbage"})
         readSettingsLine(bad, line);
     EXPECT_EQ(settingsLines(bad), lines);
 }

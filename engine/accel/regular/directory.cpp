@@ -5,6 +5,27 @@
 
 namespace lancer {
 
+AxisSchedule::AxisSchedule() : AxisSchedule(std::vector<int>{}) {}
+
+AxisSchedule::AxisSchedule(const std::vector<int>& axes) {
+    for (int l = 0; l < kLevels; ++l) {
+        const int a = l < int(axes.size()) ? axes[size_t(l)] : l % 3;
+        if (a < 0 || a > 2) throw std::invalid_argument("AxisSchedule: axis must be 0, 1 or 2");
+        axis_[l] = uint8_t(a);
+        for (int b = 0; b < 3; ++b) cuts_[l + 1][b] = uint8_t(cuts_[l][b] + (b == a));
+    }
+}
+
+std::string AxisSchedule::toString(int levels) const {
+    std::string out;
+    for (int l = 0; l < std::min(levels, kLevels); ++l) out += "xyz"[axis_[l]];
+    return out;
+}
+
+bool AxisSchedule::operator==(const AxisSchedule& o) const {
+    return std::equal(axis_, axis_ + kLevels, o.axis_);
+}
+
 int Directory::tableLevels(int level, int height, int finestLevel, bool full) {
     if (full) return finestLevel - level;
     return std::min(height, level == 0 ? kTopLevels : kSubTableLevels);
@@ -39,7 +60,9 @@ size_t Directory::estimateBytes(const BspNodes& bsp, int finestLevel, bool full)
     return entries * sizeof(uint32_t) + tables * sizeof(Table);
 }
 
-void Directory::build(const BspNodes& bsp, int finestLevel, bool full) {
+void Directory::build(const BspNodes& bsp, const AxisSchedule& schedule, int finestLevel,
+                      bool full) {
+    schedule_ = schedule;
     entries_.clear();
     tables_.clear();
     addTable(bsp, 0, 0, finestLevel, full);
@@ -53,8 +76,8 @@ uint32_t Directory::addTable(const BspNodes& bsp, int node, int level, int fines
     Table t;
     t.offset = uint32_t(entries_.size());
     for (int a = 0; a < 3; ++a) {
-        t.bits[a] = uint8_t(cutsOnAxis(level + m, a) - cutsOnAxis(level, a));
-        t.shift[a] = uint8_t(cutsOnAxis(finestLevel, a) - cutsOnAxis(level + m, a));
+        t.bits[a] = uint8_t(schedule_.cuts(level + m, a) - schedule_.cuts(level, a));
+        t.shift[a] = uint8_t(schedule_.cuts(finestLevel, a) - schedule_.cuts(level + m, a));
         t.mask[a] = (1u << t.bits[a]) - 1u;
     }
     t.lowBits = uint8_t(t.bits[1] + t.bits[2]);
@@ -78,7 +101,7 @@ void Directory::fill(const BspNodes& bsp, uint32_t table, int tableLevel, int le
         const Table t = tables_[table];  // copy: addTable may have grown tables_
         uint32_t lo[3], hi[3];
         for (int a = 0; a < 3; ++a) {
-            int size = cutsOnAxis(bottom, a) - cutsOnAxis(level, a);
+            int size = schedule_.cuts(bottom, a) - schedule_.cuts(level, a);
             lo[a] = pos[a] << size;
             hi[a] = (pos[a] + 1) << size;
         }
@@ -88,7 +111,7 @@ void Directory::fill(const BspNodes& bsp, uint32_t table, int tableLevel, int le
                     entries_[t.offset + (x << t.lowBits) + (y << t.bits[2]) + z] = value;
         return;
     }
-    int axis = level % 3;  // the cut at level + 1
+    const int axis = schedule_.axis(level);  // the cut at level + 1
     for (int side = 0; side < 2; ++side) {
         uint32_t child[3] = {pos[0], pos[1], pos[2]};
         child[axis] = 2 * pos[axis] + uint32_t(side);

@@ -5,13 +5,35 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace lancer {
 
-/// Number of cuts on `axis` (0 x, 1 y, 2 z) made by the first `level` levels of a BSP that cuts
-/// x, y, z in turn (level 1 cuts x).
-constexpr int cutsOnAxis(int level, int axis) { return (level - axis + 2) / 3; }
+/// The axis the regular BSP cuts at each level. Every node of a level is cut on the same axis,
+/// at its middle, so the cells of a level are all alike, and a cell's level fixes how many times
+/// each axis was cut: the directory's resolution per axis follows from the finest level. The
+/// report cuts x, y, z in turn; other orders keep every property of the scheme.
+class AxisSchedule {
+  public:
+    static constexpr int kLevels = 64;
+    /// The report's order: x, y, z in turn (level 0 cuts x).
+    AxisSchedule();
+    /// Level l cuts axes[l] (0 x, 1 y, 2 z); levels beyond the list cut axis l % 3.
+    explicit AxisSchedule(const std::vector<int>& axes);
+
+    /// Axis the cut of a node at `level` runs across.
+    int axis(int level) const { return axis_[level]; }
+    /// Cuts on `axis` made by levels [0, level): a node at `level` is 1 / 2^cuts of the box.
+    int cuts(int level, int axis) const { return cuts_[level][axis]; }
+    /// The first `levels` axes as letters, e.g. "xyxyxyxyzxyz".
+    std::string toString(int levels) const;
+    bool operator==(const AxisSchedule& o) const;
+
+  private:
+    uint8_t axis_[kLevels] = {};
+    uint8_t cuts_[kLevels + 1][3] = {};
+};
 
 /// The BSP the directory is built from: nodes in a flat array; an inner node's children are
 /// `first` and `first + 1` (low and high half), a leaf has first == -1 and its number in `leaf`.
@@ -39,8 +61,8 @@ class Directory {
 
     /// Bytes the table built by `build` would take, computed without allocating it.
     static size_t estimateBytes(const BspNodes& bsp, int finestLevel, bool full);
-    /// Fill the directory of a BSP whose deepest leaf is at `finestLevel`.
-    void build(const BspNodes& bsp, int finestLevel, bool full);
+    /// Fill the directory of a BSP cut by `schedule` whose deepest leaf is at `finestLevel`.
+    void build(const BspNodes& bsp, const AxisSchedule& schedule, int finestLevel, bool full);
 
     /// Leaf number of the finest cell (i, j, k), each index in [0, 2^n) of its axis.
     uint32_t lookup(uint32_t i, uint32_t j, uint32_t k) const {
@@ -84,6 +106,7 @@ class Directory {
 
     std::vector<uint32_t> entries_;
     std::vector<Table> tables_;
+    AxisSchedule schedule_;  ///< of the BSP being filled
 };
 
 }  // namespace lancer

@@ -1,5 +1,6 @@
-// The regular subdivision (report, section 3): a BSP over the scene box cut at the middle on x,
-// y, z in turn, its leaves reached through a directory at the finest level (full table or
+// The regular subdivision (report, section 3): a BSP over the scene box cut at the middle, on x,
+// y, z in turn as in the report or on the axes a cost estimate picks level by level (the same
+// axis for every node of a level), its leaves reached through a directory at the finest level (full table or
 // Tamminen sub-tables), and a ray walk from leaf to leaf by one of two methods:
 //  - push (the report's): push the exit point by `delta` across the exit face, edge or corner
 //    and locate it; a delta too large skips thin cells, a delta too small stalls;
@@ -84,6 +85,8 @@ class RegularGrid {
     const Box3& box() const { return box_; }
     /// Directory cells per axis, 2^n.
     uint32_t cells(int axis) const { return n_[axis]; }
+    /// The axis each level of the BSP cuts.
+    const AxisSchedule& schedule() const { return schedule_; }
     /// Coordinate of grid plane k (0..2^n) on `axis`; plane 2^n is exactly box().hi.
     double plane(int axis, uint32_t k) const { return planes_[axis][k]; }
     /// The report's point location, 0-based: floor((x - min) / (max - min) * 2^n), clamped; the
@@ -113,6 +116,7 @@ class RegularGrid {
     Box3 box_;
     Box3 clipBox_;  ///< box_ grown by a hair: a grazing ray whose hit rounds outside still enters
     Vec3 ext_{0.0};
+    AxisSchedule schedule_;
     uint32_t n_[3] = {1, 1, 1};
     double scale_[3] = {1.0, 1.0, 1.0};   ///< 2^n / extent, for locate
     std::vector<double> planes_[3];       ///< grid plane coordinates, 2^n + 1 per axis
