@@ -33,6 +33,13 @@ bool coveredByAll(const Scene& scene, std::span<const uint32_t> prims, const Box
     return true;
 }
 
+/// Levels --split-axes cost plans (4 cuts per axis on a cube: they fix the cells' shape); deeper
+/// ones cut the longest axis of the level's cells, as the report's order
+/// does on a cube. Planning every level cost up to 40% more build time on scenes of thousands of
+/// triangles that stay above max-objects around shared vertices (tetra), for the same counters
+/// within 2%; 12 levels cost 1-3% more build instructions, and balls4 14% fewer.
+constexpr int kPlannedLevels = 12;
+
 /// The axes of --split-axes cost, planned level by level over the primitives' minimized boxes
 /// alone (no CSG restriction, so a little pessimistic). Every cell of a level has the same
 /// surface area A(axis) once cut on `axis`, so with the surface area heuristic the next level
@@ -44,13 +51,6 @@ bool coveredByAll(const Scene& scene, std::span<const uint32_t> prims, const Box
 /// evenly spread primitives this is the report's x, y, z; on a flat scene (balls4: 24 x 24 x 1.5)
 /// it cuts x and y until the cells are about cubes, where the report's order makes them 16 times
 /// flatter than wide.
-/// The first kPlannedLevels levels are planned so (4 cuts per axis on a cube: they fix the
-/// cells' shape); deeper ones cut the longest axis of the level's cells, as the report's order
-/// does on a cube. Planning every level cost up to 40% more build time on scenes of thousands of
-/// triangles that stay above max-objects around shared vertices (tetra), for the same counters
-/// within 2%; 12 levels cost 1-3% more build instructions, and balls4 14% fewer.
-constexpr int kPlannedLevels = 12;
-
 AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector<uint32_t>& live,
                           const BuildParams& params) {
     std::vector<double> cost(scene.prims.size(), 1.0);
