@@ -131,6 +131,34 @@ TEST(Render, PerPixelCountersAddUpAndThreadsDoNotChangeTheImage) {
         EXPECT_TRUE(j.contains(key)) << key;
 }
 
+TEST(Render, PixelTimesAddUpToTheRenderTime) {
+    // Per-pixel times (the viewer's time heat map) are counter ticks turned into microseconds per
+    // tile: on one thread they add up to about the render's wall time, and slow pixels show.
+    Scene s = loadScene("builtin:balls:2");
+    auto accel = buildAccelerator(s, BuildParams{});
+    RenderOptions ro;
+    ro.width = 160, ro.height = 100, ro.threads = 1;
+    Image img(160, 100);
+    RenderStats st = render(s, *accel, ro, img);
+    double sumUs = 0.0;
+    std::vector<std::pair<uint32_t, float>> work;  // (primitive tests, time) per pixel
+    for (size_t i = 0; i < img.timeUs.size(); ++i) {
+        ASSERT_GT(img.timeUs[i], 0.0f) << "pixel " << i;
+        ASSERT_LT(img.timeUs[i], 1e6f) << "pixel " << i;
+        sumUs += img.timeUs[i];
+        work.push_back({img.primTests[i] + img.regionVisits[i], img.timeUs[i]});
+    }
+    EXPECT_LE(sumUs, 1000.0 * st.renderMs * 1.02);
+    EXPECT_GE(sumUs, 1000.0 * st.renderMs * 0.5);
+    // The quarter of pixels with the most tests and visits take longer than the quarter with
+    // the fewest.
+    std::sort(work.begin(), work.end());
+    const size_t q = work.size() / 4;
+    double low = 0.0, high = 0.0;
+    for (size_t i = 0; i < q; ++i) low += work[i].second, high += work[work.size() - 1 - i].second;
+    EXPECT_GT(high, 1.5 * low);
+}
+
 TEST(Render, ProgressivePassesCoverEveryPixelOnce) {
     Scene s = loadScene("builtin:default");
     auto accel = buildAccelerator(s, BuildParams{});

@@ -8,8 +8,26 @@
 
 #include <algorithm>
 #include <chrono>
+#if defined(__x86_64__) || defined(__i386__)
+#include <x86intrin.h>
+#endif
 
 namespace lancer {
+
+namespace {
+
+/// A cheap per-pixel clock: the time-stamp counter where there is one (a few nanoseconds a read,
+/// against 60 ns for steady_clock's on this VM: 4% of a balls4 render), else steady_clock's
+/// nanoseconds. Ticks are turned into microseconds per tile, against steady_clock over the tile.
+inline uint64_t ticks() {
+#if defined(__x86_64__) || defined(__i386__)
+    return __rdtsc();
+#else
+    return uint64_t(std::chrono::steady_clock::now().time_since_epoch().count());
+#endif
+}
+
+}  // namespace
 
 int effectiveThreads(int requested) {
     int cores = tbb::info::default_concurrency();
@@ -55,14 +73,18 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                 TraceContext& ctx = contexts.local();
                 NullObserver obs;
                 size_t done = 0;
-                for (int y = r.rows().begin(); y < r.rows().end(); ++y) {
+                // One counter read per pixel: a pixel's time runs from the previous one's end.
+                // Held in timeUs as ticks until the tile ends.
+                const auto tileStart = Clock::now();
+                const uint64_t tileTicks = ticks();
+                int rowsDone = r.rows().begin();
+                for (int y = r.rows().begin(); y < r.rows().end(); ++y, rowsDone = y) {
                     // Checked per row too, so a cancel lands within a row of slow pixels.
                     if (cancel && cancel->load(std::memory_order_relaxed)) {
                         stopped = true;
                         break;
                     }
-                    // One clock read per pixel: a pixel's time runs from the previous one's end.
-                    auto t0 = Clock::now();
+                    uint64_t t0 = ticks();
                     for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
                         if (!pass.contains(x, y)) continue;
                         RayCounters before = ctx.counters;
@@ -77,12 +99,19 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                         RayCounters d = ctx.counters - before;
                         img.primTests[i] = uint32_t(d.primTests);
                         img.regionVisits[i] = uint32_t(d.regionVisits);
-                        const auto t1 = Clock::now();
-                        img.timeUs[i] = std::chrono::duration<float, std::micro>(t1 - t0).count();
+                        const uint64_t t1 = ticks();
+                        img.timeUs[i] = float(t1 - t0);
                         t0 = t1;
                         ++done;
                     }
                 }
+                const uint64_t spent = ticks() - tileTicks;
+                const double us =
+                    std::chrono::duration<double, std::micro>(Clock::now() - tileStart).count();
+                const float usPerTick = spent > 0 ? float(us / double(spent)) : 0.0f;
+                for (int y = r.rows().begin(); y < rowsDone; ++y)
+                    for (int x = r.cols().begin(); x < r.cols().end(); ++x)
+                        if (pass.contains(x, y)) img.timeUs[img.index(x, y)] *= usPerTick;
                 if (progress) progress->fetch_add(done, std::memory_order_relaxed);
             },
             tbb::simple_partitioner());
