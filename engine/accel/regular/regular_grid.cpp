@@ -144,6 +144,13 @@ struct RegularBuilder {
         uint32_t pos[3];
     };
     std::vector<LeafPlace> places;
+    /// The scene's tree has only unions: a restriction then keeps every primitive it is given.
+    bool unionOnly = false;
+    struct Scratch {
+        std::vector<uint32_t> in, live;
+        CsgTree sub;
+    };
+    std::vector<Scratch> scratch = {};  ///< per level, for the children of a node there
     uint64_t primRefs = 0;
     uint32_t maxPrims = 0;
     size_t emptyLeaves = 0;
@@ -222,30 +229,36 @@ struct RegularBuilder {
         bsp.nodes.resize(bsp.nodes.size() + 2);
         bsp.nodes[size_t(id)].first = first;
         uint8_t height = 0;
+        // The children's lists and trees, kept per level so that their memory is reused: a
+        // child's own children use the next level's.
+        Scratch& sc = scratch[size_t(level) + 1];
         for (int side = 0; side < 2; ++side) {
             Box3 child = box;
             (side ? child.lo : child.hi)[axis] = mid;
             // Primitives whose minimized boxes overlap the closed child box, then the tree
             // restricted to them; a primitive the restriction drops cannot contribute here.
-            std::vector<uint32_t> in;
-            in.reserve(prims.size());
+            sc.in.clear();
             for (uint32_t p : prims)
-                if (scene.minBox[p].overlaps(child)) in.push_back(p);
+                if (scene.minBox[p].overlaps(child)) sc.in.push_back(p);
             uint32_t cpos[3] = {pos[0], pos[1], pos[2]};
             cpos[axis] = 2 * pos[axis] + uint32_t(side);
-            if (in.size() == prims.size()) {
+            if (sc.in.size() == prims.size()) {
                 // Every primitive overlaps the child: the restriction is this tree, whose
                 // primitives all count (`prims` are the live ones).
                 build(first + side, level + 1, cpos, child, tree, prims);
             } else {
-                CsgTree sub;
-                sub.nodes.reserve(2 * in.size());
-                for (uint32_t p : in) keep[p] = 1;
-                sub.root = restrictTree(tree, tree.root, keep, sub);
-                for (uint32_t p : in) keep[p] = 0;
-                std::vector<uint32_t> live = sub.primitives();
-                sortedUnique(live);
-                build(first + side, level + 1, cpos, child, sub, live);
+                sc.sub.nodes.clear();
+                for (uint32_t p : sc.in) keep[p] = 1;
+                sc.sub.root = restrictTree(tree, tree.root, keep, sc.sub);
+                for (uint32_t p : sc.in) keep[p] = 0;
+                if (unionOnly) {
+                    // Restricting a union drops no primitive it keeps: all of them are live.
+                    build(first + side, level + 1, cpos, child, sc.sub, sc.in);
+                } else {
+                    sc.live = sc.sub.primitives();
+                    sortedUnique(sc.live);
+                    build(first + side, level + 1, cpos, child, sc.sub, sc.live);
+                }
             }
             height = std::max<uint8_t>(height, bsp.nodes[size_t(first + side)].height + 1);
         }
@@ -282,6 +295,10 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
     // Build the BSP.
     RegularBuilder b{scene, params, *this, {}, std::vector<char>(scene.prims.size(), 0), {}, {}};
     b.bsp.nodes.resize(1);
+    b.unionOnly = std::all_of(scene.tree.nodes.begin(), scene.tree.nodes.end(), [](const CsgNode& n) {
+        return n.op == Op::Primitive || n.op == Op::Union;
+    });
+    b.scratch.resize(size_t(std::max(0, params.maxLevel)) + 2);
     std::vector<uint32_t> live =
         scene.tree.empty() ? std::vector<uint32_t>{} : scene.tree.primitives();
     sortedUnique(live);
