@@ -23,6 +23,59 @@ bool waitFor(const std::function<bool()>& done, double seconds = 30.0) {
     return true;
 }
 
+/// Follow job `job` of `pr` snapshot by snapshot into `shown` until it is finished, checking
+/// each snapshot against `direct`, the same view rendered at once: only the rows said to have
+/// changed change, and every pixel shows its block's corner pixel. Returns the strides seen.
+std::vector<int> followJob(ProgressiveRenderer& pr, uint64_t job, const Image& direct,
+                           Image& shown, uint64_t& version) {
+    std::vector<int> seenStrides;
+    const int w = direct.width, h = direct.height;
+    auto start = std::chrono::steady_clock::now();
+    for (;;) {
+        EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
+        if (std::chrono::steady_clock::now() - start > std::chrono::seconds(30)) break;
+        const bool finished = pr.finished();  // read first: then the snapshot below is the last
+        ProgressiveRenderer::Shown what;
+        const Image before = shown;
+        if (pr.snapshot(version, shown, &what)) {
+            seenStrides.push_back(what.stride);
+            EXPECT_EQ(what.job, job);
+            EXPECT_GT(what.rows, 0);
+            // Only the rows said to have changed are copied; they reach the last band's end
+            // (further when an earlier pass, whole, was not taken yet).
+            EXPECT_LT(what.changedBegin, what.changedEnd);
+            EXPECT_GE(what.changedEnd, what.rows);
+            for (int y = 0; y < h && before.width == shown.width; ++y) {
+                if (y >= what.changedBegin && y < what.changedEnd) continue;
+                for (int x = 0; x < w; ++x)
+                    if (shown.color[shown.index(x, y)] != before.color[before.index(x, y)]) {
+                        ADD_FAILURE() << "row " << y << " outside the changed rows changed";
+                        return seenStrides;
+                    }
+            }
+            // Every pixel shows its block's corner pixel of the direct render: at the stride of
+            // the pass above its band's end, of the pass before below it.
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    const int stride = y < what.rows ? what.stride : what.previousStride;
+                    if (stride <= 0) {
+                        ADD_FAILURE() << "row " << y << " shown before it was rendered";
+                        return seenStrides;
+                    }
+                    size_t s = direct.index(x - x % stride, y - y % stride), d = shown.index(x, y);
+                    if (shown.color[d] != direct.color[s] ||
+                        shown.primTests[d] != direct.primTests[s]) {
+                        ADD_FAILURE() << x << "," << y << " stride " << stride << " job " << job;
+                        return seenStrides;
+                    }
+                }
+        }
+        if (finished) break;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return seenStrides;
+}
+
 TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
     auto scene = std::make_shared<const Scene>(loadScene("builtin:default"));
     std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
@@ -38,43 +91,7 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
     pr.start({scene, accel, opt});
     Image shown;
     uint64_t version = 0;
-    std::vector<int> seenStrides;
-    auto start = std::chrono::steady_clock::now();
-    for (;;) {
-        ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
-        const bool finished = pr.finished();  // read first: then the snapshot below is the last
-        ProgressiveRenderer::Shown what;
-        const Image before = shown;
-        if (pr.snapshot(version, shown, &what)) {
-            seenStrides.push_back(what.stride);
-            ASSERT_EQ(what.job, 1u) << "the only job started is number 1";
-            ASSERT_GT(what.rows, 0);
-            // Only the rows said to have changed are copied; they reach the last band's end
-            // (further when an earlier pass, whole, was not taken yet).
-            ASSERT_LT(what.changedBegin, what.changedEnd);
-            ASSERT_GE(what.changedEnd, what.rows);
-            for (int y = 0; y < opt.height && before.width == shown.width; ++y) {
-                if (y >= what.changedBegin && y < what.changedEnd) continue;
-                for (int x = 0; x < opt.width; ++x) {
-                    ASSERT_EQ(shown.color[shown.index(x, y)], before.color[before.index(x, y)])
-                        << "row " << y << " outside the changed rows changed";
-                }
-            }
-            // Every pixel shows its block's corner pixel of the direct render: at the stride of
-            // the pass above its band's end, of the pass before below it.
-            for (int y = 0; y < opt.height; ++y)
-                for (int x = 0; x < opt.width; ++x) {
-                    const int stride = y < what.rows ? what.stride : what.previousStride;
-                    ASSERT_GT(stride, 0) << "row " << y << " shown before it was rendered";
-                    size_t s = direct.index(x - x % stride, y - y % stride), d = shown.index(x, y);
-                    ASSERT_EQ(shown.color[d], direct.color[s])
-                        << x << "," << y << " stride " << stride;
-                    ASSERT_EQ(shown.primTests[d], direct.primTests[s]);
-                }
-        }
-        if (finished) break;
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
+    std::vector<int> seenStrides = followJob(pr, 1, direct, shown, version);
     ASSERT_FALSE(seenStrides.empty());
     EXPECT_EQ(seenStrides.back(), 1);
     // Shown one band at a time: passes 8 and 4 whole, passes 2 and 1 in bands of 8 rows.
@@ -95,6 +112,23 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
     EXPECT_EQ(what.changedEnd, opt.height);
     EXPECT_EQ(fresh.color, direct.color);
     EXPECT_EQ(fresh.timeUs, shown.timeUs);
+
+    // A second job of the same size, another view, into the same image: every snapshot is
+    // checked as above (an earlier attempt to hand the display over instead of copying it
+    // showed stale rows here), and the end is the direct render.
+    RenderOptions moved = opt;
+    Camera cam = scene->camera;
+    cam.from += 0.3 * (cam.at - cam.from);
+    moved.camera = cam;
+    Image direct2(opt.width, opt.height);
+    render(*scene, *accel, moved, direct2);
+    ASSERT_NE(direct2.color, direct.color);
+    pr.start({scene, accel, moved});
+    seenStrides = followJob(pr, 2, direct2, shown, version);
+    ASSERT_FALSE(seenStrides.empty());
+    EXPECT_EQ(seenStrides.back(), 1);
+    EXPECT_EQ(shown.color, direct2.color);
+    EXPECT_EQ(shown.primTests, direct2.primTests);
 }
 
 TEST(Progressive, ANewJobCancelsTheOneInFlight) {

@@ -271,17 +271,29 @@ void ViewerApp::takeSnapshot() {
     shownJob_ = what.job;
     shownStride_ = what.stride;
     updateAutoScale();
+    if (!logTimings_) return;
+    // Passes this snapshot holds whole (one may have finished since it was taken), logged once
+    // the frame showing them is on screen (presented()).
     std::vector<PassRecord> passes = renderer_.passes();
     for (; passesLogged_ < passes.size(); ++passesLogged_) {
         const PassRecord& p = passes[passesLogged_];
-        logTiming(changeWhy_ + ": pass stride " + std::to_string(p.stride) + " visible " +
-                  std::to_string(msSince(changeAt_)) + " ms after the change (pass render " +
-                  std::to_string(p.renderMs) + " ms, " + std::to_string(shown_.width) + "x" +
-                  std::to_string(shown_.height) + ")");
+        if (p.stride < what.stride || (p.stride == what.stride && what.rows < shown_.height))
+            break;
+        pendingLogs_.push_back({changeWhy_ + ": pass stride " + std::to_string(p.stride) +
+                                    " visible ",
+                                " ms after the change (pass render " + std::to_string(p.renderMs) +
+                                    " ms, " + std::to_string(shown_.width) + "x" +
+                                    std::to_string(shown_.height) + ")",
+                                changeAt_});
+        if (p.stride == 1)
+            pendingLogs_.push_back({changeWhy_ + ": full image ", " ms after the change", changeAt_});
     }
-    if (!passes.empty() && passes.back().stride == 1)
-        logTiming(changeWhy_ + ": full image " + std::to_string(msSince(changeAt_)) +
-                  " ms after the change");
+}
+
+void ViewerApp::presented() {
+    for (const PendingLog& l : pendingLogs_)
+        logTiming(l.before + std::to_string(msSince(l.since)) + l.after);
+    pendingLogs_.clear();
 }
 
 void ViewerApp::frame(int fbWidth, int fbHeight) {

@@ -44,6 +44,9 @@ class ViewerApp {
     /// refining the pass on screen band by band, and a window may show its bands at a lower
     /// rate.
     bool eager() const;
+    /// The frame drawn by the last frame() is on screen (after the window's swap): logs, with
+    /// --log-timings, the passes it shows for the first time, with their latency.
+    void presented();
     /// Write the framebuffer as drawn by the last frame() to a PNG. Throws std::runtime_error.
     void saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const;
 
@@ -125,6 +128,13 @@ class ViewerApp {
     Clock::time_point changeAt_ = Clock::now(), buildChangeAt_ = Clock::now();
     std::string changeWhy_, buildWhy_;
     size_t passesLogged_ = 0;
+    /// Timing lines of passes in the image drawn but not yet on screen: text before the latency,
+    /// after it, and the change it counts from.
+    struct PendingLog {
+        std::string before, after;
+        Clock::time_point since;
+    };
+    std::vector<PendingLog> pendingLogs_;
 
     // UI scratch.
     std::string pathInput_, cameraJson_, cameraError_, screenshotNote_, pendingScreenshot_;

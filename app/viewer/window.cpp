@@ -226,10 +226,13 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                         status = 2;
                     }
                 }
+                glfwSwapBuffers(window);  // after the screenshot, which reads the back buffer
+                app.presented();
                 break;
             }
             auto beforeSwap = Clock::now();
             glfwSwapBuffers(window);
+            app.presented();
             lastDrawn = Clock::now();
             statSwapMs +=
                 std::chrono::duration<double, std::milli>(Clock::now() - beforeSwap).count();

@@ -19,9 +19,22 @@ void fillBlocks(const Image& src, int stride, Image& dst, int rowBegin, int rowE
         rowBegin = 0;
         rowEnd = -1;
     }
+    const int begin = std::max(rowBegin, 0);
     const int end = rowEnd < 0 ? src.height : std::min(rowEnd, src.height);
-    for (int y = std::max(rowBegin, 0); y < end; ++y) {
+    const size_t w = size_t(src.width);
+    for (int y = begin; y < end; ++y) {
         const int sy = y - y % stride;
+        if (y > begin && y != sy) {  // the same blocks as the row above, just written: copy it
+            const size_t d = dst.index(0, y), a = d - w;
+            auto row = [&](auto& v) { std::copy_n(v.begin() + ptrdiff_t(a), w, v.begin() + ptrdiff_t(d)); };
+            row(dst.color);
+            row(dst.depth);
+            row(dst.hitPrim);
+            row(dst.primTests);
+            row(dst.regionVisits);
+            row(dst.timeUs);
+            continue;
+        }
         for (int x = 0; x < src.width; ++x) {
             const size_t s = src.index(x - x % stride, sy), d = dst.index(x, y);
             dst.color[d] = src.color[s];
