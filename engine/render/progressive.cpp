@@ -9,7 +9,7 @@ namespace lancer {
 void lowerThreadPriority() {
 #ifdef __linux__
     // On Linux the nice value is per thread: this leaves the caller's other threads alone.
-    setpriority(PRIO_PROCESS, id_t(syscall(SYS_gettid)), 5);
+    setpriority(PRIO_PROCESS, id_t(syscall(SYS_gettid)), 19);
 #endif
 }
 
