@@ -1,5 +1,6 @@
 #include "app/viewer/image_view.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -141,7 +142,44 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
         dirty_.add(rowBegin, rowEnd);
 }
 
-void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) const {
+std::vector<PixelRect> uncovered(int width, int height, const std::vector<PixelRect>& covered) {
+    std::vector<int> ys = {0, height};
+    for (const PixelRect& r : covered)
+        for (int y : {r.y0, r.y1}) ys.push_back(std::clamp(y, 0, height));
+    std::sort(ys.begin(), ys.end());
+    ys.erase(std::unique(ys.begin(), ys.end()), ys.end());
+    std::vector<PixelRect> out;
+    std::vector<std::pair<int, int>> spans;
+    for (size_t b = 0; b + 1 < ys.size(); ++b) {
+        const int ya = ys[b], yb = ys[b + 1];
+        spans.clear();
+        for (const PixelRect& r : covered)
+            if (r.y0 <= ya && r.y1 >= yb && r.x0 < r.x1)
+                spans.push_back({std::clamp(r.x0, 0, width), std::clamp(r.x1, 0, width)});
+        std::sort(spans.begin(), spans.end());
+        int x = 0;
+        for (const auto& [a, e] : spans) {
+            if (a > x) out.push_back({x, ya, a, yb});
+            x = std::max(x, e);
+        }
+        if (x < width) out.push_back({x, ya, width, yb});
+    }
+    // A run continues the identical run of the band above: one taller copy.
+    std::vector<PixelRect> merged;
+    for (const PixelRect& r : out) {
+        auto same = std::find_if(merged.begin(), merged.end(), [&](const PixelRect& m) {
+            return m.x0 == r.x0 && m.x1 == r.x1 && m.y1 == r.y0;
+        });
+        if (same != merged.end())
+            same->y1 = r.y1;
+        else
+            merged.push_back(r);
+    }
+    return merged;
+}
+
+void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
+                     const std::vector<PixelRect>& covered) const {
     if (width_ == 0) return;
     scale = scale > 0.0f ? scale : 1.0f;
     if (!shadedValid_ || mode != shadedMode_ || (mode != ViewMode::Color && scale != shadedScale_))
@@ -151,8 +189,15 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale) cons
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
-    glBlitFramebuffer(0, 0, width_, height_, 0, 0, fbWidth, fbHeight, GL_COLOR_BUFFER_BIT,
-                      GL_NEAREST);
+    if (covered.empty() || width_ != fbWidth || height_ != fbHeight) {
+        glBlitFramebuffer(0, 0, width_, height_, 0, 0, fbWidth, fbHeight, GL_COLOR_BUFFER_BIT,
+                          GL_NEAREST);
+    } else {
+        // One texel per pixel: each uncovered rectangle is copied as is (GL's rows go up).
+        for (const PixelRect& r : uncovered(fbWidth, fbHeight, covered))
+            glBlitFramebuffer(r.x0, fbHeight - r.y1, r.x1, fbHeight - r.y0, r.x0, fbHeight - r.y1,
+                              r.x1, fbHeight - r.y0, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
 }

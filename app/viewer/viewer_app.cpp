@@ -88,6 +88,11 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
         builder_.setOnReady(wake);
     }
     pathInput_ = s_.scene.rfind("builtin:", 0) == 0 ? "" : s_.scene;
+    // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
+    // drawn at all (frame()).
+    ImGuiStyle& style = ImGui::GetStyle();
+    style.Colors[ImGuiCol_WindowBg].w = 1.0f;
+    style.Colors[ImGuiCol_PopupBg].w = 1.0f;
     requestBuild(true, "open scene");
 }
 
@@ -343,7 +348,20 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
     }
-    view_->draw(fbWidth, fbHeight, s_.mode, scale_);
+    // The panels drawn next are opaque and, unrounded, cover their rectangles: the image is
+    // copied only around them.
+    std::vector<PixelRect> panels;
+    const ImGuiIO& io = ImGui::GetIO();
+    if (ImGui::GetStyle().WindowRounding == 0.0f)
+        for (const ImGuiWindow* w : ImGui::GetCurrentContext()->Windows)
+            if (w->Active && !w->Hidden &&
+                !(w->Flags & (ImGuiWindowFlags_ChildWindow | ImGuiWindowFlags_NoBackground))) {
+                const float sx = io.DisplayFramebufferScale.x, sy = io.DisplayFramebufferScale.y;
+                panels.push_back({int(std::ceil(w->Pos.x * sx)), int(std::ceil(w->Pos.y * sy)),
+                                  int(std::floor((w->Pos.x + w->Size.x) * sx)),
+                                  int(std::floor((w->Pos.y + w->Size.y) * sy))});
+            }
+    view_->draw(fbWidth, fbHeight, s_.mode, scale_, panels);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     if (!pendingScreenshot_.empty()) {
         try {

@@ -2,7 +2,10 @@
 // the viewer library this binary links).
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "app/viewer/camera_control.h"
+#include "app/viewer/image_view.h"
 #include "app/viewer/viewer_settings.h"
 #include "engine/scene/scene.h"
 
@@ -130,6 +133,46 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
           "threads=x", "garbage"})
         readSettingsLine(bad, line);
     EXPECT_EQ(settingsLines(bad), lines);
+}
+
+}  // namespace
+}  // namespace lancer::viewer
+
+namespace lancer::viewer {
+namespace {
+
+TEST(ImageCopy, UncoveredRectanglesTileExactlyWhatNoPanelCovers) {
+    // What the window copies of the image around opaque panels: every pixel outside the panels
+    // in exactly one rectangle, none inside one; panels may overlap, touch or leave the window.
+    std::mt19937 rng(7);
+    for (int trial = 0; trial < 200; ++trial) {
+        const int w = 40 + int(rng() % 60), h = 30 + int(rng() % 50);
+        std::vector<PixelRect> panels(rng() % 6);
+        for (PixelRect& p : panels) {
+            p.x0 = int(rng() % unsigned(w + 20)) - 10;
+            p.y0 = int(rng() % unsigned(h + 20)) - 10;
+            p.x1 = p.x0 + int(rng() % unsigned(w));
+            p.y1 = p.y0 + int(rng() % unsigned(h));
+        }
+        std::vector<int> count(size_t(w * h), 0);
+        const std::vector<PixelRect> rects = uncovered(w, h, panels);
+        for (const PixelRect& r : rects) {
+            ASSERT_TRUE(0 <= r.x0 && r.x0 < r.x1 && r.x1 <= w && 0 <= r.y0 && r.y0 < r.y1 && r.y1 <= h);
+            for (int y = r.y0; y < r.y1; ++y)
+                for (int x = r.x0; x < r.x1; ++x) ++count[size_t(y * w + x)];
+        }
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                bool covered = false;
+                for (const PixelRect& p : panels)
+                    covered |= x >= p.x0 && x < p.x1 && y >= p.y0 && y < p.y1;
+                ASSERT_EQ(count[size_t(y * w + x)], covered ? 0 : 1)
+                    << "trial " << trial << " pixel " << x << "," << y;
+            }
+        if (panels.empty()) {
+            ASSERT_EQ(rects.size(), 1u);  // the whole window, one copy
+        }
+    }
 }
 
 }  // namespace
