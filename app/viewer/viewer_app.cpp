@@ -89,10 +89,11 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
     }
     pathInput_ = s_.scene.rfind("builtin:", 0) == 0 ? "" : s_.scene;
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
-    // drawn at all (frame()).
+    // drawn at all, and each is copied from its own texture (frame(), PanelCache).
     ImGuiStyle& style = ImGui::GetStyle();
     style.Colors[ImGuiCol_WindowBg].w = 1.0f;
     style.Colors[ImGuiCol_PopupBg].w = 1.0f;
+    style.Colors[ImGuiCol_TitleBgCollapsed].w = 1.0f;
     requestBuild(true, "open scene");
 }
 
@@ -362,7 +363,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
                                   int(std::floor((w->Pos.y + w->Size.y) * sy))});
             }
     view_->draw(fbWidth, fbHeight, s_.mode, scale_, panels);
-    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    panels_.render(ImGui::GetDrawData(), fbWidth, fbHeight);
     if (!pendingScreenshot_.empty()) {
         try {
             saveScreenshot(pendingScreenshot_, fbWidth, fbHeight);

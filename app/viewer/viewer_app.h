@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "app/viewer/image_view.h"
+#include "app/viewer/panel_cache.h"
 #include "app/viewer/structure_builder.h"
 #include "app/viewer/viewer_settings.h"
 #include "engine/render/progressive.h"
@@ -107,6 +108,7 @@ class ViewerApp {
     ViewerSettings& s_;
     bool logTimings_;
     std::unique_ptr<ImageView> view_;
+    PanelCache panels_;  ///< ImGui's panels, each redrawn only when it changed
     StructureBuilder builder_;
     ProgressiveRenderer renderer_;
     std::shared_ptr<const Structure> structure_;

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "app/viewer/image_view.h"
+#include "app/viewer/panel_cache.h"
 #include "app/viewer/viewer_app.h"
 #include "engine/scene/loader.h"
 
@@ -158,6 +159,93 @@ TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnly) {
         const float v = (y >= rowBegin && y < rowEnd ? 7.0f : 1.0f) / 8.0f;
         ASSERT_LE(maxDiff(&hot[4 * a.index(0, y)], colormap(v)), 2) << "row " << y;
     }
+}
+
+TEST(ViewerGl, PanelsFromTheirTexturesMatchImGuisOwnDrawingAndRedrawOnlyWhenChanged) {
+    const int w = 420, h = 300;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;
+    ImGui::GetIO().DisplaySize = ImVec2(float(w), float(h));
+    ASSERT_TRUE(ImGui_ImplOpenGL3_Init("#version 330 core"));
+    ImGuiStyle& style = ImGui::GetStyle();  // opaque panels, as the viewer has them
+    style.Colors[ImGuiCol_WindowBg].w = 1.0f;
+    style.Colors[ImGuiCol_PopupBg].w = 1.0f;
+    style.Colors[ImGuiCol_TitleBgCollapsed].w = 1.0f;
+    {
+        PanelCache cache;
+        // Two panels, one partly off the window, one with a child region and a table; a
+        // counter in the first changes when asked.
+        auto frame = [&](int counter) {
+            ImGui::GetIO().DeltaTime = 1.0f / 60.0f;
+            ImGui_ImplOpenGL3_NewFrame();  // builds the font atlas on the first frame
+            ImGui::NewFrame();
+            ImGui::SetNextWindowPos(ImVec2(10, 10));
+            ImGui::SetNextWindowSize(ImVec2(200, 150));
+            ImGui::Begin("first");
+            ImGui::Text("counter %d", counter);
+            ImGui::Button("a button");
+            float f = 0.5f;
+            ImGui::SliderFloat("slider", &f, 0.0f, 1.0f);
+            ImGui::End();
+            ImGui::SetNextWindowPos(ImVec2(260, 120));
+            ImGui::SetNextWindowSize(ImVec2(220, 220));
+            ImGui::Begin("second");
+            ImGui::BeginChild("child", ImVec2(0, 80), true);
+            for (int i = 0; i < 8; ++i) ImGui::Text("line %d", i);
+            ImGui::EndChild();
+            if (ImGui::BeginTable("t", 2, ImGuiTableFlags_Borders)) {
+                ImGui::TableNextColumn();
+                ImGui::Text("x");
+                ImGui::TableNextColumn();
+                ImGui::Text("y");
+                ImGui::EndTable();
+            }
+            ImGui::End();
+            ImGui::Render();
+        };
+        auto background = [&] {  // stands for the image under the panels
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            glViewport(0, 0, w, h);
+            glClearColor(0.3f, 0.6f, 0.2f, 1.0f);
+            glClear(GL_COLOR_BUFFER_BIT);
+        };
+        // Within 1 of ImGui's own drawing: blended edges (the resize grip's) round by 1 in a few
+        // channels when drawn into the panel's texture.
+        auto near = [](const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
+            if (a.size() != b.size()) return false;
+            for (size_t i = 0; i < a.size(); ++i)
+                if (std::abs(int(a[i]) - int(b[i])) > 1) return false;
+            return true;
+        };
+        for (int warm = 0; warm < 3; ++warm) frame(0);  // let ImGui settle its layout
+        background();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        const std::vector<uint8_t> direct = gl.read();
+        background();
+        cache.render(ImGui::GetDrawData(), w, h);
+        EXPECT_EQ(cache.redrawn(), 2) << "both panels drawn into their textures";
+        EXPECT_TRUE(near(gl.read(), direct)) << "the cached panels must be ImGui's own pixels";
+
+        frame(0);  // the same content: copied, not drawn again
+        background();
+        cache.render(ImGui::GetDrawData(), w, h);
+        EXPECT_EQ(cache.redrawn(), 0);
+        EXPECT_TRUE(near(gl.read(), direct));
+
+        frame(1);  // the counter changes: that panel only
+        background();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        const std::vector<uint8_t> changed = gl.read();
+        EXPECT_FALSE(near(changed, direct));
+        background();
+        cache.render(ImGui::GetDrawData(), w, h);
+        EXPECT_EQ(cache.redrawn(), 1);
+        EXPECT_TRUE(near(gl.read(), changed));
+    }
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui::DestroyContext();
 }
 
 /// Run the whole viewer (panels, progressive render, drawing) until it has settled.
