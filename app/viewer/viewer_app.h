@@ -87,8 +87,6 @@ class ViewerApp {
     void pollBackground();
     /// Upload what the renderer has new, if anything, and log the passes that became visible.
     void takeSnapshot();
-    /// How long a frame waits for the first pass of a change made without dragging.
-    static constexpr std::chrono::milliseconds kFirstPassWait{40};
     void handleInput(int fbWidth, int fbHeight);
     void handleKeys();
     void panels();
