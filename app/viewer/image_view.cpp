@@ -107,17 +107,13 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
     if (rows > 0) {
         // 8 bits per channel, quantised as the PNG writer does: the screen shows what `render`
         // saves.
-        std::vector<uint8_t> rgba = img.rgba8(rowBegin, rowEnd);
         if (mode == ViewMode::Color && !resized && shadedValid_ && shadedMode_ == ViewMode::Color) {
             // The colour shader only copies: the rows go straight into the shaded texture,
             // bottom row first as the FBO holds them, and need no shading (under llvmpipe,
             // shading a whole 1280x720 image took 7 ms of the UI thread). colorTex_ is left
             // behind: a change of mode or size uploads the whole image, through it.
-            const size_t stride = size_t(width_) * 4;
-            std::vector<uint8_t> flipped(rgba.size());
-            for (int r = 0; r < rows; ++r)
-                std::copy_n(rgba.data() + size_t(r) * stride, stride,
-                            flipped.data() + size_t(rows - 1 - r) * stride);
+            std::vector<uint8_t> flipped(size_t(width_) * size_t(rows) * 4);
+            img.rgba8Into(flipped.data(), rowBegin, rowEnd, true);
             glBindTexture(GL_TEXTURE_2D, shadedTex_);
             glTexSubImage2D(GL_TEXTURE_2D, 0, 0, height_ - rowEnd, width_, rows, GL_RGBA,
                             GL_UNSIGNED_BYTE, flipped.data());
@@ -125,6 +121,7 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
             return;
         }
         // Texture row y is image row y, as in the first upload.
+        std::vector<uint8_t> rgba = img.rgba8(rowBegin, rowEnd);
         glBindTexture(GL_TEXTURE_2D, colorTex_);
         glTexSubImage2D(GL_TEXTURE_2D, 0, 0, rowBegin, width_, rows, GL_RGBA, GL_UNSIGNED_BYTE,
                         rgba.data());

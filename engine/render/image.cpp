@@ -38,15 +38,25 @@ std::vector<uint8_t> Image::rgba8(int rowBegin, int rowEnd) const {
     size_t first, last;
     pixelRange(rowBegin, rowEnd, first, last);
     std::vector<uint8_t> out((last - first) * 4);
-    for (size_t i = first; i < last; ++i) {
-        uint8_t* o = &out[4 * (i - first)];
-        for (int c = 0; c < 3; ++c) {
-            float v = std::min(std::max(color[i][c], 0.0f), 1.0f);
-            o[c] = uint8_t(v * 255.0f + 0.5f);
-        }
-        o[3] = 255;
-    }
+    rgba8Into(out.data(), rowBegin, rowEnd, false);
     return out;
+}
+
+void Image::rgba8Into(uint8_t* out, int rowBegin, int rowEnd, bool bottomUp) const {
+    size_t first, last;
+    pixelRange(rowBegin, rowEnd, first, last);
+    const size_t w = size_t(width), rows = w ? (last - first) / w : 0;
+    for (size_t r = 0; r < rows; ++r) {
+        const glm::vec3* src = color.data() + first + r * w;
+        uint8_t* o = out + 4 * w * (bottomUp ? rows - 1 - r : r);
+        for (size_t x = 0; x < w; ++x, o += 4) {
+            for (int c = 0; c < 3; ++c) {
+                const float v = std::min(std::max(src[x][c], 0.0f), 1.0f);
+                o[c] = uint8_t(v * 255.0f + 0.5f);
+            }
+            o[3] = 255;
+        }
+    }
 }
 
 void copyRows(const Image& src, Image& dst, int rowBegin, int rowEnd) {

@@ -26,6 +26,9 @@ struct Image {
     /// 8-bit sRGB-ish bytes (clamped, gamma 1/2.2 not applied: NFF colours are display values)
     /// of rows [rowBegin, rowEnd) (-1: to the last).
     std::vector<uint8_t> rgba8(int rowBegin = 0, int rowEnd = -1) const;
+    /// The same bytes written to `out` (4 x width bytes a row), the rows in the opposite order
+    /// when `bottomUp` (as an OpenGL texture holds them).
+    void rgba8Into(uint8_t* out, int rowBegin, int rowEnd, bool bottomUp) const;
     /// Rows [rowBegin, rowEnd) clamped to the image, as a pixel index range [first, last).
     void pixelRange(int rowBegin, int rowEnd, size_t& first, size_t& last) const;
 };
