@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <unordered_map>
-#include <vector>
 
 #include "app/viewer/gl.h"
 
@@ -38,136 +37,143 @@ uint64_t hashList(uint64_t h, const ImDrawList& l) {
     return h;
 }
 
-/// Draw `lists` through ImGui's OpenGL backend into the bound framebuffer, which shows the
-/// rectangle at `pos` of `size` (framebuffer pixels).
-void drawLists(std::vector<ImDrawList*>& lists, ImVec2 pos, ImVec2 size) {
-    ImDrawData dd;
-    dd.Valid = true;
-    dd.CmdLists = lists.data();
-    dd.CmdListsCount = int(lists.size());
-    for (const ImDrawList* l : lists) {
-        dd.TotalVtxCount += l->VtxBuffer.Size;
-        dd.TotalIdxCount += l->IdxBuffer.Size;
-    }
-    dd.DisplayPos = pos;
-    dd.DisplaySize = size;
-    dd.FramebufferScale = ImVec2(1.0f, 1.0f);
-    ImGui_ImplOpenGL3_RenderDrawData(&dd);
+bool overlap(int ax0, int ay0, int ax1, int ay1, int bx0, int by0, int bx1, int by1) {
+    return ax0 < bx1 && bx0 < ax1 && ay0 < by1 && by0 < ay1;
 }
 
 }  // namespace
 
 PanelCache::~PanelCache() {
-    for (auto& [id, e] : entries_) {
-        glDeleteFramebuffers(1, &e.fbo);
-        glDeleteTextures(1, &e.tex);
-    }
+    if (fbo_) glDeleteFramebuffers(1, &fbo_);
+    if (tex_) glDeleteTextures(1, &tex_);
 }
 
 void PanelCache::render(ImDrawData* dd, int fbWidth, int fbHeight) {
     redrawn_ = 0;
     if (!dd || fbWidth <= 0 || fbHeight <= 0) return;
-    const ImVec2 scale = dd->FramebufferScale;
-    // A rounded panel leaves its corners transparent in its texture: draw everything directly.
+    // Drawn directly when a panel's pixels are not all inside its rectangle and opaque: a
+    // rounded panel leaves its corners transparent, and at a framebuffer scale other than 1 a
+    // panel's anti-aliased border reaches a pixel outside it (blended over the image there,
+    // over nothing in the layer).
     const ImGuiStyle& style = ImGui::GetStyle();
-    if (style.WindowRounding > 0.0f || style.PopupRounding > 0.0f) {
+    if (style.WindowRounding > 0.0f || style.PopupRounding > 0.0f ||
+        dd->FramebufferScale.x != 1.0f || dd->FramebufferScale.y != 1.0f) {
+        last_.clear();
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         ImGui_ImplOpenGL3_RenderDrawData(dd);
         return;
     }
+    bool redrawAll = false;
+    if (w_ != fbWidth || h_ != fbHeight) {
+        if (!tex_) {
+            glGenTextures(1, &tex_);
+            glGenFramebuffers(1, &fbo_);
+        }
+        glBindTexture(GL_TEXTURE_2D, tex_);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, fbWidth, fbHeight, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                     nullptr);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex_, 0);
+        w_ = fbWidth, h_ = fbHeight;
+        redrawAll = true;
+    }
+
     // Which top-level window each draw list belongs to.
     std::unordered_map<const ImDrawList*, ImGuiWindow*> owner;
     for (ImGuiWindow* w : ImGui::GetCurrentContext()->Windows)
         if (w->Active && !w->Hidden) owner[w->DrawList] = w->RootWindow;
-    for (auto& [id, e] : entries_) e.used = false;
 
-    // The lists in drawing order, each run of one window's lists as one panel.
-    std::vector<ImDrawList*> group;
-    ImGuiWindow* groupWindow = nullptr;
-    auto flush = [&] {
-        if (group.empty()) return;
-        if (!groupWindow || (groupWindow->Flags & ImGuiWindowFlags_NoBackground)) {
-            // No window, or one that lets the image show through: drawn directly.
-            glBindFramebuffer(GL_FRAMEBUFFER, 0);
-            ImDrawData direct = *dd;
-            direct.CmdLists = group.data();
-            direct.CmdListsCount = int(group.size());
-            ImGui_ImplOpenGL3_RenderDrawData(&direct);
-            group.clear();
-            return;
-        }
-        // The panel's rectangle in framebuffer pixels, inside the framebuffer.
-        const ImVec2 p = groupWindow->Pos, s = groupWindow->Size;
-        const int x0 = std::max(0, int(std::floor((p.x - dd->DisplayPos.x) * scale.x)));
-        const int y0 = std::max(0, int(std::floor((p.y - dd->DisplayPos.y) * scale.y)));
-        const int x1 = std::min(fbWidth, int(std::ceil((p.x + s.x - dd->DisplayPos.x) * scale.x)));
-        const int y1 = std::min(fbHeight, int(std::ceil((p.y + s.y - dd->DisplayPos.y) * scale.y)));
-        if (x1 > x0 && y1 > y0) {
-            uint64_t h = 1469598103934665603ull;
-            const int rect[4] = {x0, y0, x1, y1};
-            h = hashBytes(h, rect, sizeof rect);
-            for (const ImDrawList* l : group) h = hashList(h, *l);
-            Entry& e = entries_[groupWindow->ID];
-            e.used = true;
-            const int w = x1 - x0, hh = y1 - y0;
-            if (e.tex == 0) {
-                glGenTextures(1, &e.tex);
-                glGenFramebuffers(1, &e.fbo);
-            }
-            if (e.w != w || e.h != hh) {
-                glBindTexture(GL_TEXTURE_2D, e.tex);
-                glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, hh, 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                             nullptr);
-                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-                glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-                glBindTexture(GL_TEXTURE_2D, 0);
-                glBindFramebuffer(GL_FRAMEBUFFER, e.fbo);
-                glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D,
-                                       e.tex, 0);
-                e.hash = 0;
-            }
-            if (e.hash != h || e.x0 != x0 || e.y0 != y0 || e.w != w || e.h != hh) {
-                glBindFramebuffer(GL_FRAMEBUFFER, e.fbo);
-                glDisable(GL_SCISSOR_TEST);
-                glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-                glClear(GL_COLOR_BUFFER_BIT);
-                drawLists(group, ImVec2(dd->DisplayPos.x + float(x0) / scale.x,
-                                        dd->DisplayPos.y + float(y0) / scale.y),
-                          ImVec2(float(w) / scale.x, float(hh) / scale.y));
-                e.hash = h;
-                ++redrawn_;
-            }
-            e.x0 = x0, e.y0 = y0, e.w = w, e.h = hh;
-            glBindFramebuffer(GL_READ_FRAMEBUFFER, e.fbo);
-            glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
-            glDisable(GL_SCISSOR_TEST);
-            glBlitFramebuffer(0, 0, w, hh, x0, fbHeight - y1, x1, fbHeight - y0,
-                              GL_COLOR_BUFFER_BIT, GL_NEAREST);
-            glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        }
-        group.clear();
+    // The draw data as runs: a panel's lists (a window and its children), or lists drawn
+    // directly (no window, or a window without a background).
+    struct Run {
+        ImGuiWindow* window = nullptr;
+        std::vector<ImDrawList*> lists;
+        Panel panel;
     };
+    std::vector<Run> runs;
     for (int i = 0; i < dd->CmdListsCount; ++i) {
         ImDrawList* l = dd->CmdLists[i];
         auto it = owner.find(l);
         ImGuiWindow* w = it == owner.end() ? nullptr : it->second;
-        if (w != groupWindow || !w) flush();
-        groupWindow = w;
-        group.push_back(l);
+        if (w && (w->Flags & ImGuiWindowFlags_NoBackground)) w = nullptr;
+        if (runs.empty() || runs.back().window != w || !w) runs.push_back({w, {}, {}});
+        runs.back().lists.push_back(l);
     }
-    flush();
+    const ImVec2 scale = dd->FramebufferScale;
+    std::vector<Panel> panels;
+    for (Run& r : runs) {
+        if (!r.window) continue;
+        const ImVec2 p = r.window->Pos, s = r.window->Size;
+        Panel& q = r.panel;
+        q.id = r.window->ID;
+        q.x0 = std::max(0, int(std::floor((p.x - dd->DisplayPos.x) * scale.x)));
+        q.y0 = std::max(0, int(std::floor((p.y - dd->DisplayPos.y) * scale.y)));
+        q.x1 = std::min(fbWidth, int(std::ceil((p.x + s.x - dd->DisplayPos.x) * scale.x)));
+        q.y1 = std::min(fbHeight, int(std::ceil((p.y + s.y - dd->DisplayPos.y) * scale.y)));
+        q.hash = 1469598103934665603ull;
+        for (const ImDrawList* l : r.lists) q.hash = hashList(q.hash, *l);
+        panels.push_back(q);
+    }
+    // A panel that moved, appeared, vanished or changed places leaves the layer stale where it
+    // was: then every panel is drawn again (windows move rarely; a tooltip follows the mouse).
+    bool sameLayout = panels.size() == last_.size();
+    for (size_t i = 0; sameLayout && i < panels.size(); ++i) {
+        const Panel &a = panels[i], &b = last_[i];
+        sameLayout = a.id == b.id && a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 && a.y1 == b.y1;
+    }
+    if (!sameLayout) redrawAll = true;
+    // Otherwise a panel whose content changed is drawn again, with every panel above that
+    // overlaps it (drawing it covers their pixels in the layer).
+    std::vector<char> dirty(panels.size(), redrawAll ? 1 : 0);
+    for (size_t i = 0; !redrawAll && i < panels.size(); ++i) {
+        if (panels[i].hash != last_[i].hash) dirty[i] = 1;
+        if (!dirty[i]) continue;
+        for (size_t j = i + 1; j < panels.size(); ++j)
+            if (overlap(panels[i].x0, panels[i].y0, panels[i].x1, panels[i].y1, panels[j].x0,
+                        panels[j].y0, panels[j].x1, panels[j].y1))
+                dirty[j] = 1;
+    }
+
+    size_t k = 0;  // index of the next panel
+    for (Run& r : runs) {
+        if (!r.window) {
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            ImDrawData direct = *dd;
+            direct.CmdLists = r.lists.data();
+            direct.CmdListsCount = int(r.lists.size());
+            ImGui_ImplOpenGL3_RenderDrawData(&direct);
+            continue;
+        }
+        const Panel& q = panels[k];
+        const bool redraw = dirty[k++] != 0;
+        if (q.x1 <= q.x0 || q.y1 <= q.y0) continue;  // off the framebuffer
+        if (redraw) {
+            // Into the layer as ImGui draws on the framebuffer: the same projection and pixels.
+            glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+            glEnable(GL_SCISSOR_TEST);
+            glScissor(q.x0, fbHeight - q.y1, q.x1 - q.x0, q.y1 - q.y0);
+            glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+            glClear(GL_COLOR_BUFFER_BIT);
+            glDisable(GL_SCISSOR_TEST);
+            ImDrawData one = *dd;
+            one.CmdLists = r.lists.data();
+            one.CmdListsCount = int(r.lists.size());
+            ImGui_ImplOpenGL3_RenderDrawData(&one);
+            ++redrawn_;
+        }
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+        glDisable(GL_SCISSOR_TEST);
+        const int gy0 = fbHeight - q.y1, gy1 = fbHeight - q.y0;  // GL's rows go up
+        glBlitFramebuffer(q.x0, gy0, q.x1, gy1, q.x0, gy0, q.x1, gy1, GL_COLOR_BUFFER_BIT,
+                          GL_NEAREST);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
-    // Panels gone since the last frame.
-    for (auto it = entries_.begin(); it != entries_.end();) {
-        if (!it->second.used) {
-            glDeleteFramebuffers(1, &it->second.fbo);
-            glDeleteTextures(1, &it->second.tex);
-            it = entries_.erase(it);
-        } else {
-            ++it;
-        }
-    }
+    last_ = std::move(panels);
 }
 
 }  // namespace lancer::viewer

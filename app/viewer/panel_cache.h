@@ -1,14 +1,18 @@
-// ImGui's panels drawn from textures: each top-level window (with its child windows) is
-// rasterized into a texture of its own only when its draw lists changed, and copied to the
-// framebuffer every frame. Under software GL (llvmpipe) rasterizing the panels cost 8-11 ms a
-// frame; copying a panel that did not change costs a third of drawing it. Needs the panels
-// opaque (ViewerApp makes them so): a panel's texture replaces the pixels under it.
+// ImGui's panels drawn from a layer: every top-level window (with its child windows) is
+// rasterized into one framebuffer-sized texture only when its draw lists changed, and its
+// rectangle is copied from there to the framebuffer every frame. Under software GL (llvmpipe)
+// rasterizing the panels cost 8-11 ms a frame; copying a panel that did not change costs a
+// third of drawing it. The panels are drawn into the layer exactly as ImGui would draw them on
+// the framebuffer (same projection, same pixels), so they must be opaque (ViewerApp makes them
+// so): a panel's rectangle replaces the pixels under it. At a framebuffer scale other than 1,
+// or with rounded windows, the panels are drawn directly.
 #pragma once
 
 #include <imgui.h>
 
 #include <cstdint>
 #include <unordered_map>
+#include <vector>
 
 namespace lancer::viewer {
 
@@ -27,13 +31,14 @@ class PanelCache {
     int redrawn() const { return redrawn_; }
 
   private:
-    struct Entry {
+    struct Panel {
+        unsigned id = 0;
         uint64_t hash = 0;
-        unsigned tex = 0, fbo = 0;
-        int x0 = 0, y0 = 0, w = 0, h = 0;  ///< the panel's rectangle, row 0 at the top
-        bool used = false;
+        int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  ///< framebuffer pixels, row 0 at the top
     };
-    std::unordered_map<unsigned, Entry> entries_;  ///< by the root window's ImGuiID
+    std::vector<Panel> last_;  ///< last frame's panels, bottom to top
+    unsigned tex_ = 0, fbo_ = 0;
+    int w_ = 0, h_ = 0;
     int redrawn_ = 0;
 };
 

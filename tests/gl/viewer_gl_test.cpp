@@ -243,6 +243,31 @@ TEST(ViewerGl, PanelsFromTheirTexturesMatchImGuisOwnDrawingAndRedrawOnlyWhenChan
         cache.render(ImGui::GetDrawData(), w, h);
         EXPECT_EQ(cache.redrawn(), 1);
         EXPECT_TRUE(near(gl.read(), changed));
+
+        // A high-density display (ImGui's units are 2 framebuffer pixels): a panel's border
+        // reaches a pixel outside its rectangle there, so the panels are drawn directly.
+        ImGui::GetIO().DisplaySize = ImVec2(float(w) / 2, float(h) / 2);
+        ImGui::GetIO().DisplayFramebufferScale = ImVec2(2.0f, 2.0f);
+        for (int warm = 0; warm < 3; ++warm) frame(2);
+        background();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        const std::vector<uint8_t> dense = gl.read();
+        background();
+        cache.render(ImGui::GetDrawData(), w, h);
+        EXPECT_EQ(cache.redrawn(), 0);
+        EXPECT_EQ(gl.read(), dense) << "at a framebuffer scale of 2";
+        // Back at scale 1 with the second panel off the right and bottom edges: the layer is
+        // drawn again and still matches.
+        ImGui::GetIO().DisplaySize = ImVec2(float(w), float(h));
+        ImGui::GetIO().DisplayFramebufferScale = ImVec2(1.0f, 1.0f);
+        for (int warm = 0; warm < 3; ++warm) frame(3);
+        background();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        const std::vector<uint8_t> again = gl.read();
+        background();
+        cache.render(ImGui::GetDrawData(), w, h);
+        EXPECT_EQ(cache.redrawn(), 2);
+        EXPECT_TRUE(near(gl.read(), again));
     }
     ImGui_ImplOpenGL3_Shutdown();
     ImGui::DestroyContext();
