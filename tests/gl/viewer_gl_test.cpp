@@ -219,55 +219,53 @@ TEST(ViewerGl, PanelsFromTheirTexturesMatchImGuisOwnDrawingAndRedrawOnlyWhenChan
                 if (std::abs(int(a[i]) - int(b[i])) > 1) return false;
             return true;
         };
+        // The frame's draw data drawn by ImGui's backend, then through the cache, each over the
+        // background: both images.
+        struct Drawn {
+            std::vector<uint8_t> direct, cached;
+        };
+        auto drawBoth = [&] {
+            Drawn d;
+            background();
+            ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+            d.direct = gl.read();
+            background();
+            cache.render(ImGui::GetDrawData(), w, h);
+            d.cached = gl.read();
+            return d;
+        };
         for (int warm = 0; warm < 3; ++warm) frame(0);  // let ImGui settle its layout
-        background();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        const std::vector<uint8_t> direct = gl.read();
-        background();
-        cache.render(ImGui::GetDrawData(), w, h);
-        EXPECT_EQ(cache.redrawn(), 2) << "both panels drawn into their textures";
-        EXPECT_TRUE(near(gl.read(), direct)) << "the cached panels must be ImGui's own pixels";
+        const Drawn first = drawBoth();
+        EXPECT_EQ(cache.redrawn(), 2) << "both panels drawn into the layer";
+        EXPECT_TRUE(near(first.cached, first.direct)) << "the panels must be ImGui's own pixels";
 
         frame(0);  // the same content: copied, not drawn again
-        background();
-        cache.render(ImGui::GetDrawData(), w, h);
+        const Drawn same = drawBoth();
         EXPECT_EQ(cache.redrawn(), 0);
-        EXPECT_TRUE(near(gl.read(), direct));
+        EXPECT_TRUE(near(same.cached, first.direct));
 
         frame(1);  // the counter changes: that panel only
-        background();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        const std::vector<uint8_t> changed = gl.read();
-        EXPECT_FALSE(near(changed, direct));
-        background();
-        cache.render(ImGui::GetDrawData(), w, h);
+        const Drawn changed = drawBoth();
+        EXPECT_FALSE(near(changed.direct, first.direct));
         EXPECT_EQ(cache.redrawn(), 1);
-        EXPECT_TRUE(near(gl.read(), changed));
+        EXPECT_TRUE(near(changed.cached, changed.direct));
 
         // A high-density display (ImGui's units are 2 framebuffer pixels): a panel's border
         // reaches a pixel outside its rectangle there, so the panels are drawn directly.
         ImGui::GetIO().DisplaySize = ImVec2(float(w) / 2, float(h) / 2);
         ImGui::GetIO().DisplayFramebufferScale = ImVec2(2.0f, 2.0f);
         for (int warm = 0; warm < 3; ++warm) frame(2);
-        background();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        const std::vector<uint8_t> dense = gl.read();
-        background();
-        cache.render(ImGui::GetDrawData(), w, h);
+        const Drawn dense = drawBoth();
         EXPECT_EQ(cache.redrawn(), 0);
-        EXPECT_EQ(gl.read(), dense) << "at a framebuffer scale of 2";
+        EXPECT_EQ(dense.cached, dense.direct) << "at a framebuffer scale of 2";
         // Back at scale 1 with the second panel off the right and bottom edges: the layer is
         // drawn again and still matches.
         ImGui::GetIO().DisplaySize = ImVec2(float(w), float(h));
         ImGui::GetIO().DisplayFramebufferScale = ImVec2(1.0f, 1.0f);
         for (int warm = 0; warm < 3; ++warm) frame(3);
-        background();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        const std::vector<uint8_t> again = gl.read();
-        background();
-        cache.render(ImGui::GetDrawData(), w, h);
+        const Drawn again = drawBoth();
         EXPECT_EQ(cache.redrawn(), 2);
-        EXPECT_TRUE(near(gl.read(), again));
+        EXPECT_TRUE(near(again.cached, again.direct));
     }
     ImGui_ImplOpenGL3_Shutdown();
     ImGui::DestroyContext();
