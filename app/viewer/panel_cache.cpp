@@ -37,8 +37,22 @@ uint64_t hashList(uint64_t h, const ImDrawList& l) {
     return h;
 }
 
-bool overlap(int ax0, int ay0, int ax1, int ay1, int bx0, int by0, int bx1, int by1) {
-    return ax0 < bx1 && bx0 < ax1 && ay0 < by1 && by0 < ay1;
+bool empty(const PixelRect& r) { return r.x1 <= r.x0 || r.y1 <= r.y0; }
+
+bool overlap(const PixelRect& a, const PixelRect& b) {
+    return a.x0 < b.x1 && b.x0 < a.x1 && a.y0 < b.y1 && b.y0 < a.y1;
+}
+
+bool operator==(const PixelRect& a, const PixelRect& b) {
+    return a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 && a.y1 == b.y1;
+}
+
+/// `dd` with only `lists`, drawn by ImGui's backend into the bound framebuffer.
+void drawLists(const ImDrawData& dd, std::vector<ImDrawList*>& lists) {
+    ImDrawData part = dd;
+    part.CmdLists = lists.data();
+    part.CmdListsCount = int(lists.size());
+    ImGui_ImplOpenGL3_RenderDrawData(&part);
 }
 
 }  // namespace
@@ -48,21 +62,62 @@ PanelCache::~PanelCache() {
     if (tex_) glDeleteTextures(1, &tex_);
 }
 
-void PanelCache::render(ImDrawData* dd, int fbWidth, int fbHeight) {
-    redrawn_ = 0;
-    if (!dd || fbWidth <= 0 || fbHeight <= 0) return;
+const std::vector<PixelRect>& PanelCache::layout(ImDrawData* dd, int fbWidth, int fbHeight) {
+    dd_ = dd;
+    fbWidth_ = fbWidth, fbHeight_ = fbHeight;
+    runs_.clear();
+    panels_.clear();
+    covered_.clear();
     // Drawn directly when a panel's pixels are not all inside its rectangle and opaque: a
     // rounded panel leaves its corners transparent, and at a framebuffer scale other than 1 a
     // panel's anti-aliased border reaches a pixel outside it (blended over the image there,
     // over nothing in the layer).
     const ImGuiStyle& style = ImGui::GetStyle();
-    if (style.WindowRounding > 0.0f || style.PopupRounding > 0.0f ||
-        dd->FramebufferScale.x != 1.0f || dd->FramebufferScale.y != 1.0f) {
+    direct_ = !dd || fbWidth <= 0 || fbHeight <= 0 || style.WindowRounding > 0.0f ||
+              style.PopupRounding > 0.0f || dd->FramebufferScale.x != 1.0f ||
+              dd->FramebufferScale.y != 1.0f;
+    if (direct_) return covered_;
+
+    // Which top-level window each draw list belongs to.
+    std::unordered_map<const ImDrawList*, const ImGuiWindow*> owner;
+    for (const ImGuiWindow* w : ImGui::GetCurrentContext()->Windows)
+        if (w->Active && !w->Hidden) owner[w->DrawList] = w->RootWindow;
+    for (int i = 0; i < dd->CmdListsCount; ++i) {
+        ImDrawList* l = dd->CmdLists[i];
+        auto it = owner.find(l);
+        const ImGuiWindow* w = it == owner.end() ? nullptr : it->second;
+        if (w && (w->Flags & ImGuiWindowFlags_NoBackground)) w = nullptr;
+        if (runs_.empty() || runs_.back().window != w || !w) runs_.push_back({w, {}, -1});
+        runs_.back().lists.push_back(l);
+    }
+    for (Run& r : runs_) {
+        if (!r.window) continue;
+        const ImVec2 s = r.window->Size;
+        const ImVec2 p(r.window->Pos.x - dd->DisplayPos.x, r.window->Pos.y - dd->DisplayPos.y);
+        Panel q;
+        q.id = r.window->ID;
+        q.rect = {std::max(0, int(std::floor(p.x))), std::max(0, int(std::floor(p.y))),
+                  std::min(fbWidth, int(std::ceil(p.x + s.x))),
+                  std::min(fbHeight, int(std::ceil(p.y + s.y)))};
+        q.hash = 1469598103934665603ull;
+        for (const ImDrawList* l : r.lists) q.hash = hashList(q.hash, *l);
+        r.panel = int(panels_.size());
+        panels_.push_back(q);
+        if (!empty(q.rect)) covered_.push_back(q.rect);
+    }
+    return covered_;
+}
+
+void PanelCache::render() {
+    redrawn_ = 0;
+    if (!dd_) return;
+    if (direct_) {
         last_.clear();
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        ImGui_ImplOpenGL3_RenderDrawData(dd);
+        ImGui_ImplOpenGL3_RenderDrawData(dd_);
         return;
     }
+    const int fbWidth = fbWidth_, fbHeight = fbHeight_;
     bool redrawAll = false;
     if (w_ != fbWidth || h_ != fbHeight) {
         if (!tex_) {
@@ -80,100 +135,51 @@ void PanelCache::render(ImDrawData* dd, int fbWidth, int fbHeight) {
         w_ = fbWidth, h_ = fbHeight;
         redrawAll = true;
     }
-
-    // Which top-level window each draw list belongs to.
-    std::unordered_map<const ImDrawList*, ImGuiWindow*> owner;
-    for (ImGuiWindow* w : ImGui::GetCurrentContext()->Windows)
-        if (w->Active && !w->Hidden) owner[w->DrawList] = w->RootWindow;
-
-    // The draw data as runs: a panel's lists (a window and its children), or lists drawn
-    // directly (no window, or a window without a background).
-    struct Run {
-        ImGuiWindow* window = nullptr;
-        std::vector<ImDrawList*> lists;
-        Panel panel;
-    };
-    std::vector<Run> runs;
-    for (int i = 0; i < dd->CmdListsCount; ++i) {
-        ImDrawList* l = dd->CmdLists[i];
-        auto it = owner.find(l);
-        ImGuiWindow* w = it == owner.end() ? nullptr : it->second;
-        if (w && (w->Flags & ImGuiWindowFlags_NoBackground)) w = nullptr;
-        if (runs.empty() || runs.back().window != w || !w) runs.push_back({w, {}, {}});
-        runs.back().lists.push_back(l);
-    }
-    const ImVec2 scale = dd->FramebufferScale;
-    std::vector<Panel> panels;
-    for (Run& r : runs) {
-        if (!r.window) continue;
-        const ImVec2 p = r.window->Pos, s = r.window->Size;
-        Panel& q = r.panel;
-        q.id = r.window->ID;
-        q.x0 = std::max(0, int(std::floor((p.x - dd->DisplayPos.x) * scale.x)));
-        q.y0 = std::max(0, int(std::floor((p.y - dd->DisplayPos.y) * scale.y)));
-        q.x1 = std::min(fbWidth, int(std::ceil((p.x + s.x - dd->DisplayPos.x) * scale.x)));
-        q.y1 = std::min(fbHeight, int(std::ceil((p.y + s.y - dd->DisplayPos.y) * scale.y)));
-        q.hash = 1469598103934665603ull;
-        for (const ImDrawList* l : r.lists) q.hash = hashList(q.hash, *l);
-        panels.push_back(q);
-    }
     // A panel that moved, appeared, vanished or changed places leaves the layer stale where it
     // was: then every panel is drawn again (windows move rarely; a tooltip follows the mouse).
-    bool sameLayout = panels.size() == last_.size();
-    for (size_t i = 0; sameLayout && i < panels.size(); ++i) {
-        const Panel &a = panels[i], &b = last_[i];
-        sameLayout = a.id == b.id && a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 && a.y1 == b.y1;
-    }
+    bool sameLayout = panels_.size() == last_.size();
+    for (size_t i = 0; sameLayout && i < panels_.size(); ++i)
+        sameLayout = panels_[i].id == last_[i].id && panels_[i].rect == last_[i].rect;
     if (!sameLayout) redrawAll = true;
     // Otherwise a panel whose content changed is drawn again, with every panel above that
     // overlaps it (drawing it covers their pixels in the layer).
-    std::vector<char> dirty(panels.size(), redrawAll ? 1 : 0);
-    for (size_t i = 0; !redrawAll && i < panels.size(); ++i) {
-        if (panels[i].hash != last_[i].hash) dirty[i] = 1;
+    std::vector<char> dirty(panels_.size(), redrawAll ? 1 : 0);
+    for (size_t i = 0; !redrawAll && i < panels_.size(); ++i) {
+        if (panels_[i].hash != last_[i].hash) dirty[i] = 1;
         if (!dirty[i]) continue;
-        for (size_t j = i + 1; j < panels.size(); ++j)
-            if (overlap(panels[i].x0, panels[i].y0, panels[i].x1, panels[i].y1, panels[j].x0,
-                        panels[j].y0, panels[j].x1, panels[j].y1))
-                dirty[j] = 1;
+        for (size_t j = i + 1; j < panels_.size(); ++j)
+            if (overlap(panels_[i].rect, panels_[j].rect)) dirty[j] = 1;
     }
 
-    size_t k = 0;  // index of the next panel
-    for (Run& r : runs) {
-        if (!r.window) {
+    for (Run& r : runs_) {
+        if (r.panel < 0) {
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
-            ImDrawData direct = *dd;
-            direct.CmdLists = r.lists.data();
-            direct.CmdListsCount = int(r.lists.size());
-            ImGui_ImplOpenGL3_RenderDrawData(&direct);
+            drawLists(*dd_, r.lists);
             continue;
         }
-        const Panel& q = panels[k];
-        const bool redraw = dirty[k++] != 0;
-        if (q.x1 <= q.x0 || q.y1 <= q.y0) continue;  // off the framebuffer
-        if (redraw) {
+        const PixelRect& q = panels_[size_t(r.panel)].rect;
+        if (empty(q)) continue;  // off the framebuffer
+        const int gy0 = fbHeight - q.y1, gy1 = fbHeight - q.y0;  // GL's rows go up
+        if (dirty[size_t(r.panel)]) {
             // Into the layer as ImGui draws on the framebuffer: the same projection and pixels.
             glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
             glEnable(GL_SCISSOR_TEST);
-            glScissor(q.x0, fbHeight - q.y1, q.x1 - q.x0, q.y1 - q.y0);
+            glScissor(q.x0, gy0, q.x1 - q.x0, q.y1 - q.y0);
             glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
             glClear(GL_COLOR_BUFFER_BIT);
             glDisable(GL_SCISSOR_TEST);
-            ImDrawData one = *dd;
-            one.CmdLists = r.lists.data();
-            one.CmdListsCount = int(r.lists.size());
-            ImGui_ImplOpenGL3_RenderDrawData(&one);
+            drawLists(*dd_, r.lists);
             ++redrawn_;
         }
         glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
         glDisable(GL_SCISSOR_TEST);
-        const int gy0 = fbHeight - q.y1, gy1 = fbHeight - q.y0;  // GL's rows go up
         glBlitFramebuffer(q.x0, gy0, q.x1, gy1, q.x0, gy0, q.x1, gy1, GL_COLOR_BUFFER_BIT,
                           GL_NEAREST);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
-    last_ = std::move(panels);
+    last_ = panels_;
 }
 
 }  // namespace lancer::viewer

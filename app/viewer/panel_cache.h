@@ -10,9 +10,12 @@
 
 #include <imgui.h>
 
+struct ImGuiWindow;  // imgui_internal.h
+
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
+
+#include "app/viewer/image_view.h"  // PixelRect
 
 namespace lancer::viewer {
 
@@ -23,10 +26,13 @@ class PanelCache {
     PanelCache(const PanelCache&) = delete;
     PanelCache& operator=(const PanelCache&) = delete;
 
-    /// Draw `dd` (ImGui::GetDrawData(), after ImGui::Render()) into framebuffer 0 of
-    /// fbWidth x fbHeight pixels, as ImGui_ImplOpenGL3_RenderDrawData does. Draw lists that
-    /// belong to no window (the foreground and background lists) are drawn directly.
-    void render(ImDrawData* dd, int fbWidth, int fbHeight);
+    /// Take the frame's draw data (ImGui::GetDrawData(), after ImGui::Render()) for framebuffer
+    /// 0 of fbWidth x fbHeight pixels. Returns the rectangles render() will fill with opaque
+    /// panels (none when it draws them directly): what lies under them need not be drawn.
+    const std::vector<PixelRect>& layout(ImDrawData* dd, int fbWidth, int fbHeight);
+    /// Draw the draw data given to layout(), as ImGui_ImplOpenGL3_RenderDrawData does. Draw
+    /// lists that belong to no window (the foreground and background lists) are drawn directly.
+    void render();
     /// Panels rasterized again by the last render() (for tests and timings).
     int redrawn() const { return redrawn_; }
 
@@ -34,11 +40,27 @@ class PanelCache {
     struct Panel {
         unsigned id = 0;
         uint64_t hash = 0;
-        int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  ///< framebuffer pixels, row 0 at the top
+        PixelRect rect;  ///< inside the framebuffer; empty when the window is off it
     };
-    std::vector<Panel> last_;  ///< last frame's panels, bottom to top
+    /// A run of the draw data: a panel's lists (a window and its children), or lists drawn
+    /// directly (panel < 0: no window, or a window without a background).
+    struct Run {
+        const ImGuiWindow* window = nullptr;
+        std::vector<ImDrawList*> lists;
+        int panel = -1;
+    };
+
+    // This frame, from layout().
+    ImDrawData* dd_ = nullptr;
+    int fbWidth_ = 0, fbHeight_ = 0;
+    bool direct_ = true;
+    std::vector<Run> runs_;
+    std::vector<Panel> panels_;  ///< bottom to top
+    std::vector<PixelRect> covered_;
+
+    std::vector<Panel> last_;  ///< the last frame drawn through the layer
     unsigned tex_ = 0, fbo_ = 0;
-    int w_ = 0, h_ = 0;
+    int w_ = 0, h_ = 0;  ///< the layer's size
     int redrawn_ = 0;
 };
 

@@ -89,7 +89,8 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
     }
     pathInput_ = s_.scene.rfind("builtin:", 0) == 0 ? "" : s_.scene;
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
-    // drawn at all, and each is copied from its own texture (frame(), PanelCache).
+    // drawn at all, and each is copied from a layer where it is redrawn only when it changes
+    // (frame(), PanelCache).
     ImGuiStyle& style = ImGui::GetStyle();
     style.Colors[ImGuiCol_WindowBg].w = 1.0f;
     style.Colors[ImGuiCol_PopupBg].w = 1.0f;
@@ -344,21 +345,10 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
     }
-    // The panels drawn next are opaque and, unrounded, cover their rectangles: the image is
-    // copied only around them.
-    std::vector<PixelRect> panels;
-    const ImGuiIO& io = ImGui::GetIO();
-    if (ImGui::GetStyle().WindowRounding == 0.0f)
-        for (const ImGuiWindow* w : ImGui::GetCurrentContext()->Windows)
-            if (w->Active && !w->Hidden &&
-                !(w->Flags & (ImGuiWindowFlags_ChildWindow | ImGuiWindowFlags_NoBackground))) {
-                const float sx = io.DisplayFramebufferScale.x, sy = io.DisplayFramebufferScale.y;
-                panels.push_back({int(std::ceil(w->Pos.x * sx)), int(std::ceil(w->Pos.y * sy)),
-                                  int(std::floor((w->Pos.x + w->Size.x) * sx)),
-                                  int(std::floor((w->Pos.y + w->Size.y) * sy))});
-            }
-    view_->draw(fbWidth, fbHeight, s_.mode, scale_, panels);
-    panels_.render(ImGui::GetDrawData(), fbWidth, fbHeight);
+    // The image is copied only around the opaque panels drawn over it next.
+    view_->draw(fbWidth, fbHeight, s_.mode, scale_,
+                panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight));
+    panels_.render();
     if (!pendingScreenshot_.empty()) {
         try {
             saveScreenshot(pendingScreenshot_, fbWidth, fbHeight);

@@ -174,9 +174,8 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             // change or each finer pass at once too (the workers post an empty event); idle once
             // settled. While a render only refines a pass band by band and nobody interacts, its
             // bands (and the progress bar) are shown at most kRefineHz times a second: each
-            // frame drawn takes CPU from
-            // the render threads (33 ms of it per frame under llvmpipe and Xvfb). A scripted
-            // run (--frames) counts its frames quickly once the image is complete.
+            // frame drawn takes CPU from the render threads. A scripted run (--frames) counts
+            // its frames quickly once the image is complete.
             if (v.continuous || (v.frames > 0 && app.settled())) {
                 glfwPollEvents();
             } else if (app.settled()) {

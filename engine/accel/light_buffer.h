@@ -77,16 +77,6 @@ class LightBuffer {
         return count;
     }
 
-    /// For the shadow ray from `o` along `dir` toward light `light`: the t beyond which nothing
-    /// can block it. <= 0: nothing can; +inf: the buffer does not know (the light is inside the
-    /// bounds, or `o` outside them).
-    double freeFrom(const Vec3& o, const Vec3& dir, uint32_t light) const {
-        double d, rate;
-        const Slot* bin = shadowBin(o, dir, light, d, rate);
-        // Past its bin's least depth (widened by the rounding allowance, in t units).
-        return bin ? (d - bin[0].near + hair_) / rate : kInf;
-    }
-
     /// For a ray leaving point `point` itself along `dir` (a primary ray from the eye): a t
     /// before which it can meet nothing. 0 when the buffer does not know.
     double nearFrom(const Vec3& dir, uint32_t point) const {

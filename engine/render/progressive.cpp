@@ -104,11 +104,6 @@ uint64_t ProgressiveRenderer::job() const {
     return jobs_;
 }
 
-bool ProgressiveRenderer::waitForJob(uint64_t job, std::chrono::microseconds timeout) const {
-    std::unique_lock lock(mutex_);
-    return shown_.wait_for(lock, timeout, [&] { return displayShown_.job == job; });
-}
-
 ProgressiveRenderer::Shown ProgressiveRenderer::latest() const {
     std::lock_guard lock(mutex_);
     return displayShown_;
@@ -209,7 +204,6 @@ void ProgressiveRenderer::run() {
                     passes_.push_back(rec);
                 }
                 lock.unlock();
-                shown_.notify_all();
                 if (onPass_) onPass_();
             }
             if (!complete) break;

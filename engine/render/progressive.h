@@ -86,9 +86,6 @@ class ProgressiveRenderer {
     /// The number of the last job started (1 for the first; 0: none yet). A caller whose last
     /// snapshot has another number has not yet seen anything of the current job.
     uint64_t job() const;
-    /// Wait until something of job `job` can be snapshot (its first pass, at least), at most
-    /// `timeout`. True if it can.
-    bool waitForJob(uint64_t job, std::chrono::microseconds timeout) const;
     /// If a band or pass finished since `version`, bring `out` up to date with the displayable
     /// image, update `version` and return true; `shown` (if given) tells what the image holds
     /// and which rows changed. Only the rows written since the last snapshot are copied, so
@@ -113,7 +110,6 @@ class ProgressiveRenderer {
     std::vector<int> strides_;
     mutable std::mutex mutex_;
     std::condition_variable wake_;
-    mutable std::condition_variable shown_;  ///< notified when the display changes
     std::unique_ptr<ProgressiveJob> pending_;
     uint64_t jobs_ = 0;  ///< jobs started
     Clock::time_point pendingRequested_;

@@ -223,6 +223,7 @@ TEST(ViewerGl, PanelsFromTheirTexturesMatchImGuisOwnDrawingAndRedrawOnlyWhenChan
         // background: both images.
         struct Drawn {
             std::vector<uint8_t> direct, cached;
+            size_t covered = 0;  ///< rectangles the cache said its panels fill
         };
         auto drawBoth = [&] {
             Drawn d;
@@ -230,13 +231,15 @@ TEST(ViewerGl, PanelsFromTheirTexturesMatchImGuisOwnDrawingAndRedrawOnlyWhenChan
             ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
             d.direct = gl.read();
             background();
-            cache.render(ImGui::GetDrawData(), w, h);
+            d.covered = cache.layout(ImGui::GetDrawData(), w, h).size();
+            cache.render();
             d.cached = gl.read();
             return d;
         };
         for (int warm = 0; warm < 3; ++warm) frame(0);  // let ImGui settle its layout
         const Drawn first = drawBoth();
         EXPECT_EQ(cache.redrawn(), 2) << "both panels drawn into the layer";
+        EXPECT_EQ(first.covered, 2u);
         EXPECT_TRUE(near(first.cached, first.direct)) << "the panels must be ImGui's own pixels";
 
         frame(0);  // the same content: copied, not drawn again
@@ -258,6 +261,7 @@ TEST(ViewerGl, PanelsFromTheirTexturesMatchImGuisOwnDrawingAndRedrawOnlyWhenChan
         const Drawn dense = drawBoth();
         EXPECT_EQ(cache.redrawn(), 0);
         EXPECT_EQ(dense.cached, dense.direct) << "at a framebuffer scale of 2";
+        EXPECT_EQ(dense.covered, 0u) << "drawn directly, the panels let the image be drawn whole";
         // Back at scale 1 with the second panel off the right and bottom edges: the layer is
         // drawn again and still matches.
         ImGui::GetIO().DisplaySize = ImVec2(float(w), float(h));

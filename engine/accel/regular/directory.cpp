@@ -22,10 +22,6 @@ std::string AxisSchedule::toString(int levels) const {
     return out;
 }
 
-bool AxisSchedule::operator==(const AxisSchedule& o) const {
-    return std::equal(axis_, axis_ + kLevels, o.axis_);
-}
-
 int Directory::tableLevels(int level, int height, int finestLevel, bool full) {
     if (full) return finestLevel - level;
     return std::min(height, level == 0 ? kTopLevels : kSubTableLevels);

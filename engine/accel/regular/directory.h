@@ -28,7 +28,6 @@ class AxisSchedule {
     int cuts(int level, int axis) const { return cuts_[level][axis]; }
     /// The first `levels` axes as letters, e.g. "xyxyxyxyzxyz".
     std::string toString(int levels) const;
-    bool operator==(const AxisSchedule& o) const;
 
   private:
     uint8_t axis_[kLevels] = {};
