@@ -12,65 +12,89 @@
 using namespace lancer;
 
 int main(int argc, char** argv) {
-    CLI::App app{"lancer: see and measure how space subdivision accelerates ray tracing of CSG solids"};
+    CLI::App app{
+        "lancer: see and measure how space subdivision accelerates ray tracing of CSG solids"};
     app.require_subcommand(0, 1);
     std::string builtins = "Built-in scenes:";
     for (const BuiltinInfo& b : builtinScenes())
-        builtins += std::string("\n  builtin:") + b.name + (b.maxSize > b.minSize ? "[:SIZE]" : "") + "  " + b.description;
+        builtins += std::string("\n  builtin:") + b.name +
+                    (b.maxSize > b.minSize ? "[:SIZE]" : "") + "  " + b.description;
     app.footer(builtins);
 
     cli::CommonOptions viewOpt, renderOpt, traceOpt;
     std::string viewOut = "lancer-view.png";
-    CLI::App* view = app.add_subcommand("view", "Open the viewer (the default); without a display, render headless");
+    CLI::App* view = app.add_subcommand(
+        "view", "Open the viewer (the default); without a display, render headless");
     view->add_option("scene", viewOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]");
-    view->add_option("--headless-output", viewOut, "Where the headless render goes when there is no display");
+    view->add_option("--headless-output", viewOut,
+                     "Where the headless render goes when there is no display");
     cli::addCommonOptions(*view, viewOpt);
 #ifdef LANCER_WITH_VIEWER
     viewer::ViewOptions vopt;
     CLI::Option* frames =
-        view->add_option("--frames", vopt.frames, "Run this many frames, wait for the render to finish, then exit")
+        view->add_option("--frames", vopt.frames,
+                         "Run this many frames, wait for the render to finish, then exit")
             ->check(CLI::Range(1, 1000000));
-    view->add_option("--screenshot", vopt.screenshot, "With --frames: save the window as a PNG before exiting")
+    view->add_option("--screenshot", vopt.screenshot,
+                     "With --frames: save the window as a PNG before exiting")
         ->needs(frames);
-    view->add_flag("--log-timings", vopt.logTimings, "Print the latency of each pass after a change to stderr");
+    view->add_flag("--log-timings", vopt.logTimings,
+                   "Print the latency of each pass after a change to stderr");
     view->add_flag("--replay-change", vopt.replayChange,
-                   "After the first complete image, rebuild the structure once, as a parameter change does (to time it)");
+                   "After the first complete image, rebuild the structure once, as a parameter "
+                   "change does (to time it)");
     view->add_flag("--continuous", vopt.continuous,
-                   "Redraw every frame, as while the user interacts (to measure the UI's frame rate under load)");
+                   "Redraw every frame, as while the user interacts (to measure the UI's frame "
+                   "rate under load)");
     view->add_option("--drop", vopt.drop,
-                     "After the first complete image, hand FILE to the window's drop handler, as the desktop does "
+                     "After the first complete image, hand FILE to the window's drop handler, as "
+                     "the desktop does "
                      "when a file is dropped on the window")
         ->needs(frames);
-    view->add_option("--ini", vopt.ini, "Settings file (default: ~/.config/lancer/imgui.ini; \"none\": none)");
+    view->add_option("--ini", vopt.ini,
+                     "Settings file (default: ~/.config/lancer/imgui.ini; \"none\": none)");
 #endif
 
     std::string out;
     bool quiet = false;
     CLI::App* render = app.add_subcommand("render", "Render a scene to a PNG");
-    render->add_option("scene", renderOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")->required();
+    render->add_option("scene", renderOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")
+        ->required();
     render->add_option("-o,--output", out, "Output PNG")->required();
     render->add_flag("-q,--quiet", quiet, "Print nothing on success");
     cli::addCommonOptions(*render, renderOpt);
 
     cli::TraceOptions topt;
     CLI::App* trace = app.add_subcommand("trace", "Trace one primary ray and print its walk");
-    trace->add_option("scene", traceOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")->required();
+    trace->add_option("scene", traceOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")
+        ->required();
     std::vector<int> pixel;
-    trace->add_option("--pixel", pixel, "Pixel X Y (y = 0 on the top row)")->expected(2)->required();
+    trace->add_option("--pixel", pixel, "Pixel X Y (y = 0 on the top row)")
+        ->expected(2)
+        ->required();
     trace->add_flag("--json", topt.json, "Machine-readable output");
     cli::addCommonOptions(*trace, traceOpt);
 
     bench::BenchOptions bopt;
-    CLI::App* benchCmd = app.add_subcommand("bench", "Write the speed-against-error report (CSV and plots)");
+    CLI::App* benchCmd =
+        app.add_subcommand("bench", "Write the speed-against-error report (CSV and plots)");
     benchCmd->add_option("--scenes", bopt.scenes, "Scenes to measure")->capture_default_str();
-    benchCmd->add_option("--width", bopt.width, "Image width")->check(CLI::Range(1, 16384))->capture_default_str();
-    benchCmd->add_option("--height", bopt.height, "Image height")->check(CLI::Range(1, 16384))->capture_default_str();
-    benchCmd->add_option("--threads", bopt.threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
-    benchCmd->add_option("--bounces", bopt.bounces, "Reflection/refraction depth")->check(CLI::Range(0, 64))->capture_default_str();
+    benchCmd->add_option("--width", bopt.width, "Image width")
+        ->check(CLI::Range(1, 16384))
+        ->capture_default_str();
+    benchCmd->add_option("--height", bopt.height, "Image height")
+        ->check(CLI::Range(1, 16384))
+        ->capture_default_str();
+    benchCmd->add_option("--threads", bopt.threads, "Worker threads (0: all cores)")
+        ->check(CLI::Range(0, 1024));
+    benchCmd->add_option("--bounces", bopt.bounces, "Reflection/refraction depth")
+        ->check(CLI::Range(0, 64))
+        ->capture_default_str();
     benchCmd->add_option("--out", bopt.outDir, "Output directory")->capture_default_str();
     benchCmd->add_flag("--quick", bopt.quick, "Fewer knob values (a smoke run)");
     benchCmd->add_flag("--no-plots{false}", bopt.plots, "Write the CSV only");
-    benchCmd->add_flag("--schemes-only", bopt.schemesOnly, "Each scheme at its defaults, and the peer: the comparison table");
+    benchCmd->add_flag("--schemes-only", bopt.schemesOnly,
+                       "Each scheme at its defaults, and the peer: the comparison table");
 
     try {
         app.parse(argc, argv);
@@ -91,7 +115,8 @@ int main(int argc, char** argv) {
     std::string why = "the interactive viewer is not available in this build";
 #ifdef LANCER_WITH_VIEWER
     auto given = [&](const std::string& name) { return view->count(name) > 0; };
-    if (int status = viewer::runViewer(viewOpt, vopt, given, why); status != viewer::kNoDisplay) return status;
+    if (int status = viewer::runViewer(viewOpt, vopt, given, why); status != viewer::kNoDisplay)
+        return status;
 #endif
     std::cout << "lancer: " << why << "; rendering " << viewOpt.scene << " headless.\n";
     return cli::runRender(viewOpt, viewOut, false);

@@ -9,7 +9,7 @@ LANCER_PACKAGES=(
   libglfw3-dev libimgui-dev libglm-dev libosmesa6-dev libgl-dev xvfb xauth
   libtbb-dev nlohmann-json3-dev libcli11-dev libstb-dev
   libgtest-dev libbenchmark-dev libembree-dev gnuplot-nox
-  clang libclang-rt-14-dev
+  clang clang-format libclang-rt-14-dev
 )
 
 lancer_install_packages() {

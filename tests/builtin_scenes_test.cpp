@@ -1,8 +1,9 @@
 // Every built-in scene loads, renders, and gives the brute-force hit on every pixel with both
 // subdivision schemes at their defaults.
+#include "engine/scene/builtin_scenes.h"
+
 #include <gtest/gtest.h>
 
-#include "engine/scene/builtin_scenes.h"
 #include "tests/support/differential.h"
 
 namespace lancer {
@@ -20,13 +21,14 @@ TEST(BuiltinScenes, EverySchemeAgreesWithBruteForceOnEveryPixel) {
             auto accel = buildAccelerator(s, bp);
             auto bad = test::compareWithBrute(s, *accel, rays);
             EXPECT_TRUE(bad.empty()) << info.name << " " << schemeName(k) << ": " << bad.size()
-                                     << " mismatches, first:\n" << (bad.empty() ? "" : bad[0].toString(s));
+                                     << " mismatches, first:\n"
+                                     << (bad.empty() ? "" : bad[0].toString(s));
         }
     }
 }
 
 TEST(BuiltinScenes, SizesFollowTheirDefinition) {
-    EXPECT_EQ(makeBuiltin("tetra", 3).prims.size(), 64u);   // 4^SIZE triangles, as SPD tetra3
+    EXPECT_EQ(makeBuiltin("tetra", 3).prims.size(), 64u);  // 4^SIZE triangles, as SPD tetra3
     EXPECT_EQ(makeBuiltin("tetra", 4).prims.size(), 256u);
     EXPECT_EQ(makeBuiltin("rings", 2).prims.size(), 2u * 2u * 20u + 1u);
     EXPECT_EQ(makeBuiltin("balls", 3).prims.size(), 821u);  // 820 spheres and the floor

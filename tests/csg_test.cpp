@@ -33,7 +33,8 @@ TEST(Restriction, EveryRuleOfTheReport) {
     EXPECT_EQ(restrictPair(Op::Intersection, true, true), "(p0 ∩ p1)");
     EXPECT_EQ(restrictPair(Op::Difference, true, true), "(p0 − p1)");
     // Both empty: empty.
-    for (Op op : {Op::Union, Op::Intersection, Op::Difference}) EXPECT_EQ(restrictPair(op, false, false), "∅");
+    for (Op op : {Op::Union, Op::Intersection, Op::Difference})
+        EXPECT_EQ(restrictPair(op, false, false), "∅");
     // Only B: union gives B; difference and intersection give empty.
     EXPECT_EQ(restrictPair(Op::Union, false, true), "p1");
     EXPECT_EQ(restrictPair(Op::Difference, false, true), "∅");
@@ -72,8 +73,8 @@ TEST(MinimizedBoxes, IntersectionClipsBothSides) {
 TEST(MinimizedBoxes, DifferenceClipsTheSubtrahendAndDropsWhatLiesOutside) {
     Scene s;
     s.prims.push_back(makePrimitive(Block{{0, 0, 0}, {2, 2, 2}}, Transform()));
-    s.prims.push_back(makePrimitive(Sphere{{2, 1, 1}, 0.5}, Transform()));   // half inside
-    s.prims.push_back(makePrimitive(Sphere{{9, 9, 9}, 0.5}, Transform()));   // far outside
+    s.prims.push_back(makePrimitive(Sphere{{2, 1, 1}, 0.5}, Transform()));  // half inside
+    s.prims.push_back(makePrimitive(Sphere{{9, 9, 9}, 0.5}, Transform()));  // far outside
     int cut = s.tree.combine(Op::Union, s.tree.leaf(1), s.tree.leaf(2));
     s.tree.root = s.tree.combine(Op::Difference, s.tree.leaf(0), cut);
     s.prepare();
@@ -115,8 +116,9 @@ TEST(MinimizedBoxes, EveryVisibleHitLiesInItsPrimitivesBox) {
             Box3 b = s.minBox[h.prim];
             Vec3 slack = Vec3(1e-9 * std::max(1.0, glm::length(p)));
             Box3 loose{b.lo - slack, b.hi + slack};
-            ASSERT_TRUE(loose.contains(p)) << "seed " << seed << " " << r.toString() << " hit p" << h.prim
-                                           << " at " << toString(p) << " outside " << b.toString();
+            ASSERT_TRUE(loose.contains(p))
+                << "seed " << seed << " " << r.toString() << " hit p" << h.prim << " at "
+                << toString(p) << " outside " << b.toString();
         }
     }
 }
@@ -150,8 +152,9 @@ TEST(Restriction, RestrictedTreeAgreesInsideRandomRegions) {
                 bool f = hitInRegion(s, s.tree, s.tree.root, ray, -kInf, t0, t1, ctx, obs, full);
                 ctx.beginRay();
                 bool p = hitInRegion(s, r, r.root, ray, -kInf, t0, t1, ctx, obs, part);
-                ASSERT_EQ(f, p) << "seed " << seed << " " << ray.toString() << " region " << region.toString()
-                                << "\nfull " << s.tree.toString() << "\nrestricted " << r.toString();
+                ASSERT_EQ(f, p) << "seed " << seed << " " << ray.toString() << " region "
+                                << region.toString() << "\nfull " << s.tree.toString()
+                                << "\nrestricted " << r.toString();
                 if (f) {
                     ASSERT_EQ(full.t, part.t) << ray.toString();
                     ++checkedHits;

@@ -2,13 +2,13 @@
 // walks by corner pointers that reach the region holding any point, pointers that land where
 // they should, and refused parameters.
 #include "engine/accel/irregular/irregular.h"
-#include "engine/accel/irregular/tree_restrictor.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <random>
 
+#include "engine/accel/irregular/tree_restrictor.h"
 #include "engine/scene/loader.h"
 #include "tests/support/differential.h"
 
@@ -112,8 +112,12 @@ std::vector<Ray> eyeRaysOnZoneCorners(const Scene& scene, const IrregularSubdivi
     for (size_t k = 0; k < maxZones && z.zoneCount() > 0; ++k) {
         uint32_t i = uint32_t(rng() % z.zoneCount());
         for (int j = 0; j < 9; ++j) {
-            double a = j % 3 == 0 ? z.zoneLo[i].x : (j % 3 == 1 ? 0.5 * (z.zoneLo[i].x + z.zoneHi[i].x) : z.zoneHi[i].x);
-            double b = j / 3 == 0 ? z.zoneLo[i].y : (j / 3 == 1 ? 0.5 * (z.zoneLo[i].y + z.zoneHi[i].y) : z.zoneHi[i].y);
+            double a = j % 3 == 0
+                           ? z.zoneLo[i].x
+                           : (j % 3 == 1 ? 0.5 * (z.zoneLo[i].x + z.zoneHi[i].x) : z.zoneHi[i].x);
+            double b = j / 3 == 0
+                           ? z.zoneLo[i].y
+                           : (j / 3 == 1 ? 0.5 * (z.zoneLo[i].y + z.zoneHi[i].y) : z.zoneHi[i].y);
             Vec3 d = a * s.frame().x + b * s.frame().y + s.frame().z;
             rays.push_back({scene.camera.from, glm::normalize(d)});
         }

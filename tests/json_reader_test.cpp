@@ -1,8 +1,8 @@
 // The native JSON format: what it builds, and errors that name file, line and column.
+#include "engine/scene/json_reader.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-
-#include "engine/scene/json_reader.h"
 
 namespace lancer {
 namespace {
@@ -40,7 +40,8 @@ TEST(JsonScene, BuildsTreeMaterialsAndTransforms) {
 }
 
 TEST(JsonScene, MaterialOnAnInnerNodeIsInherited) {
-    Scene s = read(R"({"scene": {"union": [{"sphere": {"radius": 1}}, {"sphere": {"center": [3, 0, 0], "radius": 1}}],
+    Scene s = read(
+        R"({"scene": {"union": [{"sphere": {"radius": 1}}, {"sphere": {"center": [3, 0, 0], "radius": 1}}],
                          "material": {"color": [0, 1, 0]}}})");
     EXPECT_EQ(s.prims[0].material, s.prims[1].material);
     EXPECT_EQ(s.materials[size_t(s.prims[0].material)].color, Vec3(0, 1, 0));
@@ -56,7 +57,8 @@ TEST(JsonScene, EmptyOperatorContributesNothing) {
 TEST(JsonSceneErrors, SyntaxErrorNamesLineAndColumn) {
     EXPECT_THAT(errorOf("{\n  \"scene\": {\"sphere\": {\"radius\": 1,}}\n}"),
                 HasSubstr("scene.json:2:"));
-    EXPECT_THAT(errorOf("{\n  \"scene\": {\"sphere\": {\"radius\": 1,}}\n}"), HasSubstr("JSON syntax error"));
+    EXPECT_THAT(errorOf("{\n  \"scene\": {\"sphere\": {\"radius\": 1,}}\n}"),
+                HasSubstr("JSON syntax error"));
     EXPECT_THAT(errorOf("{\"scene\": "), HasSubstr("scene.json:1:"));  // truncated
 }
 
@@ -64,20 +66,27 @@ TEST(JsonSceneErrors, ValidationErrorsPointAtTheValue) {
     // Negative radius: line 3, at the "radius" key.
     EXPECT_THAT(errorOf("{\n \"scene\":\n  {\"sphere\": {\"radius\": -1}}\n}"),
                 HasSubstr("scene.json:3:15: expected a positive number, got -1"));
-    EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"raduis": 1}}})"), HasSubstr("unknown key \"raduis\""));
+    EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"raduis": 1}}})"),
+                HasSubstr("unknown key \"raduis\""));
     EXPECT_THAT(errorOf(R"({"scene": {"sphere": {}}})"), HasSubstr("missing \"radius\""));
-    EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"radius": "big"}}})"), HasSubstr("expected a number"));
-    EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"radius": 1, "center": [1, 2]}}})"), HasSubstr("expected [x, y, z]"));
+    EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"radius": "big"}}})"),
+                HasSubstr("expected a number"));
+    EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"radius": 1, "center": [1, 2]}}})"),
+                HasSubstr("expected [x, y, z]"));
     EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"radius": 1}, "material": "nope"}})"),
                 HasSubstr("unknown material \"nope\""));
     EXPECT_THAT(errorOf(R"({"scene": {"box": {"min": [1, 0, 0], "max": [0, 1, 1]}}})"),
                 HasSubstr("box \"min\" must be below \"max\""));
     EXPECT_THAT(errorOf(R"({"scene": {"torus": {}}})"), HasSubstr("expected a node"));
-    EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"radius": 1}, "box": {"size": 1}}})"), HasSubstr("exactly one of"));
-    EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"radius": 1}, "transform": [{"scale": [1, 0, 1]}]}})"),
-                HasSubstr("non-zero"));
-    EXPECT_THAT(errorOf(R"({"camera": {"from": [0, 0, 0], "at": [0, 0, 0]}, "scene": {"sphere": {"radius": 1}}})"),
-                HasSubstr("'from' and 'at' are the same point"));
+    EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"radius": 1}, "box": {"size": 1}}})"),
+                HasSubstr("exactly one of"));
+    EXPECT_THAT(
+        errorOf(R"({"scene": {"sphere": {"radius": 1}, "transform": [{"scale": [1, 0, 1]}]}})"),
+        HasSubstr("non-zero"));
+    EXPECT_THAT(
+        errorOf(
+            R"({"camera": {"from": [0, 0, 0], "at": [0, 0, 0]}, "scene": {"sphere": {"radius": 1}}})"),
+        HasSubstr("'from' and 'at' are the same point"));
     EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"radius": 1e999}}})"), HasSubstr("scene.json:1:"));
 }
 
@@ -89,7 +98,8 @@ TEST(JsonSceneErrors, SurfaceUnderDifferenceIsRefusedNamingTheNode) {
     EXPECT_THAT(e, HasSubstr("scene.json:3:9"));
     EXPECT_THAT(e, HasSubstr("difference"));
     // Under a union it is fine.
-    EXPECT_NO_THROW(read(R"({"scene": {"union": [{"box": {"size": 2}}, {"triangle": [[0, 0, 0], [1, 0, 0], [0, 1, 0]]}]}})"));
+    EXPECT_NO_THROW(read(
+        R"({"scene": {"union": [{"box": {"size": 2}}, {"triangle": [[0, 0, 0], [1, 0, 0], [0, 1, 0]]}]}})"));
 }
 
 TEST(JsonSceneErrors, MissingFileIsNamed) {

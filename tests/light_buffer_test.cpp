@@ -171,7 +171,8 @@ TEST(LightBuffer, EveryBoxAlongAShadowRayLiesInItsStretches) {
         const int count = 1 + scene % 30;
         for (int k = 0; k < count; ++k) {  // an object of small boxes over the floor
             const Vec3 c(u(rng) * 2.0 - 1.0, u(rng) * 2.0 - 1.0, u(rng) * 1.5 - 0.3);
-            const Vec3 h(0.01 + 0.3 * u(rng), 0.01 + 0.3 * u(rng), k % 4 == 0 ? 0.0 : 0.01 + 0.3 * u(rng));
+            const Vec3 h(0.01 + 0.3 * u(rng), 0.01 + 0.3 * u(rng),
+                         k % 4 == 0 ? 0.0 : 0.01 + 0.3 * u(rng));
             add(c - h, c + h);
         }
         std::vector<Vec3> lights;
@@ -208,17 +209,18 @@ TEST(LightBuffer, EveryBoxAlongAShadowRayLiesInItsStretches) {
                     ++checked;
                     bool covered = false;
                     for (int i = 0; i < n; ++i) covered |= seg[i].t0 <= ta && tb <= seg[i].t1;
-                    ASSERT_TRUE(covered) << "scene " << scene << ", " << bins << " bins: "
-                                         << ray.toString() << " toward light " << light
-                                         << " passes through " << b.toString() << " on ["
-                                         << ta << ", " << tb << "], outside its " << n
-                                         << " stretches";
+                    ASSERT_TRUE(covered)
+                        << "scene " << scene << ", " << bins << " bins: " << ray.toString()
+                        << " toward light " << light << " passes through " << b.toString()
+                        << " on [" << ta << ", " << tb << "], outside its " << n << " stretches";
                 }
             }
         }
     }
-    std::printf("%zu boxes on shadow rays checked; %zu rays walked, %zu with two stretches, "
-                "%zu with none\n", checked, walked, two, none);
+    std::printf(
+        "%zu boxes on shadow rays checked; %zu rays walked, %zu with two stretches, "
+        "%zu with none\n",
+        checked, walked, two, none);
     EXPECT_GT(checked, 10000u);
     EXPECT_GT(two, 1000u) << "a floor's stretch apart from the object's";
     EXPECT_GT(none, 1000u);
@@ -234,8 +236,8 @@ TEST(LightBuffer, LightInsideTheBoundsHasNoMap) {
     const Vec3 o = s.bounds.lo + 0.25 * s.bounds.extent();
     LightBuffer::Segment seg[LightBuffer::kSlots];
     EXPECT_EQ(lb.shadowSegments(o, glm::normalize(s.lights[0].position - o), 0, 1.0, seg), -1);
-    Tally t = checkShadowRays("balls1, light 0 inside", s,
-                              shadowRays(s, test::pixelRays(s, 24, 24), 5));
+    Tally t =
+        checkShadowRays("balls1, light 0 inside", s, shadowRays(s, test::pixelRays(s, 24, 24), 5));
     EXPECT_GT(t.skipped, 0u);  // the other lights still have theirs
 }
 
@@ -254,8 +256,8 @@ size_t checkEyeRays(const std::string& name, const Scene& s, const std::vector<R
         const double near = eye.nearFrom(r.d, 0);
         skipped += near > 0.0;
         if (brute->intersect(r, 0.0, kInf, ctx, obs, hit) && !(hit.t > near) && failures++ < 5)
-            ADD_FAILURE() << name << ": " << r.toString() << " hits p" << hit.prim << " at t = "
-                          << hit.t << ", before the eye buffer's " << near;
+            ADD_FAILURE() << name << ": " << r.toString() << " hits p" << hit.prim
+                          << " at t = " << hit.t << ", before the eye buffer's " << near;
     }
     EXPECT_EQ(failures, 0u) << name;
     return skipped;

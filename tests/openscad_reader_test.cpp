@@ -1,5 +1,7 @@
 // The OpenSCAD .csg reader: hand-written exports compared, depth image against depth image,
 // with the same scenes in the native JSON format; modifiers; and one error per malformed class.
+#include "engine/scene/openscad_reader.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 #include "engine/render/renderer.h"
 #include "engine/scene/json_reader.h"
 #include "engine/scene/loader.h"
-#include "engine/scene/openscad_reader.h"
 
 namespace lancer {
 namespace {
@@ -103,7 +104,9 @@ TEST(OpenScadReader, RootModifierMakesItsSubtreeTheWholeModel) {
 
 TEST(OpenScadReader, OperatorsTakeAnyNumberOfChildren) {
     // difference: the first child minus all the others.
-    Scene d = csgText("difference() { cube(10, true); sphere(1); cylinder(h = 20, r = 0.5, center = true); group(); }");
+    Scene d = csgText(
+        "difference() { cube(10, true); sphere(1); cylinder(h = 20, r = 0.5, center = true); "
+        "group(); }");
     EXPECT_EQ(d.prims.size(), 3u);
     EXPECT_EQ(d.tree.nodes[size_t(d.tree.root)].op, Op::Difference);
     // An empty group or operator contributes nothing; an empty intersection operand empties it.
@@ -112,7 +115,8 @@ TEST(OpenScadReader, OperatorsTakeAnyNumberOfChildren) {
     EXPECT_TRUE(csgText("intersection() { cube(1); cube(0); }").tree.empty());
     EXPECT_EQ(csgText("intersection() { cube(1); *sphere(1); }").prims.size(), 1u);
     EXPECT_TRUE(csgText("difference() { group(); cube(1); }").tree.empty());
-    EXPECT_EQ(csgText("difference() { *group(); cube(1); }").prims.size(), 1u);  // * child is not there
+    EXPECT_EQ(csgText("difference() { *group(); cube(1); }").prims.size(),
+              1u);  // * child is not there
     // A child without braces, render() as a transparent group, named transforms.
     Scene t = csgText("translate([1, 2, 3]) rotate([0, 0, 90]) scale(2) render() cube(1);");
     EXPECT_NEAR(t.bounds.lo.x, -1.0, 1e-12);
@@ -129,10 +133,12 @@ TEST(OpenScadReader, PrimitiveArgumentsAsOpenScadReadsThem) {
     EXPECT_EQ(box("cube([1, 2, 3]);"), (Box3{Vec3(0.0), Vec3(1, 2, 3)}));
     EXPECT_EQ(box("sphere(d = 4);"), (Box3{Vec3(-2.0), Vec3(2.0)}));
     EXPECT_EQ(box("sphere(3);"), (Box3{Vec3(-3.0), Vec3(3.0)}));
-    EXPECT_EQ(box("cylinder(h = 4, r = 1, center = true);"), (Box3{Vec3(-1, -1, -2), Vec3(1, 1, 2)}));
+    EXPECT_EQ(box("cylinder(h = 4, r = 1, center = true);"),
+              (Box3{Vec3(-1, -1, -2), Vec3(1, 1, 2)}));
     EXPECT_EQ(box("cylinder(h = 4, d = 6, r = 1);"), (Box3{Vec3(-3, -3, 0), Vec3(3, 3, 4)}));
     EXPECT_EQ(box("cylinder(4, 1, 3);"), (Box3{Vec3(-3, -3, 0), Vec3(3, 3, 4)}));
-    EXPECT_EQ(box("cylinder(h = 1, r = 5, r2 = 2, $fn = 64);"), (Box3{Vec3(-5, -5, 0), Vec3(5, 5, 1)}));
+    EXPECT_EQ(box("cylinder(h = 1, r = 5, r2 = 2, $fn = 64);"),
+              (Box3{Vec3(-5, -5, 0), Vec3(5, 5, 1)}));
     Scene cone = csgText("cylinder(h = 2, d1 = 4, d2 = 0, r = undef);");
     const Cone& k = std::get<Cone>(cone.prims[0].shape);
     EXPECT_EQ(k.r1, 2.0);
@@ -142,7 +148,8 @@ TEST(OpenScadReader, PrimitiveArgumentsAsOpenScadReadsThem) {
     EXPECT_TRUE(csgText("sphere(0); cube([1, 0, 1]); cylinder(h = 0, r = 1);", &c).tree.empty());
     EXPECT_EQ(c.empty, 3);
     // Colours: rgba vectors, SVG names in any case, #hex; innermost wins.
-    Scene col = csgText("color(\"Red\") { cube(); color([0, 0, 1, 0.5]) sphere(); color(\"#0f0\") sphere(); }");
+    Scene col = csgText(
+        "color(\"Red\") { cube(); color([0, 0, 1, 0.5]) sphere(); color(\"#0f0\") sphere(); }");
     ASSERT_EQ(col.prims.size(), 3u);
     EXPECT_EQ(col.materials[size_t(col.prims[0].material)].color, Vec3(1, 0, 0));
     EXPECT_EQ(col.materials[size_t(col.prims[1].material)].color, Vec3(0, 0, 1));
@@ -174,53 +181,80 @@ void expectCsgError(const std::string& text, const std::string& message) {
 
 TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
     // Truncated.
-    expectCsgError("group() {\n\tcube(size = [1, 2", "mem.csg:2:19: unexpected end of file: missing ']' for the '[' at mem.csg:2:14");
-    expectCsgError("group() {\n\tcube();\n", "mem.csg:3:1: unexpected end of file: missing '}' for the '{' at mem.csg:1:9");
-    expectCsgError("cube()", "mem.csg:1:7: unexpected end of file: expected ';' or '{' after cube(...)");
-    expectCsgError("/* never closed\ncube();", "mem.csg:1:1: unterminated comment: '/*' without '*/'");
+    expectCsgError("group() {\n\tcube(size = [1, 2",
+                   "mem.csg:2:19: unexpected end of file: missing ']' for the '[' at mem.csg:2:14");
+    expectCsgError("group() {\n\tcube();\n",
+                   "mem.csg:3:1: unexpected end of file: missing '}' for the '{' at mem.csg:1:9");
+    expectCsgError("cube()",
+                   "mem.csg:1:7: unexpected end of file: expected ';' or '{' after cube(...)");
+    expectCsgError("/* never closed\ncube();",
+                   "mem.csg:1:1: unterminated comment: '/*' without '*/'");
     expectCsgError("color(\"red) cube();", "mem.csg:1:7: unterminated string: no closing '\"'");
     // Unbalanced braces.
     expectCsgError("group() { cube(); }\n}\n", "mem.csg:2:1: unmatched '}'");
-    expectCsgError("group() { cube(); ) }", "mem.csg:1:19: expected a node name such as cube or multmatrix, got ')'");
+    expectCsgError("group() { cube(); ) }",
+                   "mem.csg:1:19: expected a node name such as cube or multmatrix, got ')'");
     // Wrong arity.
     expectCsgError("multmatrix([[1, 0, 0], [0, 1, 0], [0, 0, 1]]) cube();",
-                   "mem.csg:1:12: multmatrix expects a 4x4 matrix (or its first 3 rows) of numbers, as [[a, b, c, d], ...]");
+                   "mem.csg:1:12: multmatrix expects a 4x4 matrix (or its first 3 rows) of "
+                   "numbers, as [[a, b, c, d], ...]");
     expectCsgError("cube(size = [1, 2]);", "mem.csg:1:13: expected [x, y, z] for 'size' of cube()");
     expectCsgError("sphere(1, 2);", "mem.csg:1:11: sphere() takes at most 1 positional argument");
     expectCsgError("cube(1, size = 2);", "mem.csg:1:9: argument 'size' of cube() is given twice");
-    expectCsgError("cube(sise = 2);", "mem.csg:1:6: unknown argument 'sise' of cube() (expected size, center)");
+    expectCsgError("cube(sise = 2);",
+                   "mem.csg:1:6: unknown argument 'sise' of cube() (expected size, center)");
     expectCsgError("cube(1) { sphere(); }", "mem.csg:1:11: cube() takes no children");
     // Not numbers.
     expectCsgError("sphere(r = \"big\");", "mem.csg:1:12: expected a number for 'r' of sphere()");
-    expectCsgError("cube(center = 1);", "mem.csg:1:15: expected true or false for 'center' of cube()");
-    expectCsgError("sphere(r = 2 * 3);", "mem.csg:1:14: expected ')' to close the arguments of sphere, got '*'");
-    expectCsgError("sphere(r = x);", "mem.csg:1:12: expected a value (number, true, false, undef, string or [vector]), got 'x': expressions are not part of OpenSCAD's CSG export");
+    expectCsgError("cube(center = 1);",
+                   "mem.csg:1:15: expected true or false for 'center' of cube()");
+    expectCsgError("sphere(r = 2 * 3);",
+                   "mem.csg:1:14: expected ')' to close the arguments of sphere, got '*'");
+    expectCsgError("sphere(r = x);",
+                   "mem.csg:1:12: expected a value (number, true, false, undef, string or "
+                   "[vector]), got 'x': expressions are not part of OpenSCAD's CSG export");
     // NaN and infinities.
     expectCsgError("sphere(r = nan);", "mem.csg:1:12: expected a finite number, got 'nan'");
-    expectCsgError("cube(size = [1, -inf, 1]);", "mem.csg:1:18: expected a finite number, got '-inf'");
-    expectCsgError("sphere(r = 1e999);", "mem.csg:1:12: number '1e999' is out of range (not a finite double)");
-    expectCsgError("multmatrix([[1e100, 0, 0, 0], [0, 1e100, 0, 0], [0, 0, 1e100, 0], [0, 0, 0, 1]]) multmatrix([[1e300, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) cube();",
-                   "mem.csg:1:82: multmatrix() gives a transform with non-finite entries");
+    expectCsgError("cube(size = [1, -inf, 1]);",
+                   "mem.csg:1:18: expected a finite number, got '-inf'");
+    expectCsgError("sphere(r = 1e999);",
+                   "mem.csg:1:12: number '1e999' is out of range (not a finite double)");
+    expectCsgError(
+        "multmatrix([[1e100, 0, 0, 0], [0, 1e100, 0, 0], [0, 0, 1e100, 0], [0, 0, 0, 1]]) "
+        "multmatrix([[1e300, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) cube();",
+        "mem.csg:1:82: multmatrix() gives a transform with non-finite entries");
     // Negative sizes and radii; singular transforms.
     expectCsgError("sphere(r = -1);", "mem.csg:1:12: 'r' must not be negative");
     expectCsgError("cylinder(h = 1, r1 = 1, r2 = -2);", "mem.csg:1:30: 'r2' must not be negative");
     expectCsgError("cube([1, -1, 1]);", "mem.csg:1:6: cube sizes must not be negative");
-    expectCsgError("scale([1, 0, 1]) cube();", "mem.csg:1:1: scale() is singular (it flattens its children to nothing)");
+    expectCsgError("scale([1, 0, 1]) cube();",
+                   "mem.csg:1:1: scale() is singular (it flattens its children to nothing)");
     expectCsgError("multmatrix([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]]) cube();",
-                   "mem.csg:1:55: the last row of a multmatrix must be [0, 0, 0, 1] (projective transforms are not supported)");
+                   "mem.csg:1:55: the last row of a multmatrix must be [0, 0, 0, 1] (projective "
+                   "transforms are not supported)");
     // Unsupported nodes, named with their position.
-    expectCsgError("group() {\n\tlinear_extrude(height = 10, center = false, convexity = 1, scale = [1, 1], $fn = 0, $fa = 12, $fs = 2) {\n\t\tsquare(size = [1, 1], center = false);\n\t}\n}",
-                   "mem.csg:2:2: the node 'linear_extrude' is not supported (supported: group, union, difference, intersection, render, multmatrix, translate, rotate, scale, mirror, color, cube, sphere, cylinder)");
-    expectCsgError("circle(r = 1);", "mem.csg:1:1: the 2D node 'circle' is not supported: Lancer traces 3D solids");
-    expectCsgError("color(\"blurple\") cube();", "mem.csg:1:7: unknown colour name 'blurple' (OpenSCAD accepts the SVG colour names)");
-    expectCsgError("x = 3;", "mem.csg:1:3: assignments ('x = ...') are not part of OpenSCAD's CSG export; export the model with 'openscad -o model.csg'");
+    expectCsgError(
+        "group() {\n\tlinear_extrude(height = 10, center = false, convexity = 1, scale = [1, 1], "
+        "$fn = 0, $fa = 12, $fs = 2) {\n\t\tsquare(size = [1, 1], center = false);\n\t}\n}",
+        "mem.csg:2:2: the node 'linear_extrude' is not supported (supported: group, union, "
+        "difference, intersection, render, multmatrix, translate, rotate, scale, mirror, color, "
+        "cube, sphere, cylinder)");
+    expectCsgError("circle(r = 1);",
+                   "mem.csg:1:1: the 2D node 'circle' is not supported: Lancer traces 3D solids");
+    expectCsgError(
+        "color(\"blurple\") cube();",
+        "mem.csg:1:7: unknown colour name 'blurple' (OpenSCAD accepts the SVG colour names)");
+    expectCsgError("x = 3;",
+                   "mem.csg:1:3: assignments ('x = ...') are not part of OpenSCAD's CSG export; "
+                   "export the model with 'openscad -o model.csg'");
     expectCsgError("cube(\x01);", "mem.csg:1:6: unexpected character '\\x01'");
     // Deep nesting is refused before the recursion can exhaust the stack.
     std::string deep, vec;
     for (int i = 0; i < 100000; ++i) deep += "group() ";
     expectCsgError(deep + "cube();", "mem.csg:1:4009: nesting deeper than 500 levels is refused");
     for (int i = 0; i < 100000; ++i) vec += "[";
-    expectCsgError("cube(size = " + vec + ");", "mem.csg:1:513: nesting deeper than 500 levels is refused");
+    expectCsgError("cube(size = " + vec + ");",
+                   "mem.csg:1:513: nesting deeper than 500 levels is refused");
 }
 
 }  // namespace

@@ -42,7 +42,8 @@ TEST(Sphere, MissAndTangent) {
     // Just inside the tangent: a short span.
     Result r = spans(Sphere{{0, 0, 0}, 1.0}, {{0, 1.0 - 1e-6, -5}, {0, 0, 1}});
     ASSERT_EQ(r.n, 1);
-    EXPECT_NEAR(r.s[0].out.t - r.s[0].in.t, 2.0 * std::sqrt(1.0 - (1.0 - 1e-6) * (1.0 - 1e-6)), 1e-9);
+    EXPECT_NEAR(r.s[0].out.t - r.s[0].in.t, 2.0 * std::sqrt(1.0 - (1.0 - 1e-6) * (1.0 - 1e-6)),
+                1e-9);
 }
 
 TEST(Sphere, OriginInsideGivesNegativeEntry) {
@@ -166,8 +167,8 @@ TEST(Triangle, BothSidesAndEdges) {
     EXPECT_NEAR(front.s[0].in.t, 1.0, kTol);
     EXPECT_EQ(spans(t, {{0.25, 0.25, -1}, {0, 0, 1}}).n, 1);  // from behind too
     EXPECT_EQ(spans(t, {{0.75, 0.75, 1}, {0, 0, -1}}).n, 0);
-    EXPECT_EQ(spans(t, {{0.5, 0.0, 1}, {0, 0, -1}}).n, 1);    // on an edge: closed
-    EXPECT_EQ(spans(t, {{0, 0, 1}, {1, 0, 0}}).n, 0);         // parallel to the plane
+    EXPECT_EQ(spans(t, {{0.5, 0.0, 1}, {0, 0, -1}}).n, 1);  // on an edge: closed
+    EXPECT_EQ(spans(t, {{0, 0, 1}, {1, 0, 0}}).n, 0);       // parallel to the plane
 }
 
 TEST(Triangle, SmoothNormalsInterpolate) {
@@ -184,7 +185,8 @@ TEST(Triangle, SmoothNormalsInterpolate) {
 TEST(Polygon, NonConvexEvenOdd) {
     // An L shape: the notch at (1.5, 1.5) is outside.
     Polygon pg;
-    ASSERT_TRUE(makePolygon({{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}}, pg));
+    ASSERT_TRUE(
+        makePolygon({{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}}, pg));
     EXPECT_NEAR(std::abs(pg.n.z), 1.0, kTol);
     EXPECT_EQ(spans(pg, {{0.5, 1.5, 3}, {0, 0, -1}}).n, 1);
     EXPECT_EQ(spans(pg, {{1.5, 0.5, 3}, {0, 0, -1}}).n, 1);
@@ -240,7 +242,6 @@ TEST(Box3, ClipLineHandlesZeroDirections) {
     EXPECT_TRUE(b.overlaps(Box3{{1, 1, 1}, {2, 2, 2}}));  // touching boxes overlap
     EXPECT_TRUE(overlap(b, Box3{{2, 2, 2}, {3, 3, 3}}).isEmpty());
 }
-
 
 // The walks test spheres from the scene's packed table: the same spans, bit for bit, as the
 // primitive's own test, for world spheres (packed) and transformed ones (not packed).

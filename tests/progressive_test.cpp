@@ -26,8 +26,8 @@ bool waitFor(const std::function<bool()>& done, double seconds = 30.0) {
 /// Follow job `job` of `pr` snapshot by snapshot into `shown` until it is finished, checking
 /// each snapshot against `direct`, the same view rendered at once: only the rows said to have
 /// changed change, and every pixel shows its block's corner pixel. Returns the strides seen.
-std::vector<int> followJob(ProgressiveRenderer& pr, uint64_t job, const Image& direct,
-                           Image& shown, uint64_t& version) {
+std::vector<int> followJob(ProgressiveRenderer& pr, uint64_t job, const Image& direct, Image& shown,
+                           uint64_t& version) {
     std::vector<int> seenStrides;
     const int w = direct.width, h = direct.height;
     auto start = std::chrono::steady_clock::now();

@@ -152,10 +152,10 @@ void randomScenesMatchBrute(StepMethod step, int seeds) {
             auto rays = hardRays(s, gridOf(*accel), seed, 1500);
             total += rays.size();
             auto bad = test::compareWithBrute(s, *accel, rays);
-            ASSERT_TRUE(bad.empty()) << s.name << " offset " << toString(opt.offset) << " level "
-                                     << p.maxLevel << " " << splitAxesName(p.splitAxes) << ": "
-                                     << bad.size() << " rays differ\n"
-                                     << describe(s, bad);
+            ASSERT_TRUE(bad.empty())
+                << s.name << " offset " << toString(opt.offset) << " level " << p.maxLevel << " "
+                << splitAxesName(p.splitAxes) << ": " << bad.size() << " rays differ\n"
+                << describe(s, bad);
             ASSERT_EQ(walkErrors(s, *accel, rays), 0u) << s.name;
             auto secondary = test::compareWithBrute(s, *accel, rays, 1e-3 * s.scale());
             ASSERT_TRUE(secondary.empty()) << s.name << " tmin > 0\n" << describe(s, secondary);
@@ -470,8 +470,8 @@ TEST(RegularAxes, CostOrderIsTheReportsOnACubeAndCubicCellsOnAFlatScene) {
     auto byCost = buildAccelerator(s, cost), byCycle = buildAccelerator(s, cycle);
     const RegularGrid &gc = gridOf(*byCost), &gr = gridOf(*byCycle);
     EXPECT_EQ(gc.schedule().toString(8).find('z'), std::string::npos) << gc.schedule().toString(8);
-    EXPECT_EQ(byCycle->info().extra["axis_schedule"], gr.schedule().toString(64).substr(
-                                                          0, size_t(byCycle->info().extra["finest_level"])));
+    EXPECT_EQ(byCycle->info().extra["axis_schedule"],
+              gr.schedule().toString(64).substr(0, size_t(byCycle->info().extra["finest_level"])));
     EXPECT_LT(gc.cells(2), gr.cells(2)) << "fewer cuts across the flat axis";
     std::vector<Ray> rays = test::randomRays(s, 5, 4000);
     const auto pts = gridPoints(gc, 5);

@@ -34,14 +34,16 @@ Rendered renderScene(const std::string& spec, int w, int h, int bounces = 3) {
 TEST(Golden, DefaultSceneMatchesTheStoredImage) {
     Rendered r = renderScene("builtin:default", 160, 100);
     int gw, gh;
-    std::vector<uint8_t> golden = readPng(std::string(LANCER_SOURCE_DIR) + "/tests/golden/default_160x100.png", gw, gh);
+    std::vector<uint8_t> golden =
+        readPng(std::string(LANCER_SOURCE_DIR) + "/tests/golden/default_160x100.png", gw, gh);
     ASSERT_EQ(gw, 160);
     ASSERT_EQ(gh, 100);
     std::vector<uint8_t> got = r.img.rgba8();
     int off = 0, worst = 0;
     for (size_t i = 0; i < got.size(); i += 4) {
         int d = 0;
-        for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(int(got[i + size_t(c)]) - int(golden[i + size_t(c)])));
+        for (int c = 0; c < 3; ++c)
+            d = std::max(d, std::abs(int(got[i + size_t(c)]) - int(golden[i + size_t(c)])));
         off += d > 3;
         worst = std::max(worst, d);
     }
@@ -50,7 +52,9 @@ TEST(Golden, DefaultSceneMatchesTheStoredImage) {
 }
 
 // Ray-plane and ray-sphere distances computed here, independently of the engine.
-double planeDistance(const Ray& r, int axis, double value) { return (value - r.o[axis]) / r.d[axis]; }
+double planeDistance(const Ray& r, int axis, double value) {
+    return (value - r.o[axis]) / r.d[axis];
+}
 double sphereDistance(const Ray& r, Vec3 c, double radius) {
     Vec3 oc = r.o - c;
     double b = glm::dot(oc, r.d), cc = glm::dot(oc, oc) - radius * radius;
@@ -70,12 +74,14 @@ TEST(Golden, DepthMatchesAnalyticValues) {
             // The green rounded cube's front face (y = -1) where the sphere does not cut it.
             double tf = planeDistance(ray, 1, -1.0);
             Vec3 pf = ray.at(tf);
-            if (std::abs(pf.x) < 0.85 && std::abs(pf.z) < 0.85 && pf.x * pf.x + pf.z * pf.z < 0.8) expected = tf;
+            if (std::abs(pf.x) < 0.85 && std::abs(pf.z) < 0.85 && pf.x * pf.x + pf.z * pf.z < 0.8)
+                expected = tf;
             // The red sphere's front (above the cylinder, in front of nothing else).
             Vec3 red(-3.0, 0.0, 0.6);
             Vec3 oc = ray.o - red;
             double b = glm::dot(oc, ray.d);
-            if (b * b - (glm::dot(oc, oc) - 0.81) > 0.05 && ray.at(sphereDistance(ray, red, 0.9)).z > 0.2)
+            if (b * b - (glm::dot(oc, oc) - 0.81) > 0.05 &&
+                ray.at(sphereDistance(ray, red, 0.9)).z > 0.2)
                 expected = sphereDistance(ray, red, 0.9);
             // The floor's top (z = -1) in the front strip, clear of every object's shadow of view.
             double tz = planeDistance(ray, 2, -1.0);
@@ -105,7 +111,8 @@ TEST(Render, DepthPfmIsStandardBottomToTop) {
     std::vector<float> back = readPfm(path, w, h);
     ASSERT_EQ(back.size(), r.img.depth.size());
     for (size_t i = 0; i < back.size(); ++i)
-        ASSERT_TRUE(back[i] == r.img.depth[i] || (std::isinf(back[i]) && std::isinf(r.img.depth[i])));
+        ASSERT_TRUE(back[i] == r.img.depth[i] ||
+                    (std::isinf(back[i]) && std::isinf(r.img.depth[i])));
 }
 
 TEST(Render, PerPixelCountersAddUpAndThreadsDoNotChangeTheImage) {
@@ -115,7 +122,8 @@ TEST(Render, PerPixelCountersAddUpAndThreadsDoNotChangeTheImage) {
     EXPECT_EQ(sum, one.stats.counters.primTests);
     EXPECT_EQ(one.stats.counters.primaryRays, 64u * 40u);
     EXPECT_GT(one.stats.counters.shadowRays, 0u);
-    EXPECT_GT(one.stats.counters.rays, one.stats.counters.primaryRays + one.stats.counters.shadowRays);
+    EXPECT_GT(one.stats.counters.rays,
+              one.stats.counters.primaryRays + one.stats.counters.shadowRays);
     // Single-threaded gives the same pixels.
     Scene s = loadScene("builtin:default");
     auto accel = buildAccelerator(s, BuildParams{});
@@ -125,9 +133,9 @@ TEST(Render, PerPixelCountersAddUpAndThreadsDoNotChangeTheImage) {
     render(s, *accel, ro, img);
     EXPECT_EQ(img.rgba8(), one.img.rgba8());
     nlohmann::json j = statsJson(s, *accel, ro, one.stats);
-    for (const char* key : {"scheme", "width", "height", "threads", "build_ms", "render_ms", "rays", "primary_rays",
-                            "prim_tests", "mailbox_hits", "region_visits", "regions", "memory_bytes", "max_level",
-                            "max_objects", "step"})
+    for (const char* key : {"scheme", "width", "height", "threads", "build_ms", "render_ms", "rays",
+                            "primary_rays", "prim_tests", "mailbox_hits", "region_visits",
+                            "regions", "memory_bytes", "max_level", "max_objects", "step"})
         EXPECT_TRUE(j.contains(key)) << key;
 }
 

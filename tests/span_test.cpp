@@ -1,12 +1,14 @@
 // Span booleans on hand-made lists, including equal endpoints and surfaces.
-#include <gtest/gtest.h>
-
 #include "engine/model/span.h"
+
+#include <gtest/gtest.h>
 
 namespace lancer {
 namespace {
 
-Span sp(double a, double b, uint32_t pa = 0, uint32_t pb = 0) { return {{a, pa, 0, false}, {b, pb, 0, false}}; }
+Span sp(double a, double b, uint32_t pa = 0, uint32_t pb = 0) {
+    return {{a, pa, 0, false}, {b, pb, 0, false}};
+}
 std::vector<std::pair<double, double>> ts(const SpanList& l) {
     std::vector<std::pair<double, double>> r;
     for (const Span& s : l) r.emplace_back(s.in.t, s.out.t);
@@ -73,12 +75,12 @@ TEST(SpanDifference, CutsFlipsAndCoplanarFaces) {
 TEST(FirstBoundary, RespectsTminAndRegionInterval) {
     SpanList l{sp(1, 3, 1, 1), sp(5, 5, 2, 2), sp(7, 9, 3, 3)};
     EXPECT_EQ(firstBoundary(l, 0.0, -kInf, kInf)->t, 1.0);
-    EXPECT_EQ(firstBoundary(l, 2.0, -kInf, kInf)->t, 3.0);   // origin inside: the exit
-    EXPECT_EQ(firstBoundary(l, 3.0, -kInf, kInf)->t, 5.0);   // strictly after tmin
-    EXPECT_EQ(firstBoundary(l, 0.0, 4.0, 6.0)->t, 5.0);      // region [4, 6]
-    EXPECT_EQ(firstBoundary(l, 0.0, 5.0, 6.0)->t, 5.0);      // closed at the region's start
+    EXPECT_EQ(firstBoundary(l, 2.0, -kInf, kInf)->t, 3.0);  // origin inside: the exit
+    EXPECT_EQ(firstBoundary(l, 3.0, -kInf, kInf)->t, 5.0);  // strictly after tmin
+    EXPECT_EQ(firstBoundary(l, 0.0, 4.0, 6.0)->t, 5.0);     // region [4, 6]
+    EXPECT_EQ(firstBoundary(l, 0.0, 5.0, 6.0)->t, 5.0);     // closed at the region's start
     EXPECT_EQ(firstBoundary(l, 0.0, 5.5, 6.9), nullptr);
-    EXPECT_EQ(firstBoundary(l, 0.0, 7.5, 10.0)->t, 9.0);     // entry before the region: its exit
+    EXPECT_EQ(firstBoundary(l, 0.0, 7.5, 10.0)->t, 9.0);  // entry before the region: its exit
 }
 
 }  // namespace

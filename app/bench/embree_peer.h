@@ -10,7 +10,7 @@
 namespace lancer::bench {
 
 class EmbreePeer {
-public:
+  public:
     /// True when this build has Embree.
     static bool available();
     /// True when the scene is a union of primitives (no intersection or difference).
@@ -26,7 +26,7 @@ public:
     /// Primary rays and shadow rays (one per light the surface faces); Lambert shading.
     RenderStats render(const RenderOptions& opt, Image& img) const;
 
-private:
+  private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
     double buildMs_ = 0.0;

@@ -26,8 +26,8 @@ struct Config {
 
 /// Difference of an image against the reference.
 struct ImageError {
-    size_t hitDiff = 0;     ///< pixels whose primary hit (primitive or distance) differs
-    size_t colorDiff = 0;   ///< pixels whose colour differs by more than 2/255
+    size_t hitDiff = 0;    ///< pixels whose primary hit (primitive or distance) differs
+    size_t colorDiff = 0;  ///< pixels whose colour differs by more than 2/255
     double maxDepthDiff = 0.0;
 };
 
@@ -37,10 +37,14 @@ ImageError compare(const Image& ref, const Image& img) {
     for (size_t i = 0; i < ref.depth.size(); ++i) {
         float da = ref.depth[i], db = img.depth[i];
         bool bothMiss = std::isinf(da) && std::isinf(db);
-        double dd = bothMiss ? 0.0 : (std::isinf(da) || std::isinf(db)) ? kInf : std::abs(double(da) - double(db));
+        double dd = bothMiss                             ? 0.0
+                    : (std::isinf(da) || std::isinf(db)) ? kInf
+                                                         : std::abs(double(da) - double(db));
         if (ref.hitPrim[i] != img.hitPrim[i] || dd > 1e-6 * std::max(1.0, double(da))) ++e.hitDiff;
-        if (std::isfinite(dd)) e.maxDepthDiff = std::max(e.maxDepthDiff, dd);
-        else e.maxDepthDiff = kInf;
+        if (std::isfinite(dd))
+            e.maxDepthDiff = std::max(e.maxDepthDiff, dd);
+        else
+            e.maxDepthDiff = kInf;
         for (int c = 0; c < 3; ++c)
             if (std::abs(int(a[4 * i + size_t(c)]) - int(b[4 * i + size_t(c)])) > 2) {
                 ++e.colorDiff;
@@ -74,7 +78,8 @@ std::string num(double v) {
 
 std::vector<Config> sweep(bool quick, bool schemesOnly) {
     std::vector<Config> out;
-    auto add = [&](const std::string& knob, const std::string& value, BuildParams b, ShadingOptions s = {}) {
+    auto add = [&](const std::string& knob, const std::string& value, BuildParams b,
+                   ShadingOptions s = {}) {
         out.push_back({knob, value, b, s});
     };
     BuildParams regular;
@@ -84,13 +89,15 @@ std::vector<Config> sweep(bool quick, bool schemesOnly) {
     add("scheme", "regular", regular);
     add("scheme", "irregular", irregular);
     if (schemesOnly) return out;
-    std::vector<int> levels = quick ? std::vector<int>{6, 12} : std::vector<int>{3, 6, 9, 12, 15, 18, 21, 24};
+    std::vector<int> levels =
+        quick ? std::vector<int>{6, 12} : std::vector<int>{3, 6, 9, 12, 15, 18, 21, 24};
     for (int l : levels) {
         BuildParams b = regular;
         b.maxLevel = l;
         add("regular max-level", std::to_string(l), b);
     }
-    std::vector<int> objects = quick ? std::vector<int>{1, 8} : std::vector<int>{1, 2, 4, 8, 16, 32};
+    std::vector<int> objects =
+        quick ? std::vector<int>{1, 8} : std::vector<int>{1, 2, 4, 8, 16, 32};
     for (int m : objects) {
         BuildParams b = regular;
         b.maxObjects = m;
@@ -99,7 +106,9 @@ std::vector<Config> sweep(bool quick, bool schemesOnly) {
         c.maxObjects = m;
         add("irregular max-objects", std::to_string(m), c);
     }
-    std::vector<double> deltas = quick ? std::vector<double>{1e-12, 1e-2} : std::vector<double>{1e-15, 1e-12, 1e-9, 1e-6, 1e-4, 1e-3, 1e-2, 5e-2};
+    std::vector<double> deltas =
+        quick ? std::vector<double>{1e-12, 1e-2}
+              : std::vector<double>{1e-15, 1e-12, 1e-9, 1e-6, 1e-4, 1e-3, 1e-2, 5e-2};
     for (double d : deltas) {
         BuildParams b = regular;
         b.step = StepMethod::Push;
@@ -121,7 +130,9 @@ std::vector<Config> sweep(bool quick, bool schemesOnly) {
         b.mailboxes = mail;
         add("regular mailboxes", mail ? "on" : "off", b);
     }
-    std::vector<double> offsets = quick ? std::vector<double>{0.0, 1e-9} : std::vector<double>{0.0, 1e-14, 1e-12, 1e-9, 1e-6, 1e-4, 1e-2};
+    std::vector<double> offsets =
+        quick ? std::vector<double>{0.0, 1e-9}
+              : std::vector<double>{0.0, 1e-14, 1e-12, 1e-9, 1e-6, 1e-4, 1e-2};
     for (double o : offsets) {
         ShadingOptions s;
         s.offsetScale = o;
@@ -131,8 +142,10 @@ std::vector<Config> sweep(bool quick, bool schemesOnly) {
 }
 
 const char* kHeader =
-    "scene,scheme,knob,value,build_ms,memory_bytes,regions,render_ms,speedup,rays,prim_tests_per_ray,"
-    "region_visits_per_ray,mailbox_hits,walk_errors,hit_diff_pixels,color_diff_pixels,max_depth_diff\n";
+    "scene,scheme,knob,value,build_ms,memory_bytes,regions,render_ms,speedup,rays,prim_tests_per_"
+    "ray,"
+    "region_visits_per_ray,mailbox_hits,walk_errors,hit_diff_pixels,color_diff_pixels,max_depth_"
+    "diff\n";
 
 void writePlots(const std::string& dir, const std::vector<std::string>& scenes) {
     // One gnuplot script per figure; each reads report.csv with awk-filtered rows.
@@ -143,27 +156,45 @@ void writePlots(const std::string& dir, const std::vector<std::string>& scenes) 
           << body;
     };
     auto rows = [](const std::string& scene, const std::string& knob) {
-        return "'< awk -F, \"\\$1==\\\"" + scene + "\\\" && \\$3==\\\"" + knob + "\\\"\" report.csv'";
+        return "'< awk -F, \"\\$1==\\\"" + scene + "\\\" && \\$3==\\\"" + knob +
+               "\\\"\" report.csv'";
     };
-    std::string speedErr = "set title 'Speed against error (every configuration)'\nset xlabel 'speedup over brute force'\n"
-                           "set ylabel 'pixels whose primary hit differs from brute force'\nset logscale x\nset yrange [-1:*]\nplot ";
-    std::string level = "set title 'Regular scheme: max-level'\nset xlabel 'max-level'\nset ylabel 'speedup'\nset y2label 'memory (KiB)'\nset y2tics\nplot ";
-    std::string delta = "set title 'Push step: delta against error'\nset xlabel 'delta (relative to the scene size)'\nset logscale x\n"
-                        "set ylabel 'pixels whose hit differs'\nset yrange [-1:*]\nplot ";
-    std::string offset = "set title 'Secondary-ray offset against error'\nset xlabel 'offset (relative to the scene scale; 0 plotted at 1e-16)'\nset logscale x\n"
-                         "set ylabel 'pixels whose colour differs'\nset yrange [-1:*]\nplot ";
-    std::string prog = "set title 'Progressive passes: error and time'\nset xlabel 'pass stride'\nset logscale x 2\nset xrange [*:*] reverse\n"
-                       "set ylabel 'pixels differing from the final image'\nset y2label 'time since the start (ms)'\nset y2tics\nplot ";
+    std::string speedErr =
+        "set title 'Speed against error (every configuration)'\nset xlabel 'speedup over brute "
+        "force'\n"
+        "set ylabel 'pixels whose primary hit differs from brute force'\nset logscale x\nset "
+        "yrange [-1:*]\nplot ";
+    std::string level =
+        "set title 'Regular scheme: max-level'\nset xlabel 'max-level'\nset ylabel 'speedup'\nset "
+        "y2label 'memory (KiB)'\nset y2tics\nplot ";
+    std::string delta =
+        "set title 'Push step: delta against error'\nset xlabel 'delta (relative to the scene "
+        "size)'\nset logscale x\n"
+        "set ylabel 'pixels whose hit differs'\nset yrange [-1:*]\nplot ";
+    std::string offset =
+        "set title 'Secondary-ray offset against error'\nset xlabel 'offset (relative to the scene "
+        "scale; 0 plotted at 1e-16)'\nset logscale x\n"
+        "set ylabel 'pixels whose colour differs'\nset yrange [-1:*]\nplot ";
+    std::string prog =
+        "set title 'Progressive passes: error and time'\nset xlabel 'pass stride'\nset logscale x "
+        "2\nset xrange [*:*] reverse\n"
+        "set ylabel 'pixels differing from the final image'\nset y2label 'time since the start "
+        "(ms)'\nset y2tics\nplot ";
     for (size_t i = 0; i < scenes.size(); ++i) {
         const std::string& s = scenes[i];
         std::string sep = i + 1 < scenes.size() ? ", \\\n  " : "\n";
-        speedErr += "'< awk -F, \"\\$1==\\\"" + s + "\\\"\" report.csv' using 9:15 with points pt 7 title '" + s + "'" + sep;
-        level += rows(s, "regular max-level") + " using 4:9 with linespoints title '" + s + " speedup', " +
-                 rows(s, "regular max-level") + " using 4:($6/1024) axes x1y2 with linespoints dt 2 title '" + s + " memory'" + sep;
+        speedErr += "'< awk -F, \"\\$1==\\\"" + s +
+                    "\\\"\" report.csv' using 9:15 with points pt 7 title '" + s + "'" + sep;
+        level += rows(s, "regular max-level") + " using 4:9 with linespoints title '" + s +
+                 " speedup', " + rows(s, "regular max-level") +
+                 " using 4:($6/1024) axes x1y2 with linespoints dt 2 title '" + s + " memory'" +
+                 sep;
         delta += rows(s, "push delta") + " using 4:15 with linespoints title '" + s + "'" + sep;
-        offset += rows(s, "offset") + " using ($4==0?1e-16:$4):16 with linespoints title '" + s + "'" + sep;
-        prog += rows(s, "progressive pass") + " using 4:16 with linespoints title '" + s + " error', " +
-                rows(s, "progressive pass") + " using 4:8 axes x1y2 with linespoints dt 2 title '" + s + " time'" + sep;
+        offset += rows(s, "offset") + " using ($4==0?1e-16:$4):16 with linespoints title '" + s +
+                  "'" + sep;
+        prog += rows(s, "progressive pass") + " using 4:16 with linespoints title '" + s +
+                " error', " + rows(s, "progressive pass") +
+                " using 4:8 axes x1y2 with linespoints dt 2 title '" + s + " time'" + sep;
     }
     script("speed_vs_error", speedErr);
     script("regular_max_level", level);
@@ -184,7 +215,8 @@ int runBench(const BenchOptions& opt) {
     }
     std::ostringstream csv, table;
     csv << kHeader;
-    table << "| scene | scheme | build ms | regions | memory | render ms | us/ray | prim tests/ray | region visits/ray | speedup | hits differing |\n"
+    table << "| scene | scheme | build ms | regions | memory | render ms | us/ray | prim tests/ray "
+             "| region visits/ray | speedup | hits differing |\n"
           << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     std::vector<std::string> done;
     for (const std::string& spec : opt.scenes) {
@@ -208,23 +240,27 @@ int runBench(const BenchOptions& opt) {
         render(scene, *brute, ro, ref, PassLattice{16, 0});
         RenderStats rs = render(scene, *brute, ro, ref);
         double bruteMs = rs.renderMs;
-        auto row = [&](const char* scheme, const std::string& knob, const std::string& value, const AccelInfo& info,
-                       const RenderStats& s, const ImageError& e) {
+        auto row = [&](const char* scheme, const std::string& knob, const std::string& value,
+                       const AccelInfo& info, const RenderStats& s, const ImageError& e) {
             const RayCounters& c = s.counters;
             double rays = c.rays ? double(c.rays) : 1.0;
             if (knob == "scheme" || knob == "peer (bounces 0)") {
                 char line[512];
-                std::snprintf(line, sizeof line, "| %s | %s%s | %.0f | %zu | %.1f MiB | %.0f | %.2f | %.1f | %.1f | %.1fx | %zu |\n",
-                              spec.c_str(), scheme, knob == "scheme" ? "" : " (bounces 0)", info.buildMs, info.regions,
-                              double(info.memoryBytes) / 1048576.0, s.renderMs, 1000.0 * s.renderMs / rays,
-                              double(c.primTests) / rays, double(c.regionVisits) / rays, bruteMs / s.renderMs, e.hitDiff);
+                std::snprintf(line, sizeof line,
+                              "| %s | %s%s | %.0f | %zu | %.1f MiB | %.0f | %.2f | %.1f | %.1f | "
+                              "%.1fx | %zu |\n",
+                              spec.c_str(), scheme, knob == "scheme" ? "" : " (bounces 0)",
+                              info.buildMs, info.regions, double(info.memoryBytes) / 1048576.0,
+                              s.renderMs, 1000.0 * s.renderMs / rays, double(c.primTests) / rays,
+                              double(c.regionVisits) / rays, bruteMs / s.renderMs, e.hitDiff);
                 table << line;
             }
-            csv << spec << "," << scheme << "," << knob << "," << value << "," << num(info.buildMs) << ","
-                << info.memoryBytes << "," << info.regions << "," << num(s.renderMs) << "," << num(bruteMs / s.renderMs)
-                << "," << c.rays << "," << num(double(c.primTests) / rays) << "," << num(double(c.regionVisits) / rays)
-                << "," << c.mailboxHits << "," << c.walkErrors << "," << e.hitDiff << "," << e.colorDiff << ","
-                << num(e.maxDepthDiff) << "\n";
+            csv << spec << "," << scheme << "," << knob << "," << value << "," << num(info.buildMs)
+                << "," << info.memoryBytes << "," << info.regions << "," << num(s.renderMs) << ","
+                << num(bruteMs / s.renderMs) << "," << c.rays << ","
+                << num(double(c.primTests) / rays) << "," << num(double(c.regionVisits) / rays)
+                << "," << c.mailboxHits << "," << c.walkErrors << "," << e.hitDiff << ","
+                << e.colorDiff << "," << num(e.maxDepthDiff) << "\n";
         };
         row("brute", "scheme", "brute", brute->info(), rs, {});
         std::cerr << spec << ": brute force " << int(bruteMs) << " ms\n";
@@ -234,7 +270,8 @@ int runBench(const BenchOptions& opt) {
             try {
                 accel = buildAccelerator(scene, c.build);
             } catch (const std::invalid_argument& e) {
-                std::cerr << spec << ": " << c.knob << " = " << c.value << ": skipped: " << e.what() << "\n";
+                std::cerr << spec << ": " << c.knob << " = " << c.value << ": skipped: " << e.what()
+                          << "\n";
                 continue;
             }
             RenderOptions r = ro;
@@ -242,7 +279,8 @@ int runBench(const BenchOptions& opt) {
             Image img(ro.width, ro.height);
             RenderStats s = render(scene, *accel, r, img);
             row(schemeName(c.build.scheme), c.knob, c.value, accel->info(), s, compare(ref, img));
-            std::cerr << spec << ": " << c.knob << " = " << c.value << ": " << int(s.renderMs) << " ms\n";
+            std::cerr << spec << ": " << c.knob << " = " << c.value << ": " << int(s.renderMs)
+                      << " ms\n";
         }
 
         // Against a peer: Embree on union-only scenes, on primary and shadow rays
@@ -253,7 +291,8 @@ int runBench(const BenchOptions& opt) {
             Image ref0(ro.width, ro.height);
             RenderStats b0 = render(scene, *brute, r0, ref0);
             double brute0 = b0.renderMs;
-            std::swap(bruteMs, brute0);  // speedups of these rows are over brute force at --bounces 0
+            std::swap(bruteMs,
+                      brute0);  // speedups of these rows are over brute force at --bounces 0
             row("brute", "peer (bounces 0)", "brute", brute->info(), b0, {});
             for (SchemeKind k : {SchemeKind::Regular, SchemeKind::Irregular}) {
                 BuildParams b;
@@ -262,7 +301,8 @@ int runBench(const BenchOptions& opt) {
                     auto a = buildAccelerator(scene, b);
                     Image img(ro.width, ro.height);
                     RenderStats s = render(scene, *a, r0, img);
-                    row(schemeName(k), "peer (bounces 0)", schemeName(k), a->info(), s, compare(ref0, img));
+                    row(schemeName(k), "peer (bounces 0)", schemeName(k), a->info(), s,
+                        compare(ref0, img));
                 } catch (const std::invalid_argument&) {
                 }
             }
@@ -274,7 +314,8 @@ int runBench(const BenchOptions& opt) {
             info.regions = 0;
             row("embree", "peer (bounces 0)", "embree", info, s, compare(ref0, img));
             std::swap(bruteMs, brute0);
-            std::cerr << spec << ": embree " << int(s.renderMs) << " ms (brute force at --bounces 0: " << int(b0.renderMs) << " ms)\n";
+            std::cerr << spec << ": embree " << int(s.renderMs)
+                      << " ms (brute force at --bounces 0: " << int(b0.renderMs) << " ms)\n";
         }
 
         if (opt.schemesOnly) {
@@ -301,7 +342,8 @@ int runBench(const BenchOptions& opt) {
             elapsed += s.renderMs;
             s.renderMs = elapsed;
             ImageError e = compare(ref, upsample(prog, stride));
-            row(schemeName(best->params().scheme), "progressive pass", std::to_string(stride), best->info(), s, e);
+            row(schemeName(best->params().scheme), "progressive pass", std::to_string(stride),
+                best->info(), s, e);
             prev = stride;
         }
         done.push_back(spec);
@@ -312,16 +354,18 @@ int runBench(const BenchOptions& opt) {
     if (opt.plots) {
         writePlots(opt.outDir, done);
         // A plot is drawn when the CSV has rows for its knob.
-        const std::pair<const char*, const char*> plots[] = {{"speed_vs_error", ",scheme,"},
-                                                             {"regular_max_level", ",regular max-level,"},
-                                                             {"push_delta", ",push delta,"},
-                                                             {"offset", ",offset,"},
-                                                             {"progressive", ",progressive pass,"}};
+        const std::pair<const char*, const char*> plots[] = {
+            {"speed_vs_error", ",scheme,"},
+            {"regular_max_level", ",regular max-level,"},
+            {"push_delta", ",push delta,"},
+            {"offset", ",offset,"},
+            {"progressive", ",progressive pass,"}};
         for (const auto& [name, knob] : plots) {
             if (csv.str().find(knob) == std::string::npos) continue;
             std::string cmd = "cd '" + opt.outDir + "' && gnuplot " + name + ".gp 2>/dev/null";
             if (std::system(cmd.c_str()) != 0)
-                std::cerr << "warning: gnuplot failed on " << name << ".gp (is gnuplot installed?)\n";
+                std::cerr << "warning: gnuplot failed on " << name
+                          << ".gp (is gnuplot installed?)\n";
             else
                 std::cout << "wrote " << opt.outDir << "/" << name << ".png\n";
         }

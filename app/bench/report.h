@@ -14,8 +14,8 @@ struct BenchOptions {
     int threads = 0;
     int bounces = 3;
     std::string outDir = "bench-out";
-    bool quick = false;  ///< fewer knob values (used by the test suite)
-    bool plots = true;   ///< run gnuplot on the CSV
+    bool quick = false;        ///< fewer knob values (used by the test suite)
+    bool plots = true;         ///< run gnuplot on the CSV
     bool schemesOnly = false;  ///< default settings of each scheme (and the peer) only: the table
 };
 

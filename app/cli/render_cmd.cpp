@@ -15,7 +15,7 @@ namespace {
 
 /// A progress bar on stderr, shown only on a terminal and only after the first second.
 class ProgressBar {
-public:
+  public:
     ProgressBar(std::atomic<size_t>& done, size_t total) : done_(done), total_(total) {
         if (!isatty(STDERR_FILENO) || total == 0) return;
         thread_ = std::thread([this] { loop(); });
@@ -25,17 +25,19 @@ public:
         if (thread_.joinable()) thread_.join();
     }
 
-private:
+  private:
     void loop() {
         auto start = std::chrono::steady_clock::now();
         bool shown = false;
         while (!stop_) {
             std::this_thread::sleep_for(std::chrono::milliseconds(100));
-            double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            double secs =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             if (secs < 1.0) continue;
             double f = double(done_.load()) / double(total_);
             int bar = int(f * 40.0);
-            std::fprintf(stderr, "\r[%-40s] %5.1f%% %6.1fs", std::string(size_t(bar), '#').c_str(), 100.0 * f, secs);
+            std::fprintf(stderr, "\r[%-40s] %5.1f%% %6.1fs", std::string(size_t(bar), '#').c_str(),
+                         100.0 * f, secs);
             shown = true;
         }
         if (shown) std::fprintf(stderr, "\r%-70s\r", "");
@@ -63,14 +65,16 @@ int runRender(const CommonOptions& o, const std::string& outPath, bool quiet) {
         }
         writePng(outPath, img);
         if (!o.depthPath.empty()) writeDepthPfm(o.depthPath, img);
-        if (!o.statsPath.empty()) writeFileAtomic(o.statsPath, statsJson(scene, *accel, ro, rs).dump(2) + "\n");
+        if (!o.statsPath.empty())
+            writeFileAtomic(o.statsPath, statsJson(scene, *accel, ro, rs).dump(2) + "\n");
         if (!quiet) {
             std::cout << "rendered " << o.scene << " (" << ro.width << "x" << ro.height << ", "
                       << schemeName(o.build.scheme) << ", " << rs.threads << " threads) in "
                       << int(rs.renderMs) << " ms -> " << outPath << "\n";
         }
         if (rs.counters.walkErrors)
-            std::cerr << "warning: " << rs.counters.walkErrors << " ray walks could not advance and were ended\n";
+            std::cerr << "warning: " << rs.counters.walkErrors
+                      << " ray walks could not advance and were ended\n";
         return 0;
     } catch (const SceneError& e) {
         std::cerr << "error: " << e.what() << "\n";

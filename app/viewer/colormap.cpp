@@ -44,10 +44,14 @@ std::vector<float> heatChannel(const Image& img, ViewMode mode, int rowBegin, in
                                   channel.begin() + std::ptrdiff_t(last));
     };
     switch (mode) {
-        case ViewMode::Color: break;
-        case ViewMode::PrimTests: return rows(img.primTests);
-        case ViewMode::RegionVisits: return rows(img.regionVisits);
-        case ViewMode::TimeUs: return rows(img.timeUs);
+        case ViewMode::Color:
+            break;
+        case ViewMode::PrimTests:
+            return rows(img.primTests);
+        case ViewMode::RegionVisits:
+            return rows(img.regionVisits);
+        case ViewMode::TimeUs:
+            return rows(img.timeUs);
     }
     return {};
 }

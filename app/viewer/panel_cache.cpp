@@ -158,7 +158,7 @@ void PanelCache::render() {
             continue;
         }
         const PixelRect& q = panels_[size_t(r.panel)].rect;
-        if (empty(q)) continue;  // off the framebuffer
+        if (empty(q)) continue;                                  // off the framebuffer
         const int gy0 = fbHeight - q.y1, gy1 = fbHeight - q.y0;  // GL's rows go up
         if (dirty[size_t(r.panel)]) {
             // Into the layer as ImGui draws on the framebuffer: the same projection and pixels.

@@ -284,16 +284,15 @@ void ViewerApp::takeSnapshot() {
     std::vector<PassRecord> passes = renderer_.passes();
     for (; passesLogged_ < passes.size(); ++passesLogged_) {
         const PassRecord& p = passes[passesLogged_];
-        if (p.stride < what.stride || (p.stride == what.stride && what.rows < shown_.height))
-            break;
-        pendingLogs_.push_back({changeWhy_ + ": pass stride " + std::to_string(p.stride) +
-                                    " visible ",
-                                " ms after the change (pass render " + std::to_string(p.renderMs) +
-                                    " ms, " + std::to_string(shown_.width) + "x" +
-                                    std::to_string(shown_.height) + ")",
-                                changeAt_});
+        if (p.stride < what.stride || (p.stride == what.stride && what.rows < shown_.height)) break;
+        pendingLogs_.push_back(
+            {changeWhy_ + ": pass stride " + std::to_string(p.stride) + " visible ",
+             " ms after the change (pass render " + std::to_string(p.renderMs) + " ms, " +
+                 std::to_string(shown_.width) + "x" + std::to_string(shown_.height) + ")",
+             changeAt_});
         if (p.stride == 1)
-            pendingLogs_.push_back({changeWhy_ + ": full image ", " ms after the change", changeAt_});
+            pendingLogs_.push_back(
+                {changeWhy_ + ": full image ", " ms after the change", changeAt_});
     }
 }
 
@@ -448,8 +447,9 @@ void ViewerApp::parametersPanel() {
     }
     rebuild |= enumCombo("split axes", s_.build.splitAxes, 2, splitAxesName);
     if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("Regular: cycle cuts x, y, z in turn (the report's); cost picks each\n"
-                          "level's axis by an area estimate (cells stay about cubic)");
+        ImGui::SetTooltip(
+            "Regular: cycle cuts x, y, z in turn (the report's); cost picks each\n"
+            "level's axis by an area estimate (cells stay about cubic)");
     rebuild |= enumCombo("step", s_.build.step, 2, stepName);
     if (s_.build.step == StepMethod::Push) {
         double d = s_.build.delta;

@@ -11,7 +11,7 @@
 namespace lancer::viewer {
 
 struct ViewerSettings {
-    std::string scene = "builtin:default";  ///< last scene opened
+    std::string scene = "builtin:default";                   ///< last scene opened
     BuildParams build = cli::CommonOptions::defaultBuild();  ///< the command line's default
     ShadingOptions shading;
     int threads = 0;  ///< render threads (0: all cores)

@@ -150,13 +150,12 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
         int frames = 0, statFrames = 0;
         bool replayed = false, droppedScripted = false;
         double statWorkMs = 0.0, statSwapMs = 0.0;
-        Clock::time_point frameStart = Clock::now(), statStart = frameStart,
-                          lastDrawn = frameStart;
+        Clock::time_point frameStart = Clock::now(), statStart = frameStart, lastDrawn = frameStart;
         // When the next frame may start: frames are paced on a fixed 60 Hz timeline, so a wait
         // that oversleeps is made up by the next one (paced from each frame's own start, 15 ms
         // frames came at 55-57 a second).
-        const auto period = std::chrono::duration_cast<Clock::duration>(
-            std::chrono::duration<double>(1.0 / 60.0));
+        const auto period =
+            std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / 60.0));
         Clock::time_point due = frameStart;
         while (!glfwWindowShouldClose(window)) {
             // At most 60 frames per second for input (no swap interval is guaranteed, e.g.

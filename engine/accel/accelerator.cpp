@@ -9,9 +9,12 @@ namespace lancer {
 
 const char* schemeName(SchemeKind k) {
     switch (k) {
-        case SchemeKind::Brute: return "brute";
-        case SchemeKind::Regular: return "regular";
-        case SchemeKind::Irregular: return "irregular";
+        case SchemeKind::Brute:
+            return "brute";
+        case SchemeKind::Regular:
+            return "regular";
+        case SchemeKind::Irregular:
+            return "irregular";
     }
     return "?";
 }
@@ -20,9 +23,12 @@ const char* stepName(StepMethod s) { return s == StepMethod::Exact ? "exact" : "
 
 const char* heuristicName(BspHeuristic h) {
     switch (h) {
-        case BspHeuristic::First: return "first";
-        case BspHeuristic::Balanced: return "balanced";
-        case BspHeuristic::FewestCuts: return "fewest-cuts";
+        case BspHeuristic::First:
+            return "first";
+        case BspHeuristic::Balanced:
+            return "balanced";
+        case BspHeuristic::FewestCuts:
+            return "fewest-cuts";
     }
     return "?";
 }
@@ -84,15 +90,21 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
             return std::make_unique<Accelerator>(std::move(b), params, std::move(info));
         }
         case SchemeKind::Regular:
-            return withLightBuffer<RegularGrid>(scene, params, [&](AccelInfo& info) {
-                RegularGrid g(scene, params);
-                info.extra = g.extra();
-                return g;
-            }, elapsedMs);
+            return withLightBuffer<RegularGrid>(
+                scene, params,
+                [&](AccelInfo& info) {
+                    RegularGrid g(scene, params);
+                    info.extra = g.extra();
+                    return g;
+                },
+                elapsedMs);
         case SchemeKind::Irregular:
-            return withLightBuffer<IrregularSubdivision>(scene, params, [&](AccelInfo& info) {
-                return IrregularSubdivision::build(scene, params, info.extra);
-            }, elapsedMs);
+            return withLightBuffer<IrregularSubdivision>(
+                scene, params,
+                [&](AccelInfo& info) {
+                    return IrregularSubdivision::build(scene, params, info.extra);
+                },
+                elapsedMs);
     }
     throw std::logic_error("buildAccelerator: unknown scheme");
 }

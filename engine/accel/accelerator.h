@@ -37,16 +37,16 @@ struct BuildParams {
     /// primitive tests per ray (at 18 / 2: 65), and no built-in CSG scene explodes (at 24 / 2
     /// lattice does, where box faces run through other boxes). Were 18 and 2.
     int maxLevel = 24;
-    int maxObjects = 4;         ///< stop subdividing a cell holding at most this many primitives
+    int maxObjects = 4;  ///< stop subdividing a cell holding at most this many primitives
     StepMethod step = StepMethod::Exact;
-    double delta = 1e-6;        ///< push distance, relative to the scene box's largest extent
+    double delta = 1e-6;  ///< push distance, relative to the scene box's largest extent
     BspHeuristic heuristic = BspHeuristic::Balanced;
     SplitAxes splitAxes = SplitAxes::Cost;  ///< regular: which axis each level cuts
-    bool mailboxes = true;      ///< --no-mailbox turns them off to measure their effect
+    bool mailboxes = true;                  ///< --no-mailbox turns them off to measure their effect
     /// Accelerated schemes: shorten shadow rays with the light buffer (light_buffer.h);
     /// --no-light-buffer turns it off to measure its effect. Brute force never uses it.
     bool lightBuffer = true;
-    bool fullTable = false;     ///< regular: one full directory table instead of sub-tables
+    bool fullTable = false;  ///< regular: one full directory table instead of sub-tables
     IrregularFrame irregularFrame = IrregularFrame::Projective;  ///< --irregular-frame
 };
 
@@ -59,7 +59,7 @@ struct AccelInfo {
 };
 
 class Accelerator {
-public:
+  public:
     using Impl = std::variant<BruteForce, RegularGrid, IrregularSubdivision>;
 
     Accelerator(Impl impl, BuildParams params, AccelInfo info, LightBuffer lightBuffer = {})
@@ -72,8 +72,8 @@ public:
     template <class Obs>
     bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                    Hit& hit) const {
-        return std::visit([&](const auto& s) { return s.intersect(ray, tmin, tmax, ctx, obs, hit); },
-                          impl_);
+        return std::visit(
+            [&](const auto& s) { return s.intersect(ray, tmin, tmax, ctx, obs, hit); }, impl_);
     }
     /// Whether the shadow ray toward scene light `light` (its direction points at the light)
     /// meets anything with t in (0, tmax]: the answer intersect() gives. The accelerated schemes
@@ -116,7 +116,7 @@ public:
     const AccelInfo& info() const { return info_; }
     const Impl& impl() const { return impl_; }
 
-private:
+  private:
     Impl impl_;
     BuildParams params_;
     AccelInfo info_;

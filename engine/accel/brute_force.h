@@ -6,7 +6,7 @@
 namespace lancer {
 
 class BruteForce {
-public:
+  public:
     explicit BruteForce(const Scene& scene) : scene_(&scene) {}
 
     template <class Obs>
@@ -21,7 +21,7 @@ public:
     size_t memoryBytes() const { return 0; }
     bool usesMailboxes() const { return false; }
 
-private:
+  private:
     const Scene* scene_;
 };
 

@@ -91,10 +91,17 @@ void evalTree(const Scene& scene, const CsgTree& tree, int node, const Ray& ray,
     }
     evalTree<Obs, F>(scene, tree, x.right, ray, ctx, obs, level + 1, b);
     switch (x.op) {
-        case Op::Union: spanUnion(a, b, out); break;
-        case Op::Intersection: spanIntersection(a, b, out); break;
-        case Op::Difference: spanDifference(a, b, out); break;
-        case Op::Primitive: break;
+        case Op::Union:
+            spanUnion(a, b, out);
+            break;
+        case Op::Intersection:
+            spanIntersection(a, b, out);
+            break;
+        case Op::Difference:
+            spanDifference(a, b, out);
+            break;
+        case Op::Primitive:
+            break;
     }
 }
 
@@ -148,7 +155,8 @@ template <class Obs>
             if (s.out.t >= from && s.out.t > tmin) pend.add(s.out.t);
         }
     }
-    if (!(pend.next <= t1) && !Obs::kActive) return false;  // the observer is shown the spans anyway
+    if (!(pend.next <= t1) && !Obs::kActive)
+        return false;  // the observer is shown the spans anyway
     evalTree<Obs, Fetch::Fresh>(scene, tree, root, ray, ctx, obs, 0, ctx.result);
     if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
     const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);

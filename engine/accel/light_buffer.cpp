@@ -7,8 +7,8 @@
 
 namespace lancer {
 
-void LightBuffer::Map::project(const Box3& x, double& dNear, double& uLo, double& uHi,
-                               double& vLo, double& vHi) const {
+void LightBuffer::Map::project(const Box3& x, double& dNear, double& uLo, double& uHi, double& vLo,
+                               double& vHi) const {
     dNear = s > 0.0 ? L[a] - x.hi[a] : x.lo[a] - L[a];
     const double dFar = s > 0.0 ? L[a] - x.lo[a] : x.hi[a] - L[a];
     uLo = vLo = kInf;
@@ -126,7 +126,7 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
         double wu0 = kInf, wu1 = -kInf, wv0 = kInf, wv1 = -kInf;
         bool anyLarge = false;
         for (const Box3& mb : boxes) {
-            if (mb.isEmpty()) continue;  // a dropped primitive
+            if (mb.isEmpty()) continue;                      // a dropped primitive
             Box3 x{mb.lo - Vec3(side), mb.hi + Vec3(side)};  // widened across the view axis only
             x.lo[m.a] = mb.lo[m.a], x.hi[m.a] = mb.hi[m.a];
             BoxImage im;
@@ -222,7 +222,8 @@ void LightBuffer::Grid::add(const BoxImage& im, std::vector<double>& colLo,
         hi = std::min(im.df, hi * (1.0 + rel));
         Slot* row = at(0, j);
         for (int i = i0; i <= i1; ++i) {
-            const Slot depths{std::max(lo, colLo[size_t(i - i0)]), std::min(hi, colHi[size_t(i - i0)])};
+            const Slot depths{std::max(lo, colLo[size_t(i - i0)]),
+                              std::min(hi, colHi[size_t(i - i0)])};
             if (depths.near <= depths.far) insert(row + size_t(i) * size_t(k), k, depths);
         }
     }
@@ -230,12 +231,14 @@ void LightBuffer::Grid::add(const BoxImage& im, std::vector<double>& colLo,
 
 size_t LightBuffer::memoryBytes() const {
     size_t bytes = maps_.size() * sizeof(Map);
-    for (const Map& m : maps_) bytes += (m.fine.slots.size() + m.coarse.slots.size()) * sizeof(Slot);
+    for (const Map& m : maps_)
+        bytes += (m.fine.slots.size() + m.coarse.slots.size()) * sizeof(Slot);
     return bytes;
 }
 
 size_t LightBuffer::mappedLights() const {
-    return size_t(std::count_if(maps_.begin(), maps_.end(), [](const Map& m) { return !m.fine.slots.empty(); }));
+    return size_t(std::count_if(maps_.begin(), maps_.end(),
+                                [](const Map& m) { return !m.fine.slots.empty(); }));
 }
 
 }  // namespace lancer

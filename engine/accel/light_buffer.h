@@ -68,7 +68,7 @@ class LightBuffer {
         if (!bin) return -1;
         int count = 0;
         for (int i = maps_[light].fine.k - 1; i >= 0; --i) {  // deepest first: the one nearest o
-            if (!(bin[i].near <= bin[i].far)) continue;  // unused
+            if (!(bin[i].near <= bin[i].far)) continue;       // unused
             // Widened by the rounding allowance, in t units.
             const double t0 = std::max(0.0, (d - bin[i].far - hair_) / rate);
             const double t1 = std::min(tmax, (d - bin[i].near + hair_) / rate);
@@ -171,8 +171,8 @@ class LightBuffer {
     }
     /// Add depth interval x to a bin of k (1 or 2) intervals.
     static void insert(Slot* bin, int k, Slot x);
-    Box3 box_;           ///< the scene bounds, widened by hair_
-    double hair_ = 0.0;  ///< rounding allowance, in scene units
+    Box3 box_;               ///< the scene bounds, widened by hair_
+    double hair_ = 0.0;      ///< rounding allowance, in scene units
     std::vector<Map> maps_;  ///< per scene light
 };
 

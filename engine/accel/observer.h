@@ -24,11 +24,11 @@ struct NullObserver {
 /// One event of a walk, in order.
 struct WalkEvent {
     enum Kind : uint8_t { Region, Pointer, PrimTest, MailboxHit, Spans, Error } kind;
-    uint32_t a = 0, b = 0;       ///< region id / prim id; pointer: from, to
-    int corner = -1;             ///< pointer: which corner
-    double t0 = 0.0, t1 = 0.0;   ///< region interval
-    SpanList spans;              ///< PrimTest: the primitive's spans; Spans: the region's tree
-    std::string what;            ///< Error
+    uint32_t a = 0, b = 0;      ///< region id / prim id; pointer: from, to
+    int corner = -1;            ///< pointer: which corner
+    double t0 = 0.0, t1 = 0.0;  ///< region interval
+    SpanList spans;             ///< PrimTest: the primitive's spans; Spans: the region's tree
+    std::string what;           ///< Error
 };
 
 struct RecordingObserver {
@@ -43,9 +43,15 @@ struct RecordingObserver {
     void primTest(uint32_t prim, const Span* spans, int n) {
         events.push_back({WalkEvent::PrimTest, prim, 0, -1, 0, 0, SpanList(spans, spans + n), {}});
     }
-    void mailboxHit(uint32_t prim) { events.push_back({WalkEvent::MailboxHit, prim, 0, -1, 0, 0, {}, {}}); }
-    void regionSpans(const SpanList& s) { events.push_back({WalkEvent::Spans, 0, 0, -1, 0, 0, s, {}}); }
-    void walkError(const char* what) { events.push_back({WalkEvent::Error, 0, 0, -1, 0, 0, {}, what}); }
+    void mailboxHit(uint32_t prim) {
+        events.push_back({WalkEvent::MailboxHit, prim, 0, -1, 0, 0, {}, {}});
+    }
+    void regionSpans(const SpanList& s) {
+        events.push_back({WalkEvent::Spans, 0, 0, -1, 0, 0, s, {}});
+    }
+    void walkError(const char* what) {
+        events.push_back({WalkEvent::Error, 0, 0, -1, 0, 0, {}, what});
+    }
 };
 
 }  // namespace lancer

@@ -10,14 +10,14 @@ namespace lancer {
 
 /// Counters every scheme reports; summed over threads for `--stats`, per pixel for heatmaps.
 struct RayCounters {
-    uint64_t rays = 0;          ///< all rays traced (primary, shadow, reflected, refracted)
+    uint64_t rays = 0;  ///< all rays traced (primary, shadow, reflected, refracted)
     uint64_t primaryRays = 0;
     uint64_t shadowRays = 0;
-    uint64_t primTests = 0;     ///< ray-primitive intersection computations done
-    uint64_t mailboxHits = 0;   ///< computations saved by a mailbox
-    uint64_t regionVisits = 0;  ///< regions entered
-    uint64_t pointerSteps = 0;  ///< region changes by corner pointer (irregular scheme)
-    uint64_t walkErrors = 0;    ///< walks that could not advance and were ended
+    uint64_t primTests = 0;         ///< ray-primitive intersection computations done
+    uint64_t mailboxHits = 0;       ///< computations saved by a mailbox
+    uint64_t regionVisits = 0;      ///< regions entered
+    uint64_t pointerSteps = 0;      ///< region changes by corner pointer (irregular scheme)
+    uint64_t walkErrors = 0;        ///< walks that could not advance and were ended
     uint64_t lightBufferSkips = 0;  ///< shadow rays the light buffer found unblocked, no walk
 
     RayCounters& operator+=(const RayCounters& o);
@@ -64,7 +64,7 @@ struct PendingBoundaries {
 struct TraceContext {
     std::vector<uint64_t> stamp;  ///< per primitive: the ray id its mailbox holds spans for
     std::vector<Mailbox> mail;
-    PendingBoundaries pending;    ///< of the ray the regular walk is on
+    PendingBoundaries pending;      ///< of the ray the regular walk is on
     std::vector<SpanList> scratch;  ///< two buffers per tree level, reused without allocation
     SpanList result;                ///< spans of the tree evaluated last
     uint64_t rayId = 0;

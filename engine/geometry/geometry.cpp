@@ -1,8 +1,7 @@
 #include "engine/geometry/geometry.h"
 
-#include <glm/gtc/matrix_transform.hpp>
-
 #include <cstdio>
+#include <glm/gtc/matrix_transform.hpp>
 
 namespace lancer {
 
@@ -12,7 +11,9 @@ std::string toString(const Vec3& v) {
     return buf;
 }
 
-std::string Ray::toString() const { return "Ray{o=" + lancer::toString(o) + " d=" + lancer::toString(d) + "}"; }
+std::string Ray::toString() const {
+    return "Ray{o=" + lancer::toString(o) + " d=" + lancer::toString(d) + "}";
+}
 
 std::string Box3::toString() const {
     if (isEmpty()) return "Box3{empty}";

@@ -1,10 +1,9 @@
 // Rays, axis-aligned boxes and affine transforms, in double precision.
 #pragma once
 
-#include <glm/glm.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <glm/glm.hpp>
 #include <limits>
 #include <string>
 
@@ -98,9 +97,7 @@ struct Transform {
     Vec3 point(const Vec3& p) const { return Vec3(m * glm::dvec4(p, 1.0)); }
     Vec3 vector(const Vec3& v) const { return Mat3(m) * v; }
     Vec3 normalOf(const Vec3& n) const { return glm::normalize(normal * n); }
-    Ray toLocal(const Ray& r) const {
-        return {Vec3(inv * glm::dvec4(r.o, 1.0)), Mat3(inv) * r.d};
-    }
+    Ray toLocal(const Ray& r) const { return {Vec3(inv * glm::dvec4(r.o, 1.0)), Mat3(inv) * r.d}; }
     /// World box of a local box (hull of its eight transformed corners).
     Box3 box(const Box3& local) const;
     bool isIdentity() const { return m == Mat4(1.0); }

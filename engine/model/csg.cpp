@@ -6,10 +6,14 @@ namespace lancer {
 
 const char* opName(Op op) {
     switch (op) {
-        case Op::Primitive: return "primitive";
-        case Op::Union: return "union";
-        case Op::Intersection: return "intersection";
-        case Op::Difference: return "difference";
+        case Op::Primitive:
+            return "primitive";
+        case Op::Union:
+            return "union";
+        case Op::Intersection:
+            return "intersection";
+        case Op::Difference:
+            return "difference";
     }
     return "?";
 }
@@ -98,11 +102,14 @@ std::string CsgTree::toString() const {
 Box3 nodeBox(const CsgTree& tree, int node, const std::vector<Box3>& primBox) {
     const CsgNode& x = tree.nodes[node];
     switch (x.op) {
-        case Op::Primitive: return primBox[x.prim];
-        case Op::Union: return hull(nodeBox(tree, x.left, primBox), nodeBox(tree, x.right, primBox));
+        case Op::Primitive:
+            return primBox[x.prim];
+        case Op::Union:
+            return hull(nodeBox(tree, x.left, primBox), nodeBox(tree, x.right, primBox));
         case Op::Intersection:
             return overlap(nodeBox(tree, x.left, primBox), nodeBox(tree, x.right, primBox));
-        case Op::Difference: return nodeBox(tree, x.left, primBox);
+        case Op::Difference:
+            return nodeBox(tree, x.left, primBox);
     }
     return Box3::empty();
 }
@@ -119,10 +126,24 @@ MinimizedBoxes minimizeBoxes(const CsgTree& tree, const std::vector<Primitive>& 
         const CsgNode& x = tree.nodes[n];
         Box3 b;
         switch (x.op) {
-            case Op::Primitive: b = r.box[x.prim]; break;
-            case Op::Union: { Box3 a = up(x.left); b = hull(a, up(x.right)); break; }
-            case Op::Intersection: { Box3 a = up(x.left); b = overlap(a, up(x.right)); break; }
-            case Op::Difference: { b = up(x.left); up(x.right); break; }
+            case Op::Primitive:
+                b = r.box[x.prim];
+                break;
+            case Op::Union: {
+                Box3 a = up(x.left);
+                b = hull(a, up(x.right));
+                break;
+            }
+            case Op::Intersection: {
+                Box3 a = up(x.left);
+                b = overlap(a, up(x.right));
+                break;
+            }
+            case Op::Difference: {
+                b = up(x.left);
+                up(x.right);
+                break;
+            }
         }
         return nb[n] = b;
     };
@@ -172,8 +193,8 @@ int restrictTree(const CsgTree& src, int node, const std::vector<char>& keep, Cs
     int b = restrictTree(src, x.right, keep, dst);
     if (a >= 0 && b >= 0) return dst.combine(x.op, a, b);
     if (a < 0 && b < 0) return -1;
-    if (a < 0) return b;                          // only B: union gives B
-    return x.op == Op::Intersection ? -1 : a;     // only A: union and difference give A
+    if (a < 0) return b;                       // only B: union gives B
+    return x.op == Op::Intersection ? -1 : a;  // only A: union and difference give A
 }
 
 std::string checkSurfacesUnderUnions(const CsgTree& tree, const std::vector<Primitive>& prims) {
@@ -186,7 +207,9 @@ std::string checkSurfacesUnderUnions(const CsgTree& tree, const std::vector<Prim
             if (badAncestor >= 0 && prims[x.prim].isSurface()) {
                 const Primitive& p = prims[x.prim];
                 err = std::string("a ") + shapeName(p.shape) +
-                      (p.origin.empty() ? "" : " (" + p.origin + ")") + " is a surface with no inside; it may appear only under unions, not under the " +
+                      (p.origin.empty() ? "" : " (" + p.origin + ")") +
+                      " is a surface with no inside; it may appear only under unions, not under "
+                      "the " +
                       opName(tree.nodes[badAncestor].op) + " node";
             }
             return;

@@ -16,11 +16,11 @@ const char* opName(Op op);
 /// A primitive instance: a shape in its local frame placed by an affine transform.
 struct Primitive {
     Shape shape;
-    Transform xf;               ///< local to world
-    bool hasXf = false;         ///< false: the shape is already in world coordinates
-    int material = 0;           ///< index into Scene::materials
-    Box3 worldBox;              ///< bounds of the untrimmed shape
-    std::string origin;         ///< where it came from, for messages ("file:line:col")
+    Transform xf;        ///< local to world
+    bool hasXf = false;  ///< false: the shape is already in world coordinates
+    int material = 0;    ///< index into Scene::materials
+    Box3 worldBox;       ///< bounds of the untrimmed shape
+    std::string origin;  ///< where it came from, for messages ("file:line:col")
 
     bool isSurface() const { return shapeIsSurface(shape); }
     int spans(const Ray& r, uint32_t id, Span* out) const {
@@ -59,9 +59,9 @@ struct CsgTree {
 
 /// Result of CSG-driven box minimization.
 struct MinimizedBoxes {
-    std::vector<Box3> box;      ///< per primitive; empty for dropped primitives
+    std::vector<Box3> box;  ///< per primitive; empty for dropped primitives
     int iterations = 0;
-    int dropped = 0;            ///< primitives whose box emptied (they cannot contribute)
+    int dropped = 0;  ///< primitives whose box emptied (they cannot contribute)
 };
 
 /// Boxes of the report's Fig. 1, iterated to a fixed point: under A ∩ B each primitive of A is

@@ -39,24 +39,44 @@ int blockSpans(const Block& b, const Ray& r, uint32_t prim, Span* out) {
 int quadricInside(double a, double b, double c, double* lo, double* hi) {
     if (a == 0.0) {
         if (b == 0.0) {
-            if (c <= 0.0) { lo[0] = -kInf; hi[0] = kInf; return 1; }
+            if (c <= 0.0) {
+                lo[0] = -kInf;
+                hi[0] = kInf;
+                return 1;
+            }
             return 0;
         }
         double t = -c / b;
-        if (b > 0.0) { lo[0] = -kInf; hi[0] = t; } else { lo[0] = t; hi[0] = kInf; }
+        if (b > 0.0) {
+            lo[0] = -kInf;
+            hi[0] = t;
+        } else {
+            lo[0] = t;
+            hi[0] = kInf;
+        }
         return 1;
     }
     double disc = b * b - 4.0 * a * c;
     if (disc <= 0.0) {
-        if (a < 0.0) { lo[0] = -kInf; hi[0] = kInf; return 1; }
+        if (a < 0.0) {
+            lo[0] = -kInf;
+            hi[0] = kInf;
+            return 1;
+        }
         return 0;
     }
     double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
     double t0 = q / a, t1 = (q != 0.0) ? c / q : -t0;
     if (t0 > t1) std::swap(t0, t1);
-    if (a > 0.0) { lo[0] = t0; hi[0] = t1; return 1; }
-    lo[0] = -kInf; hi[0] = t0;
-    lo[1] = t1; hi[1] = kInf;
+    if (a > 0.0) {
+        lo[0] = t0;
+        hi[0] = t1;
+        return 1;
+    }
+    lo[0] = -kInf;
+    hi[0] = t0;
+    lo[1] = t1;
+    hi[1] = kInf;
     return 2;
 }
 
@@ -164,58 +184,60 @@ int shapeSpans(const Shape& s, const Ray& r, uint32_t prim, Span* out) {
 
 Vec3 shapeNormal(const Shape& s, const Vec3& p, uint8_t part) {
     return std::visit(
-        Overloaded{
-            [&](const Sphere& x) { return (p - x.c) / x.r; },
-            [&](const Block&) {
-                Vec3 n(0.0);
-                n[part / 2] = (part & 1) ? 1.0 : -1.0;
-                return n;
-            },
-            [&](const Cone& x) {
-                if (part == 1) return Vec3(0, 0, -1);
-                if (part == 2) return Vec3(0, 0, 1);
-                double s = (x.r2 - x.r1) / x.h;
-                double rz = x.r1 + s * p.z;
-                Vec3 n(p.x, p.y, -s * rz);
-                if (glm::dot(n, n) == 0.0) return Vec3(0, 0, x.r2 > x.r1 ? -1.0 : 1.0);
-                return glm::normalize(n);
-            },
-            [&](const Triangle& x) {
-                Vec3 g = glm::cross(x.p[1] - x.p[0], x.p[2] - x.p[0]);
-                if (!x.smooth) return glm::normalize(g);
-                // Barycentric weights of p; shading normal oriented like the geometric one.
-                double area = glm::dot(g, g);
-                double w1 = glm::dot(glm::cross(x.p[2] - p, x.p[0] - p), g) / area;
-                double w2 = glm::dot(glm::cross(x.p[0] - p, x.p[1] - p), g) / area;
-                double w0 = 1.0 - w1 - w2;
-                Vec3 n = w0 * x.n[0] + w1 * x.n[1] + w2 * x.n[2];
-                if (glm::dot(n, n) == 0.0) return glm::normalize(g);
-                n = glm::normalize(n);
-                return glm::dot(n, g) < 0.0 ? -n : n;
-            },
-            [&](const Polygon& x) { return x.n; }},
+        Overloaded{[&](const Sphere& x) { return (p - x.c) / x.r; },
+                   [&](const Block&) {
+                       Vec3 n(0.0);
+                       n[part / 2] = (part & 1) ? 1.0 : -1.0;
+                       return n;
+                   },
+                   [&](const Cone& x) {
+                       if (part == 1) return Vec3(0, 0, -1);
+                       if (part == 2) return Vec3(0, 0, 1);
+                       double s = (x.r2 - x.r1) / x.h;
+                       double rz = x.r1 + s * p.z;
+                       Vec3 n(p.x, p.y, -s * rz);
+                       if (glm::dot(n, n) == 0.0) return Vec3(0, 0, x.r2 > x.r1 ? -1.0 : 1.0);
+                       return glm::normalize(n);
+                   },
+                   [&](const Triangle& x) {
+                       Vec3 g = glm::cross(x.p[1] - x.p[0], x.p[2] - x.p[0]);
+                       if (!x.smooth) return glm::normalize(g);
+                       // Barycentric weights of p; shading normal oriented like the geometric one.
+                       double area = glm::dot(g, g);
+                       double w1 = glm::dot(glm::cross(x.p[2] - p, x.p[0] - p), g) / area;
+                       double w2 = glm::dot(glm::cross(x.p[0] - p, x.p[1] - p), g) / area;
+                       double w0 = 1.0 - w1 - w2;
+                       Vec3 n = w0 * x.n[0] + w1 * x.n[1] + w2 * x.n[2];
+                       if (glm::dot(n, n) == 0.0) return glm::normalize(g);
+                       n = glm::normalize(n);
+                       return glm::dot(n, g) < 0.0 ? -n : n;
+                   },
+                   [&](const Polygon& x) { return x.n; }},
         s);
 }
 
 Box3 shapeBounds(const Shape& s) {
-    return std::visit(
-        Overloaded{[](const Sphere& x) { return Box3{x.c - Vec3(x.r), x.c + Vec3(x.r)}; },
-                   [](const Block& x) { return Box3{x.lo, x.hi}; },
-                   [](const Cone& x) {
-                       double r = std::max(x.r1, x.r2);
-                       return Box3{Vec3(-r, -r, 0.0), Vec3(r, r, x.h)};
-                   },
-                   [](const Triangle& x) {
-                       Box3 b;
-                       for (const Vec3& p : x.p) b.expand(p);
-                       return b;
-                   },
-                   [](const Polygon& x) {
-                       Box3 b;
-                       for (const Vec3& p : x.p) b.expand(p);
-                       return b;
-                   }},
-        s);
+    return std::visit(Overloaded{[](const Sphere& x) {
+                                     return Box3{x.c - Vec3(x.r), x.c + Vec3(x.r)};
+                                 },
+                                 [](const Block& x) {
+                                     return Box3{x.lo, x.hi};
+                                 },
+                                 [](const Cone& x) {
+                                     double r = std::max(x.r1, x.r2);
+                                     return Box3{Vec3(-r, -r, 0.0), Vec3(r, r, x.h)};
+                                 },
+                                 [](const Triangle& x) {
+                                     Box3 b;
+                                     for (const Vec3& p : x.p) b.expand(p);
+                                     return b;
+                                 },
+                                 [](const Polygon& x) {
+                                     Box3 b;
+                                     for (const Vec3& p : x.p) b.expand(p);
+                                     return b;
+                                 }},
+                      s);
 }
 
 bool shapeIsSurface(const Shape& s) {

@@ -66,9 +66,9 @@ struct Triangle {
 /// Planar polygon, convex or not (even-odd rule), at least three vertices.
 struct Polygon {
     std::vector<Vec3> p;
-    Vec3 n{0.0};       ///< unit plane normal (Newell)
-    double d = 0.0;    ///< plane: dot(n, x) = d
-    int drop = 2;      ///< axis dropped for the 2D inside test
+    Vec3 n{0.0};     ///< unit plane normal (Newell)
+    double d = 0.0;  ///< plane: dot(n, x) = d
+    int drop = 2;    ///< axis dropped for the 2D inside test
 };
 
 using Shape = std::variant<Sphere, Block, Cone, Triangle, Polygon>;

@@ -23,7 +23,8 @@ void spanUnion(const SpanList& a, const SpanList& b, SpanList& out) {
     size_t i = 0, j = 0;
     while (i < a.size() || j < b.size()) {
         // Take the span that starts first (ties: a first, which keeps the result deterministic).
-        const Span& s = (j >= b.size() || (i < a.size() && a[i].in.t <= b[j].in.t)) ? a[i++] : b[j++];
+        const Span& s =
+            (j >= b.size() || (i < a.size() && a[i].in.t <= b[j].in.t)) ? a[i++] : b[j++];
         if (!out.empty() && s.in.t <= out.back().out.t) {
             if (s.out.t > out.back().out.t) out.back().out = s.out;
         } else {

@@ -131,12 +131,14 @@ std::vector<float> readPfm(const std::string& path, int& w, int& h) {
     double scale;
     f >> magic >> w >> h >> scale;
     f.get();
-    if (magic != "Pf" || w <= 0 || h <= 0 || scale >= 0) throw std::runtime_error(path + ": not a little-endian one-channel PFM");
+    if (magic != "Pf" || w <= 0 || h <= 0 || scale >= 0)
+        throw std::runtime_error(path + ": not a little-endian one-channel PFM");
     std::vector<float> rows(size_t(w) * size_t(h)), out(rows.size());
     f.read(reinterpret_cast<char*>(rows.data()), std::streamsize(rows.size() * 4));
     if (!f) throw std::runtime_error(path + ": truncated");
     for (int y = 0; y < h; ++y)
-        std::memcpy(&out[size_t(y) * size_t(w)], &rows[size_t(h - 1 - y) * size_t(w)], size_t(w) * 4);
+        std::memcpy(&out[size_t(y) * size_t(w)], &rows[size_t(h - 1 - y) * size_t(w)],
+                    size_t(w) * 4);
     return out;
 }
 

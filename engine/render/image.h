@@ -12,12 +12,12 @@ namespace lancer {
 
 struct Image {
     int width = 0, height = 0;
-    std::vector<glm::vec3> color;    ///< linear RGB, row 0 on top
-    std::vector<float> depth;        ///< primary hit distance along the unit direction; +inf: miss
-    std::vector<uint32_t> hitPrim;   ///< primitive of the primary hit; kNoPrim on a miss
-    std::vector<uint32_t> primTests; ///< per pixel, every ray of the pixel
+    std::vector<glm::vec3> color;     ///< linear RGB, row 0 on top
+    std::vector<float> depth;         ///< primary hit distance along the unit direction; +inf: miss
+    std::vector<uint32_t> hitPrim;    ///< primitive of the primary hit; kNoPrim on a miss
+    std::vector<uint32_t> primTests;  ///< per pixel, every ray of the pixel
     std::vector<uint32_t> regionVisits;
-    std::vector<float> timeUs;       ///< per pixel wall time in microseconds
+    std::vector<float> timeUs;  ///< per pixel wall time in microseconds
 
     Image() = default;
     Image(int w, int h) { resize(w, h); }

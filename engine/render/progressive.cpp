@@ -26,7 +26,9 @@ void fillBlocks(const Image& src, int stride, Image& dst, int rowBegin, int rowE
         const int sy = y - y % stride;
         if (y > begin && y != sy) {  // the same blocks as the row above, just written: copy it
             const size_t d = dst.index(0, y), a = d - w;
-            auto row = [&](auto& v) { std::copy_n(v.begin() + ptrdiff_t(a), w, v.begin() + ptrdiff_t(d)); };
+            auto row = [&](auto& v) {
+                std::copy_n(v.begin() + ptrdiff_t(a), w, v.begin() + ptrdiff_t(d));
+            };
             row(dst.color);
             row(dst.depth);
             row(dst.hitPrim);
@@ -199,8 +201,7 @@ void ProgressiveRenderer::run() {
                 displayShown_ = {stride, lattice.rowEnd, previous, 0, 0, jobNumber};
                 if (passDone) {
                     rec.sinceStartMs =
-                        std::chrono::duration<double, std::milli>(Clock::now() - requested)
-                            .count();
+                        std::chrono::duration<double, std::milli>(Clock::now() - requested).count();
                     passes_.push_back(rec);
                 }
                 lock.unlock();

@@ -55,8 +55,8 @@ class ProgressiveRenderer {
     /// cores, 16, 4, 1 was 6% faster to the full image than 16, 8, 4, 2, 1 (medians of 9).
     static constexpr std::array<int, 3> kDefaultStrides = {16, 4, 1};
     /// Passes from coarse to fine; the last must be 1.
-    explicit ProgressiveRenderer(
-        std::vector<int> strides = {kDefaultStrides.begin(), kDefaultStrides.end()});
+    explicit ProgressiveRenderer(std::vector<int> strides = {kDefaultStrides.begin(),
+                                                             kDefaultStrides.end()});
     /// Bands the passes of stride 2 and 1 are cut into (each band becomes visible when done).
     static constexpr int kBands = 8;
     /// Cancels the job in flight and joins the worker.
@@ -69,8 +69,8 @@ class ProgressiveRenderer {
     void start(ProgressiveJob job, Clock::time_point requested = Clock::now());
     /// Cancel the job in flight without starting another.
     void cancel();
-    /// Called on the worker thread after each band or pass becomes available (e.g. to wake a UI loop
-    /// waiting for events). Set it before the first start().
+    /// Called on the worker thread after each band or pass becomes available (e.g. to wake a UI
+    /// loop waiting for events). Set it before the first start().
     void setOnPass(std::function<void()> f) { onPass_ = std::move(f); }
 
     /// What a snapshot shows: rows [0, rows) the pass of `stride`, the rows below it the pass
@@ -119,7 +119,7 @@ class ProgressiveRenderer {
     std::atomic<bool> cancel_{false};
     std::atomic<size_t> progressDone_{0};
     std::atomic<size_t> progressTotal_{0};
-    Image display_;  ///< what snapshot() copies from: the passes' blocks, band by band
+    Image display_;     ///< what snapshot() copies from: the passes' blocks, band by band
     RowRange changed_;  ///< rows of display_ written since the last snapshot
     uint64_t displayVersion_ = 0;
     Shown displayShown_;

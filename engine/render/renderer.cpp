@@ -62,8 +62,8 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     arena.execute([&] {
         tbb::parallel_for(
             tbb::blocked_range2d<int>(std::clamp(pass.rowBegin, 0, h),
-                                      pass.rowEnd < 0 ? h : std::clamp(pass.rowEnd, 0, h), tile,
-                                      0, w, tile),
+                                      pass.rowEnd < 0 ? h : std::clamp(pass.rowEnd, 0, h), tile, 0,
+                                      w, tile),
             [&](const tbb::blocked_range2d<int>& r) {
                 if (stopped.load(std::memory_order_relaxed)) return;
                 if (cancel && cancel->load(std::memory_order_relaxed)) {
@@ -94,7 +94,8 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                         Vec3 c = tracer.radiance(ray, 0, ctx, obs, &hit, eye.nearFrom(ray.d, 0));
                         size_t i = img.index(x, y);
                         img.color[i] = glm::vec3(c);
-                        img.depth[i] = hit.valid() ? float(hit.t) : std::numeric_limits<float>::infinity();
+                        img.depth[i] =
+                            hit.valid() ? float(hit.t) : std::numeric_limits<float>::infinity();
                         img.hitPrim[i] = hit.prim;
                         RayCounters d = ctx.counters - before;
                         img.primTests[i] = uint32_t(d.primTests);

@@ -11,7 +11,7 @@ namespace lancer {
 
 struct RenderOptions {
     int width = 512, height = 512;
-    int threads = 0;            ///< 0: all cores
+    int threads = 0;  ///< 0: all cores
     int tile = 16;
     ShadingOptions shading;
     std::optional<Camera> camera;  ///< overrides scene.camera (the viewer moves its own camera)

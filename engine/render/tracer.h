@@ -9,7 +9,7 @@
 namespace lancer {
 
 struct ShadingOptions {
-    int bounces = 3;            ///< reflection/refraction depth; 0 = primary and shadow rays only
+    int bounces = 3;  ///< reflection/refraction depth; 0 = primary and shadow rays only
     bool shadows = true;
     bool reflections = true;
     bool refractions = true;
@@ -22,14 +22,14 @@ struct ShadingOptions {
 /// A hit resolved to a point, its normals and material.
 struct SurfacePoint {
     Vec3 p;
-    Vec3 n;          ///< outward normal (solids), geometric normal facing the ray (surfaces)
-    Vec3 facing;     ///< n turned to face the incoming ray
-    bool entering;   ///< the ray enters the solid here
+    Vec3 n;         ///< outward normal (solids), geometric normal facing the ray (surfaces)
+    Vec3 facing;    ///< n turned to face the incoming ray
+    bool entering;  ///< the ray enters the solid here
     const Material* material;
 };
 
 class Tracer {
-public:
+  public:
     Tracer(const Scene& scene, const Accelerator& accel, const ShadingOptions& opt)
         : scene_(scene), accel_(accel), opt_(opt), scale_(scene.scale()) {}
 
@@ -119,13 +119,13 @@ public:
             if (glm::dot(t, t) == 0.0)  // total internal reflection
                 color += m.transmit * radiance(Ray{above, refl}, depth + 1, ctx, obs);
             else
-                color += m.transmit *
-                         radiance(Ray{s.p - eps * s.facing, glm::normalize(t)}, depth + 1, ctx, obs);
+                color += m.transmit * radiance(Ray{s.p - eps * s.facing, glm::normalize(t)},
+                                               depth + 1, ctx, obs);
         }
         return color;
     }
 
-private:
+  private:
     const Scene& scene_;
     const Accelerator& accel_;
     ShadingOptions opt_;

@@ -56,17 +56,19 @@ Scene defaultScene() {
     std::vector<int> parts;
     parts.push_back(b.prim(Block{{-6, -4, -1.2}, {6, 5, -1.0}}, floorM));
     // Union: a sphere on a cylinder.
-    parts.push_back(b.op(Op::Union, b.prim(Sphere{{-3.0, 0.0, 0.6}, 0.9}, red),
-                         b.prim(cylinderZ(0.5, 1.6), red, Transform::translate({-3.0, 0.0, -1.0}))));
+    parts.push_back(
+        b.op(Op::Union, b.prim(Sphere{{-3.0, 0.0, 0.6}, 0.9}, red),
+             b.prim(cylinderZ(0.5, 1.6), red, Transform::translate({-3.0, 0.0, -1.0}))));
     // Intersection: a rounded cube (cube ∩ sphere).
     parts.push_back(b.op(Op::Intersection, b.prim(cube({0.0, 0.0, 0.0}, 1.0), green),
                          b.prim(Sphere{{0.0, 0.0, 0.0}, 1.35}, green)));
     // Difference: a cube drilled by a sphere and a cylinder across it.
     int drilled = b.op(Op::Difference, b.prim(cube({3.0, 0.0, 0.0}, 1.0), blue),
                        b.prim(Sphere{{3.0, 0.0, 1.0}, 0.9}, blue));
-    drilled = b.op(Op::Difference, drilled,
-                   b.prim(cylinderZ(0.45, 4.0), blue,
-                          Transform::translate({3.0, 2.0, 0.0}) * Transform::rotate(90.0, {1, 0, 0})));
+    drilled =
+        b.op(Op::Difference, drilled,
+             b.prim(cylinderZ(0.45, 4.0), blue,
+                    Transform::translate({3.0, 2.0, 0.0}) * Transform::rotate(90.0, {1, 0, 0})));
     parts.push_back(drilled);
     parts.push_back(b.prim(Sphere{{-1.5, -2.2, -0.45}, 0.55}, glass));
     Scene s = b.finish(b.all(Op::Union, parts), "default");
@@ -139,7 +141,8 @@ Scene drilledScene(int n) {
                 Vec3 c = Vec3(-extent) + step * (Vec3(i, j, k) + 0.5);
                 holes.push_back(b.prim(Sphere{c, r}, steel));
             }
-    Scene s = b.finish(b.op(Op::Difference, block, b.all(Op::Union, holes)), "drilled:" + std::to_string(n));
+    Scene s = b.finish(b.op(Op::Difference, block, b.all(Op::Union, holes)),
+                       "drilled:" + std::to_string(n));
     s.background = {0.1, 0.1, 0.12};
     s.frameCamera({-1.0, 2.2, -1.4}, {0, 0, 1});
     s.defaultLights();
@@ -159,12 +162,15 @@ Scene latticeScene(int n) {
             for (int k = 0; k < n; ++k) {
                 Vec3 c = Vec3(-1.0) + step * (Vec3(i, j, k) + 0.5);
                 int m = ((i + j + k) % 2) ? ma : mb;
-                int rounded = b.op(Op::Intersection, b.prim(cube(c, half), m), b.prim(Sphere{c, 1.3 * half}, m));
-                int bore = b.prim(cylinderZ(0.45 * half, 2.4 * half), m, Transform::translate(c - Vec3(0, 0, 1.2 * half)));
+                int rounded = b.op(Op::Intersection, b.prim(cube(c, half), m),
+                                   b.prim(Sphere{c, 1.3 * half}, m));
+                int bore = b.prim(cylinderZ(0.45 * half, 2.4 * half), m,
+                                  Transform::translate(c - Vec3(0, 0, 1.2 * half)));
                 cells.push_back(b.op(Op::Difference, rounded, bore));
             }
     int slab = b.prim(Block{{-1.1, -1.1, -0.55}, {1.1, 1.1, 0.55}}, ma);
-    Scene s = b.finish(b.op(Op::Intersection, b.all(Op::Union, cells), slab), "lattice:" + std::to_string(n));
+    Scene s = b.finish(b.op(Op::Intersection, b.all(Op::Union, cells), slab),
+                       "lattice:" + std::to_string(n));
     s.background = {0.1, 0.1, 0.12};
     s.frameCamera({-1.0, 2.0, -1.2}, {0, 0, 1});
     s.defaultLights();
@@ -176,7 +182,8 @@ Scene tetraScene(int size) {
     SceneBuilder b;
     int m = b.material(mat({1.0, 0.2, 0.2}, 0.7, 0.3, 20.0));
     std::vector<int> leaves;
-    std::function<void(const std::array<Vec3, 4>&, int)> split = [&](const std::array<Vec3, 4>& v, int depth) {
+    std::function<void(const std::array<Vec3, 4>&, int)> split = [&](const std::array<Vec3, 4>& v,
+                                                                     int depth) {
         if (depth == 0) {
             static const int faces[4][3] = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};
             for (const auto& f : faces) {
@@ -215,7 +222,8 @@ Scene ringsScene(int size) {
         for (int j = 0; j < size; ++j) {
             Vec3 c(2.6 * (i - 0.5 * (size - 1)), 2.6 * (j - 0.5 * (size - 1)), 0.4 * ((i + j) % 2));
             // Tilt alternate rings so the chains interleave.
-            Transform tilt = Transform::translate(c) * Transform::rotate(20.0 * ((i * 3 + j) % 4), {1, 1, 0});
+            Transform tilt =
+                Transform::translate(c) * Transform::rotate(20.0 * ((i * 3 + j) % 4), {1, 1, 0});
             std::vector<Vec3> pts;
             for (int k = 0; k < beads; ++k) {
                 double a = 2.0 * M_PI * k / beads;
@@ -230,7 +238,9 @@ Scene ringsScene(int size) {
         }
     double half = 1.3 * size + 1.5;
     Polygon floor;
-    makePolygon({{half, half, -1.2}, {-half, half, -1.2}, {-half, -half, -1.2}, {half, -half, -1.2}}, floor);
+    makePolygon(
+        {{half, half, -1.2}, {-half, half, -1.2}, {-half, -half, -1.2}, {half, -half, -1.2}},
+        floor);
     leaves.push_back(b.prim(floor, floorM));
     Scene s = b.finish(b.all(Op::Union, leaves), "rings:" + std::to_string(size));
     s.background = {0.078, 0.361, 0.753};
@@ -246,9 +256,11 @@ const std::vector<BuiltinInfo>& builtinScenes() {
         {"default", 1, 1, 1, "union, intersection and difference on a floor, with a glass ball"},
         {"balls", 3, 0, 5, "SPD sphereflake: 1 + 9 + ... + 9^SIZE spheres and a floor polygon"},
         {"drilled", 6, 1, 40, "a block minus SIZE^3 spheres (CSG stress)"},
-        {"lattice", 6, 1, 30, "SIZE^3 cells of (cube ∩ sphere) − cylinder, cut by a slab (CSG stress)"},
+        {"lattice", 6, 1, 30,
+         "SIZE^3 cells of (cube ∩ sphere) − cylinder, cut by a slab (CSG stress)"},
         {"tetra", 3, 1, 7, "SPD-style Sierpinski tetrahedron: 4^SIZE triangles"},
-        {"rings", 3, 1, 20, "SPD-style rings: SIZE^2 chains of 10 spheres and 10 open cylinders, a floor"},
+        {"rings", 3, 1, 20,
+         "SPD-style rings: SIZE^2 chains of 10 spheres and 10 open cylinders, a floor"},
     };
     return list;
 }
@@ -258,8 +270,9 @@ Scene makeBuiltin(const std::string& name, int size) {
         if (name != info.name) continue;
         if (size < 0) size = info.defaultSize;
         if (size < info.minSize || size > info.maxSize)
-            throw SceneError("builtin:" + name + ": size " + std::to_string(size) + " is outside [" +
-                             std::to_string(info.minSize) + ", " + std::to_string(info.maxSize) + "]");
+            throw SceneError("builtin:" + name + ": size " + std::to_string(size) +
+                             " is outside [" + std::to_string(info.minSize) + ", " +
+                             std::to_string(info.maxSize) + "]");
         if (name == "default") return defaultScene();
         if (name == "balls") return ballsScene(size);
         if (name == "drilled") return drilledScene(size);
@@ -268,7 +281,8 @@ Scene makeBuiltin(const std::string& name, int size) {
         if (name == "rings") return ringsScene(size);
     }
     std::string names;
-    for (const BuiltinInfo& info : builtinScenes()) names += std::string(names.empty() ? "" : ", ") + info.name;
+    for (const BuiltinInfo& info : builtinScenes())
+        names += std::string(names.empty() ? "" : ", ") + info.name;
     throw SceneError("builtin:" + name + ": unknown built-in scene (available: " + names + ")");
 }
 

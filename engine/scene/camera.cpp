@@ -39,7 +39,8 @@ std::string Camera::validate() const {
     if (glm::dot(c, c) < 1e-24) return "camera 'up' is parallel to the view direction";
     if (projection == Projection::Perspective && !(fov > 0.0 && fov < 180.0))
         return "camera 'fov' must be in (0, 180) degrees";
-    if (projection == Projection::Orthographic && !(orthoHeight > 0.0 && std::isfinite(orthoHeight)))
+    if (projection == Projection::Orthographic &&
+        !(orthoHeight > 0.0 && std::isfinite(orthoHeight)))
         return "camera 'ortho_height' must be positive";
     return "";
 }

@@ -13,7 +13,7 @@ struct Camera {
     Vec3 from{0.0, -10.0, 0.0};
     Vec3 at{0.0};
     Vec3 up{0.0, 0.0, 1.0};
-    double fov = 45.0;          ///< full vertical field of view, degrees, edge to edge
+    double fov = 45.0;  ///< full vertical field of view, degrees, edge to edge
     Projection projection = Projection::Perspective;
     double orthoHeight = 10.0;  ///< full image height in scene units (orthographic)
 

@@ -36,9 +36,12 @@ struct CountingIterator {
 std::string escapePointerToken(const std::string& s) {
     std::string r;
     for (char c : s) {
-        if (c == '~') r += "~0";
-        else if (c == '/') r += "~1";
-        else r += c;
+        if (c == '~')
+            r += "~0";
+        else if (c == '/')
+            r += "~1";
+        else
+            r += c;
     }
     return r;
 }
@@ -69,7 +72,9 @@ struct LocatingSax {
             while (p > 0 && !(text[p] == '"' && text[p - 1] != '\\')) --p;
             return p;
         }
-        auto part = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '+' || c == '-'; };
+        auto part = [](char c) {
+            return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '+' || c == '-';
+        };
         while (p > 0 && !part(text[p])) --p;
         while (p > 0 && part(text[p - 1])) --p;
         return p;
@@ -132,7 +137,8 @@ struct LocatingSax {
         return true;
     }
     bool end_array() { return end_object(); }
-    bool parse_error(std::size_t position, const std::string&, const nlohmann::detail::exception& ex) {
+    bool parse_error(std::size_t position, const std::string&,
+                     const nlohmann::detail::exception& ex) {
         errorPos = position ? position - 1 : 0;
         std::string m = ex.what();
         // Keep nlohmann's explanation, drop its "[json.exception...] parse error at ...:" prefix.
@@ -174,7 +180,8 @@ JsonAt JsonAt::operator[](const std::string& key) const {
 }
 
 JsonAt JsonAt::operator[](size_t index) const {
-    if (!value.is_array() || index >= value.size()) fail("expected an array with at least " + std::to_string(index + 1) + " elements");
+    if (!value.is_array() || index >= value.size())
+        fail("expected an array with at least " + std::to_string(index + 1) + " elements");
     return {doc, value[index], pointer + "/" + std::to_string(index)};
 }
 
@@ -197,7 +204,8 @@ double JsonAt::nonNegative() const {
 int JsonAt::integer(int lo, int hi) const {
     if (!value.is_number_integer()) fail("expected an integer");
     long long v = value.get<long long>();
-    if (v < lo || v > hi) fail("expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    if (v < lo || v > hi)
+        fail("expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return int(v);
 }
 bool JsonAt::boolean() const {
@@ -250,7 +258,8 @@ static void readLights(const JsonAt& ls, Scene& scene) {
 
 void applyCameraJson(const JsonAt& cam, Scene& scene, bool strictKeys) {
     if (strictKeys)
-        cam.onlyKeys({"from", "at", "up", "fov", "width", "height", "projection", "ortho_height", "lights", "background"});
+        cam.onlyKeys({"from", "at", "up", "fov", "width", "height", "projection", "ortho_height",
+                      "lights", "background"});
     Camera& c = scene.camera;
     if (cam.has("from")) c.from = cam["from"].vec3();
     if (cam.has("at")) c.at = cam["at"].vec3();
@@ -263,9 +272,12 @@ void applyCameraJson(const JsonAt& cam, Scene& scene, bool strictKeys) {
     if (cam.has("height")) scene.height = cam["height"].integer(1, 16384);
     if (cam.has("projection")) {
         std::string p = cam["projection"].string();
-        if (p == "perspective") c.projection = Projection::Perspective;
-        else if (p == "orthographic") c.projection = Projection::Orthographic;
-        else cam["projection"].fail("expected \"perspective\" or \"orthographic\"");
+        if (p == "perspective")
+            c.projection = Projection::Perspective;
+        else if (p == "orthographic")
+            c.projection = Projection::Orthographic;
+        else
+            cam["projection"].fail("expected \"perspective\" or \"orthographic\"");
     }
     if (cam.has("ortho_height")) c.orthoHeight = cam["ortho_height"].positive();
     if (cam.has("background")) scene.background = cam["background"].vec3();
@@ -285,7 +297,8 @@ struct JsonSceneBuilder {
             if (it == materialByName.end()) m.fail("unknown material \"" + m.string() + "\"");
             return it->second;
         }
-        m.onlyKeys({"color", "ambient", "diffuse", "specular", "shininess", "reflect", "transmit", "ior", "name"});
+        m.onlyKeys({"color", "ambient", "diffuse", "specular", "shininess", "reflect", "transmit",
+                    "ior", "name"});
         Material mat = scene.materials[size_t(inherited)];
         mat.name.clear();
         if (m.has("color")) mat.color = m["color"].vec3();
@@ -305,14 +318,16 @@ struct JsonSceneBuilder {
         for (size_t i = 0; i < list.array().size(); ++i) {
             JsonAt step = list[i];
             step.onlyKeys({"translate", "scale", "rotate", "matrix"});
-            if (step.object().size() != 1) step.fail("a transform step has exactly one of translate, scale, rotate, matrix");
+            if (step.object().size() != 1)
+                step.fail("a transform step has exactly one of translate, scale, rotate, matrix");
             Transform t;
             if (step.has("translate")) {
                 t = Transform::translate(step["translate"].vec3());
             } else if (step.has("scale")) {
                 JsonAt s = step["scale"];
                 Vec3 v = s.value.is_number() ? Vec3(s.number()) : s.vec3();
-                if (v.x == 0.0 || v.y == 0.0 || v.z == 0.0) s.fail("scale factors must be non-zero");
+                if (v.x == 0.0 || v.y == 0.0 || v.z == 0.0)
+                    s.fail("scale factors must be non-zero");
                 t = Transform::scale(v);
             } else if (step.has("rotate")) {
                 // Euler angles in degrees, applied about x, then y, then z (as OpenSCAD's rotate).
@@ -324,8 +339,10 @@ struct JsonSceneBuilder {
                 if (!m.value.is_array() || (m.value.size() != 16 && m.value.size() != 12))
                     m.fail("expected 12 or 16 numbers (row-major 3x4 or 4x4)");
                 Mat4 mm(1.0);
-                for (size_t k = 0; k < m.value.size(); ++k) mm[int(k % 4)][int(k / 4)] = m[k].number();
-                if (m.value.size() == 16 && (mm[0][3] != 0 || mm[1][3] != 0 || mm[2][3] != 0 || mm[3][3] != 1))
+                for (size_t k = 0; k < m.value.size(); ++k)
+                    mm[int(k % 4)][int(k / 4)] = m[k].number();
+                if (m.value.size() == 16 &&
+                    (mm[0][3] != 0 || mm[1][3] != 0 || mm[2][3] != 0 || mm[3][3] != 1))
                     m.fail("the last row of an affine matrix must be [0, 0, 0, 1]");
                 t = Transform(mm);
             }
@@ -338,7 +355,8 @@ struct JsonSceneBuilder {
     std::vector<Vec3> points(const JsonAt& list, size_t minCount) {
         std::vector<Vec3> pts;
         for (size_t i = 0; i < list.array().size(); ++i) pts.push_back(list[i].vec3());
-        if (pts.size() < minCount) list.fail("expected at least " + std::to_string(minCount) + " points");
+        if (pts.size() < minCount)
+            list.fail("expected at least " + std::to_string(minCount) + " points");
         return pts;
     }
 
@@ -352,16 +370,25 @@ struct JsonSceneBuilder {
     static constexpr int kMaxDepth = 2000;  // deeper nesting is refused, not recursed into
 
     int node(const JsonAt& n, const Transform& parentXf, int parentMat, int depth = 0) {
-        if (depth > kMaxDepth) n.fail("nesting deeper than " + std::to_string(kMaxDepth) + " levels");
-        static const char* kinds[] = {"sphere", "box", "cylinder", "cone", "triangle", "polygon", "union", "intersection", "difference"};
+        if (depth > kMaxDepth)
+            n.fail("nesting deeper than " + std::to_string(kMaxDepth) + " levels");
+        static const char* kinds[] = {"sphere",  "box",   "cylinder",     "cone",      "triangle",
+                                      "polygon", "union", "intersection", "difference"};
         n.object();
         std::string kind;
         for (const char* k : kinds)
             if (n.has(k)) {
-                if (!kind.empty()) n.fail("a node has exactly one of sphere, box, cylinder, cone, triangle, polygon, union, intersection, difference; found both \"" + kind + "\" and \"" + k + "\"");
+                if (!kind.empty())
+                    n.fail(
+                        "a node has exactly one of sphere, box, cylinder, cone, triangle, polygon, "
+                        "union, intersection, difference; found both \"" +
+                        kind + "\" and \"" + k + "\"");
                 kind = k;
             }
-        if (kind.empty()) n.fail("expected a node: one of sphere, box, cylinder, cone, triangle, polygon, union, intersection, difference");
+        if (kind.empty())
+            n.fail(
+                "expected a node: one of sphere, box, cylinder, cone, triangle, polygon, union, "
+                "intersection, difference");
         for (const auto& [k, v] : n.object())
             if (k != kind && k != "transform" && k != "material" && k != "name")
                 n[k].fail("unknown key \"" + k + "\" in a " + kind + " node");
@@ -371,7 +398,9 @@ struct JsonSceneBuilder {
         JsonAt body = n[kind];
 
         if (kind == "union" || kind == "intersection" || kind == "difference") {
-            Op op = kind == "union" ? Op::Union : kind == "intersection" ? Op::Intersection : Op::Difference;
+            Op op = kind == "union"          ? Op::Union
+                    : kind == "intersection" ? Op::Intersection
+                                             : Op::Difference;
             std::vector<int> kids;
             for (size_t i = 0; i < body.array().size(); ++i) {
                 int k = node(body[i], xf, mat, depth + 1);
@@ -411,7 +440,8 @@ struct JsonSceneBuilder {
             } else {
                 b.lo = body["min"].vec3();
                 b.hi = body["max"].vec3();
-                if (!(b.lo.x < b.hi.x && b.lo.y < b.hi.y && b.lo.z < b.hi.z)) body.fail("box \"min\" must be below \"max\" on every axis");
+                if (!(b.lo.x < b.hi.x && b.lo.y < b.hi.y && b.lo.z < b.hi.z))
+                    body.fail("box \"min\" must be below \"max\" on every axis");
             }
             return primitive(n, b, xf, mat);
         }
@@ -427,7 +457,9 @@ struct JsonSceneBuilder {
                 if (c.r1 == 0.0 && c.r2 == 0.0) body.fail("a cone needs r1 > 0 or r2 > 0");
             }
             c.h = body["height"].positive();
-            Transform local = (body.has("center") && body["center"].boolean()) ? Transform::translate({0, 0, -0.5 * c.h}) : Transform();
+            Transform local = (body.has("center") && body["center"].boolean())
+                                  ? Transform::translate({0, 0, -0.5 * c.h})
+                                  : Transform();
             return primitive(n, c, xf * local, mat);
         }
         // Surfaces: world-space points through the transform.
@@ -437,7 +469,8 @@ struct JsonSceneBuilder {
             if (pts.size() != 3) body.fail("a triangle has exactly 3 points");
             Triangle t;
             for (int i = 0; i < 3; ++i) t.p[i] = pts[size_t(i)];
-            if (glm::length(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0])) == 0.0) body.fail("degenerate triangle (zero area)");
+            if (glm::length(glm::cross(t.p[1] - t.p[0], t.p[2] - t.p[0])) == 0.0)
+                body.fail("degenerate triangle (zero area)");
             return primitive(n, t, Transform(), mat);
         }
         Polygon pg;

@@ -12,7 +12,7 @@ namespace lancer {
 
 /// A parsed JSON document that remembers where each value starts (keyed by JSON pointer).
 class LocatedJson {
-public:
+  public:
     /// Parse; a syntax error throws SceneError with the file, line and column.
     explicit LocatedJson(const SourceText& src);
     const nlohmann::json& root() const { return root_; }
@@ -21,7 +21,7 @@ public:
     size_t offset(const std::string& pointer) const;
     [[noreturn]] void fail(const std::string& pointer, const std::string& message) const;
 
-private:
+  private:
     const SourceText* src_;
     nlohmann::json root_;
     std::unordered_map<std::string, size_t> offsets_;
@@ -38,13 +38,13 @@ struct JsonAt {
     JsonAt operator[](size_t index) const;
     bool has(const std::string& key) const { return value.is_object() && value.contains(key); }
     [[noreturn]] void fail(const std::string& message) const { doc.fail(pointer, message); }
-    double number() const;                       ///< finite number
-    double positive() const;                     ///< finite, > 0
+    double number() const;    ///< finite number
+    double positive() const;  ///< finite, > 0
     double nonNegative() const;
     int integer(int lo, int hi) const;
     bool boolean() const;
     std::string string() const;
-    Vec3 vec3() const;                           ///< [x, y, z], finite
+    Vec3 vec3() const;  ///< [x, y, z], finite
     const nlohmann::json::array_t& array() const;
     const nlohmann::json::object_t& object() const;
     /// Reject keys not in `allowed` (catches typos such as "raduis").

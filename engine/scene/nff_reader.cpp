@@ -20,7 +20,7 @@ bool isConvex(const std::vector<Vec3>& p) {
     }
     return true;
 }
-}
+}  // namespace
 
 Scene readNff(const SourceText& src, NffCounts* countsOut) {
     WordReader in(src);
@@ -55,9 +55,13 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             // from, at, up, angle, hither, resolution: keyword-led, in this order.
             auto expect = [&](const char* word) {
                 Token w = in.next();
-                if (w.text.empty()) src.fail(w.pos, std::string("unexpected end of file: expected '") + word + "' in the viewpoint ('v') block");
+                if (w.text.empty())
+                    src.fail(w.pos, std::string("unexpected end of file: expected '") + word +
+                                        "' in the viewpoint ('v') block");
                 if (w.text != word)
-                    src.fail(w.pos, std::string("expected '") + word + "' in the viewpoint ('v') block, got '" + std::string(w.text) + "'");
+                    src.fail(w.pos, std::string("expected '") + word +
+                                        "' in the viewpoint ('v') block, got '" +
+                                        std::string(w.text) + "'");
             };
             expect("from");
             scene.camera.from = in.vec3("the 'from' point");
@@ -68,12 +72,14 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             expect("angle");
             size_t apos = in.peek().pos;
             angle = in.number("the view angle");
-            if (!(angle > 0.0 && angle < 180.0)) src.fail(apos, "the view angle must be in (0, 180) degrees");
+            if (!(angle > 0.0 && angle < 180.0))
+                src.fail(apos, "the view angle must be in (0, 180) degrees");
             expect("hither");
             // Hither is the near clipping distance; primary rays start at the eye, as in SPD's
             // reference tracers, so it is checked and otherwise unused.
             size_t hpos = in.peek().pos;
-            if (in.number("the hither distance") < 0.0) src.fail(hpos, "the hither distance must not be negative");
+            if (in.number("the hither distance") < 0.0)
+                src.fail(hpos, "the hither distance must not be negative");
             expect("resolution");
             size_t wpos = in.peek().pos;
             scene.width = in.count("the image width", 16384);
@@ -109,7 +115,9 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             m.ior = in.number("the index of refraction");
             // SPD writes 0 for opaque materials (T = 0), where the index is unused.
             if (m.ior < 0.0) src.fail(ipos, "the index of refraction must not be negative");
-            if (m.ior == 0.0 && m.transmit > 0.0) src.fail(ipos, "a transmitting material (T > 0) needs a positive index of refraction");
+            if (m.ior == 0.0 && m.transmit > 0.0)
+                src.fail(ipos,
+                         "a transmitting material (T > 0) needs a positive index of refraction");
             if (m.ior == 0.0) m.ior = 1.0;
             m.reflect = m.specular;  // NFF: Ks also weights the mirror reflection
             m.ambient = 0.1;
@@ -180,9 +188,16 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             // NFF: both radii negative means only the inside is visible. Lancer's surfaces
             // are seen from both sides, so that is the same open cone.
             if (r0 < 0.0 && r1 < 0.0) r0 = -r0, r1 = -r1;
-            if (r0 < 0.0) src.fail(r0pos, "a cone radius must not be negative (unless both are, for an inside-visible cone)");
-            if (r1 < 0.0) src.fail(r1pos, "a cone radius must not be negative (unless both are, for an inside-visible cone)");
-            if (r0 == 0.0 && r1 == 0.0) src.fail(r0pos, "a cone needs a positive radius at one end");
+            if (r0 < 0.0)
+                src.fail(r0pos,
+                         "a cone radius must not be negative (unless both are, for an "
+                         "inside-visible cone)");
+            if (r1 < 0.0)
+                src.fail(r1pos,
+                         "a cone radius must not be negative (unless both are, for an "
+                         "inside-visible cone)");
+            if (r0 == 0.0 && r1 == 0.0)
+                src.fail(r0pos, "a cone needs a positive radius at one end");
             Vec3 axis = apex - base;
             double h = glm::length(axis);
             if (!(h > 0.0)) src.fail(t.pos, "the cone's base and apex are the same point");
@@ -190,14 +205,16 @@ Scene readNff(const SourceText& src, NffCounts* countsOut) {
             addPrim(c, Transform::alongAxis(base, axis / h), t.pos);
             ++counts.cones;
         } else {
-            src.fail(t.pos, "unknown NFF entity '" + std::string(k) + "' (expected v, b, l, f, s, p, pp, c or #)");
+            src.fail(t.pos, "unknown NFF entity '" + std::string(k) +
+                                "' (expected v, b, l, f, s, p, pp, c or #)");
         }
     }
 
     // NFF lights have equal intensity; scale so several lights do not wash the image out.
     double share = lightPos.empty() ? 1.0 : 1.0 / std::sqrt(double(lightPos.size()));
     for (size_t i = 0; i < lightPos.size(); ++i)
-        scene.lights.push_back({lightPos[i], lightHasColor[i] ? lightColor[i] * share : Vec3(share)});
+        scene.lights.push_back(
+            {lightPos[i], lightHasColor[i] ? lightColor[i] * share : Vec3(share)});
     scene.tree.root = scene.tree.balanced(Op::Union, leaves);
     scene.prepare();
     if (haveView) {

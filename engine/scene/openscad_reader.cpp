@@ -184,11 +184,13 @@ struct ScadToken {
     Tok kind = Tok::End;
     std::string_view text;  ///< as written (for strings: with the quotes)
     size_t pos = 0;
-    double number = 0.0;    ///< Number tokens
-    std::string str;        ///< String tokens, escapes decoded
+    double number = 0.0;  ///< Number tokens
+    std::string str;      ///< String tokens, escapes decoded
 };
 
-bool identStart(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_' || c == '$'; }
+bool identStart(char c) {
+    return std::isalpha(static_cast<unsigned char>(c)) || c == '_' || c == '$';
+}
 bool identPart(char c) { return identStart(c) || std::isdigit(static_cast<unsigned char>(c)); }
 bool digit(char c) { return c >= '0' && c <= '9'; }
 
@@ -221,7 +223,8 @@ std::vector<ScadToken> tokenize(const SourceText& src) {
                 while (p < s.size() && s[p] != '\n') ++p;
             } else if (s.compare(p, 2, "/*") == 0) {
                 size_t end = s.find("*/", p + 2);
-                if (end == std::string::npos) src.fail(p, "unterminated comment: '/*' without '*/'");
+                if (end == std::string::npos)
+                    src.fail(p, "unterminated comment: '/*' without '*/'");
                 p = end + 2;
             } else {
                 break;
@@ -247,14 +250,16 @@ std::vector<ScadToken> tokenize(const SourceText& src) {
             if (p < s.size() && (s[p] == 'e' || s[p] == 'E')) {
                 size_t q = p + 1;
                 if (q < s.size() && (s[q] == '+' || s[q] == '-')) ++q;
-                if (q >= s.size() || !digit(s[q])) src.fail(start, "malformed number: an exponent needs digits");
+                if (q >= s.size() || !digit(s[q]))
+                    src.fail(start, "malformed number: an exponent needs digits");
                 while (q < s.size() && digit(s[q])) ++q;
                 p = q;
             }
             t.kind = Tok::Number;
             auto r = std::from_chars(s.data() + start, s.data() + p, t.number);
             if (r.ec != std::errc() || r.ptr != s.data() + p || !std::isfinite(t.number))
-                src.fail(start, "number '" + s.substr(start, p - start) + "' is out of range (not a finite double)");
+                src.fail(start, "number '" + s.substr(start, p - start) +
+                                    "' is out of range (not a finite double)");
         } else if (c == '"') {
             ++p;
             while (true) {
@@ -300,19 +305,20 @@ struct ScadArg {
 
 struct ScadNode {
     std::string name;
-    size_t pos = 0;          ///< of the name
-    bool disable = false;    ///< `*`
-    bool background = false; ///< `%`
-    bool highlight = false;  ///< `#`
-    bool root = false;       ///< `!`
+    size_t pos = 0;           ///< of the name
+    bool disable = false;     ///< `*`
+    bool background = false;  ///< `%`
+    bool highlight = false;   ///< `#`
+    bool root = false;        ///< `!`
     std::vector<ScadArg> args;
     std::vector<ScadNode> children;
 };
 
 /// Recursive descent over the token list: statements, arguments and values.
 class Parser {
-public:
-    Parser(const SourceText& src, std::vector<ScadToken> toks) : src_(src), toks_(std::move(toks)) {}
+  public:
+    Parser(const SourceText& src, std::vector<ScadToken> toks)
+        : src_(src), toks_(std::move(toks)) {}
 
     std::vector<ScadNode> file() {
         std::vector<ScadNode> nodes;
@@ -323,7 +329,7 @@ public:
         return nodes;
     }
 
-private:
+  private:
     const ScadToken& peek() const { return toks_[i_]; }
     const ScadToken& take() {
         const ScadToken& t = toks_[i_];
@@ -337,14 +343,17 @@ private:
     void expect(std::string_view p, const char* context) {
         const ScadToken& t = peek();
         if (t.kind == Tok::End)
-            src_.fail(t.pos, std::string("unexpected end of file: expected '") + std::string(p) + "' " + context);
+            src_.fail(t.pos, std::string("unexpected end of file: expected '") + std::string(p) +
+                                 "' " + context);
         if (!isPunct(p))
-            src_.fail(t.pos, std::string("expected '") + std::string(p) + "' " + context + ", got " + describe(t));
+            src_.fail(t.pos, std::string("expected '") + std::string(p) + "' " + context +
+                                 ", got " + describe(t));
         take();
     }
     void checkDepth(int depth, size_t pos) {
         if (depth > kMaxDepth)
-            src_.fail(pos, "nesting deeper than " + std::to_string(kMaxDepth) + " levels is refused");
+            src_.fail(pos,
+                      "nesting deeper than " + std::to_string(kMaxDepth) + " levels is refused");
     }
 
     /// One statement: `;`, or [modifiers] name(args) followed by `;`, `{ ... }` or one child.
@@ -355,7 +364,8 @@ private:
             return;
         }
         ScadNode n;
-        while (peek().kind == Tok::Punct && (peek().text == "*" || peek().text == "%" || peek().text == "#" || peek().text == "!")) {
+        while (peek().kind == Tok::Punct && (peek().text == "*" || peek().text == "%" ||
+                                             peek().text == "#" || peek().text == "!")) {
             char m = take().text[0];
             n.disable |= m == '*';
             n.background |= m == '%';
@@ -363,13 +373,18 @@ private:
             n.root |= m == '!';
         }
         const ScadToken& name = peek();
-        if (name.kind == Tok::End) src_.fail(name.pos, "unexpected end of file: expected a node name");
-        if (name.kind != Tok::Ident) src_.fail(name.pos, "expected a node name such as cube or multmatrix, got " + describe(name));
+        if (name.kind == Tok::End)
+            src_.fail(name.pos, "unexpected end of file: expected a node name");
+        if (name.kind != Tok::Ident)
+            src_.fail(name.pos,
+                      "expected a node name such as cube or multmatrix, got " + describe(name));
         n.name = std::string(name.text);
         n.pos = name.pos;
         take();
         if (peek().kind == Tok::Punct && peek().text == "=")
-            src_.fail(peek().pos, "assignments ('" + n.name + " = ...') are not part of OpenSCAD's CSG export; export the model with 'openscad -o model.csg'");
+            src_.fail(peek().pos, "assignments ('" + n.name +
+                                      " = ...') are not part of OpenSCAD's CSG export; export the "
+                                      "model with 'openscad -o model.csg'");
         expect("(", ("after '" + n.name + "'").c_str());
         arguments(n, depth);
         if (isPunct(";")) {
@@ -378,12 +393,14 @@ private:
             size_t open = take().pos;
             while (!isPunct("}")) {
                 if (peek().kind == Tok::End)
-                    src_.fail(peek().pos, "unexpected end of file: missing '}' for the '{' at " + src_.where(open));
+                    src_.fail(peek().pos, "unexpected end of file: missing '}' for the '{' at " +
+                                              src_.where(open));
                 statement(n.children, depth + 1);
             }
             take();
         } else if (peek().kind == Tok::End) {
-            src_.fail(peek().pos, "unexpected end of file: expected ';' or '{' after " + n.name + "(...)");
+            src_.fail(peek().pos,
+                      "unexpected end of file: expected ';' or '{' after " + n.name + "(...)");
         } else {
             statement(n.children, depth + 1);  // a single child without braces
         }
@@ -398,7 +415,8 @@ private:
         while (true) {
             ScadArg a;
             a.pos = peek().pos;
-            if (peek().kind == Tok::Ident && toks_[i_ + 1].kind == Tok::Punct && toks_[i_ + 1].text == "=") {
+            if (peek().kind == Tok::Ident && toks_[i_ + 1].kind == Tok::Punct &&
+                toks_[i_ + 1].text == "=") {
                 a.name = std::string(take().text);
                 take();
             }
@@ -429,8 +447,10 @@ private:
             const ScadToken& num = peek();
             if (num.kind != Tok::Number) {
                 if (num.kind == Tok::Ident && (num.text == "inf" || num.text == "nan"))
-                    src_.fail(num.pos, "expected a finite number, got '" + std::string(t.text) + std::string(num.text) + "'");
-                src_.fail(num.pos, "expected a number after '" + std::string(t.text) + "', got " + describe(num));
+                    src_.fail(num.pos, "expected a finite number, got '" + std::string(t.text) +
+                                           std::string(num.text) + "'");
+                src_.fail(num.pos, "expected a number after '" + std::string(t.text) + "', got " +
+                                       describe(num));
             }
             v.kind = ScadValue::Kind::Number;
             v.number = neg ? -take().number : take().number;
@@ -453,7 +473,10 @@ private:
             }
             if (t.text == "inf" || t.text == "nan")
                 src_.fail(t.pos, "expected a finite number, got '" + std::string(t.text) + "'");
-            src_.fail(t.pos, "expected a value (number, true, false, undef, string or [vector]), got '" + printable(t.text) + "': expressions are not part of OpenSCAD's CSG export");
+            src_.fail(t.pos,
+                      "expected a value (number, true, false, undef, string or [vector]), got '" +
+                          printable(t.text) +
+                          "': expressions are not part of OpenSCAD's CSG export");
         }
         if (t.kind == Tok::Punct && t.text == "[") {
             size_t open = take().pos;
@@ -468,9 +491,11 @@ private:
                     take();
                     continue;
                 }
-                if (isPunct(":")) src_.fail(peek().pos, "ranges ('[a:b]') are not supported in a .csg file");
+                if (isPunct(":"))
+                    src_.fail(peek().pos, "ranges ('[a:b]') are not supported in a .csg file");
                 if (peek().kind == Tok::End)
-                    src_.fail(peek().pos, "unexpected end of file: missing ']' for the '[' at " + src_.where(open));
+                    src_.fail(peek().pos, "unexpected end of file: missing ']' for the '[' at " +
+                                              src_.where(open));
                 expect("]", "to close the vector");
                 return v;
             }
@@ -497,7 +522,7 @@ struct Built {
 
 /// A node's arguments, matched to OpenSCAD's parameter names (positional ones in order).
 class Args {
-public:
+  public:
     Args(const SourceText& src, const ScadNode& n, std::initializer_list<const char*> positional,
          std::initializer_list<const char*> named)
         : src_(src), node_(n) {
@@ -508,7 +533,8 @@ public:
             std::string name = a.name;
             if (name.empty()) {
                 if (next >= pos.size())
-                    src.fail(a.pos, n.name + "() takes at most " + std::to_string(pos.size()) + " positional argument" + (pos.size() == 1 ? "" : "s"));
+                    src.fail(a.pos, n.name + "() takes at most " + std::to_string(pos.size()) +
+                                        " positional argument" + (pos.size() == 1 ? "" : "s"));
                 name = pos[next++];
             } else if (name[0] == '$') {
                 continue;  // $fn, $fa, $fs: tessellation settings; Lancer traces the exact solid
@@ -518,11 +544,14 @@ public:
                 if (!known) {
                     std::string list;
                     for (const char* k : all) list += std::string(list.empty() ? "" : ", ") + k;
-                    src.fail(a.pos, "unknown argument '" + name + "' of " + n.name + "() (expected " + (list.empty() ? "none" : list) + ")");
+                    src.fail(a.pos, "unknown argument '" + name + "' of " + n.name +
+                                        "() (expected " + (list.empty() ? "none" : list) + ")");
                 }
             }
-            if (values_.count(name)) src.fail(a.pos, "argument '" + name + "' of " + n.name + "() is given twice");
-            if (a.value.kind != ScadValue::Kind::Undef) values_[name] = &a.value;  // undef: as if absent
+            if (values_.count(name))
+                src.fail(a.pos, "argument '" + name + "' of " + n.name + "() is given twice");
+            if (a.value.kind != ScadValue::Kind::Undef)
+                values_[name] = &a.value;  // undef: as if absent
         }
     }
     const ScadValue* get(const std::string& name) const {
@@ -541,26 +570,31 @@ public:
     bool boolean(const std::string& name, bool fallback) const {
         const ScadValue* v = get(name);
         if (!v) return fallback;
-        if (v->kind != ScadValue::Kind::Bool) src_.fail(v->pos, "expected true or false for '" + name + "' of " + node_.name + "()");
+        if (v->kind != ScadValue::Kind::Bool)
+            src_.fail(v->pos, "expected true or false for '" + name + "' of " + node_.name + "()");
         return v->boolean;
     }
     /// [x, y, z] (or [x, y] with z = `z2d` when `allow2d`).
-    Vec3 vec3(const ScadValue& v, const std::string& what, bool allow2d = false, double z2d = 0.0) const {
-        if (v.kind != ScadValue::Kind::Vector || !(v.items.size() == 3 || (allow2d && v.items.size() == 2)))
-            src_.fail(v.pos, "expected " + std::string(allow2d ? "[x, y] or [x, y, z]" : "[x, y, z]") + " for " + what);
+    Vec3 vec3(const ScadValue& v, const std::string& what, bool allow2d = false,
+              double z2d = 0.0) const {
+        if (v.kind != ScadValue::Kind::Vector ||
+            !(v.items.size() == 3 || (allow2d && v.items.size() == 2)))
+            src_.fail(v.pos, "expected " +
+                                 std::string(allow2d ? "[x, y] or [x, y, z]" : "[x, y, z]") +
+                                 " for " + what);
         Vec3 r(z2d);
         for (size_t k = 0; k < v.items.size(); ++k) r[int(k)] = number(v.items[k], what);
         return r;
     }
 
-private:
+  private:
     const SourceText& src_;
     const ScadNode& node_;
     std::map<std::string, const ScadValue*> values_;
 };
 
 class Builder {
-public:
+  public:
     Builder(const SourceText& src, Scene& scene, OpenScadCounts& counts)
         : src_(src), scene_(scene), counts_(counts) {}
 
@@ -581,7 +615,7 @@ public:
         return b.kind == Built::Kind::Node ? b.node : -1;
     }
 
-private:
+  private:
     const ScadNode* findRoot(const ScadNode& n) {
         if (n.disable) return nullptr;
         if (n.root) return &n;
@@ -592,8 +626,10 @@ private:
     void countLeftOut(const std::vector<ScadNode>& nodes, const ScadNode* root) {
         for (const ScadNode& n : nodes) {
             if (&n == root) continue;
-            if (findRoot(n) == root) countLeftOut(n.children, root);
-            else ++counts_.leftOut;
+            if (findRoot(n) == root)
+                countLeftOut(n.children, root);
+            else
+                ++counts_.leftOut;
         }
     }
 
@@ -613,8 +649,10 @@ private:
         }
         const std::string& k = n.name;
         if (k == "group" || k == "union" || k == "render") {
-            if (k == "render") Args(src_, n, {"convexity"}, {});  // checks the arguments
-            else Args(src_, n, {}, {});
+            if (k == "render")
+                Args(src_, n, {"convexity"}, {});  // checks the arguments
+            else
+                Args(src_, n, {}, {});
             ++counts_.operators;
             return unionOf(n.children, xf, mat);
         }
@@ -623,7 +661,8 @@ private:
             ++counts_.operators;
             return boolean(n, k == "intersection" ? Op::Intersection : Op::Difference, xf, mat);
         }
-        if (k == "multmatrix" || k == "translate" || k == "rotate" || k == "scale" || k == "mirror") {
+        if (k == "multmatrix" || k == "translate" || k == "rotate" || k == "scale" ||
+            k == "mirror") {
             ++counts_.transforms;
             Transform t = xf * transform(n);
             // Each step is finite and invertible; their product may still overflow.
@@ -638,19 +677,22 @@ private:
             return unionOf(n.children, xf, color(n, mat));
         }
         if (k == "cube" || k == "sphere" || k == "cylinder") {
-            if (!n.children.empty())
-                src_.fail(n.children.front().pos, k + "() takes no children");
+            if (!n.children.empty()) src_.fail(n.children.front().pos, k + "() takes no children");
             return primitive(n, xf, mat);
         }
         refuse(n);
     }
 
     [[noreturn]] void refuse(const ScadNode& n) {
-        static const char* twoD[] = {"circle", "square", "polygon", "text", "offset", "projection", "import_dxf"};
+        static const char* twoD[] = {"circle", "square",     "polygon",   "text",
+                                     "offset", "projection", "import_dxf"};
         for (const char* t : twoD)
-            if (n.name == t) src_.fail(n.pos, "the 2D node '" + n.name + "' is not supported: Lancer traces 3D solids");
+            if (n.name == t)
+                src_.fail(n.pos,
+                          "the 2D node '" + n.name + "' is not supported: Lancer traces 3D solids");
         std::string list;
-        for (const std::string& s : openScadSupportedNodes()) list += (list.empty() ? "" : ", ") + s;
+        for (const std::string& s : openScadSupportedNodes())
+            list += (list.empty() ? "" : ", ") + s;
         src_.fail(n.pos, "the node '" + n.name + "' is not supported (supported: " + list + ")");
     }
 
@@ -676,7 +718,8 @@ private:
         for (size_t i = 1; i < kids.size(); ++i)
             if (kids[i].kind == Built::Kind::Node) cut.push_back(kids[i].node);
         if (cut.empty()) return kids[0];
-        return Built::of(scene_.tree.combine(Op::Difference, kids[0].node, scene_.tree.balanced(Op::Union, cut)));
+        return Built::of(scene_.tree.combine(Op::Difference, kids[0].node,
+                                             scene_.tree.balanced(Op::Union, cut)));
     }
 
     Transform transform(const ScadNode& n) {
@@ -686,24 +729,37 @@ private:
             Args a(src_, n, {"m"}, {});
             const ScadValue* m = a.get("m");
             if (!m) return t;  // OpenSCAD's default: the identity
-            auto bad = [&] { src_.fail(m->pos, "multmatrix expects a 4x4 matrix (or its first 3 rows) of numbers, as [[a, b, c, d], ...]"); };
-            if (m->kind != ScadValue::Kind::Vector || (m->items.size() != 4 && m->items.size() != 3)) bad();
+            auto bad = [&] {
+                src_.fail(m->pos,
+                          "multmatrix expects a 4x4 matrix (or its first 3 rows) of numbers, as "
+                          "[[a, b, c, d], ...]");
+            };
+            if (m->kind != ScadValue::Kind::Vector ||
+                (m->items.size() != 4 && m->items.size() != 3))
+                bad();
             Mat4 mm(1.0);
             for (size_t r = 0; r < m->items.size(); ++r) {
                 const ScadValue& row = m->items[r];
                 if (row.kind != ScadValue::Kind::Vector || row.items.size() != 4) bad();
-                for (size_t c = 0; c < 4; ++c) mm[int(c)][int(r)] = a.number(row.items[c], "a multmatrix entry");  // row-major in the file
+                for (size_t c = 0; c < 4; ++c)
+                    mm[int(c)][int(r)] =
+                        a.number(row.items[c], "a multmatrix entry");  // row-major in the file
             }
             if (mm[0][3] != 0.0 || mm[1][3] != 0.0 || mm[2][3] != 0.0 || mm[3][3] != 1.0)
-                src_.fail(m->items.back().pos, "the last row of a multmatrix must be [0, 0, 0, 1] (projective transforms are not supported)");
+                src_.fail(m->items.back().pos,
+                          "the last row of a multmatrix must be [0, 0, 0, 1] (projective "
+                          "transforms are not supported)");
             t = Transform(mm);
         } else if (k == "translate") {
             Args a(src_, n, {"v"}, {});
-            if (const ScadValue* v = a.get("v")) t = Transform::translate(a.vec3(*v, "'v' of translate()", true));
+            if (const ScadValue* v = a.get("v"))
+                t = Transform::translate(a.vec3(*v, "'v' of translate()", true));
         } else if (k == "scale") {
             Args a(src_, n, {"v"}, {});
             if (const ScadValue* v = a.get("v"))
-                t = Transform::scale(v->kind == ScadValue::Kind::Number ? Vec3(v->number) : a.vec3(*v, "'v' of scale()", true, 1.0));
+                t = Transform::scale(v->kind == ScadValue::Kind::Number
+                                         ? Vec3(v->number)
+                                         : a.vec3(*v, "'v' of scale()", true, 1.0));
         } else if (k == "mirror") {
             Args a(src_, n, {"v"}, {});
             if (const ScadValue* v = a.get("v")) {
@@ -717,24 +773,29 @@ private:
                     t = Transform(mm);
                 }
             }
-        } else {  // rotate(a, v): a number about v (default z), or [x, y, z] applied x, then y, then z
+        } else {  // rotate(a, v): a number about v (default z), or [x, y, z] applied x, then y,
+                  // then z
             Args a(src_, n, {"a", "v"}, {});
             const ScadValue* ang = a.get("a");
             if (!ang) return t;
             if (ang->kind == ScadValue::Kind::Number) {
                 Vec3 axis(0, 0, 1);
                 if (const ScadValue* v = a.get("v")) axis = a.vec3(*v, "'v' of rotate()");
-                if (glm::dot(axis, axis) == 0.0 || !std::isfinite(glm::dot(axis, axis))) src_.fail(n.pos, "rotate() needs a non-zero axis 'v'");
+                if (glm::dot(axis, axis) == 0.0 || !std::isfinite(glm::dot(axis, axis)))
+                    src_.fail(n.pos, "rotate() needs a non-zero axis 'v'");
                 t = Transform::rotate(ang->number, axis);
             } else {
                 Vec3 e = a.vec3(*ang, "'a' of rotate()", true);
-                t = Transform::rotate(e.z, {0, 0, 1}) * Transform::rotate(e.y, {0, 1, 0}) * Transform::rotate(e.x, {1, 0, 0});
+                t = Transform::rotate(e.z, {0, 0, 1}) * Transform::rotate(e.y, {0, 1, 0}) *
+                    Transform::rotate(e.x, {1, 0, 0});
             }
         }
         for (int c = 0; c < 4; ++c)
             for (int r = 0; r < 4; ++r)
-                if (!std::isfinite(t.m[c][r])) src_.fail(n.pos, k + "() gives a transform with non-finite entries");
-        if (!t.isInvertible()) src_.fail(n.pos, k + "() is singular (it flattens its children to nothing)");
+                if (!std::isfinite(t.m[c][r]))
+                    src_.fail(n.pos, k + "() gives a transform with non-finite entries");
+        if (!t.isInvertible())
+            src_.fail(n.pos, k + "() is singular (it flattens its children to nothing)");
         return t;
     }
 
@@ -745,13 +806,16 @@ private:
         if (a.get("alpha")) a.number("alpha");  // checked; opacity is not modelled
         Vec3 rgb;
         if (c->kind == ScadValue::Kind::Vector) {
-            if (c->items.size() != 3 && c->items.size() != 4) src_.fail(c->pos, "expected [r, g, b] or [r, g, b, a] for the colour");
-            for (int i = 0; i < 3; ++i) rgb[i] = std::clamp(a.number(c->items[size_t(i)], "a colour component"), 0.0, 1.0);
+            if (c->items.size() != 3 && c->items.size() != 4)
+                src_.fail(c->pos, "expected [r, g, b] or [r, g, b, a] for the colour");
+            for (int i = 0; i < 3; ++i)
+                rgb[i] = std::clamp(a.number(c->items[size_t(i)], "a colour component"), 0.0, 1.0);
             if (c->items.size() == 4) a.number(c->items[3], "the alpha component");
         } else if (c->kind == ScadValue::Kind::String) {
             rgb = namedColor(*c);
         } else {
-            src_.fail(c->pos, "expected a colour: [r, g, b, a], a name such as \"red\", or \"#rrggbb\"");
+            src_.fail(c->pos,
+                      "expected a colour: [r, g, b, a], a name such as \"red\", or \"#rrggbb\"");
         }
         return material(rgb);
     }
@@ -765,14 +829,18 @@ private:
             std::string h = s.substr(1);
             bool ok = h.size() == 3 || h.size() == 4 || h.size() == 6 || h.size() == 8;
             for (char ch : h) ok = ok && std::isxdigit(static_cast<unsigned char>(ch));
-            if (!ok) src_.fail(c.pos, "malformed colour '" + printable(c.str) + "' (expected #rgb, #rgba, #rrggbb or #rrggbbaa)");
+            if (!ok)
+                src_.fail(c.pos, "malformed colour '" + printable(c.str) +
+                                     "' (expected #rgb, #rgba, #rrggbb or #rrggbbaa)");
             if (h.size() <= 4) h = std::string{h[0], h[0], h[1], h[1], h[2], h[2]};
             hex = uint32_t(std::stoul(h.substr(0, 6), nullptr, 16));
         } else if (s == "transparent") {
             hex = 0;
         } else {
             auto it = kColorNames.find(s);
-            if (it == kColorNames.end()) src_.fail(c.pos, "unknown colour name '" + printable(c.str) + "' (OpenSCAD accepts the SVG colour names)");
+            if (it == kColorNames.end())
+                src_.fail(c.pos, "unknown colour name '" + printable(c.str) +
+                                     "' (OpenSCAD accepts the SVG colour names)");
             hex = it->second;
         }
         return hexColor(hex);
@@ -804,7 +872,8 @@ private:
             Args a(src_, n, {"size", "center"}, {});
             Vec3 size(1.0);
             if (const ScadValue* s = a.get("size")) {
-                size = s->kind == ScadValue::Kind::Number ? Vec3(s->number) : a.vec3(*s, "'size' of cube()");
+                size = s->kind == ScadValue::Kind::Number ? Vec3(s->number)
+                                                          : a.vec3(*s, "'size' of cube()");
                 for (int i = 0; i < 3; ++i)
                     if (size[i] < 0.0) src_.fail(s->pos, "cube sizes must not be negative");
             }
@@ -818,8 +887,10 @@ private:
         } else if (k == "sphere") {
             Args a(src_, n, {"r"}, {"d"});
             double r = 1.0;
-            if (auto d = a.number("d")) r = 0.5 * nonNegative(a, "d", *d);  // d takes precedence, as in OpenSCAD
-            else if (auto rr = a.number("r")) r = nonNegative(a, "r", *rr);
+            if (auto d = a.number("d"))
+                r = 0.5 * nonNegative(a, "d", *d);  // d takes precedence, as in OpenSCAD
+            else if (auto rr = a.number("r"))
+                r = nonNegative(a, "r", *rr);
             if (r == 0.0) return emptyPrimitive();
             shape = Sphere{Vec3(0.0), r};
             ++counts_.spheres;
@@ -829,12 +900,18 @@ private:
             if (auto v = a.number("h")) h = nonNegative(a, "h", *v);
             // OpenSCAD: d over r, d1 over r1, d2 over r2; r1/r2 (or d1/d2) over r (or d).
             std::optional<double> r, rr1, rr2;
-            if (auto d = a.number("d")) r = 0.5 * nonNegative(a, "d", *d);
-            else if (auto v = a.number("r")) r = nonNegative(a, "r", *v);
-            if (auto d = a.number("d1")) rr1 = 0.5 * nonNegative(a, "d1", *d);
-            else if (auto v = a.number("r1")) rr1 = nonNegative(a, "r1", *v);
-            if (auto d = a.number("d2")) rr2 = 0.5 * nonNegative(a, "d2", *d);
-            else if (auto v = a.number("r2")) rr2 = nonNegative(a, "r2", *v);
+            if (auto d = a.number("d"))
+                r = 0.5 * nonNegative(a, "d", *d);
+            else if (auto v = a.number("r"))
+                r = nonNegative(a, "r", *v);
+            if (auto d = a.number("d1"))
+                rr1 = 0.5 * nonNegative(a, "d1", *d);
+            else if (auto v = a.number("r1"))
+                rr1 = nonNegative(a, "r1", *v);
+            if (auto d = a.number("d2"))
+                rr2 = 0.5 * nonNegative(a, "d2", *d);
+            else if (auto v = a.number("r2"))
+                rr2 = nonNegative(a, "r2", *v);
             if (r) r1 = r2 = *r;
             if (rr1) r1 = *rr1;
             if (rr2) r2 = *rr2;
@@ -845,7 +922,8 @@ private:
             ++(r1 == r2 ? counts_.cylinders : counts_.cones);
         }
         Primitive p = makePrimitive(std::move(shape), xf * local, mat);
-        if (!p.worldBox.isBounded()) src_.fail(n.pos, k + "() is too large: its bounds overflow a double");
+        if (!p.worldBox.isBounded())
+            src_.fail(n.pos, k + "() is too large: its bounds overflow a double");
         p.origin = src_.where(n.pos);
         scene_.prims.push_back(std::move(p));
         return Built::of(scene_.tree.leaf(uint32_t(scene_.prims.size() - 1)));
@@ -866,8 +944,8 @@ private:
 
 const std::vector<std::string>& openScadSupportedNodes() {
     static const std::vector<std::string> nodes = {
-        "group", "union", "difference", "intersection", "render", "multmatrix", "translate",
-        "rotate", "scale", "mirror", "color", "cube", "sphere", "cylinder"};
+        "group",  "union", "difference", "intersection", "render", "multmatrix", "translate",
+        "rotate", "scale", "mirror",     "color",        "cube",   "sphere",     "cylinder"};
     return nodes;
 }
 

@@ -13,11 +13,11 @@ namespace lancer {
 /// What a .csg file held, for tests and messages.
 struct OpenScadCounts {
     int cubes = 0, spheres = 0, cylinders = 0, cones = 0;  ///< primitives modelled
-    int operators = 0;     ///< union/group/render, intersection, difference nodes read
-    int transforms = 0;    ///< multmatrix/translate/rotate/scale/mirror nodes read
+    int operators = 0;   ///< union/group/render, intersection, difference nodes read
+    int transforms = 0;  ///< multmatrix/translate/rotate/scale/mirror nodes read
     int colors = 0;
-    int leftOut = 0;       ///< subtrees dropped by the `*` or `%` modifier (or outside a `!` root)
-    int empty = 0;         ///< zero-size primitives (OpenSCAD makes nothing of them)
+    int leftOut = 0;  ///< subtrees dropped by the `*` or `%` modifier (or outside a `!` root)
+    int empty = 0;    ///< zero-size primitives (OpenSCAD makes nothing of them)
 };
 
 /// Nodes the reader models exactly; every other node is refused naming the node and position.

@@ -50,10 +50,10 @@ struct Scene {
     int width = 512, height = 512;  ///< default image size
 
     // Filled by prepare():
-    std::vector<Box3> minBox;       ///< CSG-minimized box per primitive (empty: dropped)
-    int droppedPrims = 0;           ///< primitives removed by bound minimization
+    std::vector<Box3> minBox;  ///< CSG-minimized box per primitive (empty: dropped)
+    int droppedPrims = 0;      ///< primitives removed by bound minimization
     int minimizeIterations = 0;
-    Box3 bounds;                    ///< hull of the minimized boxes of live primitives
+    Box3 bounds;  ///< hull of the minimized boxes of live primitives
     /// Per primitive, a sphere in world coordinates packed in 32 bytes (r < 0: another shape or
     /// a transformed one): the walks' inner loop tests it without the variant, the transform or
     /// a call, and reads 7,000 of them from a quarter of a megabyte, not from the primitives.

@@ -7,7 +7,7 @@
 namespace lancer {
 
 class SourceText {
-public:
+  public:
     SourceText(std::string path, std::string text);
     /// Read a whole file; throws SceneError naming the path when it cannot be read.
     static SourceText fromFile(const std::string& path);
@@ -20,7 +20,7 @@ public:
     /// Throw SceneError("path:line:col: message").
     [[noreturn]] void fail(size_t pos, const std::string& message) const;
 
-private:
+  private:
     std::string path_, text_;
     std::vector<size_t> lineStarts_;
 };

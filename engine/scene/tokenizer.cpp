@@ -43,7 +43,8 @@ double WordReader::number(const char* what) {
     if (t.text.empty()) src_.fail(t.pos, std::string("unexpected end of file: expected ") + what);
     double v;
     if (!parseFiniteDouble(t.text, v))
-        src_.fail(t.pos, std::string("expected ") + what + " (a finite number), got '" + std::string(t.text) + "'");
+        src_.fail(t.pos, std::string("expected ") + what + " (a finite number), got '" +
+                             std::string(t.text) + "'");
     return v;
 }
 
@@ -52,8 +53,11 @@ int WordReader::count(const char* what, int max) {
     if (t.text.empty()) src_.fail(t.pos, std::string("unexpected end of file: expected ") + what);
     double v;
     if (!parseFiniteDouble(t.text, v) || v != std::floor(v) || v < 0)
-        src_.fail(t.pos, std::string("expected ") + what + " (a non-negative integer), got '" + std::string(t.text) + "'");
-    if (v > max) src_.fail(t.pos, std::string(what) + " " + std::string(t.text) + " is larger than the limit of " + std::to_string(max));
+        src_.fail(t.pos, std::string("expected ") + what + " (a non-negative integer), got '" +
+                             std::string(t.text) + "'");
+    if (v > max)
+        src_.fail(t.pos, std::string(what) + " " + std::string(t.text) +
+                             " is larger than the limit of " + std::to_string(max));
     return int(v);
 }
 

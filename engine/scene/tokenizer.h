@@ -16,7 +16,7 @@ struct Token {
 
 /// Whitespace-separated words; `#` starts a comment to the end of the line.
 class WordReader {
-public:
+  public:
     explicit WordReader(const SourceText& src) : src_(src) {}
     Token next();
     Token peek();
@@ -27,7 +27,7 @@ public:
     Vec3 vec3(const char* what);
     const SourceText& source() const { return src_; }
 
-private:
+  private:
     const SourceText& src_;
     size_t pos_ = 0;
 };

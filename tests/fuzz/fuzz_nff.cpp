@@ -8,7 +8,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     try {
-        lancer::readNff(lancer::SourceText("fuzz.nff", std::string(reinterpret_cast<const char*>(data), size)));
+        lancer::readNff(
+            lancer::SourceText("fuzz.nff", std::string(reinterpret_cast<const char*>(data), size)));
     } catch (const lancer::SceneError&) {
     }
     return 0;

@@ -19,14 +19,65 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 namespace {
 
 // Tokens of both formats, so mutations reach deeper than random bytes would.
-const char* kDictionary[] = {
-    " ", "\n", "\t", "0", "-1", "1e308", "1e999", "nan", "inf", "-inf", "0.5", "99999999999", "#",
-    "v\n", "from", "at", "up", "angle", "hither", "resolution", "b", "l", "f", "s", "p", "pp", "c",
-    "{", "}", "(", ")", "[", "]", ",", ";", "=", "%", "*", "!", "\"", "//", "/*", "*/",
-    "group()", "union()", "difference()", "intersection()", "render()", "color(\"red\")",
-    "multmatrix([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])", "cube(1);",
-    "sphere(r = 1);", "cylinder(h = 1, r1 = 1, r2 = 0);", "center = true", "$fn = 0", "undef",
-    "hull()", "[[", "]]"};
+const char* kDictionary[] = {" ",
+                             "\n",
+                             "\t",
+                             "0",
+                             "-1",
+                             "1e308",
+                             "1e999",
+                             "nan",
+                             "inf",
+                             "-inf",
+                             "0.5",
+                             "99999999999",
+                             "#",
+                             "v\n",
+                             "from",
+                             "at",
+                             "up",
+                             "angle",
+                             "hither",
+                             "resolution",
+                             "b",
+                             "l",
+                             "f",
+                             "s",
+                             "p",
+                             "pp",
+                             "c",
+                             "{",
+                             "}",
+                             "(",
+                             ")",
+                             "[",
+                             "]",
+                             ",",
+                             ";",
+                             "=",
+                             "%",
+                             "*",
+                             "!",
+                             "\"",
+                             "//",
+                             "/*",
+                             "*/",
+                             "group()",
+                             "union()",
+                             "difference()",
+                             "intersection()",
+                             "render()",
+                             "color(\"red\")",
+                             "multmatrix([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])",
+                             "cube(1);",
+                             "sphere(r = 1);",
+                             "cylinder(h = 1, r1 = 1, r2 = 0);",
+                             "center = true",
+                             "$fn = 0",
+                             "undef",
+                             "hull()",
+                             "[[",
+                             "]]"};
 
 bool run(const std::string& input, const std::string& what) {
     auto start = std::chrono::steady_clock::now();
@@ -40,7 +91,8 @@ bool run(const std::string& input, const std::string& what) {
     return true;
 }
 
-std::string mutate(const std::string& in, const std::vector<std::string>& corpus, std::mt19937_64& rng) {
+std::string mutate(const std::string& in, const std::vector<std::string>& corpus,
+                   std::mt19937_64& rng) {
     std::string s = in;
     int steps = 1 + int(rng() % 4);
     for (int k = 0; k < steps; ++k) {
@@ -105,8 +157,10 @@ int main(int argc, char** argv) {
         if (!run(corpus[i], names[i])) return 1;
         ++runs;
         for (long m = 0; m < mutations; ++m, ++runs)
-            if (!run(mutate(corpus[i], corpus, rng), names[i] + " mutation " + std::to_string(m))) return 1;
+            if (!run(mutate(corpus[i], corpus, rng), names[i] + " mutation " + std::to_string(m)))
+                return 1;
     }
-    std::printf("PASS: %ld inputs from %zu seeds, no crash, none slower than 1 s\n", runs, corpus.size());
+    std::printf("PASS: %ld inputs from %zu seeds, no crash, none slower than 1 s\n", runs,
+                corpus.size());
     return 0;
 }

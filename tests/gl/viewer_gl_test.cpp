@@ -454,7 +454,8 @@ TEST_F(ViewerFrames, DragsMoveTheCameraExceptWhenImGuiWantsTheMouse) {
         io.MouseDown[0] = true;
         frame();
         for (int i = 1; i <= 5; ++i) {
-            io.MousePos = ImVec2(x0 + (x1 - x0) * float(i) / 5.0f, y0 + (y1 - y0) * float(i) / 5.0f);
+            io.MousePos =
+                ImVec2(x0 + (x1 - x0) * float(i) / 5.0f, y0 + (y1 - y0) * float(i) / 5.0f);
             frame();
         }
         io.MouseDown[0] = false;

@@ -128,9 +128,8 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     }
     EXPECT_EQ(settingsLines(r), lines);
     ViewerSettings bad = r;
-    for (const char* line :
-         {"max_level=999", "scheme=octree", "split_axes=diagonal", "window=5 5", "delta=-1",
-          "threads=x", "garbage"})
+    for (const char* line : {"max_level=999", "scheme=octree", "split_axes=diagonal", "window=5 5",
+                             "delta=-1", "threads=x", "garbage"})
         readSettingsLine(bad, line);
     EXPECT_EQ(settingsLines(bad), lines);
 }
@@ -157,7 +156,8 @@ TEST(ImageCopy, UncoveredRectanglesTileExactlyWhatNoPanelCovers) {
         std::vector<int> count(size_t(w * h), 0);
         const std::vector<PixelRect> rects = uncovered(w, h, panels);
         for (const PixelRect& r : rects) {
-            ASSERT_TRUE(0 <= r.x0 && r.x0 < r.x1 && r.x1 <= w && 0 <= r.y0 && r.y0 < r.y1 && r.y1 <= h);
+            ASSERT_TRUE(0 <= r.x0 && r.x0 < r.x1 && r.x1 <= w && 0 <= r.y0 && r.y0 < r.y1 &&
+                        r.y1 <= h);
             for (int y = r.y0; y < r.y1; ++y)
                 for (int x = r.x0; x < r.x1; ++x) ++count[size_t(y * w + x)];
         }

@@ -15,10 +15,21 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
         Shape shape;
         Transform xf = Transform::translate(c + opt.offset);
         switch (rng() % 4) {
-            case 0: shape = Sphere{Vec3(0.0), pos(rng)}; break;
-            case 1: shape = Block{-Vec3(pos(rng), pos(rng), pos(rng)), Vec3(pos(rng), pos(rng), pos(rng))}; break;
-            case 2: { double r = pos(rng); shape = Cone{r, r, 2.0 * pos(rng), false}; break; }
-            default: shape = Cone{pos(rng), (rng() % 3 == 0) ? 0.0 : pos(rng), 2.0 * pos(rng), false}; break;
+            case 0:
+                shape = Sphere{Vec3(0.0), pos(rng)};
+                break;
+            case 1:
+                shape =
+                    Block{-Vec3(pos(rng), pos(rng), pos(rng)), Vec3(pos(rng), pos(rng), pos(rng))};
+                break;
+            case 2: {
+                double r = pos(rng);
+                shape = Cone{r, r, 2.0 * pos(rng), false};
+                break;
+            }
+            default:
+                shape = Cone{pos(rng), (rng() % 3 == 0) ? 0.0 : pos(rng), 2.0 * pos(rng), false};
+                break;
         }
         if (opt.transforms && rng() % 2) {
             xf = xf * Transform::rotate(180.0 * u(rng), {u(rng), u(rng), u(rng) + 1.5}) *
@@ -34,7 +45,8 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
         nodes.erase(nodes.begin() + long(i));
         size_t j = rng() % nodes.size();
         int b = nodes[j];
-        Op op = std::array<Op, 4>{Op::Union, Op::Union, Op::Intersection, Op::Difference}[rng() % 4];
+        Op op =
+            std::array<Op, 4>{Op::Union, Op::Union, Op::Intersection, Op::Difference}[rng() % 4];
         nodes[j] = s.tree.combine(op, a, b);
     }
     int root = nodes.empty() ? -1 : nodes[0];
@@ -47,7 +59,8 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
             s.prims.push_back(makePrimitive(t, Transform(), 0));
             top.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
             Cone open{pos(rng), pos(rng), 2.0 * pos(rng), true};
-            s.prims.push_back(makePrimitive(open, Transform::translate(c) * Transform::rotate(90.0 * u(rng), {1, 0, 0}), 0));
+            s.prims.push_back(makePrimitive(
+                open, Transform::translate(c) * Transform::rotate(90.0 * u(rng), {1, 0, 0}), 0));
             top.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
         }
         root = s.tree.balanced(Op::Union, top);
@@ -78,7 +91,9 @@ std::vector<Ray> randomRays(const Scene& scene, uint64_t seed, int count) {
                 origin = b.center() + d * diag * 1.5;
                 break;
             }
-            case 2: origin = inside(); break;  // from inside the scene
+            case 2:
+                origin = inside();
+                break;  // from inside the scene
             default: {  // axis-parallel
                 int axis = int(rng() % 3);
                 Vec3 d(0.0);
@@ -94,7 +109,8 @@ std::vector<Ray> randomRays(const Scene& scene, uint64_t seed, int count) {
     return rays;
 }
 
-std::vector<Ray> raysThroughPoints(const std::vector<Vec3>& points, const Box3& bounds, uint64_t seed) {
+std::vector<Ray> raysThroughPoints(const std::vector<Vec3>& points, const Box3& bounds,
+                                   uint64_t seed) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     double diag = std::max(glm::length(bounds.extent()), 1e-9);
@@ -120,11 +136,16 @@ std::string RayMismatch::toString(const Scene& scene) const {
     std::ostringstream os;
     os.precision(17);
     os << ray.toString() << "\n  brute: ";
-    if (expectedFound) os << "t=" << expected.t << " p" << expected.prim << " " << scene.prims[expected.prim].toString();
-    else os << "miss";
+    if (expectedFound)
+        os << "t=" << expected.t << " p" << expected.prim << " "
+           << scene.prims[expected.prim].toString();
+    else
+        os << "miss";
     os << "\n  got:   ";
-    if (gotFound) os << "t=" << got.t << " p" << got.prim << " " << scene.prims[got.prim].toString();
-    else os << "miss";
+    if (gotFound)
+        os << "t=" << got.t << " p" << got.prim << " " << scene.prims[got.prim].toString();
+    else
+        os << "miss";
     return os.str();
 }
 
@@ -134,7 +155,8 @@ std::vector<RayMismatch> compareWithBrute(const Scene& scene, const Accelerator&
     BuildParams bp;
     bp.scheme = SchemeKind::Brute;
     auto brute = buildAccelerator(scene, bp);
-    TraceContext cb(scene.prims.size(), scene.tree.depth()), ca(scene.prims.size(), scene.tree.depth());
+    TraceContext cb(scene.prims.size(), scene.tree.depth()),
+        ca(scene.prims.size(), scene.tree.depth());
     cb.useMailboxes = brute->usesMailboxes();
     ca.useMailboxes = accel.usesMailboxes();
     NullObserver obs;

@@ -14,10 +14,10 @@ namespace lancer::test {
 
 struct RandomSceneOptions {
     int primitives = 12;
-    bool transforms = true;     ///< rotated, non-uniformly scaled primitives
-    bool surfaces = false;      ///< add triangles/polygons/open cones under a top-level union
-    Vec3 offset{0.0};           ///< translate everything (far-from-origin scenes)
-    double spread = 4.0;        ///< primitives' centres in [-spread, spread]^3
+    bool transforms = true;  ///< rotated, non-uniformly scaled primitives
+    bool surfaces = false;   ///< add triangles/polygons/open cones under a top-level union
+    Vec3 offset{0.0};        ///< translate everything (far-from-origin scenes)
+    double spread = 4.0;     ///< primitives' centres in [-spread, spread]^3
 };
 
 /// A random binary CSG tree over random solids (spheres, boxes, cylinders, cones), prepared.
@@ -29,7 +29,8 @@ std::vector<Ray> randomRays(const Scene& scene, uint64_t seed, int count);
 
 /// Rays aimed exactly at the given points (cell corners, edge midpoints, face centres) from
 /// random origins, and axis-parallel rays through them.
-std::vector<Ray> raysThroughPoints(const std::vector<Vec3>& points, const Box3& bounds, uint64_t seed);
+std::vector<Ray> raysThroughPoints(const std::vector<Vec3>& points, const Box3& bounds,
+                                   uint64_t seed);
 
 struct RayMismatch {
     Ray ray;

@@ -10,8 +10,8 @@ namespace lancer {
 
 ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& frame,
                                        const std::vector<Box3>& box,
-                                       const std::vector<uint32_t>& live,
-                                       const ScreenBspParams& sp, nlohmann::json& extra) {
+                                       const std::vector<uint32_t>& live, const ScreenBspParams& sp,
+                                       nlohmann::json& extra) {
     ProjectiveZones s;
     s.scene_ = &scene;
     s.eye_ = frame.origin;
@@ -30,7 +30,8 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     // (wider images, and rays outside it, take the camera-frame walk).
     double half = std::tan(glm::radians(cam.fov) * 0.5);
     double aspect = std::max(4.0, double(scene.width) / double(std::max(scene.height, 1)));
-    glm::dvec2 limLo(-half * aspect, -half * (1.0 + 1e-6)), limHi(half * aspect, half * (1.0 + 1e-6));
+    glm::dvec2 limLo(-half * aspect, -half * (1.0 + 1e-6)),
+        limHi(half * aspect, half * (1.0 + 1e-6));
 
     // Projected boxes: x/z over a box in front of the eye is extreme at its corners. A relative
     // pad of 1e-12 covers the rounding of these divisions (the camera-frame padding gives the

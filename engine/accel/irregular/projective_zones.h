@@ -61,7 +61,7 @@ class ProjectiveZones {
   private:
     const Scene* scene_ = nullptr;
     Vec3 eye_{0.0};
-    glm::dvec2 lo_{0.0}, hi_{0.0};  ///< the screen rectangle in (u, v)
+    glm::dvec2 lo_{0.0}, hi_{0.0};     ///< the screen rectangle in (u, v)
     double zNear_ = 0.0, zFar_ = 0.0;  ///< depth range of the slabs
     int nearRoot_ = -1;  ///< restricted tree of the primitives reaching in front of zNear
     size_t zones_ = 0;

@@ -133,7 +133,7 @@ struct RegularBuilder {
     const BuildParams& params;
     RegularGrid& grid;
     BspNodes bsp;
-    std::vector<char> keep;                          ///< membership marks, all 0 between uses
+    std::vector<char> keep;  ///< membership marks, all 0 between uses
     struct SharedTree {
         int32_t root = -1;
         uint32_t first = 0;  ///< in grid.primList_
@@ -295,9 +295,9 @@ RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
     // Build the BSP.
     RegularBuilder b{scene, params, *this, {}, std::vector<char>(scene.prims.size(), 0), {}, {}};
     b.bsp.nodes.resize(1);
-    b.unionOnly = std::all_of(scene.tree.nodes.begin(), scene.tree.nodes.end(), [](const CsgNode& n) {
-        return n.op == Op::Primitive || n.op == Op::Union;
-    });
+    b.unionOnly =
+        std::all_of(scene.tree.nodes.begin(), scene.tree.nodes.end(),
+                    [](const CsgNode& n) { return n.op == Op::Primitive || n.op == Op::Union; });
     b.scratch.resize(size_t(std::max(0, params.maxLevel)) + 2);
     std::vector<uint32_t> live =
         scene.tree.empty() ? std::vector<uint32_t>{} : scene.tree.primitives();

@@ -1,7 +1,7 @@
 // The regular subdivision (report, section 3): a BSP over the scene box cut at the middle, on x,
 // y, z in turn as in the report or on the axes a cost estimate picks level by level (the same
-// axis for every node of a level), its leaves reached through a directory at the finest level (full table or
-// Tamminen sub-tables), and a ray walk from leaf to leaf by one of two methods:
+// axis for every node of a level), its leaves reached through a directory at the finest level (full
+// table or Tamminen sub-tables), and a ray walk from leaf to leaf by one of two methods:
 //  - push (the report's): push the exit point by `delta` across the exit face, edge or corner
 //    and locate it; a delta too large skips thin cells, a delta too small stalls;
 //  - exact: leaves are aligned on the directory's integer grid, so the next cell's index on the
@@ -118,8 +118,8 @@ class RegularGrid {
     Vec3 ext_{0.0};
     AxisSchedule schedule_;
     uint32_t n_[3] = {1, 1, 1};
-    double scale_[3] = {1.0, 1.0, 1.0};   ///< 2^n / extent, for locate
-    std::vector<double> planes_[3];       ///< grid plane coordinates, 2^n + 1 per axis
+    double scale_[3] = {1.0, 1.0, 1.0};  ///< 2^n / extent, for locate
+    std::vector<double> planes_[3];      ///< grid plane coordinates, 2^n + 1 per axis
     size_t maxSteps_ = 16;
     std::vector<RegularLeaf> leaves_;
     CsgTree pool_;  ///< restricted trees of all leaves, shared between equal primitive sets
@@ -154,7 +154,8 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
     const bool up[3] = {ray.d.x > 0.0, ray.d.y > 0.0, ray.d.z > 0.0};
     double inv[3], bias[3];
-    uint32_t side[3];  // where a leaf's exit plane on each axis is in RegularLeaf::plane: lo a, hi 3 + a
+    uint32_t
+        side[3];  // where a leaf's exit plane on each axis is in RegularLeaf::plane: lo a, hi 3 + a
     uint32_t rope[3];  // the rope across that plane
     for (int a = 0; a < 3; ++a) {
         const bool parallel = ray.d[a] == 0.0;
