@@ -189,7 +189,8 @@ class StructureView {
     std::string toString(uint32_t id) const;
     /// The region holding a world point, for picking in 3D (clamped into the structure): brute
     /// force 0, the regular leaf, the irregular camera-frame region (projective regions are
-    /// reached from pixels: ZoneFrameView::zoneAtPixel).
+    /// reached from pixels: ZoneFrameView::zoneAtPixel). Needs regionCount() > 0 (an irregular
+    /// structure over an empty scene has no region).
     uint32_t regionAt(const Vec3& world) const;
     /// The structure's box in the world: scene bounds, the regular grid's box, the irregular
     /// bounds' box in the world (a box of the camera frame: see structureCorners).
