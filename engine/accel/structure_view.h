@@ -58,9 +58,12 @@ struct RegionInfo {
     uint32_t cellLo[3] = {}, cellHi[3] = {};  ///< regular: directory cells [lo, hi) per axis
     int64_t zone = -1;  ///< irregular: zone in its frame's BSP; -1 for the near region
     uint32_t slab = 0;  ///< irregular: index of the slab in its zone, by increasing depth
-    std::span<const uint32_t> prims;  ///< primitives listed in the region (tracer ids)
-    const CsgTree* pool = nullptr;    ///< the pool holding the region's restricted tree
-    int root = -1;                    ///< restricted tree's root in `pool`; -1: empty
+    /// Primitives listed in the region (tracer ids), sorted: those whose minimized box (its
+    /// bound in the region's frame, irregular) crosses the region; the regular scheme keeps
+    /// only those its restricted tree keeps (the others cannot contribute there).
+    std::span<const uint32_t> prims;
+    const CsgTree* pool = nullptr;  ///< the pool holding the region's restricted tree
+    int root = -1;                  ///< restricted tree's root in `pool`; -1: empty
     /// Neighbours across the low and high face of each frame axis: regular ropes (one leaf
     /// covers the face, or kSeveralNeighbours); irregular corner pointers (region.h: the region
     /// just beyond the low / high corner across that face); projective slabs: the previous /
@@ -136,6 +139,9 @@ class ZoneFrameView {
     std::span<const uint32_t> zonePrims(uint32_t z) const;
     /// Zone z's slabs, by increasing depth.
     std::vector<SlabInfo> slabs(uint32_t z) const;
+    /// Zone z's whole column as 8 world corners (the regionCorners order): its rectangle through
+    /// the depth of its slabs; a box of the camera frame, or a frustum of the projective frame.
+    std::array<Vec3, 8> zoneCorners(uint32_t z) const;
     /// Zone holding the frame point (x, y); -1 outside the rectangle.
     int64_t zoneAt(glm::dvec2 p) const;
 
