@@ -30,6 +30,16 @@ struct SceneBuilder {
         s.prepare();
         return std::move(s);
     }
+    /// finish(), then the look the generated scenes share: a background, a camera framed on the
+    /// bounds looking along `viewDir` (z up) and the default lights.
+    Scene finishFramed(int root, const std::string& name, int size, const Vec3& background,
+                       const Vec3& viewDir) {
+        Scene scene = finish(root, name, size);
+        scene.background = background;
+        scene.frameCamera(viewDir, {0, 0, 1});
+        scene.defaultLights();
+        return scene;
+    }
 };
 
 Material mat(Vec3 c, double diffuse, double specular, double shine, double reflect = 0.0,
@@ -144,11 +154,8 @@ Scene drilledScene(int n) {
                 Vec3 c = Vec3(-extent) + step * (Vec3(i, j, k) + 0.5);
                 holes.push_back(b.prim(Sphere{c, r}, steel));
             }
-    Scene s = b.finish(b.op(Op::Difference, block, b.all(Op::Union, holes)), "drilled", n);
-    s.background = {0.1, 0.1, 0.12};
-    s.frameCamera({-1.0, 2.2, -1.4}, {0, 0, 1});
-    s.defaultLights();
-    return s;
+    return b.finishFramed(b.op(Op::Difference, block, b.all(Op::Union, holes)), "drilled", n,
+                          {0.1, 0.1, 0.12}, {-1.0, 2.2, -1.4});
 }
 
 // An n x n x n lattice of cells, each a rounded cube (cube ∩ sphere) bored by a cylinder,
@@ -171,11 +178,8 @@ Scene latticeScene(int n) {
                 cells.push_back(b.op(Op::Difference, rounded, bore));
             }
     int slab = b.prim(Block{{-1.1, -1.1, -0.55}, {1.1, 1.1, 0.55}}, ma);
-    Scene s = b.finish(b.op(Op::Intersection, b.all(Op::Union, cells), slab), "lattice", n);
-    s.background = {0.1, 0.1, 0.12};
-    s.frameCamera({-1.0, 2.0, -1.2}, {0, 0, 1});
-    s.defaultLights();
-    return s;
+    return b.finishFramed(b.op(Op::Intersection, b.all(Op::Union, cells), slab), "lattice", n,
+                          {0.1, 0.1, 0.12}, {-1.0, 2.0, -1.2});
 }
 
 // SPD-style "tetra": a Sierpinski tetrahedron of 4^SIZE triangles (surfaces in one union).
@@ -202,11 +206,8 @@ Scene tetraScene(int size) {
     };
     double r = 1.0;
     split({Vec3(r, r, r), Vec3(-r, -r, r), Vec3(-r, r, -r), Vec3(r, -r, -r)}, size - 1);
-    Scene s = b.finish(b.all(Op::Union, leaves), "tetra", size);
-    s.background = {0.078, 0.361, 0.753};
-    s.frameCamera({-0.45, 1.0, 0.35}, {0, 0, 1});
-    s.defaultLights();
-    return s;
+    return b.finishFramed(b.all(Op::Union, leaves), "tetra", size, {0.078, 0.361, 0.753},
+                          {-0.45, 1.0, 0.35});
 }
 
 // SPD-style "rings": SIZE x SIZE rings, each a chain of spheres joined by open cylinders
@@ -243,11 +244,8 @@ Scene ringsScene(int size) {
         {{half, half, -1.2}, {-half, half, -1.2}, {-half, -half, -1.2}, {half, -half, -1.2}},
         floor);
     leaves.push_back(b.prim(floor, floorM));
-    Scene s = b.finish(b.all(Op::Union, leaves), "rings", size);
-    s.background = {0.078, 0.361, 0.753};
-    s.frameCamera({-1.0, 1.6, -1.1}, {0, 0, 1});
-    s.defaultLights();
-    return s;
+    return b.finishFramed(b.all(Op::Union, leaves), "rings", size, {0.078, 0.361, 0.753},
+                          {-1.0, 1.6, -1.1});
 }
 
 }  // namespace
