@@ -22,7 +22,7 @@ struct StructureOptions {
     bool all = false;    ///< list every region even over the summary limit
     bool quiet = false;
 };
-/// Build the structure and write its dump (DESIGN.md section 6, "Structure dump").
+/// Build the structure and write its dump (docs/design.md section 6, "Structure dump").
 int runStructure(const CommonOptions& o, const StructureOptions& s);
 
 }  // namespace lancer::cli

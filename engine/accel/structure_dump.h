@@ -1,4 +1,4 @@
-// The structure dump of DESIGN.md section 6 (`lancer structure`): a StructureView as JSON.
+// The structure dump of docs/design.md section 6 (`lancer structure`): a StructureView as JSON.
 #pragma once
 
 #include <iosfwd>

@@ -31,12 +31,12 @@ enum class RegionKind : uint8_t {
 };
 const char* regionKindName(RegionKind k);
 
-/// The irregular scheme's two screen frames (DESIGN.md section 4).
+/// The irregular scheme's two screen frames (docs/design.md section 4).
 enum class ZoneFrameKind : uint8_t {
     Camera,      ///< screen x along R, screen y along U (scene units)
     Projective,  ///< u = x / z, v = y / z (primary rays only)
 };
-/// Units a frame's 2D coordinates are given in by the dump (DESIGN.md section 6): pixels when
+/// Units a frame's 2D coordinates are given in by the dump (docs/design.md section 6): pixels when
 /// the frame maps linearly to the image (orthographic camera frame, projective zones), camera
 /// units (scene units) for a perspective camera's camera frame.
 enum class FrameUnits : uint8_t { Pixels, Camera };
@@ -186,7 +186,7 @@ class StructureView {
     size_t regionCount() const;
     /// Region `id`'s volume as 8 world-space corners, corner c = i + 2j + 4k with i, j, k the
     /// low (0) or high (1) side along the region's own axes (regular and brute force: x, y, z;
-    /// camera frame: R, U, F; projective: u, v, depth), the trace contract's order (DESIGN.md
+    /// camera frame: R, U, F; projective: u, v, depth), the trace contract's order (docs/design.md
     /// section 6). Regions are finite: every scheme's structure is bounded.
     std::array<Vec3, 8> regionCorners(uint32_t id) const;
     /// Region `id`: kind, frame box, level or zone, primitives, restricted tree, neighbours.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `lancer structure`: the dump of DESIGN.md section 6 for each scheme and both cameras, read back
+# `lancer structure`: the dump of docs/design.md section 6 for each scheme and both cameras, read back
 # and checked (keys, counts, zones tiling the image, slabs in depth order); bad options and
 # unwritable outputs refused with exit status 2, naming the option, leaving no file.
 set -u
