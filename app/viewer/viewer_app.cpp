@@ -437,30 +437,30 @@ void ViewerApp::parametersPanel() {
     ImGui::Separator();
     ImGui::TextUnformatted("Subdivision");
     rebuild |= enumCombo("scheme", s_.build.scheme, 3, schemeName);
-    if (ImGui::InputInt("max-level", &s_.build.maxLevel)) {
-        s_.build.maxLevel = std::clamp(s_.build.maxLevel, 0, 48);
+    if (ImGui::InputInt("max-level", &s_.build.regular.maxLevel)) {
+        s_.build.regular.maxLevel = std::clamp(s_.build.regular.maxLevel, 0, 48);
         rebuild = true;
     }
-    if (ImGui::InputInt("max-objects", &s_.build.maxObjects)) {
-        s_.build.maxObjects = std::clamp(s_.build.maxObjects, 1, 1000000);
+    if (ImGui::InputInt("max-objects", &s_.build.regular.maxObjects)) {
+        s_.build.regular.maxObjects = std::clamp(s_.build.regular.maxObjects, 1, 1000000);
         rebuild = true;
     }
-    rebuild |= enumCombo("split axes", s_.build.splitAxes, 2, splitAxesName);
+    rebuild |= enumCombo("split axes", s_.build.regular.splitAxes, 2, splitAxesName);
     if (ImGui::IsItemHovered())
         ImGui::SetTooltip(
             "Regular: cycle cuts x, y, z in turn (the report's); cost picks each\n"
             "level's axis by an area estimate (cells stay about cubic)");
-    rebuild |= enumCombo("step", s_.build.step, 2, stepName);
-    if (s_.build.step == StepMethod::Push) {
-        double d = s_.build.delta;
+    rebuild |= enumCombo("step", s_.build.regular.step, 2, stepName);
+    if (s_.build.regular.step == StepMethod::Push) {
+        double d = s_.build.regular.delta;
         if (ImGui::InputDouble("delta", &d, 0.0, 0.0, "%.3e",
                                ImGuiInputTextFlags_EnterReturnsTrue) &&
             d >= 1e-15 && d <= 0.5) {
-            s_.build.delta = d;
+            s_.build.regular.delta = d;
             rebuild = true;
         }
     }
-    rebuild |= enumCombo("BSP heuristic", s_.build.heuristic, 3, heuristicName);
+    rebuild |= enumCombo("BSP heuristic", s_.build.irregular.heuristic, 3, heuristicName);
     rebuild |= ImGui::Checkbox("mailboxes", &s_.build.mailboxes);
     ImGui::SameLine();
     rebuild |= ImGui::Checkbox("light buffer", &s_.build.lightBuffer);

@@ -93,21 +93,21 @@ TEST(CameraControl, JsonRoundTripAndErrors) {
 TEST(ViewerSettingsIni, DefaultsAreTheCommandLineDefaults) {
     ViewerSettings s;
     EXPECT_EQ(s.build.scheme, SchemeKind::Regular);
-    EXPECT_EQ(s.build.scheme, cli::CommonOptions{}.build.scheme);
-    EXPECT_EQ(s.build.maxLevel, cli::CommonOptions{}.build.maxLevel);
-    EXPECT_EQ(s.build.maxObjects, cli::CommonOptions{}.build.maxObjects);
+    EXPECT_EQ(s.build.scheme, cli::Knobs{}.build.scheme);
+    EXPECT_EQ(s.build.regular.maxLevel, cli::Knobs{}.build.regular.maxLevel);
+    EXPECT_EQ(s.build.regular.maxObjects, cli::Knobs{}.build.regular.maxObjects);
 }
 
 TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     ViewerSettings s;
     s.scene = "assets/spd/balls4.nff";
     s.build.scheme = SchemeKind::Irregular;
-    s.build.maxLevel = 7;
-    s.build.maxObjects = 5;
-    s.build.step = StepMethod::Push;
-    s.build.delta = 3.5e-7;
-    s.build.heuristic = BspHeuristic::FewestCuts;
-    s.build.splitAxes = SplitAxes::Cycle;  // not the default: the line must carry it
+    s.build.regular.maxLevel = 7;
+    s.build.regular.maxObjects = s.build.irregular.maxObjects = 5;
+    s.build.regular.step = StepMethod::Push;
+    s.build.regular.delta = 3.5e-7;
+    s.build.irregular.heuristic = BspHeuristic::FewestCuts;
+    s.build.regular.splitAxes = SplitAxes::Cycle;  // not the default: the line must carry it
     s.build.mailboxes = false;
     s.threads = 1;
     s.shading.bounces = 2;
