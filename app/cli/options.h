@@ -1,4 +1,4 @@
-// The common options of every subcommand (DESIGN.md section 6), registered from the parameter
+// The common options of every subcommand (docs/design.md section 6), registered from the parameter
 // table (param_table.h), and the command line's error messages.
 #pragma once
 
@@ -17,7 +17,7 @@ struct CommonOptions {
     Knobs knobs;  ///< every option of the table
 };
 
-/// Add the common options (every entry of paramTable()) to a subcommand.
+/// Add the common options (docs/design.md section 6; every entry of paramTable()) to a subcommand.
 void addCommonOptions(CLI::App& app, CommonOptions& o);
 /// The image size from the options and the scene's default size.
 void resolveSize(const CommonOptions& o, const Scene& scene, int& w, int& h);

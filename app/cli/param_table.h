@@ -1,4 +1,4 @@
-// The one table of the common options (DESIGN.md section 6): each knob's flag, ini key, help,
+// The one table of the common options (docs/design.md section 6): each knob's flag, ini key, help,
 // range, enum names, the schemes it applies to and where it reaches in the viewer. The command
 // line (options.cpp), the viewer's Parameters panel, its ini handler and the command-line-over-
 // ini merge all walk it, so an option cannot be lost on the way to one of them.

@@ -24,7 +24,8 @@ const char* heuristicName(BspHeuristic h);
 const char* splitAxesName(SplitAxes s);
 const char* irregularFrameName(IrregularFrame f);
 
-/// The regular scheme's knobs (report, section 3). Defaults measured in docs/regular.md:
+/// The regular scheme's knobs (report, section 3). Defaults measured in docs/regular.md
+/// ("Defaults", "Axis order", "Where push goes wrong"):
 /// at max-level 24 / max-objects 4 balls4 makes 11.7 primitive tests per ray (at 18 / 2: 65) and
 /// no built-in CSG scene explodes (at 24 / 2 lattice does); split axes `cost` takes 25% fewer
 /// render instructions than `cycle` on balls4, at most 4% more on the SPD scenes; push matches
@@ -38,7 +39,8 @@ struct RegularConfig {
     bool fullTable = false;                 ///< one full directory instead of sub-tables
 };
 
-/// The irregular scheme's knobs (report, section 2). Defaults measured in docs/irregular.md:
+/// The irregular scheme's knobs (report, section 2). Defaults measured in docs/irregular.md
+/// ("Growth", "Segment heuristics", "Projective zones for primary rays"):
 /// `balanced` makes 30% fewer zones than `first` and fewer region visits per ray than `first` or
 /// `fewest-cuts`; the projective zones save 2-26% of the instructions per ray. max-objects 4 is
 /// the regular scheme's value; on balls4, 32 renders in the same time with a 28th of the memory.
