@@ -9,13 +9,15 @@ namespace lancer::viewer {
 
 BuildResult buildStructure(const BuildRequest& r) {
     BuildResult out;
-    auto s = std::make_shared<Structure>();
+    auto s = std::make_shared<SceneBuild>();
     s->spec = r.spec;
     std::shared_ptr<const Scene> scene = r.loaded;
     if (!scene) {
         auto start = std::chrono::steady_clock::now();
         try {
-            scene = std::make_shared<const Scene>(loadScene(r.spec));
+            Scene loaded = loadScene(r.spec);
+            if (!r.cameraFile.empty()) applyCameraFile(loaded, r.cameraFile);
+            scene = std::make_shared<const Scene>(std::move(loaded));
         } catch (const std::exception& e) {
             out.error = e.what();
             out.sceneFailed = true;
@@ -38,7 +40,7 @@ BuildResult buildStructure(const BuildRequest& r) {
         return out;
     }
     s->scene = std::move(scene);
-    out.structure = std::move(s);
+    out.sceneBuild = std::move(s);
     return out;
 }
 

@@ -24,6 +24,7 @@ cli::Knobs knobsOf(const ViewerSettings& s) {
     k.threads = s.threads;
     k.width = s.windowWidth;
     k.height = s.windowHeight;
+    k.cameraPath = s.cameraPath;
     return k;
 }
 
@@ -33,6 +34,7 @@ void setKnobs(ViewerSettings& s, const cli::Knobs& k) {
     s.threads = k.threads;
     s.windowWidth = k.width;
     s.windowHeight = k.height;
+    s.cameraPath = k.cameraPath;
 }
 
 std::string settingsLines(const ViewerSettings& s) {

@@ -14,6 +14,8 @@ struct ViewerSettings {
     std::string scene = "builtin:default";   ///< last scene opened
     BuildParams build = cli::Knobs{}.build;  ///< the command line's default
     ShadingOptions shading;
+    /// --camera FILE: replaces the camera of the first scene opened (not saved in the ini).
+    std::string cameraPath;
     int threads = 0;  ///< render threads (0: all cores)
     int windowWidth = 1280, windowHeight = 720;
     bool showParameters = true, showStatistics = true, showCamera = true, showView = true;

@@ -41,13 +41,13 @@ std::string defaultIniPath() {
 }
 
 /// Settings explicitly given on the command line win over those saved in the ini: every entry
-/// of the parameter table the viewer keeps.
+/// of the parameter table that reaches the viewer.
 void applyCommandLine(const cli::CommonOptions& o,
                       const std::function<bool(const std::string&)>& given, ViewerSettings& s) {
     if (given("scene")) s.scene = o.scene;
     cli::Knobs k = knobsOf(s);
     for (const cli::ParamDesc& d : cli::paramTable())
-        if (d.iniKey && given(d.flag)) cli::copyValue(d, o.knobs, k);
+        if (d.reach != cli::ViewerReach::BatchOnly && given(d.flag)) cli::copyValue(d, o.knobs, k);
     setKnobs(s, k);
 }
 
@@ -195,10 +195,10 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             ImGui_ImplGlfw_NewFrame();
             app.frame(fbw, fbh);
             ++frames;
-            if (v.replayChange && !replayed && app.settled() && app.structure()) {
+            if (v.replayChange && !replayed && app.settled() && app.sceneBuild()) {
                 app.rebuild("replayed parameter change");
                 replayed = true;
-            } else if (!v.drop.empty() && !droppedScripted && app.settled() && app.structure()) {
+            } else if (!v.drop.empty() && !droppedScripted && app.settled() && app.sceneBuild()) {
                 // Through the callback the window has installed, as a drop from the desktop.
                 GLFWdropfun onDrop = glfwSetDropCallback(window, nullptr);
                 glfwSetDropCallback(window, onDrop);
@@ -206,7 +206,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 if (onDrop) onDrop(window, 1, paths);
                 droppedScripted = true;
             } else if (v.frames > 0 && frames >= v.frames && app.settled()) {
-                if (!app.structure()) {  // a scripted run on a scene that cannot be shown fails
+                if (!app.sceneBuild()) {  // a scripted run on a scene that cannot be shown fails
                     std::cerr << "error: lancer view: the scene could not be shown (see above)\n";
                     status = 2;
                 }

@@ -1,4 +1,4 @@
-#include "app/viewer/param_controls.h"
+#include "app/viewer/panels/param_controls.h"
 
 #include <imgui.h>
 
