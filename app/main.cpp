@@ -25,7 +25,8 @@ int main(int argc, char** argv) {
     std::string viewOut = "lancer-view.png";
     CLI::App* view = app.add_subcommand(
         "view", "Open the viewer (the default); without a display, render headless");
-    view->add_option("scene", viewOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]");
+    view->add_option("scene", viewOpt.scene,
+                     "Scene: a .json/.nff/.csg file or builtin:NAME[:SIZE]");
     view->add_option("--headless-output", viewOut,
                      "Where the headless render goes when there is no display");
     cli::addCommonOptions(*view, viewOpt);
@@ -58,7 +59,9 @@ int main(int argc, char** argv) {
     std::string out;
     bool quiet = false;
     CLI::App* render = app.add_subcommand("render", "Render a scene to a PNG");
-    render->add_option("scene", renderOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")
+    render
+        ->add_option("scene", renderOpt.scene,
+                     "Scene: a .json/.nff/.csg file or builtin:NAME[:SIZE]")
         ->required();
     render->add_option("-o,--output", out, "Output PNG")->required();
     render->add_flag("-q,--quiet", quiet, "Print nothing on success");
@@ -66,7 +69,9 @@ int main(int argc, char** argv) {
 
     cli::TraceOptions topt;
     CLI::App* trace = app.add_subcommand("trace", "Trace one primary ray and print its walk");
-    trace->add_option("scene", traceOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")
+    trace
+        ->add_option("scene", traceOpt.scene,
+                     "Scene: a .json/.nff/.csg file or builtin:NAME[:SIZE]")
         ->required();
     std::vector<int> pixel;
     trace->add_option("--pixel", pixel, "Pixel X Y (y = 0 on the top row)")
@@ -107,11 +112,22 @@ int main(int argc, char** argv) {
     benchCmd->add_flag("--schemes-only", bopt.schemesOnly,
                        "Each scheme at its defaults, and the peer: the comparison table");
 
+    // Hidden: the README's option section, generated from the parameter table.
+    CLI::App* helpOptions = app.add_subcommand("help-options", "")->group("");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         // --help prints and succeeds; every other parse error names the option and exits 2.
-        return app.exit(e) == 0 ? 0 : 2;
+        if (e.get_exit_code() == 0) return app.exit(e);
+        std::cerr << cli::parseErrorMessage(app, e, std::vector<std::string>(argv + 1, argv + argc))
+                  << "\n";
+        return 2;
+    }
+
+    if (*helpOptions) {
+        std::cout << cli::optionsMarkdown();
+        return 0;
     }
 
     if (*benchCmd) return bench::runBench(bopt);

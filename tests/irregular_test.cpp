@@ -25,9 +25,9 @@ std::unique_ptr<Accelerator> buildIrregular(const Scene& scene,
                                             IrregularFrame frame = IrregularFrame::Projective) {
     BuildParams p;
     p.scheme = SchemeKind::Irregular;
-    p.irregularFrame = frame;
-    p.heuristic = h;
-    p.maxObjects = maxObjects;
+    p.irregular.frame = frame;
+    p.irregular.heuristic = h;
+    p.irregular.maxObjects = maxObjects;
     return buildAccelerator(scene, p);
 }
 
@@ -452,14 +452,14 @@ TEST(Irregular, RefusesBadParameters) {
     Scene scene = loadScene("builtin:default");
     BuildParams p;
     p.scheme = SchemeKind::Irregular;
-    p.maxObjects = -1;
+    p.irregular.maxObjects = -1;
     try {
         buildAccelerator(scene, p);
         ADD_FAILURE() << "negative --max-objects accepted";
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("--max-objects"), std::string::npos) << e.what();
     }
-    p.maxObjects = 0;
+    p.irregular.maxObjects = 0;
     scene.camera.at = scene.camera.from;  // no viewing direction
     EXPECT_THROW(buildAccelerator(scene, p), std::invalid_argument);
 }

@@ -62,7 +62,7 @@ Tally checkShadowRays(const std::string& name, const Scene& s, const std::vector
     for (StepMethod step : {StepMethod::Exact, StepMethod::Push}) {
         BuildParams p;
         p.scheme = SchemeKind::Regular;
-        p.step = step;
+        p.regular.step = step;
         schemes.push_back(buildAccelerator(s, p));
     }
     BuildParams irr;
@@ -100,7 +100,7 @@ Tally checkShadowRays(const std::string& name, const Scene& s, const std::vector
             const bool got = a->occluded(sr.ray, sr.tmax, sr.light, ctx, obs);
             if (got != blocked && failures++ < 5)
                 ADD_FAILURE() << name << " " << schemeName(a->params().scheme) << " "
-                              << stepName(a->params().step) << ": " << sr.ray.toString()
+                              << stepName(a->params().regular.step) << ": " << sr.ray.toString()
                               << " toward light " << sr.light << ": occluded " << got
                               << ", brute force " << blocked;
         }

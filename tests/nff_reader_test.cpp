@@ -105,7 +105,7 @@ TEST(NffReader, WidthAndHeightOptionsKeepTheFieldOfView) {
     cli::resolveSize(o, s, w, h);
     EXPECT_EQ(w, 512);
     EXPECT_EQ(h, 512);
-    o.height = 101;
+    o.knobs.height = 101;
     cli::resolveSize(o, s, w, h);
     EXPECT_EQ(w, 101);
     EXPECT_EQ(h, 101);

@@ -16,7 +16,7 @@ namespace {
 BuildParams regular(StepMethod step = StepMethod::Exact) {
     BuildParams p;
     p.scheme = SchemeKind::Regular;
-    p.step = step;
+    p.regular.step = step;
     return p;
 }
 
@@ -145,16 +145,17 @@ void randomScenesMatchBrute(StepMethod step, int seeds) {
         for (uint64_t seed = 1; seed <= uint64_t(seeds); ++seed) {
             Scene s = test::randomCsgScene(seed * 31 + 7, opt);
             BuildParams p = regular(step);
-            p.maxObjects = 1 + int(seed % 3);
-            p.maxLevel = 9 + int(seed % 10);
-            p.splitAxes = seed % 2 ? SplitAxes::Cycle : SplitAxes::Cost;  // both orders
+            p.regular.maxObjects = 1 + int(seed % 3);
+            p.regular.maxLevel = 9 + int(seed % 10);
+            p.regular.splitAxes = seed % 2 ? SplitAxes::Cycle : SplitAxes::Cost;  // both orders
             auto accel = buildAccelerator(s, p);
             auto rays = hardRays(s, gridOf(*accel), seed, 1500);
             total += rays.size();
             auto bad = test::compareWithBrute(s, *accel, rays);
             ASSERT_TRUE(bad.empty())
-                << s.name << " offset " << toString(opt.offset) << " level " << p.maxLevel << " "
-                << splitAxesName(p.splitAxes) << ": " << bad.size() << " rays differ\n"
+                << s.name << " offset " << toString(opt.offset) << " level " << p.regular.maxLevel
+                << " " << splitAxesName(p.regular.splitAxes) << ": " << bad.size()
+                << " rays differ\n"
                 << describe(s, bad);
             ASSERT_EQ(walkErrors(s, *accel, rays), 0u) << s.name;
             auto secondary = test::compareWithBrute(s, *accel, rays, 1e-3 * s.scale());
@@ -179,19 +180,19 @@ TEST(RegularPush, WrongForDeltaTooLargeOrTooSmallWhereExactIsRight) {
         opt.primitives = 20;
         Scene s = test::randomCsgScene(seed * 11, opt);
         BuildParams p = regular(StepMethod::Exact);
-        p.maxLevel = 18;  // cells 1/64 of the box
-        p.maxObjects = 1;
+        p.regular.maxLevel = 18;  // cells 1/64 of the box
+        p.regular.maxObjects = 1;
         auto exact = buildAccelerator(s, p);
         auto rays = hardRays(s, gridOf(*exact), seed, 3000);
         ASSERT_TRUE(test::compareWithBrute(s, *exact, rays).empty());
         ASSERT_EQ(walkErrors(s, *exact, rays), 0u);
 
-        p.step = StepMethod::Push;
-        p.delta = 0.05;  // wider than the finest cells
+        p.regular.step = StepMethod::Push;
+        p.regular.delta = 0.05;  // wider than the finest cells
         auto large = buildAccelerator(s, p);
         skipped += test::compareWithBrute(s, *large, rays, 0.0, 1e-9, SIZE_MAX).size();
 
-        p.delta = 1e-19;  // below the rounding of the coordinates
+        p.regular.delta = 1e-19;  // below the rounding of the coordinates
         auto tiny = buildAccelerator(s, p);
         stalledOrWrong += walkErrors(s, *tiny, rays) +
                           test::compareWithBrute(s, *tiny, rays, 0.0, 1e-9, SIZE_MAX).size();
@@ -286,10 +287,10 @@ TEST(RegularSubTables, SameLeafAsFullTableInLessMemory) {
          {std::string(LANCER_SPD_DIR) + "/balls2.nff", std::string("builtin:default")}) {
         Scene s = loadScene(spec);
         BuildParams pf = regular();
-        pf.maxLevel = 18;  // deeper than the top table, so sub-tables appear
-        pf.maxObjects = 1;
+        pf.regular.maxLevel = 18;  // deeper than the top table, so sub-tables appear
+        pf.regular.maxObjects = 1;
         BuildParams ps = pf;
-        pf.fullTable = true;
+        pf.regular.fullTable = true;
         auto full = buildAccelerator(s, pf), sub = buildAccelerator(s, ps);
         const RegularGrid &gf = gridOf(*full), &gs = gridOf(*sub);
         ASSERT_EQ(gf.regionCount(), gs.regionCount());
@@ -323,8 +324,8 @@ TEST(RegularRopes, EveryRopeIsTheLeafTheDirectoryGivesAcrossTheFace) {
                              std::string("builtin:drilled:3"), std::string("builtin:default")}) {
         Scene s = loadScene(spec);
         BuildParams p = regular();
-        p.maxLevel = 15;
-        p.maxObjects = 1;
+        p.regular.maxLevel = 15;
+        p.regular.maxObjects = 1;
         auto accel = buildAccelerator(s, p);
         const RegularGrid& g = gridOf(*accel);
         size_t roped = 0, split = 0, border = 0;
@@ -375,8 +376,8 @@ TEST(RegularSubTables, DeepLevelBuiltWhereTheFullTableWouldNotFit) {
     s.prepare();
     s.frameCamera({-1.0, 2.0, -1.0}, {0, 0, 1});
     BuildParams p = regular();
-    p.maxLevel = 40;
-    p.maxObjects = 1;
+    p.regular.maxLevel = 40;
+    p.regular.maxObjects = 1;
     auto accel = buildAccelerator(s, p);
     const RegularGrid& g = gridOf(*accel);
     int finest = accel->info().extra["finest_level"];
@@ -384,7 +385,7 @@ TEST(RegularSubTables, DeepLevelBuiltWhereTheFullTableWouldNotFit) {
     EXPECT_GT(double(std::ldexp(4.0, finest)), double(RegularGrid::kMemoryBudget));
     // The cells along the near-touching pair's gap: tens of thousands of leaves, a few MiB.
     EXPECT_LT(accel->info().memoryBytes, size_t(16) << 20);
-    p.fullTable = true;
+    p.regular.fullTable = true;
     EXPECT_THROW(buildAccelerator(s, p), std::invalid_argument);
     // Rays at the near-touching pair and through its grid points.
     std::vector<Ray> rays = test::raysThroughPoints(gridPoints(g, 3, 400), g.box(), 9);
@@ -405,8 +406,8 @@ TEST(RegularRefusal, AbsurdLevelAndObjectsAreRefusedWithAMessage) {
     s.tree.root = s.tree.combine(Op::Union, s.tree.leaf(0), s.tree.leaf(1));
     s.prepare();
     BuildParams p = regular();
-    p.maxLevel = 48;
-    p.maxObjects = 1;
+    p.regular.maxLevel = 48;
+    p.regular.maxObjects = 1;
     try {
         buildAccelerator(s, p);
         FAIL() << "not refused";
@@ -414,10 +415,10 @@ TEST(RegularRefusal, AbsurdLevelAndObjectsAreRefusedWithAMessage) {
         EXPECT_NE(std::string(e.what()).find("--max-level 48"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("--max-objects 1"), std::string::npos) << e.what();
     }
-    p.maxLevel = 49;
+    p.regular.maxLevel = 49;
     EXPECT_THROW(buildAccelerator(s, p), std::invalid_argument);
-    p.maxLevel = 10;
-    p.maxObjects = 0;
+    p.regular.maxLevel = 10;
+    p.regular.maxObjects = 0;
     EXPECT_THROW(buildAccelerator(s, p), std::invalid_argument);
 }
 
@@ -455,8 +456,8 @@ Scene sphereLattice(int n, int layers) {
 
 TEST(RegularAxes, CostOrderIsTheReportsOnACubeAndCubicCellsOnAFlatScene) {
     BuildParams cost = regular(), cycle = regular();
-    cycle.splitAxes = SplitAxes::Cycle;
-    cost.maxObjects = cycle.maxObjects = 1;
+    cycle.regular.splitAxes = SplitAxes::Cycle;
+    cost.regular.maxObjects = cycle.regular.maxObjects = 1;
     {  // a cube of evenly spread spheres: the planner's ties give the report's order
         Scene s = sphereLattice(8, 8);
         auto a = buildAccelerator(s, cost);
@@ -495,7 +496,7 @@ TEST(RegularBuild, LeavesHoldTheirOverlappingPrimitivesAndShareTrees) {
     const auto& x = accel->info().extra;
     EXPECT_EQ(size_t(x["leaves"]), g.regionCount());
     EXPECT_LT(size_t(x["distinct_trees"]), g.regionCount());  // shared, not copied
-    EXPECT_LE(int(x["finest_level"]), BuildParams{}.maxLevel);
+    EXPECT_LE(int(x["finest_level"]), BuildParams{}.regular.maxLevel);
     CsgTree t = g.treePool();
     for (const RegularLeaf& L : g.leaves()) {
         Box3 cell;

@@ -81,17 +81,17 @@ std::vector<Config> sweep(bool quick, bool schemesOnly) {
         quick ? std::vector<int>{6, 12} : std::vector<int>{3, 6, 9, 12, 15, 18, 21, 24};
     for (int l : levels) {
         BuildParams b = regular;
-        b.maxLevel = l;
+        b.regular.maxLevel = l;
         add("regular max-level", std::to_string(l), b);
     }
     std::vector<int> objects =
         quick ? std::vector<int>{1, 8} : std::vector<int>{1, 2, 4, 8, 16, 32};
     for (int m : objects) {
         BuildParams b = regular;
-        b.maxObjects = m;
+        b.regular.maxObjects = m;
         add("regular max-objects", std::to_string(m), b);
         BuildParams c = irregular;
-        c.maxObjects = m;
+        c.irregular.maxObjects = m;
         add("irregular max-objects", std::to_string(m), c);
     }
     std::vector<double> deltas =
@@ -99,18 +99,18 @@ std::vector<Config> sweep(bool quick, bool schemesOnly) {
               : std::vector<double>{1e-15, 1e-12, 1e-9, 1e-6, 1e-4, 1e-3, 1e-2, 5e-2};
     for (double d : deltas) {
         BuildParams b = regular;
-        b.step = StepMethod::Push;
-        b.delta = d;
+        b.regular.step = StepMethod::Push;
+        b.regular.delta = d;
         add("push delta", num(d), b);
     }
     for (BspHeuristic h : {BspHeuristic::First, BspHeuristic::Balanced, BspHeuristic::FewestCuts}) {
         BuildParams b = irregular;
-        b.heuristic = h;
+        b.irregular.heuristic = h;
         add("bsp-heuristic", heuristicName(h), b);
     }
     for (SplitAxes a : {SplitAxes::Cycle, SplitAxes::Cost}) {
         BuildParams b = regular;
-        b.splitAxes = a;
+        b.regular.splitAxes = a;
         add("split-axes", splitAxesName(a), b);
     }
     for (bool mail : {true, false}) {

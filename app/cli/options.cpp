@@ -1,99 +1,157 @@
 #include "app/cli/options.h"
 
-#include <map>
+#include <algorithm>
+
+#include "engine/scene/loader.h"
 
 namespace lancer::cli {
 
 void addCommonOptions(CLI::App& app, CommonOptions& o) {
-    static const std::map<std::string, SchemeKind> schemes = {{"brute", SchemeKind::Brute},
-                                                              {"regular", SchemeKind::Regular},
-                                                              {"irregular", SchemeKind::Irregular}};
-    static const std::map<std::string, StepMethod> steps = {{"exact", StepMethod::Exact},
-                                                            {"push", StepMethod::Push}};
-    static const std::map<std::string, BspHeuristic> heuristics = {
-        {"first", BspHeuristic::First},
-        {"balanced", BspHeuristic::Balanced},
-        {"fewest-cuts", BspHeuristic::FewestCuts}};
-
-    app.add_option("--width", o.width, "Image width in pixels (default: the scene's)")
-        ->check(CLI::Range(1, 16384));
-    app.add_option("--height", o.height, "Image height in pixels (default: the scene's)")
-        ->check(CLI::Range(1, 16384));
-    app.add_option("--scheme", o.build.scheme, "Acceleration scheme: brute, regular or irregular")
-        ->transform(CLI::CheckedTransformer(schemes, CLI::ignore_case)
-                        .description("{brute, regular, irregular}"))
-        ->default_str(schemeName(o.build.scheme));
-    app.add_option("--max-level", o.build.maxLevel, "Deepest subdivision level")
-        ->check(CLI::Range(0, 48))
-        ->default_val(o.build.maxLevel);
-    app.add_option("--max-objects", o.build.maxObjects,
-                   "Stop subdividing at this many primitives per cell")
-        ->check(CLI::Range(1, 1000000))
-        ->default_val(o.build.maxObjects);
-    app.add_option("--step", o.build.step, "Regular scheme's next-cell method: exact or push")
-        ->transform(CLI::CheckedTransformer(steps, CLI::ignore_case).description("{exact, push}"))
-        ->default_str("exact");
-    app.add_option("--delta", o.build.delta,
-                   "Push distance of --step push, relative to the scene size")
-        ->check(CLI::Range(1e-15, 0.5))
-        ->default_val(o.build.delta);
-    app.add_option("--bsp-heuristic", o.build.heuristic,
-                   "Irregular scheme's choice of splitting segment: first, balanced, fewest-cuts")
-        ->transform(CLI::CheckedTransformer(heuristics, CLI::ignore_case)
-                        .description("{first, balanced, fewest-cuts}"))
-        ->default_str("balanced");
-    static const std::map<std::string, SplitAxes> splitAxes = {{"cycle", SplitAxes::Cycle},
-                                                               {"cost", SplitAxes::Cost}};
-    app.add_option("--split-axes", o.build.splitAxes,
-                   "Regular scheme's axis per BSP level: cycle (x, y, z in turn, the report's) or "
-                   "cost (per level, the axis of least estimated cost)")
-        ->transform(
-            CLI::CheckedTransformer(splitAxes, CLI::ignore_case).description("{cycle, cost}"))
-        ->default_str(splitAxesName(o.build.splitAxes));
-    app.add_flag("--full-table", o.build.fullTable,
-                 "Regular scheme: one full directory table instead of sub-tables");
-    static const std::map<std::string, IrregularFrame> frames = {
-        {"camera", IrregularFrame::Camera}, {"projective", IrregularFrame::Projective}};
-    app.add_option("--irregular-frame", o.build.irregularFrame,
-                   "Irregular scheme's structure for primary rays: camera (the camera-frame walk) "
-                   "or projective (zones in screen x/z, y/z)")
-        ->transform(
-            CLI::CheckedTransformer(frames, CLI::ignore_case).description("{camera, projective}"))
-        ->default_str(irregularFrameName(o.build.irregularFrame));
-    app.add_flag("--no-mailbox{false}", o.build.mailboxes,
-                 "Turn the mailboxes off (to measure their effect)");
-    app.add_flag(
-        "--no-light-buffer{false}", o.build.lightBuffer,
-        "Accelerated schemes: trace shadow rays without the light buffer (to measure its effect)");
-    app.add_option("--threads", o.render.threads, "Worker threads (0: all cores)")
-        ->check(CLI::Range(0, 1024))
-        ->default_val(0);
-    app.add_option("--bounces", o.render.shading.bounces,
-                   "Reflection/refraction depth; 0 = primary and shadow rays only")
-        ->check(CLI::Range(0, 64))
-        ->default_val(o.render.shading.bounces);
-    app.add_option("--offset", o.render.shading.offsetScale,
-                   "Secondary-ray origin offset, relative to the scene scale")
-        ->check(CLI::Range(0.0, 1e-2))
-        ->default_val(o.render.shading.offsetScale);
-    app.add_flag("--no-shadows{false}", o.render.shading.shadows, "Trace no shadow rays");
-    app.add_option("--stats", o.statsPath, "Write statistics as JSON to this file");
-    app.add_option("--depth", o.depthPath, "Write the primary hit distances as a PFM to this file");
+    const Knobs defaults;
+    for (const ParamDesc& d : paramTable()) {
+        const ParamDesc* p = &d;
+        Knobs* k = &o.knobs;
+        std::string help = d.help;
+        if (d.schemes != kAllSchemes) {
+            std::string only;
+            for (int i = 0; i < kSchemeCount; ++i)
+                if (d.schemes & schemeBit(SchemeKind(i)))
+                    only += (only.empty() ? "" : " and ") + std::string(schemeName(SchemeKind(i)));
+            help += " (" + only + " scheme" + (only.find(" and ") != std::string::npos ? "s" : "") +
+                    ")";
+        }
+        CLI::Option* opt = nullptr;
+        switch (d.kind) {
+            case ParamKind::Int:
+                opt = app.add_option_function<long long>(
+                             d.flag, [p, k](const long long& v) { p->set(*k, double(v)); }, help)
+                          ->check(CLI::Range((long long)d.lo, (long long)d.hi));
+                break;
+            case ParamKind::Real:
+                opt = app.add_option_function<double>(
+                             d.flag, [p, k](const double& v) { p->set(*k, v); }, help)
+                          ->check(CLI::Range(d.lo, d.hi));
+                break;
+            case ParamKind::Enum: {
+                std::vector<std::string> names(d.names.begin(), d.names.end());
+                std::string set = "{";
+                for (const std::string& n : names) set += (set.size() > 1 ? ", " : "") + n;
+                opt =
+                    app.add_option_function<std::string>(
+                           d.flag, [p, k](const std::string& v) { parseValue(*p, v, *k); }, help)
+                        ->transform(CLI::IsMember(names, CLI::ignore_case).description(set + "}"));
+                break;
+            }
+            case ParamKind::Switch:
+                opt = app.add_flag_function(
+                    d.flag, [p, k](std::int64_t) { p->set(*k, p->flagValue ? 1.0 : 0.0); }, help);
+                break;
+            case ParamKind::Path:
+                opt = app.add_option(d.flag, o.knobs.*d.path, help);
+                break;
+        }
+        if (d.kind != ParamKind::Switch && d.kind != ParamKind::Path &&
+            d.reach != ViewerReach::Window)
+            opt->default_str(formatValue(d, defaults));
+        if (*d.metavar) opt->type_name(d.metavar);
+    }
 }
 
 void resolveSize(const CommonOptions& o, const Scene& scene, int& w, int& h) {
+    const int ow = o.knobs.width, oh = o.knobs.height;
     w = scene.width;
     h = scene.height;
-    if (o.width && o.height) {
-        w = o.width;
-        h = o.height;
-    } else if (o.width) {
-        h = std::max(1, int(std::lround(double(o.width) * scene.height / scene.width)));
-        w = o.width;
-    } else if (o.height) {
-        w = std::max(1, int(std::lround(double(o.height) * scene.width / scene.height)));
-        h = o.height;
+    if (ow && oh) {
+        w = ow;
+        h = oh;
+    } else if (ow) {
+        h = std::max(1, int(std::lround(double(ow) * scene.height / scene.width)));
+        w = ow;
+    } else if (oh) {
+        w = std::max(1, int(std::lround(double(oh) * scene.width / scene.height)));
+        h = oh;
     }
+}
+
+RenderOptions renderOptions(const CommonOptions& o, const Scene& scene) {
+    RenderOptions ro;
+    ro.threads = o.knobs.threads;
+    ro.shading = o.knobs.shading;
+    resolveSize(o, scene, ro.width, ro.height);
+    return ro;
+}
+
+Scene loadSceneWithCamera(const CommonOptions& o) {
+    Scene scene = loadScene(o.scene);
+    if (!o.knobs.cameraPath.empty()) applyCameraFile(scene, o.knobs.cameraPath);
+    return scene;
+}
+
+namespace {
+
+size_t editDistance(const std::string& a, const std::string& b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        size_t diag = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j) {
+            size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1])});
+            diag = up;
+        }
+    }
+    return row[b.size()];
+}
+
+/// The known name nearest to `word`, if it is near enough to be a slip of the keyboard.
+std::string nearest(const std::string& word, const std::vector<std::string>& known) {
+    std::string best;
+    size_t bestDistance = std::max<size_t>(2, word.size() / 3) + 1;
+    for (const std::string& n : known)
+        if (size_t dist = editDistance(word, n); dist < bestDistance) {
+            bestDistance = dist;
+            best = n;
+        }
+    return best;
+}
+
+}  // namespace
+
+std::string parseErrorMessage(const CLI::App& app, const CLI::ParseError& e,
+                              const std::vector<std::string>& args) {
+    std::string msg = "error: " + std::string(e.what());
+    // Options and subcommands of the subcommand that was given (or of the program).
+    const CLI::App* where = &app;
+    std::vector<std::string> options, commands;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+        commands.push_back(sub->get_name());
+        for (const std::string& a : args)
+            if (a == sub->get_name()) where = sub;
+    }
+    for (const CLI::App* a : {&app, where})
+        for (const CLI::Option* opt : a->get_options())
+            for (const std::string& n : opt->get_lnames()) options.push_back("--" + n);
+    std::vector<std::string> suggestions;
+    bool afterCommand = where == &app;
+    for (const std::string& a : args) {
+        if (!afterCommand) {
+            afterCommand = a == where->get_name();
+            continue;
+        }
+        std::string word = a.substr(0, a.find('='));
+        if (word.rfind("--", 0) == 0) {
+            if (std::find(options.begin(), options.end(), word) != options.end()) continue;
+            if (std::string n = nearest(word, options); !n.empty())
+                suggestions.push_back(word + ": did you mean " + n + "?");
+        } else if (where == &app && !word.empty() && word[0] != '-' &&
+                   dynamic_cast<const CLI::ExtrasError*>(&e)) {
+            if (std::string n = nearest(word, commands); !n.empty() && n != word)
+                suggestions.push_back(word + ": did you mean " + n + "?");
+        }
+    }
+    for (const std::string& s : suggestions) msg += "\n  " + s;
+    return msg + "\nRun with --help for more information.";
 }
 
 }  // namespace lancer::cli

@@ -1,9 +1,11 @@
-// The option table shared by every subcommand (and the viewer's defaults).
+// The common options of every subcommand (docs/design.md section 6), registered from the parameter
+// table (param_table.h), and the command line's error messages.
 #pragma once
 
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "app/cli/param_table.h"
 #include "engine/accel/accelerator.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/scene.h"
@@ -11,23 +13,23 @@
 namespace lancer::cli {
 
 struct CommonOptions {
-    /// The command line's default scheme is the fastest one measured (docs/benchmarks.md);
-    /// BuildParams itself defaults to brute force, the reference.
-    static BuildParams defaultBuild() {
-        BuildParams b;
-        b.scheme = SchemeKind::Regular;
-        return b;
-    }
     std::string scene = "builtin:default";
-    int width = 0, height = 0;  ///< 0: the scene's own size (the other follows its aspect)
-    BuildParams build = defaultBuild();
-    RenderOptions render;
-    std::string statsPath, depthPath;
+    Knobs knobs;  ///< every option of the table
 };
 
-/// Add the common options (docs/design.md section 6) to a subcommand.
+/// Add the common options (docs/design.md section 6; every entry of paramTable()) to a subcommand.
 void addCommonOptions(CLI::App& app, CommonOptions& o);
 /// The image size from the options and the scene's default size.
 void resolveSize(const CommonOptions& o, const Scene& scene, int& w, int& h);
+/// The render options the knobs ask for, at the size resolveSize gives.
+RenderOptions renderOptions(const CommonOptions& o, const Scene& scene);
+/// Load the scene of `o`, with the camera of --camera when given. Throws SceneError.
+Scene loadSceneWithCamera(const CommonOptions& o);
+
+/// The message a parse error prints: "error: ..." and, for an option or subcommand that does
+/// not exist, the nearest one that does ("did you mean --max-level?"). `args` are the
+/// command line's arguments after the program name.
+std::string parseErrorMessage(const CLI::App& app, const CLI::ParseError& e,
+                              const std::vector<std::string>& args);
 
 }  // namespace lancer::cli

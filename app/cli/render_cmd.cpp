@@ -52,10 +52,9 @@ class ProgressBar {
 
 int runRender(const CommonOptions& o, const std::string& outPath, bool quiet) {
     try {
-        Scene scene = loadScene(o.scene);
-        auto accel = buildAccelerator(scene, o.build);
-        RenderOptions ro = o.render;
-        resolveSize(o, scene, ro.width, ro.height);
+        Scene scene = loadSceneWithCamera(o);
+        auto accel = buildAccelerator(scene, o.knobs.build);
+        RenderOptions ro = renderOptions(o, scene);
         Image img(ro.width, ro.height);
         std::atomic<size_t> done{0};
         RenderStats rs;
@@ -64,12 +63,12 @@ int runRender(const CommonOptions& o, const std::string& outPath, bool quiet) {
             rs = render(scene, *accel, ro, img, {}, nullptr, &done);
         }
         writePng(outPath, img);
-        if (!o.depthPath.empty()) writeDepthPfm(o.depthPath, img);
-        if (!o.statsPath.empty())
-            writeFileAtomic(o.statsPath, statsJson(scene, *accel, ro, rs).dump(2) + "\n");
+        if (!o.knobs.depthPath.empty()) writeDepthPfm(o.knobs.depthPath, img);
+        if (!o.knobs.statsPath.empty())
+            writeFileAtomic(o.knobs.statsPath, statsJson(scene, *accel, ro, rs).dump(2) + "\n");
         if (!quiet) {
             std::cout << "rendered " << o.scene << " (" << ro.width << "x" << ro.height << ", "
-                      << schemeName(o.build.scheme) << ", " << rs.threads << " threads) in "
+                      << schemeName(o.knobs.build.scheme) << ", " << rs.threads << " threads) in "
                       << int(rs.renderMs) << " ms -> " << outPath << "\n";
         }
         if (rs.counters.walkErrors)

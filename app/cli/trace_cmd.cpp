@@ -79,15 +79,15 @@ void printEvents(const Scene& scene, const std::vector<WalkEvent>& events) {
 
 int runTrace(const CommonOptions& o, const TraceOptions& t) {
     try {
-        Scene scene = loadScene(o.scene);
-        auto accel = buildAccelerator(scene, o.build);
+        Scene scene = loadSceneWithCamera(o);
+        auto accel = buildAccelerator(scene, o.knobs.build);
         int w, h;
         resolveSize(o, scene, w, h);
         if (t.x < 0 || t.x >= w || t.y < 0 || t.y >= h)
             throw std::invalid_argument("--pixel " + std::to_string(t.x) + " " +
                                         std::to_string(t.y) + " is outside the " +
                                         std::to_string(w) + "x" + std::to_string(h) + " image");
-        Tracer tracer(scene, *accel, o.render.shading);
+        Tracer tracer(scene, *accel, o.knobs.shading);
         TraceContext ctx(scene.prims.size(), scene.tree.depth());
         ctx.useMailboxes = accel->usesMailboxes();
         Ray ray = scene.camera.primaryRay(t.x, t.y, w, h);
@@ -97,7 +97,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
 
         nlohmann::json j;
         j["scene"] = o.scene;
-        j["scheme"] = schemeName(o.build.scheme);
+        j["scheme"] = schemeName(o.knobs.build.scheme);
         j["pixel"] = {t.x, t.y};
         j["ray"] = {{"origin", vec(ray.o)}, {"direction", vec(ray.d)}};
         j["events"] = eventsJson(obs.events);
@@ -122,7 +122,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
         }
         std::cout.precision(10);
         std::cout << "pixel (" << t.x << ", " << t.y << ") of " << w << "x" << h << ", scheme "
-                  << schemeName(o.build.scheme) << "\n"
+                  << schemeName(o.knobs.build.scheme) << "\n"
                   << ray.toString() << "\n";
         printEvents(scene, obs.events);
         std::cout << "primitive tests " << ctx.counters.primTests << ", mailbox hits "

@@ -15,7 +15,9 @@ BuildResult buildStructure(const BuildRequest& r) {
     if (!scene) {
         auto start = std::chrono::steady_clock::now();
         try {
-            scene = std::make_shared<const Scene>(loadScene(r.spec));
+            Scene loaded = loadScene(r.spec);
+            if (!r.cameraFile.empty()) applyCameraFile(loaded, r.cameraFile);
+            scene = std::make_shared<const Scene>(std::move(loaded));
         } catch (const std::exception& e) {
             out.error = e.what();
             out.sceneFailed = true;

@@ -30,6 +30,8 @@ struct BuildRequest {
         loaded;  ///< the scene of `spec` when already loaded; else it is read
     BuildParams params;
     std::optional<Camera> camera;  ///< the view the structure is built for (irregular scheme)
+    /// --camera: a .camera.json replacing the camera of the scene read (its home view).
+    std::string cameraFile;
 };
 
 struct BuildResult {

@@ -11,9 +11,11 @@
 namespace lancer::viewer {
 
 struct ViewerSettings {
-    std::string scene = "builtin:default";                   ///< last scene opened
-    BuildParams build = cli::CommonOptions::defaultBuild();  ///< the command line's default
+    std::string scene = "builtin:default";   ///< last scene opened
+    BuildParams build = cli::Knobs{}.build;  ///< the command line's default
     ShadingOptions shading;
+    /// --camera FILE: replaces the camera of the first scene opened (not saved in the ini).
+    std::string cameraPath;
     int threads = 0;  ///< render threads (0: all cores)
     int windowWidth = 1280, windowHeight = 720;
     bool showParameters = true, showStatistics = true, showCamera = true, showView = true;
@@ -25,6 +27,10 @@ struct ViewerSettings {
 /// Register the [Lancer][Settings] ini handler of the current ImGui context, reading into and
 /// writing from `*s` (which must outlive the context). Call before the ini is loaded.
 void registerSettingsHandler(ViewerSettings* s);
+/// The settings as the parameter table's values, and back (the window size is width, height).
+cli::Knobs knobsOf(const ViewerSettings& s);
+void setKnobs(ViewerSettings& s, const cli::Knobs& k);
+
 /// Serialise as the ini lines the handler writes ("key=value"), and parse one such line
 /// (unknown keys and bad values are ignored: an old ini must never stop the viewer).
 std::string settingsLines(const ViewerSettings& s);

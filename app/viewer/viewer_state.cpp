@@ -88,6 +88,7 @@ void ViewerState::requestBuild(bool reloadScene, const char* why) {
     r.params = s_.build;
     if (reloadScene || !sceneBuild_) {
         r.spec = s_.scene;
+        r.cameraFile = s_.cameraPath;
     } else {
         r.spec = sceneBuild_->spec;
         r.loaded = sceneBuild_->scene;
@@ -149,6 +150,7 @@ void ViewerState::pollBuilder() {
                   " ms, build " + std::to_string(r->sceneBuild->accel->info().buildMs) + " ms)");
         sceneBuild_ = r->sceneBuild;
         if (newScene) {
+            s_.cameraPath.clear();  // --camera is the first scene's, not the next ones'
             home_ = sceneBuild_->scene->camera;
             camera_ = home_;
             s_.scene = sceneBuild_->spec;
@@ -161,6 +163,7 @@ void ViewerState::pollBuilder() {
         return;
     }
     error_ = (r->sceneFailed ? "Scene not loaded: " : "Structure not built: ") + r->error;
+    if (r->sceneFailed) s_.cameraPath.clear();
     std::cerr << "lancer view: " << error_ << "\n";
     if (sceneBuild_) {
         // Keep what is on screen, and the settings that describe it.

@@ -40,25 +40,15 @@ std::string defaultIniPath() {
     return (dir / "imgui.ini").string();
 }
 
-/// Settings explicitly given on the command line win over those saved in the ini.
+/// Settings explicitly given on the command line win over those saved in the ini: every entry
+/// of the parameter table that reaches the viewer.
 void applyCommandLine(const cli::CommonOptions& o,
                       const std::function<bool(const std::string&)>& given, ViewerSettings& s) {
     if (given("scene")) s.scene = o.scene;
-    if (given("--scheme")) s.build.scheme = o.build.scheme;
-    if (given("--max-level")) s.build.maxLevel = o.build.maxLevel;
-    if (given("--max-objects")) s.build.maxObjects = o.build.maxObjects;
-    if (given("--split-axes")) s.build.splitAxes = o.build.splitAxes;
-    if (given("--step")) s.build.step = o.build.step;
-    if (given("--delta")) s.build.delta = o.build.delta;
-    if (given("--bsp-heuristic")) s.build.heuristic = o.build.heuristic;
-    if (given("--no-mailbox")) s.build.mailboxes = o.build.mailboxes;
-    if (given("--no-light-buffer")) s.build.lightBuffer = o.build.lightBuffer;
-    if (given("--threads")) s.threads = o.render.threads;
-    if (given("--bounces")) s.shading.bounces = o.render.shading.bounces;
-    if (given("--no-shadows")) s.shading.shadows = o.render.shading.shadows;
-    if (given("--offset")) s.shading.offsetScale = o.render.shading.offsetScale;
-    if (given("--width")) s.windowWidth = o.width;
-    if (given("--height")) s.windowHeight = o.height;
+    cli::Knobs k = knobsOf(s);
+    for (const cli::ParamDesc& d : cli::paramTable())
+        if (d.reach != cli::ViewerReach::BatchOnly && given(d.flag)) cli::copyValue(d, o.knobs, k);
+    setKnobs(s, k);
 }
 
 }  // namespace

@@ -7,38 +7,6 @@
 
 namespace lancer {
 
-const char* schemeName(SchemeKind k) {
-    switch (k) {
-        case SchemeKind::Brute:
-            return "brute";
-        case SchemeKind::Regular:
-            return "regular";
-        case SchemeKind::Irregular:
-            return "irregular";
-    }
-    return "?";
-}
-
-const char* stepName(StepMethod s) { return s == StepMethod::Exact ? "exact" : "push"; }
-
-const char* heuristicName(BspHeuristic h) {
-    switch (h) {
-        case BspHeuristic::First:
-            return "first";
-        case BspHeuristic::Balanced:
-            return "balanced";
-        case BspHeuristic::FewestCuts:
-            return "fewest-cuts";
-    }
-    return "?";
-}
-
-const char* splitAxesName(SplitAxes s) { return s == SplitAxes::Cycle ? "cycle" : "cost"; }
-
-const char* irregularFrameName(IrregularFrame f) {
-    return f == IrregularFrame::Camera ? "camera" : "projective";
-}
-
 namespace {
 
 /// An accelerated scheme's structure, from `build`, and its light buffer, counted in its memory
@@ -82,8 +50,8 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
     };
     switch (params.scheme) {
         case SchemeKind::Brute: {
-            BruteForce b(scene);
             AccelInfo info;
+            BruteForce b = BruteForce::build(scene, BruteConfig{}, info.extra);
             info.regions = b.regionCount();
             info.memoryBytes = b.memoryBytes();
             info.buildMs = elapsedMs();
@@ -93,16 +61,14 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
             return withLightBuffer<RegularGrid>(
                 scene, params,
                 [&](AccelInfo& info) {
-                    RegularGrid g(scene, params);
-                    info.extra = g.extra();
-                    return g;
+                    return RegularGrid::build(scene, params.regular, info.extra);
                 },
                 elapsedMs);
         case SchemeKind::Irregular:
             return withLightBuffer<IrregularSubdivision>(
                 scene, params,
                 [&](AccelInfo& info) {
-                    return IrregularSubdivision::build(scene, params, info.extra);
+                    return IrregularSubdivision::build(scene, params.irregular, info.extra);
                 },
                 elapsedMs);
     }

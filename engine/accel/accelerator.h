@@ -8,47 +8,12 @@
 #include <variant>
 
 #include "engine/accel/brute_force.h"
+#include "engine/accel/build_params.h"
 #include "engine/accel/irregular/irregular.h"
 #include "engine/accel/light_buffer.h"
 #include "engine/accel/regular/regular_grid.h"
 
 namespace lancer {
-
-enum class SchemeKind : uint8_t { Brute, Regular, Irregular };
-enum class StepMethod : uint8_t { Exact, Push };
-enum class BspHeuristic : uint8_t { First, Balanced, FewestCuts };
-/// Regular scheme: the axis each level of the BSP cuts. Cycle: x, y, z in turn (the report's);
-/// cost: per level, the axis of least estimated cost (regular_grid.cpp, planSchedule).
-enum class SplitAxes : uint8_t { Cycle, Cost };
-/// Irregular scheme: primary rays walk the camera-frame structure, or the projective zones.
-enum class IrregularFrame : uint8_t { Camera, Projective };
-
-const char* schemeName(SchemeKind k);
-const char* stepName(StepMethod s);
-const char* heuristicName(BspHeuristic h);
-const char* splitAxesName(SplitAxes s);
-const char* irregularFrameName(IrregularFrame f);
-
-/// Builder parameters: a plain struct the command line, the viewer and the tests fill in.
-struct BuildParams {
-    SchemeKind scheme = SchemeKind::Brute;
-    /// Deepest subdivision level (regular: total BSP depth, one axis cut per level). 24 and 4
-    /// measured best for the regular scheme (docs/regular.md, "Defaults"): balls4 11.7
-    /// primitive tests per ray (at 18 / 2: 65), and no built-in CSG scene explodes (at 24 / 2
-    /// lattice does, where box faces run through other boxes). Were 18 and 2.
-    int maxLevel = 24;
-    int maxObjects = 4;  ///< stop subdividing a cell holding at most this many primitives
-    StepMethod step = StepMethod::Exact;
-    double delta = 1e-6;  ///< push distance, relative to the scene box's largest extent
-    BspHeuristic heuristic = BspHeuristic::Balanced;
-    SplitAxes splitAxes = SplitAxes::Cost;  ///< regular: which axis each level cuts
-    bool mailboxes = true;                  ///< --no-mailbox turns them off to measure their effect
-    /// Accelerated schemes: shorten shadow rays with the light buffer (light_buffer.h);
-    /// --no-light-buffer turns it off to measure its effect. Brute force never uses it.
-    bool lightBuffer = true;
-    bool fullTable = false;  ///< regular: one full directory table instead of sub-tables
-    IrregularFrame irregularFrame = IrregularFrame::Projective;  ///< --irregular-frame
-};
 
 /// What a built structure reports: `--stats` and the viewer show it.
 struct AccelInfo {

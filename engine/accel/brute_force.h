@@ -1,13 +1,22 @@
 // The reference: every primitive, the full tree, for every ray. One region, no mailboxes.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include "engine/accel/eval.h"
 
 namespace lancer {
 
+/// Brute force has no knobs; its empty config gives every scheme the same build shape.
+struct BruteConfig {};
+
 class BruteForce {
   public:
     explicit BruteForce(const Scene& scene) : scene_(&scene) {}
+    /// The scheme's build, in the shape every scheme has: nothing to build, nothing to report.
+    static BruteForce build(const Scene& scene, const BruteConfig&, nlohmann::json& /*extra*/) {
+        return BruteForce(scene);
+    }
 
     template <class Obs>
     bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,

@@ -28,4 +28,15 @@ Scene loadScene(const std::string& spec) {
                      "' (expected .json, .nff, .csg, or builtin:NAME[:SIZE])");
 }
 
+void applyCameraFile(Scene& scene, const std::string& path) {
+    SourceText src = SourceText::fromFile(path);
+    LocatedJson doc(src);
+    JsonAt root{doc, doc.root(), ""};
+    if (!root.value.is_object())
+        root.fail("expected a JSON object with \"from\", \"at\", \"up\", \"fov\"");
+    // As in a sidecar, which starts from a perspective camera.
+    scene.camera.projection = Projection::Perspective;
+    applyCameraJson(root, scene, false);
+}
+
 }  // namespace lancer

@@ -9,5 +9,11 @@ namespace lancer {
 
 /// Throws SceneError with the file, line and column of any problem.
 Scene loadScene(const std::string& spec);
+/// Replace the camera of a loaded scene with the one in `path`, a JSON object with the
+/// .camera.json sidecar's keys (docs/design.md section 6; what the viewer's Copy JSON writes): keys
+/// not given keep the scene's values, except a missing "projection", which means perspective;
+/// "width" and "height" set the scene's own size, "lights" and "background" replace its own.
+/// Throws SceneError naming the file, line and column.
+void applyCameraFile(Scene& scene, const std::string& path);
 
 }  // namespace lancer

@@ -44,6 +44,24 @@ echo "$out" | grep -q -- "--width" || fail "bad --width not named: $out"
 out=$("$LANCER" render builtin:default -o "$tmp/c.png" --max-level 100000 2>&1) && fail "huge max-level accepted"
 echo "$out" | grep -q -- "--max-level" || fail "huge --max-level not named: $out"
 [ ! -e "$tmp/c.png" ] || fail "an image was written despite the error"
+out=$("$LANCER" render builtin:default -o "$tmp/c.png" --max-levle 3 2>&1); status=$?
+[ "$status" -eq 2 ] || fail "misspelt option: exit status $status, expected 2"
+echo "$out" | grep -q "^error: " || fail "misspelt option: no 'error:' prefix: $out"
+echo "$out" | grep -q "did you mean --max-level?" || fail "misspelt option: no suggestion: $out"
+
+# --camera: the sidecar's keys; a .csg's own sidecar given again changes nothing; errors name
+# the file, line and column.
+csg="$SRC/assets/openscad/bracket.csg"
+"$LANCER" render "$csg" --width 40 -q -o "$tmp/own.png" --depth "$tmp/own.pfm" || fail "render .csg"
+"$LANCER" render "$csg" --width 40 -q -o "$tmp/cam.png" --depth "$tmp/cam.pfm" \
+  --camera "$SRC/assets/openscad/bracket.camera.json" || fail "render --camera"
+cmp -s "$tmp/own.pfm" "$tmp/cam.pfm" || fail "--camera with the scene's own sidecar changed the image"
+printf '{"from": [0, 0, 5],\n "at": [0, 0, 5]}\n' > "$tmp/bad.camera.json"
+out=$("$LANCER" render builtin:default -o "$tmp/c.png" --camera "$tmp/bad.camera.json" 2>&1); status=$?
+[ "$status" -eq 2 ] || fail "bad --camera: exit status $status, expected 2"
+echo "$out" | grep -q "^error: .*bad.camera.json:1:1: " || fail "bad --camera message: $out"
+out=$("$LANCER" trace builtin:default --pixel 1 1 --camera "$tmp/none.json" 2>&1) && fail "missing --camera accepted"
+echo "$out" | grep -q "none.json" || fail "missing --camera not named: $out"
 
 # A bad scene file: file:line:col, non-zero exit, no output written.
 printf '{\n  "scene": {"sphere": {"radius": -2}}\n}\n' > "$tmp/bad.json"

@@ -498,7 +498,7 @@ TEST_F(ViewerFrames, ASceneThatFailsToLoadKeepsThePreviousOne) {
     EXPECT_EQ(app_->sceneBuild(), before);
     EXPECT_EQ(settings_.scene, "builtin:default");
     // A scheme that cannot be built (or an invalid parameter) keeps the structure too.
-    settings_.build.maxLevel = 18;
+    settings_.build.regular.maxLevel = 18;
     app_->openScene("builtin:balls:1");
     runUntilSettled();
     EXPECT_TRUE(app_->error().empty()) << app_->error();

@@ -93,22 +93,26 @@ TEST(CameraControl, JsonRoundTripAndErrors) {
 TEST(ViewerSettingsIni, DefaultsAreTheCommandLineDefaults) {
     ViewerSettings s;
     EXPECT_EQ(s.build.scheme, SchemeKind::Regular);
-    EXPECT_EQ(s.build.scheme, cli::CommonOptions{}.build.scheme);
-    EXPECT_EQ(s.build.maxLevel, cli::CommonOptions{}.build.maxLevel);
-    EXPECT_EQ(s.build.maxObjects, cli::CommonOptions{}.build.maxObjects);
+    EXPECT_EQ(s.build.scheme, cli::Knobs{}.build.scheme);
+    EXPECT_EQ(s.build.regular.maxLevel, cli::Knobs{}.build.regular.maxLevel);
+    EXPECT_EQ(s.build.regular.maxObjects, cli::Knobs{}.build.regular.maxObjects);
 }
 
 TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     ViewerSettings s;
     s.scene = "assets/spd/balls4.nff";
     s.build.scheme = SchemeKind::Irregular;
-    s.build.maxLevel = 7;
-    s.build.maxObjects = 5;
-    s.build.step = StepMethod::Push;
-    s.build.delta = 3.5e-7;
-    s.build.heuristic = BspHeuristic::FewestCuts;
-    s.build.splitAxes = SplitAxes::Cycle;  // not the default: the line must carry it
+    s.build.regular.maxLevel = 7;
+    s.build.regular.maxObjects = s.build.irregular.maxObjects = 5;
+    s.build.regular.step = StepMethod::Push;
+    s.build.regular.delta = 3.5e-7;
+    s.build.irregular.heuristic = BspHeuristic::FewestCuts;
+    s.build.regular.splitAxes = SplitAxes::Cycle;  // not the default: the line must carry it
     s.build.mailboxes = false;
+    s.build.regular.fullTable = true;  // options the ini once dropped
+    s.build.irregular.frame = IrregularFrame::Camera;
+    s.shading.offsetScale = 2.5e-8;
+    s.shading.reflections = false;
     s.threads = 1;
     s.shading.bounces = 2;
     s.shading.shadows = false;
@@ -127,9 +131,20 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
         start = end + 1;
     }
     EXPECT_EQ(settingsLines(r), lines);
+    // Every ini key of the parameter table is written, with the value set above.
+    for (const cli::ParamDesc& d : cli::paramTable())
+        if (d.iniKey)
+            EXPECT_NE(lines.find(std::string("\n") + d.iniKey + "=" +
+                                 cli::formatValue(d, knobsOf(s)) + "\n"),
+                      std::string::npos)
+                << d.iniKey;
+    EXPECT_TRUE(r.build.regular.fullTable);
+    EXPECT_EQ(r.build.irregular.frame, IrregularFrame::Camera);
+    EXPECT_EQ(r.shading.offsetScale, 2.5e-8);
     ViewerSettings bad = r;
-    for (const char* line : {"max_level=999", "scheme=octree", "split_axes=diagonal", "window=5 5",
-                             "delta=-1", "threads=x", "garbage"})
+    for (const char* line :
+         {"max_level=999", "max_objects=-1", "full_table=2", "scheme=octree", "split_axes=diagonal",
+          "window=5 5", "delta=-1", "threads=x", "garbage"})
         readSettingsLine(bad, line);
     EXPECT_EQ(settingsLines(bad), lines);
 }

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "app/viewer/panels/panels.h"
+#include "app/viewer/panels/param_controls.h"
 #include "app/viewer/panels/widgets.h"
 #include "engine/scene/builtin_scenes.h"
 
@@ -59,7 +60,6 @@ void parametersPanel(ViewerState& st) {
         ImGui::End();
         return;
     }
-    bool rebuild = false, rerender = false;
 
     // Scene: a built-in (with its size) or a file.
     std::string bname;
@@ -88,38 +88,13 @@ void parametersPanel(ViewerState& st) {
     hintText("or drop a .json / .nff / .csg file on the window");
     errorText(st.error());
 
+    // The knobs, from the parameter table: a knob the scheme does not read is greyed out.
+    const cli::Knobs before = knobsOf(s);
+    cli::Knobs k = before;
+    const int maxThreads = effectiveThreads(0);
     ImGui::Separator();
     ImGui::TextUnformatted("Subdivision");
-    rebuild |= enumCombo("scheme", s.build.scheme, 3, schemeName);
-    if (ImGui::InputInt("max-level", &s.build.maxLevel)) {
-        s.build.maxLevel = std::clamp(s.build.maxLevel, 0, 48);
-        rebuild = true;
-    }
-    if (ImGui::InputInt("max-objects", &s.build.maxObjects)) {
-        s.build.maxObjects = std::clamp(s.build.maxObjects, 1, 1000000);
-        rebuild = true;
-    }
-    rebuild |= enumCombo("split axes", s.build.splitAxes, 2, splitAxesName);
-    if (ImGui::IsItemHovered())
-        ImGui::SetTooltip(
-            "Regular: cycle cuts x, y, z in turn (the report's); cost picks each\n"
-            "level's axis by an area estimate (cells stay about cubic)");
-    rebuild |= enumCombo("step", s.build.step, 2, stepName);
-    if (s.build.step == StepMethod::Push) {
-        double d = s.build.delta;
-        if (ImGui::InputDouble("delta", &d, 0.0, 0.0, "%.3e",
-                               ImGuiInputTextFlags_EnterReturnsTrue) &&
-            d >= 1e-15 && d <= 0.5) {
-            s.build.delta = d;
-            rebuild = true;
-        }
-    }
-    rebuild |= enumCombo("BSP heuristic", s.build.heuristic, 3, heuristicName);
-    rebuild |= ImGui::Checkbox("mailboxes", &s.build.mailboxes);
-    ImGui::SameLine();
-    rebuild |= ImGui::Checkbox("light buffer", &s.build.lightBuffer);
-    if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("Shadow rays stop where the light's depth map says nothing is left");
+    paramControls(cli::ChangeEffect::Rebuild, k, maxThreads);
     if (const std::shared_ptr<const SceneBuild>& b = st.sceneBuild()) {
         const AccelInfo& ai = b->accel->info();
         ImGui::Text("on screen: %s, built in %.1f ms", schemeName(b->accel->params().scheme),
@@ -133,25 +108,18 @@ void parametersPanel(ViewerState& st) {
 
     ImGui::Separator();
     ImGui::TextUnformatted("Rendering");
-    int maxThreads = effectiveThreads(0);
-    rerender |= ImGui::SliderInt("threads", &s.threads, 0, std::max(maxThreads, 1),
-                                 s.threads ? "%d" : "all");
-    rerender |= ImGui::Checkbox("shadows", &s.shading.shadows);
-    ImGui::SameLine();
-    rerender |= ImGui::Checkbox("reflection", &s.shading.reflections);
-    ImGui::SameLine();
-    rerender |= ImGui::Checkbox("refraction", &s.shading.refractions);
-    rerender |= ImGui::SliderInt("bounces", &s.shading.bounces, 0, 10);
+    paramControls(cli::ChangeEffect::Rerender, k, maxThreads);
     ImGui::End();
 
-    if (rebuild) {
+    // What the change asks for is the table's decision (cli::changeEffect, tested without a
+    // window): a knob another scheme reads never rebuilds.
+    const cli::ChangeEffect effect = cli::changeEffect(before, k);
+    if (effect != cli::ChangeEffect::None) {
+        setKnobs(s, k);
         ImGui::MarkIniSettingsDirty();
-        st.requestBuild(false, "subdivision parameter");
     }
-    if (rerender) {
-        ImGui::MarkIniSettingsDirty();
-        st.markRender("shading parameter");
-    }
+    if (effect == cli::ChangeEffect::Rebuild) st.requestBuild(false, "subdivision parameter");
+    if (effect == cli::ChangeEffect::Rerender) st.markRender("shading parameter");
 }
 
 }  // namespace lancer::viewer

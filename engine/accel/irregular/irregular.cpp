@@ -23,7 +23,7 @@ constexpr size_t kMaxRegions = 50'000'000;
 
 }  // namespace
 
-IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const BuildParams& params,
+IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const IrregularConfig& params,
                                                  nlohmann::json& extra) {
     using Clock = std::chrono::steady_clock;
     auto ms = [](Clock::time_point a) {
@@ -92,8 +92,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Build
     s.budget_ = 16 * s.regions_.size() + 1024;
 
     double eyeMs = 0.0;
-    extra["frame"] = irregularFrameName(params.irregularFrame);
-    if (params.irregularFrame == IrregularFrame::Projective) {
+    extra["frame"] = irregularFrameName(params.frame);
+    if (params.frame == IrregularFrame::Projective) {
         auto t3 = Clock::now();
         s.eye_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, extra);
         eyeMs = ms(t3);

@@ -31,6 +31,7 @@
 #include <nlohmann/json.hpp>
 #include <span>
 
+#include "engine/accel/build_params.h"
 #include "engine/accel/eval.h"
 #include "engine/accel/irregular/camera_frame.h"
 #include "engine/accel/irregular/projective_zones.h"
@@ -39,13 +40,11 @@
 
 namespace lancer {
 
-struct BuildParams;  // accelerator.h
-
 class IrregularSubdivision {
   public:
     /// Build over a prepared scene from scene.camera; scheme figures go to `extra`. Throws
     /// std::invalid_argument for refused parameters or a structure over its limits.
-    static IrregularSubdivision build(const Scene& scene, const BuildParams& params,
+    static IrregularSubdivision build(const Scene& scene, const IrregularConfig& params,
                                       nlohmann::json& extra);
 
     template <class Obs>

@@ -11,7 +11,7 @@
 
 namespace lancer {
 
-enum class BspHeuristic : uint8_t;  // accelerator.h
+enum class BspHeuristic : uint8_t;  // build_params.h
 
 struct ScreenBspParams {
     BspHeuristic heuristic{};  ///< the choice of splitting line

@@ -52,7 +52,7 @@ constexpr int kPlannedLevels = 12;
 /// it cuts x and y until the cells are about cubes, where the report's order makes them 16 times
 /// flatter than wide.
 AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector<uint32_t>& live,
-                          const BuildParams& params) {
+                          const RegularConfig& params) {
     std::vector<double> cost(scene.prims.size(), 1.0);
     for (size_t i = 0; i < cost.size(); ++i)
         if (const Polygon* pg = std::get_if<Polygon>(&scene.prims[i].shape))
@@ -130,7 +130,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
 /// costs the size of its parent's small tree, not of the scene's tree.
 struct RegularBuilder {
     const Scene& scene;
-    const BuildParams& params;
+    const RegularConfig& params;
     RegularGrid& grid;
     BspNodes bsp;
     std::vector<char> keep;  ///< membership marks, all 0 between uses
@@ -266,7 +266,7 @@ struct RegularBuilder {
     }
 };
 
-RegularGrid::RegularGrid(const Scene& scene, const BuildParams& params)
+RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params)
     : scene_(&scene), exact_(params.step == StepMethod::Exact) {
     if (params.maxLevel < 0 || params.maxLevel > 48)
         throw std::invalid_argument("--max-level " + std::to_string(params.maxLevel) +

@@ -13,12 +13,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "engine/accel/build_params.h"
 #include "engine/accel/eval.h"
 #include "engine/accel/regular/directory.h"
 
 namespace lancer {
-
-struct BuildParams;  // engine/accel/accelerator.h, which includes this header
 
 /// A BSP leaf: its block of the finest grid, [lo, hi) per axis, and its restricted tree; with
 /// everything the walk reads of it in one 128-byte block (two cache lines the hardware fetches
@@ -58,7 +57,14 @@ class RegularGrid {
 
     /// Build over a prepared scene. Throws std::invalid_argument naming the option when the
     /// parameters are invalid or the structure would not fit in kMemoryBudget.
-    RegularGrid(const Scene& scene, const BuildParams& params);
+    RegularGrid(const Scene& scene, const RegularConfig& params);
+    /// The same, in the build shape every scheme has; the scheme's figures go to `extra`.
+    static RegularGrid build(const Scene& scene, const RegularConfig& config,
+                             nlohmann::json& extra) {
+        RegularGrid g(scene, config);
+        extra = g.extra();
+        return g;
+    }
 
     /// Nearest visible hit with t in (tmin, tmax], walking the leaves in ray order.
     template <class Obs>

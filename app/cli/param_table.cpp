@@ -1,0 +1,396 @@
+#include "app/cli/param_table.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace lancer::cli {
+
+namespace {
+
+constexpr uint8_t kRegular = schemeBit(SchemeKind::Regular);
+constexpr uint8_t kIrregular = schemeBit(SchemeKind::Irregular);
+constexpr uint8_t kAccelerated = kRegular | kIrregular;
+
+std::vector<ParamDesc> makeTable() {
+    using K = Knobs;
+    std::vector<ParamDesc> t;
+    auto add = [&](ParamDesc d) { t.push_back(std::move(d)); };
+    ParamDesc d{};
+
+    d = {"--width",      "W", "width", "width", "Image width in pixels (default: the scene's)",
+         ParamKind::Int, 1,   16384};
+    d.reach = ViewerReach::Window;
+    d.get = [](const K& k) { return double(k.width); };
+    d.set = [](K& k, double v) { k.width = int(v); };
+    add(d);
+    d = {"--height",     "H", "height", "height", "Image height in pixels (default: the scene's)",
+         ParamKind::Int, 1,   16384};
+    d.reach = ViewerReach::Window;
+    d.get = [](const K& k) { return double(k.height); };
+    d.set = [](K& k, double v) { k.height = int(v); };
+    add(d);
+
+    d = {"--scheme", "S", "scheme", "scheme", "Acceleration scheme", ParamKind::Enum};
+    d.names = {"brute", "regular", "irregular"};
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.scheme); };
+    d.set = [](K& k, double v) { k.build.scheme = SchemeKind(int(v)); };
+    add(d);
+    d = {"--max-level",
+         "N",
+         "max_level",
+         "max-level",
+         "Deepest subdivision level (one axis cut per level)",
+         ParamKind::Int,
+         0,
+         48};
+    d.schemes = kRegular;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.regular.maxLevel); };
+    d.set = [](K& k, double v) { k.build.regular.maxLevel = int(v); };
+    add(d);
+    // One knob for both schemes, as the report has one: the regular scheme refuses 0 when it
+    // builds (a cell must stop on a count), the irregular one splits until no segment is left.
+    d = {"--max-objects",
+         "N",
+         "max_objects",
+         "max-objects",
+         "Stop subdividing a cell holding at most N primitives (irregular: 0 never stops; "
+         "regular: at least 1)",
+         ParamKind::Int,
+         0,
+         1000000};
+    d.schemes = kAccelerated;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) {
+        return double(k.build.scheme == SchemeKind::Irregular ? k.build.irregular.maxObjects
+                                                              : k.build.regular.maxObjects);
+    };
+    d.set = [](K& k, double v) {
+        k.build.regular.maxObjects = k.build.irregular.maxObjects = int(v);
+    };
+    add(d);
+    d = {"--step",       "M", "step", "step", "Next-cell method: exact, or the report's push",
+         ParamKind::Enum};
+    d.names = {"exact", "push"};
+    d.schemes = kRegular;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.regular.step); };
+    d.set = [](K& k, double v) { k.build.regular.step = StepMethod(int(v)); };
+    add(d);
+    d = {"--delta",
+         "D",
+         "delta",
+         "delta",
+         "Push distance of --step push, relative to the scene size",
+         ParamKind::Real,
+         1e-15,
+         0.5};
+    d.schemes = kRegular;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return k.build.regular.delta; };
+    d.set = [](K& k, double v) { k.build.regular.delta = v; };
+    d.when = [](const K& k) { return k.build.regular.step == StepMethod::Push; };
+    add(d);
+    d = {"--split-axes",
+         "A",
+         "split_axes",
+         "split axes",
+         "Axis per BSP level: cycle (x, y, z in turn, the report's) or cost (the cheapest by an "
+         "area estimate)",
+         ParamKind::Enum};
+    d.names = {"cycle", "cost"};
+    d.schemes = kRegular;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.regular.splitAxes); };
+    d.set = [](K& k, double v) { k.build.regular.splitAxes = SplitAxes(int(v)); };
+    add(d);
+    d = {"--full-table",
+         "",
+         "full_table",
+         "full table",
+         "One full directory table instead of sub-tables",
+         ParamKind::Switch};
+    d.schemes = kRegular;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.regular.fullTable); };
+    d.set = [](K& k, double v) { k.build.regular.fullTable = v != 0.0; };
+    add(d);
+    d = {"--bsp-heuristic",
+         "H",
+         "bsp_heuristic",
+         "BSP heuristic",
+         "Choice of the screen BSP's splitting segment",
+         ParamKind::Enum};
+    d.names = {"first", "balanced", "fewest-cuts"};
+    d.schemes = kIrregular;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.irregular.heuristic); };
+    d.set = [](K& k, double v) { k.build.irregular.heuristic = BspHeuristic(int(v)); };
+    add(d);
+    d = {"--irregular-frame",
+         "F",
+         "irregular_frame",
+         "primary rays",
+         "What primary rays walk: camera (the camera-frame structure) or projective (zones in "
+         "screen x/z, y/z)",
+         ParamKind::Enum};
+    d.names = {"camera", "projective"};
+    d.schemes = kIrregular;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.irregular.frame); };
+    d.set = [](K& k, double v) { k.build.irregular.frame = IrregularFrame(int(v)); };
+    add(d);
+    d = {"--no-mailbox",
+         "",
+         "mailboxes",
+         "mailboxes",
+         "Turn the mailboxes off (to measure their effect)",
+         ParamKind::Switch};
+    d.flagValue = false;
+    d.schemes = kAccelerated;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.mailboxes); };
+    d.set = [](K& k, double v) { k.build.mailboxes = v != 0.0; };
+    add(d);
+    d = {"--no-light-buffer",
+         "",
+         "light_buffer",
+         "light buffer",
+         "Trace shadow rays without the light buffer (to measure its effect)",
+         ParamKind::Switch};
+    d.flagValue = false;
+    d.schemes = kAccelerated;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.lightBuffer); };
+    d.set = [](K& k, double v) { k.build.lightBuffer = v != 0.0; };
+    add(d);
+
+    d = {"--threads",    "N", "threads", "threads", "Worker threads (0: all cores)",
+         ParamKind::Int, 0,   1024};
+    d.effect = ChangeEffect::Rerender;
+    d.get = [](const K& k) { return double(k.threads); };
+    d.set = [](K& k, double v) { k.threads = int(v); };
+    add(d);
+    d = {"--bounces",
+         "N",
+         "bounces",
+         "bounces",
+         "Reflection/refraction depth; 0 = primary and shadow rays only",
+         ParamKind::Int,
+         0,
+         64};
+    d.effect = ChangeEffect::Rerender;
+    d.get = [](const K& k) { return double(k.shading.bounces); };
+    d.set = [](K& k, double v) { k.shading.bounces = int(v); };
+    add(d);
+    d = {"--offset",
+         "E",
+         "offset",
+         "offset",
+         "Secondary-ray origin offset, relative to the scene scale",
+         ParamKind::Real,
+         0.0,
+         1e-2};
+    d.effect = ChangeEffect::Rerender;
+    d.get = [](const K& k) { return k.shading.offsetScale; };
+    d.set = [](K& k, double v) { k.shading.offsetScale = v; };
+    add(d);
+    d = {"--no-shadows", "", "shadows", "shadows", "Trace no shadow rays", ParamKind::Switch};
+    d.flagValue = false;
+    d.effect = ChangeEffect::Rerender;
+    d.get = [](const K& k) { return double(k.shading.shadows); };
+    d.set = [](K& k, double v) { k.shading.shadows = v != 0.0; };
+    add(d);
+    d = {"--no-reflections", "", "reflections", "reflection", "Trace no reflected rays",
+         ParamKind::Switch};
+    d.flagValue = false;
+    d.effect = ChangeEffect::Rerender;
+    d.get = [](const K& k) { return double(k.shading.reflections); };
+    d.set = [](K& k, double v) { k.shading.reflections = v != 0.0; };
+    add(d);
+    d = {"--no-refractions", "", "refractions", "refraction", "Trace no refracted rays",
+         ParamKind::Switch};
+    d.flagValue = false;
+    d.effect = ChangeEffect::Rerender;
+    d.get = [](const K& k) { return double(k.shading.refractions); };
+    d.set = [](K& k, double v) { k.shading.refractions = v != 0.0; };
+    add(d);
+
+    d = {"--camera",
+         "FILE",
+         nullptr,
+         "camera",
+         "A camera in the .camera.json sidecar's keys (the viewer's Copy JSON), replacing the "
+         "scene's",
+         ParamKind::Path};
+    d.reach = ViewerReach::Startup;
+    d.path = &Knobs::cameraPath;
+    add(d);
+    d = {"--stats",      "FILE", nullptr, "stats", "Write statistics as JSON to this file",
+         ParamKind::Path};
+    d.reach = ViewerReach::BatchOnly;
+    d.path = &Knobs::statsPath;
+    add(d);
+    d = {"--depth",
+         "FILE",
+         nullptr,
+         "depth",
+         "Write the primary hit distances as a PFM to this file",
+         ParamKind::Path};
+    d.reach = ViewerReach::BatchOnly;
+    d.path = &Knobs::depthPath;
+    add(d);
+    return t;
+}
+
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    // The shortest form that reads back to the same double.
+    for (int p = 1; p <= 17; ++p) {
+        char s[32];
+        std::snprintf(s, sizeof s, "%.*g", p, v);
+        if (std::strtod(s, nullptr) == v) return s;
+    }
+    return buf;
+}
+
+std::string schemesText(uint8_t schemes) {
+    if (schemes == kAllSchemes) return "all";
+    std::string out;
+    for (int i = 0; i < kSchemeCount; ++i)
+        if (schemes & schemeBit(SchemeKind(i)))
+            out += (out.empty() ? "" : ", ") + std::string(schemeName(SchemeKind(i)));
+    return out;
+}
+
+}  // namespace
+
+std::span<const ParamDesc> paramTable() {
+    static const std::vector<ParamDesc> table = makeTable();
+    return table;
+}
+
+const ParamDesc* findParam(const std::string& flag) {
+    for (const ParamDesc& d : paramTable())
+        if (flag == d.flag) return &d;
+    return nullptr;
+}
+
+bool applies(const ParamDesc& d, const Knobs& k) {
+    return (d.schemes & schemeBit(k.build.scheme)) && (!d.when || d.when(k));
+}
+
+ChangeEffect changeEffect(const Knobs& before, const Knobs& after) {
+    ChangeEffect e = ChangeEffect::None;
+    for (const ParamDesc& d : paramTable()) {
+        if (d.reach != ViewerReach::Panel || !d.get || d.get(before) == d.get(after)) continue;
+        if (!applies(d, after)) continue;
+        if (d.effect == ChangeEffect::Rebuild) return ChangeEffect::Rebuild;
+        if (d.effect == ChangeEffect::Rerender) e = ChangeEffect::Rerender;
+    }
+    return e;
+}
+
+std::string formatValue(const ParamDesc& d, const Knobs& k) {
+    switch (d.kind) {
+        case ParamKind::Int:
+            return std::to_string(int(d.get(k)));
+        case ParamKind::Real:
+            return number(d.get(k));
+        case ParamKind::Enum:
+            return d.names[size_t(d.get(k))];
+        case ParamKind::Switch:
+            return d.get(k) != 0.0 ? "1" : "0";
+        case ParamKind::Path:
+            return k.*d.path;
+    }
+    return "";
+}
+
+bool parseValue(const ParamDesc& d, const std::string& text, Knobs& k) {
+    switch (d.kind) {
+        case ParamKind::Int: {
+            long long v = 0;
+            auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+            if (r.ec != std::errc() || r.ptr != text.data() + text.size()) return false;
+            if (double(v) < d.lo || double(v) > d.hi) return false;
+            d.set(k, double(v));
+            return true;
+        }
+        case ParamKind::Real: {
+            char* end = nullptr;
+            double v = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end || !std::isfinite(v) || v < d.lo || v > d.hi) return false;
+            d.set(k, v);
+            return true;
+        }
+        case ParamKind::Enum:
+            for (size_t i = 0; i < d.names.size(); ++i)
+                if (text == d.names[i]) {
+                    d.set(k, double(i));
+                    return true;
+                }
+            return false;
+        case ParamKind::Switch:
+            if (text != "0" && text != "1") return false;
+            d.set(k, text == "1" ? 1.0 : 0.0);
+            return true;
+        case ParamKind::Path:
+            k.*d.path = text;
+            return true;
+    }
+    return false;
+}
+
+void copyValue(const ParamDesc& d, const Knobs& from, Knobs& to) {
+    if (d.kind == ParamKind::Path)
+        to.*d.path = from.*d.path;
+    else
+        d.set(to, d.get(from));
+}
+
+std::string optionsMarkdown() {
+    static const char* reach[] = {"panel", "window size", "at start", "batch only"};
+    const Knobs defaults;
+    std::ostringstream o;
+    o << "| option | values | default | schemes | viewer | what it does |\n"
+      << "|---|---|---|---|---|---|\n";
+    for (const ParamDesc& d : paramTable()) {
+        std::string flag = d.flag, values, def;
+        if (*d.metavar) flag += std::string(" ") + d.metavar;
+        switch (d.kind) {
+            case ParamKind::Int:
+            case ParamKind::Real:
+                values = d.kind == ParamKind::Int ? std::to_string((long long)d.lo) + " to " +
+                                                        std::to_string((long long)d.hi)
+                                                  : number(d.lo) + " to " + number(d.hi);
+                def = formatValue(d, defaults);
+                if (d.kind == ParamKind::Int &&
+                    (d.flag == std::string("--width") || d.flag == std::string("--height")))
+                    def = "the scene's";
+                break;
+            case ParamKind::Enum:
+                for (const char* n : d.names)
+                    values += (values.empty() ? "" : ", ") + std::string(n);
+                def = formatValue(d, defaults);
+                break;
+            case ParamKind::Switch:
+                values = "flag";
+                def = std::string(d.label) + (d.get(defaults) != 0.0 ? " on" : " off");
+                break;
+            case ParamKind::Path:
+                values = "file";
+                def = "none";
+                break;
+        }
+        o << "| `" << flag << "` | " << values << " | " << def << " | " << schemesText(d.schemes)
+          << " | " << reach[int(d.reach)] << " | " << d.help << " |\n";
+    }
+    return o.str();
+}
+
+}  // namespace lancer::cli

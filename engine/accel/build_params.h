@@ -1,0 +1,64 @@
+// What a structure is built from: the scheme, the knobs common to every scheme, and each
+// scheme's own knobs in a Config of its own. Plain structs the command line, the viewer and the
+// tests fill in; app/cli/param_table.* describes each field to the command line, the viewer's
+// panel and its ini file.
+#pragma once
+
+#include <cstdint>
+
+namespace lancer {
+
+enum class SchemeKind : uint8_t { Brute, Regular, Irregular };
+inline constexpr int kSchemeCount = 3;
+enum class StepMethod : uint8_t { Exact, Push };
+enum class BspHeuristic : uint8_t { First, Balanced, FewestCuts };
+/// Regular scheme: the axis each level of the BSP cuts. Cycle: x, y, z in turn (the report's);
+/// cost: per level, the axis of least estimated cost (regular_grid.cpp, planSchedule).
+enum class SplitAxes : uint8_t { Cycle, Cost };
+/// Irregular scheme: primary rays walk the camera-frame structure, or the projective zones.
+enum class IrregularFrame : uint8_t { Camera, Projective };
+
+const char* schemeName(SchemeKind k);
+const char* stepName(StepMethod s);
+const char* heuristicName(BspHeuristic h);
+const char* splitAxesName(SplitAxes s);
+const char* irregularFrameName(IrregularFrame f);
+
+/// The regular scheme's knobs (report, section 3). Defaults measured in docs/regular.md
+/// ("Defaults", "Axis order", "Where push goes wrong"):
+/// at max-level 24 / max-objects 4 balls4 makes 11.7 primitive tests per ray (at 18 / 2: 65) and
+/// no built-in CSG scene explodes (at 24 / 2 lattice does); split axes `cost` takes 25% fewer
+/// render instructions than `cycle` on balls4, at most 4% more on the SPD scenes; push matches
+/// brute force on every test ray at delta 1e-6, 0.05 skips thin cells, 1e-19 stalls.
+struct RegularConfig {
+    int maxLevel = 24;                      ///< deepest BSP level (one axis cut per level)
+    int maxObjects = 4;                     ///< a cell with at most this many primitives stops
+    StepMethod step = StepMethod::Exact;    ///< next-leaf method: exact, or the report's push
+    double delta = 1e-6;                    ///< push distance, relative to the box's extent
+    SplitAxes splitAxes = SplitAxes::Cost;  ///< the axis each BSP level cuts
+    bool fullTable = false;                 ///< one full directory instead of sub-tables
+};
+
+/// The irregular scheme's knobs (report, section 2). Defaults measured in docs/irregular.md
+/// ("Growth", "Segment heuristics", "Projective zones for primary rays"):
+/// `balanced` makes 30% fewer zones than `first` and fewer region visits per ray than `first` or
+/// `fewest-cuts`; the projective zones save 2-26% of the instructions per ray. max-objects 4 is
+/// the regular scheme's value; on balls4, 32 renders in the same time with a 28th of the memory.
+struct IrregularConfig {
+    int maxObjects = 4;  ///< a screen cell over at most this many rectangles is a zone (0: never)
+    BspHeuristic heuristic = BspHeuristic::Balanced;    ///< choice of the splitting segment
+    IrregularFrame frame = IrregularFrame::Projective;  ///< what primary rays walk
+};
+
+/// Builder parameters: the scheme, the knobs every scheme reads, and each scheme's Config.
+struct BuildParams {
+    SchemeKind scheme = SchemeKind::Brute;  ///< the command line's default is regular
+    bool mailboxes = true;                  ///< --no-mailbox turns them off to measure their effect
+    /// Accelerated schemes: shorten shadow rays with the light buffer (light_buffer.h);
+    /// --no-light-buffer turns it off to measure its effect. Brute force never uses it.
+    bool lightBuffer = true;
+    RegularConfig regular;      ///< read by the regular scheme only
+    IrregularConfig irregular;  ///< read by the irregular scheme only
+};
+
+}  // namespace lancer
