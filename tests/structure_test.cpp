@@ -80,9 +80,10 @@ Built build(const Case& c) {
     if (c.ortho) makeOrthographic(b.scene);
     BuildParams p;
     p.scheme = c.scheme;
-    p.maxLevel = 12;  // 4096 directory cells at most: every cell can be checked
-    p.maxObjects = c.scheme == SchemeKind::Irregular ? 0 : 2;
-    p.irregularFrame = c.frame;
+    p.regular.maxLevel = 12;  // 4096 directory cells at most: every cell can be checked
+    p.regular.maxObjects = 2;
+    p.irregular.maxObjects = 0;
+    p.irregular.frame = c.frame;
     b.accel = buildAccelerator(b.scene, p);
     return b;
 }

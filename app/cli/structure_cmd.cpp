@@ -10,8 +10,8 @@ namespace lancer::cli {
 
 int runStructure(const CommonOptions& o, const StructureOptions& s) {
     try {
-        Scene scene = loadScene(o.scene);
-        auto accel = buildAccelerator(scene, o.build);
+        Scene scene = loadSceneWithCamera(o);
+        auto accel = buildAccelerator(scene, o.knobs.build);
         StructureDumpOptions d;
         resolveSize(o, scene, d.width, d.height);
         d.all = s.all;
@@ -22,7 +22,7 @@ int runStructure(const CommonOptions& o, const StructureOptions& s) {
             throw std::runtime_error(std::string("-o ") + e.what());
         }
         if (!s.quiet) {
-            std::cout << "structure of " << o.scene << " (" << schemeName(o.build.scheme) << ", "
+            std::cout << "structure of " << o.scene << " (" << schemeName(o.knobs.build.scheme) << ", "
                       << view.regionCount() << " regions"
                       << (dumpIsSummary(view, d) ? ", summarised: --all lists them" : "") << ") -> "
                       << s.output << "\n";
