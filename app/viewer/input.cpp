@@ -37,7 +37,10 @@ void handleMouse(ViewerState& st, int fbHeight) {
 
 void handleKeys(ViewerState& st) {
     ImGuiIO& io = ImGui::GetIO();
-    if (io.WantCaptureKeyboard || io.WantTextInput || !st.sceneBuild()) return;
+    if (io.WantCaptureKeyboard || io.WantTextInput) return;
+    const int tab = ImGui::GetKeyIndex(ImGuiKey_Tab);
+    if (tab >= 0 && ImGui::IsKeyPressed(tab, false)) st.setPanelsHidden(!st.panelsHidden());
+    if (!st.sceneBuild()) return;
     for (ImWchar ch : io.InputQueueCharacters) {
         if (ch == 'r' || ch == 'R') {
             st.setCamera(st.home());

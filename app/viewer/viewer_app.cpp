@@ -51,7 +51,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         glClear(GL_COLOR_BUFFER_BIT);
     }
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(),
-                panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight));
+                panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight), s.logScale);
 
     // 5. Overlays: drawn over the image, under the panels (the panel layer replaces the pixels
     // of every panel's rectangle next). Nothing is drawn here yet; app/viewer/overlay/ draws
@@ -74,7 +74,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
 }
 
 void ViewerApp::saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const {
-    writePng(path, fbWidth, fbHeight, readFramebuffer(fbWidth, fbHeight));
+    writeImage(path, fbWidth, fbHeight, readFramebuffer(fbWidth, fbHeight));
 }
 
 }  // namespace lancer::viewer

@@ -47,7 +47,8 @@ class ViewerApp {
     /// The frame drawn by the last frame() is on screen (after the window's swap): logs, with
     /// --log-timings, the passes it shows for the first time, with their latency.
     void presented() { state_.presented(); }
-    /// Write the framebuffer as drawn by the last frame() to a PNG. Throws std::runtime_error.
+    /// Write the framebuffer as drawn by the last frame() to a PNG or JPEG (by the path's
+    /// extension). Throws std::runtime_error.
     void saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const;
 
     /// What the image area shows, and its heat scale (turns automatic scaling off).

@@ -154,7 +154,12 @@ void ViewerState::pollBuilder() {
             home_ = sceneBuild_->scene->camera;
             camera_ = home_;
             s_.scene = sceneBuild_->spec;
+            // What the panels said of the previous scene no longer applies.
             notes_.builtinSize = -1;
+            notes_.cameraError.clear();
+            notes_.screenshotNote.clear();
+            if (speedup_) speedup_->cancel = true;
+            speedup_.reset();
         }
         if (sceneBuild_->accel->params().scheme == s_.build.scheme) error_.clear();
         changeAt_ = buildChangeAt_;

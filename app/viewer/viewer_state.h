@@ -71,6 +71,8 @@ class ViewerState {
     /// The scene and accelerator on screen (null until the first build succeeds).
     const std::shared_ptr<const SceneBuild>& sceneBuild() const { return sceneBuild_; }
     bool building() const { return builder_.busy(); }
+    /// A render of the current view is under way (false before the first scene is shown).
+    bool rendering() const { return renderer_.job() != 0 && !renderer_.finished(); }
     const ProgressiveRenderer& renderer() const { return renderer_; }
     const std::string& error() const { return error_; }
     const Camera& camera() const { return camera_; }
@@ -85,6 +87,9 @@ class ViewerState {
     float autoHeatScale() const { return autoScale_; }
     PanelNotes& notes() { return notes_; }
     const PanelNotes& notes() const { return notes_; }
+    /// Every panel and the menu bar hidden (Tab, --hide-panels): the image alone.
+    bool panelsHidden() const { return panelsHidden_; }
+    void setPanelsHidden(bool hidden) { panelsHidden_ = hidden; }
 
     // What the panels do.
     /// Open a scene: loaded in the background; on failure the error shows and the previous
@@ -137,6 +142,7 @@ class ViewerState {
     Camera camera_, home_;
     std::string error_;
     PanelNotes notes_;
+    bool panelsHidden_ = false;
 
     // The image on screen.
     Image shown_;

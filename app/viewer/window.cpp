@@ -136,6 +136,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             wakeCv.notify_one();
             glfwPostEmptyEvent();  // thread-safe in GLFW
         });
+        app.state().setPanelsHidden(v.hidePanels);
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
         bool replayed = false, droppedScripted = false;

@@ -21,6 +21,7 @@ struct ViewOptions {
     /// Redraw every frame (at most 60 per second), as while the user keeps interacting; else
     /// only on input, on a worker's result and at 10 Hz while rendering.
     bool continuous = false;
+    bool hidePanels = false;  ///< start with the panels hidden (Tab shows them)
 };
 
 /// What runViewer returns when no window can be opened (no display, no OpenGL 3.3).

@@ -7,12 +7,6 @@
 namespace lancer::viewer {
 
 void cameraPanel(ViewerState& st) {
-    ImGui::SetNextWindowPos(ImVec2(8, 468), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(330, 215), ImGuiCond_FirstUseEver);
-    if (!ImGui::Begin("Camera", &st.settings().showCamera)) {
-        ImGui::End();
-        return;
-    }
     Camera c = st.camera();
     bool changed = false;
     int proj = int(c.projection);
@@ -42,9 +36,7 @@ void cameraPanel(ViewerState& st) {
     if (ImGui::Button("Paste JSON")) st.pasteCameraJson();
     errorText(st.notes().cameraError);
     hintText(
-        "Left drag: orbit. Middle drag: pan. Right drag or wheel: zoom. R: reset. O: "
-        "perspective/orthographic.");
-    ImGui::End();
+        "Drag: orbit (left), pan (middle), zoom (right, wheel). R reset, O ortho, Tab panels.");
 }
 
 }  // namespace lancer::viewer

@@ -6,10 +6,11 @@
 
 namespace lancer::viewer {
 
-/// The main menu bar (which panels are shown, the scene, build and error notes) and every
-/// panel the settings show, in order.
+/// The main menu bar and every panel the settings show, in two columns (none while the panels
+/// are hidden). The functions below draw a panel's content, between its Begin and End.
 void drawPanels(ViewerState& st);
 
+/// Which panels are shown, the scene, build and error notes.
 void menuBar(ViewerState& st);
 /// Scene, subdivision and rendering parameters.
 void parametersPanel(ViewerState& st);

@@ -54,12 +54,6 @@ const BuiltinInfo* findBuiltin(const std::string& name) {
 void parametersPanel(ViewerState& st) {
     ViewerSettings& s = st.settings();
     PanelNotes& notes = st.notes();
-    ImGui::SetNextWindowPos(ImVec2(8, 28), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(330, 430), ImGuiCond_FirstUseEver);
-    if (!ImGui::Begin("Parameters", &s.showParameters)) {
-        ImGui::End();
-        return;
-    }
 
     // Scene: a built-in (with its size) or a file.
     std::string bname;
@@ -82,11 +76,16 @@ void parametersPanel(ViewerState& st) {
             st.openScene("builtin:" + std::string(info->name) + ":" +
                          std::to_string(notes.builtinSize));
     }
-    ImGui::InputText("file", &notes.pathInput);
-    ImGui::SameLine();
+    ImGui::SetNextItemWidth(ImGui::CalcItemWidth() - ImGui::CalcTextSize("Open").x -
+                            2.0f * ImGui::GetStyle().FramePadding.x -
+                            ImGui::GetStyle().ItemInnerSpacing.x);
+    ImGui::InputTextWithHint("##file", ".json / .nff / .csg", &notes.pathInput);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("or drop a scene file on the window");
+    ImGui::SameLine(0.0f, ImGui::GetStyle().ItemInnerSpacing.x);
     if (ImGui::Button("Open") && !notes.pathInput.empty()) st.openScene(notes.pathInput);
-    hintText("or drop a .json / .nff / .csg file on the window");
-    errorText(st.error());
+    ImGui::SameLine(0.0f, ImGui::GetStyle().ItemInnerSpacing.x);
+    ImGui::TextUnformatted("file");
+    errorLines(st.error(), 2);
 
     // The knobs, from the parameter table: a knob the scheme does not read is greyed out.
     const cli::Knobs before = knobsOf(s);
@@ -103,13 +102,13 @@ void parametersPanel(ViewerState& st) {
         ImGui::Text("%zu primitives (%d dropped by minimization)", b->scene->prims.size(),
                     b->scene->droppedPrims);
     }
-    if (st.building())
-        ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "building in the background...");
+    // The line is there while idle too, so the controls under it do not move.
+    ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "%s",
+                       st.building() ? "building in the background..." : "");
 
     ImGui::Separator();
     ImGui::TextUnformatted("Rendering");
     paramControls(cli::ChangeEffect::Rerender, k, maxThreads);
-    ImGui::End();
 
     // What the change asks for is the table's decision (cli::changeEffect, tested without a
     // window): a knob another scheme reads never rebuilds.

@@ -7,12 +7,6 @@ namespace lancer::viewer {
 void statisticsPanel(ViewerState& st) {
     ImGuiIO& io = ImGui::GetIO();
     ViewerSettings& s = st.settings();
-    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 348, 28), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(340, 265), ImGuiCond_FirstUseEver);
-    if (!ImGui::Begin("Statistics", &s.showStatistics)) {
-        ImGui::End();
-        return;
-    }
     const ProgressiveRenderer& renderer = st.renderer();
     ImGui::Text("%d x %d, %d threads, %.0f fps", st.width(), st.height(),
                 effectiveThreads(s.threads), io.Framerate);
@@ -39,13 +33,23 @@ void statisticsPanel(ViewerState& st) {
             total += p.counters;
             renderMs += p.renderMs;
         }
+        // A row for each pass still to come, and the progress bar's line while none renders:
+        // the panel keeps its height through a render, and the one under it stays put.
+        for (size_t i = passes.size(); i < ProgressiveRenderer::kDefaultStrides.size(); ++i) {
+            ImGui::TableNextRow();
+            ImGui::TableNextColumn();
+            ImGui::TextUnformatted("");
+        }
         ImGui::EndTable();
     }
-    if (!renderer.finished()) {
+    if (st.rendering()) {
         size_t done = 0, count = 0;
         renderer.progress(done, count);
         ImGui::ProgressBar(count ? float(done) / float(count) : 0.0f, ImVec2(-1, 0),
                            "rendering next pass");
+    } else {
+        ImGui::AlignTextToFramePadding();  // as tall as the progress bar
+        ImGui::TextDisabled("%s", st.sceneBuild() ? "render complete" : "nothing to render");
     }
     if (total.rays) {
         const double rays = double(total.rays);
@@ -88,7 +92,6 @@ void statisticsPanel(ViewerState& st) {
                 r->scheme.c_str(), m.scheme.renderMs, m.brute.renderMs, m.pixels, m.ratio(),
                 m.schemeTestsPerRay(), m.bruteTestsPerRay());
     }
-    ImGui::End();
 }
 
 }  // namespace lancer::viewer

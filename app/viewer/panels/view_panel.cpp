@@ -2,6 +2,7 @@
 #include <imgui_internal.h>  // MarkIniSettingsDirty
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "app/viewer/panels/panels.h"
@@ -10,8 +11,9 @@ namespace lancer::viewer {
 
 namespace {
 
-/// The colour bar: the stops of the shader's map, value 0 on the left, `scale` on the right.
-void colourBar(float scale, ViewMode mode) {
+/// The colour bar: the stops of the shader's map, value 0 on the left, `scale` on the right
+/// (and, on a log scale, the value in the middle).
+void colourBar(float scale, ViewMode mode, bool logScale) {
     ImVec2 p = ImGui::GetCursorScreenPos();
     const float w = ImGui::GetContentRegionAvail().x, h = 16.0f;
     const auto& stops = colormapStops();
@@ -28,6 +30,12 @@ void colourBar(float scale, ViewMode mode) {
     }
     ImGui::Dummy(ImVec2(w, h));
     ImGui::Text("0");
+    if (logScale) {
+        char mid[32];
+        std::snprintf(mid, sizeof mid, "%.3g", double(std::expm1(0.5f * std::log1p(scale))));
+        ImGui::SameLine(std::max(0.0f, 0.5f * (w - ImGui::CalcTextSize(mid).x)));
+        ImGui::TextUnformatted(mid);
+    }
     char right[32];
     std::snprintf(right, sizeof right, "%.6g %s", double(scale),
                   mode == ViewMode::TimeUs ? "us" : "");
@@ -40,12 +48,6 @@ void colourBar(float scale, ViewMode mode) {
 void viewPanel(ViewerState& st) {
     ImGuiIO& io = ImGui::GetIO();
     ViewerSettings& s = st.settings();
-    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 348, 301), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(340, 175), ImGuiCond_FirstUseEver);
-    if (!ImGui::Begin("View", &s.showView)) {
-        ImGui::End();
-        return;
-    }
     int mode = int(s.mode);
     for (int i = 0; i < kViewModeCount; ++i) {
         if (i) ImGui::SameLine();
@@ -63,12 +65,17 @@ void viewPanel(ViewerState& st) {
         if (ImGui::Checkbox("auto scale", &s.autoScale)) ImGui::MarkIniSettingsDirty();
         ImGui::SameLine();
         if (s.autoScale) s.heatScale = st.heatScale();
+        ImGui::SetNextItemWidth(150.0f);
         if (ImGui::SliderFloat("##scale", &s.heatScale, 1.0f, 1e6f, "%.0f",
                                ImGuiSliderFlags_Logarithmic)) {
             s.autoScale = false;
             ImGui::MarkIniSettingsDirty();
         }
-        colourBar(st.heatScale(), s.mode);
+        ImGui::SameLine();
+        if (ImGui::Checkbox("log", &s.logScale)) ImGui::MarkIniSettingsDirty();
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("Colour by log(1 + count): the low counts spread out");
+        colourBar(st.heatScale(), s.mode, s.logScale);
     }
     // The pixel under the cursor, from the same per-pixel counters as --stats.
     const Image& shown = st.shown();
@@ -79,7 +86,11 @@ void viewPanel(ViewerState& st) {
             size_t i = shown.index(x, y);
             ImGui::Text("pixel %d %d: %u prim tests, %u regions, %.1f us", x, y, shown.primTests[i],
                         shown.regionVisits[i], double(shown.timeUs[i]));
+        } else {
+            ImGui::TextDisabled("(the pixel under the cursor)");
         }
+    } else {
+        ImGui::TextDisabled("(the pixel under the cursor)");
     }
     ImGui::Separator();
     PanelNotes& notes = st.notes();
@@ -89,7 +100,6 @@ void viewPanel(ViewerState& st) {
             "lancer-screenshot-" + std::to_string(++notes.screenshotCount) + ".png";
     }
     if (!notes.screenshotNote.empty()) ImGui::TextWrapped("%s", notes.screenshotNote.c_str());
-    ImGui::End();
 }
 
 }  // namespace lancer::viewer

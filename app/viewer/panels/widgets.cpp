@@ -9,6 +9,14 @@ void errorText(const std::string& text) {
     ImGui::PopStyleColor();
 }
 
+void errorLines(const std::string& text, int lines) {
+    const float h = float(lines) * ImGui::GetTextLineHeightWithSpacing();
+    ImGui::BeginChild("##error", ImVec2(0.0f, h), false);
+    errorText(text);
+    ImGui::EndChild();
+    if (!text.empty() && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text.c_str());
+}
+
 void hintText(const char* text) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
     ImGui::TextWrapped("%s", text);

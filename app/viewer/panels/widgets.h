@@ -26,6 +26,9 @@ bool enumCombo(const char* label, E& value, int count, const char* (*name)(E)) {
 
 /// `text` wrapped, in the colour of errors (nothing for an empty one).
 void errorText(const std::string& text);
+/// `text` as errorText() in a region `lines` lines high, there with or without an error, so the
+/// controls under it stay where they are; a longer error scrolls and shows whole when hovered.
+void errorLines(const std::string& text, int lines);
 /// `text` wrapped, greyed out (hints).
 void hintText(const char* text);
 
