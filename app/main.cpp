@@ -73,7 +73,9 @@ int main(int argc, char** argv) {
     cli::addCommonOptions(*render, renderOpt);
 
     cli::TraceOptions topt;
-    CLI::App* trace = app.add_subcommand("trace", "Trace one primary ray and print its walk");
+    CLI::App* trace = app.add_subcommand(
+        "trace",
+        "Trace one pixel's rays (primary, shadow, reflected, refracted) and print their walks");
     trace->add_option("scene", traceOpt.scene, kSceneHelp)->required();
     std::vector<int> pixel;
     trace->add_option("--pixel", pixel, "Pixel X Y (y = 0 on the top row)")
@@ -85,8 +87,7 @@ int main(int argc, char** argv) {
     cli::StructureOptions sopt;
     CLI::App* structure = app.add_subcommand(
         "structure", "Write the built structure as JSON (regions, zones, slabs)");
-    structure->add_option("scene", structureOpt.scene, kSceneHelp)
-        ->required();
+    structure->add_option("scene", structureOpt.scene, kSceneHelp)->required();
     structure->add_option("-o,--output", sopt.output, "Output JSON")->required();
     structure->add_flag("--all", sopt.all, "List every region even beyond a million (else counts)");
     structure->add_flag("-q,--quiet", sopt.quiet, "Print nothing on success");

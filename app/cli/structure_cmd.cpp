@@ -22,8 +22,8 @@ int runStructure(const CommonOptions& o, const StructureOptions& s) {
             throw std::runtime_error(std::string("-o ") + e.what());
         }
         if (!s.quiet) {
-            std::cout << "structure of " << o.scene << " (" << schemeName(o.knobs.build.scheme) << ", "
-                      << view.regionCount() << " regions"
+            std::cout << "structure of " << o.scene << " (" << schemeName(o.knobs.build.scheme)
+                      << ", " << view.regionCount() << " regions"
                       << (dumpIsSummary(view, d) ? ", summarised: --all lists them" : "") << ") -> "
                       << s.output << "\n";
         }
