@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 
 #include "app/viewer/camera_control.h"
 #include "app/viewer/gl.h"
@@ -82,7 +83,10 @@ bool enumCombo(const char* label, E& value, int count, const char* (*name)(E)) {
 }  // namespace
 
 ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<void()> wake)
-    : s_(settings), logTimings_(logTimings), view_(std::make_unique<ImageView>()) {
+    : s_(settings),
+      logTimings_(logTimings),
+      view_(std::make_unique<ImageView>()),
+      overlays_(std::make_unique<overlay::Overlays>()) {
     if (wake) {
         renderer_.setOnPass(wake);
         builder_.setOnReady(wake);
@@ -239,7 +243,7 @@ void ViewerApp::handleInput(int fbWidth, int fbHeight) {
     const float dx = io.MouseDelta.x * io.DisplayFramebufferScale.x;
     const float dy = io.MouseDelta.y * io.DisplayFramebufferScale.y;
     if (dx != 0.0f || dy != 0.0f) {
-        if (ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+        if (ImGui::IsMouseDown(ImGuiMouseButton_Left) && !io.KeyCtrl) {
             orbit(c, -0.008 * dx, 0.008 * dy);
             moved = true;
         } else if (ImGui::IsMouseDown(ImGuiMouseButton_Middle)) {
@@ -257,9 +261,34 @@ void ViewerApp::handleInput(int fbWidth, int fbHeight) {
     if (moved) setCamera(c);
 }
 
+void ViewerApp::overlayInput(int fbWidth, int fbHeight) {
+    ImGuiIO& io = ImGui::GetIO();
+    // Clicks ImGui wants never pick; a plain left drag orbits, so picking takes Ctrl+click.
+    if (io.WantCaptureMouse || !structure_ || !ImGui::IsMousePosValid()) return;
+    const double x = double(io.MousePos.x * io.DisplayFramebufferScale.x);
+    const double y = double(io.MousePos.y * io.DisplayFramebufferScale.y);
+    if (x < 0.0 || y < 0.0 || x >= fbWidth || y >= fbHeight) return;
+    // The primary hit's depth under the mouse, from the image on screen when it is this size.
+    float depth = std::numeric_limits<float>::infinity();
+    if (shown_.width == fbWidth && shown_.height == fbHeight && !shown_.depth.empty())
+        depth = shown_.depth[shown_.index(int(x), int(y))];
+    if (io.KeyCtrl && ImGui::IsMouseClicked(ImGuiMouseButton_Left)) {
+        overlays_->pickAt(camera_, fbWidth, fbHeight, x, y, depth);
+        s_.showSelection = true;
+    } else if (!ImGui::IsAnyMouseDown() && !panelsHidden_ && overlays_->options.any()) {
+        overlays_->tooltip(camera_, fbWidth, fbHeight, x, y, depth);
+    }
+}
+
+std::vector<std::string> ViewerApp::applyShow(const std::string& list) {
+    return overlay::applyShowList(list, overlays_->options);
+}
+
 void ViewerApp::handleKeys() {
     ImGuiIO& io = ImGui::GetIO();
     if (io.WantCaptureKeyboard || io.WantTextInput || !structure_) return;
+    if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Tab), false))
+        panelsHidden_ = !panelsHidden_;
     for (ImWchar ch : io.InputQueueCharacters) {
         if (ch == 'r' || ch == 'R') {
             setCamera(home_);
@@ -314,6 +343,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui::NewFrame();
     handleInput(fbWidth, fbHeight);
+    overlayInput(fbWidth, fbHeight);
     handleKeys();
     panels();
     if (fbWidth > 0 && fbHeight > 0 && (fbWidth != jobWidth_ || fbHeight != jobHeight_)) {
@@ -347,6 +377,9 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // The image is copied only around the opaque panels drawn over it next.
     view_->draw(fbWidth, fbHeight, s_.mode, scale_,
                 panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight));
+    // Overlays after the image, before the panels (opaque, drawn over them).
+    overlays_->update(structure_, camera_, fbWidth, fbHeight);
+    overlays_->draw(camera_, fbWidth, fbHeight);
     panels_.render();
     if (!pendingScreenshot_.empty()) {
         try {
@@ -374,12 +407,15 @@ void ViewerApp::saveScreenshot(const std::string& path, int fbWidth, int fbHeigh
 }
 
 void ViewerApp::panels() {
+    if (panelsHidden_) return;
     if (ImGui::BeginMainMenuBar()) {
         if (ImGui::BeginMenu("Panels")) {
             ImGui::MenuItem("Parameters", nullptr, &s_.showParameters);
             ImGui::MenuItem("Camera", nullptr, &s_.showCamera);
             ImGui::MenuItem("Statistics", nullptr, &s_.showStatistics);
             ImGui::MenuItem("View", nullptr, &s_.showView);
+            ImGui::MenuItem("Overlays", nullptr, &s_.showOverlays);
+            ImGui::MenuItem("Selection", nullptr, &s_.showSelection);
             ImGui::EndMenu();
         }
         ImGui::TextDisabled("%s", s_.scene.c_str());
@@ -392,6 +428,8 @@ void ViewerApp::panels() {
     if (s_.showCamera) cameraPanel();
     if (s_.showStatistics) statisticsPanel();
     if (s_.showView) viewPanel();
+    if (s_.showOverlays) overlays_->panel(&s_.showOverlays);
+    if (s_.showSelection) overlays_->selectionPanel(&s_.showSelection);
 }
 
 void ViewerApp::parametersPanel() {

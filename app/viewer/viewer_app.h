@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "app/viewer/image_view.h"
+#include "app/viewer/overlay/overlays.h"
 #include "app/viewer/panel_cache.h"
 #include "app/viewer/structure_builder.h"
 #include "app/viewer/viewer_settings.h"
@@ -67,6 +68,17 @@ class ViewerApp {
     const std::string& cameraError() const { return cameraError_; }
     /// The scene and structure on screen (null until the first build succeeds).
     const std::shared_ptr<const Structure>& structure() const { return structure_; }
+    /// The overlays over the image (layers, selection); the inspector reads the selection.
+    overlay::Overlays& overlays() { return *overlays_; }
+    const overlay::Overlays& overlays() const { return *overlays_; }
+    /// Apply a --show list (DESIGN.md section 6) to the overlays. Returns the items nothing in
+    /// the viewer draws yet (to be refused by the caller); throws std::invalid_argument naming an
+    /// unknown item. Views other than the overlays (the inspector's boxes, frustum and view, the
+    /// ray) take their items here, from what the overlays leave.
+    std::vector<std::string> applyShow(const std::string& list);
+    /// Hide the panels and the menu bar (only the image and its overlays show); Tab toggles.
+    void setPanelsHidden(bool hidden) { panelsHidden_ = hidden; }
+    bool panelsHidden() const { return panelsHidden_; }
     /// The heat scale in use this frame.
     float heatScale() const { return scale_; }
 
@@ -89,6 +101,8 @@ class ViewerApp {
     void takeSnapshot();
     void handleInput(int fbWidth, int fbHeight);
     void handleKeys();
+    /// The hover tooltip and Ctrl+click picking over the image (mouse not taken by ImGui).
+    void overlayInput(int fbWidth, int fbHeight);
     void panels();
     void parametersPanel();
     void cameraPanel();
@@ -106,6 +120,8 @@ class ViewerApp {
     ViewerSettings& s_;
     bool logTimings_;
     std::unique_ptr<ImageView> view_;
+    std::unique_ptr<overlay::Overlays> overlays_;
+    bool panelsHidden_ = false;
     PanelCache panels_;  ///< ImGui's panels, each redrawn only when it changed
     StructureBuilder builder_;
     ProgressiveRenderer renderer_;

@@ -146,6 +146,17 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             wakeCv.notify_one();
             glfwPostEmptyEvent();  // thread-safe in GLFW
         });
+        if (!v.show.empty()) {
+            // Every item names something drawn: an item no view draws is refused, not ignored.
+            std::vector<std::string> notDrawn = app.applyShow(v.show);
+            if (!notDrawn.empty()) {
+                std::string names;
+                for (const std::string& n : notDrawn) names += (names.empty() ? "" : ", ") + n;
+                throw std::invalid_argument("--show: not drawn by this viewer yet: " + names);
+            }
+        }
+        app.setPanelsHidden(v.hidePanels);
+        if (v.select >= 0) app.overlays().select(uint32_t(v.select));
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
         bool replayed = false, droppedScripted = false;
@@ -218,6 +229,11 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             } else if (v.frames > 0 && frames >= v.frames && app.settled()) {
                 if (!app.structure()) {  // a scripted run on a scene that cannot be shown fails
                     std::cerr << "error: lancer view: the scene could not be shown (see above)\n";
+                    status = 2;
+                } else if (v.select >= 0 && !app.overlays().selection()) {
+                    const StructureView* sv = app.overlays().view();
+                    std::cerr << "error: --select: no region " << v.select << " in the structure ("
+                              << (sv ? sv->regionCount() : 0) << " regions)\n";
                     status = 2;
                 }
                 if (!v.screenshot.empty()) {
