@@ -28,6 +28,8 @@ ImageView::ImageView() {
     locStopCount_ = program_->uniform("stopCount");
     locColor_ = program_->uniform("colorTex");
     locHeat_ = program_->uniform("heatTex");
+    locOverlay_ = program_->uniform("overlayTex");
+    locHasOverlay_ = program_->uniform("hasOverlay");
     glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even an empty one
     GLuint tex[3];
     glGenTextures(3, tex);
@@ -75,7 +77,8 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
     if (rows > 0) {
         // 8 bits per channel, quantised as the PNG writer does: the screen shows what `render`
         // saves.
-        if (mode == ViewMode::Color && !resized && shadedValid_ && shadedMode_ == ViewMode::Color) {
+        if (mode == ViewMode::Color && !resized && shadedValid_ && shadedMode_ == ViewMode::Color &&
+            overlayTex_ == 0) {
             // The colour shader only copies: the rows go straight into the shaded texture,
             // bottom row first as the FBO holds them, and need no shading (under llvmpipe,
             // shading a whole 1280x720 image took 7 ms of the UI thread). colorTex_ is left
@@ -105,6 +108,13 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
         shadedValid_ = false;
     else
         dirty_.add(rowBegin, rowEnd);
+}
+
+void ImageView::setOverlay(unsigned texture, uint64_t version) {
+    if (texture == overlayTex_ && (texture == 0 || version == overlayVersion_)) return;
+    overlayTex_ = texture;
+    overlayVersion_ = version;
+    shadedValid_ = false;
 }
 
 std::vector<PixelRect> uncovered(int width, int height, const std::vector<PixelRect>& covered) {
@@ -183,6 +193,10 @@ void ImageView::shade(ViewMode mode, float scale, int rowBegin, int rowEnd) cons
     glBindTexture(GL_TEXTURE_2D, heatTex_);
     glUniform1i(locColor_, 0);
     glUniform1i(locHeat_, 1);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, overlayTex_);
+    glUniform1i(locOverlay_, 2);
+    glUniform1i(locHasOverlay_, overlayTex_ != 0);
     glUniform1i(locMode_, mode == ViewMode::Color ? 0 : 1);
     glUniform1f(locScale_, scale);
     const auto& stops = colormapStops();
@@ -191,6 +205,8 @@ void ImageView::shade(ViewMode mode, float scale, int rowBegin, int rowEnd) cons
     glBindVertexArray(vao_);
     glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
     glBindVertexArray(0);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, 0);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, 0);
     glActiveTexture(GL_TEXTURE0);

@@ -43,6 +43,11 @@ class ImageView {
     /// under software GL the copy costs 7 ns a pixel.
     void draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
               const std::vector<PixelRect>& covered = {}) const;
+    /// Composite a layer over the image when it is shaded: `texture` an RGBA8 texture of
+    /// premultiplied colour drawn like the framebuffer (row 0 at the bottom), any size; 0: none.
+    /// A new `version` shades the whole image again; otherwise only uploaded rows are, so a
+    /// layer that does not change costs nothing per frame (the draw stays one copy).
+    void setOverlay(unsigned texture, uint64_t version);
     /// Size of the uploaded image (0 x 0 before the first upload).
     int width() const { return width_; }
     int height() const { return height_; }
@@ -61,6 +66,9 @@ class ImageView {
     /// pass each time).
     mutable RowRange dirty_;
     int width_ = 0, height_ = 0;
+    unsigned overlayTex_ = 0;
+    uint64_t overlayVersion_ = 0;
+    int locOverlay_ = -1, locHasOverlay_ = -1;
     int locMode_ = -1, locScale_ = -1, locStops_ = -1, locStopCount_ = -1, locColor_ = -1,
         locHeat_ = -1;
 };

@@ -375,11 +375,17 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         glClear(GL_COLOR_BUFFER_BIT);
     }
     // The image is copied only around the opaque panels drawn over it next.
+    // The overlays' layers are composited into the image when it is shaded (drawn again only
+    // when they change); the selection is drawn over the image, before the panels.
+    overlays_->update(structure_, camera_, fbWidth, fbHeight);
+    const unsigned layer = overlays_->layerTexture(camera_, fbWidth, fbHeight);
+    if (layer != 0 && !overlayShown_ && view_->width() > 0)
+        view_->upload(shown_, s_.mode);  // colour bands may have bypassed the texture shaded
+    overlayShown_ = layer != 0;
+    view_->setOverlay(layer, overlays_->layerVersion());
     view_->draw(fbWidth, fbHeight, s_.mode, scale_,
                 panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight));
-    // Overlays after the image, before the panels (opaque, drawn over them).
-    overlays_->update(structure_, camera_, fbWidth, fbHeight);
-    overlays_->draw(camera_, fbWidth, fbHeight);
+    overlays_->drawSelection(camera_, fbWidth, fbHeight);
     panels_.render();
     if (!pendingScreenshot_.empty()) {
         try {

@@ -122,7 +122,8 @@ class ViewerApp {
     std::unique_ptr<ImageView> view_;
     std::unique_ptr<overlay::Overlays> overlays_;
     bool panelsHidden_ = false;
-    PanelCache panels_;  ///< ImGui's panels, each redrawn only when it changed
+    bool overlayShown_ = false;  ///< the image view composites the overlays' layer
+    PanelCache panels_;          ///< ImGui's panels, each redrawn only when it changed
     StructureBuilder builder_;
     ProgressiveRenderer renderer_;
     std::shared_ptr<const Structure> structure_;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "app/viewer/gl/transforms.h"
+#include "app/viewer/image_view.h"
 #include "app/viewer/overlay/overlays.h"
 #include "engine/accel/irregular/irregular.h"
 #include "engine/accel/regular/regular_grid.h"
@@ -275,6 +276,52 @@ TEST(Overlays, ARebuildAtAnotherMaxLevelChangesTheDrawnLeavesAndOnlyThen) {
         changed += lit(after, int(i / 4) % kW, int(i / 4) / kW) !=
                    lit(before, int(i / 4) % kW, int(i / 4) / kW);
     EXPECT_GT(changed, 10u);
+}
+
+TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShows) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Irregular);
+    const Camera& cam = s->scene->camera;
+    Overlays ov;
+    ov.options.bsp = ov.options.zones = true;
+    ov.update(s, cam, kW, kH);
+    Image img(kW, kH);
+    for (size_t i = 0; i < img.color.size(); ++i) img.color[i] = glm::vec3(0.2f, 0.3f, 0.4f);
+    // Drawn directly over the image, then composited by the image view: the same pixels.
+    ImageView view;
+    view.upload(img, ViewMode::Color);
+    view.draw(kW, kH, ViewMode::Color, 1.0f);
+    ov.drawLayers(cam, kW, kH);
+    const std::vector<uint8_t> direct = gl.read();
+    const unsigned tex = ov.layerTexture(cam, kW, kH);
+    ASSERT_NE(tex, 0u);
+    const uint64_t version = ov.layerVersion();
+    EXPECT_EQ(ov.layerTexture(cam, kW, kH), tex);
+    EXPECT_EQ(ov.layerVersion(), version) << "nothing changed: the texture is not drawn again";
+    view.setOverlay(tex, version);
+    gl.clear(0, 0, 0);
+    view.draw(kW, kH, ViewMode::Color, 1.0f);
+    const std::vector<uint8_t> composited = gl.read();
+    int worst = 0;
+    size_t differing = 0;
+    for (size_t i = 0; i < direct.size(); ++i) {
+        worst = std::max(worst, std::abs(int(direct[i]) - int(composited[i])));
+        differing += direct[i] != composited[i];
+    }
+    EXPECT_LE(worst, 2);
+    size_t overlaid = 0;  // and the overlays are there at all
+    for (size_t i = 0; i < direct.size(); i += 4)
+        overlaid += std::abs(int(composited[i + 2]) - int(std::lround(0.4f * 255.0f))) > 8;
+    EXPECT_GT(overlaid, size_t(kW));
+    // A change of look draws the texture again; turning the layer off restores the image.
+    ov.look.fillOpacity = 0.8f;
+    ov.layerTexture(cam, kW, kH);
+    EXPECT_EQ(ov.layerVersion(), version + 1);
+    view.setOverlay(0, 0);
+    view.draw(kW, kH, ViewMode::Color, 1.0f);
+    const std::vector<uint8_t> plain = gl.read();
+    for (size_t i = 0; i < plain.size(); i += 4) ASSERT_NEAR(plain[i + 2], 102, 1);
 }
 
 TEST(Overlays, TheShowListTurnsLayersOnAndNamesWhatItDoesNotDraw) {

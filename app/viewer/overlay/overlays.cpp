@@ -34,7 +34,10 @@ Overlays::Overlays()
       fills_(std::make_unique<gl::GpuBatch>()),
       wires_(std::make_unique<gl::GpuBatch>()) {}
 
-Overlays::~Overlays() = default;
+Overlays::~Overlays() {
+    glDeleteFramebuffers(1, &layerFbo_);
+    glDeleteTextures(1, &layerTex_);
+}
 
 bool Overlays::select(uint32_t id) {
     if (!view_) {  // before the first structure: applied when it arrives
@@ -91,8 +94,8 @@ void Overlays::update(const std::shared_ptr<const Structure>& structure, const C
     ++rebuilds_;
 }
 
-void Overlays::draw(const Camera& view, int width, int height) {
-    if (!view_ || width <= 0 || height <= 0) return;
+void Overlays::drawLayers(const Camera& view, int width, int height) {
+    if (!view_ || width <= 0 || height <= 0 || !options.any()) return;
     const auto [nearDepth, farDepth] = clipDepths(*view_, view);
     const glm::mat4 toClip = gl::worldToClip(view, width, height, nearDepth, farDepth);
     glViewport(0, 0, width, height);
@@ -107,16 +110,59 @@ void Overlays::draw(const Camera& view, int width, int height) {
     gl::DrawOptions cuts = wire;
     if (look.replayCuts >= 0) cuts.lineLimit = size_t(look.replayCuts) * geometry_.linesPerCut;
     renderer_->draw(*cuts_, toClip, cuts);
-    if (selection_ && selection_->region < view_->regionCount()) {
-        // The selected region: its faces tinted, its edges bright.
-        const std::array<Vec3, 8> wc = view_->regionCorners(selection_->region);
-        std::array<glm::vec3, 8> c;
-        for (size_t i = 0; i < 8; ++i) c[i] = glm::vec3(wc[i]);
-        gl::Batch b;
-        b.fillBox(c, gl::rgba8(glm::vec3(0.2f, 1.0f, 1.0f), 0.18f));
-        b.box(c, gl::rgba8(glm::vec3(0.3f, 1.0f, 1.0f)));
-        renderer_->drawNow(b, toClip);
+}
+
+void Overlays::drawSelection(const Camera& view, int width, int height) {
+    if (!view_ || width <= 0 || height <= 0) return;
+    if (!selection_ || selection_->region >= view_->regionCount()) return;
+    const auto [nearDepth, farDepth] = clipDepths(*view_, view);
+    const glm::mat4 toClip = gl::worldToClip(view, width, height, nearDepth, farDepth);
+    glViewport(0, 0, width, height);
+    // The selected region: its faces tinted, its edges bright.
+    const std::array<Vec3, 8> wc = view_->regionCorners(selection_->region);
+    std::array<glm::vec3, 8> c;
+    for (size_t i = 0; i < 8; ++i) c[i] = glm::vec3(wc[i]);
+    gl::Batch b;
+    b.fillBox(c, gl::rgba8(glm::vec3(0.2f, 1.0f, 1.0f), 0.18f));
+    b.box(c, gl::rgba8(glm::vec3(0.3f, 1.0f, 1.0f)));
+    renderer_->drawNow(b, toClip);
+}
+
+unsigned Overlays::layerTexture(const Camera& view, int width, int height) {
+    if (!view_ || !options.any() || width <= 0 || height <= 0) return 0;
+    if (layerTex_ != 0 && layerRebuild_ == rebuilds_ && layerWidth_ == width &&
+        layerHeight_ == height && layerLook_ == look && sameCamera(layerCamera_, view))
+        return layerTex_;
+    if (layerTex_ == 0) {
+        glGenTextures(1, &layerTex_);
+        glGenFramebuffers(1, &layerFbo_);
     }
+    if (layerWidth_ != width || layerHeight_ != height) {
+        glBindTexture(GL_TEXTURE_2D, layerTex_);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                     nullptr);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, layerFbo_);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, layerTex_, 0);
+        layerWidth_ = width;
+        layerHeight_ = height;
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, layerFbo_);
+    glDisable(GL_SCISSOR_TEST);
+    glViewport(0, 0, width, height);
+    glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    drawLayers(view, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    layerRebuild_ = rebuilds_;
+    layerLook_ = look;
+    layerCamera_ = view;
+    ++layerVersion_;
+    return layerTex_;
 }
 
 bool Overlays::pickAt(const Camera& view, int width, int height, double x, double y, float depth) {

@@ -16,6 +16,7 @@ namespace lancer::viewer::overlay {
 
 /// Drawing choices that need no rebuild of the batches.
 struct OverlayLook {
+    bool operator==(const OverlayLook&) const = default;
     int replayCuts = -1;        ///< cuts drawn, in the order they were made (-1: all)
     float fillOpacity = 0.35f;  ///< zones' fills
     float lineOpacity = 0.9f;   ///< cut lines and wireframes
@@ -47,7 +48,21 @@ class Overlays {
                 int height);
     /// Draw the layers and the selection into the current framebuffer (width x height, the
     /// image filling it), as seen by `view`.
-    void draw(const Camera& view, int width, int height);
+    void draw(const Camera& view, int width, int height) {
+        drawLayers(view, width, height);
+        drawSelection(view, width, height);
+    }
+    /// The layers alone (cut lines, fills, wireframes), blended into the current framebuffer.
+    void drawLayers(const Camera& view, int width, int height);
+    /// The selection's highlight alone (a few lines and faces: cheap to draw every frame).
+    void drawSelection(const Camera& view, int width, int height);
+    /// The layers drawn into a texture of their own (premultiplied RGBA, framebuffer rows),
+    /// again only when the batches, the camera, the size or the look changed: the image view
+    /// composites it when it shades the image (ImageView::setOverlay), so layers of a million
+    /// lines cost nothing in a frame where nothing changed. 0 when no layer is on.
+    unsigned layerTexture(const Camera& view, int width, int height);
+    /// Incremented each time layerTexture() draws the texture again.
+    uint64_t layerVersion() const { return layerVersion_; }
 
     /// The Overlays panel (layers, replay, opacity, level range, cap, counts).
     void panel(bool* open);
@@ -87,6 +102,12 @@ class Overlays {
     bool built_ = false;
     uint64_t rebuilds_ = 0;
     double lastBuildMs_ = 0.0;
+    // The layers' texture and what it was drawn for.
+    unsigned layerFbo_ = 0, layerTex_ = 0;
+    int layerWidth_ = 0, layerHeight_ = 0;
+    uint64_t layerVersion_ = 0, layerRebuild_ = ~uint64_t(0);
+    Camera layerCamera_;
+    OverlayLook layerLook_;
     std::optional<Selection> selection_;
     uint32_t pendingSelect_ = 0;
     bool hasPendingSelect_ = false;
