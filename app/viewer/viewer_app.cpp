@@ -280,6 +280,27 @@ void ViewerApp::overlayInput(int fbWidth, int fbHeight) {
     }
 }
 
+void ViewerApp::logOverlayTiming(double ms, bool layerDrawn) {
+    // The overlays' UI work, per frame, apart from frames that drew the layers again (a
+    // change): those are logged one by one.
+    if (layerDrawn) {
+        char line[160];
+        std::snprintf(line, sizeof line,
+                      "overlays: layers drawn again in %.2f ms (batches built in %.2f ms)",
+                      overlays_->lastLayerMs(), overlays_->lastBuildMs());
+        logTiming(line);
+        return;
+    }
+    overlayStat_.ms += ms;
+    ++overlayStat_.frames;
+    if (Clock::now() - overlayStat_.since < std::chrono::seconds(2)) return;
+    char line[160];
+    std::snprintf(line, sizeof line, "overlays: %.3f ms of UI work a frame (%d frames)",
+                  overlayStat_.ms / overlayStat_.frames, overlayStat_.frames);
+    logTiming(line);
+    overlayStat_ = {};
+}
+
 std::vector<std::string> ViewerApp::applyShow(const std::string& list) {
     return overlay::applyShowList(list, overlays_->options);
 }
@@ -377,15 +398,26 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // The image is copied only around the opaque panels drawn over it next.
     // The overlays' layers are composited into the image when it is shaded (drawn again only
     // when they change); the selection is drawn over the image, before the panels.
+    const Clock::time_point overlayStart = Clock::now();
+    const uint64_t layerVersion = overlays_->layerVersion();
     overlays_->update(structure_, camera_, fbWidth, fbHeight);
-    const unsigned layer = overlays_->layerTexture(camera_, fbWidth, fbHeight);
+    // While a drag moves the camera the layers are left out rather than drawn again each
+    // frame (balls4's regular leaves take llvmpipe about 0.9 s); they return when it ends.
+    const bool dragging = ImGui::IsAnyMouseDown() && !ImGui::GetIO().WantCaptureMouse &&
+                          overlays_->layerStale(camera_, fbWidth, fbHeight);
+    const unsigned layer = dragging ? 0 : overlays_->layerTexture(camera_, fbWidth, fbHeight);
+    double overlayMs =
+        std::chrono::duration<double, std::milli>(Clock::now() - overlayStart).count();
     if (layer != 0 && !overlayShown_ && view_->width() > 0)
         view_->upload(shown_, s_.mode);  // colour bands may have bypassed the texture shaded
     overlayShown_ = layer != 0;
     view_->setOverlay(layer, overlays_->layerVersion());
     view_->draw(fbWidth, fbHeight, s_.mode, scale_,
                 panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight));
+    const Clock::time_point selectionStart = Clock::now();
     overlays_->drawSelection(camera_, fbWidth, fbHeight);
+    overlayMs += std::chrono::duration<double, std::milli>(Clock::now() - selectionStart).count();
+    if (logTimings_) logOverlayTiming(overlayMs, overlays_->layerVersion() != layerVersion);
     panels_.render();
     if (!pendingScreenshot_.empty()) {
         try {

@@ -113,6 +113,8 @@ class ViewerApp {
     void markRender(const char* why);
     void startSpeedup();
     void logTiming(const std::string& line) const;
+    /// --log-timings: the overlays' work in this frame (`layerDrawn`: it drew the layers).
+    void logOverlayTiming(double ms, bool layerDrawn);
     void updateAutoScale();
     /// The heat scale this frame draws with: the automatic one or the user's.
     void updateScale();
@@ -123,7 +125,12 @@ class ViewerApp {
     std::unique_ptr<overlay::Overlays> overlays_;
     bool panelsHidden_ = false;
     bool overlayShown_ = false;  ///< the image view composites the overlays' layer
-    PanelCache panels_;          ///< ImGui's panels, each redrawn only when it changed
+    struct OverlayStat {
+        double ms = 0.0;
+        int frames = 0;
+        Clock::time_point since = Clock::now();
+    } overlayStat_;
+    PanelCache panels_;  ///< ImGui's panels, each redrawn only when it changed
     StructureBuilder builder_;
     ProgressiveRenderer renderer_;
     std::shared_ptr<const Structure> structure_;

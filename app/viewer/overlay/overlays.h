@@ -61,6 +61,10 @@ class Overlays {
     /// composites it when it shades the image (ImageView::setOverlay), so layers of a million
     /// lines cost nothing in a frame where nothing changed. 0 when no layer is on.
     unsigned layerTexture(const Camera& view, int width, int height);
+    /// layerTexture() would draw the texture again (or has none to give).
+    bool layerStale(const Camera& view, int width, int height) const;
+    /// Milliseconds the last drawing of the layers' texture took (to the end of GL's work).
+    double lastLayerMs() const { return lastLayerMs_; }
     /// Incremented each time layerTexture() draws the texture again.
     uint64_t layerVersion() const { return layerVersion_; }
 
@@ -106,6 +110,7 @@ class Overlays {
     unsigned layerFbo_ = 0, layerTex_ = 0;
     int layerWidth_ = 0, layerHeight_ = 0;
     uint64_t layerVersion_ = 0, layerRebuild_ = ~uint64_t(0);
+    double lastLayerMs_ = 0.0;
     Camera layerCamera_;
     OverlayLook layerLook_;
     std::optional<Selection> selection_;
