@@ -98,6 +98,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
         ImGui::LoadIniSettingsFromDisk(ini.c_str());
     }
     applyCommandLine(o, given, settings);
+    if (v.select >= 0) settings.showSelection = true;
 
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);

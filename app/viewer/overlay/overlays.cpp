@@ -202,7 +202,10 @@ void Overlays::tooltip(const Camera& view, int width, int height, double x, doub
 }
 
 void Overlays::panel(bool* open) {
-    ImGui::SetNextWindowSize(ImVec2(330, 0), ImGuiCond_FirstUseEver);
+    // Under the View panel, in the right-hand column (the image's middle stays clear).
+    ImGui::SetNextWindowPos(ImVec2(ImGui::GetIO().DisplaySize.x - 348, 484),
+                            ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(340, 230), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Overlays", open)) {
         ImGui::End();
         return;
@@ -295,6 +298,7 @@ void csgTreeNode(const CsgTree& pool, int node, const Scene& scene) {
 }  // namespace
 
 void Overlays::selectionPanel(bool* open) {
+    ImGui::SetNextWindowPos(ImVec2(346, 28), ImGuiCond_FirstUseEver);
     ImGui::SetNextWindowSize(ImVec2(360, 420), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Selection", open)) {
         ImGui::End();
