@@ -403,7 +403,7 @@ std::vector<std::string> applyShowList(const std::string& list, OverlayOptions& 
             notDrawn.push_back(item);
         else
             throw std::invalid_argument(
-                "--show: unknown item '" + item +
+                "unknown item '" + item +
                 "' (expected bsp, zones, slabs, leaves, grid, boxes, frustum, inspector, ray, "
                 "none)");
     }
