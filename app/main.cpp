@@ -12,6 +12,11 @@
 
 using namespace lancer;
 
+namespace {
+constexpr const char* kSceneHelp =
+    "Scene: a .json, .nff or .csg (OpenSCAD's CSG export) file, or builtin:NAME[:SIZE]";
+}  // namespace
+
 int main(int argc, char** argv) {
     CLI::App app{
         "lancer: see and measure how space subdivision accelerates ray tracing of CSG solids"};
@@ -26,7 +31,7 @@ int main(int argc, char** argv) {
     std::string viewOut = "lancer-view.png";
     CLI::App* view = app.add_subcommand(
         "view", "Open the viewer (the default); without a display, render headless");
-    view->add_option("scene", viewOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]");
+    view->add_option("scene", viewOpt.scene, kSceneHelp);
     view->add_option("--headless-output", viewOut,
                      "Where the headless render goes when there is no display");
     cli::addCommonOptions(*view, viewOpt);
@@ -36,9 +41,13 @@ int main(int argc, char** argv) {
         view->add_option("--frames", vopt.frames,
                          "Run this many frames, wait for the render to finish, then exit")
             ->check(CLI::Range(1, 1000000));
-    view->add_option("--screenshot", vopt.screenshot,
-                     "With --frames: save the window as a PNG before exiting")
-        ->needs(frames);
+    CLI::Option* screenshot =
+        view->add_option("--screenshot", vopt.screenshot,
+                         "With --frames: save the window (PNG or JPEG) before exiting; without a "
+                         "display, the headless render goes there")
+            ->needs(frames);
+    view->add_flag("--hide-panels", vopt.hidePanels,
+                   "Start with the panels hidden (Tab shows and hides them)");
     view->add_flag("--log-timings", vopt.logTimings,
                    "Print the latency of each pass after a change to stderr");
     view->add_flag("--replay-change", vopt.replayChange,
@@ -64,8 +73,6 @@ int main(int argc, char** argv) {
             }
             return std::string();
         });
-    view->add_flag("--hide-panels", vopt.hidePanels,
-                   "Show only the image and its overlays (Tab shows the panels again)");
     view->add_option("--select", vopt.select,
                      "Select region ID once the structure is built (its Selection panel, its "
                      "highlight)")
@@ -76,17 +83,15 @@ int main(int argc, char** argv) {
 
     std::string out;
     bool quiet = false;
-    CLI::App* render = app.add_subcommand("render", "Render a scene to a PNG");
-    render->add_option("scene", renderOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")
-        ->required();
-    render->add_option("-o,--output", out, "Output PNG")->required();
+    CLI::App* render = app.add_subcommand("render", "Render a scene to a PNG or JPEG");
+    render->add_option("scene", renderOpt.scene, kSceneHelp)->required();
+    render->add_option("-o,--output", out, "Output image: .png, .jpg or .jpeg")->required();
     render->add_flag("-q,--quiet", quiet, "Print nothing on success");
     cli::addCommonOptions(*render, renderOpt);
 
     cli::TraceOptions topt;
     CLI::App* trace = app.add_subcommand("trace", "Trace one primary ray and print its walk");
-    trace->add_option("scene", traceOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")
-        ->required();
+    trace->add_option("scene", traceOpt.scene, kSceneHelp)->required();
     std::vector<int> pixel;
     trace->add_option("--pixel", pixel, "Pixel X Y (y = 0 on the top row)")
         ->expected(2)
@@ -136,6 +141,10 @@ int main(int argc, char** argv) {
     auto given = [&](const std::string& name) { return view->count(name) > 0; };
     if (int status = viewer::runViewer(viewOpt, vopt, given, why); status != viewer::kNoDisplay)
         return status;
+#endif
+#ifdef LANCER_WITH_VIEWER
+    // A screenshot asked of the window is what the headless render stands for.
+    if (*screenshot && view->count("--headless-output") == 0) viewOut = vopt.screenshot;
 #endif
     std::cout << "lancer: " << why << "; rendering " << viewOpt.scene << " headless.\n";
     return cli::runRender(viewOpt, viewOut, false);

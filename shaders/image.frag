@@ -4,7 +4,7 @@ in vec2 uv;
 out vec4 fragColor;
 uniform sampler2D colorTex;  // the image as 8-bit RGBA, as the PNG writer quantises it
 uniform sampler2D heatTex;   // one counter per pixel
-uniform int mode;            // 0: colour, 1: heat map
+uniform int mode;            // 0: colour, 1: heat map, 2: heat map on a log scale
 uniform float scale;         // counter value shown at the top of the colour map
 uniform vec3 stops[8];       // colour map, evenly spaced (app/viewer/colormap.cpp)
 uniform int stopCount;
@@ -22,8 +22,10 @@ void main() {
     vec3 c;
     if (mode == 0)
         c = clamp(texture(colorTex, t).rgb, 0.0, 1.0);
-    else
+    else if (mode == 1)
         c = colormap(texture(heatTex, t).r / scale);
+    else  // as heatValue() in app/viewer/colormap.cpp
+        c = colormap(log(1.0 + texture(heatTex, t).r) / log(1.0 + scale));
     if (hasOverlay != 0) {
         // Drawn like the framebuffer (row 0 at the bottom), as this FBO is.
         vec4 o = texture(overlayTex, uv);

@@ -51,6 +51,10 @@ class ProgressBar {
 }  // namespace
 
 int runRender(const CommonOptions& o, const std::string& outPath, bool quiet) {
+    if (!imageFormatOf(outPath)) {  // refused before the render, not after
+        std::cerr << "error: " << outPath << ": unknown image format (use .png, .jpg or .jpeg)\n";
+        return 2;
+    }
     try {
         Scene scene = loadScene(o.scene);
         auto accel = buildAccelerator(scene, o.build);
@@ -63,7 +67,7 @@ int runRender(const CommonOptions& o, const std::string& outPath, bool quiet) {
             ProgressBar bar(done, size_t(ro.width) * size_t(ro.height));
             rs = render(scene, *accel, ro, img, {}, nullptr, &done);
         }
-        writePng(outPath, img);
+        writeImage(outPath, img);
         if (!o.depthPath.empty()) writeDepthPfm(o.depthPath, img);
         if (!o.statsPath.empty())
             writeFileAtomic(o.statsPath, statsJson(scene, *accel, ro, rs).dump(2) + "\n");

@@ -57,9 +57,18 @@ std::vector<float> heatChannel(const Image& img, ViewMode mode, int rowBegin, in
 }
 
 float autoScale(const std::vector<float>& heat) {
-    float m = 1.0f;
-    for (float v : heat) m = std::max(m, v);
-    return m;
+    if (heat.empty()) return 1.0f;
+    std::vector<float> v = heat;
+    const auto at = v.begin() + std::ptrdiff_t((v.size() - 1) * 99 / 100);
+    std::nth_element(v.begin(), at, v.end());
+    return std::max(1.0f, *at);
+}
+
+float heatValue(float count, float scale, bool logScale) {
+    scale = scale > 0.0f ? scale : 1.0f;
+    const float v =
+        logScale ? std::log1p(std::max(0.0f, count)) / std::log1p(scale) : count / scale;
+    return std::clamp(v, 0.0f, 1.0f);
 }
 
 }  // namespace lancer::viewer

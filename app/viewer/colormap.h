@@ -23,7 +23,12 @@ glm::vec3 colormap(float v);
 /// The per-pixel counter `mode` shows, as floats, of rows [rowBegin, rowEnd) (-1: to the last);
 /// empty for ViewMode::Color.
 std::vector<float> heatChannel(const Image& img, ViewMode mode, int rowBegin = 0, int rowEnd = -1);
-/// A scale that fits the counter: its largest value (at least 1).
+/// A scale that fits the counter: its 99th percentile (at least 1), so a few outliers (a pixel
+/// whose thread was preempted, in the time map) do not leave the rest of the map dark; pixels
+/// above it show at the top of the map.
 float autoScale(const std::vector<float>& heat);
+/// Where `count` falls on the colour map of `scale`, in [0, 1]: count / scale, or on a log
+/// scale log(1 + count) / log(1 + scale) (the shader computes the same).
+float heatValue(float count, float scale, bool logScale);
 
 }  // namespace lancer::viewer

@@ -1,6 +1,8 @@
 #include "app/viewer/image_view.h"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 #include "app/viewer/gl.h"
 #include "app/viewer/gl/program.h"
@@ -154,13 +156,14 @@ std::vector<PixelRect> uncovered(int width, int height, const std::vector<PixelR
 }
 
 void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
-                     const std::vector<PixelRect>& covered) const {
+                     const std::vector<PixelRect>& covered, bool logScale) const {
     if (width_ == 0) return;
     scale = scale > 0.0f ? scale : 1.0f;
-    if (!shadedValid_ || mode != shadedMode_ || (mode != ViewMode::Color && scale != shadedScale_))
-        shade(mode, scale, 0, height_);
+    if (!shadedValid_ || mode != shadedMode_ ||
+        (mode != ViewMode::Color && (scale != shadedScale_ || logScale != shadedLog_)))
+        shade(mode, scale, logScale, 0, height_);
     else if (!dirty_.empty())
-        shade(mode, scale, dirty_.begin, dirty_.end);
+        shade(mode, scale, logScale, dirty_.begin, dirty_.end);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
@@ -177,7 +180,7 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     glViewport(0, 0, fbWidth, fbHeight);
 }
 
-void ImageView::shade(ViewMode mode, float scale, int rowBegin, int rowEnd) const {
+void ImageView::shade(ViewMode mode, float scale, bool logScale, int rowBegin, int rowEnd) const {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, width_, height_);
     glDisable(GL_BLEND);
@@ -197,7 +200,7 @@ void ImageView::shade(ViewMode mode, float scale, int rowBegin, int rowEnd) cons
     glBindTexture(GL_TEXTURE_2D, overlayTex_);
     glUniform1i(locOverlay_, 2);
     glUniform1i(locHasOverlay_, overlayTex_ != 0);
-    glUniform1i(locMode_, mode == ViewMode::Color ? 0 : 1);
+    glUniform1i(locMode_, mode == ViewMode::Color ? 0 : logScale ? 2 : 1);
     glUniform1f(locScale_, scale);
     const auto& stops = colormapStops();
     glUniform3fv(locStops_, GLsizei(stops.size()), &stops[0].x);
@@ -218,6 +221,7 @@ void ImageView::shade(ViewMode mode, float scale, int rowBegin, int rowEnd) cons
     shadedValid_ = true;
     shadedMode_ = mode;
     shadedScale_ = scale;
+    shadedLog_ = logScale;
 }
 
 std::vector<uint8_t> readFramebuffer(int width, int height) {

@@ -40,9 +40,10 @@ class ImageView {
     /// first upload. The shader runs once per upload, mode or scale, into a texture; each frame
     /// then only copies that texture (a blit), which software GL does far faster than shading.
     /// Pixels inside `covered` (opaque panels drawn over the image next) are left as they are:
-    /// under software GL the copy costs 7 ns a pixel.
+    /// under software GL the copy costs 7 ns a pixel. `logScale`: heat maps show
+    /// heatValue(count, scale, true).
     void draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
-              const std::vector<PixelRect>& covered = {}) const;
+              const std::vector<PixelRect>& covered = {}, bool logScale = false) const;
     /// Composite a layer over the image when it is shaded: `texture` an RGBA8 texture of
     /// premultiplied colour drawn like the framebuffer (row 0 at the bottom), any size; 0: none.
     /// A new `version` shades the whole image again; otherwise only uploaded rows are, so a
@@ -54,13 +55,14 @@ class ImageView {
 
   private:
     /// Shade image rows [rowBegin, rowEnd) into the FBO (the rest keeps its pixels).
-    void shade(ViewMode mode, float scale, int rowBegin, int rowEnd) const;
+    void shade(ViewMode mode, float scale, bool logScale, int rowBegin, int rowEnd) const;
 
     std::unique_ptr<gl::Program> program_;
     unsigned vao_ = 0, colorTex_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
     mutable bool shadedValid_ = false;
     mutable ViewMode shadedMode_ = ViewMode::Color;
     mutable float shadedScale_ = 0.0f;
+    mutable bool shadedLog_ = false;
     /// Image rows uploaded since the FBO was last shaded: only they are shaded again (a band of
     /// a progressive pass is a few rows; shading all of them per band cost llvmpipe a full-image
     /// pass each time).

@@ -50,7 +50,8 @@ std::string settingsLines(const ViewerSettings& s) {
       << s.showView << "\n"
       << "view=" << viewModeKey(s.mode) << "\n"
       << "auto_scale=" << s.autoScale << "\n"
-      << "heat_scale=" << s.heatScale << "\n";
+      << "heat_scale=" << s.heatScale << "\n"
+      << "log_scale=" << s.logScale << "\n";
     return o.str();
 }
 
@@ -117,6 +118,8 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
             if (value == viewModeKey(ViewMode(i))) s.mode = ViewMode(i);
     } else if (key == "auto_scale")
         flag(s.autoScale);
+    else if (key == "log_scale")
+        flag(s.logScale);
     else if (key == "heat_scale") {
         float v;
         if (in >> v && v > 0.0f && v < 1e12f) s.heatScale = v;

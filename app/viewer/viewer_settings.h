@@ -22,6 +22,7 @@ struct ViewerSettings {
     ViewMode mode = ViewMode::Color;
     bool autoScale = true;     ///< heat scale follows the image's largest value
     float heatScale = 100.0f;  ///< counter value at the top of the colour map
+    bool logScale = false;     ///< heat maps on a log scale (log(1 + count))
 };
 
 /// Register the [Lancer][Settings] ini handler of the current ImGui context, reading into and

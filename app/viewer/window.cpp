@@ -147,6 +147,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             wakeCv.notify_one();
             glfwPostEmptyEvent();  // thread-safe in GLFW
         });
+        app.state().setPanelsHidden(v.hidePanels);
         if (!v.show.empty()) {
             // Every item names something drawn: an item no view draws is refused, not ignored.
             std::vector<std::string> notDrawn = app.applyShow(v.show);
@@ -156,7 +157,6 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 throw std::invalid_argument("--show: not drawn by this viewer yet: " + names);
             }
         }
-        app.setPanelsHidden(v.hidePanels);
         if (v.select >= 0) app.overlays().select(uint32_t(v.select));
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
@@ -217,10 +217,10 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             ImGui_ImplGlfw_NewFrame();
             app.frame(fbw, fbh);
             ++frames;
-            if (v.replayChange && !replayed && app.settled() && app.structure()) {
+            if (v.replayChange && !replayed && app.settled() && app.sceneBuild()) {
                 app.rebuild("replayed parameter change");
                 replayed = true;
-            } else if (!v.drop.empty() && !droppedScripted && app.settled() && app.structure()) {
+            } else if (!v.drop.empty() && !droppedScripted && app.settled() && app.sceneBuild()) {
                 // Through the callback the window has installed, as a drop from the desktop.
                 GLFWdropfun onDrop = glfwSetDropCallback(window, nullptr);
                 glfwSetDropCallback(window, onDrop);
@@ -228,7 +228,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 if (onDrop) onDrop(window, 1, paths);
                 droppedScripted = true;
             } else if (v.frames > 0 && frames >= v.frames && app.settled()) {
-                if (!app.structure()) {  // a scripted run on a scene that cannot be shown fails
+                if (!app.sceneBuild()) {  // a scripted run on a scene that cannot be shown fails
                     std::cerr << "error: lancer view: the scene could not be shown (see above)\n";
                     status = 2;
                 } else if (v.select >= 0 && !app.overlays().selection()) {

@@ -22,11 +22,11 @@ struct ViewOptions {
     /// Redraw every frame (at most 60 per second), as while the user keeps interacting; else
     /// only on input, on a worker's result and at 10 Hz while rendering.
     bool continuous = false;
+    bool hidePanels = false;  ///< start with the panels hidden (Tab shows them)
     /// The layers shown (DESIGN.md section 6: a comma list, "none" for none); empty: the
     /// saved ones.
     std::string show;
-    bool hidePanels = false;  ///< no panels and no menu bar (Tab toggles them)
-    int64_t select = -1;      ///< a region id to select once the structure is built; -1: none
+    int64_t select = -1;  ///< a region id to select once the structure is built; -1: none
 };
 
 /// What runViewer returns when no window can be opened (no display, no OpenGL 3.3).

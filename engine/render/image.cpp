@@ -1,6 +1,7 @@
 #include "engine/render/image.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -108,6 +109,34 @@ void writePng(const std::string& path, int w, int h, const std::vector<uint8_t>&
 
 void writePng(const std::string& path, const Image& img) {
     writePng(path, img.width, img.height, img.rgba8());
+}
+
+std::optional<ImageFormat> imageFormatOf(const std::string& path) {
+    const size_t dot = path.find_last_of("./");
+    if (dot == std::string::npos || path[dot] != '.') return std::nullopt;
+    std::string ext = path.substr(dot + 1);
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == "png") return ImageFormat::Png;
+    if (ext == "jpg" || ext == "jpeg") return ImageFormat::Jpeg;
+    return std::nullopt;
+}
+
+void writeImage(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba) {
+    const std::optional<ImageFormat> format = imageFormatOf(path);
+    if (!format)
+        throw std::runtime_error(path + ": unknown image format (use .png, .jpg or .jpeg)");
+    if (*format == ImageFormat::Png) return writePng(path, w, h, rgba);
+    std::string data;
+    auto sink = [](void* ctx, void* bytes, int n) {
+        static_cast<std::string*>(ctx)->append(static_cast<const char*>(bytes), size_t(n));
+    };
+    if (!stbi_write_jpg_to_func(sink, &data, w, h, 4, rgba.data(), 95))
+        throw std::runtime_error(path + ": JPEG encoding failed");
+    writeFileAtomic(path, data);
+}
+
+void writeImage(const std::string& path, const Image& img) {
+    writeImage(path, img.width, img.height, img.rgba8());
 }
 
 void writeDepthPfm(const std::string& path, const Image& img) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,14 @@ void copyRows(const Image& src, Image& dst, int rowBegin = 0, int rowEnd = -1);
 /// Write a PNG atomically (a temporary file renamed into place). Throws std::runtime_error.
 void writePng(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba);
 void writePng(const std::string& path, const Image& img);
+/// The image files Lancer writes, named by their extension (any case): .png, .jpg or .jpeg.
+enum class ImageFormat : uint8_t { Png, Jpeg };
+/// The format `path`'s extension names; nullopt for any other (nothing is written then).
+std::optional<ImageFormat> imageFormatOf(const std::string& path);
+/// Write a PNG or a JPEG (quality 95), as `path`'s extension says, atomically. Throws
+/// std::runtime_error for another extension.
+void writeImage(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba);
+void writeImage(const std::string& path, const Image& img);
 /// Standard PFM ("Pf", little endian, rows bottom to top) of the depth channel.
 void writeDepthPfm(const std::string& path, const Image& img);
 /// Read a one-channel PFM. Throws std::runtime_error.

@@ -24,7 +24,7 @@ constexpr int kW = 100, kH = 100;
 /// by an orthographic camera, 10 pixels a unit, whose x and y faces project half a pixel off the
 /// pixel grid, onto pixel centres: x = -2.95 is column 20, and so on (columns 20, 40, 60, 80; rows
 /// 29, 39, 59, 69).
-std::shared_ptr<Structure> twoBoxes(SchemeKind scheme, int maxLevel = 24) {
+std::shared_ptr<SceneBuild> twoBoxes(SchemeKind scheme, int maxLevel = 24) {
     auto scene = std::make_shared<Scene>();
     scene->prims.push_back(makePrimitive(Block{{-2.95, -1.95, -1.0}, {-0.95, 1.05, 1.0}}, {}));
     scene->prims.push_back(makePrimitive(Block{{1.05, -0.95, -0.5}, {3.05, 2.05, 0.5}}, {}));
@@ -50,7 +50,7 @@ std::shared_ptr<Structure> twoBoxes(SchemeKind scheme, int maxLevel = 24) {
     p.scheme = scheme;
     p.maxLevel = maxLevel;
     p.maxObjects = scheme == SchemeKind::Regular ? 1 : 0;
-    auto s = std::make_shared<Structure>();
+    auto s = std::make_shared<SceneBuild>();
     s->spec = "two boxes";
     s->scene = scene;
     s->accel = buildAccelerator(*scene, p);

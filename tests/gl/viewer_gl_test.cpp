@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <imgui.h>
 #include <imgui_impl_opengl3.h>
+#include <imgui_internal.h>  // FindWindowByName: where the panels are
 
 #include <chrono>
 #include <thread>
@@ -464,12 +465,13 @@ TEST_F(ViewerFrames, DragsMoveTheCameraExceptWhenImGuiWantsTheMouse) {
     const Camera home = app_->camera();
     drag(150.0f, 200.0f, 250.0f, 260.0f);  // starts on the Parameters panel: ImGui's
     EXPECT_EQ(app_->camera().from, home.from);
-    drag(600.0f, 300.0f, 680.0f, 300.0f);  // starts on the image: orbits about the target
+    // Starts on the image, between the columns of panels: orbits about the target.
+    drag(450.0f, 300.0f, 530.0f, 300.0f);
     EXPECT_NE(app_->camera().from, home.from);
     EXPECT_EQ(app_->camera().at, home.at);
     EXPECT_NEAR(glm::length(app_->camera().from - home.at), glm::length(home.from - home.at), 1e-9);
     const Camera orbited = app_->camera();
-    io.MousePos = ImVec2(600.0f, 300.0f);
+    io.MousePos = ImVec2(450.0f, 300.0f);
     io.MouseWheel = 1.0f;  // zoom in
     frame();
     io.MouseWheel = 0.0f;
@@ -489,12 +491,12 @@ TEST_F(ViewerFrames, DragsMoveTheCameraExceptWhenImGuiWantsTheMouse) {
 
 TEST_F(ViewerFrames, ASceneThatFailsToLoadKeepsThePreviousOne) {
     runUntilSettled();
-    auto before = app_->structure();
+    auto before = app_->sceneBuild();
     ASSERT_TRUE(before);
     app_->openScene("/nonexistent/scene.nff");
     runUntilSettled();
     EXPECT_NE(app_->error().find("/nonexistent/scene.nff"), std::string::npos) << app_->error();
-    EXPECT_EQ(app_->structure(), before);
+    EXPECT_EQ(app_->sceneBuild(), before);
     EXPECT_EQ(settings_.scene, "builtin:default");
     // A scheme that cannot be built (or an invalid parameter) keeps the structure too.
     settings_.build.maxLevel = 18;
@@ -511,11 +513,11 @@ TEST_F(ViewerFrames, SpeedupTracesTheSamePixelsAndRaysWithBothSchemes) {
     settings_.build.scheme = SchemeKind::Regular;
     app_->rebuild("scheme");
     runUntilSettled();
-    ASSERT_TRUE(app_->structure());
-    ASSERT_EQ(app_->structure()->accel->params().scheme, SchemeKind::Regular);
+    ASSERT_TRUE(app_->sceneBuild());
+    ASSERT_EQ(app_->sceneBuild()->accel->params().scheme, SchemeKind::Regular);
     EXPECT_FALSE(app_->speedupResult()) << "nothing measured before it is asked for";
     app_->measureSpeedup(4);
-    std::optional<ViewerApp::SpeedupResult> r;
+    std::optional<SpeedupResult> r;
     auto start = std::chrono::steady_clock::now();
     while (!(r = app_->speedupResult()) &&
            std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
@@ -525,15 +527,16 @@ TEST_F(ViewerFrames, SpeedupTracesTheSamePixelsAndRaysWithBothSchemes) {
     ASSERT_TRUE(r) << "the measurement did not finish";
     ASSERT_TRUE(r->error.empty()) << r->error;
     EXPECT_EQ(r->scheme, "regular");
-    EXPECT_EQ(r->pixels, size_t((kW + 3) / 4) * size_t((kH + 3) / 4));
-    EXPECT_GE(r->schemeRays, r->pixels);
-    EXPECT_EQ(r->schemeRays, r->bruteRays);
-    const Scene& scene = *app_->structure()->scene;
-    EXPECT_LE(r->bruteTests, r->bruteRays * scene.livePrimitives().size());
-    EXPECT_GT(r->bruteTests, r->bruteRays);
-    EXPECT_LT(r->schemeTests, r->bruteTests);
-    EXPECT_GT(r->schemeMs, 0.0);
-    EXPECT_GT(r->bruteMs, 0.0);
+    const bench::Speedup& m = r->speedup;
+    EXPECT_EQ(m.pixels, size_t((kW + 3) / 4) * size_t((kH + 3) / 4));
+    EXPECT_GE(m.scheme.counters.rays, m.pixels);
+    EXPECT_EQ(m.scheme.counters.rays, m.brute.counters.rays);
+    const Scene& scene = *app_->sceneBuild()->scene;
+    EXPECT_LE(m.brute.counters.primTests, m.brute.counters.rays * scene.livePrimitives().size());
+    EXPECT_GT(m.brute.counters.primTests, m.brute.counters.rays);
+    EXPECT_LT(m.scheme.counters.primTests, m.brute.counters.primTests);
+    EXPECT_GT(m.scheme.renderMs, 0.0);
+    EXPECT_GT(m.brute.renderMs, 0.0);
 }
 
 TEST_F(ViewerFrames, CameraCopiedAsJsonPastesBackAndABadPasteKeepsTheCamera) {
@@ -563,6 +566,239 @@ TEST_F(ViewerFrames, CameraCopiedAsJsonPastesBackAndABadPasteKeepsTheCamera) {
     Camera cam = app_->camera();
     Traced t = traceCpu("builtin:default", &cam, kW, kH);
     EXPECT_EQ(app_->displayed().color, t.img.color);
+}
+
+// A panel showing a texture: the layer knows the texture by its id, so when its pixels change the
+// panel is copied stale until the panel says so (PanelCache::invalidate), then drawn again.
+TEST(ViewerGl, APanelShowingALiveTextureIsDrawnAgainWhenInvalidated) {
+    const int w = 320, h = 240;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;
+    ImGui::GetIO().DisplaySize = ImVec2(float(w), float(h));
+    ASSERT_TRUE(ImGui_ImplOpenGL3_Init("#version 330 core"));
+    ImGui::GetStyle().Colors[ImGuiCol_WindowBg].w = 1.0f;
+    {
+        unsigned tex = 0;
+        glGenTextures(1, &tex);
+        auto fill = [&](uint8_t r, uint8_t g, uint8_t b) {
+            std::vector<uint8_t> px(16 * 16 * 4);
+            for (size_t i = 0; i < px.size(); i += 4)
+                px[i] = r, px[i + 1] = g, px[i + 2] = b, px[i + 3] = 255;
+            glBindTexture(GL_TEXTURE_2D, tex);
+            glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 16, 16, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                         px.data());
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+            glBindTexture(GL_TEXTURE_2D, 0);
+        };
+        PanelCache cache;
+        unsigned windowId = 0;
+        auto frame = [&] {
+            ImGui::GetIO().DeltaTime = 1.0f / 60.0f;
+            ImGui_ImplOpenGL3_NewFrame();
+            ImGui::NewFrame();
+            ImGui::SetNextWindowPos(ImVec2(10, 10));
+            ImGui::SetNextWindowSize(ImVec2(200, 160));
+            ImGui::Begin("inspector");
+            windowId = ImGui::GetCurrentWindow()->ID;
+            ImGui::Image(ImTextureID(uintptr_t(tex)), ImVec2(100, 100));
+            ImGui::End();
+            ImGui::Render();
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            glViewport(0, 0, w, h);
+            glClearColor(0.3f, 0.6f, 0.2f, 1.0f);
+            glClear(GL_COLOR_BUFFER_BIT);
+            cache.layout(ImGui::GetDrawData(), w, h);
+            cache.render();
+            return gl.read();
+        };
+        // A pixel inside the image, at (60, 80) from the top left.
+        auto at = [&](const std::vector<uint8_t>& px) { return &px[4 * (size_t(80) * w + 60)]; };
+        fill(255, 0, 0);
+        for (int warm = 0; warm < 3; ++warm) frame();
+        std::vector<uint8_t> red = frame();
+        EXPECT_EQ(cache.redrawn(), 0);
+        EXPECT_EQ(at(red)[0], 255);
+        EXPECT_EQ(at(red)[1], 0);
+        fill(0, 0, 255);  // the same texture id, other pixels: the draw lists are the same
+        std::vector<uint8_t> stale = frame();
+        EXPECT_EQ(cache.redrawn(), 0);
+        EXPECT_EQ(at(stale)[0], 255) << "without invalidate() the layer keeps the old pixels";
+        cache.invalidate(windowId);
+        std::vector<uint8_t> blue = frame();
+        EXPECT_EQ(cache.redrawn(), 1);
+        EXPECT_EQ(at(blue)[0], 0);
+        EXPECT_EQ(at(blue)[2], 255);
+        frame();
+        EXPECT_EQ(cache.redrawn(), 0) << "an invalidation holds for one frame";
+        glDeleteTextures(1, &tex);
+    }
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui::DestroyContext();
+}
+
+// The log scale: each pixel is the colour map of log(1 + count) / log(1 + scale).
+TEST(ViewerGl, HeatMapsOnALogScale) {
+    const int w = 160, h = 100;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    Traced t = traceCpu("builtin:default", nullptr, w, h);
+    ImageView view;
+    std::vector<float> heat = heatChannel(t.img, ViewMode::PrimTests);
+    const float scale = autoScale(heat);
+    view.upload(t.img, ViewMode::PrimTests);
+    view.draw(w, h, ViewMode::PrimTests, scale, {}, true);
+    std::vector<uint8_t> shown = gl.read();
+    int worst = 0;
+    size_t differ = 0;
+    for (size_t i = 0; i < heat.size(); ++i) {
+        worst = std::max(worst, maxDiff(&shown[4 * i], colormap(heatValue(heat[i], scale, true))));
+        differ += heatValue(heat[i], scale, true) != heatValue(heat[i], scale, false);
+    }
+    EXPECT_LE(worst, 2);
+    EXPECT_GT(differ, heat.size() / 2) << "the log scale must differ from the linear one";
+}
+
+namespace {
+ImGuiWindow* panelWindow(const char* name) {
+    ImGuiWindow* w = ImGui::FindWindowByName(name);
+    return w && w->Active ? w : nullptr;
+}
+
+/// Every panel lies inside the display and, if `apart`, none overlaps another.
+void expectPanelsOnScreen(float width, float height, bool apart) {
+    std::vector<ImGuiWindow*> shown;
+    for (const char* name : {"Parameters", "Camera", "Statistics", "View"}) {
+        ImGuiWindow* w = panelWindow(name);
+        ASSERT_TRUE(w) << name;
+        EXPECT_GE(w->Pos.x, 0.0f) << name;
+        EXPECT_GE(w->Pos.y, 0.0f) << name;
+        EXPECT_LE(w->Pos.x + w->Size.x, width) << name;
+        EXPECT_LE(w->Pos.y + w->Size.y, height) << name;
+        shown.push_back(w);
+    }
+    for (size_t i = 0; apart && i < shown.size(); ++i)
+        for (size_t j = i + 1; j < shown.size(); ++j) {
+            const ImGuiWindow* a = shown[i];
+            const ImGuiWindow* b = shown[j];
+            const bool apart = a->Pos.x + a->Size.x <= b->Pos.x ||
+                               b->Pos.x + b->Size.x <= a->Pos.x ||
+                               a->Pos.y + a->Size.y <= b->Pos.y || b->Pos.y + b->Size.y <= a->Pos.y;
+            EXPECT_TRUE(apart) << a->Name << " overlaps " << b->Name;
+        }
+}
+}  // namespace
+
+// Panels are as tall as their content (bounces and the speedup result are never under a
+// scrollbar or another panel while the window has room) and stay on screen when it shrinks.
+TEST_F(ViewerFrames, PanelsFitTheirContentAndStayOnScreen) {
+    ImGuiIO& io = ImGui::GetIO();
+    io.DisplaySize = ImVec2(float(kW), 720.0f);  // a 900 x 720 window (the buffer is shorter)
+    runUntilSettled();
+    app_->measureSpeedup(4);
+    auto start = std::chrono::steady_clock::now();
+    while (!app_->speedupResult() &&
+           std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
+        app_->frame(kW, kH);
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_TRUE(app_->speedupResult());
+    for (int i = 0; i < 3; ++i) app_->frame(kW, kH);  // auto-fit follows the content a frame late
+    expectPanelsOnScreen(float(kW), 720.0f, true);
+    for (const char* name : {"Parameters", "Camera", "Statistics", "View"})
+        EXPECT_FALSE(panelWindow(name)->ScrollbarY) << name << " needs a scrollbar at 900 x 720";
+
+    // A smaller window: the right column follows its edge, every panel stays inside (the
+    // panels no longer all fit: the last one scrolls, over another if it must).
+    io.DisplaySize = ImVec2(700.0f, 520.0f);
+    for (int i = 0; i < 3; ++i) app_->frame(700, 520);
+    expectPanelsOnScreen(700.0f, 520.0f, false);
+    io.DisplaySize = ImVec2(float(kW), float(kH));
+    runUntilSettled();
+}
+
+// An error line appearing in Parameters does not move the controls under it.
+TEST_F(ViewerFrames, TheErrorLineIsReservedSoTheControlsStayPut) {
+    runUntilSettled();
+    ASSERT_TRUE(app_->error().empty());
+    const float before = panelWindow("Parameters")->Size.y;
+    app_->openScene("/nonexistent/scene.nff");
+    runUntilSettled();
+    for (int i = 0; i < 3; ++i) app_->frame(kW, kH);
+    ASSERT_FALSE(app_->error().empty());
+    EXPECT_EQ(panelWindow("Parameters")->Size.y, before);
+}
+
+// Tab hides every panel (and the menu bar): the window shows the render alone; Tab again
+// brings them back.
+TEST_F(ViewerFrames, TabHidesThePanels) {
+    runUntilSettled();
+    ImGuiIO& io = ImGui::GetIO();
+    io.KeyMap[ImGuiKey_Tab] = 9;  // as a platform backend maps its keys
+    auto tab = [&] {
+        io.KeysDown[9] = true;
+        io.DeltaTime = 1.0f / 60.0f;
+        app_->frame(kW, kH);
+        io.KeysDown[9] = false;
+        app_->frame(kW, kH);
+    };
+    tab();
+    EXPECT_TRUE(app_->state().panelsHidden());
+    runUntilSettled();
+    Camera cam = app_->camera();
+    Traced t = traceCpu("builtin:default", &cam, kW, kH);
+    std::vector<uint8_t> shown = gl_->read(), cpu = t.img.rgba8();
+    size_t differing = 0;
+    for (size_t i = 0; i < shown.size(); i += 4)
+        for (size_t c = 0; c < 3; ++c)
+            differing += std::abs(int(shown[i + c]) - int(cpu[i + c])) > 1;
+    EXPECT_EQ(differing, 0u) << "with the panels hidden, every pixel is the render's";
+    tab();
+    EXPECT_FALSE(app_->state().panelsHidden());
+    runUntilSettled();
+    EXPECT_TRUE(panelWindow("Parameters"));
+}
+
+// What the panels said of a scene goes with it: the speedup result, a camera paste's error and
+// the screenshot note.
+TEST_F(ViewerFrames, ASceneChangeClearsWhatThePanelsSaidOfTheLastOne) {
+    runUntilSettled();
+    app_->measureSpeedup(8);
+    auto start = std::chrono::steady_clock::now();
+    while (!app_->speedupResult() &&
+           std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
+        app_->frame(kW, kH);
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_TRUE(app_->speedupResult());
+    ImGui::SetClipboardText("not a camera");
+    EXPECT_FALSE(app_->pasteCameraJson());
+    ASSERT_FALSE(app_->cameraError().empty());
+    const std::string shot = ::testing::TempDir() + "lancer-clear-test.png";
+    app_->state().notes().pendingScreenshot = shot;
+    app_->frame(kW, kH);
+    ASSERT_EQ(app_->state().notes().screenshotNote, "saved " + shot);
+    std::remove(shot.c_str());
+    app_->openScene("builtin:balls:1");
+    runUntilSettled();
+    ASSERT_EQ(settings_.scene, "builtin:balls:1");
+    EXPECT_FALSE(app_->speedupResult());
+    EXPECT_TRUE(app_->cameraError().empty());
+    EXPECT_TRUE(app_->state().notes().screenshotNote.empty());
+}
+
+// A scene that cannot be opened at start: the error shows, and nothing claims to be rendering.
+TEST_F(ViewerFrames, ASceneThatNeverLoadedShowsNoRenderInProgress) {
+    app_.reset();
+    settings_.scene = "/no/such/file.nff";
+    app_ = std::make_unique<ViewerApp>(settings_, false);
+    runUntilSettled();
+    EXPECT_TRUE(app_->settled());
+    EXPECT_FALSE(app_->sceneBuild());
+    EXPECT_NE(app_->error().find("/no/such/file.nff"), std::string::npos) << app_->error();
+    EXPECT_FALSE(app_->state().rendering());
 }
 
 }  // namespace

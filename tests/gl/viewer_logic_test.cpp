@@ -177,3 +177,26 @@ TEST(ImageCopy, UncoveredRectanglesTileExactlyWhatNoPanelCovers) {
 
 }  // namespace
 }  // namespace lancer::viewer
+
+namespace lancer::viewer {
+namespace {
+
+// The automatic heat scale is a high percentile, not the largest value: a few outliers (a
+// preempted pixel in the time map) leave the rest of the map readable.
+TEST(HeatScale, AutomaticScaleIgnoresAFewOutliers) {
+    std::vector<float> heat(1000, 10.0f);
+    for (int i = 0; i < 5; ++i) heat[size_t(i) * 100] = 1e6f;
+    EXPECT_EQ(autoScale(heat), 10.0f);
+    std::vector<float> ramp(1000);
+    for (size_t i = 0; i < ramp.size(); ++i) ramp[i] = float(i);
+    EXPECT_EQ(autoScale(ramp), 989.0f) << "the 99th percentile";
+    EXPECT_EQ(autoScale({}), 1.0f);
+    EXPECT_EQ(autoScale(std::vector<float>(10, 0.0f)), 1.0f) << "at least 1";
+    EXPECT_FLOAT_EQ(heatValue(5.0f, 10.0f, false), 0.5f);
+    EXPECT_FLOAT_EQ(heatValue(20.0f, 10.0f, false), 1.0f);
+    EXPECT_FLOAT_EQ(heatValue(std::expm1(0.5f * std::log1p(99.0f)), 99.0f, true), 0.5f);
+    EXPECT_FLOAT_EQ(heatValue(0.0f, 99.0f, true), 0.0f);
+}
+
+}  // namespace
+}  // namespace lancer::viewer

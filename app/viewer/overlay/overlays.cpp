@@ -59,7 +59,7 @@ bool Overlays::select(uint32_t id) {
     return true;
 }
 
-void Overlays::update(const std::shared_ptr<const Structure>& structure, const Camera& view,
+void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const Camera& view,
                       int width, int height) {
     if (structure && structure != structure_) {
         // The new structure replaces the old one only now that it is ready: until then the old

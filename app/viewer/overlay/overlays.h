@@ -44,7 +44,7 @@ class Overlays {
     /// Take the structure on screen (null: none yet) and rebuild the batches if the structure,
     /// the camera they depend on, the size or the options changed. Until a new structure
     /// arrives the previous one's overlays stay.
-    void update(const std::shared_ptr<const Structure>& structure, const Camera& view, int width,
+    void update(const std::shared_ptr<const SceneBuild>& structure, const Camera& view, int width,
                 int height);
     /// Draw the layers and the selection into the current framebuffer (width x height, the
     /// image filling it), as seen by `view`.
@@ -94,7 +94,7 @@ class Overlays {
     double lastBuildMs() const { return lastBuildMs_; }
 
   private:
-    std::shared_ptr<const Structure> structure_;
+    std::shared_ptr<const SceneBuild> structure_;
     std::unique_ptr<StructureView> view_;
     std::unique_ptr<gl::BatchRenderer> renderer_;
     std::unique_ptr<gl::GpuBatch> cuts_, fills_, wires_;
