@@ -6,6 +6,7 @@
 #include "app/cli/commands.h"
 #include "engine/scene/builtin_scenes.h"
 #ifdef LANCER_WITH_VIEWER
+#include "app/viewer/overlay/overlays.h"
 #include "app/viewer/window.h"
 #endif
 
@@ -60,6 +61,22 @@ int main(int argc, char** argv) {
                      "the desktop does "
                      "when a file is dropped on the window")
         ->needs(frames);
+    view->add_option("--show", vopt.show,
+                     "Layers drawn, a comma list of bsp, zones, slabs, leaves, grid, boxes, "
+                     "frustum, inspector, ray, none")
+        ->check([](const std::string& list) {
+            viewer::overlay::OverlayOptions o;
+            try {
+                viewer::overlay::applyShowList(list, o);
+            } catch (const std::invalid_argument& e) {
+                return std::string(e.what());
+            }
+            return std::string();
+        });
+    view->add_option("--select", vopt.select,
+                     "Select region ID once the structure is built (its Selection panel, its "
+                     "highlight)")
+        ->check(CLI::NonNegativeNumber);
     view->add_option("--ini", vopt.ini,
                      "Settings file (default: ~/.config/lancer/imgui.ini; \"none\": none)");
 #endif

@@ -8,6 +8,8 @@ uniform int mode;            // 0: colour, 1: heat map, 2: heat map on a log sca
 uniform float scale;         // counter value shown at the top of the colour map
 uniform vec3 stops[8];       // colour map, evenly spaced (app/viewer/colormap.cpp)
 uniform int stopCount;
+uniform sampler2D overlayTex;  // the overlays' layer, premultiplied RGBA, framebuffer rows
+uniform int hasOverlay;
 
 vec3 colormap(float v) {
     float x = clamp(v, 0.0, 1.0) * float(stopCount - 1);
@@ -17,10 +19,17 @@ vec3 colormap(float v) {
 
 void main() {
     vec2 t = vec2(uv.x, 1.0 - uv.y);  // image row 0 is the top row
+    vec3 c;
     if (mode == 0)
-        fragColor = vec4(clamp(texture(colorTex, t).rgb, 0.0, 1.0), 1.0);
+        c = clamp(texture(colorTex, t).rgb, 0.0, 1.0);
     else if (mode == 1)
-        fragColor = vec4(colormap(texture(heatTex, t).r / scale), 1.0);
+        c = colormap(texture(heatTex, t).r / scale);
     else  // as heatValue() in app/viewer/colormap.cpp
-        fragColor = vec4(colormap(log(1.0 + texture(heatTex, t).r) / log(1.0 + scale)), 1.0);
+        c = colormap(log(1.0 + texture(heatTex, t).r) / log(1.0 + scale));
+    if (hasOverlay != 0) {
+        // Drawn like the framebuffer (row 0 at the bottom), as this FBO is.
+        vec4 o = texture(overlayTex, uv);
+        c = c * (1.0 - o.a) + o.rgb;
+    }
+    fragColor = vec4(c, 1.0);
 }

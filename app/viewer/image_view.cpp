@@ -5,26 +5,11 @@
 #include <string>
 
 #include "app/viewer/gl.h"
-#include "lancer_shaders.h"  // generated from shaders/*.{vert,frag} at configure time
+#include "app/viewer/gl/program.h"
 
 namespace lancer::viewer {
 
 namespace {
-
-GLuint compile(GLenum type, const char* source, const char* name) {
-    GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &source, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = {};
-        glGetShaderInfoLog(s, sizeof log, nullptr, log);
-        glDeleteShader(s);
-        throw std::runtime_error(std::string("shader ") + name + ": " + log);
-    }
-    return s;
-}
 
 void setupTexture(GLuint tex) {
     glBindTexture(GL_TEXTURE_2D, tex);
@@ -38,27 +23,15 @@ void setupTexture(GLuint tex) {
 }  // namespace
 
 ImageView::ImageView() {
-    GLuint vs = compile(GL_VERTEX_SHADER, shaders::kImageVert, "image.vert");
-    GLuint fs = compile(GL_FRAGMENT_SHADER, shaders::kImageFrag, "image.frag");
-    program_ = glCreateProgram();
-    glAttachShader(program_, vs);
-    glAttachShader(program_, fs);
-    glLinkProgram(program_);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = {};
-        glGetProgramInfoLog(program_, sizeof log, nullptr, log);
-        throw std::runtime_error(std::string("image shader link: ") + log);
-    }
-    locMode_ = glGetUniformLocation(program_, "mode");
-    locScale_ = glGetUniformLocation(program_, "scale");
-    locStops_ = glGetUniformLocation(program_, "stops");
-    locStopCount_ = glGetUniformLocation(program_, "stopCount");
-    locColor_ = glGetUniformLocation(program_, "colorTex");
-    locHeat_ = glGetUniformLocation(program_, "heatTex");
+    program_ = std::make_unique<gl::Program>("image.vert", "image.frag");
+    locMode_ = program_->uniform("mode");
+    locScale_ = program_->uniform("scale");
+    locStops_ = program_->uniform("stops");
+    locStopCount_ = program_->uniform("stopCount");
+    locColor_ = program_->uniform("colorTex");
+    locHeat_ = program_->uniform("heatTex");
+    locOverlay_ = program_->uniform("overlayTex");
+    locHasOverlay_ = program_->uniform("hasOverlay");
     glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even an empty one
     GLuint tex[3];
     glGenTextures(3, tex);
@@ -77,7 +50,6 @@ ImageView::~ImageView() {
     glDeleteTextures(3, tex);
     glDeleteFramebuffers(1, &fbo_);
     glDeleteVertexArrays(1, &vao_);
-    glDeleteProgram(program_);
 }
 
 void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd) {
@@ -107,7 +79,8 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
     if (rows > 0) {
         // 8 bits per channel, quantised as the PNG writer does: the screen shows what `render`
         // saves.
-        if (mode == ViewMode::Color && !resized && shadedValid_ && shadedMode_ == ViewMode::Color) {
+        if (mode == ViewMode::Color && !resized && shadedValid_ && shadedMode_ == ViewMode::Color &&
+            overlayTex_ == 0) {
             // The colour shader only copies: the rows go straight into the shaded texture,
             // bottom row first as the FBO holds them, and need no shading (under llvmpipe,
             // shading a whole 1280x720 image took 7 ms of the UI thread). colorTex_ is left
@@ -137,6 +110,13 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
         shadedValid_ = false;
     else
         dirty_.add(rowBegin, rowEnd);
+}
+
+void ImageView::setOverlay(unsigned texture, uint64_t version) {
+    if (texture == overlayTex_ && (texture == 0 || version == overlayVersion_)) return;
+    overlayTex_ = texture;
+    overlayVersion_ = version;
+    shadedValid_ = false;
 }
 
 std::vector<PixelRect> uncovered(int width, int height, const std::vector<PixelRect>& covered) {
@@ -209,13 +189,17 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, int rowBegin, i
     // Image row r is FBO row height - 1 - r (the shader flips): rows [b, e) are [h - e, h - b).
     glEnable(GL_SCISSOR_TEST);
     glScissor(0, height_ - rowEnd, width_, rowEnd - rowBegin);
-    glUseProgram(program_);
+    glUseProgram(program_->id());
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, colorTex_);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, heatTex_);
     glUniform1i(locColor_, 0);
     glUniform1i(locHeat_, 1);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, overlayTex_);
+    glUniform1i(locOverlay_, 2);
+    glUniform1i(locHasOverlay_, overlayTex_ != 0);
     glUniform1i(locMode_, mode == ViewMode::Color ? 0 : logScale ? 2 : 1);
     glUniform1f(locScale_, scale);
     const auto& stops = colormapStops();
@@ -224,6 +208,8 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, int rowBegin, i
     glBindVertexArray(vao_);
     glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
     glBindVertexArray(0);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, 0);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, 0);
     glActiveTexture(GL_TEXTURE0);

@@ -2,12 +2,17 @@
 // the framebuffer size: no window involved, so the OSMesa test drives exactly this code.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "app/viewer/colormap.h"
 #include "engine/render/image.h"
 
 namespace lancer::viewer {
+
+namespace gl {
+class Program;
+}
 
 /// A rectangle of framebuffer pixels, [x0, x1) x [y0, y1), row 0 at the top (as ImGui has it).
 struct PixelRect {
@@ -39,6 +44,11 @@ class ImageView {
     /// heatValue(count, scale, true).
     void draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
               const std::vector<PixelRect>& covered = {}, bool logScale = false) const;
+    /// Composite a layer over the image when it is shaded: `texture` an RGBA8 texture of
+    /// premultiplied colour drawn like the framebuffer (row 0 at the bottom), any size; 0: none.
+    /// A new `version` shades the whole image again; otherwise only uploaded rows are, so a
+    /// layer that does not change costs nothing per frame (the draw stays one copy).
+    void setOverlay(unsigned texture, uint64_t version);
     /// Size of the uploaded image (0 x 0 before the first upload).
     int width() const { return width_; }
     int height() const { return height_; }
@@ -47,7 +57,8 @@ class ImageView {
     /// Shade image rows [rowBegin, rowEnd) into the FBO (the rest keeps its pixels).
     void shade(ViewMode mode, float scale, bool logScale, int rowBegin, int rowEnd) const;
 
-    unsigned program_ = 0, vao_ = 0, colorTex_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
+    std::unique_ptr<gl::Program> program_;
+    unsigned vao_ = 0, colorTex_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
     mutable bool shadedValid_ = false;
     mutable ViewMode shadedMode_ = ViewMode::Color;
     mutable float shadedScale_ = 0.0f;
@@ -57,6 +68,9 @@ class ImageView {
     /// pass each time).
     mutable RowRange dirty_;
     int width_ = 0, height_ = 0;
+    unsigned overlayTex_ = 0;
+    uint64_t overlayVersion_ = 0;
+    int locOverlay_ = -1, locHasOverlay_ = -1;
     int locMode_ = -1, locScale_ = -1, locStops_ = -1, locStopCount_ = -1, locColor_ = -1,
         locHeat_ = -1;
 };

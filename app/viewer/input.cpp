@@ -17,7 +17,7 @@ void handleMouse(ViewerState& st, int fbHeight) {
     const float dx = io.MouseDelta.x * io.DisplayFramebufferScale.x;
     const float dy = io.MouseDelta.y * io.DisplayFramebufferScale.y;
     if (dx != 0.0f || dy != 0.0f) {
-        if (ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+        if (ImGui::IsMouseDown(ImGuiMouseButton_Left) && !io.KeyCtrl) {  // Ctrl+click picks
             orbit(c, -0.008 * dx, 0.008 * dy);
             moved = true;
         } else if (ImGui::IsMouseDown(ImGuiMouseButton_Middle)) {

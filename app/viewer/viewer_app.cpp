@@ -3,6 +3,10 @@
 #include <imgui.h>
 #include <imgui_impl_opengl3.h>
 
+#include <cstdio>
+#include <iostream>
+#include <limits>
+
 #include "app/viewer/gl.h"
 #include "app/viewer/input.h"
 #include "app/viewer/panels/panels.h"
@@ -10,7 +14,10 @@
 namespace lancer::viewer {
 
 ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<void()> wake)
-    : state_(settings, logTimings, std::move(wake)), view_(std::make_unique<ImageView>()) {
+    : state_(settings, logTimings, std::move(wake)),
+      view_(std::make_unique<ImageView>()),
+      overlays_(std::make_unique<overlay::Overlays>()),
+      logTimings_(logTimings) {
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
     // drawn at all, and each is copied from a layer where it is redrawn only when it changes
     // (frame(), PanelCache).
@@ -30,12 +37,18 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui::NewFrame();
     handleMouse(state_, fbHeight);
+    overlayInput(fbWidth, fbHeight);
     handleKeys(state_);
 
     // 3. Panels: each reads and acts on the state (panels/). An inspector view, a panel showing
     // a texture of its own drawing, goes in drawPanels' list and calls
     // panels_.invalidate(its window's ID) whenever that texture's pixels change.
     drawPanels(state_);
+    if (!state_.panelsHidden()) {
+        ViewerSettings& set = state_.settings();
+        if (set.showOverlays) overlays_->panel(&set.showOverlays);
+        if (set.showSelection) overlays_->selectionPanel(&set.showSelection);
+    }
     state_.startWork(fbWidth, fbHeight);
     ImGui::Render();
 
@@ -45,6 +58,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     const ViewerSettings& s = state_.settings();
     if (RowRange rows; state_.takeUpload(rows))
         view_->upload(state_.shown(), s.mode, rows.begin, rows.end);
+    prepareOverlays(fbWidth, fbHeight);
     glViewport(0, 0, fbWidth, fbHeight);
     if (view_->width() == 0) {
         glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
@@ -53,9 +67,13 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(),
                 panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight), s.logScale);
 
-    // 5. Overlays: drawn over the image, under the panels (the panel layer replaces the pixels
-    // of every panel's rectangle next). Nothing is drawn here yet; app/viewer/overlay/ draws
-    // the structure's regions and the rays here.
+    // 5. Overlays: their layers were composited into the image when it was shaded
+    // (prepareOverlays); the selection's highlight is drawn over the image, under the panels
+    // (the panel layer replaces the pixels of every panel's rectangle next).
+    const Clock::time_point selectionStart = Clock::now();
+    overlays_->drawSelection(state_.camera(), fbWidth, fbHeight);
+    overlayStat_.ms +=
+        std::chrono::duration<double, std::milli>(Clock::now() - selectionStart).count();
 
     // 6. Panel layer: ImGui's panels, each rasterized again only when it changed.
     panels_.render();
@@ -71,6 +89,66 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         notes.pendingScreenshot.clear();
     }
     settled_ = state_.settledSince();
+}
+
+void ViewerApp::prepareOverlays(int fbWidth, int fbHeight) {
+    const Clock::time_point start = Clock::now();
+    const uint64_t version = overlays_->layerVersion();
+    const Camera& camera = state_.camera();
+    overlays_->update(state_.sceneBuild(), camera, fbWidth, fbHeight);
+    // While a drag moves the camera the layers are left out rather than drawn again each
+    // frame (balls4's regular leaves take llvmpipe about 0.9 s); they return when it ends.
+    const bool dragging = ImGui::IsAnyMouseDown() && !ImGui::GetIO().WantCaptureMouse &&
+                          overlays_->layerStale(camera, fbWidth, fbHeight);
+    const unsigned layer = dragging ? 0 : overlays_->layerTexture(camera, fbWidth, fbHeight);
+    if (layer != 0 && !overlayShown_ && view_->width() > 0)
+        view_->upload(state_.shown(), state_.settings().mode);  // colour bands bypass colorTex
+    overlayShown_ = layer != 0;
+    view_->setOverlay(layer, overlays_->layerVersion());
+    if (logTimings_)
+        logOverlayTiming(std::chrono::duration<double, std::milli>(Clock::now() - start).count(),
+                         overlays_->layerVersion() != version);
+}
+
+void ViewerApp::logOverlayTiming(double ms, bool layerDrawn) {
+    // The overlays' UI work, per frame, apart from frames that drew the layers again (a
+    // change): those are logged one by one.
+    if (layerDrawn) {
+        std::fprintf(stderr,
+                     "timing: overlays: layers drawn again in %.2f ms (batches built in %.2f ms)\n",
+                     overlays_->lastLayerMs(), overlays_->lastBuildMs());
+        return;
+    }
+    overlayStat_.ms += ms;
+    ++overlayStat_.frames;
+    if (Clock::now() - overlayStat_.since < std::chrono::seconds(2)) return;
+    std::fprintf(stderr, "timing: overlays: %.3f ms of UI work a frame (%d frames)\n",
+                 overlayStat_.ms / overlayStat_.frames, overlayStat_.frames);
+    overlayStat_ = {};
+}
+
+void ViewerApp::overlayInput(int fbWidth, int fbHeight) {
+    ImGuiIO& io = ImGui::GetIO();
+    // Clicks ImGui wants never pick; a plain left drag orbits, so picking takes Ctrl+click.
+    if (io.WantCaptureMouse || !state_.sceneBuild() || !ImGui::IsMousePosValid()) return;
+    const double x = double(io.MousePos.x * io.DisplayFramebufferScale.x);
+    const double y = double(io.MousePos.y * io.DisplayFramebufferScale.y);
+    if (x < 0.0 || y < 0.0 || x >= fbWidth || y >= fbHeight) return;
+    // The primary hit's depth under the mouse, from the image on screen when it is this size.
+    const Image& shown = state_.shown();
+    float depth = std::numeric_limits<float>::infinity();
+    if (shown.width == fbWidth && shown.height == fbHeight && !shown.depth.empty())
+        depth = shown.depth[shown.index(int(x), int(y))];
+    if (io.KeyCtrl && ImGui::IsMouseClicked(ImGuiMouseButton_Left)) {
+        overlays_->pickAt(state_.camera(), fbWidth, fbHeight, x, y, depth);
+        state_.settings().showSelection = true;
+    } else if (!ImGui::IsAnyMouseDown() && !state_.panelsHidden() && overlays_->options.any()) {
+        overlays_->tooltip(state_.camera(), fbWidth, fbHeight, x, y, depth);
+    }
+}
+
+std::vector<std::string> ViewerApp::applyShow(const std::string& list) {
+    return overlay::applyShowList(list, overlays_->options);
 }
 
 void ViewerApp::saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const {

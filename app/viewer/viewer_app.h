@@ -11,6 +11,7 @@
 #include <string>
 
 #include "app/viewer/image_view.h"
+#include "app/viewer/overlay/overlays.h"
 #include "app/viewer/panel_cache.h"
 #include "app/viewer/viewer_state.h"
 
@@ -74,6 +75,14 @@ class ViewerApp {
     void measureSpeedup(int stride) { state_.measureSpeedup(stride); }
     std::optional<SpeedupResult> speedupResult() const { return state_.speedupResult(); }
 
+    /// The overlays over the image (layers, selection); the inspector reads the selection.
+    overlay::Overlays& overlays() { return *overlays_; }
+    const overlay::Overlays& overlays() const { return *overlays_; }
+    /// Apply a --show list (DESIGN.md section 6) to the overlays. Returns the items nothing in
+    /// the viewer draws yet (to be refused by the caller); throws std::invalid_argument naming an
+    /// unknown item. Views other than the overlays (the inspector's boxes, frustum and view, the
+    /// ray) take their items here, from what the overlays leave.
+    std::vector<std::string> applyShow(const std::string& list);
     /// What is built, rendered and shown (what the panels read).
     ViewerState& state() { return state_; }
     const ViewerState& state() const { return state_; }
@@ -82,8 +91,23 @@ class ViewerApp {
     PanelCache& panelLayer() { return panels_; }
 
   private:
+    /// The hover tooltip and Ctrl+click picking over the image (mouse not taken by ImGui).
+    void overlayInput(int fbWidth, int fbHeight);
+    /// Steps 5 of frame(): the overlays' layer handed to the image view, and its timing.
+    void prepareOverlays(int fbWidth, int fbHeight);
+    /// --log-timings: the overlays' work in this frame (`layerDrawn`: it drew the layers).
+    void logOverlayTiming(double ms, bool layerDrawn);
+
     ViewerState state_;
     std::unique_ptr<ImageView> view_;
+    std::unique_ptr<overlay::Overlays> overlays_;
+    bool logTimings_ = false;
+    bool overlayShown_ = false;  ///< the image view composites the overlays' layer
+    struct OverlayStat {
+        double ms = 0.0;
+        int frames = 0;
+        Clock::time_point since = Clock::now();
+    } overlayStat_;
     PanelCache panels_;  ///< ImGui's panels, each redrawn only when it changed
     bool settled_ = false;
 };

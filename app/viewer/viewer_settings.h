@@ -19,6 +19,8 @@ struct ViewerSettings {
     int threads = 0;  ///< render threads (0: all cores)
     int windowWidth = 1280, windowHeight = 720;
     bool showParameters = true, showStatistics = true, showCamera = true, showView = true;
+    bool showOverlays = true;
+    bool showSelection = false;  ///< opened by a pick or --select
     ViewMode mode = ViewMode::Color;
     bool autoScale = true;     ///< heat scale follows the image's largest value
     float heatScale = 100.0f;  ///< counter value at the top of the colour map

@@ -88,6 +88,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
         ImGui::LoadIniSettingsFromDisk(ini.c_str());
     }
     applyCommandLine(o, given, settings);
+    if (v.select >= 0) settings.showSelection = true;
 
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -137,6 +138,16 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             glfwPostEmptyEvent();  // thread-safe in GLFW
         });
         app.state().setPanelsHidden(v.hidePanels);
+        if (!v.show.empty()) {
+            // Every item names something drawn: an item no view draws is refused, not ignored.
+            std::vector<std::string> notDrawn = app.applyShow(v.show);
+            if (!notDrawn.empty()) {
+                std::string names;
+                for (const std::string& n : notDrawn) names += (names.empty() ? "" : ", ") + n;
+                throw std::invalid_argument("--show: not drawn by this viewer yet: " + names);
+            }
+        }
+        if (v.select >= 0) app.overlays().select(uint32_t(v.select));
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
         bool replayed = false, droppedScripted = false;
@@ -209,6 +220,11 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             } else if (v.frames > 0 && frames >= v.frames && app.settled()) {
                 if (!app.sceneBuild()) {  // a scripted run on a scene that cannot be shown fails
                     std::cerr << "error: lancer view: the scene could not be shown (see above)\n";
+                    status = 2;
+                } else if (v.select >= 0 && !app.overlays().selection()) {
+                    const StructureView* sv = app.overlays().view();
+                    std::cerr << "error: --select: no region " << v.select << " in the structure ("
+                              << (sv ? sv->regionCount() : 0) << " regions)\n";
                     status = 2;
                 }
                 if (!v.screenshot.empty()) {

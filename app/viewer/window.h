@@ -1,6 +1,7 @@
 // `lancer view`: the GLFW window around ViewerApp.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 
@@ -22,6 +23,10 @@ struct ViewOptions {
     /// only on input, on a worker's result and at 10 Hz while rendering.
     bool continuous = false;
     bool hidePanels = false;  ///< start with the panels hidden (Tab shows them)
+    /// The layers shown (DESIGN.md section 6: a comma list, "none" for none); empty: the
+    /// saved ones.
+    std::string show;
+    int64_t select = -1;  ///< a region id to select once the structure is built; -1: none
 };
 
 /// What runViewer returns when no window can be opened (no display, no OpenGL 3.3).

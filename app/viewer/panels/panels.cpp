@@ -56,6 +56,8 @@ void menuBar(ViewerState& st) {
         ImGui::MenuItem("Camera", nullptr, &s.showCamera);
         ImGui::MenuItem("Statistics", nullptr, &s.showStatistics);
         ImGui::MenuItem("View", nullptr, &s.showView);
+        ImGui::MenuItem("Overlays", nullptr, &s.showOverlays);
+        ImGui::MenuItem("Selection", nullptr, &s.showSelection);
         ImGui::Separator();
         bool hidden = st.panelsHidden();
         if (ImGui::MenuItem("Hide all", "Tab", &hidden)) st.setPanelsHidden(hidden);

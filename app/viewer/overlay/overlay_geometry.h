@@ -1,0 +1,83 @@
+// What the overlays draw over the image, as batches (no GL): the screen BSP's cut lines by
+// depth in cut order, zones filled by primitive or slab count, slabs, regular leaves and the
+// directory grid, all in world space (projected with the current camera, so a zone of the
+// projective frame or of an orthographic camera frame lands on its pixels, and a perspective
+// camera frame's BSP is drawn in perspective). Also picking: the region under a pixel.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "app/viewer/gl/batch.h"
+#include "engine/accel/structure_view.h"
+#include "engine/render/image.h"
+
+namespace lancer::viewer::overlay {
+
+/// What colours a zone's fill.
+enum class ZoneFill : uint8_t { Prims, Slabs };
+/// What colours a leaf's wireframe.
+enum class LeafColor : uint8_t { Level, Prims };
+
+/// The layers and what selects their geometry; a change rebuilds the batches.
+struct OverlayOptions {
+    bool bsp = false;     ///< irregular: the screen BSP's cut lines
+    bool zones = false;   ///< irregular: zones filled
+    bool slabs = false;   ///< irregular: slabs' wireframes
+    bool leaves = false;  ///< regular: the leaves' wireframes
+    bool grid = false;    ///< regular: the directory's entries and sub-table blocks
+    ZoneFill zoneFill = ZoneFill::Prims;
+    LeafColor leafColor = LeafColor::Level;
+    /// Irregular: the projective zones (when primary rays walk them), else the camera frame.
+    bool projective = true;
+    int levelMin = 0, levelMax = 64;  ///< regular: leaves and blocks drawn by BSP level / depth
+    /// Most regions (leaves, slabs, blocks) and cuts drawn; the visible ones first.
+    size_t cap = 100000;
+    bool operator==(const OverlayOptions&) const = default;
+    /// Any layer on.
+    bool any() const { return bsp || zones || slabs || leaves || grid; }
+};
+
+/// The batches of one structure, camera, image size and options.
+struct OverlayGeometry {
+    gl::Batch cuts;          ///< cut lines in cut order, linesPerCut each
+    size_t linesPerCut = 1;  ///< 2 for a perspective camera frame (its near and far depth)
+    size_t cutsTotal = 0;    ///< cuts of the BSP (cuts.lineCount() / linesPerCut drawn)
+    int maxCutDepth = 0;
+    gl::Batch fills;  ///< zones, filled (alpha 1: the draw's opacity makes them translucent)
+    gl::Batch wires;  ///< leaves, blocks, slabs
+    size_t regionsTotal = 0;  ///< regions (or blocks) the options select
+    size_t regionsDrawn = 0;  ///< of them, drawn (visible, under the cap)
+    size_t zonesTotal = 0, zonesDrawn = 0;
+    bool cameraDependent = false;  ///< culled or capped by visibility: rebuild when it moves
+};
+
+/// Build the layers `options` asks for, for a width x height image seen by `view`.
+OverlayGeometry buildOverlayGeometry(const StructureView& sv, const Camera& view, int width,
+                                     int height, const OverlayOptions& options);
+
+/// Near and far depths that keep the whole structure inside the clip volume of `view`.
+std::pair<double, double> clipDepths(const StructureView& sv, const Camera& view);
+
+/// What lies under a pixel: the region its primary ray is in at the depth it hits (or, on a
+/// miss, where it enters the structure), and for the irregular scheme the zone.
+struct PickResult {
+    uint32_t region = 0;
+    int64_t zone = -1;  ///< irregular: the zone of `frame` under the pixel
+    ZoneFrameKind frame = ZoneFrameKind::Camera;
+};
+/// Pick at continuous image point (x, y) of a width x height image seen by `view`; `depth` is
+/// the primary hit distance along the unit ray there (+inf on a miss). Nothing when the pixel
+/// sees no region.
+std::optional<PickResult> pick(const StructureView& sv, const Camera& view, int width, int height,
+                               double x, double y, float depth, bool projective = true);
+
+/// The frame the irregular overlays draw: the projective one when asked and present.
+const ZoneFrameView* overlayFrame(const StructureView& sv, bool projective);
+
+/// A colour for a BSP depth or a level out of `count` (hues from red to violet, all bright on a
+/// dark or a light image).
+glm::vec3 depthColor(int depth, int count);
+
+}  // namespace lancer::viewer::overlay

@@ -1,0 +1,414 @@
+#include "app/viewer/overlay/overlays.h"
+
+#include <imgui.h>
+
+#include <chrono>
+#include <sstream>
+#include <stdexcept>
+
+#include "app/viewer/gl.h"
+#include "app/viewer/gl/transforms.h"
+#include "engine/model/csg.h"
+
+namespace lancer::viewer::overlay {
+
+namespace {
+
+std::string boxText(const Box3& b) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "[%.4g %.4g %.4g] .. [%.4g %.4g %.4g]", b.lo.x, b.lo.y, b.lo.z,
+                  b.hi.x, b.hi.y, b.hi.z);
+    return buf;
+}
+
+bool sameCamera(const Camera& a, const Camera& b) {
+    return a.from == b.from && a.at == b.at && a.up == b.up && a.fov == b.fov &&
+           a.projection == b.projection && a.orthoHeight == b.orthoHeight;
+}
+
+}  // namespace
+
+Overlays::Overlays()
+    : renderer_(std::make_unique<gl::BatchRenderer>()),
+      cuts_(std::make_unique<gl::GpuBatch>()),
+      fills_(std::make_unique<gl::GpuBatch>()),
+      wires_(std::make_unique<gl::GpuBatch>()) {}
+
+Overlays::~Overlays() {
+    glDeleteFramebuffers(1, &layerFbo_);
+    glDeleteTextures(1, &layerTex_);
+}
+
+bool Overlays::select(uint32_t id) {
+    if (!view_) {  // before the first structure: applied when it arrives
+        pendingSelect_ = id;
+        hasPendingSelect_ = true;
+        return true;
+    }
+    if (id >= view_->regionCount()) {
+        selection_.reset();
+        return false;
+    }
+    const RegionInfo r = view_->region(id);
+    Selection s;
+    s.region = id;
+    s.zone = r.zone;
+    s.frame =
+        r.kind == RegionKind::ProjectiveSlab ? ZoneFrameKind::Projective : ZoneFrameKind::Camera;
+    selection_ = s;
+    return true;
+}
+
+void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const Camera& view,
+                      int width, int height) {
+    if (structure && structure != structure_) {
+        // The new structure replaces the old one only now that it is ready: until then the old
+        // overlays stayed on screen. Region ids of the old one mean nothing in the new one.
+        structure_ = structure;
+        view_ = std::make_unique<StructureView>(*structure->scene, *structure->accel);
+        built_ = false;
+        if (selection_ && !select(selection_->region)) selection_.reset();
+        if (hasPendingSelect_) {
+            hasPendingSelect_ = false;
+            select(pendingSelect_);
+        }
+    }
+    if (!view_) return;
+    const bool stale = !built_ || builtOptions_ != options || builtWidth_ != width ||
+                       builtHeight_ != height ||
+                       (geometry_.cameraDependent && !sameCamera(builtCamera_, view));
+    if (!stale) return;
+    const auto t0 = std::chrono::steady_clock::now();
+    geometry_ = options.any() ? buildOverlayGeometry(*view_, view, width, height, options)
+                              : OverlayGeometry{};
+    cuts_->upload(geometry_.cuts);
+    fills_->upload(geometry_.fills);
+    wires_->upload(geometry_.wires);
+    lastBuildMs_ =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    builtOptions_ = options;
+    builtCamera_ = view;
+    builtWidth_ = width;
+    builtHeight_ = height;
+    built_ = true;
+    ++rebuilds_;
+}
+
+void Overlays::drawLayers(const Camera& view, int width, int height) {
+    if (!view_ || width <= 0 || height <= 0 || !options.any()) return;
+    const auto [nearDepth, farDepth] = clipDepths(*view_, view);
+    const glm::mat4 toClip = gl::worldToClip(view, width, height, nearDepth, farDepth);
+    glViewport(0, 0, width, height);
+    gl::DrawOptions fill;
+    fill.opacity = look.fillOpacity;
+    fill.lines = false;
+    renderer_->draw(*fills_, toClip, fill);
+    gl::DrawOptions wire;
+    wire.opacity = look.lineOpacity;
+    wire.triangles = false;
+    renderer_->draw(*wires_, toClip, wire);
+    gl::DrawOptions cuts = wire;
+    if (look.replayCuts >= 0) cuts.lineLimit = size_t(look.replayCuts) * geometry_.linesPerCut;
+    renderer_->draw(*cuts_, toClip, cuts);
+}
+
+void Overlays::drawSelection(const Camera& view, int width, int height) {
+    if (!view_ || width <= 0 || height <= 0) return;
+    if (!selection_ || selection_->region >= view_->regionCount()) return;
+    const auto [nearDepth, farDepth] = clipDepths(*view_, view);
+    const glm::mat4 toClip = gl::worldToClip(view, width, height, nearDepth, farDepth);
+    glViewport(0, 0, width, height);
+    // The selected region: its faces tinted, its edges bright.
+    const std::array<Vec3, 8> wc = view_->regionCorners(selection_->region);
+    std::array<glm::vec3, 8> c;
+    for (size_t i = 0; i < 8; ++i) c[i] = glm::vec3(wc[i]);
+    gl::Batch b;
+    b.fillBox(c, gl::rgba8(glm::vec3(0.2f, 1.0f, 1.0f), 0.18f));
+    b.box(c, gl::rgba8(glm::vec3(0.3f, 1.0f, 1.0f)));
+    renderer_->drawNow(b, toClip);
+}
+
+bool Overlays::layerStale(const Camera& view, int width, int height) const {
+    return !(layerTex_ != 0 && layerRebuild_ == rebuilds_ && layerWidth_ == width &&
+             layerHeight_ == height && layerLook_ == look && sameCamera(layerCamera_, view));
+}
+
+unsigned Overlays::layerTexture(const Camera& view, int width, int height) {
+    if (!view_ || !options.any() || width <= 0 || height <= 0) return 0;
+    if (!layerStale(view, width, height)) return layerTex_;
+    if (layerTex_ == 0) {
+        glGenTextures(1, &layerTex_);
+        glGenFramebuffers(1, &layerFbo_);
+    }
+    if (layerWidth_ != width || layerHeight_ != height) {
+        glBindTexture(GL_TEXTURE_2D, layerTex_);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                     nullptr);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, layerFbo_);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, layerTex_, 0);
+        layerWidth_ = width;
+        layerHeight_ = height;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    glBindFramebuffer(GL_FRAMEBUFFER, layerFbo_);
+    glDisable(GL_SCISSOR_TEST);
+    glViewport(0, 0, width, height);
+    glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    drawLayers(view, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    // Finished here, so the time is the drawing's (it happens on a change only).
+    glFinish();
+    lastLayerMs_ =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    layerRebuild_ = rebuilds_;
+    layerLook_ = look;
+    layerCamera_ = view;
+    ++layerVersion_;
+    return layerTex_;
+}
+
+bool Overlays::pickAt(const Camera& view, int width, int height, double x, double y, float depth) {
+    if (!view_) return false;
+    const auto p = pick(*view_, view, width, height, x, y, depth, options.projective);
+    if (!p) return false;
+    selection_ = Selection{p->region, p->zone, p->frame};
+    return true;
+}
+
+void Overlays::tooltip(const Camera& view, int width, int height, double x, double y, float depth) {
+    if (!view_ || !look.tooltip) return;
+    const auto p = pick(*view_, view, width, height, x, y, depth, options.projective);
+    if (!p) return;
+    const RegionInfo r = view_->region(p->region);
+    ImGui::BeginTooltip();
+    if (view_->irregular() && p->zone >= 0) {
+        const ZoneFrameView* fr = view_->frame(p->frame);
+        ImGui::Text("zone %lld (%s frame)", static_cast<long long>(p->zone),
+                    p->frame == ZoneFrameKind::Projective ? "projective" : "camera");
+        if (fr)
+            ImGui::Text("%zu primitives, %zu slabs", fr->zonePrims(uint32_t(p->zone)).size(),
+                        fr->slabs(uint32_t(p->zone)).size());
+    }
+    ImGui::Text("%s %u: %zu primitives", regionKindName(r.kind), r.id, r.prims.size());
+    if (r.level >= 0) ImGui::Text("level %d", r.level);
+    ImGui::TextDisabled("Ctrl+click selects");
+    ImGui::EndTooltip();
+}
+
+void Overlays::panel(bool* open) {
+    // Under the View panel, in the right-hand column (the image's middle stays clear).
+    ImGui::SetNextWindowPos(ImVec2(ImGui::GetIO().DisplaySize.x - 348, 484),
+                            ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(340, 230), ImGuiCond_FirstUseEver);
+    if (!ImGui::Begin("Overlays", open)) {
+        ImGui::End();
+        return;
+    }
+    if (!view_) {
+        ImGui::TextDisabled("no structure yet");
+        ImGui::End();
+        return;
+    }
+    OverlayOptions& o = options;
+    if (view_->irregular()) {
+        const bool hasProjective = view_->frame(ZoneFrameKind::Projective) != nullptr;
+        ImGui::Checkbox("BSP cut lines", &o.bsp);
+        ImGui::SameLine();
+        ImGui::Checkbox("zones", &o.zones);
+        ImGui::SameLine();
+        ImGui::Checkbox("slabs", &o.slabs);
+        if (hasProjective) ImGui::Checkbox("projective zones (else camera frame)", &o.projective);
+        const ZoneFrameView* fr = overlayFrame(*view_, o.projective);
+        if (fr)
+            ImGui::TextDisabled("%s frame, %s: %zu zones",
+                                fr->kind() == ZoneFrameKind::Projective ? "projective" : "camera",
+                                fr->mapsToImage() ? "maps to pixels" : "drawn in perspective",
+                                fr->zoneCount());
+        if (o.bsp) {
+            int all = int(geometry_.cuts.lineCount() / std::max<size_t>(1, geometry_.linesPerCut));
+            int n = look.replayCuts < 0 ? all : std::min(look.replayCuts, all);
+            if (ImGui::SliderInt("cuts replayed", &n, 0, all)) look.replayCuts = n >= all ? -1 : n;
+            ImGui::TextDisabled("%zu cuts, depth 0..%d", geometry_.cutsTotal,
+                                geometry_.maxCutDepth);
+        }
+        if (o.zones) {
+            int fill = int(o.zoneFill);
+            ImGui::RadioButton("fill by primitives", &fill, int(ZoneFill::Prims));
+            ImGui::SameLine();
+            ImGui::RadioButton("by slabs", &fill, int(ZoneFill::Slabs));
+            o.zoneFill = ZoneFill(fill);
+            ImGui::SliderFloat("fill opacity", &look.fillOpacity, 0.0f, 1.0f);
+        }
+        if (o.zones || o.slabs)
+            ImGui::Text("zones drawn: %zu of %zu", geometry_.zonesDrawn, geometry_.zonesTotal);
+    } else if (view_->regular()) {
+        ImGui::Checkbox("leaves", &o.leaves);
+        ImGui::SameLine();
+        ImGui::Checkbox("directory grid", &o.grid);
+        int color = int(o.leafColor);
+        ImGui::RadioButton("colour by level", &color, int(LeafColor::Level));
+        ImGui::SameLine();
+        ImGui::RadioButton("by primitives", &color, int(LeafColor::Prims));
+        o.leafColor = LeafColor(color);
+        const int top = std::max(1, view_->accelerator().params().maxLevel);
+        ImGui::DragIntRange2("levels", &o.levelMin, &o.levelMax, 0.1f, 0, top, "from %d", "to %d");
+        o.levelMin = std::clamp(o.levelMin, 0, top);
+        o.levelMax = std::clamp(o.levelMax, o.levelMin, std::max(top, o.levelMax));
+        ImGui::TextDisabled("grid: the level range selects sub-table depths");
+    } else {
+        ImGui::TextDisabled("brute force has no subdivision to draw");
+    }
+    ImGui::SliderFloat("line opacity", &look.lineOpacity, 0.0f, 1.0f);
+    int cap = int(std::min<size_t>(o.cap, 10000000));
+    if (ImGui::InputInt("cap (regions drawn)", &cap, 1000, 100000))
+        o.cap = size_t(std::max(0, cap));
+    if (geometry_.regionsTotal > 0)
+        ImGui::Text(
+            "regions drawn: %zu of %zu%s", geometry_.regionsDrawn, geometry_.regionsTotal,
+            geometry_.regionsDrawn < geometry_.regionsTotal ? " (visible first, capped)" : "");
+    ImGui::Checkbox("hover tooltip", &look.tooltip);
+    ImGui::TextDisabled("batches built in %.1f ms (%llu builds), drawn in %.1f ms", lastBuildMs_,
+                        static_cast<unsigned long long>(rebuilds_), lastLayerMs_);
+    ImGui::End();
+}
+
+namespace {
+
+void csgTreeNode(const CsgTree& pool, int node, const Scene& scene) {
+    if (node < 0 || size_t(node) >= pool.nodes.size()) return;
+    const CsgNode& n = pool.nodes[size_t(node)];
+    ImGui::PushID(node);
+    if (n.op == Op::Primitive) {
+        const char* kind = n.prim < scene.prims.size() ? shapeName(scene.prims[n.prim].shape) : "?";
+        ImGui::BulletText("%s %u", kind, n.prim);
+    } else if (ImGui::TreeNodeEx("op", ImGuiTreeNodeFlags_DefaultOpen, "%s", opName(n.op))) {
+        csgTreeNode(pool, n.left, scene);
+        csgTreeNode(pool, n.right, scene);
+        ImGui::TreePop();
+    }
+    ImGui::PopID();
+}
+
+}  // namespace
+
+void Overlays::selectionPanel(bool* open) {
+    ImGui::SetNextWindowPos(ImVec2(346, 28), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(360, 420), ImGuiCond_FirstUseEver);
+    if (!ImGui::Begin("Selection", open)) {
+        ImGui::End();
+        return;
+    }
+    if (!view_ || !selection_ || selection_->region >= view_->regionCount()) {
+        ImGui::TextWrapped("Nothing selected: Ctrl+click the image (or --select REGION).");
+        ImGui::End();
+        return;
+    }
+    const RegionInfo r = view_->region(selection_->region);
+    const Scene& scene = view_->scene();
+    ImGui::Text("%s %u", regionKindName(r.kind), r.id);
+    if (r.level >= 0) ImGui::Text("level %d", r.level);
+    if (r.zone >= 0) ImGui::Text("zone %lld, slab %u", static_cast<long long>(r.zone), r.slab);
+    ImGui::TextWrapped("box (%s frame): %s",
+                       r.kind == RegionKind::Leaf || r.kind == RegionKind::SceneBox ? "world"
+                       : r.kind == RegionKind::Slab                                 ? "camera"
+                                                                                    : "projective",
+                       boxText(r.frameBox).c_str());
+    if (ImGui::Button("clear")) selection_.reset();
+    if (!selection_) {
+        ImGui::End();
+        return;
+    }
+    if (ImGui::CollapsingHeader("primitives", ImGuiTreeNodeFlags_DefaultOpen)) {
+        ImGui::Text("%zu listed", r.prims.size());
+        const size_t shown = std::min<size_t>(r.prims.size(), 200);
+        if (ImGui::BeginTable("prims", 3, ImGuiTableFlags_Borders | ImGuiTableFlags_ScrollY,
+                              ImVec2(0, 140))) {
+            ImGui::TableSetupColumn("id");
+            ImGui::TableSetupColumn("kind");
+            ImGui::TableSetupColumn("minimized box");
+            ImGui::TableHeadersRow();
+            for (size_t i = 0; i < shown; ++i) {
+                const uint32_t p = r.prims[i];
+                ImGui::TableNextColumn();
+                ImGui::Text("%u", p);
+                ImGui::TableNextColumn();
+                ImGui::TextUnformatted(p < scene.prims.size() ? shapeName(scene.prims[p].shape)
+                                                              : "?");
+                ImGui::TableNextColumn();
+                ImGui::TextUnformatted(p < scene.minBox.size() ? boxText(scene.minBox[p]).c_str()
+                                                               : "");
+            }
+            ImGui::EndTable();
+        }
+        if (shown < r.prims.size()) ImGui::TextDisabled("(first %zu shown)", shown);
+    }
+    if (ImGui::CollapsingHeader("restricted CSG tree", ImGuiTreeNodeFlags_DefaultOpen)) {
+        if (r.root < 0 || !r.pool)
+            ImGui::TextDisabled("empty");
+        else
+            csgTreeNode(*r.pool, r.root, scene);
+    }
+    if (ImGui::CollapsingHeader("neighbours", ImGuiTreeNodeFlags_DefaultOpen)) {
+        const bool regular = r.kind == RegionKind::Leaf;
+        ImGui::TextDisabled(regular ? "ropes across each face"
+                                    : "corner pointers (the region beyond each face's corner)");
+        static const char* axes[3] = {"x", "y", "z"};
+        std::optional<uint32_t> go;
+        for (int a = 0; a < 3; ++a)
+            for (int side = 0; side < 2; ++side) {
+                const int64_t n = side ? r.hi[a] : r.lo[a];
+                ImGui::Text("%s %s:", side ? "high" : "low", axes[a]);
+                ImGui::SameLine();
+                if (n >= 0) {
+                    ImGui::PushID(a * 2 + side);
+                    if (ImGui::SmallButton(std::to_string(n).c_str())) go = uint32_t(n);
+                    ImGui::PopID();
+                } else {
+                    ImGui::TextDisabled("%s", n == kNoNeighbour         ? "border"
+                                              : n == kSeveralNeighbours ? "several leaves"
+                                                                        : "not linked");
+                }
+            }
+        if (go) select(*go);
+    }
+    ImGui::End();
+}
+
+std::vector<std::string> applyShowList(const std::string& list, OverlayOptions& o) {
+    OverlayOptions out = o;
+    out.bsp = out.zones = out.slabs = out.leaves = out.grid = false;
+    std::vector<std::string> notDrawn;
+    std::stringstream in(list);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        if (item == "bsp")
+            out.bsp = true;
+        else if (item == "zones")
+            out.zones = true;
+        else if (item == "slabs")
+            out.slabs = true;
+        else if (item == "leaves")
+            out.leaves = true;
+        else if (item == "grid")
+            out.grid = true;
+        else if (item == "none")
+            continue;
+        else if (item == "boxes" || item == "frustum" || item == "inspector" || item == "ray")
+            notDrawn.push_back(item);
+        else
+            throw std::invalid_argument(
+                "unknown item '" + item +
+                "' (expected bsp, zones, slabs, leaves, grid, boxes, frustum, inspector, ray, "
+                "none)");
+    }
+    o = out;
+    return notDrawn;
+}
+
+}  // namespace lancer::viewer::overlay

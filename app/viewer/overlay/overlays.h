@@ -1,0 +1,126 @@
+// The overlays drawn over the image, after it and before the panels: their options and
+// panels (Overlays, Selection), their batches cached per structure, camera, image size and
+// options, the hover tooltip, picking and the selection (which the inspector reads to
+// highlight the same region).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "app/viewer/gl/batch.h"
+#include "app/viewer/overlay/overlay_geometry.h"
+#include "app/viewer/structure_builder.h"
+
+namespace lancer::viewer::overlay {
+
+/// Drawing choices that need no rebuild of the batches.
+struct OverlayLook {
+    bool operator==(const OverlayLook&) const = default;
+    int replayCuts = -1;        ///< cuts drawn, in the order they were made (-1: all)
+    float fillOpacity = 0.35f;  ///< zones' fills
+    float lineOpacity = 0.9f;   ///< cut lines and wireframes
+    bool tooltip = true;        ///< the hover tooltip over the image
+};
+
+/// The region picked in the image (or set by --select, or by the inspector).
+struct Selection {
+    uint32_t region = 0;
+    int64_t zone = -1;  ///< irregular: the zone, in `frame`
+    ZoneFrameKind frame = ZoneFrameKind::Camera;
+};
+
+class Overlays {
+  public:
+    /// Needs a current OpenGL 3.3 core context from construction to destruction.
+    Overlays();
+    ~Overlays();
+    Overlays(const Overlays&) = delete;
+    Overlays& operator=(const Overlays&) = delete;
+
+    OverlayOptions options;  ///< the layers (a change rebuilds the batches at the next update)
+    OverlayLook look;
+
+    /// Take the structure on screen (null: none yet) and rebuild the batches if the structure,
+    /// the camera they depend on, the size or the options changed. Until a new structure
+    /// arrives the previous one's overlays stay.
+    void update(const std::shared_ptr<const SceneBuild>& structure, const Camera& view, int width,
+                int height);
+    /// Draw the layers and the selection into the current framebuffer (width x height, the
+    /// image filling it), as seen by `view`.
+    void draw(const Camera& view, int width, int height) {
+        drawLayers(view, width, height);
+        drawSelection(view, width, height);
+    }
+    /// The layers alone (cut lines, fills, wireframes), blended into the current framebuffer.
+    void drawLayers(const Camera& view, int width, int height);
+    /// The selection's highlight alone (a few lines and faces: cheap to draw every frame).
+    void drawSelection(const Camera& view, int width, int height);
+    /// The layers drawn into a texture of their own (premultiplied RGBA, framebuffer rows),
+    /// again only when the batches, the camera, the size or the look changed: the image view
+    /// composites it when it shades the image (ImageView::setOverlay), so layers of a million
+    /// lines cost nothing in a frame where nothing changed. 0 when no layer is on.
+    unsigned layerTexture(const Camera& view, int width, int height);
+    /// layerTexture() would draw the texture again (or has none to give).
+    bool layerStale(const Camera& view, int width, int height) const;
+    /// Milliseconds the last drawing of the layers' texture took (to the end of GL's work).
+    double lastLayerMs() const { return lastLayerMs_; }
+    /// Incremented each time layerTexture() draws the texture again.
+    uint64_t layerVersion() const { return layerVersion_; }
+
+    /// The Overlays panel (layers, replay, opacity, level range, cap, counts).
+    void panel(bool* open);
+    /// The Selection panel: the selected region's box, primitives, restricted tree, neighbours.
+    void selectionPanel(bool* open);
+    /// The tooltip for the image point (x, y) under the mouse (continuous image coordinates);
+    /// `depth` is the primary hit distance there.
+    void tooltip(const Camera& view, int width, int height, double x, double y, float depth);
+    /// Select the region under image point (x, y); false (selection unchanged) when none.
+    bool pickAt(const Camera& view, int width, int height, double x, double y, float depth);
+
+    /// The selection, if any.
+    const std::optional<Selection>& selection() const { return selection_; }
+    /// Select region `id` of the structure on screen; false (nothing selected) when there is no
+    /// such region.
+    bool select(uint32_t id);
+    void clearSelection() { selection_.reset(); }
+    /// The description of the structure on screen (null before the first).
+    const StructureView* view() const { return view_.get(); }
+    /// The cached geometry (what the last update built).
+    const OverlayGeometry& geometry() const { return geometry_; }
+    /// Times the batches were rebuilt (tests: a change rebuilds, nothing else does).
+    uint64_t rebuilds() const { return rebuilds_; }
+    /// Milliseconds the last rebuild took (building and uploading the batches).
+    double lastBuildMs() const { return lastBuildMs_; }
+
+  private:
+    std::shared_ptr<const SceneBuild> structure_;
+    std::unique_ptr<StructureView> view_;
+    std::unique_ptr<gl::BatchRenderer> renderer_;
+    std::unique_ptr<gl::GpuBatch> cuts_, fills_, wires_;
+    OverlayGeometry geometry_;
+    // What the batches were built for.
+    OverlayOptions builtOptions_;
+    Camera builtCamera_;
+    int builtWidth_ = 0, builtHeight_ = 0;
+    bool built_ = false;
+    uint64_t rebuilds_ = 0;
+    double lastBuildMs_ = 0.0;
+    // The layers' texture and what it was drawn for.
+    unsigned layerFbo_ = 0, layerTex_ = 0;
+    int layerWidth_ = 0, layerHeight_ = 0;
+    uint64_t layerVersion_ = 0, layerRebuild_ = ~uint64_t(0);
+    double lastLayerMs_ = 0.0;
+    Camera layerCamera_;
+    OverlayLook layerLook_;
+    std::optional<Selection> selection_;
+    uint32_t pendingSelect_ = 0;
+    bool hasPendingSelect_ = false;
+};
+
+/// The names --show accepts (DESIGN.md section 6), and which of them the overlays draw.
+/// Parse a --show list into `options`; returns the items the overlays do not draw (an empty
+/// list when all were taken) and throws std::invalid_argument naming an unknown item.
+std::vector<std::string> applyShowList(const std::string& list, OverlayOptions& options);
+
+}  // namespace lancer::viewer::overlay

@@ -1,0 +1,345 @@
+// The overlays over the image (app/viewer/overlay/), drawn into an OSMesa context: the screen
+// BSP's cut lines on the projected box edges, the selection highlighted where its corners
+// project, the level range, a rebuild at another max-level, and the --show list.
+#include <gtest/gtest.h>
+
+#include <set>
+#include <stdexcept>
+
+#include "app/viewer/gl/transforms.h"
+#include "app/viewer/image_view.h"
+#include "app/viewer/overlay/overlays.h"
+#include "engine/accel/irregular/irregular.h"
+#include "engine/accel/regular/regular_grid.h"
+#include "tests/gl/offscreen_gl.h"
+
+namespace lancer::viewer::overlay {
+namespace {
+
+using viewer::testing::OffscreenGl;
+
+constexpr int kW = 100, kH = 100;
+
+/// Two blocks (the irregular BSP cut while a zone holds any primitive: maxObjects 0) seen from +z
+/// by an orthographic camera, 10 pixels a unit, whose x and y faces project half a pixel off the
+/// pixel grid, onto pixel centres: x = -2.95 is column 20, and so on (columns 20, 40, 60, 80; rows
+/// 29, 39, 59, 69).
+std::shared_ptr<SceneBuild> twoBoxes(SchemeKind scheme, int maxLevel = 24) {
+    auto scene = std::make_shared<Scene>();
+    scene->prims.push_back(makePrimitive(Block{{-2.95, -1.95, -1.0}, {-0.95, 1.05, 1.0}}, {}));
+    scene->prims.push_back(makePrimitive(Block{{1.05, -0.95, -0.5}, {3.05, 2.05, 0.5}}, {}));
+    if (scheme == SchemeKind::Regular) {
+        // The regular scheme stops at one primitive a cell: small blocks around make its BSP
+        // cut to several levels.
+        for (const Vec3& c : {Vec3(-4.0, 3.0, 0.0), Vec3(0.2, -4.0, 0.3), Vec3(4.1, -3.2, -0.2),
+                              Vec3(0.1, 3.6, 0.0), Vec3(-4.2, -3.9, 0.1)})
+            scene->prims.push_back(makePrimitive(Block{c - 0.4, c + 0.4}, {}));
+    }
+    std::vector<int> leaves;
+    for (uint32_t i = 0; i < scene->prims.size(); ++i) leaves.push_back(scene->tree.leaf(i));
+    scene->tree.root = scene->tree.balanced(Op::Union, leaves);
+    scene->camera.from = {0.0, 0.0, 10.0};
+    scene->camera.at = {0.0, 0.0, 0.0};
+    scene->camera.up = {0.0, 1.0, 0.0};
+    scene->camera.projection = Projection::Orthographic;
+    scene->camera.orthoHeight = 10.0;
+    scene->width = kW;
+    scene->height = kH;
+    scene->prepare();
+    BuildParams p;
+    p.scheme = scheme;
+    p.maxLevel = maxLevel;
+    p.maxObjects = scheme == SchemeKind::Regular ? 1 : 0;
+    auto s = std::make_shared<SceneBuild>();
+    s->spec = "two boxes";
+    s->scene = scene;
+    s->accel = buildAccelerator(*scene, p);
+    return s;
+}
+
+bool lit(const std::vector<uint8_t>& px, int x, int y) {
+    const uint8_t* p = &px[(size_t(y) * kW + size_t(x)) * 4];
+    return p[0] > 20 || p[1] > 20 || p[2] > 20;
+}
+
+TEST(Overlays, BspCutLinesFallOnTheProjectedBoxEdges) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Irregular);
+    Overlays ov;
+    ov.options.bsp = true;
+    ov.look.lineOpacity = 1.0f;
+    const Camera& cam = s->scene->camera;
+    ov.update(s, cam, kW, kH);
+    ASSERT_NE(ov.view(), nullptr);
+    const ZoneFrameView* fr = overlayFrame(*ov.view(), true);
+    ASSERT_NE(fr, nullptr);
+    EXPECT_TRUE(fr->mapsToImage()) << "an orthographic camera frame maps to pixels";
+    // Every cut of the description lies on a projected face of a box.
+    const std::set<double> xs = {20.5, 40.5, 60.5, 80.5}, ys = {29.5, 39.5, 59.5, 69.5};
+    size_t inside = 0;
+    for (const BspCut& c : fr->cuts()) {
+        const glm::dvec2 a = fr->toPixel(c.a, kW, kH), b = fr->toPixel(c.b, kW, kH);
+        if (c.axis == 0) {
+            EXPECT_NEAR(a.x, b.x, 1e-9);
+            bool onEdge = false;
+            for (double x : xs) onEdge |= std::abs(a.x - x) < 1e-6;
+            // Cuts on the padded bounds' rim lie outside the image: they separate nothing seen.
+            if (a.x > 0.0 && a.x < kW) {
+                EXPECT_TRUE(onEdge) << "cut x = " << a.x;
+                ++inside;
+            }
+        } else {
+            bool onEdge = false;
+            for (double y : ys) onEdge |= std::abs(a.y - y) < 1e-6;
+            if (a.y > 0.0 && a.y < kH) {
+                EXPECT_TRUE(onEdge) << "cut y = " << a.y;
+                ++inside;
+            }
+        }
+    }
+    EXPECT_GE(inside, 4u) << "the boxes' sides must be cut";
+    // And the drawing: every lit pixel is on one of those columns or rows, and the columns
+    // between the two boxes' sides are lit.
+    gl.clear(0, 0, 0);
+    ov.draw(cam, kW, kH);
+    const std::vector<uint8_t> px = gl.read();
+    size_t litCount = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x)
+            if (lit(px, x, y)) {
+                ++litCount;
+                EXPECT_TRUE(xs.count(x + 0.5) || ys.count(y + 0.5))
+                    << "pixel " << x << "," << y << " lit off every box edge";
+            }
+    EXPECT_GT(litCount, size_t(kH)) << "cut lines must be drawn";
+    int litColumns = 0;
+    for (double x : xs) litColumns += lit(px, int(x), 50);
+    EXPECT_GE(litColumns, 2) << "vertical cuts cross row 50 between the boxes";
+
+    // The replay: no cut drawn at 0, and the first cut only at 1.
+    ov.look.replayCuts = 0;
+    gl.clear(0, 0, 0);
+    ov.draw(cam, kW, kH);
+    const std::vector<uint8_t> none = gl.read();
+    size_t litNone = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) litNone += lit(none, x, y);
+    EXPECT_EQ(litNone, 0u);
+}
+
+TEST(Overlays, TheSelectionIsHighlightedWhereItsCornersProject) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Regular);
+    const Camera& cam = s->scene->camera;
+    Overlays ov;
+    ov.update(s, cam, kW, kH);
+    // Pick the pixel at the centre of the second box: its leaf holds primitive 1.
+    const gl::ImageProjector proj(cam, kW, kH);
+    const glm::dvec2 centre = *proj.toImage({2.05, 0.55, 0.5});
+    ASSERT_TRUE(ov.pickAt(cam, kW, kH, centre.x, centre.y, 9.5f));
+    const uint32_t id = ov.selection()->region;
+    const RegionInfo r = ov.view()->region(id);
+    ASSERT_EQ(r.kind, RegionKind::Leaf);
+    EXPECT_TRUE(std::find(r.prims.begin(), r.prims.end(), 1u) != r.prims.end());
+    // Drawn: the leaf's outline on the pixels its corners project to (one pixel of slack
+    // across an edge on the pixel grid), tinted inside, nothing far outside.
+    gl.clear(0, 0, 0);
+    ov.draw(cam, kW, kH);
+    const std::vector<uint8_t> px = gl.read();
+    const std::array<Vec3, 8> c = ov.view()->regionCorners(id);
+    glm::dvec2 lo(1e9), hi(-1e9);
+    for (const Vec3& p : c) {
+        const glm::dvec2 q = *proj.toImage(p);
+        lo = glm::min(lo, q);
+        hi = glm::max(hi, q);
+    }
+    auto cyanNear = [&](double x, double y) {
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int xi = std::clamp(int(std::floor(x)) + dx, 0, kW - 1),
+                          yi = std::clamp(int(std::floor(y)) + dy, 0, kH - 1);
+                const uint8_t* p = &px[(size_t(yi) * kW + size_t(xi)) * 4];
+                if (p[1] > 200 && p[2] > 200 && p[0] < 120) return true;
+            }
+        return false;
+    };
+    const glm::dvec2 mid = 0.5 * (lo + hi);
+    EXPECT_TRUE(cyanNear(lo.x, mid.y)) << "left edge at x " << lo.x;
+    EXPECT_TRUE(cyanNear(hi.x, mid.y)) << "right edge at x " << hi.x;
+    EXPECT_TRUE(cyanNear(mid.x, lo.y)) << "top edge at y " << lo.y;
+    EXPECT_TRUE(cyanNear(mid.x, hi.y)) << "bottom edge at y " << hi.y;
+    const uint8_t* in = &px[(size_t(mid.y) * kW + size_t(mid.x)) * 4];
+    EXPECT_GT(in[2], 20) << "the inside is tinted";
+    EXPECT_LT(in[2], 120) << "translucently";
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x)
+            if (x + 0.5 < lo.x - 2 || x + 0.5 > hi.x + 2 || y + 0.5 < lo.y - 2 ||
+                y + 0.5 > hi.y + 2)
+                ASSERT_FALSE(lit(px, x, y)) << x << "," << y << " outside the selection";
+    // A region id the structure does not have selects nothing.
+    EXPECT_FALSE(ov.select(uint32_t(ov.view()->regionCount())));
+    EXPECT_FALSE(ov.selection().has_value());
+}
+
+/// Pixels lit by drawing `ov` on black.
+std::vector<uint8_t> drawn(const OffscreenGl& gl, Overlays& ov, const Camera& cam) {
+    gl.clear(0, 0, 0);
+    ov.draw(cam, kW, kH);
+    return gl.read();
+}
+
+TEST(Overlays, TheLevelRangeHidesTheLevelsOutsideIt) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Regular);
+    const Camera& cam = s->scene->camera;
+    Overlays ov;
+    ov.options.leaves = true;
+    ov.update(s, cam, kW, kH);
+    const StructureView& sv = *ov.view();
+    const size_t n = sv.regionCount();
+    ASSERT_GT(n, 2u);
+    std::map<int, size_t> perLevel;
+    for (uint32_t i = 0; i < n; ++i) ++perLevel[sv.leafLevel(i)];
+    ASSERT_GE(perLevel.size(), 2u) << "the test needs leaves at two levels";
+    EXPECT_EQ(ov.geometry().wires.lineCount(), 12 * n);
+    const gl::ImageProjector proj(cam, kW, kH);
+    for (const auto& [level, count] : perLevel) {
+        ov.options.levelMin = ov.options.levelMax = level;
+        ov.update(s, cam, kW, kH);
+        EXPECT_EQ(ov.geometry().wires.lineCount(), 12 * count) << "level " << level;
+        // Every lit pixel lies on the outline of a leaf of this level (a pixel of slack).
+        std::vector<uint8_t> mask(size_t(kW) * kH, 0);
+        for (uint32_t i = 0; i < n; ++i) {
+            if (sv.leafLevel(i) != level) continue;
+            const std::array<Vec3, 8> c = sv.regionCorners(i);
+            const glm::dvec2 a = *proj.toImage(c[0]), b = *proj.toImage(c[7]);
+            const glm::dvec2 lo = glm::min(a, b), hi = glm::max(a, b);
+            for (int y = 0; y < kH; ++y)
+                for (int x = 0; x < kW; ++x) {
+                    const double px = x + 0.5, py = y + 0.5;
+                    const bool inY = py > lo.y - 1.5 && py < hi.y + 1.5;
+                    const bool inX = px > lo.x - 1.5 && px < hi.x + 1.5;
+                    if ((inY && (std::abs(px - lo.x) < 1.5 || std::abs(px - hi.x) < 1.5)) ||
+                        (inX && (std::abs(py - lo.y) < 1.5 || std::abs(py - hi.y) < 1.5)))
+                        mask[size_t(y) * kW + size_t(x)] = 1;
+                }
+        }
+        const std::vector<uint8_t> px = drawn(gl, ov, cam);
+        size_t litCount = 0;
+        for (int y = 0; y < kH; ++y)
+            for (int x = 0; x < kW; ++x)
+                if (lit(px, x, y)) {
+                    ++litCount;
+                    ASSERT_TRUE(mask[size_t(y) * kW + size_t(x)])
+                        << "level " << level << ": pixel " << x << "," << y
+                        << " lit off every leaf of the level";
+                }
+        EXPECT_GT(litCount, 0u) << "level " << level;
+    }
+    // A range with no leaf draws nothing.
+    ov.options.levelMin = ov.options.levelMax = perLevel.rbegin()->first + 1;
+    ov.update(s, cam, kW, kH);
+    EXPECT_EQ(ov.geometry().wires.lineCount(), 0u);
+    const std::vector<uint8_t> px = drawn(gl, ov, cam);
+    for (size_t i = 0; i < px.size(); i += 4) ASSERT_LE(px[i] + px[i + 1] + px[i + 2], 0);
+}
+
+TEST(Overlays, ARebuildAtAnotherMaxLevelChangesTheDrawnLeavesAndOnlyThen) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto coarse = twoBoxes(SchemeKind::Regular, 3), fine = twoBoxes(SchemeKind::Regular, 8);
+    const Camera& cam = coarse->scene->camera;
+    Overlays ov;
+    ov.options.leaves = true;
+    ov.update(coarse, cam, kW, kH);
+    const uint64_t builds = ov.rebuilds();
+    const size_t coarseLines = ov.geometry().wires.lineCount();
+    const std::vector<uint8_t> before = drawn(gl, ov, cam);
+    // Same structure, camera, size and options: the cached batches are drawn as they are.
+    ov.update(coarse, cam, kW, kH);
+    EXPECT_EQ(ov.rebuilds(), builds);
+    // No new structure yet (a build under way): the old overlays stay.
+    ov.update(nullptr, cam, kW, kH);
+    EXPECT_EQ(ov.rebuilds(), builds);
+    EXPECT_EQ(drawn(gl, ov, cam), before);
+    // The new structure arrives: rebuilt once, more leaves, other pixels.
+    ov.update(fine, cam, kW, kH);
+    EXPECT_EQ(ov.rebuilds(), builds + 1);
+    EXPECT_GT(ov.geometry().wires.lineCount(), coarseLines);
+    EXPECT_EQ(ov.geometry().wires.lineCount(), 12 * ov.view()->regionCount());
+    const std::vector<uint8_t> after = drawn(gl, ov, cam);
+    size_t changed = 0;
+    for (size_t i = 0; i < after.size(); i += 4)
+        changed += lit(after, int(i / 4) % kW, int(i / 4) / kW) !=
+                   lit(before, int(i / 4) % kW, int(i / 4) / kW);
+    EXPECT_GT(changed, 10u);
+}
+
+TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShows) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Irregular);
+    const Camera& cam = s->scene->camera;
+    Overlays ov;
+    ov.options.bsp = ov.options.zones = true;
+    ov.update(s, cam, kW, kH);
+    Image img(kW, kH);
+    for (size_t i = 0; i < img.color.size(); ++i) img.color[i] = glm::vec3(0.2f, 0.3f, 0.4f);
+    // Drawn directly over the image, then composited by the image view: the same pixels.
+    ImageView view;
+    view.upload(img, ViewMode::Color);
+    view.draw(kW, kH, ViewMode::Color, 1.0f);
+    ov.drawLayers(cam, kW, kH);
+    const std::vector<uint8_t> direct = gl.read();
+    const unsigned tex = ov.layerTexture(cam, kW, kH);
+    ASSERT_NE(tex, 0u);
+    const uint64_t version = ov.layerVersion();
+    EXPECT_EQ(ov.layerTexture(cam, kW, kH), tex);
+    EXPECT_EQ(ov.layerVersion(), version) << "nothing changed: the texture is not drawn again";
+    view.setOverlay(tex, version);
+    gl.clear(0, 0, 0);
+    view.draw(kW, kH, ViewMode::Color, 1.0f);
+    const std::vector<uint8_t> composited = gl.read();
+    int worst = 0;
+    size_t differing = 0;
+    for (size_t i = 0; i < direct.size(); ++i) {
+        worst = std::max(worst, std::abs(int(direct[i]) - int(composited[i])));
+        differing += direct[i] != composited[i];
+    }
+    EXPECT_LE(worst, 2);
+    size_t overlaid = 0;  // and the overlays are there at all
+    for (size_t i = 0; i < direct.size(); i += 4)
+        overlaid += std::abs(int(composited[i + 2]) - int(std::lround(0.4f * 255.0f))) > 8;
+    EXPECT_GT(overlaid, size_t(kW));
+    // A change of look draws the texture again; turning the layer off restores the image.
+    ov.look.fillOpacity = 0.8f;
+    ov.layerTexture(cam, kW, kH);
+    EXPECT_EQ(ov.layerVersion(), version + 1);
+    view.setOverlay(0, 0);
+    view.draw(kW, kH, ViewMode::Color, 1.0f);
+    const std::vector<uint8_t> plain = gl.read();
+    for (size_t i = 0; i < plain.size(); i += 4) ASSERT_NEAR(plain[i + 2], 102, 1);
+}
+
+TEST(Overlays, TheShowListTurnsLayersOnAndNamesWhatItDoesNotDraw) {
+    OverlayOptions o;
+    EXPECT_TRUE(applyShowList("bsp,zones", o).empty());
+    EXPECT_TRUE(o.bsp && o.zones && !o.leaves && !o.grid && !o.slabs);
+    EXPECT_EQ(applyShowList("leaves,inspector,ray", o),
+              (std::vector<std::string>{"inspector", "ray"}));
+    EXPECT_TRUE(o.leaves && !o.bsp);
+    EXPECT_TRUE(applyShowList("none", o).empty());
+    EXPECT_FALSE(o.any());
+    try {
+        applyShowList("bsp,bogus", o);
+        ADD_FAILURE() << "an unknown item must throw";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("bogus"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace lancer::viewer::overlay
