@@ -64,6 +64,10 @@ class IrregularSubdivision {
     const ScreenBsp& screen() const { return bsp_; }
     /// The projective zones that primary rays walk (empty with --irregular-frame camera).
     const ProjectiveZones& projective() const { return eye_; }
+    /// Zone z's regions are [zoneFirstRegion()[z], zoneFirstRegion()[z + 1]), by depth.
+    const std::vector<uint32_t>& zoneFirstRegion() const { return zoneFirstRegion_; }
+    /// The pool of the regions' restricted trees.
+    const CsgTree& treePool() const { return pool_; }
     /// Primitives of a region.
     std::span<const uint32_t> primitives(uint32_t region) const {
         uint32_t l = regions_[region].list;

@@ -75,10 +75,14 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     for (const IrregularRegion& r : slabs.regions) {
         s.slabLo_.push_back(r.box.lo.z);
         s.slabRoot_.push_back(r.root);
+        s.slabList_.push_back(r.list);
     }
     s.pool_ = std::move(slabs.pool);
+    s.listFirst_ = std::move(slabs.listFirst);
+    s.listPrims_ = std::move(slabs.listPrims);
     std::sort(nearPrims.begin(), nearPrims.end());
     if (!nearPrims.empty()) s.nearRoot_ = TreeRestrictor(scene.tree).restrict(nearPrims, s.pool_);
+    s.nearPrims_ = nearPrims;
 
     extra["projective_zones"] = s.zones_;
     extra["projective_slabs"] = s.slabRoot_.size();

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <span>
 
 #include "engine/accel/eval.h"
 #include "engine/accel/irregular/camera_frame.h"
@@ -58,6 +59,26 @@ class ProjectiveZones {
     /// Primitives listed in the near region [0, zNear].
     bool hasNearRegion() const { return nearRoot_ >= 0; }
 
+    // Inspection (structure_view.h).
+    /// The screen rectangle in (u, v) that the zones tile.
+    glm::dvec2 rectLo() const { return lo_; }
+    glm::dvec2 rectHi() const { return hi_; }
+    double zFar() const { return zFar_; }
+    /// Zone z's slabs are [zoneFirst()[z], zoneFirst()[z + 1]).
+    const std::vector<uint32_t>& zoneFirst() const { return zoneFirst_; }
+    /// Depth where slab i starts; it ends where slab i + 1 of its zone starts, or at zFar().
+    double slabLo(uint32_t i) const { return slabLo_[i]; }
+    int32_t slabRoot(uint32_t i) const { return slabRoot_[i]; }
+    int nearRoot() const { return nearRoot_; }
+    const CsgTree& treePool() const { return pool_; }
+    /// Primitives of slab i (those whose projected box overlaps it).
+    std::span<const uint32_t> slabPrimitives(uint32_t i) const {
+        uint32_t l = slabList_[i];
+        return {listPrims_.data() + listFirst_[l], listPrims_.data() + listFirst_[l + 1]};
+    }
+    /// Primitives of the near region.
+    std::span<const uint32_t> nearPrimitives() const { return nearPrims_; }
+
   private:
     const Scene* scene_ = nullptr;
     Vec3 eye_{0.0};
@@ -70,6 +91,11 @@ class ProjectiveZones {
     std::vector<double> slabLo_;       ///< depth where each slab starts; the last one ends at zFar_
     std::vector<int32_t> slabRoot_;    ///< restricted tree of each slab (-1: empty)
     CsgTree pool_;
+    // The slabs' primitive lists, kept for inspection only: the walk reads the trees, so
+    // memoryBytes() leaves them out.
+    std::vector<uint32_t> slabList_;  ///< list of each slab
+    std::vector<uint32_t> listFirst_, listPrims_;
+    std::vector<uint32_t> nearPrims_;
 };
 
 template <class Obs>

@@ -79,6 +79,14 @@ class Directory {
         return entries_.size() * sizeof(uint32_t) + tables_.size() * sizeof(Table);
     }
     size_t tableCount() const { return tables_.size(); }
+    /// Visit every entry of every table, depth first from the top table: f(lo, hi, subTable,
+    /// value, table, depth) with [lo, hi) the entry's block of finest cells per axis, value the
+    /// leaf (subTable false) or the sub-table the block is stored in, `table` the table holding
+    /// the entry and `depth` that table's depth (0: the top table).
+    template <class F>
+    void forEachEntry(F&& f) const {
+        if (!tables_.empty()) visitTable(0, 0, 0, 0, 0, f);
+    }
     size_t entryCount() const { return entries_.size(); }
 
   private:
@@ -97,6 +105,25 @@ class Directory {
         uint32_t mask[3] = {};
     };
 
+    template <class F>
+    void visitTable(uint32_t t, uint32_t x, uint32_t y, uint32_t z, int depth, F& f) const {
+        const Table T = tables_[t];
+        const uint32_t lo0[3] = {x, y, z};
+        for (uint32_t a = 0; a <= T.mask[0]; ++a)
+            for (uint32_t b = 0; b <= T.mask[1]; ++b)
+                for (uint32_t c = 0; c <= T.mask[2]; ++c) {
+                    const uint32_t e = entries_[T.offset + (a << T.lowBits) + (b << T.bits[2]) + c];
+                    const uint32_t idx[3] = {a, b, c};
+                    uint32_t lo[3], hi[3];
+                    for (int k = 0; k < 3; ++k) {
+                        lo[k] = lo0[k] + (idx[k] << T.shift[k]);
+                        hi[k] = lo[k] + (1u << T.shift[k]);
+                    }
+                    const bool sub = (e & kSubTable) != 0;
+                    f(lo, hi, sub, sub ? e & ~kSubTable : e, t, depth);
+                    if (sub) visitTable(e & ~kSubTable, lo[0], lo[1], lo[2], depth + 1, f);
+                }
+    }
     /// Levels a table rooted at a node of `height` at `level` covers.
     static int tableLevels(int level, int height, int finestLevel, bool full);
     uint32_t addTable(const BspNodes& bsp, int node, int level, int finestLevel, bool full);

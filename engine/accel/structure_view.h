@@ -1,0 +1,228 @@
+// A description of a built structure, for every scheme, that the overlays, the 3D inspector,
+// `lancer structure` and the tests read: regions with their volume as 8 world-space corners,
+// primitives, restricted trees and neighbours; the regular scheme's leaves, directory blocks and
+// cut planes; the irregular scheme's screen BSPs (camera frame, projective zones), zones and
+// slabs. It reads the built structure in place and computes everything on demand: the
+// irregular scheme on balls4 has millions of regions, so nothing is stored per region.
+//
+// Region ids are the ids the walk reports to the observer (observer.h): brute force has one
+// region (the scene box); the regular scheme's are its leaves; the irregular scheme's are its
+// camera-frame regions, then from IrregularSubdivision::regions().size() on the projective
+// slabs in zone order, the near region last (projective_zones.h).
+#pragma once
+
+#include <array>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "engine/accel/accelerator.h"
+
+namespace lancer {
+
+/// What kind of volume a region is.
+enum class RegionKind : uint8_t {
+    SceneBox,        ///< brute force: the scene's bounds
+    Leaf,            ///< regular: a BSP leaf, a box of the world
+    Slab,            ///< irregular: a depth slab of a camera-frame zone, a box of the camera frame
+    ProjectiveSlab,  ///< irregular: a depth slab of a projective zone (a piece of a pyramid)
+    NearRegion,      ///< irregular: the projective near region, depth [0, zNear] of every pixel
+};
+const char* regionKindName(RegionKind k);
+
+/// The irregular scheme's two screen frames (DESIGN.md section 4).
+enum class ZoneFrameKind : uint8_t {
+    Camera,      ///< screen x along R, screen y along U (scene units)
+    Projective,  ///< u = x / z, v = y / z (primary rays only)
+};
+/// Units a frame's 2D coordinates are given in by the dump (DESIGN.md section 6): pixels when
+/// the frame maps linearly to the image (orthographic camera frame, projective zones), camera
+/// units (scene units) for a perspective camera's camera frame.
+enum class FrameUnits : uint8_t { Pixels, Camera };
+const char* frameUnitsName(FrameUnits u);
+
+/// Neighbour values of RegionInfo::lo / hi besides region ids.
+inline constexpr int64_t kNoNeighbour = -1;        ///< the face lies on the structure's border
+inline constexpr int64_t kSeveralNeighbours = -2;  ///< regular: several leaves across the face
+inline constexpr int64_t kNotLinked = -3;          ///< the scheme keeps no link across this face
+
+/// One region, read from the structure (cheap: no per-region storage is kept).
+struct RegionInfo {
+    uint32_t id = 0;
+    RegionKind kind = RegionKind::SceneBox;
+    /// The region's box in its own frame: world (brute force, regular), camera frame (x, y,
+    /// depth; slabs), projective (u, v, depth; projective slabs and the near region).
+    Box3 frameBox;
+    int level = -1;                           ///< regular: BSP level of the leaf; -1 otherwise
+    uint32_t cellLo[3] = {}, cellHi[3] = {};  ///< regular: directory cells [lo, hi) per axis
+    int64_t zone = -1;  ///< irregular: zone in its frame's BSP; -1 for the near region
+    uint32_t slab = 0;  ///< irregular: index of the slab in its zone, by increasing depth
+    std::span<const uint32_t> prims;  ///< primitives listed in the region (tracer ids)
+    const CsgTree* pool = nullptr;    ///< the pool holding the region's restricted tree
+    int root = -1;                    ///< restricted tree's root in `pool`; -1: empty
+    /// Neighbours across the low and high face of each frame axis: regular ropes (one leaf
+    /// covers the face, or kSeveralNeighbours); irregular corner pointers (region.h: the region
+    /// just beyond the low / high corner across that face); projective slabs: the previous /
+    /// next slab in depth, kNotLinked across screen faces. kNoNeighbour on the border.
+    int64_t lo[3] = {kNoNeighbour, kNoNeighbour, kNoNeighbour};
+    int64_t hi[3] = {kNoNeighbour, kNoNeighbour, kNoNeighbour};
+};
+
+/// Regular scheme: one cut of the BSP, a plane across the cell of an inner node.
+struct CutPlane {
+    int axis = 0;        ///< 0 x, 1 y, 2 z
+    double value = 0.0;  ///< world coordinate of the plane
+    int level = 0;       ///< the node's level (the root is level 0)
+    Box3 cell;           ///< world box of the node's cell (the plane's rectangle is its section)
+    uint32_t cellLo[3] = {}, cellHi[3] = {};  ///< the cell in directory cells, [lo, hi)
+};
+
+/// Regular scheme: one entry of the directory (directory.h): a block of finest cells stored as
+/// a single entry naming a leaf, or a block stored as a sub-table of its own.
+struct DirectoryBlock {
+    uint32_t lo[3] = {}, hi[3] = {};  ///< directory cells [lo, hi) per axis
+    bool subTable = false;            ///< true: a sub-table's block; false: one entry
+    uint32_t leaf = 0;                ///< the leaf, for an entry
+    uint32_t child = 0;               ///< the sub-table storing the block (subTable)
+    uint32_t table = 0;               ///< the table holding this entry
+    int depth = 0;                    ///< tables above it (0: the top table)
+};
+
+/// Irregular scheme: one node of a screen BSP, in the order the cuts were made.
+struct BspCut {
+    uint32_t node = 0;
+    int depth = 0;  ///< the root is depth 0
+    int axis = 0;   ///< 0: the line x = value, 1: the line y = value (frame units)
+    double value = 0.0;
+    glm::dvec2 a{0.0}, b{0.0};  ///< the cut line clipped to the node's cell, frame units
+};
+
+/// Irregular scheme: one depth slab of a zone.
+struct SlabInfo {
+    uint32_t region = 0;              ///< region id (as the walk reports it)
+    double z0 = 0.0, z1 = 0.0;        ///< depth along F, increasing
+    std::span<const uint32_t> prims;  ///< its primitives
+};
+
+/// One screen frame of the irregular scheme: its 2D BSP, zones and slabs. Coordinates are frame
+/// units (camera frame: scene units on R and U; projective: u, v); toPixel maps them to the
+/// image when mapsToImage().
+class ZoneFrameView {
+  public:
+    ZoneFrameView(const Scene& scene, const IrregularSubdivision& s, ZoneFrameKind kind);
+
+    ZoneFrameKind kind() const { return kind_; }
+    /// Pixels when the frame maps linearly to the image, else camera units.
+    FrameUnits units() const { return mapsToImage() ? FrameUnits::Pixels : FrameUnits::Camera; }
+    /// Orthographic camera frame, or projective zones.
+    bool mapsToImage() const;
+    /// The screen rectangle the BSP subdivides, frame units.
+    glm::dvec2 rectLo() const { return lo_; }
+    glm::dvec2 rectHi() const { return hi_; }
+    const ScreenBsp& bsp() const { return *bsp_; }
+    size_t zoneCount() const { return bsp_->zoneCount(); }
+    /// Regions of this frame's slabs (the near region not counted).
+    size_t slabCount() const;
+    /// Region id of the first slab of zone 0.
+    uint32_t firstRegion() const { return first_; }
+
+    /// Every node with its depth and its cut clipped to the node's cell, in cut order.
+    std::vector<BspCut> cuts() const;
+    /// Zone z's rectangle, frame units.
+    glm::dvec2 zoneLo(uint32_t z) const { return bsp_->zoneLo[z]; }
+    glm::dvec2 zoneHi(uint32_t z) const { return bsp_->zoneHi[z]; }
+    /// Primitives whose rectangle touches zone z.
+    std::span<const uint32_t> zonePrims(uint32_t z) const;
+    /// Zone z's slabs, by increasing depth.
+    std::vector<SlabInfo> slabs(uint32_t z) const;
+    /// Zone holding the frame point (x, y); -1 outside the rectangle.
+    int64_t zoneAt(glm::dvec2 p) const;
+
+    /// Frame point to continuous image coordinates of a w x h image (x right from the left edge,
+    /// y down from the top edge, pixel (i, j) covering [i, i+1] x [j, j+1]). Only when
+    /// mapsToImage().
+    glm::dvec2 toPixel(glm::dvec2 p, int w, int h) const;
+    glm::dvec2 fromPixel(glm::dvec2 px, int w, int h) const;
+    /// Zone z as a convex polygon in the dump's units (units()): clipped to the w x h image in
+    /// pixels, or to the frame's rectangle in camera units; vertices (lo, lo), (hi, lo),
+    /// (hi, hi), (lo, hi) of those coordinates; empty when nothing of it is left. The zones of
+    /// a frame tile its rectangle, so in pixels they tile the part of the image the rectangle
+    /// covers (all of it when the structure's rectangle covers the image).
+    std::vector<glm::dvec2> zonePolygon(uint32_t z, int w, int h) const;
+    /// Zone under the image point (x, y) of a w x h image, continuous coordinates (pixel (i, j)'s
+    /// centre is (i + 0.5, j + 0.5)): the zone its primary ray stays in (orthographic camera
+    /// frame, projective), or for a perspective camera frame the zone where that ray is at depth
+    /// `depth`. -1 outside the frame's rectangle.
+    int64_t zoneAtPixel(double x, double y, int w, int h, double depth = 1.0) const;
+
+  private:
+    const Scene* scene_;
+    const IrregularSubdivision* s_;
+    ZoneFrameKind kind_;
+    const ScreenBsp* bsp_;
+    glm::dvec2 lo_{0.0}, hi_{0.0};
+    uint32_t first_ = 0;
+    double half_ = 1.0;  ///< half the image height in frame units (ortho height / 2, tan(fov/2))
+};
+
+/// The description of a built structure; holds references to the scene and the accelerator,
+/// which must outlive it.
+class StructureView {
+  public:
+    StructureView(const Scene& scene, const Accelerator& accel);
+
+    SchemeKind scheme() const { return accel_->params().scheme; }
+    const Scene& scene() const { return *scene_; }
+    const Accelerator& accelerator() const { return *accel_; }
+
+    /// Every region the walk can report, ids [0, regionCount()).
+    size_t regionCount() const;
+    /// Region `id`'s volume as 8 world-space corners, corner c = i + 2j + 4k with i, j, k the
+    /// low (0) or high (1) side along the region's own axes (regular and brute force: x, y, z;
+    /// camera frame: R, U, F; projective: u, v, depth), the trace contract's order (DESIGN.md
+    /// section 6). Regions are finite: every scheme's structure is bounded.
+    std::array<Vec3, 8> regionCorners(uint32_t id) const;
+    /// Region `id`: kind, frame box, level or zone, primitives, restricted tree, neighbours.
+    RegionInfo region(uint32_t id) const;
+    /// One line: id, box, level / zone, primitive count (regular: RegularGrid::describeLeaf).
+    std::string toString(uint32_t id) const;
+    /// The region holding a world point, for picking in 3D (clamped into the structure): brute
+    /// force 0, the regular leaf, the irregular camera-frame region (projective regions are
+    /// reached from pixels: ZoneFrameView::zoneAtPixel).
+    uint32_t regionAt(const Vec3& world) const;
+    /// The structure's box in the world: scene bounds, the regular grid's box, the irregular
+    /// bounds' box in the world (a box of the camera frame: see structureCorners).
+    Box3 worldBounds() const;
+    /// The structure's bounds as 8 world corners (the irregular camera frame's bounds are not
+    /// axis-aligned in the world).
+    std::array<Vec3, 8> structureCorners() const;
+
+    // Regular scheme (nullptr / empty otherwise).
+    const RegularGrid* regular() const;
+    /// log2 of the directory's size on each axis.
+    int directoryLog2(int axis) const;
+    /// BSP level of a leaf, from its cell counts and the axis schedule.
+    int leafLevel(uint32_t leaf) const;
+    /// The BSP's cut planes, by level (breadth first), derived from the leaves' cells: a node
+    /// is an inner node when the directory does not give one leaf covering exactly its cell.
+    std::vector<CutPlane> cutPlanes() const;
+    /// The directory's entries and sub-tables, depth first.
+    std::vector<DirectoryBlock> directoryBlocks() const;
+
+    // Irregular scheme (nullptr / empty otherwise).
+    const IrregularSubdivision* irregular() const;
+    /// The screen frames present: the camera frame always, the projective one when primary rays
+    /// walk it.
+    const std::vector<ZoneFrameView>& frames() const { return frames_; }
+    /// The frame of `kind`, or nullptr when absent.
+    const ZoneFrameView* frame(ZoneFrameKind kind) const;
+
+  private:
+    const Scene* scene_;
+    const Accelerator* accel_;
+    std::vector<uint32_t> live_;  ///< brute force: the one region's primitives
+    std::vector<ZoneFrameView> frames_;
+};
+
+}  // namespace lancer
