@@ -1,11 +1,13 @@
 // The inspector's geometry: frusta and image planes where the camera's rays go, the GL
-// matrices agreeing with project(), the level range and slice slab filters, and picking.
+// depth the GL matrix writes, the level range and slice slab filters, and picking.
 #include "app/viewer/inspector/inspector_geometry.h"
 
 #include <gtest/gtest.h>
 
 #include <glm/vec4.hpp>
 #include <random>
+
+#include "app/viewer/gl/transforms.h"
 
 namespace lancer::viewer::inspector {
 namespace {
@@ -48,7 +50,7 @@ TEST(InspectorGeometry, ImagePointsLieOnThePrimaryRays) {
                 cameraDepth(cam, p),
                 cam.projection == Projection::Perspective ? depth : depth + cameraDepth(cam, ray.o),
                 1e-9);
-            std::optional<Projected> back = project(cam, w, h, p);
+            std::optional<glm::dvec2> back = gl::ImageProjector(cam, w, h).toImage(p);
             ASSERT_TRUE(back);
             EXPECT_NEAR(back->x, x + 0.5, 1e-9);
             EXPECT_NEAR(back->y, y + 0.5, 1e-9);
@@ -63,7 +65,8 @@ TEST(InspectorGeometry, FrustumCornersBoundTheImage) {
     // Near corners at depth 1, far at 20; corner 0 bottom left, 3 top right.
     for (int i = 0; i < 8; ++i)
         EXPECT_NEAR(cameraDepth(cam, c[size_t(i)]), i & 4 ? 20.0 : 1.0, 1e-9);
-    std::optional<Projected> bl = project(cam, w, h, c[0]), tr = project(cam, w, h, c[7]);
+    const gl::ImageProjector proj(cam, w, h);
+    std::optional<glm::dvec2> bl = proj.toImage(c[0]), tr = proj.toImage(c[7]);
     ASSERT_TRUE(bl && tr);
     EXPECT_NEAR(bl->x, 0.0, 1e-9);
     EXPECT_NEAR(bl->y, h, 1e-9);
@@ -84,7 +87,7 @@ TEST(InspectorGeometry, FrustumCornersBoundTheImage) {
     EXPECT_NEAR(glm::length(plane[3] - plane[0]), 2.0 * focus * std::tan(glm::radians(19.0)), 1e-9);
 }
 
-TEST(InspectorGeometry, GlMatricesPutPointsWhereProjectDoes) {
+TEST(InspectorGeometry, WindowDepthIsTheDepthTheGlMatrixWrites) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> coord(-3.0, 3.0);
     const int w = 300, h = 200;
@@ -92,18 +95,19 @@ TEST(InspectorGeometry, GlMatricesPutPointsWhereProjectDoes) {
         const Box3 b{Vec3(-3.0), Vec3(3.0)};
         double near, far;
         depthRange(cam, b, near, far);
-        const glm::mat4 m = projectionMatrix(cam, w, h, near, far) * viewMatrix(cam);
+        const glm::mat4 m = gl::worldToClip(cam, w, h, near, far);
+        const gl::ImageProjector proj(cam, w, h);
         for (int i = 0; i < 50; ++i) {
             Vec3 p{coord(rng), coord(rng), coord(rng)};
             glm::vec4 clip = m * glm::vec4(glm::vec3(p), 1.0f);
-            std::optional<Projected> e = project(cam, w, h, p);
+            std::optional<glm::dvec2> e = proj.toImage(p);
             ASSERT_TRUE(e);
             const double x = (clip.x / clip.w + 1.0) * 0.5 * w;
             const double y = (1.0 - clip.y / clip.w) * 0.5 * h;  // GL's y goes up
             EXPECT_NEAR(x, e->x, 1e-3);
             EXPECT_NEAR(y, e->y, 1e-3);
             const double wd = 0.5 * (clip.z / clip.w + 1.0);
-            EXPECT_NEAR(wd, windowDepth(cam, near, far, e->depth), 1e-4);
+            EXPECT_NEAR(wd, windowDepth(cam, near, far, proj.depth(p)), 1e-4);
             EXPECT_GT(wd, 0.0);
             EXPECT_LT(wd, 1.0);
         }
@@ -116,7 +120,7 @@ TEST(InspectorGeometry, FrameBoxShowsTheWholeBox) {
         Camera c = frameBox(b, fwd, 40.0);
         ASSERT_TRUE(c.validate().empty());
         for (const Vec3& p : boxCorners(b)) {
-            std::optional<Projected> q = project(c, 100, 100, p);
+            std::optional<glm::dvec2> q = gl::ImageProjector(c, 100, 100).toImage(p);
             ASSERT_TRUE(q);
             EXPECT_GE(q->x, 0.0);
             EXPECT_LE(q->x, 100.0);

@@ -66,7 +66,7 @@ TEST(InspectorModel, LevelRangeKeepsItsLevelsOnly) {
         EXPECT_LE(r.level, o.levelHi);
     }
     // Twelve edges a region, nothing else drawn.
-    EXPECT_EQ(some.lines.segments(), 12 * expected);
+    EXPECT_EQ(some.lines.lineCount(), 12 * expected);
 }
 
 TEST(InspectorModel, SliceSlabKeepsTheCrossingLeaves) {
@@ -161,7 +161,7 @@ TEST(InspectorModel, IrregularSlabsOfTheSelectedZoneOnly) {
     ASSERT_FALSE(one.regions.empty());
     for (const RegionView& r : one.regions) EXPECT_EQ(v.region(r.id).zone, zone);
     EXPECT_LT(one.regions.size(), all.regions.size());
-    EXPECT_EQ(one.selection.segments(), 12u);
+    EXPECT_EQ(one.selection.lineCount(), 12u);
 }
 
 }  // namespace

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <glm/gtc/matrix_transform.hpp>
 
 #include "app/viewer/colormap.h"
 
@@ -30,6 +29,12 @@ Corners boxCorners(const Box3& b) {
     for (int i = 0; i < 8; ++i)
         c[size_t(i)] = {i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z};
     return c;
+}
+
+std::array<glm::vec3, 8> toFloat(const Corners& c) {
+    std::array<glm::vec3, 8> out;
+    for (size_t i = 0; i < 8; ++i) out[i] = glm::vec3(c[i]);
+    return out;
 }
 
 Box3 cornersBox(const Corners& c) {
@@ -77,25 +82,6 @@ double cameraDepth(const Camera& cam, const Vec3& p) {
     return glm::dot(p - cam.from, glm::normalize(cam.at - cam.from));
 }
 
-std::optional<Projected> project(const Camera& cam, int w, int h, const Vec3& p) {
-    Vec3 f, r, u;
-    cam.basis(f, r, u);
-    const Vec3 v = p - cam.from;
-    const double depth = glm::dot(v, f);
-    double sx = glm::dot(v, r), sy = glm::dot(v, u);
-    if (cam.projection == Projection::Perspective) {
-        if (depth <= 0.0) return std::nullopt;
-        sx /= depth;
-        sy /= depth;
-    }
-    const double half = halfHeight(cam);
-    Projected out;
-    out.x = (sx / half * double(h) / double(w) + 1.0) * 0.5 * w;
-    out.y = (1.0 - sy / half) * 0.5 * h;
-    out.depth = depth;
-    return out;
-}
-
 void depthRange(const Camera& cam, const Box3& b, double& near, double& far) {
     double lo = kInf, hi = -kInf;
     for (const Vec3& p : boxCorners(b)) {
@@ -110,25 +96,9 @@ void depthRange(const Camera& cam, const Box3& b, double& near, double& far) {
     if (!(far > near)) far = near + 1.0;
 }
 
-glm::mat4 viewMatrix(const Camera& cam) {
-    Vec3 f, r, u;
-    cam.basis(f, r, u);
-    return glm::lookAt(glm::vec3(cam.from), glm::vec3(cam.from + f), glm::vec3(u));
-}
-
-glm::mat4 projectionMatrix(const Camera& cam, int w, int h, double near, double far) {
-    const double aspect = double(w) / double(h);
-    const double half = halfHeight(cam);
-    if (cam.projection == Projection::Orthographic)
-        return glm::ortho(float(-half * aspect), float(half * aspect), float(-half), float(half),
-                          float(near), float(far));
-    return glm::frustum(float(-half * aspect * near), float(half * aspect * near),
-                        float(-half * near), float(half * near), float(near), float(far));
-}
-
 float windowDepth(const Camera& cam, double near, double far, double depth) {
-    // glm's matrices map eye z = -near to NDC -1 and -far to +1; the window depth is half of
-    // NDC + 1.
+    // glm::perspective and glm::ortho map eye z = -near to NDC -1 and -far to +1; the window
+    // depth is half of NDC + 1.
     double ndc;
     if (cam.projection == Projection::Orthographic)
         ndc = (2.0 * depth - far - near) / (far - near);

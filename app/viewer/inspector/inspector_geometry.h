@@ -20,6 +20,8 @@ using Corners = std::array<Vec3, 8>;
 
 /// The 12 edges of a Corners volume, as pairs of corner numbers.
 const std::array<std::array<int, 2>, 12>& cornerEdges();
+/// The corners in single precision, as gl::Batch::box takes them.
+std::array<glm::vec3, 8> toFloat(const Corners& c);
 /// The corners of an axis-aligned box, in that order.
 Corners boxCorners(const Box3& b);
 /// The axis-aligned box around the corners.
@@ -41,22 +43,12 @@ std::array<Vec3, 4> imagePlane(const Camera& cam, int w, int h);
 
 /// Depth of a point along the camera's forward axis (as imagePoint's `depth`).
 double cameraDepth(const Camera& cam, const Vec3& p);
-/// Where a world point lands on a w x h image of `cam`: image coordinates (imagePoint's) and
-/// depth; nullopt for a perspective point at or behind the eye.
-struct Projected {
-    double x = 0.0, y = 0.0, depth = 0.0;
-};
-std::optional<Projected> project(const Camera& cam, int w, int h, const Vec3& p);
 
 /// Near and far depths that hold every point of `b` in view of `cam`, with a margin; near
 /// stays positive for a perspective camera (a small fraction of far when the box holds the eye).
 void depthRange(const Camera& cam, const Box3& b, double& near, double& far);
-/// The OpenGL view matrix of `cam` (world to eye space, looking down -z, y along U).
-glm::mat4 viewMatrix(const Camera& cam);
-/// The OpenGL projection of a w x h image of `cam` with clip planes at `near`, `far` (depths
-/// along F): a point lands where project() puts it.
-glm::mat4 projectionMatrix(const Camera& cam, int w, int h, double near, double far);
-/// The window depth in [0, 1] that projectionMatrix gives a point at depth `depth`.
+/// The window depth in [0, 1] that gl::worldToClip(cam, w, h, near, far) gives a point at
+/// depth `depth` along F (shaders/inspector_surface.frag computes the same).
 float windowDepth(const Camera& cam, double near, double far, double depth);
 
 /// Frame `box` in a camera looking along `forward` (up +z unless forward is vertical): its

@@ -2,30 +2,29 @@
 
 #include <algorithm>
 
+#include "app/viewer/gl/transforms.h"
+
 namespace lancer::viewer::inspector {
 
-void LineBatch::add(const Vec3& a, const Vec3& b, const glm::vec3& color) {
-    points.emplace_back(a);
-    points.emplace_back(b);
-    colors.push_back(color);
-    colors.push_back(color);
+namespace {
+
+void addLine(gl::Batch& b, const Vec3& p, const Vec3& q, const glm::vec3& color) {
+    b.line(glm::vec3(p), glm::vec3(q), gl::rgba8(color));
 }
 
-void LineBatch::addVolume(const Corners& c, const glm::vec3& color) {
-    for (const auto& e : cornerEdges()) add(c[size_t(e[0])], c[size_t(e[1])], color);
+void addVolume(gl::Batch& b, const Corners& c, const glm::vec3& color) {
+    b.box(toFloat(c), gl::rgba8(color));
 }
 
-void LineBatch::clear() {
-    points.clear();
-    colors.clear();
-}
+}  // namespace
 
 bool maybeVisible(const Camera& cam, int w, int h, const Corners& c) {
     // Outcodes: a volume is out of view when every corner is beyond the same edge.
+    const gl::ImageProjector proj(cam, w, h);
     unsigned all = 0x1f;
     for (const Vec3& p : c) {
         unsigned code = 0;
-        std::optional<Projected> q = project(cam, w, h, p);
+        std::optional<glm::dvec2> q = proj.toImage(p);
         if (!q) {
             code = 0x10;  // behind the eye: its projection is meaningless
         } else {
@@ -106,7 +105,7 @@ void irregularRegions(InspectorModel& m, const StructureView& view, const Inspec
         if (opt.zones && opt.slab.keeps(column) &&
             maybeVisible(insp.camera, insp.width, insp.height, column) &&
             columns++ < size_t(std::max(opt.cap, 0)))
-            m.lines.addVolume(column, kZoneColor);
+            addVolume(m.lines, column, kZoneColor);
         if (full || !opt.regions || (opt.zoneSlabsOnly && int64_t(z) != selectedZone)) continue;
         for (size_t k = 0; k < slabs.size(); ++k) {
             RegionView r;
@@ -138,7 +137,7 @@ void directoryBlocks(InspectorModel& m, const StructureView& view, const Inspect
         if (!opt.slab.keeps(c) || !maybeVisible(insp.camera, insp.width, insp.height, c)) continue;
         ++m.blocks;
         if (drawn++ >= size_t(std::max(opt.cap, 0))) continue;
-        m.lines.addVolume(c, b.subTable ? kSubTableColor : single ? kCellColor : kBlockColor);
+        addVolume(m.lines, c, b.subTable ? kSubTableColor : single ? kCellColor : kBlockColor);
     }
 }
 
@@ -150,20 +149,20 @@ void cameraFrustum(InspectorModel& m, const StructureView& view, const MainView&
     if (cam.projection == Projection::Perspective) {
         // From the eye to the far side of the structure: the eye's rays, then the far face.
         const Corners c = frustumCorners(cam, main.width, main.height, 0.0, far);
-        for (int i = 4; i < 8; ++i) m.lines.add(cam.from, c[size_t(i)], kFrustumColor);
+        for (int i = 4; i < 8; ++i) addLine(m.lines, cam.from, c[size_t(i)], kFrustumColor);
         for (const auto& e : cornerEdges())
-            if (e[0] & e[1] & 4) m.lines.add(c[size_t(e[0])], c[size_t(e[1])], kFrustumColor);
+            if (e[0] & e[1] & 4) addLine(m.lines, c[size_t(e[0])], c[size_t(e[1])], kFrustumColor);
     } else {
-        m.lines.addVolume(frustumCorners(cam, main.width, main.height, 0.0, far), kFrustumColor);
+        addVolume(m.lines, frustumCorners(cam, main.width, main.height, 0.0, far), kFrustumColor);
     }
     const std::array<Vec3, 4> plane = imagePlane(cam, main.width, main.height);
     for (int i = 0; i < 4; ++i)
-        m.lines.add(plane[size_t(i)], plane[size_t(i + 1) % 4], kImagePlaneColor);
+        addLine(m.lines, plane[size_t(i)], plane[size_t(i + 1) % 4], kImagePlaneColor);
     // A small triangle on its top edge, as cameras are drawn: which way is up.
     const Vec3 mid = 0.5 * (plane[0] + plane[1]), up = 0.15 * (plane[0] - plane[3]);
     const Vec3 side = 0.15 * (plane[1] - plane[0]);
-    m.lines.add(mid - side, mid + up, kImagePlaneColor);
-    m.lines.add(mid + up, mid + side, kImagePlaneColor);
+    addLine(m.lines, mid - side, mid + up, kImagePlaneColor);
+    addLine(m.lines, mid + up, mid + side, kImagePlaneColor);
 }
 
 }  // namespace
@@ -187,7 +186,7 @@ InspectorModel buildModel(const StructureView& view, const InspectorOptions& opt
     m.top = 1.0;
     for (const RegionView& r : m.regions) m.top = std::max(m.top, valueOf(r, opt.colorBy));
     for (const RegionView& r : m.regions)
-        m.lines.addVolume(r.corners, regionColor(valueOf(r, opt.colorBy), m.top));
+        addVolume(m.lines, r.corners, regionColor(valueOf(r, opt.colorBy), m.top));
     if (opt.boxes) {
         size_t drawn = 0;
         for (const Box3& b : scene.minBox) {
@@ -195,12 +194,12 @@ InspectorModel buildModel(const StructureView& view, const InspectorOptions& opt
             const Corners c = boxCorners(b);
             if (!opt.slab.keeps(c)) continue;
             if (drawn++ >= size_t(std::max(opt.cap, 0))) break;
-            m.lines.addVolume(c, kBoxColor);
+            addVolume(m.lines, c, kBoxColor);
         }
     }
     if (opt.frustum) cameraFrustum(m, view, main);
     if (selected >= 0 && uint64_t(selected) < view.regionCount())
-        m.selection.addVolume(view.regionCorners(uint32_t(selected)), kSelectionColor);
+        addVolume(m.selection, view.regionCorners(uint32_t(selected)), kSelectionColor);
     return m;
 }
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "app/viewer/gl/batch.h"
 #include "app/viewer/inspector/inspector_geometry.h"
 #include "engine/accel/structure_view.h"
 
@@ -31,16 +32,6 @@ struct InspectorOptions {
     int cap = 20000;                ///< regions (and blocks, and boxes) drawn at most
 };
 
-/// Lines as pairs of points, one colour a point.
-struct LineBatch {
-    std::vector<glm::vec3> points, colors;
-    size_t segments() const { return points.size() / 2; }
-    void add(const Vec3& a, const Vec3& b, const glm::vec3& color);
-    /// The 12 edges of a volume.
-    void addVolume(const Corners& c, const glm::vec3& color);
-    void clear();
-};
-
 /// Where the camera's image lies: the main view's camera and image size.
 struct MainView {
     Camera camera;
@@ -55,8 +46,8 @@ struct InspectorView {
 
 struct InspectorModel {
     std::vector<RegionView> regions;  ///< the regions drawn, which a click can pick
-    LineBatch lines;                  ///< everything but the selection
-    LineBatch selection;              ///< the selected region's edges
+    gl::Batch lines;                  ///< everything but the selection
+    gl::Batch selection;              ///< the selected region's edges
     size_t kept = 0;    ///< regions the filters kept in view, counted up to one past the cap
     size_t total = 0;   ///< regions of the structure (or of the frame primary rays walk)
     size_t blocks = 0;  ///< directory blocks kept (drawn: min(blocks, cap))
