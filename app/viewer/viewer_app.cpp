@@ -82,7 +82,10 @@ bool enumCombo(const char* label, E& value, int count, const char* (*name)(E)) {
 }  // namespace
 
 ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<void()> wake)
-    : s_(settings), logTimings_(logTimings), view_(std::make_unique<ImageView>()) {
+    : s_(settings),
+      logTimings_(logTimings),
+      view_(std::make_unique<ImageView>()),
+      inspector_(std::make_unique<inspector::Inspector>(wake)) {
     if (wake) {
         renderer_.setOnPass(wake);
         builder_.setOnReady(wake);
@@ -233,6 +236,12 @@ void ViewerApp::pollBackground() {
 
 void ViewerApp::handleInput(int fbWidth, int fbHeight) {
     ImGuiIO& io = ImGui::GetIO();
+    // The inspector's half of the window moves the inspector's camera, and a click there picks.
+    std::optional<int64_t> picked;
+    if (inspector_->handleMouse(fbWidth, fbHeight, picked)) {
+        if (picked) selectRegion(*picked);
+        return;
+    }
     if (io.WantCaptureMouse || !structure_) return;
     Camera c = camera_;
     bool moved = false;
@@ -263,6 +272,8 @@ void ViewerApp::handleKeys() {
     for (ImWchar ch : io.InputQueueCharacters) {
         if (ch == 'r' || ch == 'R') {
             setCamera(home_);
+        } else if (ch == 'i' || ch == 'I') {
+            showInspector(!inspector_->shown());
         } else if (ch == 'o' || ch == 'O' || ch == 'p' || ch == 'P') {
             Camera c = camera_;
             toggleProjection(c);
@@ -313,6 +324,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
 
     ImGui_ImplOpenGL3_NewFrame();
     ImGui::NewFrame();
+    inspector_->update(structure_, {camera_, std::max(jobWidth_, 1), std::max(jobHeight_, 1)},
+                       fbWidth, fbHeight, selected_);
     handleInput(fbWidth, fbHeight);
     handleKeys();
     panels();
@@ -345,8 +358,10 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         glClear(GL_COLOR_BUFFER_BIT);
     }
     // The image is copied only around the opaque panels drawn over it next.
-    view_->draw(fbWidth, fbHeight, s_.mode, scale_,
-                panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight));
+    std::vector<PixelRect> covered = panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight);
+    if (inspector_->shown()) covered.push_back(inspector::Inspector::viewport(fbWidth, fbHeight));
+    view_->draw(fbWidth, fbHeight, s_.mode, scale_, covered);
+    inspector_->draw(fbWidth, fbHeight);
     panels_.render();
     if (!pendingScreenshot_.empty()) {
         try {
@@ -359,7 +374,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     }
 
     settled_ = builtBefore && !builder_.busy() &&
-               (!structure_ || (!renderDirty_ && finishedBefore && renderer_.finished()));
+               (!structure_ || (!renderDirty_ && finishedBefore && renderer_.finished())) &&
+               inspector_->settled();
 }
 
 bool ViewerApp::eager() const {
@@ -751,6 +767,10 @@ void ViewerApp::viewPanel() {
                         shown_.primTests[i], shown_.regionVisits[i], double(shown_.timeUs[i]));
         }
     }
+    ImGui::Separator();
+    inspector_->controls();
+    if (inspector_->shown() && selected_ >= 0)
+        ImGui::Text("selected region %lld", (long long)selected_);
     ImGui::Separator();
     if (ImGui::Button("Screenshot")) {
         std::string path = "lancer-screenshot-" + std::to_string(++screenshotCount_) + ".png";

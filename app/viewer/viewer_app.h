@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "app/viewer/image_view.h"
+#include "app/viewer/inspector/inspector.h"
 #include "app/viewer/panel_cache.h"
 #include "app/viewer/structure_builder.h"
 #include "app/viewer/viewer_settings.h"
@@ -67,6 +68,14 @@ class ViewerApp {
     const std::string& cameraError() const { return cameraError_; }
     /// The scene and structure on screen (null until the first build succeeds).
     const std::shared_ptr<const Structure>& structure() const { return structure_; }
+    /// The 3D inspector (its options, camera and what it draws).
+    inspector::Inspector& inspector() { return *inspector_; }
+    /// Show or hide the inspector (the I key, the View panel's checkbox, `--show inspector`).
+    void showInspector(bool on) { inspector_->setShown(on); }
+    /// The selected region (-1: none), which the inspector highlights; a click in the inspector
+    /// sets it.
+    int64_t selectedRegion() const { return selected_; }
+    void selectRegion(int64_t id) { selected_ = id; }
     /// The heat scale in use this frame.
     float heatScale() const { return scale_; }
 
@@ -106,6 +115,8 @@ class ViewerApp {
     ViewerSettings& s_;
     bool logTimings_;
     std::unique_ptr<ImageView> view_;
+    std::unique_ptr<inspector::Inspector> inspector_;
+    int64_t selected_ = -1;
     PanelCache panels_;  ///< ImGui's panels, each redrawn only when it changed
     StructureBuilder builder_;
     ProgressiveRenderer renderer_;

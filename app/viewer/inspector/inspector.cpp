@@ -163,6 +163,8 @@ bool Inspector::handleMouse(int fbWidth, int fbHeight, std::optional<int64_t>& p
                 dragging_ = true;
                 dragButton_ = b;
             }
+        // A drag begun over the image goes on moving the main camera.
+        if (!dragging_ && ImGui::IsAnyMouseDown()) return false;
         if (io.MouseWheel != 0.0f) {
             Camera c = camera_;
             zoom(c, std::pow(0.9, double(io.MouseWheel)));
@@ -198,6 +200,10 @@ int64_t Inspector::pick(double x, double y) const {
     const Ray ray = camera_.primaryRay(x - 0.5, y - 0.5, vw_, vh_);
     const int i = pickRegion(ray, model_.regions);
     return i < 0 ? -1 : int64_t(model_.regions[size_t(i)].id);
+}
+
+bool Inspector::settled() const {
+    return !opt_.show || !structure_ || (!dirtyModel_ && (!opt_.surfaces || surfacesShown()));
 }
 
 bool Inspector::surfacesShown() const {

@@ -64,6 +64,9 @@ class Inspector {
     /// The inspector's controls, inside the current ImGui window.
     void controls();
 
+    /// Hidden, or showing everything asked for: the surfaces of its camera (when on) are traced
+    /// and the model is up to date.
+    bool settled() const;
     /// What is drawn (for the panel and tests).
     const InspectorModel& model() const { return model_; }
     /// Surfaces of the current camera are on screen (the trace arrived).
