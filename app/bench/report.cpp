@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "app/bench/embree_peer.h"
+#include "app/bench/speedup.h"
 #include "engine/render/progressive.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
@@ -238,10 +239,11 @@ int runBench(const BenchOptions& opt) {
         auto brute = buildAccelerator(scene, bruteParams);
         Image ref(ro.width, ro.height);
         render(scene, *brute, ro, ref, PassLattice{16, 0});
-        RenderStats rs = render(scene, *brute, ro, ref);
-        double bruteMs = rs.renderMs;
+        const SpeedupBaseline baseline(scene, *brute, ro, PassLattice{}, ref);
+        const double bruteMs = baseline.brute().renderMs;
         auto row = [&](const char* scheme, const std::string& knob, const std::string& value,
-                       const AccelInfo& info, const RenderStats& s, const ImageError& e) {
+                       const AccelInfo& info, const Speedup& sp, const ImageError& e) {
+            const RenderStats& s = sp.scheme;
             const RayCounters& c = s.counters;
             double rays = c.rays ? double(c.rays) : 1.0;
             if (knob == "scheme" || knob == "peer (bounces 0)") {
@@ -252,17 +254,16 @@ int runBench(const BenchOptions& opt) {
                               spec.c_str(), scheme, knob == "scheme" ? "" : " (bounces 0)",
                               info.buildMs, info.regions, double(info.memoryBytes) / 1048576.0,
                               s.renderMs, 1000.0 * s.renderMs / rays, double(c.primTests) / rays,
-                              double(c.regionVisits) / rays, bruteMs / s.renderMs, e.hitDiff);
+                              double(c.regionVisits) / rays, sp.ratio(), e.hitDiff);
                 table << line;
             }
             csv << spec << "," << scheme << "," << knob << "," << value << "," << num(info.buildMs)
                 << "," << info.memoryBytes << "," << info.regions << "," << num(s.renderMs) << ","
-                << num(bruteMs / s.renderMs) << "," << c.rays << ","
-                << num(double(c.primTests) / rays) << "," << num(double(c.regionVisits) / rays)
-                << "," << c.mailboxHits << "," << c.walkErrors << "," << e.hitDiff << ","
-                << e.colorDiff << "," << num(e.maxDepthDiff) << "\n";
+                << num(sp.ratio()) << "," << c.rays << "," << num(double(c.primTests) / rays) << ","
+                << num(double(c.regionVisits) / rays) << "," << c.mailboxHits << "," << c.walkErrors
+                << "," << e.hitDiff << "," << e.colorDiff << "," << num(e.maxDepthDiff) << "\n";
         };
-        row("brute", "scheme", "brute", brute->info(), rs, {});
+        row("brute", "scheme", "brute", brute->info(), baseline.against(baseline.brute()), {});
         std::cerr << spec << ": brute force " << int(bruteMs) << " ms\n";
 
         for (const Config& c : sweep(opt.quick, opt.schemesOnly)) {
@@ -277,10 +278,13 @@ int runBench(const BenchOptions& opt) {
             RenderOptions r = ro;
             r.shading.offsetScale = c.shading.offsetScale;
             Image img(ro.width, ro.height);
-            RenderStats s = render(scene, *accel, r, img);
+            // The offset sweep changes the options: timed against the same brute-force render.
+            const Speedup s = r.shading.offsetScale == ro.shading.offsetScale
+                                  ? baseline.measure(*accel, img)
+                                  : baseline.against(render(scene, *accel, r, img));
             row(schemeName(c.build.scheme), c.knob, c.value, accel->info(), s, compare(ref, img));
-            std::cerr << spec << ": " << c.knob << " = " << c.value << ": " << int(s.renderMs)
-                      << " ms\n";
+            std::cerr << spec << ": " << c.knob << " = " << c.value << ": "
+                      << int(s.scheme.renderMs) << " ms\n";
         }
 
         // Against a peer: Embree on union-only scenes, on primary and shadow rays
@@ -289,33 +293,31 @@ int runBench(const BenchOptions& opt) {
             RenderOptions r0 = ro;
             r0.shading.bounces = 0;
             Image ref0(ro.width, ro.height);
-            RenderStats b0 = render(scene, *brute, r0, ref0);
-            double brute0 = b0.renderMs;
-            std::swap(bruteMs,
-                      brute0);  // speedups of these rows are over brute force at --bounces 0
-            row("brute", "peer (bounces 0)", "brute", brute->info(), b0, {});
+            // Speedups of these rows are over brute force at --bounces 0.
+            const SpeedupBaseline base0(scene, *brute, r0, PassLattice{}, ref0);
+            row("brute", "peer (bounces 0)", "brute", brute->info(), base0.against(base0.brute()),
+                {});
             for (SchemeKind k : {SchemeKind::Regular, SchemeKind::Irregular}) {
                 BuildParams b;
                 b.scheme = k;
                 try {
                     auto a = buildAccelerator(scene, b);
                     Image img(ro.width, ro.height);
-                    RenderStats s = render(scene, *a, r0, img);
-                    row(schemeName(k), "peer (bounces 0)", schemeName(k), a->info(), s,
-                        compare(ref0, img));
+                    row(schemeName(k), "peer (bounces 0)", schemeName(k), a->info(),
+                        base0.measure(*a, img), compare(ref0, img));
                 } catch (const std::invalid_argument&) {
                 }
             }
             EmbreePeer peer(scene);
             Image img(ro.width, ro.height);
-            RenderStats s = peer.render(r0, img);
+            const Speedup s = base0.against(peer.render(r0, img));
             AccelInfo info;
             info.buildMs = peer.buildMs();
             info.regions = 0;
             row("embree", "peer (bounces 0)", "embree", info, s, compare(ref0, img));
-            std::swap(bruteMs, brute0);
-            std::cerr << spec << ": embree " << int(s.renderMs)
-                      << " ms (brute force at --bounces 0: " << int(b0.renderMs) << " ms)\n";
+            std::cerr << spec << ": embree " << int(s.scheme.renderMs)
+                      << " ms (brute force at --bounces 0: " << int(base0.brute().renderMs)
+                      << " ms)\n";
         }
 
         if (opt.schemesOnly) {
@@ -342,8 +344,9 @@ int runBench(const BenchOptions& opt) {
             elapsed += s.renderMs;
             s.renderMs = elapsed;
             ImageError e = compare(ref, upsample(prog, stride));
+            // Speedup of the time to this pass, over brute force on the whole image.
             row(schemeName(best->params().scheme), "progressive pass", std::to_string(stride),
-                best->info(), s, e);
+                best->info(), baseline.against(s), e);
             prev = stride;
         }
         done.push_back(spec);

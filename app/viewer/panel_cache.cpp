@@ -113,6 +113,7 @@ void PanelCache::render() {
     if (!dd_) return;
     if (direct_) {
         last_.clear();
+        invalid_.clear();
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         ImGui_ImplOpenGL3_RenderDrawData(dd_);
         return;
@@ -145,7 +146,9 @@ void PanelCache::render() {
     // overlaps it (drawing it covers their pixels in the layer).
     std::vector<char> dirty(panels_.size(), redrawAll ? 1 : 0);
     for (size_t i = 0; !redrawAll && i < panels_.size(); ++i) {
-        if (panels_[i].hash != last_[i].hash) dirty[i] = 1;
+        if (panels_[i].hash != last_[i].hash ||
+            std::find(invalid_.begin(), invalid_.end(), panels_[i].id) != invalid_.end())
+            dirty[i] = 1;
         if (!dirty[i]) continue;
         for (size_t j = i + 1; j < panels_.size(); ++j)
             if (overlap(panels_[i].rect, panels_[j].rect)) dirty[j] = 1;
@@ -180,6 +183,7 @@ void PanelCache::render() {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
     last_ = panels_;
+    invalid_.clear();
 }
 
 }  // namespace lancer::viewer

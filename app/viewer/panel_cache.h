@@ -33,6 +33,11 @@ class PanelCache {
     /// Draw the draw data given to layout(), as ImGui_ImplOpenGL3_RenderDrawData does. Draw
     /// lists that belong to no window (the foreground and background lists) are drawn directly.
     void render();
+    /// Rasterize the panel of ImGui window `windowId` (ImGuiWindow::ID of a top-level window)
+    /// again at the next render(), though its draw lists are the same: the layer knows a
+    /// texture a panel shows by its id, not its pixels, so a panel showing a texture whose
+    /// pixels changed must say so.
+    void invalidate(unsigned windowId) { invalid_.push_back(windowId); }
     /// Panels rasterized again by the last render() (for tests and timings).
     int redrawn() const { return redrawn_; }
 
@@ -58,7 +63,8 @@ class PanelCache {
     std::vector<Panel> panels_;  ///< bottom to top
     std::vector<PixelRect> covered_;
 
-    std::vector<Panel> last_;  ///< the last frame drawn through the layer
+    std::vector<Panel> last_;        ///< the last frame drawn through the layer
+    std::vector<unsigned> invalid_;  ///< windows to rasterize again (invalidate())
     unsigned tex_ = 0, fbo_ = 0;
     int w_ = 0, h_ = 0;  ///< the layer's size
     int redrawn_ = 0;

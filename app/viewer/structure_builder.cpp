@@ -9,7 +9,7 @@ namespace lancer::viewer {
 
 BuildResult buildStructure(const BuildRequest& r) {
     BuildResult out;
-    auto s = std::make_shared<Structure>();
+    auto s = std::make_shared<SceneBuild>();
     s->spec = r.spec;
     std::shared_ptr<const Scene> scene = r.loaded;
     if (!scene) {
@@ -38,7 +38,7 @@ BuildResult buildStructure(const BuildRequest& r) {
         return out;
     }
     s->scene = std::move(scene);
-    out.structure = std::move(s);
+    out.sceneBuild = std::move(s);
     return out;
 }
 

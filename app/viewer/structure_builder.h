@@ -14,9 +14,10 @@
 
 namespace lancer::viewer {
 
-/// A scene and a structure built over it; the structure refers to the scene, so they travel
-/// together (members are destroyed in reverse order: the structure first).
-struct Structure {
+/// A scene and the acceleration structure built over it (not the structure description the
+/// overlays draw); the accelerator refers to the scene, so they travel together (members are
+/// destroyed in reverse order: the accelerator first).
+struct SceneBuild {
     std::string spec;  ///< the SCENE argument it was loaded from
     std::shared_ptr<const Scene> scene;
     std::shared_ptr<const Accelerator> accel;
@@ -32,8 +33,8 @@ struct BuildRequest {
 };
 
 struct BuildResult {
-    std::shared_ptr<const Structure> structure;  ///< null on failure
-    std::string error;                           ///< why it failed
+    std::shared_ptr<const SceneBuild> sceneBuild;  ///< null on failure
+    std::string error;                             ///< why it failed
     bool sceneFailed = false;  ///< the scene could not be loaded (else: the build)
     uint64_t request = 0;
 };

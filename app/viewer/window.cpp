@@ -205,10 +205,10 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             ImGui_ImplGlfw_NewFrame();
             app.frame(fbw, fbh);
             ++frames;
-            if (v.replayChange && !replayed && app.settled() && app.structure()) {
+            if (v.replayChange && !replayed && app.settled() && app.sceneBuild()) {
                 app.rebuild("replayed parameter change");
                 replayed = true;
-            } else if (!v.drop.empty() && !droppedScripted && app.settled() && app.structure()) {
+            } else if (!v.drop.empty() && !droppedScripted && app.settled() && app.sceneBuild()) {
                 // Through the callback the window has installed, as a drop from the desktop.
                 GLFWdropfun onDrop = glfwSetDropCallback(window, nullptr);
                 glfwSetDropCallback(window, onDrop);
@@ -216,7 +216,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 if (onDrop) onDrop(window, 1, paths);
                 droppedScripted = true;
             } else if (v.frames > 0 && frames >= v.frames && app.settled()) {
-                if (!app.structure()) {  // a scripted run on a scene that cannot be shown fails
+                if (!app.sceneBuild()) {  // a scripted run on a scene that cannot be shown fails
                     std::cerr << "error: lancer view: the scene could not be shown (see above)\n";
                     status = 2;
                 }

@@ -15,21 +15,21 @@ using testing::OffscreenGl;
 
 constexpr int kW = 640, kH = 360;
 
-std::shared_ptr<const Structure> regularBalls() {
+std::shared_ptr<const SceneBuild> regularBalls() {
     BuildRequest r;
     r.spec = "builtin:balls:2";
     r.params.scheme = SchemeKind::Regular;
     r.params.maxLevel = 12;
     r.params.maxObjects = 2;
     BuildResult b = buildStructure(r);
-    if (!b.structure) throw std::runtime_error(b.error);
-    return b.structure;
+    if (!b.sceneBuild) throw std::runtime_error(b.error);
+    return b.sceneBuild;
 }
 
 /// The inspector drawn alone (frustum, boxes and surfaces off unless asked).
 struct Fixture {
     OffscreenGl gl{kW, kH};
-    std::shared_ptr<const Structure> st = regularBalls();
+    std::shared_ptr<const SceneBuild> st = regularBalls();
     std::unique_ptr<Inspector> insp;
     PixelRect v = Inspector::viewport(kW, kH);
 

@@ -489,12 +489,12 @@ TEST_F(ViewerFrames, DragsMoveTheCameraExceptWhenImGuiWantsTheMouse) {
 
 TEST_F(ViewerFrames, ASceneThatFailsToLoadKeepsThePreviousOne) {
     runUntilSettled();
-    auto before = app_->structure();
+    auto before = app_->sceneBuild();
     ASSERT_TRUE(before);
     app_->openScene("/nonexistent/scene.nff");
     runUntilSettled();
     EXPECT_NE(app_->error().find("/nonexistent/scene.nff"), std::string::npos) << app_->error();
-    EXPECT_EQ(app_->structure(), before);
+    EXPECT_EQ(app_->sceneBuild(), before);
     EXPECT_EQ(settings_.scene, "builtin:default");
     // A scheme that cannot be built (or an invalid parameter) keeps the structure too.
     settings_.build.maxLevel = 18;
@@ -511,11 +511,11 @@ TEST_F(ViewerFrames, SpeedupTracesTheSamePixelsAndRaysWithBothSchemes) {
     settings_.build.scheme = SchemeKind::Regular;
     app_->rebuild("scheme");
     runUntilSettled();
-    ASSERT_TRUE(app_->structure());
-    ASSERT_EQ(app_->structure()->accel->params().scheme, SchemeKind::Regular);
+    ASSERT_TRUE(app_->sceneBuild());
+    ASSERT_EQ(app_->sceneBuild()->accel->params().scheme, SchemeKind::Regular);
     EXPECT_FALSE(app_->speedupResult()) << "nothing measured before it is asked for";
     app_->measureSpeedup(4);
-    std::optional<ViewerApp::SpeedupResult> r;
+    std::optional<SpeedupResult> r;
     auto start = std::chrono::steady_clock::now();
     while (!(r = app_->speedupResult()) &&
            std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
@@ -525,15 +525,16 @@ TEST_F(ViewerFrames, SpeedupTracesTheSamePixelsAndRaysWithBothSchemes) {
     ASSERT_TRUE(r) << "the measurement did not finish";
     ASSERT_TRUE(r->error.empty()) << r->error;
     EXPECT_EQ(r->scheme, "regular");
-    EXPECT_EQ(r->pixels, size_t((kW + 3) / 4) * size_t((kH + 3) / 4));
-    EXPECT_GE(r->schemeRays, r->pixels);
-    EXPECT_EQ(r->schemeRays, r->bruteRays);
-    const Scene& scene = *app_->structure()->scene;
-    EXPECT_LE(r->bruteTests, r->bruteRays * scene.livePrimitives().size());
-    EXPECT_GT(r->bruteTests, r->bruteRays);
-    EXPECT_LT(r->schemeTests, r->bruteTests);
-    EXPECT_GT(r->schemeMs, 0.0);
-    EXPECT_GT(r->bruteMs, 0.0);
+    const bench::Speedup& m = r->speedup;
+    EXPECT_EQ(m.pixels, size_t((kW + 3) / 4) * size_t((kH + 3) / 4));
+    EXPECT_GE(m.scheme.counters.rays, m.pixels);
+    EXPECT_EQ(m.scheme.counters.rays, m.brute.counters.rays);
+    const Scene& scene = *app_->sceneBuild()->scene;
+    EXPECT_LE(m.brute.counters.primTests, m.brute.counters.rays * scene.livePrimitives().size());
+    EXPECT_GT(m.brute.counters.primTests, m.brute.counters.rays);
+    EXPECT_LT(m.scheme.counters.primTests, m.brute.counters.primTests);
+    EXPECT_GT(m.scheme.renderMs, 0.0);
+    EXPECT_GT(m.brute.renderMs, 0.0);
 }
 
 TEST_F(ViewerFrames, CameraCopiedAsJsonPastesBackAndABadPasteKeepsTheCamera) {

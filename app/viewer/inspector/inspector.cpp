@@ -92,7 +92,7 @@ void Inspector::setCamera(const Camera& c) {
     if (!dragging_) dirtyModel_ = true;  // what is in view changed
 }
 
-void Inspector::update(const std::shared_ptr<const Structure>& structure, const MainView& main,
+void Inspector::update(const std::shared_ptr<const SceneBuild>& structure, const MainView& main,
                        int fbWidth, int fbHeight, int64_t selected) {
     takeSurfaces();
     if (!opt_.show) return;
@@ -366,13 +366,16 @@ void Inspector::draw(int fbWidth, int fbHeight) {
     glViewport(0, 0, fbWidth, fbHeight);
 }
 
-void Inspector::controls() {
-    bool changed = false;
-    changed |= ImGui::Checkbox("inspector (I)", &opt_.show);
-    if (!opt_.show) {
-        if (changed) dirtyModel_ = true;
+void Inspector::panel(bool* open) {
+    ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 348, io.DisplaySize.y - 258),
+                            ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(340, 250), ImGuiCond_FirstUseEver);
+    if (!ImGui::Begin("Inspector", open)) {
+        ImGui::End();
         return;
     }
+    bool changed = false;
     const bool regular = view_ && view_->scheme() == SchemeKind::Regular;
     const bool irregular = view_ && view_->scheme() == SchemeKind::Irregular;
     changed |= ImGui::Checkbox(irregular ? "slabs" : "regions", &opt_.regions);
@@ -460,6 +463,13 @@ void Inspector::controls() {
         ImGui::SetTooltip("Regions (and blocks, boxes) drawn at most, among those in view");
     ImGui::Text("%zu of %zu regions drawn%s", model_.regions.size(), model_.total,
                 model_.kept > model_.regions.size() ? " (cap reached)" : "");
+    if (selected_ >= 0) ImGui::Text("selected: region %lld", (long long)selected_);
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+    ImGui::TextWrapped(
+        "Over the inspector: left drag orbits, middle drag pans, right drag or wheel zooms, a "
+        "click selects the region under the cursor.");
+    ImGui::PopStyleColor();
+    ImGui::End();
     if (changed) dirtyModel_ = true;
 }
 

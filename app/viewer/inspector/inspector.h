@@ -48,7 +48,7 @@ class Inspector {
 
     /// Once a frame, before input and drawing: the structure on screen, the main view, the
     /// selected region (-1: none). Rebuilds what changed.
-    void update(const std::shared_ptr<const Structure>& structure, const MainView& main,
+    void update(const std::shared_ptr<const SceneBuild>& structure, const MainView& main,
                 int fbWidth, int fbHeight, int64_t selected);
     /// Mouse input over the inspector (ImGui's io, framebuffer pixels): orbit (left drag), pan
     /// (middle drag), zoom (wheel, right drag), pick (left click). True when the inspector took
@@ -61,8 +61,8 @@ class Inspector {
     /// Draw into framebuffer 0 of fbWidth x fbHeight, in viewport(). Only re-rendered when
     /// something changed; otherwise the last picture is copied.
     void draw(int fbWidth, int fbHeight);
-    /// The inspector's controls, inside the current ImGui window.
-    void controls();
+    /// The Inspector panel: its layers, colours, level range, slice slab, cap and counts.
+    void panel(bool* open);
 
     /// Hidden, or showing everything asked for: the surfaces of its camera (when on) are traced
     /// and the model is up to date.
@@ -85,7 +85,7 @@ class Inspector {
     InspectorOptions opt_;
     Camera camera_;
     bool cameraFramed_ = false;
-    std::shared_ptr<const Structure> structure_;
+    std::shared_ptr<const SceneBuild> structure_;
     std::unique_ptr<StructureView> view_;
     MainView main_;
     int64_t selected_ = -1;

@@ -17,8 +17,8 @@ SurfaceTracer::~SurfaceTracer() {
     worker_.join();
 }
 
-void SurfaceTracer::request(std::shared_ptr<const Structure> structure, const Camera& camera, int w,
-                            int h) {
+void SurfaceTracer::request(std::shared_ptr<const SceneBuild> structure, const Camera& camera,
+                            int w, int h) {
     {
         std::lock_guard<std::mutex> lock(mutex_);
         SurfaceImage s;

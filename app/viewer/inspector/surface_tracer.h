@@ -19,7 +19,7 @@ namespace lancer::viewer::inspector {
 
 struct SurfaceImage {
     Camera camera;  ///< the camera it was traced for
-    std::shared_ptr<const Structure> structure;
+    std::shared_ptr<const SceneBuild> structure;
     Image image;  ///< colour and depth (hit distance along the unit ray; +inf: miss)
 };
 
@@ -31,7 +31,7 @@ class SurfaceTracer {
     SurfaceTracer& operator=(const SurfaceTracer&) = delete;
 
     /// Trace `structure`'s scene from `camera` at w x h, replacing any request not done.
-    void request(std::shared_ptr<const Structure> structure, const Camera& camera, int w, int h);
+    void request(std::shared_ptr<const SceneBuild> structure, const Camera& camera, int w, int h);
     /// The newest finished image, once.
     std::optional<SurfaceImage> poll();
     /// Called on the worker thread when an image is ready. Set it before the first request.

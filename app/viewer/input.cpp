@@ -1,0 +1,54 @@
+#include "app/viewer/input.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "app/viewer/camera_control.h"
+
+namespace lancer::viewer {
+
+void handleMouse(ViewerState& st, int fbHeight) {
+    ImGuiIO& io = ImGui::GetIO();
+    if (io.WantCaptureMouse || !st.sceneBuild()) return;
+    Camera c = st.camera();
+    bool moved = false;
+    const float dx = io.MouseDelta.x * io.DisplayFramebufferScale.x;
+    const float dy = io.MouseDelta.y * io.DisplayFramebufferScale.y;
+    if (dx != 0.0f || dy != 0.0f) {
+        if (ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+            orbit(c, -0.008 * dx, 0.008 * dy);
+            moved = true;
+        } else if (ImGui::IsMouseDown(ImGuiMouseButton_Middle)) {
+            pan(c, dx, dy, std::max(1, fbHeight));
+            moved = true;
+        } else if (ImGui::IsMouseDown(ImGuiMouseButton_Right)) {
+            zoom(c, std::exp(0.01 * dy));
+            moved = true;
+        }
+    }
+    if (io.MouseWheel != 0.0f) {
+        zoom(c, std::pow(0.9, double(io.MouseWheel)));
+        moved = true;
+    }
+    if (moved) st.setCamera(c);
+}
+
+void handleKeys(ViewerState& st) {
+    ImGuiIO& io = ImGui::GetIO();
+    if (io.WantCaptureKeyboard || io.WantTextInput || !st.sceneBuild()) return;
+    for (ImWchar ch : io.InputQueueCharacters) {
+        if (ch == 'r' || ch == 'R') {
+            st.setCamera(st.home());
+        } else if (ch == 'i' || ch == 'I') {
+            st.settings().showInspector = !st.settings().showInspector;
+        } else if (ch == 'o' || ch == 'O' || ch == 'p' || ch == 'P') {
+            Camera c = st.camera();
+            toggleProjection(c);
+            st.setCamera(c);
+        }
+    }
+}
+
+}  // namespace lancer::viewer

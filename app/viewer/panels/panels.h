@@ -1,0 +1,23 @@
+// The viewer's panels: a closed set of ImGui windows, each in a file of its own, each reading
+// and acting on the ViewerState. The frame (viewer_app.cpp) calls drawPanels() once.
+#pragma once
+
+#include "app/viewer/viewer_state.h"
+
+namespace lancer::viewer {
+
+/// The main menu bar (which panels are shown, the scene, build and error notes) and every
+/// panel the settings show, in order.
+void drawPanels(ViewerState& st);
+
+void menuBar(ViewerState& st);
+/// Scene, subdivision and rendering parameters.
+void parametersPanel(ViewerState& st);
+/// Projection, eye and target, reset, copy and paste as JSON.
+void cameraPanel(ViewerState& st);
+/// Passes, rays and work per ray, and the speedup over brute force.
+void statisticsPanel(ViewerState& st);
+/// Colour or heat map, its scale and colour bar, the pixel under the cursor, screenshots.
+void viewPanel(ViewerState& st);
+
+}  // namespace lancer::viewer

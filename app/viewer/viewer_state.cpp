@@ -1,0 +1,284 @@
+#include "app/viewer/viewer_state.h"
+
+#include <imgui.h>
+#include <imgui_internal.h>  // MarkIniSettingsDirty
+
+#include <iostream>
+
+#include "app/viewer/camera_control.h"
+
+namespace lancer::viewer {
+
+namespace {
+
+double msSince(ViewerState::Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(ViewerState::Clock::now() - t).count();
+}
+
+}  // namespace
+
+ViewerState::ViewerState(ViewerSettings& settings, bool logTimings, std::function<void()> wake)
+    : s_(settings), logTimings_(logTimings) {
+    if (wake) {
+        renderer_.setOnPass(wake);
+        builder_.setOnReady(wake);
+    }
+    notes_.pathInput = s_.scene.rfind("builtin:", 0) == 0 ? "" : s_.scene;
+    requestBuild(true, "open scene");
+}
+
+ViewerState::~ViewerState() {
+    if (speedup_) speedup_->cancel = true;
+    if (speedupThread_.joinable()) speedupThread_.join();
+    renderer_.cancel();
+}
+
+void ViewerState::logTiming(const std::string& line) const {
+    if (logTimings_) std::cerr << "timing: " << line << std::endl;
+}
+
+void ViewerState::openScene(const std::string& spec) {
+    s_.scene = spec;
+    if (spec.rfind("builtin:", 0) != 0) notes_.pathInput = spec;  // a dropped file shows
+    ImGui::MarkIniSettingsDirty();
+    requestBuild(true, "open scene");
+}
+
+void ViewerState::setViewMode(ViewMode mode) {
+    s_.mode = mode;
+    // The other counter is uploaded whole (rows uploaded earlier hold the old one).
+    uploadDue_ = true;
+    changed_.add(0, shown_.height);
+    updateAutoScale();
+    if (s_.mode != ViewMode::Color && s_.autoScale) scale_ = autoScale_;
+}
+
+void ViewerState::updateAutoScale() {
+    if (s_.mode != ViewMode::Color) autoScale_ = autoScale(heatChannel(shown_, s_.mode));
+}
+
+void ViewerState::setHeatScale(float scale) {
+    s_.autoScale = false;
+    s_.heatScale = scale;
+}
+
+void ViewerState::setCamera(const Camera& c) {
+    camera_ = c;
+    markRender("camera");
+    if (s_.build.scheme == SchemeKind::Irregular) cameraMovedForBuild_ = true;
+}
+
+void ViewerState::copyCameraJson() { ImGui::SetClipboardText(camera_.toJson().c_str()); }
+
+bool ViewerState::pasteCameraJson() {
+    const char* clip = ImGui::GetClipboardText();
+    notes_.cameraJson = clip ? clip : "";
+    try {
+        setCamera(cameraFromJson(notes_.cameraJson, camera_));
+        notes_.cameraError.clear();
+        return true;
+    } catch (const std::exception& e) {
+        notes_.cameraError = e.what();
+        return false;
+    }
+}
+
+void ViewerState::requestBuild(bool reloadScene, const char* why) {
+    BuildRequest r;
+    r.params = s_.build;
+    if (reloadScene || !sceneBuild_) {
+        r.spec = s_.scene;
+    } else {
+        r.spec = sceneBuild_->spec;
+        r.loaded = sceneBuild_->scene;
+        r.camera = camera_;
+    }
+    buildChangeAt_ = Clock::now();
+    buildWhy_ = why;
+    builder_.request(std::move(r));
+}
+
+void ViewerState::markRender(const char* why) {
+    renderDirty_ = true;
+    renderWhy_ = why;
+    changeAt_ = Clock::now();
+}
+
+void ViewerState::restartRender(const char* why) {
+    if (!sceneBuild_ || jobWidth_ <= 0 || jobHeight_ <= 0) return;
+    ProgressiveJob job;
+    job.scene = sceneBuild_->scene;
+    job.accel = sceneBuild_->accel;
+    job.options.width = jobWidth_;
+    job.options.height = jobHeight_;
+    job.options.threads = s_.threads;
+    job.options.shading = s_.shading;
+    job.options.camera = camera_;
+    if (speedup_ && !speedup_->done) speedup_->cancel = true;  // its view is gone
+    renderer_.start(std::move(job), changeAt_);
+    changeWhy_ = why;
+    passesLogged_ = 0;
+    renderDirty_ = false;
+}
+
+void ViewerState::poll() {
+    // Read before taking the snapshot: if the job was finished then, the snapshot below is final.
+    finishedBefore_ = renderer_.finished();
+    // Likewise: a builder idle before the poll has nothing left that this frame has not taken.
+    builtBefore_ = !builder_.busy();
+    pollBuilder();
+    takeSnapshot();
+    if (s_.mode != ViewMode::Color) scale_ = s_.autoScale ? autoScale_ : s_.heatScale;
+}
+
+bool ViewerState::takeUpload(RowRange& rows) {
+    rows = changed_;
+    const bool due = uploadDue_;
+    changed_ = {};
+    uploadDue_ = false;
+    return due;
+}
+
+void ViewerState::pollBuilder() {
+    std::optional<BuildResult> r = builder_.poll();
+    if (!r) return;
+    if (r->sceneBuild) {
+        const bool newScene = !sceneBuild_ || sceneBuild_->spec != r->sceneBuild->spec;
+        logTiming(buildWhy_ + ": structure ready " + std::to_string(msSince(buildChangeAt_)) +
+                  " ms after the change (load " + std::to_string(r->sceneBuild->loadMs) +
+                  " ms, build " + std::to_string(r->sceneBuild->accel->info().buildMs) + " ms)");
+        sceneBuild_ = r->sceneBuild;
+        if (newScene) {
+            home_ = sceneBuild_->scene->camera;
+            camera_ = home_;
+            s_.scene = sceneBuild_->spec;
+            notes_.builtinSize = -1;
+        }
+        if (sceneBuild_->accel->params().scheme == s_.build.scheme) error_.clear();
+        changeAt_ = buildChangeAt_;
+        renderDirty_ = true;
+        renderWhy_ = buildWhy_;
+        return;
+    }
+    error_ = (r->sceneFailed ? "Scene not loaded: " : "Structure not built: ") + r->error;
+    std::cerr << "lancer view: " << error_ << "\n";
+    if (sceneBuild_) {
+        // Keep what is on screen, and the settings that describe it.
+        if (r->sceneFailed)
+            s_.scene = sceneBuild_->spec;
+        else
+            s_.build = sceneBuild_->accel->params();
+    } else if (!r->sceneFailed && s_.build.scheme != SchemeKind::Brute) {
+        // Nothing on screen yet: show the scene with the reference scheme meanwhile.
+        s_.build.scheme = SchemeKind::Brute;
+        requestBuild(true, "fallback to brute force");
+    }
+}
+
+void ViewerState::takeSnapshot() {
+    ProgressiveRenderer::Shown what;
+    if (!renderer_.snapshot(shownVersion_, shown_, &what)) return;
+    uploadDue_ = true;
+    changed_.add(what.changedBegin, what.changedEnd < 0 ? shown_.height : what.changedEnd);
+    shownJob_ = what.job;
+    shownStride_ = what.stride;
+    updateAutoScale();
+    if (!logTimings_) return;
+    // Passes this snapshot holds whole (one may have finished since it was taken), logged once
+    // the frame showing them is on screen (presented()).
+    std::vector<PassRecord> passes = renderer_.passes();
+    for (; passesLogged_ < passes.size(); ++passesLogged_) {
+        const PassRecord& p = passes[passesLogged_];
+        if (p.stride < what.stride || (p.stride == what.stride && what.rows < shown_.height)) break;
+        pendingLogs_.push_back(
+            {changeWhy_ + ": pass stride " + std::to_string(p.stride) + " visible ",
+             " ms after the change (pass render " + std::to_string(p.renderMs) + " ms, " +
+                 std::to_string(shown_.width) + "x" + std::to_string(shown_.height) + ")",
+             changeAt_});
+        if (p.stride == 1)
+            pendingLogs_.push_back(
+                {changeWhy_ + ": full image ", " ms after the change", changeAt_});
+    }
+}
+
+void ViewerState::startWork(int fbWidth, int fbHeight) {
+    if (fbWidth > 0 && fbHeight > 0 && (fbWidth != jobWidth_ || fbHeight != jobHeight_)) {
+        jobWidth_ = fbWidth;
+        jobHeight_ = fbHeight;
+        if (!renderDirty_) markRender("window size");  // else keep the pending change's time
+    }
+    // The irregular scheme's regions live in the camera frame: rebuild once the drag ends.
+    if (cameraMovedForBuild_ && !ImGui::IsAnyMouseDown()) {
+        cameraMovedForBuild_ = false;
+        if (s_.build.scheme == SchemeKind::Irregular)
+            requestBuild(false, "camera (irregular frame)");
+    }
+    if (renderDirty_ && sceneBuild_) {
+        restartRender(renderWhy_.c_str());
+        finishedBefore_ = false;  // the snapshot of this frame is of the job just cancelled
+        // The frame does not wait for the first pass: the worker wakes the window when it is
+        // ready, and the next frame shows it. (Waiting up to 40 ms here, to show it in this
+        // frame, saved about 5 ms of latency on balls4 and cost a frame of up to 40 ms at
+        // every change: below 60 frames a second.)
+    }
+}
+
+bool ViewerState::settledSince() const {
+    return builtBefore_ && !builder_.busy() &&
+           (!sceneBuild_ || (!renderDirty_ && finishedBefore_ && renderer_.finished()));
+}
+
+bool ViewerState::eager(bool settled) const {
+    if (builder_.busy() || builder_.ready() || renderDirty_ || shownJob_ != renderer_.job())
+        return true;
+    const ProgressiveRenderer::Shown next = renderer_.latest();
+    return next.stride != shownStride_ || (renderer_.finished() && !settled);
+}
+
+void ViewerState::presented() {
+    for (const PendingLog& l : pendingLogs_)
+        logTiming(l.before + std::to_string(msSince(l.since)) + l.after);
+    pendingLogs_.clear();
+}
+
+void ViewerState::measureSpeedup(int stride) {
+    if (!sceneBuild_) return;
+    notes_.speedupStride = stride;
+    if (speedupThread_.joinable()) speedupThread_.join();
+    auto sp = std::make_shared<SpeedupJob>();
+    sp->stride = stride;
+    sp->result.scheme = schemeName(sceneBuild_->accel->params().scheme);
+    speedup_ = sp;
+    RenderOptions opt;
+    opt.width = jobWidth_;
+    opt.height = jobHeight_;
+    opt.threads = s_.threads;
+    opt.shading = s_.shading;
+    opt.camera = camera_;
+    std::shared_ptr<const SceneBuild> st = sceneBuild_;
+    // As `lancer bench` measures it, on the pixels of the current view the panel samples.
+    speedupThread_ = std::thread([sp, st, opt] {
+        lowerThreadPriority();
+        try {
+            BuildParams bp = st->accel->params();
+            bp.scheme = SchemeKind::Brute;
+            auto brute = buildAccelerator(*st->scene, bp);
+            Image img(opt.width, opt.height);
+            const bench::SpeedupBaseline baseline(*st->scene, *brute, opt,
+                                                  PassLattice{sp->stride, 0}, img, &sp->cancel);
+            SpeedupResult& r = sp->result;
+            r.speedup = baseline.measure(*st->accel, img);
+            if (r.speedup.cancelled()) r.error = "cancelled: the view changed";
+        } catch (const std::exception& e) {
+            sp->result.error = e.what();
+        }
+        sp->done = true;
+    });
+}
+
+std::optional<SpeedupResult> ViewerState::speedupResult() const {
+    if (!speedup_ || !speedup_->done) return std::nullopt;
+    return speedup_->result;
+}
+
+}  // namespace lancer::viewer

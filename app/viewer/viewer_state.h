@@ -1,0 +1,172 @@
+// What the viewer is building, rendering and showing: the scene and its accelerator, the
+// progressive render of the current view, the image on screen, the camera, errors, and the
+// speedup measurement. The panels read it and act on it through its methods; it makes no GL
+// call (the frame in viewer_app.cpp uploads and draws what it holds).
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "app/bench/speedup.h"
+#include "app/viewer/colormap.h"
+#include "app/viewer/structure_builder.h"
+#include "app/viewer/viewer_settings.h"
+#include "engine/render/progressive.h"
+
+namespace lancer::viewer {
+
+/// Text fields and notes the panels keep from frame to frame.
+struct PanelNotes {
+    std::string pathInput;          ///< the Parameters panel's file field
+    int builtinSize = -1;           ///< its size slider (-1: the scene's own size)
+    std::string cameraJson;         ///< the last camera pasted
+    std::string cameraError;        ///< why that paste was refused
+    std::string screenshotNote;     ///< "saved FILE", or why it was not
+    std::string pendingScreenshot;  ///< taken once the frame is drawn
+    int screenshotCount = 0;
+    int speedupStride = 4;  ///< the Statistics panel's sample: 1 pixel in stride x stride
+};
+
+/// The speedup over brute force on the current view, as the Statistics panel shows it.
+struct SpeedupResult {
+    std::string scheme;      ///< the scheme measured
+    std::string error;       ///< why there is no measurement (the view changed, a build failed)
+    bench::Speedup speedup;  ///< both renders, as `lancer bench` measures them
+};
+
+class ViewerState {
+  public:
+    using Clock = std::chrono::steady_clock;
+
+    /// Starts loading `settings.scene` at once. `settings` is the object the ini handler reads
+    /// and writes; it must outlive the state. `wake` (optional) is called from worker threads
+    /// when there is something new to show.
+    ViewerState(ViewerSettings& settings, bool logTimings, std::function<void()> wake);
+    ~ViewerState();
+    ViewerState(const ViewerState&) = delete;
+    ViewerState& operator=(const ViewerState&) = delete;
+
+    // Frame steps (viewer_app.cpp calls them in order).
+    /// Take what the workers finished before this frame: a new structure (or its failure) and
+    /// the newest image.
+    void poll();
+    /// Whether the image must be uploaded again since the last call, and its rows that changed
+    /// (all of them after a change of view mode).
+    bool takeUpload(RowRange& rows);
+    /// After the panels: follow the framebuffer's size, rebuild for a camera the irregular
+    /// scheme was built for once the drag ends, and start the render a change asked for.
+    void startWork(int fbWidth, int fbHeight);
+    /// Everything asked for is built and rendered (as of the frame's start and now).
+    bool settledSince() const;
+
+    // What the panels read.
+    ViewerSettings& settings() { return s_; }
+    const ViewerSettings& settings() const { return s_; }
+    /// The scene and accelerator on screen (null until the first build succeeds).
+    const std::shared_ptr<const SceneBuild>& sceneBuild() const { return sceneBuild_; }
+    bool building() const { return builder_.busy(); }
+    const ProgressiveRenderer& renderer() const { return renderer_; }
+    const std::string& error() const { return error_; }
+    const Camera& camera() const { return camera_; }
+    const Camera& home() const { return home_; }
+    /// The image on screen (the last snapshot taken).
+    const Image& shown() const { return shown_; }
+    /// Size of the render: the framebuffer's.
+    int width() const { return jobWidth_; }
+    int height() const { return jobHeight_; }
+    /// The heat scale in use this frame, and the automatic one (the shown counter's largest).
+    float heatScale() const { return scale_; }
+    float autoHeatScale() const { return autoScale_; }
+    PanelNotes& notes() { return notes_; }
+    const PanelNotes& notes() const { return notes_; }
+
+    // What the panels do.
+    /// Open a scene: loaded in the background; on failure the error shows and the previous
+    /// scene stays.
+    void openScene(const std::string& spec);
+    /// Rebuild with the current parameters (or reload the scene too).
+    void requestBuild(bool reloadScene, const char* why);
+    /// Render again (a shading parameter changed); the change is timed from now.
+    void markRender(const char* why);
+    void setCamera(const Camera& c);
+    /// The camera as JSON to ImGui's clipboard, and back (false, with notes().cameraError, for
+    /// a paste that is not a camera: the camera stays).
+    void copyCameraJson();
+    bool pasteCameraJson();
+    /// What the image area shows; heat maps are uploaded again whole.
+    void setViewMode(ViewMode mode);
+    /// A fixed heat scale (turns automatic scaling off).
+    void setHeatScale(float scale);
+    /// Measure the speedup over brute force on the current view, on a worker thread, with one
+    /// pixel in `stride` x `stride`. Nothing happens before the first structure.
+    void measureSpeedup(int stride);
+    bool measuringSpeedup() const { return speedup_ && !speedup_->done; }
+    /// The last measurement, once it is done.
+    std::optional<SpeedupResult> speedupResult() const;
+
+    // Timings (--log-timings).
+    /// Whether what the workers produce next should be drawn at once (ViewerApp::eager()).
+    bool eager(bool settled) const;
+    /// The frame drawn is on screen: log the passes it shows for the first time.
+    void presented();
+
+  private:
+    struct SpeedupJob {
+        std::atomic<bool> cancel{false}, done{false};
+        SpeedupResult result;
+        int stride = 4;
+    };
+
+    void pollBuilder();
+    void takeSnapshot();
+    void restartRender(const char* why);
+    void updateAutoScale();
+    void logTiming(const std::string& line) const;
+
+    ViewerSettings& s_;
+    bool logTimings_;
+    StructureBuilder builder_;
+    ProgressiveRenderer renderer_;
+    std::shared_ptr<const SceneBuild> sceneBuild_;
+    Camera camera_, home_;
+    std::string error_;
+    PanelNotes notes_;
+
+    // The image on screen.
+    Image shown_;
+    uint64_t shownVersion_ = 0;
+    uint64_t shownJob_ = 0;  ///< the render job the image on screen comes from
+    int shownStride_ = 0;    ///< and the pass it shows (some of its rows, at least)
+    RowRange changed_;       ///< rows not uploaded yet
+    bool uploadDue_ = false;
+    int jobWidth_ = 0, jobHeight_ = 0;
+    bool renderDirty_ = false, cameraMovedForBuild_ = false;
+    std::string renderWhy_;
+    float scale_ = 1.0f;
+    float autoScale_ = 1.0f;
+    /// As of the start of the frame: the job finished and the builder idle.
+    bool finishedBefore_ = false, builtBefore_ = false;
+
+    // Latency of the last change: when it happened, what it was, what was logged.
+    Clock::time_point changeAt_ = Clock::now(), buildChangeAt_ = Clock::now();
+    std::string changeWhy_, buildWhy_;
+    size_t passesLogged_ = 0;
+    /// Timing lines of passes in the image drawn but not yet on screen: text before the latency,
+    /// after it, and the change it counts from.
+    struct PendingLog {
+        std::string before, after;
+        Clock::time_point since;
+    };
+    std::vector<PendingLog> pendingLogs_;
+
+    std::shared_ptr<SpeedupJob> speedup_;
+    std::thread speedupThread_;
+};
+
+}  // namespace lancer::viewer
