@@ -17,7 +17,7 @@ struct ViewerSettings {
     int threads = 0;  ///< render threads (0: all cores)
     int windowWidth = 1280, windowHeight = 720;
     bool showParameters = true, showStatistics = true, showCamera = true, showView = true;
-    /// The 3D inspector over the right half of the window (not saved: it starts hidden).
+    /// The 3D inspector over the right half of the window.
     bool showInspector = false;
     ViewMode mode = ViewMode::Color;
     bool autoScale = true;     ///< heat scale follows the image's largest value

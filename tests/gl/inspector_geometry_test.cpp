@@ -117,15 +117,17 @@ TEST(InspectorGeometry, WindowDepthIsTheDepthTheGlMatrixWrites) {
 TEST(InspectorGeometry, FrameBoxShowsTheWholeBox) {
     const Box3 b{Vec3(-1.0, 2.0, 0.0), Vec3(5.0, 3.0, 1.0)};
     for (Vec3 fwd : {Vec3(1.0, 1.0, -0.5), Vec3(0.0, 0.0, -1.0)}) {
-        Camera c = frameBox(b, fwd, 40.0);
-        ASSERT_TRUE(c.validate().empty());
-        for (const Vec3& p : boxCorners(b)) {
-            std::optional<glm::dvec2> q = gl::ImageProjector(c, 100, 100).toImage(p);
-            ASSERT_TRUE(q);
-            EXPECT_GE(q->x, 0.0);
-            EXPECT_LE(q->x, 100.0);
-            EXPECT_GE(q->y, 0.0);
-            EXPECT_LE(q->y, 100.0);
+        for (int w : {100, 40, 250}) {  // square, narrow, wide
+            Camera c = frameBox(b, fwd, 40.0, w / 100.0);
+            ASSERT_TRUE(c.validate().empty());
+            for (const Vec3& p : boxCorners(b)) {
+                std::optional<glm::dvec2> q = gl::ImageProjector(c, w, 100).toImage(p);
+                ASSERT_TRUE(q);
+                EXPECT_GE(q->x, 0.0);
+                EXPECT_LE(q->x, double(w));
+                EXPECT_GE(q->y, 0.0);
+                EXPECT_LE(q->y, 100.0);
+            }
         }
     }
 }

@@ -113,7 +113,7 @@ void Inspector::update(const std::shared_ptr<const SceneBuild>& structure, const
             orbit(turned, 0.7, 0.35);
             Box3 all = view_->worldBounds();
             all.expand(main.camera.from);
-            camera_ = frameBox(all, turned.at - turned.from, 40.0);
+            camera_ = frameBox(all, turned.at - turned.from, 40.0, double(vw_) / double(vh_));
             cameraFramed_ = true;
         }
         dirtyModel_ = true;

@@ -107,15 +107,16 @@ float windowDepth(const Camera& cam, double near, double far, double depth) {
     return float(0.5 * (ndc + 1.0));
 }
 
-Camera frameBox(const Box3& box, const Vec3& forward, double fov) {
+Camera frameBox(const Box3& box, const Vec3& forward, double fov, double aspect) {
     Camera c;
     c.fov = fov;
     c.at = box.isEmpty() ? Vec3(0.0) : box.center();
     const double radius = box.isEmpty() ? 1.0 : std::max(0.5 * glm::length(box.extent()), 1e-6);
     const Vec3 f = glm::normalize(forward);
     c.up = std::abs(f.z) > 0.999 ? Vec3(0.0, 1.0, 0.0) : Vec3(0.0, 0.0, 1.0);
-    // The sphere fits the smaller of the vertical and (at least square) horizontal fields.
-    const double dist = radius / std::sin(glm::radians(fov) * 0.5);
+    // The sphere fits the narrower of the vertical and horizontal fields.
+    const double half = std::tan(glm::radians(fov) * 0.5) * std::min(1.0, aspect);
+    const double dist = radius / std::sin(std::atan(half));
     c.from = c.at - f * dist;
     return c;
 }
@@ -134,8 +135,10 @@ const char* colorByName(ColorBy c) { return c == ColorBy::Prims ? "primitives" :
 
 glm::vec3 regionColor(double v, double top) {
     top = std::max(top, 1.0);
-    // The lowest fifth of the map is too dark to read as a line on the dark background.
-    const double t = 0.2 + 0.8 * std::clamp(v / top, 0.0, 1.0);
+    // The lowest third of the map is too dark to read as a line on the dark background; the
+    // square root spreads the many small values (most leaves hold a few primitives, a few hold
+    // many) over more of the map.
+    const double t = 0.35 + 0.65 * std::sqrt(std::clamp(v / top, 0.0, 1.0));
     return colormap(float(t));
 }
 

@@ -52,8 +52,9 @@ void depthRange(const Camera& cam, const Box3& b, double& near, double& far);
 float windowDepth(const Camera& cam, double near, double far, double depth);
 
 /// Frame `box` in a camera looking along `forward` (up +z unless forward is vertical): its
-/// whole bounding sphere in view of a perspective camera with a `fov`-degree field.
-Camera frameBox(const Box3& box, const Vec3& forward, double fov);
+/// whole bounding sphere in view of a perspective camera with a `fov`-degree vertical field
+/// and a w / h image `aspect` (a narrow image narrows the horizontal field).
+Camera frameBox(const Box3& box, const Vec3& forward, double fov, double aspect = 1.0);
 
 /// What the inspector draws a regular leaf (or any region) with, for filtering and colouring.
 struct RegionView {
