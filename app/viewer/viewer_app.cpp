@@ -92,6 +92,24 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     settled_ = state_.settledSince() && inspector_->settled();
 }
 
+std::vector<std::string> ViewerApp::applyInspectorShow(const std::vector<std::string>& items) {
+    std::vector<std::string> left;
+    inspector::InspectorOptions& o = inspector_->options();
+    o.boxes = o.frustum = false;
+    for (const std::string& item : items) {
+        if (item == "inspector")
+            showInspector(true);
+        else if (item == "boxes")
+            o.boxes = true;
+        else if (item == "frustum")
+            o.frustum = true;
+        else
+            left.push_back(item);
+    }
+    inspector_->changed();
+    return left;
+}
+
 void ViewerApp::saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const {
     writePng(path, fbWidth, fbHeight, readFramebuffer(fbWidth, fbHeight));
 }

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/viewer/image_view.h"
 #include "app/viewer/inspector/inspector.h"
@@ -79,6 +80,11 @@ class ViewerApp {
     inspector::Inspector& inspector() { return *inspector_; }
     /// Show or hide the inspector.
     void showInspector(bool on) { state_.settings().showInspector = on; }
+    /// The inspector's part of a --show list (DESIGN.md section 6): given the items the overlays
+    /// do not draw, shows the inspector when "inspector" is among them and turns its boxes and
+    /// frustum on or off as "boxes" and "frustum" are listed or not. Returns the items left
+    /// (nothing draws them yet).
+    std::vector<std::string> applyInspectorShow(const std::vector<std::string>& items);
     /// The selected region (-1: none), which the inspector highlights; a click in the inspector
     /// sets it.
     int64_t selectedRegion() const { return selected_; }
