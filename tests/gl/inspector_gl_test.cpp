@@ -41,9 +41,9 @@ struct Fixture {
         o.surfaces = false;
         o.cap = 1 << 30;
     }
-    std::vector<uint8_t> draw() {
+    std::vector<uint8_t> draw(int64_t selected = -1) {
         insp->changed();
-        insp->update(st, {st->scene->camera, 64, 48}, kW, kH, -1);
+        insp->update(st, {st->scene->camera, 64, 48}, kW, kH, selected);
         gl.clear(0.0f, 0.0f, 0.0f);
         insp->draw(kW, kH);
         return gl.read();
@@ -182,6 +182,34 @@ TEST(InspectorGl, SliceSlabKeepsOnlyTheCrossingCells) {
     }
     EXPECT_GT(shown, 20);
     EXPECT_GT(hidden, 20);
+}
+
+TEST(InspectorGl, SelectionDrawnInGreenOverEverything) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    f.insp->options().surfaces = true;
+    f.draw();
+    ASSERT_TRUE(f.insp->waitSurfaces(20000));
+    // A leaf picked at the viewport's centre, then drawn as the selection.
+    const int64_t id = f.insp->pick(0.5 * (f.v.x1 - f.v.x0), 0.5 * (f.v.y1 - f.v.y0));
+    ASSERT_GE(id, 0);
+    std::vector<uint8_t> img = f.draw(id);
+    ASSERT_TRUE(f.insp->surfacesShown());
+    StructureView view(*f.st->scene, *f.st->accel);
+    const glm::vec3 green = kSelectionColor * 255.0f;
+    int checked = 0;
+    for (const glm::dvec2& p : edgeMidpoints(f, view.regionCorners(uint32_t(id)))) {
+        bool found = false;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const uint8_t* q = pixel(img, int(p.x) + dx, int(p.y) + dy);
+                found |= std::abs(q[0] - green.x) < 10 && std::abs(q[1] - green.y) < 10 &&
+                         std::abs(q[2] - green.z) < 10;
+            }
+        EXPECT_TRUE(found) << p.x << " " << p.y;
+        ++checked;
+    }
+    EXPECT_GE(checked, 6);
 }
 
 TEST(InspectorGl, SurfacesHideTheLinesBehindThem) {
