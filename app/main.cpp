@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
                     (b.maxSize > b.minSize ? "[:SIZE]" : "") + "  " + b.description;
     app.footer(builtins);
 
-    cli::CommonOptions viewOpt, renderOpt, traceOpt;
+    cli::CommonOptions viewOpt, renderOpt, traceOpt, structureOpt;
     std::string viewOut = "lancer-view.png";
     CLI::App* view = app.add_subcommand(
         "view", "Open the viewer (the default); without a display, render headless");
@@ -75,6 +75,17 @@ int main(int argc, char** argv) {
     trace->add_flag("--json", topt.json, "Machine-readable output");
     cli::addCommonOptions(*trace, traceOpt);
 
+    cli::StructureOptions sopt;
+    CLI::App* structure = app.add_subcommand(
+        "structure", "Write the built structure as JSON (regions, zones, slabs)");
+    structure
+        ->add_option("scene", structureOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")
+        ->required();
+    structure->add_option("-o,--output", sopt.output, "Output JSON")->required();
+    structure->add_flag("--all", sopt.all, "List every region even beyond a million (else counts)");
+    structure->add_flag("-q,--quiet", sopt.quiet, "Print nothing on success");
+    cli::addCommonOptions(*structure, structureOpt);
+
     bench::BenchOptions bopt;
     CLI::App* benchCmd =
         app.add_subcommand("bench", "Write the speed-against-error report (CSV and plots)");
@@ -106,6 +117,7 @@ int main(int argc, char** argv) {
     if (*benchCmd) return bench::runBench(bopt);
 
     if (*render) return cli::runRender(renderOpt, out, quiet);
+    if (*structure) return cli::runStructure(structureOpt, sopt);
     if (*trace) {
         topt.x = pixel[0];
         topt.y = pixel[1];

@@ -13,6 +13,7 @@
 #include "engine/render/progressive.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
+#include "engine/util/format.h"
 
 namespace lancer::bench {
 
@@ -53,20 +54,6 @@ ImageError compare(const Image& ref, const Image& img) {
             }
     }
     return e;
-}
-
-/// Fill the pixels a coarse pass skipped with the pass's sample of their block (what a
-/// progressive display shows).
-Image upsample(const Image& img, int stride) {
-    Image out = img;
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) {
-            size_t src = img.index(x - x % stride, y - y % stride), dst = img.index(x, y);
-            out.color[dst] = img.color[src];
-            out.depth[dst] = img.depth[src];
-            out.hitPrim[dst] = img.hitPrim[src];
-        }
-    return out;
 }
 
 std::string num(double v) {
@@ -249,11 +236,12 @@ int runBench(const BenchOptions& opt) {
             if (knob == "scheme" || knob == "peer (bounces 0)") {
                 char line[512];
                 std::snprintf(line, sizeof line,
-                              "| %s | %s%s | %.0f | %zu | %.1f MiB | %.0f | %.2f | %.1f | %.1f | "
+                              "| %s | %s%s | %.0f | %zu | %s | %.0f | %.2f | %.1f | %.1f | "
                               "%.1fx | %zu |\n",
                               spec.c_str(), scheme, knob == "scheme" ? "" : " (bounces 0)",
-                              info.buildMs, info.regions, double(info.memoryBytes) / 1048576.0,
-                              s.renderMs, 1000.0 * s.renderMs / rays, double(c.primTests) / rays,
+                              info.buildMs, info.regions,
+                              formatBytes(info.memoryBytes, ByteUnit::MiB).c_str(), s.renderMs,
+                              1000.0 * s.renderMs / rays, double(c.primTests) / rays,
                               double(c.regionVisits) / rays, sp.ratio(), e.hitDiff);
                 table << line;
             }
@@ -343,7 +331,9 @@ int runBench(const BenchOptions& opt) {
             RenderStats s = render(scene, *best, ro, prog, PassLattice{stride, prev});
             elapsed += s.renderMs;
             s.renderMs = elapsed;
-            ImageError e = compare(ref, upsample(prog, stride));
+            Image shown;  // what the viewer shows after this pass
+            fillBlocks(prog, stride, shown);
+            ImageError e = compare(ref, shown);
             // Speedup of the time to this pass, over brute force on the whole image.
             row(schemeName(best->params().scheme), "progressive pass", std::to_string(stride),
                 best->info(), baseline.against(s), e);

@@ -1,4 +1,4 @@
-// `lancer bench`: the speed-against-error report (DESIGN.md section 7). Every configuration is
+// `lancer bench`: the speed-against-error report (docs/design.md section 7). Every configuration is
 // rendered and compared with the brute-force image of the same run: build time, memory, render
 // time, speedup, work per ray, and error (pixels whose hit differs, largest depth difference).
 #pragma once

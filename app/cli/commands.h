@@ -17,4 +17,12 @@ struct TraceOptions {
 };
 int runTrace(const CommonOptions& o, const TraceOptions& t);
 
+struct StructureOptions {
+    std::string output;  ///< -o FILE.json
+    bool all = false;    ///< list every region even over the summary limit
+    bool quiet = false;
+};
+/// Build the structure and write its dump (docs/design.md section 6, "Structure dump").
+int runStructure(const CommonOptions& o, const StructureOptions& s);
+
 }  // namespace lancer::cli

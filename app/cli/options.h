@@ -11,8 +11,8 @@
 namespace lancer::cli {
 
 struct CommonOptions {
-    /// The command line's default scheme is the fastest one measured (README, "Speed against
-    /// error"); BuildParams itself defaults to brute force, the reference.
+    /// The command line's default scheme is the fastest one measured (docs/benchmarks.md);
+    /// BuildParams itself defaults to brute force, the reference.
     static BuildParams defaultBuild() {
         BuildParams b;
         b.scheme = SchemeKind::Regular;
@@ -25,7 +25,7 @@ struct CommonOptions {
     std::string statsPath, depthPath;
 };
 
-/// Add the common options (DESIGN.md section 6) to a subcommand.
+/// Add the common options (docs/design.md section 6) to a subcommand.
 void addCommonOptions(CLI::App& app, CommonOptions& o);
 /// The image size from the options and the scene's default size.
 void resolveSize(const CommonOptions& o, const Scene& scene, int& w, int& h);

@@ -33,7 +33,7 @@ const char* irregularFrameName(IrregularFrame f);
 struct BuildParams {
     SchemeKind scheme = SchemeKind::Brute;
     /// Deepest subdivision level (regular: total BSP depth, one axis cut per level). 24 and 4
-    /// measured best for the regular scheme (README, "Regular subdivision"): balls4 11.7
+    /// measured best for the regular scheme (docs/regular.md, "Defaults"): balls4 11.7
     /// primitive tests per ray (at 18 / 2: 65), and no built-in CSG scene explodes (at 24 / 2
     /// lattice does, where box faces run through other boxes). Were 18 and 2.
     int maxLevel = 24;

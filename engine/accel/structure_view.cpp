@@ -128,6 +128,19 @@ std::vector<SlabInfo> ZoneFrameView::slabs(uint32_t z) const {
     return out;
 }
 
+std::array<Vec3, 8> ZoneFrameView::zoneCorners(uint32_t z) const {
+    const bool cam = kind_ == ZoneFrameKind::Camera;
+    const double z0 = cam ? s_->bounds().lo.z : s_->projective().zNear();
+    const double z1 = cam ? s_->bounds().hi.z : s_->projective().zFar();
+    const glm::dvec2 lo = bsp_->zoneLo[z], hi = bsp_->zoneHi[z];
+    std::array<Vec3, 8> c;
+    for (int i = 0; i < 8; ++i) {
+        const double x = (i & 1) ? hi.x : lo.x, y = (i & 2) ? hi.y : lo.y, d = (i & 4) ? z1 : z0;
+        c[i] = s_->frame().toWorld(cam ? Vec3(x, y, d) : Vec3(x * d, y * d, d));
+    }
+    return c;
+}
+
 int64_t ZoneFrameView::zoneAt(glm::dvec2 p) const {
     if (zoneCount() == 0 || !(p.x >= lo_.x && p.x <= hi_.x && p.y >= lo_.y && p.y <= hi_.y))
         return -1;

@@ -31,12 +31,12 @@ enum class RegionKind : uint8_t {
 };
 const char* regionKindName(RegionKind k);
 
-/// The irregular scheme's two screen frames (DESIGN.md section 4).
+/// The irregular scheme's two screen frames (docs/design.md section 4).
 enum class ZoneFrameKind : uint8_t {
     Camera,      ///< screen x along R, screen y along U (scene units)
     Projective,  ///< u = x / z, v = y / z (primary rays only)
 };
-/// Units a frame's 2D coordinates are given in by the dump (DESIGN.md section 6): pixels when
+/// Units a frame's 2D coordinates are given in by the dump (docs/design.md section 6): pixels when
 /// the frame maps linearly to the image (orthographic camera frame, projective zones), camera
 /// units (scene units) for a perspective camera's camera frame.
 enum class FrameUnits : uint8_t { Pixels, Camera };
@@ -58,9 +58,12 @@ struct RegionInfo {
     uint32_t cellLo[3] = {}, cellHi[3] = {};  ///< regular: directory cells [lo, hi) per axis
     int64_t zone = -1;  ///< irregular: zone in its frame's BSP; -1 for the near region
     uint32_t slab = 0;  ///< irregular: index of the slab in its zone, by increasing depth
-    std::span<const uint32_t> prims;  ///< primitives listed in the region (tracer ids)
-    const CsgTree* pool = nullptr;    ///< the pool holding the region's restricted tree
-    int root = -1;                    ///< restricted tree's root in `pool`; -1: empty
+    /// Primitives listed in the region (tracer ids), sorted: those whose minimized box (its
+    /// bound in the region's frame, irregular) crosses the region; the regular scheme keeps
+    /// only those its restricted tree keeps (the others cannot contribute there).
+    std::span<const uint32_t> prims;
+    const CsgTree* pool = nullptr;  ///< the pool holding the region's restricted tree
+    int root = -1;                  ///< restricted tree's root in `pool`; -1: empty
     /// Neighbours across the low and high face of each frame axis: regular ropes (one leaf
     /// covers the face, or kSeveralNeighbours); irregular corner pointers (region.h: the region
     /// just beyond the low / high corner across that face); projective slabs: the previous /
@@ -136,6 +139,9 @@ class ZoneFrameView {
     std::span<const uint32_t> zonePrims(uint32_t z) const;
     /// Zone z's slabs, by increasing depth.
     std::vector<SlabInfo> slabs(uint32_t z) const;
+    /// Zone z's whole column as 8 world corners (the regionCorners order): its rectangle through
+    /// the depth of its slabs; a box of the camera frame, or a frustum of the projective frame.
+    std::array<Vec3, 8> zoneCorners(uint32_t z) const;
     /// Zone holding the frame point (x, y); -1 outside the rectangle.
     int64_t zoneAt(glm::dvec2 p) const;
 
@@ -180,7 +186,7 @@ class StructureView {
     size_t regionCount() const;
     /// Region `id`'s volume as 8 world-space corners, corner c = i + 2j + 4k with i, j, k the
     /// low (0) or high (1) side along the region's own axes (regular and brute force: x, y, z;
-    /// camera frame: R, U, F; projective: u, v, depth), the trace contract's order (DESIGN.md
+    /// camera frame: R, U, F; projective: u, v, depth), the trace contract's order (docs/design.md
     /// section 6). Regions are finite: every scheme's structure is bounded.
     std::array<Vec3, 8> regionCorners(uint32_t id) const;
     /// Region `id`: kind, frame box, level or zone, primitives, restricted tree, neighbours.
@@ -189,7 +195,8 @@ class StructureView {
     std::string toString(uint32_t id) const;
     /// The region holding a world point, for picking in 3D (clamped into the structure): brute
     /// force 0, the regular leaf, the irregular camera-frame region (projective regions are
-    /// reached from pixels: ZoneFrameView::zoneAtPixel).
+    /// reached from pixels: ZoneFrameView::zoneAtPixel). Needs regionCount() > 0 (an irregular
+    /// structure over an empty scene has no region).
     uint32_t regionAt(const Vec3& world) const;
     /// The structure's box in the world: scene bounds, the regular grid's box, the irregular
     /// bounds' box in the world (a box of the camera frame: see structureCorners).

@@ -79,11 +79,22 @@ void copyRows(const Image& src, Image& dst, int rowBegin, int rowEnd) {
 }
 
 void writeFileAtomic(const std::string& path, const std::string& data) {
+    writeFileAtomic(path,
+                    [&](std::ostream& f) { f.write(data.data(), std::streamsize(data.size())); });
+}
+
+void writeFileAtomic(const std::string& path, const std::function<void(std::ostream&)>& write) {
     std::string tmp = path + ".tmp";
     {
         std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
         if (!f) throw std::runtime_error(path + ": cannot open for writing");
-        f.write(data.data(), std::streamsize(data.size()));
+        try {
+            write(f);
+        } catch (...) {
+            f.close();
+            std::remove(tmp.c_str());
+            throw;
+        }
         f.close();
         if (!f) {
             std::remove(tmp.c_str());

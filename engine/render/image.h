@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -61,5 +63,8 @@ std::vector<float> readPfm(const std::string& path, int& w, int& h);
 std::vector<uint8_t> readPng(const std::string& path, int& w, int& h);
 /// Write `data` to `path` atomically.
 void writeFileAtomic(const std::string& path, const std::string& data);
+/// Write what `write` puts in the stream to `path` atomically: into a temporary file renamed
+/// into place once complete, so an exception or a failed write leaves no partial file.
+void writeFileAtomic(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 }  // namespace lancer

@@ -1,4 +1,4 @@
-// The `--stats` JSON (DESIGN.md section 6).
+// The `--stats` JSON (docs/design.md section 6).
 #pragma once
 
 #include <nlohmann/json.hpp>

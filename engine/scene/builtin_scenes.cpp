@@ -1,12 +1,15 @@
 #include "engine/scene/builtin_scenes.h"
 
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <functional>
 
 namespace lancer {
 
 namespace {
+
+constexpr std::string_view kPrefix = "builtin:";
 
 /// A small helper to assemble scenes in code.
 struct SceneBuilder {
@@ -21,11 +24,21 @@ struct SceneBuilder {
     }
     int op(Op o, int a, int b) { return s.tree.combine(o, a, b); }
     int all(Op o, const std::vector<int>& items) { return s.tree.balanced(o, items); }
-    Scene finish(int root, const std::string& name) {
+    Scene finish(int root, const std::string& name, std::optional<int> size = std::nullopt) {
         s.tree.root = root;
-        s.name = "builtin:" + name;
+        s.name = builtinSpec(name, size);
         s.prepare();
         return std::move(s);
+    }
+    /// finish(), then the look the generated scenes share: a background, a camera framed on the
+    /// bounds looking along `viewDir` (z up) and the default lights.
+    Scene finishFramed(int root, const std::string& name, int size, const Vec3& background,
+                       const Vec3& viewDir) {
+        Scene scene = finish(root, name, size);
+        scene.background = background;
+        scene.frameCamera(viewDir, {0, 0, 1});
+        scene.defaultLights();
+        return scene;
     }
 };
 
@@ -116,7 +129,7 @@ Scene ballsScene(int size) {
         }
     };
     grow(Vec3(0.0), 0.5, {0, 0, 1}, size);
-    Scene s = b.finish(b.all(Op::Union, leaves), "balls:" + std::to_string(size));
+    Scene s = b.finish(b.all(Op::Union, leaves), "balls", size);
     s.background = {0.078, 0.361, 0.753};
     s.camera.from = {2.1, 1.3, 1.7};
     s.camera.at = {0, 0, 0};
@@ -141,12 +154,8 @@ Scene drilledScene(int n) {
                 Vec3 c = Vec3(-extent) + step * (Vec3(i, j, k) + 0.5);
                 holes.push_back(b.prim(Sphere{c, r}, steel));
             }
-    Scene s = b.finish(b.op(Op::Difference, block, b.all(Op::Union, holes)),
-                       "drilled:" + std::to_string(n));
-    s.background = {0.1, 0.1, 0.12};
-    s.frameCamera({-1.0, 2.2, -1.4}, {0, 0, 1});
-    s.defaultLights();
-    return s;
+    return b.finishFramed(b.op(Op::Difference, block, b.all(Op::Union, holes)), "drilled", n,
+                          {0.1, 0.1, 0.12}, {-1.0, 2.2, -1.4});
 }
 
 // An n x n x n lattice of cells, each a rounded cube (cube ∩ sphere) bored by a cylinder,
@@ -169,12 +178,8 @@ Scene latticeScene(int n) {
                 cells.push_back(b.op(Op::Difference, rounded, bore));
             }
     int slab = b.prim(Block{{-1.1, -1.1, -0.55}, {1.1, 1.1, 0.55}}, ma);
-    Scene s = b.finish(b.op(Op::Intersection, b.all(Op::Union, cells), slab),
-                       "lattice:" + std::to_string(n));
-    s.background = {0.1, 0.1, 0.12};
-    s.frameCamera({-1.0, 2.0, -1.2}, {0, 0, 1});
-    s.defaultLights();
-    return s;
+    return b.finishFramed(b.op(Op::Intersection, b.all(Op::Union, cells), slab), "lattice", n,
+                          {0.1, 0.1, 0.12}, {-1.0, 2.0, -1.2});
 }
 
 // SPD-style "tetra": a Sierpinski tetrahedron of 4^SIZE triangles (surfaces in one union).
@@ -201,11 +206,8 @@ Scene tetraScene(int size) {
     };
     double r = 1.0;
     split({Vec3(r, r, r), Vec3(-r, -r, r), Vec3(-r, r, -r), Vec3(r, -r, -r)}, size - 1);
-    Scene s = b.finish(b.all(Op::Union, leaves), "tetra:" + std::to_string(size));
-    s.background = {0.078, 0.361, 0.753};
-    s.frameCamera({-0.45, 1.0, 0.35}, {0, 0, 1});
-    s.defaultLights();
-    return s;
+    return b.finishFramed(b.all(Op::Union, leaves), "tetra", size, {0.078, 0.361, 0.753},
+                          {-0.45, 1.0, 0.35});
 }
 
 // SPD-style "rings": SIZE x SIZE rings, each a chain of spheres joined by open cylinders
@@ -242,11 +244,8 @@ Scene ringsScene(int size) {
         {{half, half, -1.2}, {-half, half, -1.2}, {-half, -half, -1.2}, {half, -half, -1.2}},
         floor);
     leaves.push_back(b.prim(floor, floorM));
-    Scene s = b.finish(b.all(Op::Union, leaves), "rings:" + std::to_string(size));
-    s.background = {0.078, 0.361, 0.753};
-    s.frameCamera({-1.0, 1.6, -1.1}, {0, 0, 1});
-    s.defaultLights();
-    return s;
+    return b.finishFramed(b.all(Op::Union, leaves), "rings", size, {0.078, 0.361, 0.753},
+                          {-1.0, 1.6, -1.1});
 }
 
 }  // namespace
@@ -265,25 +264,61 @@ const std::vector<BuiltinInfo>& builtinScenes() {
     return list;
 }
 
-Scene makeBuiltin(const std::string& name, int size) {
-    for (const BuiltinInfo& info : builtinScenes()) {
-        if (name != info.name) continue;
-        if (size < 0) size = info.defaultSize;
-        if (size < info.minSize || size > info.maxSize)
-            throw SceneError("builtin:" + name + ": size " + std::to_string(size) +
-                             " is outside [" + std::to_string(info.minSize) + ", " +
-                             std::to_string(info.maxSize) + "]");
-        if (name == "default") return defaultScene();
-        if (name == "balls") return ballsScene(size);
-        if (name == "drilled") return drilledScene(size);
-        if (name == "lattice") return latticeScene(size);
-        if (name == "tetra") return tetraScene(size);
-        if (name == "rings") return ringsScene(size);
+bool isBuiltinSpec(std::string_view spec) { return spec.substr(0, kPrefix.size()) == kPrefix; }
+
+std::optional<BuiltinSpec> parseBuiltinSpec(const std::string& spec) {
+    if (!isBuiltinSpec(spec)) return std::nullopt;
+    std::string rest = spec.substr(kPrefix.size());
+    size_t colon = rest.find(':');
+    if (colon == std::string::npos) return BuiltinSpec{rest, std::nullopt};
+    std::string num = rest.substr(colon + 1);
+    int size = 0;
+    auto r = std::from_chars(num.data(), num.data() + num.size(), size);
+    if (r.ec != std::errc() || r.ptr != num.data() + num.size())
+        throw SceneError(spec + ": the size after the second ':' must be an integer");
+    return BuiltinSpec{rest.substr(0, colon), size};
+}
+
+std::string builtinSpec(const std::string& name, std::optional<int> size) {
+    std::string spec = std::string(kPrefix) + name;
+    if (size) {
+        spec += ':';
+        spec += std::to_string(*size);
     }
-    std::string names;
+    return spec;
+}
+
+const BuiltinInfo* findBuiltin(std::string_view name) {
     for (const BuiltinInfo& info : builtinScenes())
-        names += std::string(names.empty() ? "" : ", ") + info.name;
-    throw SceneError("builtin:" + name + ": unknown built-in scene (available: " + names + ")");
+        if (name == info.name) return &info;
+    return nullptr;
+}
+
+Scene makeBuiltin(const BuiltinSpec& spec) {
+    const BuiltinInfo* info = findBuiltin(spec.name);
+    if (!info) {
+        std::string names;
+        for (const BuiltinInfo& b : builtinScenes())
+            names += std::string(names.empty() ? "" : ", ") + b.name;
+        throw SceneError(builtinSpec(spec.name) + ": unknown built-in scene (available: " + names +
+                         ")");
+    }
+    const int size = spec.size.value_or(info->defaultSize);
+    if (size < info->minSize || size > info->maxSize)
+        throw SceneError(builtinSpec(spec.name) + ": size " + std::to_string(size) +
+                         " is outside [" + std::to_string(info->minSize) + ", " +
+                         std::to_string(info->maxSize) + "]");
+    const std::string& name = spec.name;
+    if (name == "default") return defaultScene();
+    if (name == "balls") return ballsScene(size);
+    if (name == "drilled") return drilledScene(size);
+    if (name == "lattice") return latticeScene(size);
+    if (name == "tetra") return tetraScene(size);
+    return ringsScene(size);
+}
+
+Scene makeBuiltin(const std::string& name, int size) {
+    return makeBuiltin(BuiltinSpec{name, size < 0 ? std::nullopt : std::optional<int>(size)});
 }
 
 }  // namespace lancer

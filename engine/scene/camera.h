@@ -1,4 +1,4 @@
-// Pinhole perspective and orthographic cameras (DESIGN.md section 6 conventions).
+// Pinhole perspective and orthographic cameras (docs/design.md section 6 conventions).
 #pragma once
 
 #include <string>
@@ -17,7 +17,7 @@ struct Camera {
     Projection projection = Projection::Perspective;
     double orthoHeight = 10.0;  ///< full image height in scene units (orthographic)
 
-    /// Basis per DESIGN.md: F = normalize(at - from), R = normalize(F x up), U = R x F.
+    /// docs/design.md section 6: F = normalize(at - from), R = normalize(F x up), U = R x F.
     void basis(Vec3& f, Vec3& r, Vec3& u) const;
     /// Primary ray through the centre of pixel (x, y) of a w x h image, y = 0 on the top row.
     /// The direction is unit length, so t is a distance.

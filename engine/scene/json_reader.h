@@ -1,4 +1,4 @@
-// The native JSON scene format (README "Scene formats") and the camera sidecar of .csg files.
+// The native JSON scene format (docs/scenes.md) and the camera sidecar of .csg files.
 // Every error names the file, line and column of the offending value.
 #pragma once
 

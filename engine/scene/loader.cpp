@@ -1,7 +1,5 @@
 #include "engine/scene/loader.h"
 
-#include <charconv>
-
 #include "engine/scene/builtin_scenes.h"
 #include "engine/scene/json_reader.h"
 #include "engine/scene/nff_reader.h"
@@ -21,17 +19,7 @@ std::string extension(const std::string& path) {
 }  // namespace
 
 Scene loadScene(const std::string& spec) {
-    if (spec.rfind("builtin:", 0) == 0) {
-        std::string rest = spec.substr(8);
-        size_t colon = rest.find(':');
-        if (colon == std::string::npos) return makeBuiltin(rest);
-        std::string num = rest.substr(colon + 1);
-        int size = 0;
-        auto r = std::from_chars(num.data(), num.data() + num.size(), size);
-        if (r.ec != std::errc() || r.ptr != num.data() + num.size())
-            throw SceneError(spec + ": the size after the second ':' must be an integer");
-        return makeBuiltin(rest.substr(0, colon), size);
-    }
+    if (std::optional<BuiltinSpec> builtin = parseBuiltinSpec(spec)) return makeBuiltin(*builtin);
     std::string ext = extension(spec);
     if (ext == ".json") return readJsonScene(SourceText::fromFile(spec));
     if (ext == ".nff") return readNff(SourceText::fromFile(spec));

@@ -1,4 +1,5 @@
-// A tokenizer with byte offsets for the text scene formats (NFF, OpenSCAD .csg).
+// Words with byte offsets for NFF, and the number syntax both text formats (NFF, OpenSCAD .csg)
+// share.
 #pragma once
 
 #include <string>
@@ -20,12 +21,10 @@ class WordReader {
     explicit WordReader(const SourceText& src) : src_(src) {}
     Token next();
     Token peek();
-    bool atEnd() { return peek().text.empty(); }
     /// A finite number; fails naming the position and `what` otherwise.
     double number(const char* what);
     int count(const char* what, int max);
     Vec3 vec3(const char* what);
-    const SourceText& source() const { return src_; }
 
   private:
     const SourceText& src_;

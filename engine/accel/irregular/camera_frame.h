@@ -1,6 +1,6 @@
 // The camera frame of the irregular subdivision: screen x along R, screen y along U, depth z
-// along F, origin at the eye (DESIGN.md section 4). The frame is orthonormal, so a ray keeps its
-// parameter t when it is expressed in it: region intervals and world hits share one t.
+// along F, origin at the eye (docs/design.md section 4). The frame is orthonormal, so a ray keeps
+// its parameter t when it is expressed in it: region intervals and world hits share one t.
 #pragma once
 
 #include "engine/scene/camera.h"

@@ -16,7 +16,7 @@ int sign(double v) { return v > 0.0 ? 1 : (v < 0.0 ? -1 : 0); }
 double maxAbs(const Vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
 
 /// Zones beyond this many are refused: a screen BSP that large means the 2D step should stop
-/// earlier (see README, "Irregular subdivision").
+/// earlier (see docs/irregular.md, "Growth").
 constexpr size_t kMaxZones = 4'000'000;
 /// Regions beyond this many are refused: pointers are 32-bit and memory would run out first.
 constexpr size_t kMaxRegions = 50'000'000;

@@ -1,4 +1,4 @@
-// The irregular subdivision of Arnaldi, Priol and Bouatouch (report, section 2; DESIGN.md
+// The irregular subdivision of Arnaldi, Priol and Bouatouch (report, section 2; docs/design.md
 // section 4): a screen BSP of the primitives' projected boxes (screen_bsp.h), each zone cut in
 // depth slabs (depth_slabs.h), the slabs linked by corner pointers (corner_pointers.h), and a
 // walk that follows a ray from region to region by those pointers alone.

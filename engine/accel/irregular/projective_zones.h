@@ -1,5 +1,5 @@
 // The report's perspective reading of the irregular scheme, for primary rays: zones and depth
-// slabs in the camera's projective space (u = x/z, v = y/z, depth z; DESIGN.md section 4).
+// slabs in the camera's projective space (u = x/z, v = y/z, depth z; docs/design.md section 4).
 // Every ray from the eye has constant (u, v), so it stays in the zone of its pixel and only walks
 // in depth: no corner pointer, no exit computation, the next slab is the next array entry.
 //

@@ -1,0 +1,49 @@
+// The engine's small helpers: byte counts written for people, and the hash.
+#include <gtest/gtest.h>
+
+#include <string_view>
+#include <vector>
+
+#include "engine/util/format.h"
+#include "engine/util/hash.h"
+
+namespace lancer {
+namespace {
+
+TEST(FormatBytes, TakesTheLargestUnitOfWhichThereAreTen) {
+    EXPECT_EQ(formatBytes(0), "0 B");
+    EXPECT_EQ(formatBytes(10 * 1024 - 1), "10239 B");
+    EXPECT_EQ(formatBytes(10 * 1024), "10.0 KiB");
+    EXPECT_EQ(formatBytes(3'880'000), "3789.1 KiB");
+    EXPECT_EQ(formatBytes(10 * 1024 * 1024), "10.0 MiB");
+    EXPECT_EQ(formatBytes(size_t(512) << 20), "512.0 MiB");
+}
+
+TEST(FormatBytes, AGivenUnitHoldsForEveryCount) {
+    EXPECT_EQ(formatBytes(0, ByteUnit::MiB), "0.0 MiB");
+    EXPECT_EQ(formatBytes(3'880'000, ByteUnit::MiB), "3.7 MiB");
+    EXPECT_EQ(formatBytes(1536, ByteUnit::KiB), "1.5 KiB");
+    EXPECT_EQ(formatBytes(size_t(20) << 20, ByteUnit::B), "20971520 B");
+}
+
+TEST(Hash, BytesAreFnv1a64) {
+    // The published FNV-1a 64-bit test vectors.
+    auto fnv = [](std::string_view s) { return hashBytes(s.data(), s.size()); };
+    EXPECT_EQ(fnv(""), 0xcbf29ce484222325ull);
+    EXPECT_EQ(fnv("a"), 0xaf63dc4c8601ec8cull);
+    EXPECT_EQ(fnv("foobar"), 0x85944171f73967e8ull);
+    // A chain of calls hashes the concatenation.
+    EXPECT_EQ(hashBytes("bar", 3, hashBytes("foo", 3)), fnv("foobar"));
+}
+
+TEST(Hash, WordsTakeOneStepPerValue) {
+    const std::vector<uint32_t> a = {1, 2, 3}, b = {3, 2, 1};
+    uint64_t h = kHashStart;
+    for (uint32_t w : a) h = (h ^ w) * 1099511628211ull;
+    EXPECT_EQ(hashWords(a), h);
+    EXPECT_NE(hashWords(a), hashWords(b));  // order matters
+    EXPECT_EQ(hashWords({}), kHashStart);
+}
+
+}  // namespace
+}  // namespace lancer
