@@ -98,10 +98,7 @@ void irregularRegions(InspectorModel& m, const StructureView& view, const Inspec
     for (uint32_t z = 0; z < frame->zoneCount() && !(full && columns > size_t(opt.cap)); ++z) {
         std::vector<SlabInfo> slabs = frame->slabs(z);
         if (slabs.empty()) continue;
-        const Corners nearC = view.regionCorners(slabs.front().region);
-        const Corners farC = view.regionCorners(slabs.back().region);
-        Corners column;
-        for (int c = 0; c < 8; ++c) column[size_t(c)] = (c & 4 ? farC : nearC)[size_t(c)];
+        const Corners column = frame->zoneCorners(z);
         if (opt.zones && opt.slab.keeps(column) &&
             maybeVisible(insp.camera, insp.width, insp.height, column) &&
             columns++ < size_t(std::max(opt.cap, 0)))
