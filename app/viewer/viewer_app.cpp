@@ -3,6 +3,7 @@
 #include <imgui.h>
 #include <imgui_impl_opengl3.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <limits>
@@ -14,10 +15,11 @@
 namespace lancer::viewer {
 
 ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<void()> wake)
-    : state_(settings, logTimings, std::move(wake)),
+    : state_(settings, logTimings, wake),
       view_(std::make_unique<ImageView>()),
       overlays_(std::make_unique<overlay::Overlays>()),
-      logTimings_(logTimings) {
+      logTimings_(logTimings),
+      inspector_(std::make_unique<inspector::Inspector>(std::move(wake))) {
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
     // drawn at all, and each is copied from a layer where it is redrawn only when it changes
     // (frame(), PanelCache).
@@ -36,8 +38,19 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // 2. Input: the camera's mouse and keys (unless ImGui wants them).
     ImGui_ImplOpenGL3_NewFrame();
     ImGui::NewFrame();
-    handleMouse(state_, fbHeight);
-    overlayInput(fbWidth, fbHeight);
+    ViewerSettings& s = state_.settings();
+    inspector_->setShown(s.showInspector);
+    inspector_->update(state_.sceneBuild(),
+                       {state_.camera(), std::max(state_.width(), 1), std::max(state_.height(), 1)},
+                       fbWidth, fbHeight, selectedRegion());
+    // The inspector's half of the window moves the inspector's camera, and a click there picks.
+    std::optional<int64_t> picked;
+    if (inspector_->handleMouse(fbWidth, fbHeight, picked)) {
+        if (picked) selectRegion(*picked);
+    } else {
+        handleMouse(state_, fbHeight);
+        overlayInput(fbWidth, fbHeight);
+    }
     handleKeys(state_);
 
     // 3. Panels: each reads and acts on the state (panels/). An inspector view, a panel showing
@@ -49,13 +62,13 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         if (set.showOverlays) overlays_->panel(&set.showOverlays);
         if (set.showSelection) overlays_->selectionPanel(&set.showSelection);
     }
+    if (s.showInspector) inspector_->panel(&s.showInspector);
     state_.startWork(fbWidth, fbHeight);
     ImGui::Render();
 
     // 4. Image: the traced image or a heat map, copied only around the opaque panels drawn over
     // it in step 6. The image covers the whole framebuffer: clear only while there is none (one
     // full-screen fill less per frame, which software GL feels).
-    const ViewerSettings& s = state_.settings();
     if (RowRange rows; state_.takeUpload(rows))
         view_->upload(state_.shown(), s.mode, rows.begin, rows.end);
     prepareOverlays(fbWidth, fbHeight);
@@ -64,14 +77,24 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
     }
-    view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(),
-                panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight), s.logScale);
+    std::vector<PixelRect> covered = panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight);
+    if (inspector_->shown()) covered.push_back(inspector::Inspector::viewport(fbWidth, fbHeight));
+    view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale);
+
+    // 4b. The 3D inspector over the right half (the image is not copied under it).
+    inspector_->draw(fbWidth, fbHeight);
 
     // 5. Overlays: their layers were composited into the image when it was shaded
     // (prepareOverlays); the selection's highlight is drawn over the image, under the panels
     // (the panel layer replaces the pixels of every panel's rectangle next).
     const Clock::time_point selectionStart = Clock::now();
+    if (inspector_->shown()) {  // the main view's highlight stays off the inspector's half
+        const PixelRect v = inspector::Inspector::viewport(fbWidth, fbHeight);
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(0, 0, v.x0, fbHeight);
+    }
     overlays_->drawSelection(state_.camera(), fbWidth, fbHeight);
+    glDisable(GL_SCISSOR_TEST);
     overlayStat_.ms +=
         std::chrono::duration<double, std::milli>(Clock::now() - selectionStart).count();
 
@@ -88,7 +111,25 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         }
         notes.pendingScreenshot.clear();
     }
-    settled_ = state_.settledSince();
+    settled_ = state_.settledSince() && inspector_->settled();
+}
+
+std::vector<std::string> ViewerApp::applyInspectorShow(const std::vector<std::string>& items) {
+    std::vector<std::string> left;
+    inspector::InspectorOptions& o = inspector_->options();
+    o.boxes = o.frustum = false;
+    for (const std::string& item : items) {
+        if (item == "inspector")
+            showInspector(true);
+        else if (item == "boxes")
+            o.boxes = true;
+        else if (item == "frustum")
+            o.frustum = true;
+        else
+            left.push_back(item);
+    }
+    inspector_->changed();
+    return left;
 }
 
 void ViewerApp::prepareOverlays(int fbWidth, int fbHeight) {
@@ -148,7 +189,16 @@ void ViewerApp::overlayInput(int fbWidth, int fbHeight) {
 }
 
 std::vector<std::string> ViewerApp::applyShow(const std::string& list) {
-    return overlay::applyShowList(list, overlays_->options);
+    // The overlays take their layers; the inspector takes what they leave of its own.
+    return applyInspectorShow(overlay::applyShowList(list, overlays_->options));
+}
+
+void ViewerApp::selectRegion(int64_t id) {
+    if (id < 0) {
+        overlays_->clearSelection();
+    } else if (overlays_->select(uint32_t(id))) {
+        state_.settings().showSelection = true;
+    }
 }
 
 void ViewerApp::saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const {

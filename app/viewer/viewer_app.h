@@ -9,8 +9,10 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/viewer/image_view.h"
+#include "app/viewer/inspector/inspector.h"
 #include "app/viewer/overlay/overlays.h"
 #include "app/viewer/panel_cache.h"
 #include "app/viewer/viewer_state.h"
@@ -83,6 +85,24 @@ class ViewerApp {
     /// unknown item. Views other than the overlays (the inspector's boxes, frustum and view, the
     /// ray) take their items here, from what the overlays leave.
     std::vector<std::string> applyShow(const std::string& list);
+    /// The 3D inspector (its options, camera and what it draws); shown while
+    /// settings().showInspector is set (the I key, the View panel, `--show inspector`).
+    inspector::Inspector& inspector() { return *inspector_; }
+    /// Show or hide the inspector.
+    void showInspector(bool on) { state_.settings().showInspector = on; }
+    /// The inspector's part of a --show list (DESIGN.md section 6): given the items the overlays
+    /// do not draw, shows the inspector when "inspector" is among them and turns its boxes and
+    /// frustum on or off as "boxes" and "frustum" are listed or not. Returns the items left
+    /// (nothing draws them yet).
+    std::vector<std::string> applyInspectorShow(const std::vector<std::string>& items);
+    /// The selected region (-1: none): the overlays' selection, which the inspector highlights
+    /// and a click in the inspector sets.
+    int64_t selectedRegion() const {
+        return overlays_->selection() ? int64_t(overlays_->selection()->region) : -1;
+    }
+    /// Select region `id` (-1: clear); the Selection panel opens on it.
+    void selectRegion(int64_t id);
+
     /// What is built, rendered and shown (what the panels read).
     ViewerState& state() { return state_; }
     const ViewerState& state() const { return state_; }
@@ -108,6 +128,7 @@ class ViewerApp {
         int frames = 0;
         Clock::time_point since = Clock::now();
     } overlayStat_;
+    std::unique_ptr<inspector::Inspector> inspector_;
     PanelCache panels_;  ///< ImGui's panels, each redrawn only when it changed
     bool settled_ = false;
 };

@@ -46,6 +46,7 @@ std::string settingsLines(const ViewerSettings& s) {
         if (d.iniKey) o << d.iniKey << "=" << cli::formatValue(d, k) << "\n";
     o << "panels=" << s.showParameters << " " << s.showStatistics << " " << s.showCamera << " "
       << s.showView << "\n"
+      << "inspector=" << s.showInspector << "\n"
       << "view=" << viewModeKey(s.mode) << "\n"
       << "auto_scale=" << s.autoScale << "\n"
       << "heat_scale=" << s.heatScale << "\n"
@@ -78,6 +79,9 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
             s.showCamera = c;
             s.showView = d;
         }
+    } else if (key == "inspector") {
+        int on;
+        if (in >> on) s.showInspector = on;
     } else if (key == "view") {
         for (int i = 0; i < kViewModeCount; ++i)
             if (value == viewModeKey(ViewMode(i))) s.mode = ViewMode(i);

@@ -320,6 +320,40 @@ class ViewerFrames : public ::testing::Test {
     std::unique_ptr<ViewerApp> app_;
 };
 
+TEST_F(ViewerFrames, ShowListShowsTheInspectorOverTheRightHalf) {
+    const std::vector<std::string> left = app_->applyInspectorShow({"inspector", "boxes", "ray"});
+    EXPECT_EQ(left, std::vector<std::string>{"ray"});
+    EXPECT_TRUE(app_->inspector().options().boxes);
+    EXPECT_FALSE(app_->inspector().options().frustum);
+    runUntilSettled();
+    ASSERT_TRUE(app_->settled());
+    ASSERT_TRUE(app_->inspector().shown());
+    // Settled means the inspector's surfaces are traced for its camera, and it drew regions.
+    EXPECT_TRUE(app_->inspector().surfacesShown());
+    EXPECT_FALSE(app_->inspector().model().regions.empty());
+    // Between the image's panels, the right half shows the inspector, not the traced image.
+    std::vector<uint8_t> shown = gl_->read();
+    Camera cam = app_->camera();
+    Traced t = traceCpu("builtin:default", &cam, kW, kH);
+    std::vector<uint8_t> cpu = t.img.rgba8();
+    size_t left0 = 0, leftSame = 0, right0 = 0, rightSame = 0;
+    for (int y = 60; y < kH - 20; ++y)
+        for (int x = 350; x < kW - 360; ++x) {
+            const size_t i = 4 * (size_t(y) * kW + size_t(x));
+            bool same = true;
+            for (int c = 0; c < 3; ++c) same &= std::abs(int(shown[i + c]) - int(cpu[i + c])) <= 1;
+            if (x < kW / 2) {
+                ++left0;
+                leftSame += same;
+            } else {
+                ++right0;
+                rightSame += same;
+            }
+        }
+    EXPECT_GT(leftSame, left0 * 99 / 100);
+    EXPECT_LT(rightSame, right0 / 2);
+}
+
 TEST_F(ViewerFrames, ShowsTheRenderedSceneAndThePanels) {
     runUntilSettled();
     ASSERT_TRUE(app_->settled());
