@@ -19,8 +19,8 @@ std::shared_ptr<const SceneBuild> regularBalls() {
     BuildRequest r;
     r.spec = "builtin:balls:2";
     r.params.scheme = SchemeKind::Regular;
-    r.params.maxLevel = 12;
-    r.params.maxObjects = 2;
+    r.params.regular.maxLevel = 12;
+    r.params.regular.maxObjects = 2;
     BuildResult b = buildStructure(r);
     if (!b.sceneBuild) throw std::runtime_error(b.error);
     return b.sceneBuild;

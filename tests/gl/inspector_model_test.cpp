@@ -23,8 +23,9 @@ std::unique_ptr<Built> build(const std::string& spec, SchemeKind scheme) {
     b->scene = loadScene(spec);
     BuildParams p;
     p.scheme = scheme;
-    p.maxLevel = 12;
-    p.maxObjects = 2;
+    p.regular.maxLevel = 12;
+    p.regular.maxObjects = 2;
+    p.irregular.maxObjects = 2;
     b->accel = buildAccelerator(b->scene, p);
     b->view = std::make_unique<StructureView>(b->scene, *b->accel);
     return b;

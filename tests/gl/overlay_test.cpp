@@ -48,8 +48,9 @@ std::shared_ptr<SceneBuild> twoBoxes(SchemeKind scheme, int maxLevel = 24) {
     scene->prepare();
     BuildParams p;
     p.scheme = scheme;
-    p.maxLevel = maxLevel;
-    p.maxObjects = scheme == SchemeKind::Regular ? 1 : 0;
+    p.regular.maxLevel = maxLevel;
+    p.regular.maxObjects = 1;
+    p.irregular.maxObjects = 0;
     auto s = std::make_shared<SceneBuild>();
     s->spec = "two boxes";
     s->scene = scene;
