@@ -65,7 +65,9 @@ int main(int argc, char** argv) {
     cli::addCommonOptions(*render, renderOpt);
 
     cli::TraceOptions topt;
-    CLI::App* trace = app.add_subcommand("trace", "Trace one primary ray and print its walk");
+    CLI::App* trace = app.add_subcommand(
+        "trace",
+        "Trace one pixel's rays (primary, shadow, reflected, refracted) and print their walks");
     trace->add_option("scene", traceOpt.scene, "Scene: a .json/.nff file or builtin:NAME[:SIZE]")
         ->required();
     std::vector<int> pixel;

@@ -87,16 +87,25 @@ class Accelerator {
             const int n = lightBuffer_.shadowSegments(ray.o, ray.d, light, tmax, seg);
             if (n >= 0) {  // else the buffer does not know: the whole ray below
                 ctx.counters.lightBufferSkips += n == 0;
+                if constexpr (Obs::kActive)
+                    if (n == 0) obs.lightBufferClear();
                 for (int i = 0; i < n; ++i) {
                     // Each stretch is a walk of its own: a fresh mailbox id, so the primitives a
                     // stretch tests are fresh to it (a walk's boundary check relies on that).
                     if (i > 0) ctx.newStamp();
-                    if (intersect(ray, seg[i].t0, seg[i].t1, ctx, obs, hit)) return true;
+                    obs.stretch(i, seg[i].t0, seg[i].t1);
+                    if (intersect(ray, seg[i].t0, seg[i].t1, ctx, obs, hit)) {
+                        obs.blocker(hit);
+                        return true;
+                    }
                 }
                 return false;
             }
         }
-        return intersect(ray, 0.0, tmax, ctx, obs, hit);
+        const bool blocked = intersect(ray, 0.0, tmax, ctx, obs, hit);
+        if constexpr (Obs::kActive)
+            if (blocked) obs.blocker(hit);
+        return blocked;
     }
     /// The light buffer built from a perspective camera's eye (light_buffer.h), for primary
     /// rays: the regular scheme's, when it uses a light buffer; empty otherwise (brute force is

@@ -12,15 +12,6 @@
 
 namespace lancer {
 
-/// The visible hit: a span boundary on primitive `prim`.
-struct Hit {
-    double t = kInf;
-    uint32_t prim = kNoPrim;
-    uint8_t part = 0;
-    bool flip = false;
-    bool valid() const { return prim != kNoPrim; }
-};
-
 /// The primitive's mailbox holding its spans for the current ray id: filled by a test (counted
 /// as one) unless this ray id already filled it (counted as a mailbox hit). `fresh` says which.
 template <class Obs>

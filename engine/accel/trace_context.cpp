@@ -1,5 +1,7 @@
 #include "engine/accel/trace_context.h"
 
+#include <ostream>
+
 namespace lancer {
 
 RayCounters& RayCounters::operator+=(const RayCounters& o) {
@@ -28,6 +30,17 @@ RayCounters RayCounters::operator-(const RayCounters& o) const {
     r.lightBufferSkips -= o.lightBufferSkips;
     return r;
 }
+
+std::string RayCounters::toString() const {
+    return "rays " + std::to_string(rays) + " (" + std::to_string(primaryRays) + " primary, " +
+           std::to_string(shadowRays) + " shadow), prim tests " + std::to_string(primTests) +
+           ", mailbox hits " + std::to_string(mailboxHits) + ", regions " +
+           std::to_string(regionVisits) + ", pointer steps " + std::to_string(pointerSteps) +
+           ", walk errors " + std::to_string(walkErrors) + ", light buffer skips " +
+           std::to_string(lightBufferSkips);
+}
+
+std::ostream& operator<<(std::ostream& os, const RayCounters& c) { return os << c.toString(); }
 
 void TraceContext::reset(size_t primitives, int treeDepth) {
     stamp.assign(primitives, 0);

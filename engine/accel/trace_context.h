@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cstdint>
+#include <iosfwd>
+#include <string>
 #include <vector>
 
 #include "engine/model/span.h"
@@ -22,7 +24,12 @@ struct RayCounters {
 
     RayCounters& operator+=(const RayCounters& o);
     RayCounters operator-(const RayCounters& o) const;
+    bool operator==(const RayCounters&) const = default;
+    /// "rays 3 (1 primary, 2 shadow), prim tests 9, mailbox hits 2, regions 3, ..." (no newline).
+    std::string toString() const;
 };
+
+std::ostream& operator<<(std::ostream& os, const RayCounters& c);
 
 /// The report's "boîte aux lettres": the spans of the last ray tested against a primitive, the
 /// ray's id being TraceContext::stamp. Each thread owns its own arrays, so no mailbox is ever

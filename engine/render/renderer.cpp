@@ -88,10 +88,8 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                     for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
                         if (!pass.contains(x, y)) continue;
                         RayCounters before = ctx.counters;
-                        Ray ray = primary(x, y);
-                        ++ctx.counters.primaryRays;
                         Hit hit;
-                        Vec3 c = tracer.radiance(ray, 0, ctx, obs, &hit, eye.nearFrom(ray.d, 0));
+                        Vec3 c = tracer.pixel(primary, eye, x, y, ctx, obs, hit);
                         size_t i = img.index(x, y);
                         img.color[i] = glm::vec3(c);
                         img.depth[i] =

@@ -69,18 +69,33 @@ class Tracer {
         return opt_.offsetScale * m;
     }
 
+    /// Colour of pixel (x, y) and its primary hit: its primary ray from where the eye buffer
+    /// (Accelerator::eyeBuffer) says it can first meet something, and the rays below it. What
+    /// render() computes for each pixel, and what tracePixel() records.
+    template <class Obs>
+    Vec3 pixel(const PrimaryRays& primary, const LightBuffer& eye, int x, int y, TraceContext& ctx,
+               Obs& obs, Hit& hit) const {
+        const Ray ray = primary(x, y);
+        ++ctx.counters.primaryRays;
+        return radiance(ray, 0, ctx, obs, &hit, eye.nearFrom(ray.d, 0));
+    }
+
     /// Colour seen along `ray`; depth counts reflection/refraction bounces already taken.
     /// `tmin`: the ray meets nothing before it (for a primary ray, the eye's buffer says so).
+    /// `kind`: why the ray was cast, told to the observer with every ray it casts.
     template <class Obs>
     Vec3 radiance(const Ray& ray, int depth, TraceContext& ctx, Obs& obs, Hit* first = nullptr,
-                  double tmin = 0.0) const {
+                  double tmin = 0.0, RayKind kind = RayKind::Primary) const {
         Hit hit;
+        obs.rayBegin(kind, depth, -1, ray, tmin, kInf);
         if (!nearest(ray, tmin, kInf, ctx, obs, hit)) {
+            if constexpr (Obs::kActive) obs.rayEnd({kind, hit, Vec3(0.0), Vec3(0.0), false});
             if (first) *first = hit;
             return scene_.background;
         }
         if (first) *first = hit;
         SurfacePoint s = surface(ray, hit);
+        if constexpr (Obs::kActive) obs.rayEnd({kind, hit, s.p, s.n, false});
         const Material& m = *s.material;
         Vec3 dir = ray.d;
         Vec3 color = m.ambient * m.color;
@@ -99,7 +114,12 @@ class Tracer {
             if (opt_.shadows) {
                 ++ctx.counters.shadowRays;
                 Ray shadow{above, glm::normalize(light.position - above)};
-                if (occluded(shadow, glm::length(light.position - above), li, ctx, obs)) continue;
+                const double tmax = glm::length(light.position - above);
+                obs.rayBegin(RayKind::Shadow, depth, int(li), shadow, 0.0, tmax);
+                const bool blocked = occluded(shadow, tmax, li, ctx, obs);
+                if constexpr (Obs::kActive)
+                    obs.rayEnd({RayKind::Shadow, Hit{}, Vec3(0.0), Vec3(0.0), blocked});
+                if (blocked) continue;
             }
             color += light.color * (m.diffuse * ndl) * m.color;
             if (m.specular > 0.0) {
@@ -112,15 +132,20 @@ class Tracer {
 
         Vec3 refl = glm::reflect(dir, s.facing);
         if (opt_.reflections && m.reflect > 0.0)
-            color += m.reflect * radiance(Ray{above, refl}, depth + 1, ctx, obs);
+            color += m.reflect * radiance(Ray{above, refl}, depth + 1, ctx, obs, nullptr, 0.0,
+                                          RayKind::Reflection);
         if (opt_.refractions && m.transmit > 0.0) {
             double eta = s.entering ? 1.0 / m.ior : m.ior;
             Vec3 t = glm::refract(dir, s.facing, eta);
-            if (glm::dot(t, t) == 0.0)  // total internal reflection
-                color += m.transmit * radiance(Ray{above, refl}, depth + 1, ctx, obs);
+            // Under total internal reflection the transmitted ray is the mirror ray; it is still
+            // the refraction term's ray.
+            if (glm::dot(t, t) == 0.0)
+                color += m.transmit * radiance(Ray{above, refl}, depth + 1, ctx, obs, nullptr, 0.0,
+                                               RayKind::Refraction);
             else
-                color += m.transmit * radiance(Ray{s.p - eps * s.facing, glm::normalize(t)},
-                                               depth + 1, ctx, obs);
+                color +=
+                    m.transmit * radiance(Ray{s.p - eps * s.facing, glm::normalize(t)}, depth + 1,
+                                          ctx, obs, nullptr, 0.0, RayKind::Refraction);
         }
         return color;
     }

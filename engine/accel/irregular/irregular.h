@@ -178,6 +178,8 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
     double t = std::max(tw0, tmin), tend = std::min(tw1, tmax);
     if (!(t <= tend)) return false;
     uint32_t r = locate(glm::clamp(rc.at(t), bounds_.lo, bounds_.hi), rc.d);
+    if constexpr (Obs::kActive)
+        obs.locate(frame_.toWorld(glm::clamp(rc.at(t), bounds_.lo, bounds_.hi)), r);
     size_t budget = budget_;
     int lastRoot = -1;
     for (;;) {
@@ -204,6 +206,7 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
             }
         }
         if (te >= tend) return false;
+        if constexpr (Obs::kActive) obs.regionExit(te, frame_.toWorld(p), axis, ties);
         // Out through the structure's border (a face, or an edge or corner touching it).
         for (int a = 0; a < 3; ++a)
             if ((ties >> a & 1) && onBorder(R, a, rc.d)) return false;

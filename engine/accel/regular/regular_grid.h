@@ -146,6 +146,10 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     if (!(tStart <= tEnd)) return false;
     Vec3 p = std::isfinite(tStart) ? ray.at(tStart) : ray.o;
     uint32_t leaf = dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
+    if constexpr (Obs::kActive) {
+        const uint32_t cell[3] = {locate(0, p.x), locate(1, p.y), locate(2, p.z)};
+        obs.lookup(p, cell, leaf);
+    }
     // Per ray, held locally (the loop's stores to mailboxes and counters could otherwise alias
     // the ray and the arrays, and each step would reload them): the origin, 1/d, so each exit
     // plane costs a product, not a division, and the side a cell is left by on each axis. An axis
@@ -191,6 +195,10 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         bool stalled = false;
         uint32_t next[3];
         uint32_t nextLeaf = leaf;
+        // How the walk leaves the leaf, told to an active observer after the leaf's own events.
+        [[maybe_unused]] const bool leaves = !last;
+        [[maybe_unused]] int how = 0;  // 1 rope, 2 index step + lookup, 3 push + lookup
+        [[maybe_unused]] Vec3 pushed;
         if (!last) {
             if constexpr (kExact) {
                 // The exit face lies on grid plane L.hi or L.lo of exitAxis: the next index there
@@ -202,12 +210,14 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
                     last = true;
                 } else if (across != kSplitFace) {
                     nextLeaf = across;
+                    if constexpr (Obs::kActive) how = 1;
                 } else {
                     const Vec3 q = ray.at(tExit);
                     next[a] = up[a] ? L.hi[a] : L.lo[a] - 1;
                     for (int b = 0; b < 3; ++b)
                         if (b != a) next[b] = std::clamp(locate(b, q[b]), L.lo[b], L.hi[b] - 1);
                     nextLeaf = dir_.lookup(next[0], next[1], next[2]);
+                    if constexpr (Obs::kActive) how = 2;
                 }
             } else {
                 // The report's method: the exit point, taken on the cell's box (rounding can put
@@ -224,10 +234,12 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
                     } else {
                         next[a] = std::clamp(locate(a, x), L.lo[a], L.hi[a] - 1);
                     }
+                    if constexpr (Obs::kActive) pushed[a] = x;
                 }
                 if (!last) {
                     nextLeaf = dir_.lookup(next[0], next[1], next[2]);
                     stalled = nextLeaf == leaf;
+                    if constexpr (Obs::kActive) how = 3;
                 }
             }
         }
@@ -237,6 +249,15 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         if (hitInLeaf(*scene_, pool_, L.root, L.primitives(primList), L.prims, ray, tmin, t0, t1,
                       ctx, obs, hit))
             return true;
+        if constexpr (Obs::kActive) {
+            int ties = 0;
+            for (int a = 0; a < 3; ++a) ties |= int(tAxis[a] == tExit) << a;
+            if (leaves) obs.regionExit(tExit, ray.at(tExit), exitAxis, ties);
+            if (how == 1) obs.rope(leaf, int(rope[exitAxis]), nextLeaf);
+            if (how == 2) obs.indexStep(exitAxis, next);
+            if (how == 3) obs.push(pushed, ties);
+            if (how >= 2) obs.lookup(how == 3 ? pushed : ray.at(tExit), next, nextLeaf);
+        }
         if (last) return false;
         if (stalled) {
             ++ctx.counters.walkErrors;
