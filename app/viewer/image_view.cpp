@@ -1,30 +1,13 @@
 #include "app/viewer/image_view.h"
 
 #include <algorithm>
-#include <stdexcept>
-#include <string>
 
 #include "app/viewer/gl.h"
-#include "lancer_shaders.h"  // generated from shaders/*.{vert,frag} at configure time
+#include "app/viewer/gl/program.h"
 
 namespace lancer::viewer {
 
 namespace {
-
-GLuint compile(GLenum type, const char* source, const char* name) {
-    GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &source, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = {};
-        glGetShaderInfoLog(s, sizeof log, nullptr, log);
-        glDeleteShader(s);
-        throw std::runtime_error(std::string("shader ") + name + ": " + log);
-    }
-    return s;
-}
 
 void setupTexture(GLuint tex) {
     glBindTexture(GL_TEXTURE_2D, tex);
@@ -38,27 +21,13 @@ void setupTexture(GLuint tex) {
 }  // namespace
 
 ImageView::ImageView() {
-    GLuint vs = compile(GL_VERTEX_SHADER, shaders::kImageVert, "image.vert");
-    GLuint fs = compile(GL_FRAGMENT_SHADER, shaders::kImageFrag, "image.frag");
-    program_ = glCreateProgram();
-    glAttachShader(program_, vs);
-    glAttachShader(program_, fs);
-    glLinkProgram(program_);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = {};
-        glGetProgramInfoLog(program_, sizeof log, nullptr, log);
-        throw std::runtime_error(std::string("image shader link: ") + log);
-    }
-    locMode_ = glGetUniformLocation(program_, "mode");
-    locScale_ = glGetUniformLocation(program_, "scale");
-    locStops_ = glGetUniformLocation(program_, "stops");
-    locStopCount_ = glGetUniformLocation(program_, "stopCount");
-    locColor_ = glGetUniformLocation(program_, "colorTex");
-    locHeat_ = glGetUniformLocation(program_, "heatTex");
+    program_ = std::make_unique<gl::Program>("image.vert", "image.frag");
+    locMode_ = program_->uniform("mode");
+    locScale_ = program_->uniform("scale");
+    locStops_ = program_->uniform("stops");
+    locStopCount_ = program_->uniform("stopCount");
+    locColor_ = program_->uniform("colorTex");
+    locHeat_ = program_->uniform("heatTex");
     glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even an empty one
     GLuint tex[3];
     glGenTextures(3, tex);
@@ -77,7 +46,6 @@ ImageView::~ImageView() {
     glDeleteTextures(3, tex);
     glDeleteFramebuffers(1, &fbo_);
     glDeleteVertexArrays(1, &vao_);
-    glDeleteProgram(program_);
 }
 
 void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd) {
@@ -208,7 +176,7 @@ void ImageView::shade(ViewMode mode, float scale, int rowBegin, int rowEnd) cons
     // Image row r is FBO row height - 1 - r (the shader flips): rows [b, e) are [h - e, h - b).
     glEnable(GL_SCISSOR_TEST);
     glScissor(0, height_ - rowEnd, width_, rowEnd - rowBegin);
-    glUseProgram(program_);
+    glUseProgram(program_->id());
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, colorTex_);
     glActiveTexture(GL_TEXTURE1);

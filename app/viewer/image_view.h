@@ -2,12 +2,17 @@
 // the framebuffer size: no window involved, so the OSMesa test drives exactly this code.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "app/viewer/colormap.h"
 #include "engine/render/image.h"
 
 namespace lancer::viewer {
+
+namespace gl {
+class Program;
+}
 
 /// A rectangle of framebuffer pixels, [x0, x1) x [y0, y1), row 0 at the top (as ImGui has it).
 struct PixelRect {
@@ -46,7 +51,8 @@ class ImageView {
     /// Shade image rows [rowBegin, rowEnd) into the FBO (the rest keeps its pixels).
     void shade(ViewMode mode, float scale, int rowBegin, int rowEnd) const;
 
-    unsigned program_ = 0, vao_ = 0, colorTex_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
+    std::unique_ptr<gl::Program> program_;
+    unsigned vao_ = 0, colorTex_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
     mutable bool shadedValid_ = false;
     mutable ViewMode shadedMode_ = ViewMode::Color;
     mutable float shadedScale_ = 0.0f;

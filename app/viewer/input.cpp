@@ -41,6 +41,8 @@ void handleKeys(ViewerState& st) {
     for (ImWchar ch : io.InputQueueCharacters) {
         if (ch == 'r' || ch == 'R') {
             st.setCamera(st.home());
+        } else if (ch == 'i' || ch == 'I') {
+            st.settings().showInspector = !st.settings().showInspector;
         } else if (ch == 'o' || ch == 'O' || ch == 'p' || ch == 'P') {
             Camera c = st.camera();
             toggleProjection(c);

@@ -9,7 +9,8 @@ namespace lancer::viewer {
 
 /// Left drag orbits, middle drag pans, right drag and the wheel zoom.
 void handleMouse(ViewerState& st, int fbHeight);
-/// R resets the camera, O (or P) toggles perspective and orthographic.
+/// R resets the camera, O (or P) toggles perspective and orthographic, I shows or hides the
+/// 3D inspector.
 void handleKeys(ViewerState& st);
 
 }  // namespace lancer::viewer

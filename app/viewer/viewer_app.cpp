@@ -3,6 +3,8 @@
 #include <imgui.h>
 #include <imgui_impl_opengl3.h>
 
+#include <algorithm>
+
 #include "app/viewer/gl.h"
 #include "app/viewer/input.h"
 #include "app/viewer/panels/panels.h"
@@ -10,7 +12,9 @@
 namespace lancer::viewer {
 
 ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<void()> wake)
-    : state_(settings, logTimings, std::move(wake)), view_(std::make_unique<ImageView>()) {
+    : state_(settings, logTimings, wake),
+      view_(std::make_unique<ImageView>()),
+      inspector_(std::make_unique<inspector::Inspector>(std::move(wake))) {
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
     // drawn at all, and each is copied from a layer where it is redrawn only when it changes
     // (frame(), PanelCache).
@@ -29,20 +33,31 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // 2. Input: the camera's mouse and keys (unless ImGui wants them).
     ImGui_ImplOpenGL3_NewFrame();
     ImGui::NewFrame();
-    handleMouse(state_, fbHeight);
+    ViewerSettings& s = state_.settings();
+    inspector_->setShown(s.showInspector);
+    inspector_->update(state_.sceneBuild(),
+                       {state_.camera(), std::max(state_.width(), 1), std::max(state_.height(), 1)},
+                       fbWidth, fbHeight, selected_);
+    // The inspector's half of the window moves the inspector's camera, and a click there picks.
+    std::optional<int64_t> picked;
+    if (inspector_->handleMouse(fbWidth, fbHeight, picked)) {
+        if (picked) selectRegion(*picked);
+    } else {
+        handleMouse(state_, fbHeight);
+    }
     handleKeys(state_);
 
     // 3. Panels: each reads and acts on the state (panels/). An inspector view, a panel showing
     // a texture of its own drawing, goes in drawPanels' list and calls
     // panels_.invalidate(its window's ID) whenever that texture's pixels change.
     drawPanels(state_);
+    if (s.showInspector) inspector_->panel(&s.showInspector);
     state_.startWork(fbWidth, fbHeight);
     ImGui::Render();
 
     // 4. Image: the traced image or a heat map, copied only around the opaque panels drawn over
     // it in step 6. The image covers the whole framebuffer: clear only while there is none (one
     // full-screen fill less per frame, which software GL feels).
-    const ViewerSettings& s = state_.settings();
     if (RowRange rows; state_.takeUpload(rows))
         view_->upload(state_.shown(), s.mode, rows.begin, rows.end);
     glViewport(0, 0, fbWidth, fbHeight);
@@ -50,8 +65,12 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
         glClear(GL_COLOR_BUFFER_BIT);
     }
-    view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(),
-                panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight));
+    std::vector<PixelRect> covered = panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight);
+    if (inspector_->shown()) covered.push_back(inspector::Inspector::viewport(fbWidth, fbHeight));
+    view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered);
+
+    // 4b. The 3D inspector over the right half (the image is not copied under it).
+    inspector_->draw(fbWidth, fbHeight);
 
     // 5. Overlays: drawn over the image, under the panels (the panel layer replaces the pixels
     // of every panel's rectangle next). Nothing is drawn here yet; app/viewer/overlay/ draws
@@ -70,7 +89,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         }
         notes.pendingScreenshot.clear();
     }
-    settled_ = state_.settledSince();
+    settled_ = state_.settledSince() && inspector_->settled();
 }
 
 void ViewerApp::saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "app/viewer/image_view.h"
+#include "app/viewer/inspector/inspector.h"
 #include "app/viewer/panel_cache.h"
 #include "app/viewer/viewer_state.h"
 
@@ -73,6 +74,16 @@ class ViewerApp {
     void measureSpeedup(int stride) { state_.measureSpeedup(stride); }
     std::optional<SpeedupResult> speedupResult() const { return state_.speedupResult(); }
 
+    /// The 3D inspector (its options, camera and what it draws); shown while
+    /// settings().showInspector is set (the I key, the View panel, `--show inspector`).
+    inspector::Inspector& inspector() { return *inspector_; }
+    /// Show or hide the inspector.
+    void showInspector(bool on) { state_.settings().showInspector = on; }
+    /// The selected region (-1: none), which the inspector highlights; a click in the inspector
+    /// sets it.
+    int64_t selectedRegion() const { return selected_; }
+    void selectRegion(int64_t id) { selected_ = id; }
+
     /// What is built, rendered and shown (what the panels read).
     ViewerState& state() { return state_; }
     const ViewerState& state() const { return state_; }
@@ -83,6 +94,8 @@ class ViewerApp {
   private:
     ViewerState state_;
     std::unique_ptr<ImageView> view_;
+    std::unique_ptr<inspector::Inspector> inspector_;
+    int64_t selected_ = -1;
     PanelCache panels_;  ///< ImGui's panels, each redrawn only when it changed
     bool settled_ = false;
 };

@@ -17,6 +17,8 @@ struct ViewerSettings {
     int threads = 0;  ///< render threads (0: all cores)
     int windowWidth = 1280, windowHeight = 720;
     bool showParameters = true, showStatistics = true, showCamera = true, showView = true;
+    /// The 3D inspector over the right half of the window (not saved: it starts hidden).
+    bool showInspector = false;
     ViewMode mode = ViewMode::Color;
     bool autoScale = true;     ///< heat scale follows the image's largest value
     float heatScale = 100.0f;  ///< counter value at the top of the colour map

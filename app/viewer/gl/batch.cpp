@@ -1,0 +1,187 @@
+#include "app/viewer/gl/batch.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "app/viewer/gl.h"
+#include "app/viewer/gl/program.h"
+
+namespace lancer::viewer::gl {
+
+Rgba8 rgba8(const glm::vec4& c) {
+    auto byte = [](float v) { return Rgba8(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); };
+    return byte(c.x) | byte(c.y) << 8 | byte(c.z) << 16 | byte(c.w) << 24;
+}
+
+namespace {
+
+// The 12 edges of a hexahedron as corner pairs: corners differing in one bit.
+constexpr int kEdges[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
+                               {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+// The 6 faces as corner loops (axis a side s: the corners whose bit a is s).
+constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                              {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+
+std::array<glm::vec3, 8> cornersOf(const glm::vec3& lo, const glm::vec3& hi) {
+    std::array<glm::vec3, 8> c;
+    for (int i = 0; i < 8; ++i)
+        c[size_t(i)] = {(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z};
+    return c;
+}
+
+}  // namespace
+
+void Batch::line(const glm::vec3& a, const glm::vec3& b, Rgba8 color) {
+    lines.push_back({a, color});
+    lines.push_back({b, color});
+}
+
+void Batch::box(const std::array<glm::vec3, 8>& c, Rgba8 color) {
+    for (const auto& e : kEdges) line(c[size_t(e[0])], c[size_t(e[1])], color);
+}
+
+void Batch::box(const glm::vec3& lo, const glm::vec3& hi, Rgba8 color) {
+    box(cornersOf(lo, hi), color);
+}
+
+void Batch::outline(std::span<const glm::vec3> p, Rgba8 color) {
+    for (size_t i = 0; i < p.size() && p.size() > 1; ++i) line(p[i], p[(i + 1) % p.size()], color);
+}
+
+void Batch::outline(std::span<const glm::vec2> p, Rgba8 color) {
+    for (size_t i = 0; i < p.size() && p.size() > 1; ++i) line(p[i], p[(i + 1) % p.size()], color);
+}
+
+void Batch::fill(std::span<const glm::vec3> p, Rgba8 color) {
+    for (size_t i = 1; i + 1 < p.size(); ++i) {
+        triangles.push_back({p[0], color});
+        triangles.push_back({p[i], color});
+        triangles.push_back({p[i + 1], color});
+    }
+}
+
+void Batch::fill(std::span<const glm::vec2> p, Rgba8 color) {
+    for (size_t i = 1; i + 1 < p.size(); ++i) {
+        triangles.push_back({glm::vec3(p[0], 0.0f), color});
+        triangles.push_back({glm::vec3(p[i], 0.0f), color});
+        triangles.push_back({glm::vec3(p[i + 1], 0.0f), color});
+    }
+}
+
+void Batch::fillBox(const std::array<glm::vec3, 8>& c, Rgba8 color) {
+    for (const auto& f : kFaces) {
+        const glm::vec3 quad[4] = {c[size_t(f[0])], c[size_t(f[1])], c[size_t(f[2])],
+                                   c[size_t(f[3])]};
+        fill(quad, color);
+    }
+}
+
+void Batch::fillRect(const glm::vec2& lo, const glm::vec2& hi, Rgba8 color) {
+    const glm::vec2 quad[4] = {lo, {hi.x, lo.y}, hi, {lo.x, hi.y}};
+    fill(quad, color);
+}
+
+void Batch::append(const Batch& o) {
+    lines.insert(lines.end(), o.lines.begin(), o.lines.end());
+    triangles.insert(triangles.end(), o.triangles.begin(), o.triangles.end());
+}
+
+void Batch::clear() {
+    lines.clear();
+    triangles.clear();
+}
+
+GpuBatch::GpuBatch() {
+    glGenVertexArrays(2, vao_);
+    glGenBuffers(2, vbo_);
+    for (int i = 0; i < 2; ++i) {
+        glBindVertexArray(vao_[i]);
+        glBindBuffer(GL_ARRAY_BUFFER, vbo_[i]);
+        glEnableVertexAttribArray(0);
+        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(BatchVertex),
+                              reinterpret_cast<void*>(offsetof(BatchVertex, position)));
+        glEnableVertexAttribArray(1);
+        glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(BatchVertex),
+                              reinterpret_cast<void*>(offsetof(BatchVertex, color)));
+    }
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
+GpuBatch::~GpuBatch() {
+    glDeleteBuffers(2, vbo_);
+    glDeleteVertexArrays(2, vao_);
+}
+
+void GpuBatch::upload(const Batch& batch) {
+    const std::vector<BatchVertex>* parts[2] = {&batch.lines, &batch.triangles};
+    for (int i = 0; i < 2; ++i) {
+        const size_t bytes = parts[i]->size() * sizeof(BatchVertex);
+        glBindBuffer(GL_ARRAY_BUFFER, vbo_[i]);
+        if (bytes > capacity_[i] || bytes < capacity_[i] / 4) {  // grow, or give memory back
+            glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(bytes), parts[i]->data(), GL_DYNAMIC_DRAW);
+            capacity_[i] = bytes;
+        } else if (bytes > 0) {
+            glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(bytes), parts[i]->data());
+        }
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    lineVertices_ = batch.lines.size();
+    triangleVertices_ = batch.triangles.size();
+}
+
+BatchRenderer::BatchRenderer()
+    : program_(std::make_unique<Program>("batch.vert", "batch.frag")),
+      scratch_(std::make_unique<GpuBatch>()) {
+    locToClip_ = program_->uniform("toClip");
+    locOpacity_ = program_->uniform("opacity");
+}
+
+BatchRenderer::~BatchRenderer() = default;
+
+void BatchRenderer::draw(const GpuBatch& b, const glm::mat4& toClip, const DrawOptions& o) {
+    auto range = [](size_t count, size_t first, size_t limit) {
+        first = std::min(first, count);
+        return std::pair<size_t, size_t>(first, std::min(limit, count - first));
+    };
+    const auto [t0, tn] = range(b.triangleCount(), o.firstTriangle, o.triangleLimit);
+    const auto [l0, ln] = range(b.lineCount(), o.firstLine, o.lineLimit);
+    if ((!o.triangles || tn == 0) && (!o.lines || ln == 0)) return;
+    glUseProgram(program_->id());
+    glUniformMatrix4fv(locToClip_, 1, GL_FALSE, glm::value_ptr(toClip));
+    glUniform1f(locOpacity_, o.opacity);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_SCISSOR_TEST);
+    if (o.depthTest) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LEQUAL);
+    } else {
+        glDisable(GL_DEPTH_TEST);
+    }
+    if (o.triangles && tn > 0) {
+        glBindVertexArray(b.vao_[1]);
+        glDrawArrays(GL_TRIANGLES, GLint(3 * t0), GLsizei(3 * tn));
+    }
+    if (o.lines && ln > 0) {
+        glBindVertexArray(b.vao_[0]);
+        glDrawArrays(GL_LINES, GLint(2 * l0), GLsizei(2 * ln));
+    }
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+}
+
+void BatchRenderer::drawNow(const Batch& batch, const glm::mat4& toClip,
+                            const DrawOptions& options) {
+    if (batch.empty()) return;
+    scratch_->upload(batch);
+    draw(*scratch_, toClip, options);
+}
+
+}  // namespace lancer::viewer::gl

@@ -1,0 +1,476 @@
+#include "app/viewer/inspector/inspector.h"
+
+#include <imgui.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "app/viewer/camera_control.h"
+#include "app/viewer/gl.h"
+#include "app/viewer/gl/batch.h"
+#include "app/viewer/gl/program.h"
+#include "app/viewer/gl/transforms.h"
+
+namespace lancer::viewer::inspector {
+
+namespace {
+
+bool sameCamera(const Camera& a, const Camera& b) {
+    return a.from == b.from && a.at == b.at && a.up == b.up && a.fov == b.fov &&
+           a.projection == b.projection && a.orthoHeight == b.orthoHeight;
+}
+
+/// The surfaces are traced at this fraction of the viewport (at most kMaxSurfaceWidth wide):
+/// lines are depth-tested against them, so a coarser trace only blurs where lines meet
+/// surfaces, and a trace of 320 x 360 pixels of balls4 takes one thread tens of milliseconds.
+constexpr int kMaxSurfaceWidth = 480;
+
+void surfaceSize(int vw, int vh, int& sw, int& sh) {
+    int f = 2;
+    while (vw / f > kMaxSurfaceWidth) ++f;
+    sw = std::max(1, vw / f);
+    sh = std::max(1, vh / f);
+}
+
+const glm::vec3 kBackground{0.1f, 0.1f, 0.12f};
+
+}  // namespace
+
+Inspector::Inspector(std::function<void()> wake) {
+    if (wake) tracer_.setOnReady(std::move(wake));
+    batches_ = std::make_unique<gl::BatchRenderer>();
+    lines_ = std::make_unique<gl::GpuBatch>();
+    selection_ = std::make_unique<gl::GpuBatch>();
+    surfaceProgram_ =
+        std::make_unique<gl::Program>("inspector_surface.vert", "inspector_surface.frag");
+    glGenFramebuffers(1, &fbo_);
+    GLuint tex[3];
+    glGenTextures(3, tex);
+    colorTex_ = tex[0];
+    surfColorTex_ = tex[1];
+    surfDepthTex_ = tex[2];
+    for (GLuint t : tex) {
+        glBindTexture(GL_TEXTURE_2D, t);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    // The traced colour is magnified smoothly; its depth stays nearest (no blend across an
+    // object's silhouette).
+    glBindTexture(GL_TEXTURE_2D, surfColorTex_);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glGenRenderbuffers(1, &depthRb_);
+    glGenVertexArrays(1, &vao_);
+}
+
+Inspector::~Inspector() {
+    GLuint tex[3] = {colorTex_, surfColorTex_, surfDepthTex_};
+    glDeleteTextures(3, tex);
+    glDeleteRenderbuffers(1, &depthRb_);
+    glDeleteFramebuffers(1, &fbo_);
+    glDeleteVertexArrays(1, &vao_);
+}
+
+void Inspector::setShown(bool on) {
+    if (opt_.show == on) return;
+    opt_.show = on;
+    dirtyModel_ = true;
+}
+
+PixelRect Inspector::viewport(int fbWidth, int fbHeight) {
+    return {fbWidth / 2, 0, fbWidth, fbHeight};
+}
+
+void Inspector::setCamera(const Camera& c) {
+    camera_ = c;
+    cameraFramed_ = true;
+    dirtyPicture_ = true;
+    if (!dragging_) dirtyModel_ = true;  // what is in view changed
+}
+
+void Inspector::update(const std::shared_ptr<const SceneBuild>& structure, const MainView& main,
+                       int fbWidth, int fbHeight, int64_t selected) {
+    takeSurfaces();
+    if (!opt_.show) return;
+    const PixelRect v = viewport(fbWidth, fbHeight);
+    if (v.x1 - v.x0 != vw_ || v.y1 - v.y0 != vh_) {
+        vw_ = std::max(1, v.x1 - v.x0);
+        vh_ = std::max(1, v.y1 - v.y0);
+        dirtyModel_ = true;
+    }
+    if (structure != structure_) {
+        const bool newScene = !structure_ || !structure || structure_->spec != structure->spec;
+        structure_ = structure;
+        view_ = structure_ ? std::make_unique<StructureView>(*structure_->scene, *structure_->accel)
+                           : nullptr;
+        if (structure_ && (newScene || !cameraFramed_)) {
+            // Beside the main camera, turned about the up axis, so its frustum shows.
+            Camera turned = main.camera;
+            orbit(turned, 0.7, 0.35);
+            Box3 all = view_->worldBounds();
+            all.expand(main.camera.from);
+            camera_ = frameBox(all, turned.at - turned.from, 40.0);
+            cameraFramed_ = true;
+        }
+        dirtyModel_ = true;
+    }
+    if (!sameCamera(main.camera, main_.camera) || main.width != main_.width ||
+        main.height != main_.height) {
+        main_ = main;
+        dirtyModel_ = true;
+    }
+    if (selected != selected_) {
+        selected_ = selected;
+        dirtyModel_ = true;
+    }
+    if (dirtyModel_ && !dragging_) rebuildModel();
+}
+
+void Inspector::rebuildModel() {
+    dirtyModel_ = false;
+    if (!view_) {
+        model_ = {};
+    } else {
+        InspectorView iv{camera_, vw_, vh_};
+        model_ = buildModel(*view_, opt_, main_, iv, selected_);
+    }
+    dirtyBatch_ = true;
+    dirtyPicture_ = true;
+}
+
+void Inspector::depthBounds(double& near, double& far) const {
+    Box3 all = view_ ? view_->worldBounds() : Box3{Vec3(-1.0), Vec3(1.0)};
+    for (const gl::BatchVertex& v : model_.lines.lines) all.expand(Vec3(v.position));
+    depthRange(camera_, all, near, far);
+}
+
+bool Inspector::handleMouse(int fbWidth, int fbHeight, std::optional<int64_t>& picked) {
+    if (!opt_.show) return false;
+    ImGuiIO& io = ImGui::GetIO();
+    const PixelRect v = viewport(fbWidth, fbHeight);
+    const float mx = io.MousePos.x * io.DisplayFramebufferScale.x;
+    const float my = io.MousePos.y * io.DisplayFramebufferScale.y;
+    const bool inside =
+        mx >= float(v.x0) && mx < float(v.x1) && my >= float(v.y0) && my < float(v.y1);
+    if (!dragging_) {
+        if (io.WantCaptureMouse || !inside) return false;
+        for (int b = 0; b < 3; ++b)
+            if (ImGui::IsMouseClicked(b)) {
+                dragging_ = true;
+                dragButton_ = b;
+            }
+        // A drag begun over the image goes on moving the main camera.
+        if (!dragging_ && ImGui::IsAnyMouseDown()) return false;
+        if (io.MouseWheel != 0.0f) {
+            Camera c = camera_;
+            zoom(c, std::pow(0.9, double(io.MouseWheel)));
+            setCamera(c);
+        }
+        return true;
+    }
+    const float dx = io.MouseDelta.x * io.DisplayFramebufferScale.x;
+    const float dy = io.MouseDelta.y * io.DisplayFramebufferScale.y;
+    if (dx != 0.0f || dy != 0.0f) {
+        Camera c = camera_;
+        if (dragButton_ == ImGuiMouseButton_Left)
+            orbit(c, -0.008 * dx, 0.008 * dy);
+        else if (dragButton_ == ImGuiMouseButton_Middle)
+            pan(c, dx, dy, vh_);
+        else
+            zoom(c, std::exp(0.01 * dy));
+        setCamera(c);
+    }
+    if (!ImGui::IsMouseDown(dragButton_)) {
+        dragging_ = false;
+        dirtyModel_ = true;  // cull for the camera the drag ended on
+        if (dragButton_ == ImGuiMouseButton_Left &&
+            io.MouseDragMaxDistanceSqr[ImGuiMouseButton_Left] < 9.0f)
+            picked = pick(double(mx - float(v.x0)), double(my - float(v.y0)));
+    }
+    return true;
+}
+
+int64_t Inspector::pick(double x, double y) const {
+    if (vw_ <= 0 || vh_ <= 0) return -1;
+    // Camera::primaryRay adds half a pixel: continuous coordinates minus a half.
+    const Ray ray = camera_.primaryRay(x - 0.5, y - 0.5, vw_, vh_);
+    const int i = pickRegion(ray, model_.regions);
+    return i < 0 ? -1 : int64_t(model_.regions[size_t(i)].id);
+}
+
+bool Inspector::settled() const {
+    return !opt_.show || !structure_ || (!dirtyModel_ && (!opt_.surfaces || surfacesShown()));
+}
+
+bool Inspector::surfacesShown() const {
+    return opt_.surfaces && surfaces_ && structure_ && surfaces_->structure == structure_ &&
+           sameCamera(surfaces_->camera, camera_);
+}
+
+void Inspector::requestSurfaces() {
+    if (!opt_.surfaces || !structure_ || vw_ <= 0) return;
+    int sw, sh;
+    surfaceSize(vw_, vh_, sw, sh);
+    if (surfacesRequested_ && sameCamera(requestedCamera_, camera_) && requestedW_ == sw &&
+        requestedH_ == sh && surfaces_ && surfaces_->structure == structure_)
+        return;
+    if (surfacesRequested_ && sameCamera(requestedCamera_, camera_) && requestedW_ == sw &&
+        requestedH_ == sh && tracer_.busy())
+        return;
+    tracer_.request(structure_, camera_, sw, sh);
+    surfacesRequested_ = true;
+    requestedCamera_ = camera_;
+    requestedW_ = sw;
+    requestedH_ = sh;
+}
+
+void Inspector::takeSurfaces() {
+    if (std::optional<SurfaceImage> s = tracer_.poll()) {
+        surfaces_ = std::move(s);
+        surfUploaded_ = false;
+        dirtyPicture_ = true;
+    }
+}
+
+bool Inspector::waitSurfaces(int ms) {
+    requestSurfaces();
+    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+    while (std::chrono::steady_clock::now() < until) {
+        takeSurfaces();
+        if (surfacesShown()) return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return false;
+}
+
+void Inspector::render() {
+    dirtyPicture_ = false;
+    if (fboW_ != vw_ || fboH_ != vh_) {
+        fboW_ = vw_;
+        fboH_ = vh_;
+        glBindTexture(GL_TEXTURE_2D, colorTex_);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, vw_, vh_, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glBindRenderbuffer(GL_RENDERBUFFER, depthRb_);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, vw_, vh_);
+        glBindRenderbuffer(GL_RENDERBUFFER, 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colorTex_, 0);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depthRb_);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glViewport(0, 0, vw_, vh_);
+    glDisable(GL_SCISSOR_TEST);
+    glDepthMask(GL_TRUE);
+    glClearColor(kBackground.x, kBackground.y, kBackground.z, 1.0f);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    double near, far;
+    depthBounds(near, far);
+    const bool surfaces = surfacesShown();
+    if (surfaces) {
+        const Image& img = surfaces_->image;
+        if (!surfUploaded_) {
+            surfW_ = img.width;
+            surfH_ = img.height;
+            std::vector<uint8_t> rgba(size_t(img.width) * size_t(img.height) * 4);
+            img.rgba8Into(rgba.data(), 0, img.height, true);
+            // Depth along the camera's forward axis (the projection's depth), bottom row first;
+            // -1 where the ray missed.
+            std::vector<float> depth(size_t(img.width) * size_t(img.height));
+            const PrimaryRays rays(surfaces_->camera, img.width, img.height);
+            Vec3 f, r, u;
+            surfaces_->camera.basis(f, r, u);
+            for (int y = 0; y < img.height; ++y)
+                for (int x = 0; x < img.width; ++x) {
+                    const float t = img.depth[img.index(x, y)];
+                    const size_t o = size_t(img.height - 1 - y) * size_t(img.width) + size_t(x);
+                    if (!std::isfinite(t)) {
+                        depth[o] = -1.0f;
+                        rgba[o * 4 + 0] = uint8_t(kBackground.x * 255.0f);
+                        rgba[o * 4 + 1] = uint8_t(kBackground.y * 255.0f);
+                        rgba[o * 4 + 2] = uint8_t(kBackground.z * 255.0f);
+                    } else {
+                        depth[o] = float(double(t) * glm::dot(rays(x, y).d, f));
+                    }
+                }
+            glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+            glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+            glBindTexture(GL_TEXTURE_2D, surfColorTex_);
+            glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, img.width, img.height, 0, GL_RGBA,
+                         GL_UNSIGNED_BYTE, rgba.data());
+            glBindTexture(GL_TEXTURE_2D, surfDepthTex_);
+            glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, img.width, img.height, 0, GL_RED, GL_FLOAT,
+                         depth.data());
+            glBindTexture(GL_TEXTURE_2D, 0);
+            surfUploaded_ = true;
+        }
+        // The traced picture, its depth written as the line pass's projection would write it.
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_ALWAYS);
+        glDisable(GL_BLEND);
+        const unsigned prog = surfaceProgram_->id();
+        glUseProgram(prog);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, surfColorTex_);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, surfDepthTex_);
+        glUniform1i(surfaceProgram_->uniform("colorTex"), 0);
+        glUniform1i(surfaceProgram_->uniform("depthTex"), 1);
+        glUniform1i(surfaceProgram_->uniform("ortho"),
+                    camera_.projection == Projection::Orthographic ? 1 : 0);
+        glUniform1f(surfaceProgram_->uniform("nearDepth"), float(near));
+        glUniform1f(surfaceProgram_->uniform("farDepth"), float(far));
+        glBindVertexArray(vao_);
+        glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+        glBindVertexArray(0);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glUseProgram(0);
+        glDepthFunc(GL_LESS);
+        glDisable(GL_DEPTH_TEST);
+    }
+    if (dirtyBatch_) {
+        lines_->upload(model_.lines);
+        selection_->upload(model_.selection);
+        dirtyBatch_ = false;
+    }
+    const glm::mat4 toClip = gl::worldToClip(camera_, vw_, vh_, near, far);
+    gl::DrawOptions o;
+    o.depthTest = surfaces;
+    batches_->draw(*lines_, toClip, o);
+    // The selection over everything: it must be found even behind a surface.
+    batches_->draw(*selection_, toClip, {});
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void Inspector::draw(int fbWidth, int fbHeight) {
+    if (!opt_.show || vw_ <= 0 || vh_ <= 0) return;
+    requestSurfaces();
+    takeSurfaces();
+    if (dirtyBatch_) dirtyPicture_ = true;
+    if (dirtyPicture_) render();
+    const PixelRect v = viewport(fbWidth, fbHeight);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+    glDisable(GL_SCISSOR_TEST);
+    glBlitFramebuffer(0, 0, fboW_, fboH_, v.x0, fbHeight - v.y1, v.x1, fbHeight - v.y0,
+                      GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, fbWidth, fbHeight);
+}
+
+void Inspector::panel(bool* open) {
+    ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 348, io.DisplaySize.y - 258),
+                            ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(340, 250), ImGuiCond_FirstUseEver);
+    if (!ImGui::Begin("Inspector", open)) {
+        ImGui::End();
+        return;
+    }
+    bool changed = false;
+    const bool regular = view_ && view_->scheme() == SchemeKind::Regular;
+    const bool irregular = view_ && view_->scheme() == SchemeKind::Irregular;
+    changed |= ImGui::Checkbox(irregular ? "slabs" : "regions", &opt_.regions);
+    ImGui::SameLine();
+    if (irregular) {
+        changed |= ImGui::Checkbox("zones", &opt_.zones);
+        ImGui::SameLine();
+    }
+    if (regular) {
+        changed |= ImGui::Checkbox("directory", &opt_.grid);
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip(
+                "Directory entries: grey a single cell, teal a block stored as one\n"
+                "entry, orange a block stored as a sub-table");
+        ImGui::SameLine();
+    }
+    changed |= ImGui::Checkbox("boxes", &opt_.boxes);
+    changed |= ImGui::Checkbox("frustum", &opt_.frustum);
+    ImGui::SameLine();
+    changed |= ImGui::Checkbox("surfaces", &opt_.surfaces);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip(
+            "The scene traced from the inspector's camera (exact CSG, primary rays);\n"
+            "lines behind a surface are hidden");
+    int by = int(opt_.colorBy);
+    ImGui::TextUnformatted("colour by");
+    ImGui::SameLine();
+    ImGui::RadioButton("primitives", &by, 0);
+    ImGui::SameLine();
+    ImGui::RadioButton(irregular ? "slab index" : "level", &by, 1);
+    if (by != int(opt_.colorBy)) {
+        opt_.colorBy = ColorBy(by);
+        changed = true;
+    }
+    if (regular) {
+        const int top = std::max(model_.maxLevel, 1);
+        changed |= ImGui::DragIntRange2("levels", &opt_.levelLo, &opt_.levelHi, 0.1f, 0, top);
+    }
+    if (irregular) {
+        int only = opt_.zoneSlabsOnly ? 1 : 0;
+        ImGui::TextUnformatted("slabs of");
+        ImGui::SameLine();
+        ImGui::RadioButton("every zone", &only, 0);
+        ImGui::SameLine();
+        ImGui::RadioButton("the selected zone", &only, 1);
+        if (only != int(opt_.zoneSlabsOnly)) {
+            opt_.zoneSlabsOnly = only == 1;
+            changed = true;
+        }
+    }
+    if (view_) {
+        const Box3 b = view_->worldBounds();
+        changed |= ImGui::Checkbox("slice", &opt_.slab.on);
+        ImGui::SameLine();
+        int axis = opt_.slab.axis;
+        ImGui::RadioButton("x", &axis, 0);
+        ImGui::SameLine();
+        ImGui::RadioButton("y", &axis, 1);
+        ImGui::SameLine();
+        ImGui::RadioButton("z", &axis, 2);
+        if (axis != opt_.slab.axis || (opt_.slab.lo == 0.0 && opt_.slab.hi == 0.0)) {
+            opt_.slab.axis = axis;
+            const double mid = 0.5 * (b.lo[axis] + b.hi[axis]);
+            const double w = 0.05 * (b.hi[axis] - b.lo[axis]);
+            opt_.slab.lo = mid - w;
+            opt_.slab.hi = mid + w;
+            changed = true;
+        }
+        if (opt_.slab.on) {
+            float lo = float(opt_.slab.lo), hi = float(opt_.slab.hi);
+            const float speed = float(b.hi[axis] - b.lo[axis]) / 400.0f;
+            if (ImGui::DragFloatRange2("slab", &lo, &hi, speed, float(b.lo[axis]),
+                                       float(b.hi[axis]), "%.4g")) {
+                opt_.slab.lo = lo;
+                opt_.slab.hi = hi;
+                changed = true;
+            }
+        }
+    }
+    if (ImGui::InputInt("cap", &opt_.cap, 1000, 10000)) {
+        opt_.cap = std::clamp(opt_.cap, 0, 5000000);
+        changed = true;
+    }
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("Regions (and blocks, boxes) drawn at most, among those in view");
+    ImGui::Text("%zu of %zu regions drawn%s", model_.regions.size(), model_.total,
+                model_.kept > model_.regions.size() ? " (cap reached)" : "");
+    if (selected_ >= 0) ImGui::Text("selected: region %lld", (long long)selected_);
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+    ImGui::TextWrapped(
+        "Over the inspector: left drag orbits, middle drag pans, right drag or wheel zooms, a "
+        "click selects the region under the cursor.");
+    ImGui::PopStyleColor();
+    ImGui::End();
+    if (changed) dirtyModel_ = true;
+}
+
+}  // namespace lancer::viewer::inspector

@@ -1,0 +1,113 @@
+// The 3D inspector: a view of its own, with its own orbit camera, drawn over the right half of
+// the window. It shows the structure's regions (regular leaves coloured by primitive count or
+// level, with a level range and a slice slab; irregular zones and slabs), the directory's
+// blocks, the minimized boxes, the camera's frustum and image plane, and the scene's surfaces
+// traced from its camera (surface_tracer.h), the lines hidden behind them by the traced depth.
+// A click picks the nearest drawn region. No window needed: a test drives it in OSMesa.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+
+#include "app/viewer/image_view.h"  // PixelRect
+#include "app/viewer/inspector/inspector_model.h"
+#include "app/viewer/inspector/surface_tracer.h"
+
+namespace lancer::viewer::gl {
+class BatchRenderer;
+class GpuBatch;
+class Program;
+}  // namespace lancer::viewer::gl
+
+namespace lancer::viewer::inspector {
+
+class Inspector {
+  public:
+    /// Needs a current OpenGL 3.3 core context (as do draw() and the destructor). `wake` (may
+    /// be empty) is called from the tracer's thread when the surfaces are ready.
+    explicit Inspector(std::function<void()> wake = {});
+    ~Inspector();
+    Inspector(const Inspector&) = delete;
+    Inspector& operator=(const Inspector&) = delete;
+
+    /// The switches and filters; call changed() after editing them.
+    InspectorOptions& options() { return opt_; }
+    const InspectorOptions& options() const { return opt_; }
+    void changed() { dirtyModel_ = true; }
+    /// Show or hide the inspector (the I key, the View panel, `--show inspector`).
+    void setShown(bool on);
+    bool shown() const { return opt_.show; }
+
+    /// Where the inspector draws in a fbWidth x fbHeight framebuffer: its right half.
+    static PixelRect viewport(int fbWidth, int fbHeight);
+    /// Its camera (framed on the structure when the scene changes), and setting it.
+    const Camera& camera() const { return camera_; }
+    void setCamera(const Camera& c);
+
+    /// Once a frame, before input and drawing: the structure on screen, the main view, the
+    /// selected region (-1: none). Rebuilds what changed.
+    void update(const std::shared_ptr<const SceneBuild>& structure, const MainView& main,
+                int fbWidth, int fbHeight, int64_t selected);
+    /// Mouse input over the inspector (ImGui's io, framebuffer pixels): orbit (left drag), pan
+    /// (middle drag), zoom (wheel, right drag), pick (left click). True when the inspector took
+    /// the mouse this frame (the main camera must not move). A click sets `picked` to the
+    /// region under the cursor, or -1 on empty space.
+    bool handleMouse(int fbWidth, int fbHeight, std::optional<int64_t>& picked);
+    /// The region the ray through viewport pixel (x, y) (top-left origin) meets first among
+    /// those drawn, or -1.
+    int64_t pick(double x, double y) const;
+    /// Draw into framebuffer 0 of fbWidth x fbHeight, in viewport(). Only re-rendered when
+    /// something changed; otherwise the last picture is copied.
+    void draw(int fbWidth, int fbHeight);
+    /// The Inspector panel: its layers, colours, level range, slice slab, cap and counts.
+    void panel(bool* open);
+
+    /// Hidden, or showing everything asked for: the surfaces of its camera (when on) are traced
+    /// and the model is up to date.
+    bool settled() const;
+    /// What is drawn (for the panel and tests).
+    const InspectorModel& model() const { return model_; }
+    /// Surfaces of the current camera are on screen (the trace arrived).
+    bool surfacesShown() const;
+    /// Wait (tests) until the surfaces of the current camera are traced, up to `ms`.
+    bool waitSurfaces(int ms);
+
+  private:
+    void rebuildModel();
+    void requestSurfaces();
+    void takeSurfaces();
+    void render();
+    /// Near and far depths of everything drawn, for the inspector's camera.
+    void depthBounds(double& near, double& far) const;
+
+    InspectorOptions opt_;
+    Camera camera_;
+    bool cameraFramed_ = false;
+    std::shared_ptr<const SceneBuild> structure_;
+    std::unique_ptr<StructureView> view_;
+    MainView main_;
+    int64_t selected_ = -1;
+    int vw_ = 0, vh_ = 0;  ///< viewport size
+    InspectorModel model_;
+    bool dirtyModel_ = true, dirtyPicture_ = true, dirtyBatch_ = true;
+    bool dragging_ = false;  ///< a drag that began in the inspector is under way
+    int dragButton_ = -1;
+
+    SurfaceTracer tracer_;
+    std::optional<SurfaceImage> surfaces_;  ///< the last traced surfaces
+    bool surfacesRequested_ = false;
+    Camera requestedCamera_;
+    int requestedW_ = 0, requestedH_ = 0;
+
+    // GL.
+    std::unique_ptr<gl::BatchRenderer> batches_;
+    std::unique_ptr<gl::GpuBatch> lines_, selection_;
+    std::unique_ptr<gl::Program> surfaceProgram_;
+    unsigned fbo_ = 0, colorTex_ = 0, depthRb_ = 0, surfColorTex_ = 0, surfDepthTex_ = 0, vao_ = 0;
+    int fboW_ = 0, fboH_ = 0, surfW_ = 0, surfH_ = 0;
+    bool surfUploaded_ = false;
+};
+
+}  // namespace lancer::viewer::inspector

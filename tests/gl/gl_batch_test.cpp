@@ -1,0 +1,168 @@
+// The GL room (app/viewer/gl/): embedded shaders and their errors, batches of lines and fills in
+// image pixels and in world space, drawn where the tracer's pixels are.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <stdexcept>
+
+#include "app/viewer/gl/batch.h"
+#include "app/viewer/gl/program.h"
+#include "app/viewer/gl/transforms.h"
+#include "tests/gl/offscreen_gl.h"
+
+namespace lancer::viewer::gl {
+namespace {
+
+using viewer::testing::OffscreenGl;
+
+const uint8_t* at(const std::vector<uint8_t>& px, int w, int x, int y) {
+    return &px[(size_t(y) * size_t(w) + size_t(x)) * 4];
+}
+
+bool isColor(const uint8_t* p, int r, int g, int b, int tol = 2) {
+    return std::abs(p[0] - r) <= tol && std::abs(p[1] - g) <= tol && std::abs(p[2] - b) <= tol;
+}
+
+TEST(GlRoom, EveryShaderFileIsEmbeddedAndErrorsNameTheShader) {
+    for (const char* name : {"image.vert", "image.frag", "batch.vert", "batch.frag"})
+        EXPECT_NE(std::string(shaderSource(name)).find("#version 330 core"), std::string::npos)
+            << name;
+    try {
+        shaderSource("missing.frag");
+        ADD_FAILURE() << "an unknown shader must throw";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("missing.frag"), std::string::npos) << e.what();
+    }
+    OffscreenGl gl(8, 8);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    try {
+        Program bad(shaderSource("batch.vert"), "#version 330 core\nvoid main() { oops; }\n",
+                    "broken.frag");
+        ADD_FAILURE() << "a shader that does not compile must throw";
+    } catch (const std::runtime_error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("broken.frag (fragment)"), std::string::npos) << what;
+        EXPECT_NE(what.find("oops"), std::string::npos) << "the compiler's log: " << what;
+    }
+    Program good("batch.vert", "batch.frag");
+    EXPECT_NE(good.id(), 0u);
+    EXPECT_GE(good.uniform("toClip"), 0);
+}
+
+TEST(GlRoom, ImageSpaceLinesAndTranslucentFillsLandOnTheirPixels) {
+    const int w = 64, h = 48;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    gl.clear(0, 0, 0);
+    BatchRenderer renderer;
+    Batch b;
+    // Through pixel centres: a row and a column of pixels.
+    b.line(glm::vec2(4.5f, 10.5f), glm::vec2(40.5f, 10.5f), rgba8(glm::vec3(1, 0, 0)));
+    b.line(glm::vec2(50.5f, 2.5f), glm::vec2(50.5f, 30.5f), rgba8(glm::vec3(0, 1, 0)));
+    b.fillRect({20.0f, 30.0f}, {30.0f, 40.0f}, rgba8(glm::vec3(0, 0, 1), 0.5f));
+    GpuBatch gpu;
+    gpu.upload(b);
+    EXPECT_EQ(gpu.lineCount(), 2u);
+    EXPECT_EQ(gpu.triangleCount(), 2u);
+    renderer.draw(gpu, imagePixelsToClip(float(w), float(h)));
+    auto px = gl.read();
+    for (int x = 6; x <= 39; ++x) {
+        EXPECT_TRUE(isColor(at(px, w, x, 10), 255, 0, 0)) << x;
+        EXPECT_TRUE(isColor(at(px, w, x, 9), 0, 0, 0)) << x;
+        EXPECT_TRUE(isColor(at(px, w, x, 11), 0, 0, 0)) << x;
+    }
+    for (int y = 4; y <= 29; ++y) EXPECT_TRUE(isColor(at(px, w, 50, y), 0, 255, 0)) << y;
+    // Half-transparent blue over black: half blue, inside [20, 30) x [30, 40) only.
+    EXPECT_TRUE(isColor(at(px, w, 25, 35), 0, 0, 128, 2));
+    EXPECT_TRUE(isColor(at(px, w, 20, 30), 0, 0, 128, 2));
+    EXPECT_TRUE(isColor(at(px, w, 29, 39), 0, 0, 128, 2));
+    EXPECT_TRUE(isColor(at(px, w, 19, 35), 0, 0, 0));
+    EXPECT_TRUE(isColor(at(px, w, 30, 35), 0, 0, 0));
+    EXPECT_TRUE(isColor(at(px, w, 25, 40), 0, 0, 0));
+
+    // A line range draws only its segments; the opacity scales alpha.
+    gl.clear(0, 0, 0);
+    DrawOptions only2;
+    only2.firstLine = 1;
+    only2.triangles = false;
+    renderer.draw(gpu, imagePixelsToClip(float(w), float(h)), only2);
+    px = gl.read();
+    EXPECT_TRUE(isColor(at(px, w, 20, 10), 0, 0, 0)) << "the first segment is out of range";
+    EXPECT_TRUE(isColor(at(px, w, 50, 20), 0, 255, 0));
+    EXPECT_TRUE(isColor(at(px, w, 25, 35), 0, 0, 0)) << "triangles were turned off";
+    gl.clear(0, 0, 0);
+    DrawOptions faint;
+    faint.opacity = 0.5f;
+    Batch once;
+    once.line(glm::vec2(0.0f, 5.5f), glm::vec2(float(w), 5.5f), rgba8(glm::vec3(1, 1, 1)));
+    renderer.drawNow(once, imagePixelsToClip(float(w), float(h)), faint);
+    px = gl.read();
+    EXPECT_TRUE(isColor(at(px, w, 30, 5), 128, 128, 128, 2));
+}
+
+Camera orthoCamera() {
+    Camera c;
+    c.from = {0.0, 0.0, 10.0};
+    c.at = {0.0, 0.0, 0.0};
+    c.up = {0.0, 1.0, 0.0};
+    c.projection = Projection::Orthographic;
+    c.orthoHeight = 10.0;  // 100 pixels: 10 pixels a unit
+    return c;
+}
+
+TEST(GlRoom, WorldSpaceBoxesProjectAsTheTracersRays) {
+    // CPU projection: a point on pixel (i, j)'s primary ray lands on that pixel's centre.
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    Camera persp;
+    persp.from = {1.0, -8.0, 2.0};
+    persp.at = {0.0, 0.0, 0.5};
+    persp.up = {0.0, 0.0, 1.0};
+    persp.fov = 50.0;
+    for (const Camera& cam : {persp, orthoCamera()}) {
+        const int w = 160, h = 90;
+        ImageProjector proj(cam, w, h);
+        const glm::dmat4 m = glm::dmat4(worldToClip(cam, w, h, 0.01, 100.0));
+        for (int k = 0; k < 50; ++k) {
+            const double x = std::floor(u(rng) * w), y = std::floor(u(rng) * h);
+            const Ray ray = cam.primaryRay(x, y, w, h);
+            const Vec3 p = ray.at(1.0 + 9.0 * u(rng));
+            const auto q = proj.toImage(p);
+            ASSERT_TRUE(q.has_value());
+            EXPECT_NEAR(q->x, x + 0.5, 1e-9);
+            EXPECT_NEAR(q->y, y + 0.5, 1e-9);
+            const glm::dvec4 c = m * glm::dvec4(p, 1.0);  // the GL matrix agrees (in float)
+            EXPECT_NEAR((c.x / c.w + 1.0) * 0.5 * w, x + 0.5, 1e-3);
+            EXPECT_NEAR((1.0 - c.y / c.w) * 0.5 * h, y + 0.5, 1e-3);
+        }
+    }
+    ImageProjector behind(persp, 10, 10);
+    EXPECT_FALSE(behind.toImage(Vec3(1.0, -20.0, 2.0)).has_value());
+
+    // A box under the orthographic camera: edges on the pixel columns and rows they project to
+    // (x = -2.05 is continuous x 29.5, the centre of column 29).
+    const int w = 100, h = 100;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    gl.clear(0, 0, 0);
+    BatchRenderer renderer;
+    Batch b;
+    b.box(glm::vec3(-2.05f, -1.05f, -1.0f), glm::vec3(1.95f, 2.95f, 1.0f),
+          rgba8(glm::vec3(1, 1, 0)));
+    renderer.drawNow(b, worldToClip(orthoCamera(), w, h, 0.0, 20.0));
+    auto px = gl.read();
+    // Columns 29 and 69, rows 60 (y = -1.05) and 20 (y = 2.95), image row 0 on top.
+    for (int y = 22; y <= 58; ++y) {
+        EXPECT_TRUE(isColor(at(px, w, 29, y), 255, 255, 0)) << y;
+        EXPECT_TRUE(isColor(at(px, w, 69, y), 255, 255, 0)) << y;
+        EXPECT_TRUE(isColor(at(px, w, 49, y), 0, 0, 0)) << y;
+    }
+    for (int x = 31; x <= 67; ++x) {
+        EXPECT_TRUE(isColor(at(px, w, x, 20), 255, 255, 0)) << x;
+        EXPECT_TRUE(isColor(at(px, w, x, 60), 255, 255, 0)) << x;
+        EXPECT_TRUE(isColor(at(px, w, x, 40), 0, 0, 0)) << x;
+    }
+}
+
+}  // namespace
+}  // namespace lancer::viewer::gl

@@ -1,0 +1,259 @@
+// The inspector drawn into an OSMesa context: a leaf's edges land where its corners project
+// under the inspector's camera, the level range and the slice slab hide what they should, and
+// the traced surfaces hide the lines behind them.
+#include "tests/gl/offscreen_gl.h"
+// (after the GL headers)
+#include <gtest/gtest.h>
+
+#include "app/viewer/gl/transforms.h"
+#include "app/viewer/inspector/inspector.h"
+
+namespace lancer::viewer::inspector {
+namespace {
+
+using testing::OffscreenGl;
+
+constexpr int kW = 640, kH = 360;
+
+std::shared_ptr<const SceneBuild> regularBalls() {
+    BuildRequest r;
+    r.spec = "builtin:balls:2";
+    r.params.scheme = SchemeKind::Regular;
+    r.params.maxLevel = 12;
+    r.params.maxObjects = 2;
+    BuildResult b = buildStructure(r);
+    if (!b.sceneBuild) throw std::runtime_error(b.error);
+    return b.sceneBuild;
+}
+
+/// The inspector drawn alone (frustum, boxes and surfaces off unless asked).
+struct Fixture {
+    OffscreenGl gl{kW, kH};
+    std::shared_ptr<const SceneBuild> st = regularBalls();
+    std::unique_ptr<Inspector> insp;
+    PixelRect v = Inspector::viewport(kW, kH);
+
+    Fixture() {
+        insp = std::make_unique<Inspector>();
+        InspectorOptions& o = insp->options();
+        o.show = true;
+        o.frustum = false;
+        o.surfaces = false;
+        o.cap = 1 << 30;
+    }
+    std::vector<uint8_t> draw() {
+        insp->changed();
+        insp->update(st, {st->scene->camera, 64, 48}, kW, kH, -1);
+        gl.clear(0.0f, 0.0f, 0.0f);
+        insp->draw(kW, kH);
+        return gl.read();
+    }
+    /// Where a world point lands in the framebuffer.
+    glm::dvec2 toFb(const Vec3& p) const {
+        std::optional<glm::dvec2> q =
+            gl::ImageProjector(insp->camera(), v.x1 - v.x0, v.y1 - v.y0).toImage(p);
+        return q ? *q + glm::dvec2(v.x0, v.y0) : glm::dvec2(-1e9);
+    }
+};
+
+const uint8_t* pixel(const std::vector<uint8_t>& img, int x, int y) {
+    return img.data() + (size_t(y) * kW + size_t(x)) * 4;
+}
+
+/// A line of some colour (not the background) within a pixel of (x, y).
+bool lit(const std::vector<uint8_t>& img, glm::dvec2 p) {
+    const int cx = int(std::floor(p.x)), cy = int(std::floor(p.y));
+    for (int y = cy - 1; y <= cy + 1; ++y)
+        for (int x = cx - 1; x <= cx + 1; ++x) {
+            if (x < 0 || y < 0 || x >= kW || y >= kH) continue;
+            const uint8_t* q = pixel(img, x, y);
+            if (std::abs(int(q[0]) - 26) + std::abs(int(q[1]) - 26) + std::abs(int(q[2]) - 31) > 40)
+                return true;
+        }
+    return false;
+}
+
+double segmentDistance(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {
+    const glm::dvec2 ab = b - a;
+    const double l = glm::dot(ab, ab);
+    const double t = l > 0.0 ? std::clamp(glm::dot(p - a, ab) / l, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + t * ab));
+}
+
+/// Midpoints of the edges of `corners`, in the framebuffer, inside the viewport with a margin.
+std::vector<glm::dvec2> edgeMidpoints(const Fixture& f, const Corners& c) {
+    std::vector<glm::dvec2> out;
+    for (const auto& e : cornerEdges()) {
+        const glm::dvec2 p = f.toFb(0.5 * (c[size_t(e[0])] + c[size_t(e[1])]));
+        if (p.x > f.v.x0 + 3 && p.x < f.v.x1 - 3 && p.y > 3 && p.y < kH - 3) out.push_back(p);
+    }
+    return out;
+}
+
+/// Whether p lies within `margin` pixels of a line the model drew.
+bool nearDrawnLine(const Fixture& f, glm::dvec2 p, double margin) {
+    const auto& lines = f.insp->model().lines.lines;
+    for (size_t i = 0; i + 1 < lines.size(); i += 2)
+        if (segmentDistance(p, f.toFb(Vec3(lines[i].position)),
+                            f.toFb(Vec3(lines[i + 1].position))) < margin)
+            return true;
+    return false;
+}
+
+TEST(InspectorGl, LeafDrawnWhereItsCornersProject) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    // One leaf drawn: the cap keeps the first in view.
+    f.insp->options().cap = 1;
+    std::vector<uint8_t> img = f.draw();
+    ASSERT_EQ(f.insp->model().regions.size(), 1u);
+    const RegionView& r = f.insp->model().regions[0];
+    const std::vector<glm::dvec2> mids = edgeMidpoints(f, r.corners);
+    ASSERT_GE(mids.size(), 8u);
+    for (const glm::dvec2& p : mids) EXPECT_TRUE(lit(img, p)) << p.x << " " << p.y;
+    // Off its edges, nothing: points a third of the way between two face diagonals' ends.
+    int dark = 0;
+    for (int a = 0; a < 8; ++a)
+        for (int b = a + 1; b < 8; ++b) {
+            const glm::dvec2 p =
+                f.toFb(r.corners[size_t(a)] + (r.corners[size_t(b)] - r.corners[size_t(a)]) / 3.0);
+            if (p.x < f.v.x0 + 3 || p.x > f.v.x1 - 3 || p.y < 3 || p.y > kH - 3) continue;
+            if (nearDrawnLine(f, p, 3.0)) continue;
+            EXPECT_FALSE(lit(img, p)) << p.x << " " << p.y;
+            ++dark;
+        }
+    EXPECT_GT(dark, 3);
+    // The left half of the window is not the inspector's.
+    EXPECT_EQ(pixel(img, 10, 10)[0], 0);
+}
+
+TEST(InspectorGl, LevelRangeHidesTheOtherLevels) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    f.draw();
+    const int top = f.insp->model().maxLevel;
+    ASSERT_GE(top, 4);
+    f.insp->options().levelLo = top - 3;
+    f.insp->options().levelHi = top - 2;
+    std::vector<uint8_t> img = f.draw();
+    StructureView view(*f.st->scene, *f.st->accel);
+    int shown = 0, hidden = 0;
+    for (uint32_t id = 0; id < view.regionCount(); ++id) {
+        const bool kept = inLevelRange(view.leafLevel(id), top - 3, top - 2);
+        for (const glm::dvec2& p : edgeMidpoints(f, view.regionCorners(id))) {
+            if (kept) {
+                EXPECT_TRUE(lit(img, p)) << view.toString(id);
+                ++shown;
+            } else if (!nearDrawnLine(f, p, 3.0)) {
+                EXPECT_FALSE(lit(img, p)) << view.toString(id);
+                ++hidden;
+            }
+        }
+    }
+    EXPECT_GT(shown, 20);
+    EXPECT_GT(hidden, 20);
+}
+
+TEST(InspectorGl, SliceSlabKeepsOnlyTheCrossingCells) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    f.draw();
+    StructureView view(*f.st->scene, *f.st->accel);
+    const Box3 b = view.worldBounds();
+    Slab& s = f.insp->options().slab;
+    s.on = true;
+    s.axis = 0;
+    s.lo = b.lo.x + 0.42 * b.extent().x;
+    s.hi = b.lo.x + 0.47 * b.extent().x;
+    std::vector<uint8_t> img = f.draw();
+    int shown = 0, hidden = 0;
+    for (uint32_t id = 0; id < view.regionCount(); ++id) {
+        const Corners c = view.regionCorners(id);
+        const bool crosses = s.keeps(c);
+        for (const glm::dvec2& p : edgeMidpoints(f, c)) {
+            if (crosses) {
+                EXPECT_TRUE(lit(img, p)) << view.toString(id);
+                ++shown;
+            } else if (!nearDrawnLine(f, p, 3.0)) {
+                EXPECT_FALSE(lit(img, p)) << view.toString(id);
+                ++hidden;
+            }
+        }
+    }
+    EXPECT_GT(shown, 20);
+    EXPECT_GT(hidden, 20);
+}
+
+TEST(InspectorGl, SurfacesHideTheLinesBehindThem) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    InspectorOptions& o = f.insp->options();
+    o.regions = false;
+    o.boxes = true;
+    o.surfaces = true;
+    // The largest sphere of balls (the root of the flake) and its minimized box, seen closely:
+    // the box's edges in front of the sphere show, those behind it (inside its silhouette) do
+    // not.
+    const Scene& scene = *f.st->scene;
+    int big = -1;
+    for (uint32_t i = 0; i < scene.minBox.size(); ++i) {
+        const Vec3 e = scene.minBox[i].extent();
+        if (scene.minBox[i].isEmpty() || std::abs(e.z - e.x) > 1e-6 * e.x) continue;  // not a ball
+        if (big < 0 || e.x > scene.minBox[size_t(big)].extent().x) big = int(i);
+    }
+    ASSERT_GE(big, 0);
+    const Box3 box = scene.minBox[size_t(big)];
+    f.draw();
+    f.insp->setCamera(frameBox(box, Vec3(-0.6, 1.0, -0.5), 40.0));
+    f.draw();
+    ASSERT_TRUE(f.insp->waitSurfaces(20000));
+    std::vector<uint8_t> img = f.draw();
+    ASSERT_TRUE(f.insp->surfacesShown());
+    const Vec3 centre = box.center();
+    const double radius = 0.5 * box.extent().x;
+    const glm::dvec2 c2 = f.toFb(centre);
+    // The silhouette's radius on screen, from a point on the sphere seen side-on.
+    Vec3 fwd, right, up;
+    f.insp->camera().basis(fwd, right, up);
+    const double r2 = glm::length(f.toFb(centre + radius * right) - c2);
+    const gl::ImageProjector proj(f.insp->camera(), f.v.x1 - f.v.x0, f.v.y1 - f.v.y0);
+    const glm::vec3 boxColor = kBoxColor * 255.0f;
+    auto isBoxColor = [&](glm::dvec2 p) {
+        const uint8_t* q = pixel(img, int(p.x), int(p.y));
+        return std::abs(q[0] - boxColor.x) < 12 && std::abs(q[1] - boxColor.y) < 12 &&
+               std::abs(q[2] - boxColor.z) < 12;
+    };
+    // Other boxes' edges may pass over the sphere in front of it.
+    auto nearOtherBox = [&](glm::dvec2 q) {
+        for (uint32_t i = 0; i < scene.minBox.size(); ++i) {
+            if (int(i) == big || scene.minBox[i].isEmpty()) continue;
+            const Corners o = boxCorners(scene.minBox[i]);
+            for (const auto& e : cornerEdges())
+                if (segmentDistance(q, f.toFb(o[size_t(e[0])]), f.toFb(o[size_t(e[1])])) < 3.0)
+                    return true;
+        }
+        return false;
+    };
+    int front = 0, behind = 0;
+    const Corners c = boxCorners(box);
+    for (const auto& e : cornerEdges())
+        for (double t : {0.35, 0.5, 0.65}) {
+            const Vec3 p = c[size_t(e[0])] + t * (c[size_t(e[1])] - c[size_t(e[0])]);
+            const glm::dvec2 q = f.toFb(p);
+            if (glm::length(q - c2) > 0.75 * r2) continue;  // not over the sphere
+            if (proj.depth(p) < proj.depth(centre) - 0.5 * radius) {
+                EXPECT_TRUE(isBoxColor(q)) << "front " << q.x << " " << q.y;
+                ++front;
+            } else if (proj.depth(p) > proj.depth(centre) + 0.5 * radius && !nearOtherBox(q)) {
+                EXPECT_FALSE(isBoxColor(q)) << "behind " << q.x << " " << q.y;
+                ++behind;
+            }
+        }
+    EXPECT_GT(behind, 0);
+    EXPECT_GT(front, 0);
+    // The sphere itself shows at its centre.
+    EXPECT_TRUE(lit(img, c2));
+}
+
+}  // namespace
+}  // namespace lancer::viewer::inspector
