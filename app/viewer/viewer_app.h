@@ -10,12 +10,18 @@
 #include <optional>
 #include <string>
 
+#include "app/viewer/gl/batch.h"
 #include "app/viewer/image_view.h"
 #include "app/viewer/inspector/inspector.h"
 #include "app/viewer/panel_cache.h"
+#include "app/viewer/playback/ray_player.h"
 #include "app/viewer/viewer_state.h"
 
 namespace lancer::viewer {
+
+namespace gl {
+class BatchRenderer;
+}
 
 class ViewerApp {
   public:
@@ -84,6 +90,13 @@ class ViewerApp {
     int64_t selectedRegion() const { return selected_; }
     void selectRegion(int64_t id) { selected_ = id; }
 
+    /// The ray playback: the picked pixel's tree and the ray played (Shift+click, the Ray
+    /// panel, `--pick`). The current region is the selected region while a ray is played.
+    playback::RayPlayer& rayPlayer() { return player_; }
+    /// Pick pixel (x, y) of the image, select ray `ray` of its tree and stop at step `step`, as
+    /// soon as a structure is on screen (`--pick X Y --ray K --step N`); shows the Ray panel.
+    void pickPixel(int x, int y, int ray = 0, int step = 0);
+
     /// What is built, rendered and shown (what the panels read).
     ViewerState& state() { return state_; }
     const ViewerState& state() const { return state_; }
@@ -96,7 +109,13 @@ class ViewerApp {
     std::unique_ptr<ImageView> view_;
     std::unique_ptr<inspector::Inspector> inspector_;
     int64_t selected_ = -1;
-    PanelCache panels_;  ///< ImGui's panels, each redrawn only when it changed
+    playback::RayPlayer player_;
+    std::unique_ptr<gl::BatchRenderer> rayRenderer_;
+    Clock::time_point lastFrame_ = Clock::now();
+    /// The region the playback selected last (-1: none), so a click elsewhere is not undone.
+    int64_t playedRegion_ = -1;
+    gl::Batch inspectorRay_;  ///< the lines last handed to the inspector
+    PanelCache panels_;       ///< ImGui's panels, each redrawn only when it changed
     bool settled_ = false;
 };
 

@@ -19,6 +19,8 @@ struct ViewerSettings {
     bool showParameters = true, showStatistics = true, showCamera = true, showView = true;
     /// The 3D inspector over the right half of the window (not saved: it starts hidden).
     bool showInspector = false;
+    /// The Ray panel (not saved: it opens with the first pick).
+    bool showRay = false;
     ViewMode mode = ViewMode::Color;
     bool autoScale = true;     ///< heat scale follows the image's largest value
     float heatScale = 100.0f;  ///< counter value at the top of the colour map

@@ -98,6 +98,24 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
         ImGui::LoadIniSettingsFromDisk(ini.c_str());
     }
     applyCommandLine(o, given, settings);
+    bool showRay = false, showInspector = false;
+    for (size_t at = 0; !v.show.empty() && at <= v.show.size();) {
+        size_t comma = v.show.find(',', at);
+        if (comma == std::string::npos) comma = v.show.size();
+        const std::string item = v.show.substr(at, comma - at);
+        if (item == "ray") {
+            showRay = true;
+        } else if (item == "inspector") {
+            showInspector = true;
+        } else if (item != "none") {
+            std::cerr << "error: --show " << v.show << ": unknown item '" << item
+                      << "' (known: ray, inspector, none)\n";
+            ImGui::DestroyContext();
+            glfwTerminate();
+            return 2;
+        }
+        at = comma + 1;
+    }
 
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -146,6 +164,9 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             wakeCv.notify_one();
             glfwPostEmptyEvent();  // thread-safe in GLFW
         });
+        if (showInspector) app.showInspector(true);
+        if (showRay) settings.showRay = true;
+        if (v.pick.size() == 2) app.pickPixel(v.pick[0], v.pick[1], v.pickRay, v.pickStep);
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
         bool replayed = false, droppedScripted = false;
@@ -218,6 +239,10 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             } else if (v.frames > 0 && frames >= v.frames && app.settled()) {
                 if (!app.sceneBuild()) {  // a scripted run on a scene that cannot be shown fails
                     std::cerr << "error: lancer view: the scene could not be shown (see above)\n";
+                    status = 2;
+                }
+                if (v.pick.size() == 2 && app.rayPlayer().playback().empty()) {
+                    std::cerr << "error: --pick: " << app.rayPlayer().note() << "\n";
                     status = 2;
                 }
                 if (!v.screenshot.empty()) {

@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "app/cli/options.h"
 
@@ -21,6 +22,12 @@ struct ViewOptions {
     /// Redraw every frame (at most 60 per second), as while the user keeps interacting; else
     /// only on input, on a worker's result and at 10 Hz while rendering.
     bool continuous = false;
+    /// `--pick X Y`: the pixel whose ray tree is played (empty: none).
+    std::vector<int> pick;
+    int pickRay = 0;   ///< `--ray K`: the ray of the tree played
+    int pickStep = 0;  ///< `--step N` with --pick: the step the playback stops at
+    /// `--show LIST`: comma list of `ray`, `inspector` (validated by runViewer).
+    std::string show;
 };
 
 /// What runViewer returns when no window can be opened (no display, no OpenGL 3.3).
