@@ -34,5 +34,5 @@ fails "--show" run --show rays
 fails "--pick" run --pick 5000 10
 fails "--ray 999" run --pick 320 200 --ray 999
 fails "--step 100000" run --pick 320 200 --step 100000
-run --scheme regular --pick 320 200 --step 1 --show ray --screenshot "$tmp/p.png"
+run --scheme irregular --pick 320 200 --step 2 --show ray,inspector --screenshot "$tmp/p.png"
 test -s "$tmp/p.png"
