@@ -9,8 +9,10 @@
 
 #include <sstream>
 
+#include "engine/accel/structure_view.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
+#include "support/differential.h"
 
 namespace lancer {
 namespace {
@@ -289,6 +291,135 @@ TEST(RayTree, EachStepSaysHowTheNextRegionIsReached) {
     EXPECT_GT(steps, 0u);
     EXPECT_GT(pushes, 0u);
     EXPECT_GT(pointers, 0u);
+}
+
+/// How far `p` lies outside the hexahedron of `c` (corner i + 2j + 4k; faces planar), 0 inside:
+/// the largest distance beyond one of its six face planes. A face that has collapsed to a point
+/// or a segment (a projective region's apex at the eye) bounds nothing and is skipped.
+double outside(const std::array<Vec3, 8>& c, const Vec3& p) {
+    Vec3 centre(0.0);
+    for (const Vec3& q : c) centre += q / 8.0;
+    double worst = 0.0;
+    for (int a = 0; a < 3; ++a) {
+        const int b = (a + 1) % 3, d = (a + 2) % 3;
+        for (int side = 0; side < 2; ++side) {
+            // The face's corners in cyclic order, for Newell's normal.
+            int idx[4];
+            const int bits[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+            for (int k = 0; k < 4; ++k)
+                idx[k] = (side << a) | (bits[k][0] << b) | (bits[k][1] << d);
+            Vec3 n(0.0), fc(0.0);
+            for (int k = 0; k < 4; ++k) {
+                const Vec3& u = c[size_t(idx[k])];
+                const Vec3& v = c[size_t(idx[(k + 1) % 4])];
+                n += Vec3((u.y - v.y) * (u.z + v.z), (u.z - v.z) * (u.x + v.x),
+                          (u.x - v.x) * (u.y + v.y));
+                fc += u / 4.0;
+            }
+            const double len = glm::length(n);
+            if (!(len > 1e-12 * glm::dot(fc - centre, fc - centre) + 1e-300)) continue;
+            n /= len;
+            const double towards = glm::dot(n, fc - centre);
+            const double dist = glm::dot(n, p - fc);
+            if (towards > 0.0)
+                worst = std::max(worst, dist);
+            else if (towards < 0.0)
+                worst = std::max(worst, -dist);
+            else
+                worst = std::max(worst, std::abs(dist));  // a flat region: on its plane
+        }
+    }
+    return worst;
+}
+
+/// Check that each region event's corners hold the ray's stretch in it; returns the regions
+/// checked. The walks clip a ray to their structure's box grown by a hair (a few 1e-9 of the
+/// scene's size), and the last region's stretch runs to that clip: where the ray leaves the
+/// structure through an edge or a corner it may already have left the region across the tied
+/// interior face, by up to the hair over the ray's slope. So the points checked are those inside
+/// the structure's own box.
+size_t checkCorners(const StructureView& view, const Ray& ray, const std::vector<WalkEvent>& ev,
+                    double scale) {
+    size_t n = 0;
+    const std::array<Vec3, 8> bounds = view.structureCorners();
+    for (const WalkEvent& e : ev) {
+        if (e.kind != WalkEvent::Region) continue;
+        const std::array<Vec3, 8> c = view.regionCorners(e.a);
+        for (double t : {e.t0, 0.5 * (e.t0 + e.t1), e.t1}) {
+            const Vec3 p = ray.at(t);
+            const double tol = 1e-9 * std::max(scale, glm::length(p));
+            if (outside(bounds, p) > tol) continue;
+            EXPECT_LE(outside(c, p), tol)
+                << ray.toString() << " region " << e.a << " t = " << t << " of [" << e.t0 << ", "
+                << e.t1 << "] " << view.toString(e.a);
+        }
+        ++n;
+    }
+    return n;
+}
+
+// Every region event's corners (the structure description's, which `lancer trace --json`
+// writes) hold the ray's stretch in that region: every ray of random pixels' trees of random
+// scenes (primary, shadow, reflected, refracted), and rays from the regions' own corners and
+// face centres (origins on region boundaries), for both schemes and both irregular frames.
+TEST(RayTree, RegionCornersHoldTheRaysStretch) {
+    size_t checked = 0, boundaryRays = 0;
+    for (uint64_t seed = 1; seed <= 6; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.primitives = 10 + int(seed) * 3;
+        opt.surfaces = seed % 2 == 0;
+        Scene scene = test::randomCsgScene(seed, opt);
+        scene.materials[0].reflect = 0.3;
+        scene.materials[0].transmit = 0.5;
+        scene.materials[0].ior = 1.4;
+        scene.frameCamera(Vec3(0.3, 1.0, -0.4), Vec3(0.0, 0.0, 1.0));
+        scene.defaultLights();
+        std::mt19937_64 rng(seed);
+        std::uniform_int_distribution<int> px(0, 31);
+        for (const Config& c : configs()) {
+            if (c.scheme == SchemeKind::Brute || c.scene != "builtin:default" || c.bounces == 0)
+                continue;
+            SCOPED_TRACE(c.name() + " seed " + std::to_string(seed));
+            auto accel = buildAccelerator(scene, paramsOf(c));
+            const StructureView view(scene, *accel);
+            ShadingOptions sh;
+            sh.bounces = 2;
+            for (int k = 0; k < 12; ++k) {
+                const RayTree t =
+                    tracePixel(scene, *accel, sh, scene.camera, px(rng), px(rng), 32, 32);
+                for (const TracedRay& r : t.rays)
+                    checked +=
+                        checkCorners(view, Ray{r.origin, r.direction}, r.events, scene.scale());
+            }
+            // Rays from the corners and face centres of regions the walks visit.
+            std::uniform_int_distribution<size_t> pick(0, view.regionCount() - 1);
+            std::normal_distribution<double> gauss;
+            TraceContext ctx(scene.prims.size(), scene.tree.depth());
+            ctx.useMailboxes = accel->usesMailboxes();
+            for (int k = 0; k < 30; ++k) {
+                const uint32_t id = uint32_t(pick(rng));
+                const RegionInfo info = view.region(id);
+                if (info.kind != RegionKind::Leaf && info.kind != RegionKind::Slab) continue;
+                const std::array<Vec3, 8> cs = view.regionCorners(id);
+                // A corner, and the centre of the low face on the region's first axis.
+                const Vec3 origins[2] = {cs[size_t(k % 8)], 0.5 * (cs[0] + cs[6])};
+                for (const Vec3& o : origins) {
+                    Vec3 d(gauss(rng), gauss(rng), gauss(rng));
+                    if (k % 3 == 0) {  // along an axis, in the region's face planes
+                        d = Vec3(0.0);
+                        d[k % 9 / 3] = k % 2 ? 1.0 : -1.0;
+                    }
+                    if (glm::length(d) == 0.0) continue;
+                    const Ray ray{o, glm::normalize(d)};
+                    RecordingObserver obs = test::recordWalk(*accel, ray, ctx);
+                    checked += checkCorners(view, ray, obs.events, scene.scale());
+                    ++boundaryRays;
+                }
+            }
+        }
+    }
+    EXPECT_GT(checked, 1000u);
+    EXPECT_GT(boundaryRays, 100u);
 }
 
 // The values print themselves: every event kind, the hit, the counters, a ray, the tree.

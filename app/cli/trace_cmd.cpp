@@ -2,6 +2,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli/commands.h"
+#include "engine/accel/structure_view.h"
 #include "engine/render/ray_tree.h"
 #include "engine/scene/loader.h"
 
@@ -24,6 +25,12 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
         const TracedRay& primary = tree.rays.front();
 
         if (t.json) {
+            // Every region event carries the region's 8 world corners.
+            const StructureView view(scene, *accel);
+            const RegionCornersFn corners = [&view](uint32_t id) {
+                const std::array<Vec3, 8> c = view.regionCorners(id);
+                return std::vector<Vec3>(c.begin(), c.end());
+            };
             nlohmann::json j;
             j["scene"] = o.scene;
             j["scheme"] = schemeName(o.build.scheme);
@@ -32,7 +39,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
             j["height"] = h;
             j["camera"] = nlohmann::json::parse(cam.toJson());
             j["bounces"] = o.render.shading.bounces;
-            const nlohmann::json p = toJson(primary, scene);
+            const nlohmann::json p = toJson(primary, scene, corners);
             j["ray"] = {{"origin", p["origin"]}, {"direction", p["direction"]}};
             j["events"] = p["events"];
             j["hit"] = p["hit"];
@@ -47,7 +54,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
             j["walk_errors"] = tree.counters.walkErrors;
             j["counters"] = toJson(tree.counters);
             nlohmann::json rays = nlohmann::json::array();
-            for (const TracedRay& r : tree.rays) rays.push_back(toJson(r, scene));
+            for (const TracedRay& r : tree.rays) rays.push_back(toJson(r, scene, corners));
             j["rays"] = std::move(rays);
             std::cout << j.dump(2) << "\n";
             return 0;

@@ -41,6 +41,13 @@ for i, r in enumerate(rays):
     if i:
         assert 0 <= r["parent"] < i, r
     assert r["events"][0]["event"] == "ray_begin" and r["events"][-1]["event"] == "ray_end"
+regions = 0
+for r in rays:
+    for e in r["events"]:
+        if e["event"] == "region":
+            assert len(e["corners"]) == 8 and all(len(c) == 3 for c in e["corners"]), e
+            regions += 1
+assert regions == j["region_visits"], (regions, j["region_visits"])
 tests = sum(r["counters"]["prim_tests"] for r in rays)
 assert tests == j["prim_tests"], (tests, j["prim_tests"])
 EOF
