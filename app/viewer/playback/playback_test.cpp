@@ -1,7 +1,8 @@
 // Ray playback (playback.h): step k of every ray is the k-th region event `lancer trace --json`
-// prints for the same scene, size, parameters and pixel (both schemes, shadow and reflection rays
-// included); stepping back and forth returns the same states; playing takes `speed` steps a
-// second and stops at the last; a retrace keeps the old walks' counts.
+// prints for the same scene, size, parameters and pixel, with the corners the playback draws
+// (both schemes, shadow and reflection rays included); stepping back and forth returns the same
+// states; playing takes `speed` steps a second and stops at the last; a retrace keeps the old
+// walks' counts.
 #include "app/viewer/playback/playback.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/cli/options.h"
+#include "engine/accel/structure_view.h"
 #include "engine/scene/loader.h"
 
 namespace lancer::viewer::playback {
@@ -55,6 +57,7 @@ TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
     auto accel = buildAccelerator(scene, o.build);
     int w, h;
     cli::resolveSize(o, scene, w, h);
+    const StructureView view(scene, *accel);
     int compared = 0;
     for (RayKind kind : {RayKind::Primary, RayKind::Shadow, RayKind::Reflection}) {
         std::optional<Picked> p = findPixel(scene, *accel, o.render.shading, w, h, kind);
@@ -82,6 +85,12 @@ TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
                 EXPECT_EQ(e->t0, regions[size_t(s)]["t0"].get<double>());
                 if (!regions[size_t(s)]["t1"].is_null())
                     EXPECT_EQ(e->t1, regions[size_t(s)]["t1"].get<double>());
+                // The region drawn is the one the trace describes: the same 8 corners.
+                const std::array<Vec3, 8> c = view.regionCorners(e->a);
+                const nlohmann::json& jc = regions[size_t(s)]["corners"];
+                ASSERT_EQ(jc.size(), 8u);
+                for (size_t i = 0; i < 8; ++i)
+                    for (int a = 0; a < 3; ++a) EXPECT_EQ(c[i][a], jc[i][size_t(a)].get<double>());
                 ++compared;
             }
         }
