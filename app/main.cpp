@@ -1,5 +1,6 @@
 // lancer: CSG ray tracing with the space subdivisions of Arnaldi, Priol and Bouatouch (1986).
 #include <CLI/CLI.hpp>
+#include <cctype>
 #include <iostream>
 
 #include "app/bench/report.h"
@@ -79,6 +80,22 @@ int main(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     view->add_option("--ini", vopt.ini,
                      "Settings file (default: ~/.config/lancer/imgui.ini; \"none\": none)");
+    // Ray playback (docs/design.md section 6, "Scripted views"). `--step` is the common option's
+    // next-cell method (a word) or, with --pick, the playback step to stop at (a number).
+    std::vector<int> pickXY;
+    CLI::Option* pickOpt =
+        view->add_option("--pick", pickXY, "Pick pixel X Y (y = 0 on the top row): its ray tree")
+            ->expected(2);
+    view->add_option("--ray", vopt.pickRay, "With --pick: the ray of the tree played (0: primary)")
+        ->check(CLI::Range(0, 1000000))
+        ->needs(pickOpt);
+    view->remove_option(view->get_option("--step"));
+    std::string stepArg;
+    view->add_option("--step", stepArg,
+                     "Regular scheme's next-cell method (exact or push); with --pick, a number: "
+                     "the playback step to stop at (0: the ray's first region)");
+    view->add_option("--show", vopt.show,
+                     "Comma list of what to show: ray (the Ray panel, with --pick), inspector");
 #endif
 
     std::string out;
@@ -161,7 +178,39 @@ int main(int argc, char** argv) {
     // view (explicit or default): the window when there is a display, else a headless render.
     std::string why = "the interactive viewer is not available in this build";
 #ifdef LANCER_WITH_VIEWER
-    auto given = [&](const std::string& name) { return view->count(name) > 0; };
+    bool stepIsMethod = false;
+    if (!stepArg.empty()) {
+        std::string lower;
+        for (char c : stepArg) lower += char(std::tolower(static_cast<unsigned char>(c)));
+        if (lower == "exact" || lower == "push") {
+            viewOpt.build.step = lower == "exact" ? StepMethod::Exact : StepMethod::Push;
+            stepIsMethod = true;
+        } else if (stepArg.find_first_not_of("0123456789") == std::string::npos &&
+                   stepArg.size() < 10) {
+            if (pickXY.empty()) {
+                std::cerr << "error: --step " << stepArg
+                          << ": a playback step needs --pick X Y (the step method is exact or "
+                             "push)\n";
+                return 2;
+            }
+            vopt.pickStep = std::stoi(stepArg);
+        } else {
+            std::cerr << "error: --step " << stepArg
+                      << ": expected exact, push, or with --pick a step number\n";
+            return 2;
+        }
+    }
+    if (!pickXY.empty()) {
+        if (pickXY[0] < 0 || pickXY[1] < 0) {
+            std::cerr << "error: --pick " << pickXY[0] << " " << pickXY[1]
+                      << ": pixel coordinates are not negative\n";
+            return 2;
+        }
+        vopt.pick = {pickXY[0], pickXY[1]};
+    }
+    auto given = [&](const std::string& name) {
+        return name == "--step" ? stepIsMethod : view->count(name) > 0;
+    };
     if (int status = viewer::runViewer(viewOpt, vopt, given, why); status != viewer::kNoDisplay)
         return status;
 #endif

@@ -9,8 +9,10 @@
 #include <limits>
 
 #include "app/viewer/gl.h"
+#include "app/viewer/gl/batch.h"
 #include "app/viewer/input.h"
 #include "app/viewer/panels/panels.h"
+#include "app/viewer/playback/ray_drawing.h"
 
 namespace lancer::viewer {
 
@@ -30,6 +32,31 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
 }
 
 ViewerApp::~ViewerApp() = default;
+
+void ViewerApp::pickPixel(int x, int y, int ray, int step) {
+    player_.pickScripted({x, y, ray, step});
+    state_.settings().showRay = true;
+}
+
+namespace {
+
+/// A Shift+click on the image (outside the inspector and the panels) picks the pixel for the
+/// ray playback; a Ctrl+click is the overlays' pick of a region.
+std::optional<glm::ivec2> shiftClick(int fbWidth, int fbHeight, bool inspectorShown) {
+    ImGuiIO& io = ImGui::GetIO();
+    if (io.WantCaptureMouse || !io.KeyShift || io.KeyCtrl ||
+        !ImGui::IsMouseClicked(ImGuiMouseButton_Left) || !ImGui::IsMousePosValid())
+        return std::nullopt;
+    const int x = int(io.MousePos.x * io.DisplayFramebufferScale.x);
+    const int y = int(io.MousePos.y * io.DisplayFramebufferScale.y);
+    if (x < 0 || y < 0 || x >= fbWidth || y >= fbHeight) return std::nullopt;
+    // The inspector takes the whole height of the window's right part.
+    if (inspectorShown && x >= inspector::Inspector::viewport(fbWidth, fbHeight).x0)
+        return std::nullopt;
+    return glm::ivec2(x, y);
+}
+
+}  // namespace
 
 void ViewerApp::frame(int fbWidth, int fbHeight) {
     // 1. Poll: the structure and the image the workers finished since the last frame.
@@ -53,6 +80,24 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     }
     handleKeys(state_);
 
+    // 2b. Ray playback: a Shift+click picks a pixel; the pick is traced, traced again after a
+    // rebuild, and played on the frame's clock. The current region is the selection, so the
+    // inspector highlights it.
+    if (std::optional<glm::ivec2> px = shiftClick(fbWidth, fbHeight, inspector_->shown())) {
+        player_.pick(px->x, px->y);
+        s.showRay = true;
+    }
+    const Clock::time_point now = Clock::now();
+    const double dt = std::chrono::duration<double>(now - lastFrame_).count();
+    lastFrame_ = now;
+    player_.update(state_, std::min(dt, 0.5));
+    const WalkEvent* region = player_.playback().region();
+    const int64_t played = region ? int64_t(region->a) : -1;
+    if (played != playedRegion_) {
+        if (played >= 0 || selectedRegion() == playedRegion_) selectRegion(played);
+        playedRegion_ = played;
+    }
+
     // 3. Panels: each reads and acts on the state (panels/). An inspector view, a panel showing
     // a texture of its own drawing, goes in drawPanels' list and calls
     // panels_.invalidate(its window's ID) whenever that texture's pixels change.
@@ -63,6 +108,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         if (set.showSelection) overlays_->selectionPanel(&set.showSelection);
     }
     if (s.showInspector) inspector_->panel(&s.showInspector);
+    if (s.showRay) rayPanel(state_, player_, &s.showRay);
     state_.startWork(fbWidth, fbHeight);
     ImGui::Render();
 
@@ -81,7 +127,21 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     if (inspector_->shown()) covered.push_back(inspector::Inspector::viewport(fbWidth, fbHeight));
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale);
 
-    // 4b. The 3D inspector over the right half (the image is not copied under it).
+    // 4b. The 3D inspector over the right half (the image is not copied under it), with the
+    // ray played drawn into its picture.
+    gl::Batch rayLines;
+    if (!player_.playback().empty() && player_.view())
+        rayLines = playback::rayBatch(player_.playback(), *player_.view());
+    if (inspector_->shown()) {
+        auto same = [](const gl::BatchVertex& a, const gl::BatchVertex& b) {
+            return a.position == b.position && a.color == b.color;
+        };
+        if (!std::equal(rayLines.lines.begin(), rayLines.lines.end(), inspectorRay_.lines.begin(),
+                        inspectorRay_.lines.end(), same)) {
+            inspectorRay_ = rayLines;
+            inspector_->setExtraLines(rayLines);
+        }
+    }
     inspector_->draw(fbWidth, fbHeight);
 
     // 5. Overlays: their layers were composited into the image when it was shaded
@@ -98,6 +158,22 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     overlayStat_.ms +=
         std::chrono::duration<double, std::milli>(Clock::now() - selectionStart).count();
 
+    // 5b. The ray played, with the viewer's camera, as the
+    // tracer's rays go through the pixels (gl::worldToClip), left of the inspector.
+    if (!rayLines.empty() && state_.width() > 0 && state_.height() > 0) {
+        if (!rayRenderer_) rayRenderer_ = std::make_unique<gl::BatchRenderer>();
+        const glm::mat4 toClip = playback::imageClipMatrix(
+            state_.camera(), state_.width(), state_.height(), player_.playback(), *player_.view());
+        glViewport(0, 0, fbWidth, fbHeight);
+        if (inspector_->shown()) {
+            const PixelRect r = inspector::Inspector::viewport(fbWidth, fbHeight);
+            glEnable(GL_SCISSOR_TEST);
+            glScissor(0, 0, r.x0, fbHeight);
+        }
+        rayRenderer_->drawNow(rayLines, toClip);
+        glDisable(GL_SCISSOR_TEST);
+    }
+
     // 6. Panel layer: ImGui's panels, each rasterized again only when it changed.
     panels_.render();
 
@@ -111,7 +187,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         }
         notes.pendingScreenshot.clear();
     }
-    settled_ = state_.settledSince() && inspector_->settled();
+    settled_ = state_.settledSince() && inspector_->settled() && !player_.pending() &&
+               !player_.playback().playing();
 }
 
 std::vector<std::string> ViewerApp::applyInspectorShow(const std::vector<std::string>& items) {
@@ -189,8 +266,14 @@ void ViewerApp::overlayInput(int fbWidth, int fbHeight) {
 }
 
 std::vector<std::string> ViewerApp::applyShow(const std::string& list) {
-    // The overlays take their layers; the inspector takes what they leave of its own.
-    return applyInspectorShow(overlay::applyShowList(list, overlays_->options));
+    // The overlays take their layers; the inspector and the ray playback take what they leave.
+    std::vector<std::string> left;
+    for (std::string& item : applyInspectorShow(overlay::applyShowList(list, overlays_->options)))
+        if (item == "ray")
+            state_.settings().showRay = true;
+        else
+            left.push_back(std::move(item));
+    return left;
 }
 
 void ViewerApp::selectRegion(int64_t id) {

@@ -11,13 +11,19 @@
 #include <string>
 #include <vector>
 
+#include "app/viewer/gl/batch.h"
 #include "app/viewer/image_view.h"
 #include "app/viewer/inspector/inspector.h"
 #include "app/viewer/overlay/overlays.h"
 #include "app/viewer/panel_cache.h"
+#include "app/viewer/playback/ray_player.h"
 #include "app/viewer/viewer_state.h"
 
 namespace lancer::viewer {
+
+namespace gl {
+class BatchRenderer;
+}
 
 class ViewerApp {
   public:
@@ -103,6 +109,13 @@ class ViewerApp {
     /// Select region `id` (-1: clear); the Selection panel opens on it.
     void selectRegion(int64_t id);
 
+    /// The ray playback: the picked pixel's tree and the ray played (Shift+click, the Ray
+    /// panel, `--pick`). The current region is the selected region while a ray is played.
+    playback::RayPlayer& rayPlayer() { return player_; }
+    /// Pick pixel (x, y) of the image, select ray `ray` of its tree and stop at step `step`, as
+    /// soon as a structure is on screen (`--pick X Y --ray K --step N`); shows the Ray panel.
+    void pickPixel(int x, int y, int ray = 0, int step = 0);
+
     /// What is built, rendered and shown (what the panels read).
     ViewerState& state() { return state_; }
     const ViewerState& state() const { return state_; }
@@ -129,7 +142,13 @@ class ViewerApp {
         Clock::time_point since = Clock::now();
     } overlayStat_;
     std::unique_ptr<inspector::Inspector> inspector_;
-    PanelCache panels_;  ///< ImGui's panels, each redrawn only when it changed
+    playback::RayPlayer player_;
+    std::unique_ptr<gl::BatchRenderer> rayRenderer_;
+    Clock::time_point lastFrame_ = Clock::now();
+    /// The region the playback selected last (-1: none), so a click elsewhere is not undone.
+    int64_t playedRegion_ = -1;
+    gl::Batch inspectorRay_;  ///< the lines last handed to the inspector
+    PanelCache panels_;       ///< ImGui's panels, each redrawn only when it changed
     bool settled_ = false;
 };
 

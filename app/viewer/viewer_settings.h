@@ -23,6 +23,8 @@ struct ViewerSettings {
     bool showSelection = false;  ///< opened by a pick or --select
     /// The 3D inspector over the right half of the window.
     bool showInspector = false;
+    /// The Ray panel (not saved: it opens with the first pick).
+    bool showRay = false;
     ViewMode mode = ViewMode::Color;
     bool autoScale = true;     ///< heat scale follows the image's largest value
     float heatScale = 100.0f;  ///< counter value at the top of the colour map

@@ -148,6 +148,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             }
         }
         if (v.select >= 0) app.overlays().select(uint32_t(v.select));
+        if (v.pick.size() == 2) app.pickPixel(v.pick[0], v.pick[1], v.pickRay, v.pickStep);
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
         bool replayed = false, droppedScripted = false;
@@ -225,6 +226,10 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                     const StructureView* sv = app.overlays().view();
                     std::cerr << "error: --select: no region " << v.select << " in the structure ("
                               << (sv ? sv->regionCount() : 0) << " regions)\n";
+                    status = 2;
+                }
+                if (v.pick.size() == 2 && app.rayPlayer().playback().empty()) {
+                    std::cerr << "error: --pick: " << app.rayPlayer().note() << "\n";
                     status = 2;
                 }
                 if (!v.screenshot.empty()) {

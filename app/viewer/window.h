@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "app/cli/options.h"
 
@@ -25,8 +26,14 @@ struct ViewOptions {
     bool hidePanels = false;  ///< start with the panels hidden (Tab shows them)
     /// The layers shown (DESIGN.md section 6: a comma list, "none" for none); empty: the
     /// saved ones.
-    std::string show;
     int64_t select = -1;  ///< a region id to select once the structure is built; -1: none
+    /// `--pick X Y`: the pixel whose ray tree is played (empty: none).
+    std::vector<int> pick;
+    int pickRay = 0;   ///< `--ray K`: the ray of the tree played
+    int pickStep = 0;  ///< `--step N` with --pick: the step the playback stops at
+    /// `--show LIST` (docs/design.md section 6: a comma list, "none" for none); empty: the
+    /// saved ones.
+    std::string show;
 };
 
 /// What runViewer returns when no window can be opened (no display, no OpenGL 3.3).

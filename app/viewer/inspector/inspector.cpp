@@ -347,7 +347,14 @@ void Inspector::render() {
     batches_->draw(*lines_, toClip, o);
     // The selection over everything: it must be found even behind a surface.
     batches_->draw(*selection_, toClip, {});
+    // Lines another room adds (the ray played), over everything as the selection is.
+    if (!extra_.empty()) batches_->drawNow(extra_, toClip, {});
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void Inspector::setExtraLines(gl::Batch batch) {
+    extra_ = std::move(batch);
+    dirtyPicture_ = true;
 }
 
 void Inspector::draw(int fbWidth, int fbHeight) {

@@ -61,6 +61,9 @@ class Inspector {
     /// Draw into framebuffer 0 of fbWidth x fbHeight, in viewport(). Only re-rendered when
     /// something changed; otherwise the last picture is copied.
     void draw(int fbWidth, int fbHeight);
+    /// World-space lines drawn over the picture, in front of everything (the ray playback's
+    /// region and ray); an empty batch draws nothing. Re-renders the picture.
+    void setExtraLines(gl::Batch batch);
     /// The Inspector panel: its layers, colours, level range, slice slab, cap and counts.
     void panel(bool* open);
 
@@ -95,6 +98,7 @@ class Inspector {
     bool dragging_ = false;  ///< a drag that began in the inspector is under way
     int dragButton_ = -1;
 
+    gl::Batch extra_;  ///< setExtraLines()
     SurfaceTracer tracer_;
     std::optional<SurfaceImage> surfaces_;  ///< the last traced surfaces
     bool surfacesRequested_ = false;

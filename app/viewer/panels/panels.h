@@ -2,6 +2,7 @@
 // and acting on the ViewerState. The frame (viewer_app.cpp) calls drawPanels() once.
 #pragma once
 
+#include "app/viewer/playback/ray_player.h"
 #include "app/viewer/viewer_state.h"
 
 namespace lancer::viewer {
@@ -20,5 +21,8 @@ void cameraPanel(ViewerState& st);
 void statisticsPanel(ViewerState& st);
 /// Colour or heat map, its scale and colour bar, the pixel under the cursor, screenshots.
 void viewPanel(ViewerState& st);
+/// The picked pixel's ray tree and the playback of one ray: transport, speed, the step list
+/// (the lines of `lancer trace`), old and new counts after a rebuild, copy as trace command.
+void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open);
 
 }  // namespace lancer::viewer

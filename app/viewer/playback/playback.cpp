@@ -1,0 +1,184 @@
+#include "app/viewer/playback/playback.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace lancer::viewer::playback {
+
+WalkCounts countsOf(const TracedRay& r) {
+    WalkCounts c;
+    for (const WalkEvent& e : r.events) {
+        if (e.kind == WalkEvent::PrimTest) ++c.primTests;
+        if (e.kind == WalkEvent::MailboxHit) ++c.mailboxHits;
+        if (e.kind == WalkEvent::Region) ++c.regions;
+    }
+    return c;
+}
+
+void RayPlayback::setTree(const PickedPixel& pixel, RayTree tree) {
+    pixel_ = pixel;
+    tree_ = std::move(tree);
+    previous_.clear();
+    playing_ = false;
+    carried_ = 0.0;
+    if (!empty()) setState(0, 0);
+}
+
+void RayPlayback::retrace(RayTree tree) {
+    previous_.clear();
+    for (const TracedRay& r : tree_.rays) previous_.push_back(countsOf(r));
+    const PlaybackState was = state_;
+    tree_ = std::move(tree);
+    if (empty()) return;
+    setState(std::min(was.ray, int(tree_.rays.size()) - 1), std::max(was.step, 0));
+}
+
+void RayPlayback::clear() {
+    tree_ = RayTree{};
+    steps_.clear();
+    previous_.clear();
+    state_ = PlaybackState{};
+    playing_ = false;
+}
+
+void RayPlayback::setState(int ray, int step) {
+    state_.ray = ray;
+    steps_ = tree_.rays[size_t(ray)].regionSteps();
+    const size_t events = tree_.rays[size_t(ray)].events.size();
+    if (steps_.empty()) {
+        // A ray that walks no region (the light buffer cleared it, or it misses the structure):
+        // its one state shows all of its events.
+        state_.step = -1;
+        state_.eventBegin = 0;
+        state_.eventEnd = events;
+        return;
+    }
+    state_.step = std::clamp(step, 0, int(steps_.size()) - 1);
+    // A step runs from its Region event to the next one; the last step takes the ray's end.
+    state_.eventBegin = steps_[size_t(state_.step)];
+    state_.eventEnd =
+        size_t(state_.step) + 1 < steps_.size() ? steps_[size_t(state_.step) + 1] : events;
+}
+
+void RayPlayback::selectRay(int k) {
+    if (empty()) return;
+    setState(std::clamp(k, 0, int(tree_.rays.size()) - 1), 0);
+    playing_ = false;
+}
+
+void RayPlayback::seek(int k) {
+    if (empty()) return;
+    setState(state_.ray, k);
+}
+
+bool RayPlayback::forward() {
+    if (empty() || state_.step + 1 >= stepCount()) return false;
+    setState(state_.ray, state_.step + 1);
+    return true;
+}
+
+bool RayPlayback::back() {
+    if (empty() || state_.step <= 0) return false;
+    setState(state_.ray, state_.step - 1);
+    return true;
+}
+
+void RayPlayback::play() {
+    if (empty()) return;
+    // Play from the start once the end was reached, as a media player does.
+    if (state_.step + 1 >= stepCount()) first();
+    playing_ = stepCount() > 1;
+    carried_ = 0.0;
+}
+
+void RayPlayback::setSpeed(double stepsPerSecond) {
+    speed_ = std::clamp(stepsPerSecond, 0.1, 100.0);
+}
+
+bool RayPlayback::advance(double seconds) {
+    if (!playing_) return false;
+    carried_ += std::max(seconds, 0.0) * speed_;
+    bool moved = false;
+    while (carried_ >= 1.0) {
+        carried_ -= 1.0;
+        if (!forward()) {
+            playing_ = false;
+            break;
+        }
+        moved = true;
+    }
+    if (state_.step + 1 >= stepCount()) playing_ = false;
+    return moved;
+}
+
+const WalkEvent* RayPlayback::region() const {
+    if (empty() || state_.step < 0) return nullptr;
+    return &ray().events[state_.eventBegin];
+}
+
+std::optional<WalkCounts> RayPlayback::previousCounts(int k) const {
+    if (k < 0 || size_t(k) >= previous_.size()) return std::nullopt;
+    return previous_[size_t(k)];
+}
+
+std::vector<SpanRow> stepSpans(const RayPlayback& play) {
+    std::vector<SpanRow> rows;
+    if (play.empty() || play.state().step < 0) return rows;
+    const std::vector<WalkEvent>& ev = play.ray().events;
+    for (size_t i = play.state().eventBegin; i < play.state().eventEnd; ++i) {
+        const WalkEvent& e = ev[i];
+        if (e.kind == WalkEvent::PrimTest) {
+            rows.push_back({e.a, false, e.spans});
+        } else if (e.kind == WalkEvent::MailboxHit) {
+            // The mailbox holds the spans of this primitive's last test along the ray.
+            SpanRow r{e.a, true, {}};
+            for (size_t j = i; j-- > 0;)
+                if (ev[j].kind == WalkEvent::PrimTest && ev[j].a == e.a) {
+                    r.spans = ev[j].spans;
+                    break;
+                }
+            rows.push_back(std::move(r));
+        } else if (e.kind == WalkEvent::Spans) {
+            rows.push_back({kNoPrim, false, e.spans});
+        }
+    }
+    return rows;
+}
+
+namespace {
+
+/// A word or a path as one shell argument: quoted unless made of safe characters only.
+std::string shellWord(const std::string& s) {
+    const bool safe = !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) ||
+               std::string("-_./:,=+@").find(c) != std::string::npos;
+    });
+    if (safe) return s;
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+}  // namespace
+
+std::string traceCommand(const std::string& scene, const std::string& cameraFile,
+                         const PickedPixel& px, const BuildParams& b, const ShadingOptions& sh) {
+    std::ostringstream os;
+    os.precision(17);
+    os << "lancer trace " << shellWord(scene) << " --camera " << shellWord(cameraFile)
+       << " --width " << px.width << " --height " << px.height << " --pixel " << px.x << " " << px.y
+       << " --scheme " << schemeName(b.scheme) << " --max-level " << b.maxLevel << " --max-objects "
+       << b.maxObjects << " --step " << stepName(b.step) << " --delta " << b.delta
+       << " --bsp-heuristic " << heuristicName(b.heuristic) << " --split-axes "
+       << splitAxesName(b.splitAxes) << " --irregular-frame "
+       << irregularFrameName(b.irregularFrame) << " --bounces " << sh.bounces << " --offset "
+       << sh.offsetScale;
+    if (b.fullTable) os << " --full-table";
+    if (!b.mailboxes) os << " --no-mailbox";
+    if (!b.lightBuffer) os << " --no-light-buffer";
+    if (!sh.shadows) os << " --no-shadows";
+    return os.str();
+}
+
+}  // namespace lancer::viewer::playback

@@ -1,0 +1,237 @@
+// Ray playback (playback.h): step k of every ray is the k-th region event `lancer trace --json`
+// prints for the same scene, size, parameters and pixel, with the corners the playback draws
+// (both schemes, shadow and reflection rays included); stepping back and forth returns the same
+// states; playing takes `speed` steps a second and stops at the last; a retrace keeps the old
+// walks' counts.
+#include "app/viewer/playback/playback.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "app/cli/options.h"
+#include "engine/accel/structure_view.h"
+#include "engine/scene/loader.h"
+
+namespace lancer::viewer::playback {
+namespace {
+
+std::string run(const std::string& cmd) {
+    std::string out;
+    FILE* p = popen(cmd.c_str(), "r");
+    if (!p) return out;
+    char buf[65536];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+    pclose(p);
+    return out;
+}
+
+struct Picked {
+    int x, y;
+    RayTree tree;
+};
+
+/// Pixels of the scene (a coarse sweep) whose trees hold a ray of `kind` that walks at least one
+/// region; the first such pixel.
+std::optional<Picked> findPixel(const Scene& scene, const Accelerator& accel,
+                                const ShadingOptions& sh, int w, int h, RayKind kind) {
+    for (int y = h / 16; y < h; y += h / 8)
+        for (int x = w / 16; x < w; x += w / 8) {
+            RayTree t = tracePixel(scene, accel, sh, scene.camera, x, y, w, h);
+            for (const TracedRay& r : t.rays)
+                if (r.kind == kind && r.regionSteps().size() > 1) return Picked{x, y, std::move(t)};
+        }
+    return std::nullopt;
+}
+
+class PlaybackTrace : public ::testing::TestWithParam<SchemeKind> {};
+
+TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
+    const std::string spec = "builtin:default";
+    cli::CommonOptions o;
+    o.scene = spec;
+    o.build.scheme = GetParam();
+    Scene scene = loadScene(spec);
+    auto accel = buildAccelerator(scene, o.build);
+    int w, h;
+    cli::resolveSize(o, scene, w, h);
+    const StructureView view(scene, *accel);
+    int compared = 0;
+    for (RayKind kind : {RayKind::Primary, RayKind::Shadow, RayKind::Reflection}) {
+        std::optional<Picked> p = findPixel(scene, *accel, o.render.shading, w, h, kind);
+        ASSERT_TRUE(p) << "no pixel with a " << rayKindName(kind) << " ray that walks";
+        RayPlayback play;
+        play.setTree({p->x, p->y, w, h}, std::move(p->tree));
+        const nlohmann::json j = nlohmann::json::parse(run(
+            std::string(LANCER_BINARY) + " trace " + spec + " --scheme " + schemeName(GetParam()) +
+            " --pixel " + std::to_string(p->x) + " " + std::to_string(p->y) + " --json"));
+        ASSERT_EQ(j["width"].get<int>(), w);
+        ASSERT_EQ(j["rays"].size(), play.tree().rays.size());
+        for (size_t k = 0; k < play.tree().rays.size(); ++k) {
+            play.selectRay(int(k));
+            const nlohmann::json& jr = j["rays"][k];
+            EXPECT_EQ(jr["kind"].get<std::string>(), rayKindName(play.ray().kind));
+            std::vector<nlohmann::json> regions;
+            for (const nlohmann::json& e : jr["events"])
+                if (e["event"] == "region") regions.push_back(e);
+            ASSERT_EQ(int(regions.size()), play.stepCount()) << "ray " << k;
+            for (int s = 0; s < play.stepCount(); ++s) {
+                play.seek(s);
+                const WalkEvent* e = play.region();
+                ASSERT_NE(e, nullptr);
+                EXPECT_EQ(e->a, regions[size_t(s)]["region"].get<uint32_t>());
+                EXPECT_EQ(e->t0, regions[size_t(s)]["t0"].get<double>());
+                if (!regions[size_t(s)]["t1"].is_null())
+                    EXPECT_EQ(e->t1, regions[size_t(s)]["t1"].get<double>());
+                // The region drawn is the one the trace describes: the same 8 corners.
+                const std::array<Vec3, 8> c = view.regionCorners(e->a);
+                const nlohmann::json& jc = regions[size_t(s)]["corners"];
+                ASSERT_EQ(jc.size(), 8u);
+                for (size_t i = 0; i < 8; ++i)
+                    for (int a = 0; a < 3; ++a) EXPECT_EQ(c[i][a], jc[i][size_t(a)].get<double>());
+                ++compared;
+            }
+        }
+    }
+    EXPECT_GT(compared, 3);
+}
+
+INSTANTIATE_TEST_SUITE_P(Schemes, PlaybackTrace,
+                         ::testing::Values(SchemeKind::Regular, SchemeKind::Irregular),
+                         [](const auto& info) { return std::string(schemeName(info.param)); });
+
+/// A pixel's tree on the irregular scheme (whose primary rays walk several slabs), with a
+/// primary ray of several steps.
+RayPlayback someRay() {
+    cli::CommonOptions o;
+    o.build.scheme = SchemeKind::Irregular;
+    Scene scene = loadScene("builtin:default");
+    auto accel = buildAccelerator(scene, o.build);
+    int w, h;
+    o.scene = "builtin:default";
+    cli::resolveSize(o, scene, w, h);
+    std::optional<Picked> p;
+    for (int y = 0; y < h && !p; y += h / 16)
+        for (int x = 0; x < w && !p; x += w / 16) {
+            RayTree t = tracePixel(scene, *accel, o.render.shading, scene.camera, x, y, w, h);
+            if (t.rays[0].regionSteps().size() > 2) p = Picked{x, y, std::move(t)};
+        }
+    RayPlayback play;
+    if (p) play.setTree({p->x, p->y, w, h}, std::move(p->tree));
+    return play;
+}
+
+TEST(Playback, SteppingBackAndForthReturnsTheSameStates) {
+    RayPlayback play = someRay();
+    ASSERT_FALSE(play.empty());
+    ASSERT_GT(play.stepCount(), 2);
+    std::vector<PlaybackState> forward{play.state()};
+    while (play.forward()) forward.push_back(play.state());
+    EXPECT_EQ(int(forward.size()), play.stepCount());
+    EXPECT_FALSE(play.forward());  // at the end: no move
+    EXPECT_EQ(play.state(), forward.back());
+    for (int k = int(forward.size()) - 1; k >= 0; --k) {
+        EXPECT_EQ(play.state(), forward[size_t(k)]) << "step " << k;
+        if (k > 0) EXPECT_TRUE(play.back());
+    }
+    EXPECT_FALSE(play.back());
+    // Steps tile the ray's events from its first region on, each opening with its Region event.
+    for (size_t k = 0; k < forward.size(); ++k) {
+        EXPECT_EQ(play.ray().events[forward[k].eventBegin].kind, WalkEvent::Region);
+        if (k + 1 < forward.size()) EXPECT_EQ(forward[k].eventEnd, forward[k + 1].eventBegin);
+    }
+    EXPECT_EQ(forward.back().eventEnd, play.ray().events.size());
+    play.last();
+    EXPECT_EQ(play.state(), forward.back());
+    play.first();
+    EXPECT_EQ(play.state(), forward.front());
+}
+
+TEST(Playback, PlayTakesSpeedStepsASecondAndStopsAtTheLast) {
+    RayPlayback play = someRay();
+    ASSERT_GT(play.stepCount(), 2);
+    play.setSpeed(2.0);
+    play.play();
+    EXPECT_TRUE(play.playing());
+    EXPECT_FALSE(play.advance(0.25));  // half a step
+    EXPECT_EQ(play.state().step, 0);
+    EXPECT_TRUE(play.advance(0.75));  // 1.5 steps more: two whole steps taken in all
+    EXPECT_EQ(play.state().step, 2);
+    play.pause();
+    EXPECT_FALSE(play.advance(10.0));
+    EXPECT_EQ(play.state().step, 2);
+    play.play();
+    play.advance(1000.0);
+    EXPECT_EQ(play.state().step, play.stepCount() - 1);
+    EXPECT_FALSE(play.playing());
+}
+
+TEST(Playback, RetraceKeepsTheRayAndStepAndTheOldCounts) {
+    RayPlayback play = someRay();
+    ASSERT_GT(play.stepCount(), 2);
+    const RayTree before = play.tree();
+    play.seek(2);
+    // The same pixel in a structure of another scheme: another walk of the same rays.
+    cli::CommonOptions o;
+    o.build.scheme = SchemeKind::Brute;
+    Scene scene = loadScene("builtin:default");
+    auto accel = buildAccelerator(scene, o.build);
+    play.retrace(tracePixel(scene, *accel, o.render.shading, scene.camera, play.pixel().x,
+                            play.pixel().y, play.pixel().width, play.pixel().height));
+    EXPECT_EQ(play.state().ray, 0);
+    EXPECT_EQ(play.state().step, 0);  // brute force walks one region: step 2 clamps to it
+    ASSERT_TRUE(play.previousCounts(0));
+    EXPECT_EQ(*play.previousCounts(0), countsOf(before.rays[0]));
+    EXPECT_EQ(countsOf(play.ray()).regions, 1u);
+    EXPECT_GT(play.previousCounts(0)->regions, 1u);
+}
+
+TEST(Playback, StepSpansAreTheStepsTestsAndTheRegionTree) {
+    RayPlayback play = someRay();
+    ASSERT_GT(play.stepCount(), 0);
+    size_t tests = 0, rows = 0, combined = 0;
+    for (int k = 0; k < play.stepCount(); ++k) {
+        play.seek(k);
+        const std::vector<SpanRow> r = stepSpans(play);
+        rows += r.size();
+        for (size_t i = play.state().eventBegin; i < play.state().eventEnd; ++i) {
+            const WalkEvent& e = play.ray().events[i];
+            tests += e.kind == WalkEvent::PrimTest || e.kind == WalkEvent::MailboxHit;
+            combined += e.kind == WalkEvent::Spans;
+        }
+        for (const SpanRow& row : r)
+            if (row.prim != kNoPrim && !row.mailbox) {
+                // A tested primitive's row holds the spans its test reported.
+                bool seen = false;
+                for (size_t i = play.state().eventBegin; i < play.state().eventEnd; ++i) {
+                    const WalkEvent& e = play.ray().events[i];
+                    seen = seen || (e.kind == WalkEvent::PrimTest && e.a == row.prim &&
+                                    e.spans == row.spans);
+                }
+                EXPECT_TRUE(seen);
+            }
+    }
+    EXPECT_GT(tests, 0u);
+    EXPECT_EQ(rows, tests + combined);
+}
+
+TEST(Playback, TraceCommandNamesEveryParameter) {
+    BuildParams b;
+    b.scheme = SchemeKind::Irregular;
+    b.mailboxes = false;
+    ShadingOptions sh;
+    sh.bounces = 1;
+    const std::string cmd = traceCommand("my scene.csg", "/tmp/cam.json", {3, 4, 640, 480}, b, sh);
+    EXPECT_EQ(cmd.rfind("lancer trace 'my scene.csg' --camera /tmp/cam.json --width 640 "
+                        "--height 480 --pixel 3 4 --scheme irregular",
+                        0),
+              0u)
+        << cmd;
+    EXPECT_NE(cmd.find(" --bounces 1"), std::string::npos);
+    EXPECT_NE(cmd.find(" --no-mailbox"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace lancer::viewer::playback

@@ -1,0 +1,152 @@
+#include "app/viewer/playback/ray_drawing.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "app/viewer/gl/transforms.h"
+#include "engine/accel/regular/regular_grid.h"
+
+namespace lancer::viewer::playback {
+
+namespace {
+
+glm::vec3 f(const Vec3& v) { return glm::vec3(v); }
+
+/// Colour of a ray by kind (faint when it is not the ray played).
+glm::vec3 kindColor(RayKind k) {
+    switch (k) {
+        case RayKind::Primary:
+            return {1.0f, 1.0f, 1.0f};
+        case RayKind::Shadow:
+            return {0.95f, 0.95f, 0.3f};
+        case RayKind::Reflection:
+            return {0.4f, 0.7f, 1.0f};
+        case RayKind::Refraction:
+            return {0.5f, 1.0f, 0.8f};
+    }
+    return {1.0f, 1.0f, 1.0f};
+}
+
+/// A small 3D cross at p.
+void cross(gl::Batch& b, const Vec3& p, double r, gl::Rgba8 c) {
+    for (int a = 0; a < 3; ++a) {
+        Vec3 d(0.0);
+        d[a] = r;
+        b.line(f(p - d), f(p + d), c);
+    }
+}
+
+/// The largest t at which the ray is still within reach of the corners (a region or structure
+/// reaching infinity is clipped to the structure's bounds, so its corners are finite).
+double farT(const TracedRay& r, const std::array<Vec3, 8>& corners) {
+    const double dd = glm::dot(r.direction, r.direction);
+    double t = 0.0;
+    for (const Vec3& c : corners) t = std::max(t, glm::dot(c - r.origin, r.direction) / dd);
+    return t;
+}
+
+/// Where a ray's drawing ends: its hit, its tmax, or where it leaves the structure.
+double endT(const TracedRay& r, const StructureView& view) {
+    double t = r.tmax;
+    if (r.hit.valid()) t = std::min(t, r.hit.t);
+    if (!std::isfinite(t)) t = farT(r, view.structureCorners());
+    return std::max(t, r.tmin);
+}
+
+}  // namespace
+
+std::optional<std::array<Vec3, 8>> currentCorners(const RayPlayback& play,
+                                                  const StructureView& view) {
+    const WalkEvent* e = play.region();
+    if (!e || e->a >= view.regionCount()) return std::nullopt;
+    return view.regionCorners(e->a);
+}
+
+gl::Batch rayBatch(const RayPlayback& play, const StructureView& view) {
+    gl::Batch b;
+    if (play.empty()) return b;
+    const Box3 bounds = view.worldBounds();
+    const double size = std::max(glm::length(bounds.hi - bounds.lo), 1e-9);
+    const double mark = 0.015 * size;
+
+    // The pixel's rays, each from its origin, faint; the one played brighter.
+    for (size_t k = 0; k < play.tree().rays.size(); ++k) {
+        const TracedRay& r = play.tree().rays[k];
+        const bool current = int(k) == play.state().ray;
+        const glm::vec3 c = kindColor(r.kind) * (current ? 0.9f : 0.5f);
+        b.line(f(r.origin + r.tmin * r.direction), f(r.origin + endT(r, view) * r.direction),
+               gl::rgba8(c, current ? 0.9f : 0.5f));
+    }
+
+    const TracedRay& ray = play.ray();
+    if (ray.hit.valid()) {
+        const Vec3 p = ray.origin + ray.hit.t * ray.direction;
+        cross(b, p, mark, gl::rgba8(kSegmentColor));
+        b.line(f(p), f(p + 6.0 * mark * glm::normalize(ray.normal)), gl::rgba8(kNormalColor));
+    }
+
+    const std::optional<std::array<Vec3, 8>> corners = currentCorners(play, view);
+    if (!corners) return b;
+    std::array<glm::vec3, 8> cf;
+    for (int i = 0; i < 8; ++i) cf[size_t(i)] = f((*corners)[size_t(i)]);
+    b.box(cf, gl::rgba8(kRegionColor));
+
+    // The ray's stretch inside the region.
+    const WalkEvent& region = *play.region();
+    const double t1 = std::isfinite(region.t1) ? region.t1 : farT(ray, *corners);
+    b.line(f(ray.origin + region.t0 * ray.direction), f(ray.origin + t1 * ray.direction),
+           gl::rgba8(kSegmentColor));
+
+    // The step's scheme events: why the next region is the next.
+    const PlaybackState& s = play.state();
+    for (size_t i = s.eventBegin; i < s.eventEnd; ++i) {
+        const WalkEvent& e = ray.events[i];
+        if (e.kind == WalkEvent::Exit) {
+            cross(b, e.point, mark, gl::rgba8(kPointerColor));
+        } else if (e.kind == WalkEvent::Pointer && e.corner >= 0 && e.corner < 8) {
+            // The corner whose pointer the walk followed, and the step to the next region.
+            const Vec3 c = (*corners)[size_t(e.corner)];
+            cross(b, c, 2.0 * mark, gl::rgba8(kPointerColor));
+            if (e.b < view.regionCount()) {
+                const std::array<Vec3, 8> next = view.regionCorners(e.b);
+                Vec3 centre(0.0);
+                for (const Vec3& p : next) centre += p / 8.0;
+                b.line(f(c), f(centre), gl::rgba8(kPointerColor, 0.8f));
+            }
+        } else if (e.kind == WalkEvent::Push) {
+            cross(b, e.point, mark, gl::rgba8(kCellColor));
+        } else if (e.kind == WalkEvent::Lookup || e.kind == WalkEvent::IndexStep) {
+            // The directory cell looked up (or stepped into), as a box of the grid's planes.
+            if (const RegularGrid* g = view.regular()) {
+                bool inside = true;
+                for (int a = 0; a < 3; ++a) inside = inside && e.cell[a] < g->cells(a);
+                if (inside) {
+                    Vec3 lo, hi;
+                    for (int a = 0; a < 3; ++a) {
+                        lo[a] = g->plane(a, e.cell[a]);
+                        hi[a] = g->plane(a, e.cell[a] + 1);
+                    }
+                    b.box(f(lo), f(hi), gl::rgba8(kCellColor));
+                }
+            }
+            if (e.kind == WalkEvent::Lookup) cross(b, e.point, mark, gl::rgba8(kCellColor));
+        }
+    }
+    return b;
+}
+
+glm::mat4 imageClipMatrix(const Camera& camera, int width, int height, const RayPlayback& play,
+                          const StructureView& view) {
+    const Box3 b = view.worldBounds();
+    const double size = std::max(glm::length(b.hi - b.lo), 1e-9);
+    const gl::ImageProjector proj(camera, width, height);
+    double far = 0.0;
+    for (const Vec3& c : view.structureCorners()) far = std::max(far, proj.depth(c));
+    for (const TracedRay& r : play.tree().rays) far = std::max(far, proj.depth(r.origin));
+    // Lines crossing the eye's plane are clipped by GL at the near plane, close to the eye.
+    const bool ortho = camera.projection == Projection::Orthographic;
+    return gl::worldToClip(camera, width, height, ortho ? -4.0 * size : 1e-4 * size,
+                           far + 4.0 * size);
+}
+
+}  // namespace lancer::viewer::playback

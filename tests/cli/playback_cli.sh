@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# The viewer's ray playback from the command line: `--pick X Y [--ray K] --step N` under Xvfb
+# stops the playback at step N of ray K (the screenshot is written, the run succeeds), a pick or
+# a ray or step that does not exist fails with status 2 naming the option, and `--step` keeps
+# its meaning of next-cell method (exact, push) when it is a word. Usage: playback_cli.sh LANCER
+# SOURCE_DIR
+set -euo pipefail
+lancer=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp"
+fails() {  # fails WHAT-THE-MESSAGE-NAMES COMMAND...
+  local want=$1 status=0
+  shift
+  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt" || status=$?
+  if [ "$status" != 2 ]; then
+    echo "expected status 2 from: $* (got $status)" >&2
+    cat "$tmp/err.txt" >&2
+    exit 1
+  fi
+  grep -q -- "$want" "$tmp/err.txt" || { cat "$tmp/err.txt" >&2; exit 1; }
+}
+# Checked before any window opens.
+fails "--step 3" "$lancer" view builtin:default --step 3 --frames 1 --ini none
+fails "--step sideways" "$lancer" view builtin:default --step sideways --frames 1 --ini none
+fails "--pick" "$lancer" view builtin:default --ray 1 --frames 1 --ini none
+if ! command -v xvfb-run >/dev/null; then
+  echo "xvfb-run is not installed (apt-get install xvfb)" >&2
+  exit 1
+fi
+run() { timeout 240 xvfb-run -a -s "-screen 0 800x600x24" "$lancer" view builtin:default \
+  --width 640 --height 400 --frames 3 --ini none "$@"; }
+fails "--show" run --show rays
+fails "--pick" run --pick 5000 10
+fails "--ray 999" run --pick 320 200 --ray 999
+fails "--step 100000" run --pick 320 200 --step 100000
+run --scheme irregular --pick 320 200 --step 2 --show ray,inspector --screenshot "$tmp/p.png"
+test -s "$tmp/p.png"
