@@ -183,7 +183,8 @@ int main(int argc, char** argv) {
         std::string lower;
         for (char c : stepArg) lower += char(std::tolower(static_cast<unsigned char>(c)));
         if (lower == "exact" || lower == "push") {
-            viewOpt.build.step = lower == "exact" ? StepMethod::Exact : StepMethod::Push;
+            viewOpt.knobs.build.regular.step =
+                lower == "exact" ? StepMethod::Exact : StepMethod::Push;
             stepIsMethod = true;
         } else if (stepArg.find_first_not_of("0123456789") == std::string::npos &&
                    stepArg.size() < 10) {

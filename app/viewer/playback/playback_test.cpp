@@ -52,15 +52,15 @@ TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
     const std::string spec = "builtin:default";
     cli::CommonOptions o;
     o.scene = spec;
-    o.build.scheme = GetParam();
+    o.knobs.build.scheme = GetParam();
     Scene scene = loadScene(spec);
-    auto accel = buildAccelerator(scene, o.build);
+    auto accel = buildAccelerator(scene, o.knobs.build);
     int w, h;
     cli::resolveSize(o, scene, w, h);
     const StructureView view(scene, *accel);
     int compared = 0;
     for (RayKind kind : {RayKind::Primary, RayKind::Shadow, RayKind::Reflection}) {
-        std::optional<Picked> p = findPixel(scene, *accel, o.render.shading, w, h, kind);
+        std::optional<Picked> p = findPixel(scene, *accel, o.knobs.shading, w, h, kind);
         ASSERT_TRUE(p) << "no pixel with a " << rayKindName(kind) << " ray that walks";
         RayPlayback play;
         play.setTree({p->x, p->y, w, h}, std::move(p->tree));
@@ -106,16 +106,16 @@ INSTANTIATE_TEST_SUITE_P(Schemes, PlaybackTrace,
 /// primary ray of several steps.
 RayPlayback someRay() {
     cli::CommonOptions o;
-    o.build.scheme = SchemeKind::Irregular;
+    o.knobs.build.scheme = SchemeKind::Irregular;
     Scene scene = loadScene("builtin:default");
-    auto accel = buildAccelerator(scene, o.build);
+    auto accel = buildAccelerator(scene, o.knobs.build);
     int w, h;
     o.scene = "builtin:default";
     cli::resolveSize(o, scene, w, h);
     std::optional<Picked> p;
     for (int y = 0; y < h && !p; y += h / 16)
         for (int x = 0; x < w && !p; x += w / 16) {
-            RayTree t = tracePixel(scene, *accel, o.render.shading, scene.camera, x, y, w, h);
+            RayTree t = tracePixel(scene, *accel, o.knobs.shading, scene.camera, x, y, w, h);
             if (t.rays[0].regionSteps().size() > 2) p = Picked{x, y, std::move(t)};
         }
     RayPlayback play;
@@ -175,10 +175,10 @@ TEST(Playback, RetraceKeepsTheRayAndStepAndTheOldCounts) {
     play.seek(2);
     // The same pixel in a structure of another scheme: another walk of the same rays.
     cli::CommonOptions o;
-    o.build.scheme = SchemeKind::Brute;
+    o.knobs.build.scheme = SchemeKind::Brute;
     Scene scene = loadScene("builtin:default");
-    auto accel = buildAccelerator(scene, o.build);
-    play.retrace(tracePixel(scene, *accel, o.render.shading, scene.camera, play.pixel().x,
+    auto accel = buildAccelerator(scene, o.knobs.build);
+    play.retrace(tracePixel(scene, *accel, o.knobs.shading, scene.camera, play.pixel().x,
                             play.pixel().y, play.pixel().width, play.pixel().height));
     EXPECT_EQ(play.state().ray, 0);
     EXPECT_EQ(play.state().step, 0);  // brute force walks one region: step 2 clamps to it
