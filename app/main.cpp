@@ -94,8 +94,6 @@ int main(int argc, char** argv) {
     view->add_option("--step", stepArg,
                      "Regular scheme's next-cell method (exact or push); with --pick, a number: "
                      "the playback step to stop at (0: the ray's first region)");
-    view->add_option("--show", vopt.show,
-                     "Comma list of what to show: ray (the Ray panel, with --pick), inspector");
 #endif
 
     std::string out;
