@@ -107,8 +107,10 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         if (set.showOverlays) overlays_->panel(&set.showOverlays);
         if (set.showSelection) overlays_->selectionPanel(&set.showSelection);
     }
-    if (s.showInspector) inspector_->panel(&s.showInspector);
-    if (s.showRay) rayPanel(state_, player_, &s.showRay);
+    if (!state_.panelsHidden()) {  // Tab and --hide-panels hide every panel
+        if (s.showInspector) inspector_->panel(&s.showInspector);
+        if (s.showRay) rayPanel(state_, player_, &s.showRay);
+    }
     state_.startWork(fbWidth, fbHeight);
     ImGui::Render();
 

@@ -769,7 +769,9 @@ TEST_F(ViewerFrames, TheErrorLineIsReservedSoTheControlsStayPut) {
 // Tab hides every panel (and the menu bar): the window shows the render alone; Tab again
 // brings them back.
 TEST_F(ViewerFrames, TabHidesThePanels) {
+    settings_.showRay = true;  // the playback's panel hides with the others
     runUntilSettled();
+    EXPECT_TRUE(panelWindow("Ray"));
     ImGuiIO& io = ImGui::GetIO();
     io.KeyMap[ImGuiKey_Tab] = 9;  // as a platform backend maps its keys
     auto tab = [&] {
@@ -794,6 +796,7 @@ TEST_F(ViewerFrames, TabHidesThePanels) {
     EXPECT_FALSE(app_->state().panelsHidden());
     runUntilSettled();
     EXPECT_TRUE(panelWindow("Parameters"));
+    EXPECT_TRUE(panelWindow("Ray"));
 }
 
 // What the panels said of a scene goes with it: the speedup result, a camera paste's error and

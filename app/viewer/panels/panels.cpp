@@ -58,6 +58,7 @@ void menuBar(ViewerState& st) {
         ImGui::MenuItem("View", nullptr, &s.showView);
         ImGui::MenuItem("Overlays", nullptr, &s.showOverlays);
         ImGui::MenuItem("Selection", nullptr, &s.showSelection);
+        ImGui::MenuItem("Ray", nullptr, &s.showRay);
         ImGui::Separator();
         bool hidden = st.panelsHidden();
         if (ImGui::MenuItem("Hide all", "Tab", &hidden)) st.setPanelsHidden(hidden);
