@@ -16,45 +16,12 @@
 #include "app/viewer/panel_cache.h"
 #include "app/viewer/viewer_app.h"
 #include "engine/scene/loader.h"
+#include "tests/gl/offscreen_gl.h"
 
 namespace lancer::viewer {
 namespace {
 
-/// An OpenGL 3.3 core context drawing into memory.
-class OffscreenGl {
-  public:
-    OffscreenGl(int w, int h) : w_(w), h_(h), buffer_(size_t(w) * size_t(h) * 4) {
-        const int attribs[] = {OSMESA_FORMAT,
-                               OSMESA_RGBA,
-                               OSMESA_DEPTH_BITS,
-                               0,
-                               OSMESA_PROFILE,
-                               OSMESA_CORE_PROFILE,
-                               OSMESA_CONTEXT_MAJOR_VERSION,
-                               3,
-                               OSMESA_CONTEXT_MINOR_VERSION,
-                               3,
-                               0};
-        ctx_ = OSMesaCreateContextAttribs(attribs, nullptr);
-        if (ctx_ && !OSMesaMakeCurrent(ctx_, buffer_.data(), GL_UNSIGNED_BYTE, w, h)) {
-            OSMesaDestroyContext(ctx_);
-            ctx_ = nullptr;
-        }
-    }
-    ~OffscreenGl() {
-        if (ctx_) OSMesaDestroyContext(ctx_);
-    }
-    bool ok() const { return ctx_ != nullptr; }
-    std::vector<uint8_t> read() const {
-        glFinish();
-        return readFramebuffer(w_, h_);
-    }
-
-  private:
-    int w_, h_;
-    std::vector<uint8_t> buffer_;
-    OSMesaContext ctx_ = nullptr;
-};
+using testing::OffscreenGl;
 
 struct Traced {
     Scene scene;
