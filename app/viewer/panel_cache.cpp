@@ -8,31 +8,25 @@
 #include <unordered_map>
 
 #include "app/viewer/gl.h"
+#include "engine/util/hash.h"
 
 namespace lancer::viewer {
 
 namespace {
 
-/// FNV-1a over bytes, continued from `h`.
-uint64_t hashBytes(uint64_t h, const void* data, size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
-    return h;
-}
-
 /// Everything a draw list draws: vertices, indices and commands (clip rectangles, textures,
 /// counts). Two lists with the same hash draw the same pixels.
 uint64_t hashList(uint64_t h, const ImDrawList& l) {
-    h = hashBytes(h, l.VtxBuffer.Data, size_t(l.VtxBuffer.Size) * sizeof(ImDrawVert));
-    h = hashBytes(h, l.IdxBuffer.Data, size_t(l.IdxBuffer.Size) * sizeof(ImDrawIdx));
+    h = hashBytes(l.VtxBuffer.Data, size_t(l.VtxBuffer.Size) * sizeof(ImDrawVert), h);
+    h = hashBytes(l.IdxBuffer.Data, size_t(l.IdxBuffer.Size) * sizeof(ImDrawIdx), h);
     for (const ImDrawCmd& c : l.CmdBuffer) {
-        h = hashBytes(h, &c.ClipRect, sizeof c.ClipRect);
-        h = hashBytes(h, &c.TextureId, sizeof c.TextureId);
-        h = hashBytes(h, &c.VtxOffset, sizeof c.VtxOffset);
-        h = hashBytes(h, &c.IdxOffset, sizeof c.IdxOffset);
-        h = hashBytes(h, &c.ElemCount, sizeof c.ElemCount);
+        h = hashBytes(&c.ClipRect, sizeof c.ClipRect, h);
+        h = hashBytes(&c.TextureId, sizeof c.TextureId, h);
+        h = hashBytes(&c.VtxOffset, sizeof c.VtxOffset, h);
+        h = hashBytes(&c.IdxOffset, sizeof c.IdxOffset, h);
+        h = hashBytes(&c.ElemCount, sizeof c.ElemCount, h);
         const bool callback = c.UserCallback != nullptr;
-        h = hashBytes(h, &callback, sizeof callback);
+        h = hashBytes(&callback, sizeof callback, h);
     }
     return h;
 }
@@ -99,7 +93,7 @@ const std::vector<PixelRect>& PanelCache::layout(ImDrawData* dd, int fbWidth, in
         q.rect = {std::max(0, int(std::floor(p.x))), std::max(0, int(std::floor(p.y))),
                   std::min(fbWidth, int(std::ceil(p.x + s.x))),
                   std::min(fbHeight, int(std::ceil(p.y + s.y)))};
-        q.hash = 1469598103934665603ull;
+        q.hash = kHashStart;
         for (const ImDrawList* l : r.lists) q.hash = hashList(q.hash, *l);
         r.panel = int(panels_.size());
         panels_.push_back(q);

@@ -9,44 +9,20 @@
 #include "app/viewer/panels/param_controls.h"
 #include "app/viewer/panels/widgets.h"
 #include "engine/scene/builtin_scenes.h"
+#include "engine/util/format.h"
 
 namespace lancer::viewer {
 
 namespace {
 
-std::string humanBytes(size_t b) {
-    char buf[64];
-    if (b < 10 * 1024)
-        std::snprintf(buf, sizeof buf, "%zu B", b);
-    else if (b < 10 * 1024 * 1024)
-        std::snprintf(buf, sizeof buf, "%.1f KiB", double(b) / 1024.0);
-    else
-        std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / (1024.0 * 1024.0));
-    return buf;
-}
-
-/// "builtin:NAME[:SIZE]" split into its name and size (-1: none); false for a file path.
-bool parseBuiltin(const std::string& spec, std::string& name, int& size) {
-    if (spec.rfind("builtin:", 0) != 0) return false;
-    std::string rest = spec.substr(8);
-    size = -1;
-    size_t colon = rest.find(':');
-    if (colon != std::string::npos) {
-        try {
-            size = std::stoi(rest.substr(colon + 1));
-        } catch (...) {
-            size = -1;
-        }
-        rest = rest.substr(0, colon);
+/// The scene spec taken apart when it names a built-in; a malformed size counts as none (the
+/// scene's own error says what is wrong with it).
+std::optional<BuiltinSpec> builtinOf(const std::string& spec) {
+    try {
+        return parseBuiltinSpec(spec);
+    } catch (const SceneError&) {
+        return BuiltinSpec{spec.substr(spec.find(':') + 1, spec.find(':', 8) - 8), std::nullopt};
     }
-    name = rest;
-    return true;
-}
-
-const BuiltinInfo* findBuiltin(const std::string& name) {
-    for (const BuiltinInfo& b : builtinScenes())
-        if (name == b.name) return &b;
-    return nullptr;
 }
 
 }  // namespace
@@ -56,25 +32,21 @@ void parametersPanel(ViewerState& st) {
     PanelNotes& notes = st.notes();
 
     // Scene: a built-in (with its size) or a file.
-    std::string bname;
-    int bsize = -1;
-    const bool isBuiltin = parseBuiltin(s.scene, bname, bsize);
-    const BuiltinInfo* info = isBuiltin ? findBuiltin(bname) : nullptr;
+    const std::optional<BuiltinSpec> spec = builtinOf(s.scene);
+    const BuiltinInfo* info = spec ? findBuiltin(spec->name) : nullptr;
     if (ImGui::BeginCombo("built-in", info ? info->name : "(file)")) {
         for (const BuiltinInfo& b : builtinScenes()) {
-            if (ImGui::Selectable(b.name, info == &b))
-                st.openScene(std::string("builtin:") + b.name);
+            if (ImGui::Selectable(b.name, info == &b)) st.openScene(builtinSpec(b.name));
             if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", b.description);
         }
         ImGui::EndCombo();
     }
     if (info && info->maxSize > info->minSize) {
-        if (notes.builtinSize < 0) notes.builtinSize = bsize >= 0 ? bsize : info->defaultSize;
+        if (notes.builtinSize < 0) notes.builtinSize = spec->size.value_or(info->defaultSize);
         ImGui::SliderInt("size", &notes.builtinSize, info->minSize,
                          std::min(info->maxSize, info->minSize + 64));
         if (ImGui::IsItemDeactivatedAfterEdit())
-            st.openScene("builtin:" + std::string(info->name) + ":" +
-                         std::to_string(notes.builtinSize));
+            st.openScene(builtinSpec(info->name, notes.builtinSize));
     }
     ImGui::SetNextItemWidth(ImGui::CalcItemWidth() - ImGui::CalcTextSize("Open").x -
                             2.0f * ImGui::GetStyle().FramePadding.x -
@@ -98,7 +70,7 @@ void parametersPanel(ViewerState& st) {
         const AccelInfo& ai = b->accel->info();
         ImGui::Text("on screen: %s, built in %.1f ms", schemeName(b->accel->params().scheme),
                     ai.buildMs);
-        ImGui::Text("regions %zu, memory %s", ai.regions, humanBytes(ai.memoryBytes).c_str());
+        ImGui::Text("regions %zu, memory %s", ai.regions, formatBytes(ai.memoryBytes).c_str());
         ImGui::Text("%zu primitives (%d dropped by minimization)", b->scene->prims.size(),
                     b->scene->droppedPrims);
     }
