@@ -201,6 +201,53 @@ TEST(ParamTable, CommandLineSwitchesAndEnumsSetTheKnobs) {
     EXPECT_TRUE(p.o.knobs.shading.refractions);
 }
 
+// BuildParams prints itself as the options that build it again: the knobs of the scheme in
+// use, read back by the command line into the same values.
+TEST(ParamTable, BuildParamsPrintAsTheOptionsThatBuildThemAgain) {
+    BuildParams a;
+    a.scheme = SchemeKind::Regular;
+    a.regular.maxLevel = 17;
+    a.regular.maxObjects = 3;
+    a.regular.step = StepMethod::Push;
+    a.regular.delta = 2.5e-7;
+    a.regular.splitAxes = SplitAxes::Cycle;
+    a.regular.fullTable = true;
+    a.mailboxes = false;
+    BuildParams b;
+    b.scheme = SchemeKind::Irregular;
+    b.irregular.maxObjects = 0;
+    b.irregular.heuristic = BspHeuristic::First;
+    b.irregular.frame = IrregularFrame::Camera;
+    b.lightBuffer = false;
+    for (const BuildParams& want : {a, b, BuildParams{}}) {
+        std::vector<std::string> args = {"render", "x", "--scheme"};
+        std::istringstream words(toString(want));
+        for (std::string w; words >> w;) args.push_back(w);
+        Parsed p(args);
+        ASSERT_EQ(p.error, "") << toString(want);
+        const BuildParams& got = p.o.knobs.build;
+        EXPECT_EQ(got.scheme, want.scheme) << toString(want);
+        EXPECT_EQ(got.mailboxes, want.mailboxes);
+        EXPECT_EQ(got.lightBuffer, want.lightBuffer || want.scheme == SchemeKind::Brute);
+        if (want.scheme == SchemeKind::Regular) {
+            EXPECT_EQ(got.regular.maxLevel, want.regular.maxLevel);
+            EXPECT_EQ(got.regular.maxObjects, want.regular.maxObjects);
+            EXPECT_EQ(got.regular.step, want.regular.step);
+            EXPECT_EQ(got.regular.delta, want.regular.delta);
+            EXPECT_EQ(got.regular.splitAxes, want.regular.splitAxes);
+            EXPECT_EQ(got.regular.fullTable, want.regular.fullTable);
+        }
+        if (want.scheme == SchemeKind::Irregular) {
+            EXPECT_EQ(got.irregular.maxObjects, want.irregular.maxObjects);
+            EXPECT_EQ(got.irregular.heuristic, want.irregular.heuristic);
+            EXPECT_EQ(got.irregular.frame, want.irregular.frame);
+        }
+        std::ostringstream os;
+        os << want;
+        EXPECT_EQ(os.str(), toString(want));
+    }
+}
+
 TEST(ParamTable, AMisspeltOptionGetsTheNearestOne) {
     Parsed p({"render", "x", "--max-levle", "3"});
     EXPECT_EQ(p.error.rfind("error: ", 0), 0u) << p.error;

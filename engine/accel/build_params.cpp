@@ -1,5 +1,8 @@
 #include "engine/accel/build_params.h"
 
+#include <ostream>
+#include <sstream>
+
 namespace lancer {
 
 const char* schemeName(SchemeKind k) {
@@ -33,5 +36,30 @@ const char* splitAxesName(SplitAxes s) { return s == SplitAxes::Cycle ? "cycle" 
 const char* irregularFrameName(IrregularFrame f) {
     return f == IrregularFrame::Camera ? "camera" : "projective";
 }
+
+std::string toString(const BuildParams& p) {
+    std::ostringstream os;
+    os.precision(17);
+    os << schemeName(p.scheme);
+    if (p.scheme == SchemeKind::Regular) {
+        const RegularConfig& r = p.regular;
+        os << " --max-level " << r.maxLevel << " --max-objects " << r.maxObjects << " --step "
+           << stepName(r.step);
+        if (r.step == StepMethod::Push) os << " --delta " << r.delta;
+        os << " --split-axes " << splitAxesName(r.splitAxes);
+        if (r.fullTable) os << " --full-table";
+    } else if (p.scheme == SchemeKind::Irregular) {
+        const IrregularConfig& i = p.irregular;
+        os << " --max-objects " << i.maxObjects << " --bsp-heuristic " << heuristicName(i.heuristic)
+           << " --irregular-frame " << irregularFrameName(i.frame);
+    }
+    if (p.scheme != SchemeKind::Brute) {
+        if (!p.mailboxes) os << " --no-mailbox";
+        if (!p.lightBuffer) os << " --no-light-buffer";
+    }
+    return os.str();
+}
+
+std::ostream& operator<<(std::ostream& os, const BuildParams& p) { return os << toString(p); }
 
 }  // namespace lancer

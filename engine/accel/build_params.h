@@ -5,6 +5,8 @@
 #pragma once
 
 #include <cstdint>
+#include <iosfwd>
+#include <string>
 
 namespace lancer {
 
@@ -60,5 +62,11 @@ struct BuildParams {
     RegularConfig regular;      ///< read by the regular scheme only
     IrregularConfig irregular;  ///< read by the irregular scheme only
 };
+
+/// The knobs the scheme in use reads, as command-line options: "regular --max-level 24
+/// --max-objects 4 --step exact --split-axes cost" (and --delta, --full-table, --no-mailbox,
+/// --no-light-buffer where they apply and differ from the defaults).
+std::string toString(const BuildParams& p);
+std::ostream& operator<<(std::ostream& os, const BuildParams& p);
 
 }  // namespace lancer
