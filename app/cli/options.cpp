@@ -1,5 +1,6 @@
 #include "app/cli/options.h"
 
+#include <cstdio>
 #include <map>
 
 namespace lancer::cli {
@@ -65,6 +66,23 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
     app.add_flag(
         "--no-light-buffer{false}", o.build.lightBuffer,
         "Accelerated schemes: trace shadow rays without the light buffer (to measure its effect)");
+    app.add_option_function<std::string>(
+           "--memory-budget",
+           [&o](const std::string& v) { o.build.memoryBudget = parseMemoryBudget(v); },
+           "Bytes a structure may take while it is built (512M, 2G, ...); over it the irregular "
+           "scheme stops subdividing, the regular one is refused (default: an eighth of physical "
+           "memory, " +
+               formatBytes(defaultMemoryBudget()) + ")")
+        ->check(CLI::Validator(
+            [](std::string& v) {
+                try {
+                    parseMemoryBudget(v);
+                    return std::string();
+                } catch (const std::invalid_argument& e) {
+                    return std::string(e.what());
+                }
+            },
+            "SIZE"));
     app.add_option("--threads", o.render.threads, "Worker threads (0: all cores)")
         ->check(CLI::Range(0, 1024))
         ->default_val(0);
@@ -79,6 +97,16 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
     app.add_flag("--no-shadows{false}", o.render.shading.shadows, "Trace no shadow rays");
     app.add_option("--stats", o.statsPath, "Write statistics as JSON to this file");
     app.add_option("--depth", o.depthPath, "Write the primary hit distances as a PFM to this file");
+}
+
+BuildControl buildProgressOnStderr() {
+    BuildControl c;
+    c.progress = [](const BuildProgress& p) {
+        std::fprintf(stderr, "building: %s, %.0f s, %s of the %s memory budget, %zu so far\n",
+                     p.stage, p.seconds, formatBytes(p.bytes).c_str(),
+                     formatBytes(p.budget).c_str(), p.items);
+    };
+    return c;
 }
 
 void resolveSize(const CommonOptions& o, const Scene& scene, int& w, int& h) {

@@ -53,7 +53,7 @@ class ProgressBar {
 int runRender(const CommonOptions& o, const std::string& outPath, bool quiet) {
     try {
         Scene scene = loadScene(o.scene);
-        auto accel = buildAccelerator(scene, o.build);
+        auto accel = buildAccelerator(scene, o.build, buildProgressOnStderr());
         RenderOptions ro = o.render;
         resolveSize(o, scene, ro.width, ro.height);
         Image img(ro.width, ro.height);

@@ -80,7 +80,7 @@ void printEvents(const Scene& scene, const std::vector<WalkEvent>& events) {
 int runTrace(const CommonOptions& o, const TraceOptions& t) {
     try {
         Scene scene = loadScene(o.scene);
-        auto accel = buildAccelerator(scene, o.build);
+        auto accel = buildAccelerator(scene, o.build, buildProgressOnStderr());
         int w, h;
         resolveSize(o, scene, w, h);
         if (t.x < 0 || t.x >= w || t.y < 0 || t.y >= h)

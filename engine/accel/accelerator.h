@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "engine/accel/brute_force.h"
+#include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/irregular.h"
 #include "engine/accel/light_buffer.h"
 #include "engine/accel/regular/regular_grid.h"
@@ -48,6 +49,9 @@ struct BuildParams {
     bool lightBuffer = true;
     bool fullTable = false;  ///< regular: one full directory table instead of sub-tables
     IrregularFrame irregularFrame = IrregularFrame::Projective;  ///< --irregular-frame
+    /// Bytes the structure may take while it is built (--memory-budget); 0: defaultMemoryBudget()
+    /// (build_guard.h). A build over it stops subdividing or is refused, naming the budget.
+    size_t memoryBudget = 0;
 };
 
 /// What a built structure reports: `--stats` and the viewer show it.
@@ -124,7 +128,9 @@ class Accelerator {
 };
 
 /// Build the scheme named in `params` over a prepared scene. Throws std::invalid_argument for
-/// parameters that are refused (for example a max level whose structure would not fit).
-std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params);
+/// parameters that are refused (for example a max level whose structure would not fit), and
+/// BuildCancelled when `control.stop` is requested (within 100 ms: the builders poll it).
+std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params,
+                                              const BuildControl& control = {});
 
 }  // namespace lancer
