@@ -33,6 +33,8 @@ TEST(BuiltinScenes, SizesFollowTheirDefinition) {
     EXPECT_EQ(makeBuiltin("tetra", 4).prims.size(), 256u);
     EXPECT_EQ(makeBuiltin("rings", 2).prims.size(), 2u * 2u * 20u + 1u);
     EXPECT_EQ(makeBuiltin("balls", 3).prims.size(), 821u);  // 820 spheres and the floor
+    // The largest, the 598k spheres of the scale table (docs/scale.md).
+    EXPECT_EQ(makeBuiltin("balls", 6).prims.size(), 597872u);
     EXPECT_EQ(makeBuiltin("drilled", 4).prims.size(), 65u);
     EXPECT_THROW(makeBuiltin("tetra", 99), SceneError);
 }

@@ -32,6 +32,9 @@ void changeValue(const ParamDesc& d, Knobs& k) {
         case ParamKind::Switch:
             d.set(k, d.get(k) != 0.0 ? 0.0 : 1.0);
             break;
+        case ParamKind::Size:
+            d.set(k, d.get(k) != 0.0 ? 0.0 : double(size_t(1) << 30));
+            break;
         case ParamKind::Path:
             (k.*d.path) += "x";
             break;

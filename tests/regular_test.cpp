@@ -382,7 +382,7 @@ TEST(RegularSubTables, DeepLevelBuiltWhereTheFullTableWouldNotFit) {
     const RegularGrid& g = gridOf(*accel);
     int finest = accel->info().extra["finest_level"];
     EXPECT_GE(finest, 36);
-    EXPECT_GT(double(std::ldexp(4.0, finest)), double(RegularGrid::kMemoryBudget));
+    EXPECT_GT(double(std::ldexp(4.0, finest)), double(defaultMemoryBudget()));
     // The cells along the near-touching pair's gap: tens of thousands of leaves, a few MiB.
     EXPECT_LT(accel->info().memoryBytes, size_t(16) << 20);
     p.regular.fullTable = true;

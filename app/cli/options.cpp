@@ -1,6 +1,8 @@
 #include "app/cli/options.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <stdexcept>
 
 #include "engine/scene/loader.h"
 
@@ -46,15 +48,41 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
                 opt = app.add_flag_function(
                     d.flag, [p, k](std::int64_t) { p->set(*k, p->flagValue ? 1.0 : 0.0); }, help);
                 break;
+            case ParamKind::Size:
+                opt = app.add_option_function<std::string>(
+                             d.flag, [p, k](const std::string& v) { parseValue(*p, v, *k); },
+                             help + " (here: " + formatBytes(defaultMemoryBudget()) + ")")
+                          ->check(CLI::Validator(
+                              [](std::string& v) {
+                                  if (v == "0") return std::string();
+                                  try {
+                                      parseMemoryBudget(v);
+                                      return std::string();
+                                  } catch (const std::invalid_argument& e) {
+                                      return std::string(e.what());
+                                  }
+                              },
+                              "SIZE"));
+                break;
             case ParamKind::Path:
                 opt = app.add_option(d.flag, o.knobs.*d.path, help);
                 break;
         }
-        if (d.kind != ParamKind::Switch && d.kind != ParamKind::Path &&
+        if (d.kind != ParamKind::Switch && d.kind != ParamKind::Path && d.kind != ParamKind::Size &&
             d.reach != ViewerReach::Window)
             opt->default_str(formatValue(d, defaults));
         if (*d.metavar) opt->type_name(d.metavar);
     }
+}
+
+BuildControl buildProgressOnStderr() {
+    BuildControl c;
+    c.progress = [](const BuildProgress& p) {
+        std::fprintf(stderr, "building: %s, %.0f s, %s of the %s memory budget, %zu so far\n",
+                     p.stage, p.seconds, formatBytes(p.bytes).c_str(),
+                     formatBytes(p.budget).c_str(), p.items);
+    };
+    return c;
 }
 
 void resolveSize(const CommonOptions& o, const Scene& scene, int& w, int& h) {

@@ -19,6 +19,8 @@ struct CommonOptions {
 
 /// Add the common options (docs/design.md section 6; every entry of paramTable()) to a subcommand.
 void addCommonOptions(CLI::App& app, CommonOptions& o);
+/// A build's progress, one line on stderr a second once it takes more than a second.
+BuildControl buildProgressOnStderr();
 /// The image size from the options and the scene's default size.
 void resolveSize(const CommonOptions& o, const Scene& scene, int& w, int& h);
 /// The render options the knobs ask for, at the size resolveSize gives.

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
+
+#include "engine/accel/build_guard.h"
 
 namespace lancer::cli {
 
@@ -167,6 +170,21 @@ std::vector<ParamDesc> makeTable() {
     d.get = [](const K& k) { return double(k.build.lightBuffer); };
     d.set = [](K& k, double v) { k.build.lightBuffer = v != 0.0; };
     add(d);
+    // Every scheme's builder reads it; brute force builds nothing worth bounding, so the regular
+    // and irregular schemes only. A change rebuilds under the new budget.
+    d = {"--memory-budget",
+         "SIZE",
+         "memory_budget",
+         "memory budget",
+         "Bytes a structure may take while it is built (512M, 2G, 1.5GiB; 0: an eighth of "
+         "physical memory); over it the irregular scheme stops subdividing, the regular one is "
+         "refused",
+         ParamKind::Size};
+    d.schemes = kAccelerated;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.memoryBudget); };
+    d.set = [](K& k, double v) { k.build.memoryBudget = size_t(v); };
+    add(d);
 
     d = {"--threads",    "N", "threads", "threads", "Worker threads (0: all cores)",
          ParamKind::Int, 0,   1024};
@@ -305,6 +323,8 @@ std::string formatValue(const ParamDesc& d, const Knobs& k) {
             return d.names[size_t(d.get(k))];
         case ParamKind::Switch:
             return d.get(k) != 0.0 ? "1" : "0";
+        case ParamKind::Size:
+            return std::to_string(size_t(d.get(k)));
         case ParamKind::Path:
             return k.*d.path;
     }
@@ -339,6 +359,17 @@ bool parseValue(const ParamDesc& d, const std::string& text, Knobs& k) {
             if (text != "0" && text != "1") return false;
             d.set(k, text == "1" ? 1.0 : 0.0);
             return true;
+        case ParamKind::Size:
+            if (text == "0") {
+                d.set(k, 0.0);
+                return true;
+            }
+            try {
+                d.set(k, double(parseMemoryBudget(text)));
+                return true;
+            } catch (const std::invalid_argument&) {
+                return false;
+            }
         case ParamKind::Path:
             k.*d.path = text;
             return true;
@@ -381,6 +412,11 @@ std::string optionsMarkdown() {
             case ParamKind::Switch:
                 values = "flag";
                 def = std::string(d.label) + (d.get(defaults) != 0.0 ? " on" : " off");
+                break;
+            case ParamKind::Size:
+                values = "bytes, K, M, G, T";
+                def = d.get(defaults) != 0.0 ? formatValue(d, defaults)
+                                             : "an eighth of physical memory";
                 break;
             case ParamKind::Path:
                 values = "file";

@@ -39,6 +39,7 @@ enum class ParamKind : uint8_t {
     Real,    ///< a number in [lo, hi]
     Enum,    ///< one of `names`, stored as its index
     Switch,  ///< on or off; the flag sets `flagValue`
+    Size,    ///< bytes, written 512M, 2G, 1.5GiB (parseMemoryBudget); 0: the default
     Path,    ///< a file name (Knobs' `path` member)
 };
 

@@ -57,7 +57,7 @@ int runRender(const CommonOptions& o, const std::string& outPath, bool quiet) {
     }
     try {
         Scene scene = loadSceneWithCamera(o);
-        auto accel = buildAccelerator(scene, o.knobs.build);
+        auto accel = buildAccelerator(scene, o.knobs.build, buildProgressOnStderr());
         RenderOptions ro = renderOptions(o, scene);
         Image img(ro.width, ro.height);
         std::atomic<size_t> done{0};

@@ -11,7 +11,7 @@ namespace lancer::cli {
 int runTrace(const CommonOptions& o, const TraceOptions& t) {
     try {
         Scene scene = loadSceneWithCamera(o);
-        auto accel = buildAccelerator(scene, o.knobs.build);
+        auto accel = buildAccelerator(scene, o.knobs.build, buildProgressOnStderr());
         // The size and camera `render` resolves from the same options, so the pixel's rays are
         // the ones render traces.
         int w, h;

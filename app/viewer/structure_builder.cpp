@@ -7,7 +7,7 @@
 
 namespace lancer::viewer {
 
-BuildResult buildStructure(const BuildRequest& r) {
+BuildResult buildStructure(const BuildRequest& r, std::stop_token stop) {
     BuildResult out;
     auto s = std::make_shared<SceneBuild>();
     s->spec = r.spec;
@@ -34,7 +34,7 @@ BuildResult buildStructure(const BuildRequest& r) {
         scene = viewed;
     }
     try {
-        s->accel = buildAccelerator(*scene, r.params);
+        s->accel = buildAccelerator(*scene, r.params, {std::move(stop), {}});
     } catch (const std::exception& e) {
         out.error = e.what();
         return out;
@@ -56,6 +56,7 @@ StructureBuilder::~StructureBuilder() {
         std::lock_guard lock(mutex_);
         quit_ = true;
         pending_.reset();
+        stop_.request_stop();
     }
     wake_.notify_all();
     worker_.join();
@@ -65,6 +66,7 @@ uint64_t StructureBuilder::request(BuildRequest r) {
     std::lock_guard lock(mutex_);
     pending_ = std::move(r);
     ready_.reset();
+    stop_.request_stop();  // the running build is superseded
     ++requested_;
     wake_.notify_all();
     return requested_;
@@ -91,6 +93,7 @@ void StructureBuilder::run() {
     for (;;) {
         BuildRequest r;
         uint64_t id;
+        std::stop_token stop;
         {
             std::unique_lock lock(mutex_);
             wake_.wait(lock, [&] { return quit_ || pending_; });
@@ -99,8 +102,10 @@ void StructureBuilder::run() {
             pending_.reset();
             id = requested_;
             running_ = true;
+            stop_ = std::stop_source();
+            stop = stop_.get_token();
         }
-        BuildResult result = buildStructure(r);
+        BuildResult result = buildStructure(r, stop);
         result.request = id;
         {
             std::lock_guard lock(mutex_);

@@ -1,5 +1,6 @@
 // Loads scenes and builds acceleration structures on a background thread, so the window keeps
-// drawing (with the previous structure) while a new one is made. The newest request wins.
+// drawing (with the previous structure) while a new one is made. The newest request wins: it
+// cancels a build in progress (within 100 ms, build_guard.h).
 #pragma once
 
 #include <condition_variable>
@@ -7,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <stop_token>
 #include <string>
 #include <thread>
 
@@ -44,11 +46,12 @@ struct BuildResult {
 class StructureBuilder {
   public:
     StructureBuilder();
-    ~StructureBuilder();  ///< waits for a build in progress (builds cannot be interrupted)
+    ~StructureBuilder();  ///< cancels a build in progress and waits for it to return
     StructureBuilder(const StructureBuilder&) = delete;
     StructureBuilder& operator=(const StructureBuilder&) = delete;
 
-    /// Queue a load/build, replacing any request not yet started. Returns its number.
+    /// Queue a load/build, replacing any request not yet started and cancelling the one
+    /// running. Returns its number.
     uint64_t request(BuildRequest r);
     /// The result of the newest request, once, when it is ready (older results are dropped).
     std::optional<BuildResult> poll();
@@ -68,12 +71,14 @@ class StructureBuilder {
     std::optional<BuildResult> ready_;
     uint64_t requested_ = 0;
     bool running_ = false;
+    std::stop_source stop_;  ///< the running build's
     bool quit_ = false;
     std::function<void()> onReady_;
     std::thread worker_;
 };
 
-/// Load (unless already loaded) and build, synchronously. Never throws: errors are in the result.
-BuildResult buildStructure(const BuildRequest& r);
+/// Load (unless already loaded) and build, synchronously; a requested `stop` ends the build
+/// early (the result then holds an error). Never throws: errors are in the result.
+BuildResult buildStructure(const BuildRequest& r, std::stop_token stop = {});
 
 }  // namespace lancer::viewer

@@ -15,10 +15,14 @@ namespace {
 /// of the 40-50 ms the two took one after the other.
 template <class Structure, class Build, class Clock>
 std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildParams& params,
-                                             Build&& build, Clock&& elapsedMs) {
+                                             const BuildGuard& guard, Build&& build,
+                                             Clock&& elapsedMs) {
+    // The buffer stops with the build: a cancelled build waits for it below.
     std::future<LightBuffer> lightBuffer;
     if (params.lightBuffer)
-        lightBuffer = std::async(std::launch::async, [&scene] { return LightBuffer(scene); });
+        lightBuffer = std::async(std::launch::async, [&scene, stop = guard.control().stop] {
+            return LightBuffer(scene, LightBuffer::kBins, stop);
+        });
     AccelInfo info;
     std::optional<Structure> s;
     try {
@@ -30,6 +34,7 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
     info.regions = s->regionCount();
     info.memoryBytes = s->memoryBytes();
     LightBuffer lb = lightBuffer.valid() ? lightBuffer.get() : LightBuffer();
+    guard.poll();  // the buffer may have stopped early
     if (params.lightBuffer) {
         info.memoryBytes += lb.memoryBytes();
         info.extra["light_buffer_bytes"] = lb.memoryBytes();
@@ -41,8 +46,10 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
 
 }  // namespace
 
-std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params) {
+std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params,
+                                              const BuildControl& control) {
     if (!scene.prepared) throw std::logic_error("buildAccelerator: scene not prepared");
+    BuildGuard guard(params.memoryBudget, control);
     auto start = std::chrono::steady_clock::now();
     auto elapsedMs = [&] {
         return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -59,16 +66,16 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
         }
         case SchemeKind::Regular:
             return withLightBuffer<RegularGrid>(
-                scene, params,
+                scene, params, guard,
                 [&](AccelInfo& info) {
-                    return RegularGrid::build(scene, params.regular, info.extra);
+                    return RegularGrid::build(scene, params.regular, info.extra, &guard);
                 },
                 elapsedMs);
         case SchemeKind::Irregular:
             return withLightBuffer<IrregularSubdivision>(
-                scene, params,
+                scene, params, guard,
                 [&](AccelInfo& info) {
-                    return IrregularSubdivision::build(scene, params.irregular, info.extra);
+                    return IrregularSubdivision::build(scene, params.irregular, info.extra, &guard);
                 },
                 elapsedMs);
     }

@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "engine/accel/brute_force.h"
+#include "engine/accel/build_guard.h"
 #include "engine/accel/build_params.h"
 #include "engine/accel/irregular/irregular.h"
 #include "engine/accel/light_buffer.h"
@@ -98,7 +99,9 @@ class Accelerator {
 };
 
 /// Build the scheme named in `params` over a prepared scene. Throws std::invalid_argument for
-/// parameters that are refused (for example a max level whose structure would not fit).
-std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params);
+/// parameters that are refused (for example a max level whose structure would not fit), and
+/// BuildCancelled when `control.stop` is requested (within 100 ms: the builders poll it).
+std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params,
+                                              const BuildControl& control = {});
 
 }  // namespace lancer

@@ -4,6 +4,7 @@
 // panel and its ini file.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <iosfwd>
 #include <string>
@@ -59,6 +60,9 @@ struct BuildParams {
     /// Accelerated schemes: shorten shadow rays with the light buffer (light_buffer.h);
     /// --no-light-buffer turns it off to measure its effect. Brute force never uses it.
     bool lightBuffer = true;
+    /// Bytes the structure may take while it is built (--memory-budget); 0: defaultMemoryBudget()
+    /// (build_guard.h). A build over it stops subdividing or is refused, naming the budget.
+    size_t memoryBudget = 0;
     RegularConfig regular;      ///< read by the regular scheme only
     IrregularConfig irregular;  ///< read by the irregular scheme only
 };

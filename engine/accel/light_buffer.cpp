@@ -33,8 +33,9 @@ std::vector<Vec3> positions(const std::vector<Light>& lights) {
 
 }  // namespace
 
-LightBuffer::LightBuffer(const Scene& scene, int bins)
-    : LightBuffer(scene.bounds, scene.minBox, positions(scene.lights), bins) {}
+LightBuffer::LightBuffer(const Scene& scene, int bins, std::stop_token stop)
+    : LightBuffer(scene.bounds, scene.minBox, positions(scene.lights), bins, kSlots,
+                  std::move(stop)) {}
 
 /// Add depth interval x to a bin of k intervals (sorted, disjoint, unused ones last): merged
 /// with those it overlaps; then, if three remain, the two with the smaller gap are joined (the
@@ -85,7 +86,8 @@ void LightBuffer::insert(Slot* bin, int k, Slot x) {
 }
 
 LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
-                         const std::vector<Vec3>& points, int bins, int slots) {
+                         const std::vector<Vec3>& points, int bins, int slots,
+                         std::stop_token stop) {
     if (bounds.isEmpty() || !bounds.isBounded() || points.empty()) return;
     const Vec3 e = bounds.extent();
     const double largest = std::max({e.x, e.y, e.z});
@@ -126,6 +128,10 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
         double wu0 = kInf, wu1 = -kInf, wv0 = kInf, wv1 = -kInf;
         bool anyLarge = false;
         for (const Box3& mb : boxes) {
+            if ((images.size() & 255) == 0 && stop.stop_requested()) {
+                maps_.clear();
+                return;
+            }
             if (mb.isEmpty()) continue;                      // a dropped primitive
             Box3 x{mb.lo - Vec3(side), mb.hi + Vec3(side)};  // widened across the view axis only
             x.lo[m.a] = mb.lo[m.a], x.hi[m.a] = mb.hi[m.a];
@@ -151,6 +157,10 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
         }
         std::vector<double> colLo, colHi;  // scratch of Grid::add
         for (const BoxImage& im : images) {
+            if ((&im - images.data()) % 256 == 0 && stop.stop_requested()) {
+                maps_.clear();
+                return;
+            }
             m.fine.add(im, colLo, colHi);
             if (window && im.large) m.coarse.add(im, colLo, colHi);
         }

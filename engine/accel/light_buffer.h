@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <stop_token>
 #include <utility>
 #include <vector>
 
@@ -46,12 +47,14 @@ class LightBuffer {
     LightBuffer() = default;
     /// One depth map per light of the (prepared) scene that lies outside its bounds, kSlots
     /// intervals per bin.
-    explicit LightBuffer(const Scene& scene, int bins = kBins);
+    /// A requested `stop` ends the construction early with an empty buffer (the build that
+    /// asked for it is being cancelled).
+    explicit LightBuffer(const Scene& scene, int bins = kBins, std::stop_token stop = {});
     /// One depth map per point outside `bounds`, of `boxes` (those inside `bounds`; empty
     /// ones are skipped), `slots` intervals per bin (1 to kSlots): the scene's lights, or the
     /// eye of a perspective camera (which needs only the least depth: 1).
     LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes, const std::vector<Vec3>& points,
-                int bins = kBins, int slots = kSlots);
+                int bins = kBins, int slots = kSlots, std::stop_token stop = {});
 
     /// A stretch [t0, t1] of a shadow ray that boxes may occupy.
     struct Segment {

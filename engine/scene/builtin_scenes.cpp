@@ -253,7 +253,7 @@ Scene ringsScene(int size) {
 const std::vector<BuiltinInfo>& builtinScenes() {
     static const std::vector<BuiltinInfo> list = {
         {"default", 1, 1, 1, "union, intersection and difference on a floor, with a glass ball"},
-        {"balls", 3, 0, 5, "SPD sphereflake: 1 + 9 + ... + 9^SIZE spheres and a floor polygon"},
+        {"balls", 3, 0, 6, "SPD sphereflake: 1 + 9 + ... + 9^SIZE spheres and a floor polygon"},
         {"drilled", 6, 1, 40, "a block minus SIZE^3 spheres (CSG stress)"},
         {"lattice", 6, 1, 30,
          "SIZE^3 cells of (cube ∩ sphere) − cylinder, cut by a slab (CSG stress)"},

@@ -13,10 +13,14 @@ echo "$out" | grep -q -- "--max-level 30 --max-objects 2" || fail "message does 
 echo "$out" | grep -q "memory budget" || fail "message does not say why: $out"
 [ -e "$tmp/x.png" ] && fail "an image was written for a refused build"
 
-# A full table at level 30 (4 GiB) is refused; the same level with sub-tables is built.
+# A full table at level 30 (4 GiB) is refused under a 1 GiB budget, naming both options; the
+# same level with sub-tables is built.
 out=$("$LANCER" render "$SRC/assets/spd/balls4.nff" --scheme regular --full-table --max-level 30 --max-objects 4 \
-      --width 8 --height 8 -o "$tmp/y.png" 2>&1) && fail "a 4 GiB full table accepted"
+      --memory-budget 1G --width 8 --height 8 -o "$tmp/y.png" 2>&1) && fail "a 4 GiB full table accepted"
 echo "$out" | grep -q -- "--full-table" || fail "message does not name the option: $out"
+echo "$out" | grep -q -- "--memory-budget" || fail "message does not name the budget: $out"
+out=$("$LANCER" render builtin:default --memory-budget lots -o "$tmp/w.png" 2>&1) && fail "a bad budget accepted"
+echo "$out" | grep -q -- "--memory-budget" || fail "message does not name the option: $out"
 "$LANCER" render "$SRC/assets/spd/balls4.nff" --scheme regular --max-level 30 --max-objects 4 \
     --width 8 --height 8 -o "$tmp/y.png" >/dev/null 2>"$tmp/log" || { cat "$tmp/log"; fail "sub-tables at level 30 refused"; }
 

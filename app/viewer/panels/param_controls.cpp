@@ -3,6 +3,7 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <string>
 
 namespace lancer::viewer {
@@ -55,6 +56,21 @@ bool paramControl(const cli::ParamDesc& d, cli::Knobs& k, int maxThreads) {
             if (ImGui::Checkbox(d.label, &v)) {
                 d.set(k, v ? 1.0 : 0.0);
                 changed = true;
+            }
+            break;
+        }
+        case cli::ParamKind::Size: {
+            // Written as the command line takes it (512M, 2G); applied on Enter, and a value
+            // parseValue refuses leaves the knob as it was.
+            char buf[32];
+            const std::string now = cli::formatValue(d, k);
+            std::snprintf(buf, sizeof buf, "%s", now.c_str());
+            if (ImGui::InputText(d.label, buf, sizeof buf, ImGuiInputTextFlags_EnterReturnsTrue)) {
+                cli::Knobs next = k;
+                if (cli::parseValue(d, buf, next) && d.get(next) != d.get(k)) {
+                    d.set(k, d.get(next));
+                    changed = true;
+                }
             }
             break;
         }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <unordered_map>
 
+#include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/tree_restrictor.h"
 
 namespace lancer {
@@ -20,7 +21,7 @@ struct ListHash {
 }  // namespace
 
 DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
-                           double zlo, double zhi) {
+                           double zlo, double zhi, BuildGuard* guard, size_t maxBytes) {
     DepthSlabs out;
     TreeRestrictor restrictor(scene.tree);
     // One tree and one list per distinct primitive set; list 0 is the empty set.
@@ -41,12 +42,26 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
         r.root = it->second.second;
     };
 
+    // What the slabs hold so far: vectors by capacity; the map keeps each list again, in a node
+    // (64 bytes with malloc's rounding), a key allocation (32 at least) and a bucket.
+    auto bytes = [&] {
+        return out.regions.capacity() * sizeof(IrregularRegion) +
+               out.zoneFirstRegion.capacity() * sizeof(uint32_t) +
+               out.pool.nodes.capacity() * sizeof(CsgNode) +
+               (out.listFirst.capacity() + 2 * out.listPrims.capacity()) * sizeof(uint32_t) +
+               shared.size() * 112 + shared.bucket_count() * sizeof(void*);
+    };
+    // What the zones not cut yet cost at least (merged): kept free for them.
+    size_t reserve = bsp.zoneCount() * kMergedZoneBytes + bsp.zonePrims.size() * kMergedRefBytes;
     std::vector<double> cuts;
     std::vector<uint32_t> inSlab;
     out.zoneFirstRegion.push_back(0);
     for (uint32_t z = 0; z < bsp.zoneCount(); ++z) {
         const uint32_t* first = bsp.zonePrims.data() + bsp.zoneFirst[z];
         const uint32_t* last = bsp.zonePrims.data() + bsp.zoneFirst[z + 1];
+        const size_t now = guard || maxBytes ? bytes() : 0;
+        reserve -= kMergedZoneBytes + size_t(last - first) * kMergedRefBytes;
+        if (guard) guard->poll("depth slabs", now, out.regions.size());
         IrregularRegion r;
         r.zone = z;
         r.box.lo = Vec3(bsp.zoneLo[z], zlo);
@@ -57,11 +72,19 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
             out.zoneFirstRegion.push_back(uint32_t(out.regions.size()));
             continue;
         }
-        // Depth cuts: the structure's ends and every box's zmin and zmax.
+        // Depth cuts: the structure's ends and every box's zmin and zmax, unless the zone's
+        // slabs could pass the limit: up to 2k + 1 regions, lists of k / 2 on average, and
+        // their trees (a bound: lists shared between slabs and zones cost nothing more).
+        const size_t k = size_t(last - first);
+        const size_t worst = (2 * k + 1) * (kMergedZoneBytes + k * kMergedRefBytes / 2);
         cuts = {zlo, zhi};
-        for (const uint32_t* p = first; p != last; ++p) {
-            cuts.push_back(std::clamp(box[*p].lo.z, zlo, zhi));
-            cuts.push_back(std::clamp(box[*p].hi.z, zlo, zhi));
+        if (maxBytes && now + worst + reserve > maxBytes) {
+            ++out.mergedZones;
+        } else {
+            for (const uint32_t* p = first; p != last; ++p) {
+                cuts.push_back(std::clamp(box[*p].lo.z, zlo, zhi));
+                cuts.push_back(std::clamp(box[*p].hi.z, zlo, zhi));
+            }
         }
         std::sort(cuts.begin(), cuts.end());
         cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());

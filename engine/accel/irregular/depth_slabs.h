@@ -20,13 +20,24 @@ struct DepthSlabs {
     CsgTree pool;                           ///< the restricted trees
     std::vector<uint32_t> listFirst;        ///< list l: listPrims[listFirst[l] .. [l + 1])
     std::vector<uint32_t> listPrims;
-    size_t slabs = 0;       ///< regions cut in non-empty zones
-    size_t emptyZones = 0;  ///< zones no rectangle touches (one region each)
-    size_t emptySlabs = 0;  ///< slabs of non-empty zones that hold no primitive
+    size_t slabs = 0;        ///< regions cut in non-empty zones
+    size_t emptyZones = 0;   ///< zones no rectangle touches (one region each)
+    size_t emptySlabs = 0;   ///< slabs of non-empty zones that hold no primitive
+    size_t mergedZones = 0;  ///< zones left as one slab to keep within the byte limit
 };
 
+class BuildGuard;  // build_guard.h
+
+/// Bytes a zone's slabs cost at least, merged into one: a region, a map entry, and per primitive
+/// its list entry (kept twice) and about two tree nodes.
+inline constexpr size_t kMergedZoneBytes = sizeof(IrregularRegion) + 112;
+inline constexpr size_t kMergedRefBytes = 2 * sizeof(uint32_t) + 2 * sizeof(CsgNode);
+
 /// Cut every zone of `bsp` along depth inside [zlo, zhi]; box[p] is primitive p's camera box.
+/// A zone whose slabs would take the structure past `maxBytes` (0: no limit) is one slab holding
+/// all its primitives: its slabs merge. `guard` (may be null) is polled for cancellation.
 DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
-                           double zlo, double zhi);
+                           double zlo, double zhi, BuildGuard* guard = nullptr,
+                           size_t maxBytes = 0);
 
 }  // namespace lancer

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "engine/accel/accelerator.h"
+#include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/corner_pointers.h"
 #include "engine/accel/irregular/depth_slabs.h"
 
@@ -15,7 +16,7 @@ int sign(double v) { return v > 0.0 ? 1 : (v < 0.0 ? -1 : 0); }
 
 double maxAbs(const Vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
 
-/// Zones beyond this many are refused: a screen BSP that large means the 2D step should stop
+/// The screen BSP stops at about this many zones: a BSP that large means the 2D step should stop
 /// earlier (see docs/irregular.md, "Growth").
 constexpr size_t kMaxZones = 4'000'000;
 /// Regions beyond this many are refused: pointers are 32-bit and memory would run out first.
@@ -24,7 +25,9 @@ constexpr size_t kMaxRegions = 50'000'000;
 }  // namespace
 
 IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const IrregularConfig& params,
-                                                 nlohmann::json& extra) {
+                                                 nlohmann::json& extra, BuildGuard* guardIn) {
+    BuildGuard ownGuard;
+    BuildGuard& guard = guardIn ? *guardIn : ownGuard;
     using Clock = std::chrono::steady_clock;
     auto ms = [](Clock::time_point a) {
         return std::chrono::duration<double, std::milli>(Clock::now() - a).count();
@@ -55,6 +58,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
                              maxAbs(scene.bounds.hi), maxAbs(scene.camera.from), 1e-300});
     double eps = 1e-9 * scale;
     std::vector<Box3> box(scene.prims.size());
+    guard.poll();
     for (uint32_t p : live) {
         box[p] = s.frame_.box(scene.minBox[p]);
         box[p].lo -= eps;
@@ -62,18 +66,28 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     }
     s.bounds_ = {cam.lo - 2.0 * eps, cam.hi + 2.0 * eps};
 
-    // 2D step.
+    // 2D step. The memory budget is shared by the camera-frame structure and the projective
+    // zones (when built). Of each share, the screen BSP may take a ninth (then it stops) and the
+    // slabs two ninths (then each further zone's slabs merge into one): a third in all, so the
+    // arrays can still double (BuildGuard::fits).
+    const size_t share = guard.budget() / (params.frame == IrregularFrame::Projective ? 2 : 1);
     ScreenBspParams sp;
     sp.heuristic = params.heuristic;
     sp.stopObjects = params.maxObjects;
     sp.maxZones = kMaxZones;
+    sp.maxBytes = share / 9;
+    sp.zoneBytes = kMergedZoneBytes;
+    sp.refBytes = kMergedRefBytes;
+    sp.guard = &guard;
     s.bsp_ = ScreenBsp::build(box, live, {s.bounds_.lo.x, s.bounds_.lo.y},
                               {s.bounds_.hi.x, s.bounds_.hi.y}, sp);
     double bspMs = ms(t0);
 
     // 3D step.
+    guard.poll();
     auto t1 = Clock::now();
-    DepthSlabs slabs = buildDepthSlabs(scene, s.bsp_, box, s.bounds_.lo.z, s.bounds_.hi.z);
+    DepthSlabs slabs =
+        buildDepthSlabs(scene, s.bsp_, box, s.bounds_.lo.z, s.bounds_.hi.z, &guard, 2 * share / 9);
     if (slabs.regions.size() > kMaxRegions)
         throw std::invalid_argument("--scheme irregular: " + std::to_string(slabs.regions.size()) +
                                     " regions is over the limit of " + std::to_string(kMaxRegions) +
@@ -81,7 +95,9 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     double slabMs = ms(t1);
 
     auto t2 = Clock::now();
+    guard.poll();
     linkCorners(s.bsp_, s.bounds_, slabs);
+    guard.poll();
     double linkMs = ms(t2);
 
     s.regions_ = std::move(slabs.regions);
@@ -95,7 +111,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["frame"] = irregularFrameName(params.frame);
     if (params.frame == IrregularFrame::Projective) {
         auto t3 = Clock::now();
-        s.eye_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, extra);
+        s.eye_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, extra, 2 * share / 9);
         eyeMs = ms(t3);
     }
 
@@ -113,6 +129,10 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["slabs"] = slabs.slabs;
     extra["empty_zones"] = slabs.emptyZones;
     extra["empty_slabs"] = slabs.emptySlabs;
+    // Where the memory budget stopped the 2D step or merged slabs (README, "Bounded builds").
+    extra["memory_budget"] = guard.budget();
+    extra["bsp_stopped"] = s.bsp_.stopped;
+    extra["merged_zones"] = slabs.mergedZones;
     extra["distinct_trees"] = s.listFirst_.size() - 1;
     extra["pool_nodes"] = s.pool_.nodes.size();
     extra["prims_per_region"] = double(refs) / double(s.regions_.size());

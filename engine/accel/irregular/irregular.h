@@ -40,12 +40,17 @@
 
 namespace lancer {
 
+class BuildGuard;  // build_guard.h
+
 class IrregularSubdivision {
   public:
     /// Build over a prepared scene from scene.camera; scheme figures go to `extra`. Throws
-    /// std::invalid_argument for refused parameters or a structure over its limits.
+    /// std::invalid_argument for refused parameters or a structure over its limits,
+    /// BuildCancelled when `guard`'s stop is requested. Within the guard's memory budget the 2D
+    /// step stops and slabs merge. `guard` null: a default BuildGuard (the default budget, no
+    /// cancellation).
     static IrregularSubdivision build(const Scene& scene, const IrregularConfig& params,
-                                      nlohmann::json& extra);
+                                      nlohmann::json& extra, BuildGuard* guard = nullptr);
 
     template <class Obs>
     bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,

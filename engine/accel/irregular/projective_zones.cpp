@@ -11,7 +11,7 @@ namespace lancer {
 ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& frame,
                                        const std::vector<Box3>& box,
                                        const std::vector<uint32_t>& live, const ScreenBspParams& sp,
-                                       nlohmann::json& extra) {
+                                       nlohmann::json& extra, size_t maxSlabBytes) {
     ProjectiveZones s;
     s.scene_ = &scene;
     s.eye_ = frame.origin;
@@ -67,7 +67,7 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     s.zNear_ = zNear;
     s.zFar_ = zFar;
     s.bsp_ = ScreenBsp::build(pbox, inside, lo, hi, sp);
-    DepthSlabs slabs = buildDepthSlabs(scene, s.bsp_, pbox, zNear, zFar);
+    DepthSlabs slabs = buildDepthSlabs(scene, s.bsp_, pbox, zNear, zFar, sp.guard, maxSlabBytes);
     s.zones_ = s.bsp_.zoneCount();
     s.zoneFirst_ = std::move(slabs.zoneFirstRegion);
     s.slabLo_.reserve(slabs.regions.size());
@@ -87,6 +87,8 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     extra["projective_zones"] = s.zones_;
     extra["projective_slabs"] = s.slabRoot_.size();
     extra["projective_empty_slabs"] = slabs.emptySlabs + slabs.emptyZones;
+    extra["projective_bsp_stopped"] = s.bsp_.stopped;
+    extra["projective_merged_zones"] = slabs.mergedZones;
     extra["projective_near_primitives"] = nearPrims.size();
     extra["projective_znear"] = zNear;
     return s;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "engine/accel/accelerator.h"
+#include "engine/accel/build_guard.h"
 
 namespace lancer {
 
@@ -36,7 +37,7 @@ struct Split {
 /// segment", read literally). `balanced`: the line that minimizes the larger side (segments on
 /// it plus the pieces cut), then the cuts. `fewest-cuts`: the line that cuts fewest segments,
 /// then the larger side. Each axis is scored in O(n log n) from sorted endpoints.
-Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h) {
+Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h, const BuildGuard* guard) {
     if (h == BspHeuristic::First) return {segs[0].axis, segs[0].c};
     Split best{segs[0].axis, segs[0].c};
     size_t bestMain = SIZE_MAX, bestTie = SIZE_MAX;
@@ -54,10 +55,15 @@ Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h) {
             }
         }
         if (lines.empty()) continue;
+        if (guard) guard->poll();  // a root cell of millions of segments sorts for a while
         std::sort(lines.begin(), lines.end());
+        if (guard) guard->poll();
         std::sort(lo.begin(), lo.end());
+        if (guard) guard->poll();
         std::sort(hi.begin(), hi.end());
+        if (guard) guard->poll();
         for (size_t i = 0; i < lines.size(); ++i) {
+            if (guard && (i & 8191) == 0) guard->poll();
             if (i > 0 && lines[i] == lines[i - 1]) continue;
             double c = lines[i];
             size_t below = i;
@@ -95,6 +101,7 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
     // The four edges of each rectangle, in primitive order; an edge on the cell's border splits
     // nothing and is left out.
     for (uint32_t p : prims) {
+        if (params.guard && (p & 8191) == 0) params.guard->poll();
         const Box3& r = rect[p];
         Segment e[4] = {{r.lo.x, r.lo.y, r.hi.y, 0},
                         {r.hi.x, r.lo.y, r.hi.y, 0},
@@ -111,20 +118,45 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
 
     // Depth first, smaller child first, so at most O(log n) large cells wait on the stack.
     std::vector<Cell> stack;
+    // Bytes of the cells waiting on the stack, and their primitive references. The lists are
+    // transient, about as large as the input at any time (the root's, then halves): splitting
+    // is stopped by what it adds, the BSP and the least its zones will cost.
+    size_t waiting = 0, waitingRefs = 0;
+    auto cellBytes = [](const Cell& c) {
+        return sizeof(Cell) + c.segs.capacity() * sizeof(Segment) +
+               c.prims.capacity() * sizeof(uint32_t);
+    };
+    auto bspBytes = [&] {
+        return bsp.nodes.capacity() * sizeof(Node) +
+               bsp.zoneLo.capacity() * 2 * sizeof(glm::dvec2) +
+               bsp.zoneFirst.capacity() * sizeof(uint32_t) +
+               bsp.zonePrims.capacity() * sizeof(uint32_t) +
+               (bsp.zoneLo.size() + stack.size()) * params.zoneBytes +
+               (bsp.zonePrims.size() + waitingRefs) * params.refBytes;
+    };
+    waiting += cellBytes(top);
+    waitingRefs += top.prims.size();
     stack.push_back(std::move(top));
     while (!stack.empty()) {
         Cell cell = std::move(stack.back());
         stack.pop_back();
+        const size_t bytes = bspBytes();  // what splitting adds (not the transient lists)
+        waiting -= cellBytes(cell);
+        waitingRefs -= cell.prims.size();
+        if (params.guard) params.guard->poll("screen BSP", bytes + waiting, bsp.zoneLo.size());
         int32_t& slot = cell.parent < 0 ? bsp.root : bsp.nodes[cell.parent].child[cell.side];
         bsp.depth = std::max(bsp.depth, cell.depth);
         bool stop = cell.segs.empty() ||
                     (params.stopObjects > 0 && cell.prims.size() <= size_t(params.stopObjects));
+        // Over a limit, the BSP stops: this cell and every one still waiting become zones
+        // (the waiting ones are at most O(log n), each a zone once popped).
+        if (!stop &&
+            ((params.maxZones && bsp.zoneLo.size() + stack.size() + 1 >= params.maxZones) ||
+             (params.maxBytes && bytes >= params.maxBytes))) {
+            stop = true;
+            bsp.stopped = true;
+        }
         if (stop) {
-            if (params.maxZones && bsp.zoneLo.size() >= params.maxZones)
-                throw std::invalid_argument("--scheme irregular: the screen BSP passes " +
-                                            std::to_string(params.maxZones) +
-                                            " zones; stop the 2D step earlier with --max-objects "
-                                            "or try another --bsp-heuristic");
             slot = ~int32_t(bsp.zoneLo.size());
             bsp.zoneLo.push_back(cell.lo);
             bsp.zoneHi.push_back(cell.hi);
@@ -132,7 +164,7 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
             bsp.zoneFirst.push_back(uint32_t(bsp.zonePrims.size()));
             continue;
         }
-        Split sp = chooseSplit(cell.segs, params.heuristic);
+        Split sp = chooseSplit(cell.segs, params.heuristic, params.guard);
         int32_t node = int32_t(bsp.nodes.size());
         slot = node;
         bsp.nodes.push_back({sp.axis, sp.c, {0, 0}});
@@ -142,7 +174,11 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         Cell above{cell.lo, cell.hi, {}, {}, node, 1, cell.depth + 1};
         below.hi[sp.axis] = sp.c;
         above.lo[sp.axis] = sp.c;
+        // Large cells take a while here (their children's lists grow by copies, and fresh pages
+        // fault in): poll as in the loop.
+        size_t polled = 0;
         for (const Segment& s : cell.segs) {
+            if (params.guard && (++polled & 32767) == 0) params.guard->poll();
             if (s.axis == sp.axis) {
                 if (s.c < sp.c)
                     below.segs.push_back(s);
@@ -159,11 +195,14 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
             }
         }
         for (uint32_t p : cell.prims) {
+            if (params.guard && (++polled & 32767) == 0) params.guard->poll();
             if (overlapsOpen(rect[p], below.lo, below.hi)) below.prims.push_back(p);
             if (overlapsOpen(rect[p], above.lo, above.hi)) above.prims.push_back(p);
         }
         cell = Cell{};  // free the parent's lists before descending
         if (below.segs.size() < above.segs.size()) std::swap(below, above);
+        waiting += cellBytes(below) + cellBytes(above);
+        waitingRefs += below.prims.size() + above.prims.size();
         stack.push_back(std::move(below));  // the larger one waits
         stack.push_back(std::move(above));
     }

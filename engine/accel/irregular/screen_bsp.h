@@ -12,11 +12,19 @@
 namespace lancer {
 
 enum class BspHeuristic : uint8_t;  // build_params.h
+class BuildGuard;                   // build_guard.h
 
 struct ScreenBspParams {
     BspHeuristic heuristic{};  ///< the choice of splitting line
     int stopObjects = 0;  ///< a cell overlapping at most this many rectangles is a zone (0: never)
-    size_t maxZones = 0;  ///< refuse (throw std::invalid_argument) beyond this many zones
+    /// Stop splitting at about this many zones (0: no limit): the cells left become zones.
+    size_t maxZones = 0;
+    /// Stop splitting once the BSP (with the cells waiting) and what its zones will cost at
+    /// least, `zoneBytes` a zone and `refBytes` a primitive reference, take this many bytes
+    /// (0: no limit).
+    size_t maxBytes = 0;
+    size_t zoneBytes = 0, refBytes = 0;
+    BuildGuard* guard = nullptr;  ///< polled for cancellation and progress (null: never)
 };
 
 /// The screen BSP and its leaves, the zones, each with the primitives whose rectangle it touches.
@@ -34,6 +42,8 @@ struct ScreenBsp {
     size_t segments = 0;  ///< rectangle edges fed to the BSP
     size_t cuts = 0;      ///< segments cut in two by a splitting line
     int depth = 0;        ///< deepest node
+    bool stopped =
+        false;  ///< the zone or byte limit stopped the splitting before the segments ran out
 
     size_t zoneCount() const { return zoneLo.size(); }
     /// The zone holding the point (x, y), or for a point on a line, the zone on the side given by

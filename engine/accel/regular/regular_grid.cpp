@@ -5,16 +5,11 @@
 #include <stdexcept>
 
 #include "engine/accel/accelerator.h"
+#include "engine/accel/build_guard.h"
 
 namespace lancer {
 
 namespace {
-
-std::string megabytes(size_t bytes) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / double(1 << 20));
-    return buf;
-}
 
 void sortedUnique(std::vector<uint32_t>& v) {
     std::sort(v.begin(), v.end());
@@ -52,7 +47,7 @@ constexpr int kPlannedLevels = 12;
 /// it cuts x and y until the cells are about cubes, where the report's order makes them 16 times
 /// flatter than wide.
 AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector<uint32_t>& live,
-                          const RegularConfig& params) {
+                          const RegularConfig& params, const BuildGuard& guard) {
     std::vector<double> cost(scene.prims.size(), 1.0);
     for (size_t i = 0; i < cost.size(); ++i)
         if (const Polygon* pg = std::get_if<Polygon>(&scene.prims[i].shape))
@@ -75,6 +70,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
             size[a] *= 0.5;
             continue;
         }
+        guard.poll();
         // Drop the cells that stop here.
         size_t open = 0;
         for (const Cell& c : cells)
@@ -90,6 +86,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
             child[a] *= 0.5;
             const double area = child.x * child.y + child.y * child.z + child.z * child.x;
             double tests = 0.0;
+            guard.poll();
             for (const Cell& c : cells) {
                 const double mid = 0.5 * (c.box.lo[a] + c.box.hi[a]);
                 for (size_t i = c.begin; i < c.end; ++i) {
@@ -132,6 +129,7 @@ struct RegularBuilder {
     const Scene& scene;
     const RegularConfig& params;
     RegularGrid& grid;
+    BuildGuard& guard;
     BspNodes bsp;
     std::vector<char> keep;  ///< membership marks, all 0 between uses
     struct SharedTree {
@@ -164,13 +162,40 @@ struct RegularBuilder {
                    : grid.box_.lo[axis] + grid.ext_[axis] * std::ldexp(double(i), -cuts);
     }
 
-    std::string refusal() const {
+    std::string options() const {
         return "--max-level " + std::to_string(params.maxLevel) + " --max-objects " +
-               std::to_string(params.maxObjects) +
-               ": the regular subdivision would need more than " +
-               std::to_string(RegularGrid::kMaxBspNodes) + " BSP nodes (memory budget " +
-               megabytes(RegularGrid::kMemoryBudget) +
-               "); lower --max-level or raise --max-objects";
+               std::to_string(params.maxObjects);
+    }
+
+    std::string refusal() const {
+        return options() + ": the regular subdivision would need more than " +
+               std::to_string(RegularGrid::kMaxBspNodes) +
+               " BSP nodes, the builder's limit (it keeps a build within seconds and within its "
+               "memory budget); lower --max-level or raise --max-objects";
+    }
+
+    /// The structure's size so far: what the build has allocated and keeps (vectors by their
+    /// capacity; the pool's map holds each distinct set again, in a node of 80 bytes with
+    /// malloc's rounding and a key allocation of 32 at least).
+    size_t bytes() const {
+        return bsp.nodes.capacity() * sizeof(BspNodes::Node) +
+               grid.leaves_.capacity() * sizeof(RegularLeaf) +
+               places.capacity() * sizeof(LeafPlace) +
+               grid.pool_.nodes.capacity() * sizeof(CsgNode) +
+               2 * grid.primList_.capacity() * sizeof(uint32_t) + trees.size() * 112;
+    }
+
+    /// Cancelled or over the budget: both end the build now.
+    void check() {
+        const size_t b = bytes();
+        guard.poll("regular BSP", b, bsp.nodes.size());
+        if (!guard.fits(b))
+            throw std::invalid_argument(
+                "--memory-budget " + formatBytes(guard.budget()) + ": the regular subdivision at " +
+                options() + " passes its memory budget (" + formatBytes(b) + " after " +
+                std::to_string(bsp.nodes.size()) +
+                " BSP nodes, with room to grow); lower --max-level, raise --max-objects or raise "
+                "--memory-budget");
     }
 
     /// The tree restricted to `prims` in the shared pool, and their list, added once per set.
@@ -212,6 +237,7 @@ struct RegularBuilder {
         }
         if (bsp.nodes.size() + 2 > RegularGrid::kMaxBspNodes)
             throw std::invalid_argument(refusal());
+        check();
         // A cell inside every one of its primitives' boxes is not split: every sub-cell would
         // hold the same primitives, hence the same tree, so splitting only adds leaves. (The
         // report stops at max-objects or max-level only; cells inside the overlap of more than
@@ -266,8 +292,10 @@ struct RegularBuilder {
     }
 };
 
-RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params)
+RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildGuard* guardIn)
     : scene_(&scene), exact_(params.step == StepMethod::Exact) {
+    BuildGuard ownGuard;
+    BuildGuard& guard = guardIn ? *guardIn : ownGuard;
     if (params.maxLevel < 0 || params.maxLevel > 48)
         throw std::invalid_argument("--max-level " + std::to_string(params.maxLevel) +
                                     ": must be in 0..48 for the regular scheme");
@@ -293,7 +321,8 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params)
     delta_ = params.delta * std::max({ext_.x, ext_.y, ext_.z});
 
     // Build the BSP.
-    RegularBuilder b{scene, params, *this, {}, std::vector<char>(scene.prims.size(), 0), {}, {}};
+    RegularBuilder b{scene, params, *this, guard, {}, std::vector<char>(scene.prims.size(), 0),
+                     {},    {}};
     b.bsp.nodes.resize(1);
     b.unionOnly =
         std::all_of(scene.tree.nodes.begin(), scene.tree.nodes.end(),
@@ -302,7 +331,8 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params)
     std::vector<uint32_t> live =
         scene.tree.empty() ? std::vector<uint32_t>{} : scene.tree.primitives();
     sortedUnique(live);
-    if (params.splitAxes == SplitAxes::Cost) schedule_ = planSchedule(scene, box_, live, params);
+    if (params.splitAxes == SplitAxes::Cost)
+        schedule_ = planSchedule(scene, box_, live, params, guard);
     const uint32_t origin[3] = {0, 0, 0};
     b.build(0, 0, origin, box_, scene.tree, live);
 
@@ -336,20 +366,23 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params)
     const size_t fullBytes = Directory::estimateBytes(b.bsp, finest, true);
     const size_t dirBytes = full ? fullBytes : Directory::estimateBytes(b.bsp, finest, false);
     const size_t otherBytes = memoryBytes();  // everything but the directory, not built yet
-    if (dirBytes > kMemoryBudget || dirBytes + otherBytes > kMemoryBudget) {
+    const size_t budget = guard.budget();
+    if (dirBytes > budget || dirBytes + otherBytes > budget) {
         std::string what = full ? "--full-table" : "--max-level " + std::to_string(params.maxLevel);
         throw std::invalid_argument(
             what + ": the regular directory at level " + std::to_string(finest) + " would take " +
             (dirBytes == SIZE_MAX ? std::string("2^") + std::to_string(finest + 2) + " bytes"
-                                  : megabytes(dirBytes)) +
-            ", over the memory budget of " + megabytes(kMemoryBudget) +
+                                  : formatBytes(dirBytes)) +
+            ", over the memory budget of " + formatBytes(budget) + " (--memory-budget)" +
             (full ? "; use sub-tables (drop --full-table)" : "; lower --max-level"));
     }
+    guard.poll();
     dir_.build(b.bsp, schedule_, finest, full);
 
     // Ropes: across each face, the cell at the face's low corner names the neighbour leaf; it is
     // the only one when it covers the face on the other two axes.
     for (RegularLeaf& L : leaves_) {
+        if ((&L - leaves_.data()) % 4096 == 0) guard.poll();
         for (int a = 0; a < 3; ++a) {
             for (int side = 0; side < 2; ++side) {
                 uint32_t& rope = L.rope[2 * a + side];

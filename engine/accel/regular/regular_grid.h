@@ -19,6 +19,8 @@
 
 namespace lancer {
 
+class BuildGuard;  // engine/accel/build_guard.h
+
 /// A BSP leaf: its block of the finest grid, [lo, hi) per axis, and its restricted tree; with
 /// everything the walk reads of it in one 128-byte block (two cache lines the hardware fetches
 /// together): its exit planes, ropes, tree, and up to kInline of its primitives (3.9 on average
@@ -47,21 +49,21 @@ inline constexpr uint32_t kBorder = 0xfffffffeu;
 
 class RegularGrid {
   public:
-    /// Whole structure (BSP while building, leaves, trees, directory) must fit in this.
-    static constexpr size_t kMemoryBudget = size_t(512) << 20;
     /// BSP nodes allowed while building (4M: about 200 MiB of nodes, leaves and tables). An
     /// absurd max-level / max-objects pair is refused after bounded work (a few seconds at
-    /// most) instead of exhausting memory; the largest useful builds measured (lattice at
+    /// most) even under a large memory budget; the largest useful builds measured (lattice at
     /// level 21, max-objects 1) need 2.7M.
     static constexpr size_t kMaxBspNodes = size_t(1) << 22;
 
     /// Build over a prepared scene. Throws std::invalid_argument naming the option when the
-    /// parameters are invalid or the structure would not fit in kMemoryBudget.
-    RegularGrid(const Scene& scene, const RegularConfig& params);
+    /// parameters are invalid or the structure would pass the guard's memory budget (estimated
+    /// as the BSP grows, so the refusal comes early), BuildCancelled when `guard`'s stop is
+    /// requested. `guard` null: a default BuildGuard (the default budget, no cancellation).
+    RegularGrid(const Scene& scene, const RegularConfig& params, BuildGuard* guard = nullptr);
     /// The same, in the build shape every scheme has; the scheme's figures go to `extra`.
-    static RegularGrid build(const Scene& scene, const RegularConfig& config,
-                             nlohmann::json& extra) {
-        RegularGrid g(scene, config);
+    static RegularGrid build(const Scene& scene, const RegularConfig& config, nlohmann::json& extra,
+                             BuildGuard* guard = nullptr) {
+        RegularGrid g(scene, config, guard);
         extra = g.extra();
         return g;
     }

@@ -1,0 +1,81 @@
+// A build's limits while it runs: its memory budget, its cancellation and its progress report.
+// The builders estimate their size as they go and ask the guard; a caller (the viewer, the
+// command line) controls a running build through BuildControl.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <functional>
+#include <stdexcept>
+#include <stop_token>
+#include <string>
+
+namespace lancer {
+
+/// A build ended by a stop request (a newer build superseded it). Not an input error.
+class BuildCancelled : public std::runtime_error {
+  public:
+    BuildCancelled() : std::runtime_error("build cancelled") {}
+};
+
+/// The machine's physical memory in bytes (0 when the system does not say).
+size_t physicalMemoryBytes();
+/// The budget of a build that names none: an eighth of physical memory (at least 256 MiB, and
+/// 1 GiB when the system does not say), so a build never takes the machine's memory.
+size_t defaultMemoryBudget();
+/// Bytes as a person reads them: "1.5 GiB", "12.0 MiB".
+std::string formatBytes(size_t bytes);
+/// Parse a --memory-budget value: bytes, or a number with K, M, G or T (powers of 1024), an
+/// optional "iB"/"B" after it. Throws std::invalid_argument naming the option.
+size_t parseMemoryBudget(const std::string& text);
+
+/// What a long build reports, about once a second after its first second.
+struct BuildProgress {
+    const char* stage;  ///< what is being built ("regular BSP", "screen BSP", ...)
+    double seconds;     ///< since the build started
+    size_t bytes;       ///< estimated size so far
+    size_t budget;      ///< the memory budget
+    size_t items;       ///< nodes, zones or regions made so far (the stage says which)
+};
+
+/// What a caller controls in a running build, besides its parameters.
+struct BuildControl {
+    std::stop_token stop;  ///< a stop request ends the build with BuildCancelled
+    std::function<void(const BuildProgress&)> progress;  ///< long builds report here
+};
+
+/// Checks a running build against its control: builders call poll() in their loops (an atomic
+/// load, and a clock read every 256 calls), and compare their estimated size with budget().
+/// Builders estimate their size by their arrays' capacities and keep it within a third of what
+/// they may take: an array that doubles holds its old and new storage at once, so the peak of
+/// the next growth stays within the whole (fits()).
+class BuildGuard {
+  public:
+    /// `budget` 0: defaultMemoryBudget().
+    explicit BuildGuard(size_t budget = 0, BuildControl control = {});
+
+    size_t budget() const { return budget_; }
+    /// Arrays of `bytes` (by capacity) can still grow once within `limit` (default: the budget).
+    static bool fits(size_t bytes, size_t limit) { return bytes <= limit / 3; }
+    bool fits(size_t bytes) const { return fits(bytes, budget_); }
+    /// Throws BuildCancelled once a stop is requested; reports progress when the build is long.
+    void poll(const char* stage, size_t bytes, size_t items) {
+        if (control_.stop.stop_requested()) throw BuildCancelled();
+        if (control_.progress && (++calls_ & 255) == 0) report(stage, bytes, items);
+    }
+    /// Throws BuildCancelled once a stop is requested.
+    void poll() const {
+        if (control_.stop.stop_requested()) throw BuildCancelled();
+    }
+    const BuildControl& control() const { return control_; }
+
+  private:
+    void report(const char* stage, size_t bytes, size_t items);
+
+    size_t budget_;
+    BuildControl control_;
+    std::chrono::steady_clock::time_point start_, last_;
+    unsigned calls_ = 0;
+};
+
+}  // namespace lancer
