@@ -20,7 +20,7 @@ size_t defaultMemoryBudget() {
     return std::max(phys / 8, size_t(256) << 20);
 }
 
-std::string formatBytes(size_t bytes) {
+std::string formatSize(size_t bytes) {
     static const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
     double v = double(bytes);
     int u = 0;

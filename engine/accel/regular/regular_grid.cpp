@@ -191,8 +191,8 @@ struct RegularBuilder {
         guard.poll("regular BSP", b, bsp.nodes.size());
         if (!guard.fits(b))
             throw std::invalid_argument(
-                "--memory-budget " + formatBytes(guard.budget()) + ": the regular subdivision at " +
-                options() + " passes its memory budget (" + formatBytes(b) + " after " +
+                "--memory-budget " + formatSize(guard.budget()) + ": the regular subdivision at " +
+                options() + " passes its memory budget (" + formatSize(b) + " after " +
                 std::to_string(bsp.nodes.size()) +
                 " BSP nodes, with room to grow); lower --max-level, raise --max-objects or raise "
                 "--memory-budget");
@@ -372,8 +372,8 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         throw std::invalid_argument(
             what + ": the regular directory at level " + std::to_string(finest) + " would take " +
             (dirBytes == SIZE_MAX ? std::string("2^") + std::to_string(finest + 2) + " bytes"
-                                  : formatBytes(dirBytes)) +
-            ", over the memory budget of " + formatBytes(budget) + " (--memory-budget)" +
+                                  : formatSize(dirBytes)) +
+            ", over the memory budget of " + formatSize(budget) + " (--memory-budget)" +
             (full ? "; use sub-tables (drop --full-table)" : "; lower --max-level"));
     }
     guard.poll();
