@@ -5,17 +5,16 @@
 
 #include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/tree_restrictor.h"
+#include "engine/util/hash.h"
 
 namespace lancer {
 
 namespace {
 
+/// Primitive sets keyed by their FNV-1a (the map is only looked up, never iterated, so the
+/// hash values cannot change what is built).
 struct ListHash {
-    size_t operator()(const std::vector<uint32_t>& v) const {
-        uint64_t h = 1469598103934665603ull;
-        for (uint32_t x : v) h = (h ^ x) * 1099511628211ull;
-        return size_t(h);
-    }
+    size_t operator()(const std::vector<uint32_t>& v) const { return size_t(hashWords(v)); }
 };
 
 }  // namespace
