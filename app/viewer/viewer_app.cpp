@@ -2,8 +2,10 @@
 
 #include <imgui.h>
 #include <imgui_impl_opengl3.h>
+#include <imgui_internal.h>  // MarkIniSettingsDirty
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <limits>
@@ -15,6 +17,15 @@
 #include "app/viewer/playback/ray_drawing.h"
 
 namespace lancer::viewer {
+
+namespace {
+
+bool sameCamera(const Camera& a, const Camera& b) {
+    return a.from == b.from && a.at == b.at && a.up == b.up && a.fov == b.fov &&
+           a.projection == b.projection && a.orthoHeight == b.orthoHeight;
+}
+
+}  // namespace
 
 ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<void()> wake)
     : state_(settings, logTimings, wake),
@@ -29,6 +40,46 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
     style.Colors[ImGuiCol_WindowBg].w = 1.0f;
     style.Colors[ImGuiCol_PopupBg].w = 1.0f;
     style.Colors[ImGuiCol_TitleBgCollapsed].w = 1.0f;
+    // The overlays' and the inspector's options as the ini left them (a --show list, applied
+    // after, overrides the layers).
+    overlays_->options = settings.overlays;
+    overlays_->look = settings.overlayLook;
+    settings.overlayLook.replayCuts = overlays_->look.replayCuts = -1;
+    inspector::InspectorOptions& o = inspector_->options();
+    o = settings.inspector;
+    o.show = settings.showInspector;
+    inspector_->changed();
+    if (settings.inspectorCamera)
+        inspector_->restoreCamera(*settings.inspectorCamera, settings.inspectorScene);
+}
+
+void ViewerApp::keepSettings() {
+    // The ini handler writes from the settings: they follow the overlays and the inspector,
+    // and a change marks the ini to be saved.
+    ViewerSettings& s = state_.settings();
+    bool changed = false;
+    auto keep = [&changed](auto& kept, const auto& now) {
+        if (kept == now) return;
+        kept = now;
+        changed = true;
+    };
+    keep(s.overlays, overlays_->options);
+    overlay::OverlayLook look = overlays_->look;
+    look.replayCuts = -1;  // the replay belongs to the structure on screen
+    keep(s.overlayLook, look);
+    inspector::InspectorOptions io = inspector_->options();
+    io.show = false;
+    keep(s.inspector, io);
+    if (!inspector_->cameraScene().empty()) {
+        const Camera& c = inspector_->camera();
+        if (!s.inspectorCamera || !sameCamera(*s.inspectorCamera, c) ||
+            s.inspectorScene != inspector_->cameraScene()) {
+            s.inspectorCamera = c;
+            s.inspectorScene = inspector_->cameraScene();
+            changed = true;
+        }
+    }
+    if (changed && ImGui::GetCurrentContext()) ImGui::MarkIniSettingsDirty();
 }
 
 ViewerApp::~ViewerApp() = default;
@@ -42,7 +93,7 @@ namespace {
 
 /// A Shift+click on the image (outside the inspector and the panels) picks the pixel for the
 /// ray playback; a Ctrl+click is the overlays' pick of a region.
-std::optional<glm::ivec2> shiftClick(int fbWidth, int fbHeight, bool inspectorShown) {
+std::optional<glm::ivec2> shiftClick(int fbWidth, int fbHeight, const PixelRect* inspector) {
     ImGuiIO& io = ImGui::GetIO();
     if (io.WantCaptureMouse || !io.KeyShift || io.KeyCtrl ||
         !ImGui::IsMouseClicked(ImGuiMouseButton_Left) || !ImGui::IsMousePosValid())
@@ -50,8 +101,8 @@ std::optional<glm::ivec2> shiftClick(int fbWidth, int fbHeight, bool inspectorSh
     const int x = int(io.MousePos.x * io.DisplayFramebufferScale.x);
     const int y = int(io.MousePos.y * io.DisplayFramebufferScale.y);
     if (x < 0 || y < 0 || x >= fbWidth || y >= fbHeight) return std::nullopt;
-    // The inspector takes the whole height of the window's right part.
-    if (inspectorShown && x >= inspector::Inspector::viewport(fbWidth, fbHeight).x0)
+    if (inspector && x >= inspector->x0 && x < inspector->x1 && y >= inspector->y0 &&
+        y < inspector->y1)
         return std::nullopt;
     return glm::ivec2(x, y);
 }
@@ -66,6 +117,13 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui::NewFrame();
     ViewerSettings& s = state_.settings();
+    // The layout of this frame (panels/layout.h): the inspector's view goes where it says.
+    const ImGuiIO& io = ImGui::GetIO();
+    layout_ = planPanels(state_, panelHeights_, io.DisplaySize.x, io.DisplaySize.y);
+    const glm::vec2 scale(io.DisplayFramebufferScale.x, io.DisplayFramebufferScale.y);
+    const Rect& ir = layout_.inspector;
+    inspector_->setArea({int(std::lround(ir.x0 * scale.x)), int(std::lround(ir.y0 * scale.y)),
+                         int(std::lround(ir.x1 * scale.x)), int(std::lround(ir.y1 * scale.y))});
     inspector_->setShown(s.showInspector);
     inspector_->update(state_.sceneBuild(),
                        {state_.camera(), std::max(state_.width(), 1), std::max(state_.height(), 1)},
@@ -83,7 +141,9 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // 2b. Ray playback: a Shift+click picks a pixel; the pick is traced, traced again after a
     // rebuild, and played on the frame's clock. The current region is the selection, so the
     // inspector highlights it.
-    if (std::optional<glm::ivec2> px = shiftClick(fbWidth, fbHeight, inspector_->shown())) {
+    const PixelRect inspectorArea = inspector_->area(fbWidth, fbHeight);
+    if (std::optional<glm::ivec2> px =
+            shiftClick(fbWidth, fbHeight, inspector_->shown() ? &inspectorArea : nullptr)) {
         player_.pick(px->x, px->y);
         s.showRay = true;
     }
@@ -98,19 +158,15 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         playedRegion_ = played;
     }
 
-    // 3. Panels: each reads and acts on the state (panels/). An inspector view, a panel showing
-    // a texture of its own drawing, goes in drawPanels' list and calls
-    // panels_.invalidate(its window's ID) whenever that texture's pixels change.
-    drawPanels(state_);
-    if (!state_.panelsHidden()) {
-        ViewerSettings& set = state_.settings();
-        if (set.showOverlays) overlays_->panel(&set.showOverlays);
-        if (set.showSelection) overlays_->selectionPanel(&set.showSelection);
-    }
-    if (!state_.panelsHidden()) {  // Tab and --hide-panels hide every panel
-        if (s.showInspector) inspector_->panel(&s.showInspector);
-        if (s.showRay) rayPanel(state_, player_, &s.showRay);
-    }
+    // 3. Panels: each reads and acts on the state (panels/), where the layout puts it. A panel
+    // showing a texture of its own drawing calls panels_.invalidate(its window's ID) whenever
+    // that texture's pixels change.
+    PanelContents more;
+    more.overlays = [this](bool* open) { overlays_->panel(open); };
+    more.selection = [this](bool* open) { overlays_->selectionPanel(open); };
+    more.inspector = [this](bool* open) { inspector_->panel(open); };
+    more.ray = [this](bool* open) { rayPanel(state_, player_, open); };
+    drawPanels(state_, layout_, panelHeights_, more);
     state_.startWork(fbWidth, fbHeight);
     ImGui::Render();
 
@@ -126,10 +182,10 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         glClear(GL_COLOR_BUFFER_BIT);
     }
     std::vector<PixelRect> covered = panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight);
-    if (inspector_->shown()) covered.push_back(inspector::Inspector::viewport(fbWidth, fbHeight));
+    if (inspector_->shown()) covered.push_back(inspector_->area(fbWidth, fbHeight));
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale);
 
-    // 4b. The 3D inspector over the right half (the image is not copied under it), with the
+    // 4b. The 3D inspector beside the image (the image is not copied under it), with the
     // ray played drawn into its picture.
     gl::Batch rayLines;
     if (!player_.playback().empty() && player_.view())
@@ -150,8 +206,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // (prepareOverlays); the selection's highlight is drawn over the image, under the panels
     // (the panel layer replaces the pixels of every panel's rectangle next).
     const Clock::time_point selectionStart = Clock::now();
-    if (inspector_->shown()) {  // the main view's highlight stays off the inspector's half
-        const PixelRect v = inspector::Inspector::viewport(fbWidth, fbHeight);
+    if (inspector_->shown()) {  // the main view's highlight stays off the inspector's view
+        const PixelRect v = inspector_->area(fbWidth, fbHeight);
         glEnable(GL_SCISSOR_TEST);
         glScissor(0, 0, v.x0, fbHeight);
     }
@@ -168,7 +224,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
             state_.camera(), state_.width(), state_.height(), player_.playback(), *player_.view());
         glViewport(0, 0, fbWidth, fbHeight);
         if (inspector_->shown()) {
-            const PixelRect r = inspector::Inspector::viewport(fbWidth, fbHeight);
+            const PixelRect r = inspector_->area(fbWidth, fbHeight);
             glEnable(GL_SCISSOR_TEST);
             glScissor(0, 0, r.x0, fbHeight);
         }
@@ -191,6 +247,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     }
     settled_ = state_.settledSince() && inspector_->settled() && !player_.pending() &&
                !player_.playback().playing();
+    keepSettings();
 }
 
 std::vector<std::string> ViewerApp::applyInspectorShow(const std::vector<std::string>& items) {

@@ -16,6 +16,7 @@
 #include "app/viewer/inspector/inspector.h"
 #include "app/viewer/overlay/overlays.h"
 #include "app/viewer/panel_cache.h"
+#include "app/viewer/panels/panels.h"
 #include "app/viewer/playback/ray_player.h"
 #include "app/viewer/viewer_state.h"
 
@@ -122,12 +123,17 @@ class ViewerApp {
     /// The layer the panels are drawn from (PanelCache::invalidate for a panel showing a live
     /// texture).
     PanelCache& panelLayer() { return panels_; }
+    /// Where the last frame put the panels, the image and the inspector (display units).
+    const PanelLayout& layout() const { return layout_; }
 
   private:
     /// The hover tooltip and Ctrl+click picking over the image (mouse not taken by ImGui).
     void overlayInput(int fbWidth, int fbHeight);
     /// Steps 5 of frame(): the overlays' layer handed to the image view, and its timing.
     void prepareOverlays(int fbWidth, int fbHeight);
+    /// The overlays' and the inspector's options and camera into the settings the ini is
+    /// written from (marked to be saved when they changed).
+    void keepSettings();
     /// --log-timings: the overlays' work in this frame (`layerDrawn`: it drew the layers).
     void logOverlayTiming(double ms, bool layerDrawn);
 
@@ -147,8 +153,10 @@ class ViewerApp {
     Clock::time_point lastFrame_ = Clock::now();
     /// The region the playback selected last (-1: none), so a click elsewhere is not undone.
     int64_t playedRegion_ = -1;
-    gl::Batch inspectorRay_;  ///< the lines last handed to the inspector
-    PanelCache panels_;       ///< ImGui's panels, each redrawn only when it changed
+    gl::Batch inspectorRay_;     ///< the lines last handed to the inspector
+    PanelCache panels_;          ///< ImGui's panels, each redrawn only when it changed
+    PanelHeights panelHeights_;  ///< what each panel asked for last frame
+    PanelLayout layout_;         ///< where this frame's panels, image and inspector go
     bool settled_ = false;
 };
 

@@ -15,6 +15,31 @@ const char* viewModeKey(ViewMode m) {
     return keys[int(m)];
 }
 
+/// Flags written as 0/1 separated by spaces, read back in the same order (a short line leaves
+/// the flags after it as they were).
+std::string flagsText(std::initializer_list<bool> flags) {
+    std::string out;
+    for (bool f : flags) out += std::string(out.empty() ? "" : " ") + (f ? "1" : "0");
+    return out;
+}
+
+void readFlags(std::istringstream& in, std::initializer_list<bool*> flags) {
+    for (bool* f : flags) {
+        int v;
+        if (!(in >> v)) return;
+        *f = v != 0;
+    }
+}
+
+/// Whether `v` (a count, a level, an opacity) is a value the viewer can take.
+template <class T>
+bool readIn(std::istringstream& in, T& out, T lo, T hi) {
+    T v;
+    if (!(in >> v) || !(v >= lo && v <= hi)) return false;
+    out = v;
+    return true;
+}
+
 }  // namespace
 
 cli::Knobs knobsOf(const ViewerSettings& s) {
@@ -51,6 +76,34 @@ std::string settingsLines(const ViewerSettings& s) {
       << "auto_scale=" << s.autoScale << "\n"
       << "heat_scale=" << s.heatScale << "\n"
       << "log_scale=" << s.logScale << "\n";
+    const overlay::OverlayOptions& ov = s.overlays;
+    o << "overlay_layers=" << flagsText({ov.bsp, ov.zones, ov.slabs, ov.leaves, ov.grid}) << "\n"
+      << "overlay_fill=" << (ov.zoneFill == overlay::ZoneFill::Slabs ? "slabs" : "prims") << "\n"
+      << "overlay_color=" << (ov.leafColor == overlay::LeafColor::Prims ? "prims" : "level") << "\n"
+      << "overlay_projective=" << ov.projective << "\n"
+      << "overlay_levels=" << ov.levelMin << " " << ov.levelMax << "\n"
+      << "overlay_cap=" << ov.cap << "\n"
+      << "overlay_opacity=" << s.overlayLook.fillOpacity << " " << s.overlayLook.lineOpacity << "\n"
+      << "overlay_tooltip=" << s.overlayLook.tooltip << "\n";
+    const inspector::InspectorOptions& in = s.inspector;
+    o << "inspector_layers="
+      << flagsText(
+             {in.regions, in.zones, in.grid, in.boxes, in.frustum, in.surfaces, in.zoneSlabsOnly})
+      << "\n"
+      << "inspector_color=" << inspector::colorByName(in.colorBy) << "\n"
+      << "inspector_levels=" << in.levelLo << " " << in.levelHi << "\n"
+      << "inspector_slice=" << in.slab.on << " " << in.slab.axis << " " << in.slab.lo << " "
+      << in.slab.hi << "\n"
+      << "inspector_cap=" << in.cap << "\n";
+    if (s.inspectorCamera) {
+        const Camera& c = *s.inspectorCamera;
+        o << "inspector_scene=" << s.inspectorScene << "\n"
+          << "inspector_camera=" << c.from.x << " " << c.from.y << " " << c.from.z << " " << c.at.x
+          << " " << c.at.y << " " << c.at.z << " " << c.up.x << " " << c.up.y << " " << c.up.z
+          << " " << c.fov << " "
+          << (c.projection == Projection::Orthographic ? "orthographic" : "perspective") << " "
+          << c.orthoHeight << "\n";
+    }
     return o.str();
 }
 
@@ -92,6 +145,68 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
     } else if (key == "heat_scale") {
         float v;
         if (in >> v && v > 0.0f && v < 1e12f) s.heatScale = v;
+    } else if (key == "overlay_layers") {
+        overlay::OverlayOptions& o = s.overlays;
+        readFlags(in, {&o.bsp, &o.zones, &o.slabs, &o.leaves, &o.grid});
+    } else if (key == "overlay_fill") {
+        if (value == "prims" || value == "slabs")
+            s.overlays.zoneFill =
+                value == "slabs" ? overlay::ZoneFill::Slabs : overlay::ZoneFill::Prims;
+    } else if (key == "overlay_color") {
+        if (value == "level" || value == "prims")
+            s.overlays.leafColor =
+                value == "prims" ? overlay::LeafColor::Prims : overlay::LeafColor::Level;
+    } else if (key == "overlay_projective") {
+        flag(s.overlays.projective);
+    } else if (key == "overlay_levels") {
+        int lo = 0, hi = 0;
+        if (readIn(in, lo, 0, 1 << 20) && readIn(in, hi, lo, 1 << 20)) {
+            s.overlays.levelMin = lo;
+            s.overlays.levelMax = hi;
+        }
+    } else if (key == "overlay_cap") {
+        readIn(in, s.overlays.cap, size_t(0), size_t(1) << 40);
+    } else if (key == "overlay_opacity") {
+        float fill = 0.0f, line = 0.0f;
+        if (readIn(in, fill, 0.0f, 1.0f) && readIn(in, line, 0.0f, 1.0f)) {
+            s.overlayLook.fillOpacity = fill;
+            s.overlayLook.lineOpacity = line;
+        }
+    } else if (key == "overlay_tooltip") {
+        flag(s.overlayLook.tooltip);
+    } else if (key == "inspector_layers") {
+        inspector::InspectorOptions& o = s.inspector;
+        readFlags(in, {&o.regions, &o.zones, &o.grid, &o.boxes, &o.frustum, &o.surfaces,
+                       &o.zoneSlabsOnly});
+    } else if (key == "inspector_color") {
+        for (inspector::ColorBy c : {inspector::ColorBy::Prims, inspector::ColorBy::Level})
+            if (value == inspector::colorByName(c)) s.inspector.colorBy = c;
+    } else if (key == "inspector_levels") {
+        int lo = 0, hi = 0;
+        if (readIn(in, lo, 0, 1 << 20) && readIn(in, hi, lo, 1 << 20)) {
+            s.inspector.levelLo = lo;
+            s.inspector.levelHi = hi;
+        }
+    } else if (key == "inspector_slice") {
+        int on = 0, axis = 0;
+        double lo = 0.0, hi = 0.0;
+        if (readIn(in, on, 0, 1) && readIn(in, axis, 0, 2) && readIn(in, lo, -1e300, 1e300) &&
+            readIn(in, hi, lo, 1e300))
+            s.inspector.slab = {on != 0, axis, lo, hi};
+    } else if (key == "inspector_cap") {
+        readIn(in, s.inspector.cap, 0, 1 << 30);
+    } else if (key == "inspector_scene") {
+        s.inspectorScene = value;
+    } else if (key == "inspector_camera") {
+        Camera c;
+        std::string projection;
+        if (in >> c.from.x >> c.from.y >> c.from.z >> c.at.x >> c.at.y >> c.at.z >> c.up.x >>
+                c.up.y >> c.up.z >> c.fov >> projection >> c.orthoHeight &&
+            (projection == "perspective" || projection == "orthographic")) {
+            c.projection =
+                projection == "orthographic" ? Projection::Orthographic : Projection::Perspective;
+            if (c.validate().empty()) s.inspectorCamera = c;
+        }
     }
 }
 

@@ -1,10 +1,13 @@
 // What the viewer remembers between runs, kept in the ImGui ini file under [Lancer][Settings].
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "app/cli/options.h"
 #include "app/viewer/colormap.h"
+#include "app/viewer/inspector/inspector_model.h"
+#include "app/viewer/overlay/overlays.h"
 #include "engine/accel/accelerator.h"
 #include "engine/render/tracer.h"
 
@@ -29,6 +32,16 @@ struct ViewerSettings {
     bool autoScale = true;     ///< heat scale follows the image's largest value
     float heatScale = 100.0f;  ///< counter value at the top of the colour map
     bool logScale = false;     ///< heat maps on a log scale (log(1 + count))
+    /// The overlays' layers and choices (cap, level range, colours), and how they are drawn
+    /// (opacities, tooltip; not the cut replay, which is the structure's).
+    overlay::OverlayOptions overlays;
+    overlay::OverlayLook overlayLook;
+    /// The inspector's layers and filters (`show` is showInspector).
+    inspector::InspectorOptions inspector;
+    /// The inspector's camera, kept for the scene it was last on (`inspectorScene`): a run that
+    /// opens that scene first restores it instead of framing the structure afresh.
+    std::optional<Camera> inspectorCamera;
+    std::string inspectorScene;
 };
 
 /// Register the [Lancer][Settings] ini handler of the current ImGui context, reading into and

@@ -85,6 +85,11 @@ PixelRect Inspector::viewport(int fbWidth, int fbHeight) {
     return {fbWidth / 2, 0, fbWidth, fbHeight};
 }
 
+PixelRect Inspector::area(int fbWidth, int fbHeight) const {
+    if (area_.x1 > area_.x0 && area_.y1 > area_.y0) return area_;
+    return viewport(fbWidth, fbHeight);
+}
+
 void Inspector::setCamera(const Camera& c) {
     camera_ = c;
     cameraFramed_ = true;
@@ -96,7 +101,7 @@ void Inspector::update(const std::shared_ptr<const SceneBuild>& structure, const
                        int fbWidth, int fbHeight, int64_t selected) {
     takeSurfaces();
     if (!opt_.show) return;
-    const PixelRect v = viewport(fbWidth, fbHeight);
+    const PixelRect v = area(fbWidth, fbHeight);
     if (v.x1 - v.x0 != vw_ || v.y1 - v.y0 != vh_) {
         vw_ = std::max(1, v.x1 - v.x0);
         vh_ = std::max(1, v.y1 - v.y0);
@@ -108,12 +113,18 @@ void Inspector::update(const std::shared_ptr<const SceneBuild>& structure, const
         view_ = structure_ ? std::make_unique<StructureView>(*structure_->scene, *structure_->accel)
                            : nullptr;
         if (structure_ && (newScene || !cameraFramed_)) {
-            // Beside the main camera, turned about the up axis, so its frustum shows.
-            Camera turned = main.camera;
-            orbit(turned, 0.7, 0.35);
-            Box3 all = view_->worldBounds();
-            all.expand(main.camera.from);
-            camera_ = frameBox(all, turned.at - turned.from, 40.0, double(vw_) / double(vh_));
+            if (restore_ && restore_->scene == structure_->spec) {
+                camera_ = restore_->camera;
+            } else {
+                // Beside the main camera, turned about the up axis, so its frustum shows.
+                Camera turned = main.camera;
+                orbit(turned, 0.7, 0.35);
+                Box3 all = view_->worldBounds();
+                all.expand(main.camera.from);
+                camera_ = frameBox(all, turned.at - turned.from, 40.0, double(vw_) / double(vh_));
+            }
+            restore_.reset();  // the first structure only: a scene opened later is framed
+            cameraScene_ = structure_->spec;
             cameraFramed_ = true;
         }
         dirtyModel_ = true;
@@ -151,7 +162,7 @@ void Inspector::depthBounds(double& near, double& far) const {
 bool Inspector::handleMouse(int fbWidth, int fbHeight, std::optional<int64_t>& picked) {
     if (!opt_.show) return false;
     ImGuiIO& io = ImGui::GetIO();
-    const PixelRect v = viewport(fbWidth, fbHeight);
+    const PixelRect v = area(fbWidth, fbHeight);
     const float mx = io.MousePos.x * io.DisplayFramebufferScale.x;
     const float my = io.MousePos.y * io.DisplayFramebufferScale.y;
     const bool inside =
@@ -363,7 +374,7 @@ void Inspector::draw(int fbWidth, int fbHeight) {
     takeSurfaces();
     if (dirtyBatch_) dirtyPicture_ = true;
     if (dirtyPicture_) render();
-    const PixelRect v = viewport(fbWidth, fbHeight);
+    const PixelRect v = area(fbWidth, fbHeight);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
@@ -374,10 +385,6 @@ void Inspector::draw(int fbWidth, int fbHeight) {
 }
 
 void Inspector::panel(bool* open) {
-    ImGuiIO& io = ImGui::GetIO();
-    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - 348, io.DisplaySize.y - 258),
-                            ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(340, 250), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Inspector", open)) {
         ImGui::End();
         return;

@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "app/viewer/image_view.h"  // PixelRect
 #include "app/viewer/inspector/inspector_model.h"
@@ -40,11 +41,20 @@ class Inspector {
     void setShown(bool on);
     bool shown() const { return opt_.show; }
 
-    /// Where the inspector draws in a fbWidth x fbHeight framebuffer: its right half.
+    /// Where the inspector draws in a fbWidth x fbHeight framebuffer by default: its right half.
     static PixelRect viewport(int fbWidth, int fbHeight);
+    /// Where it draws (framebuffer pixels, row 0 on top): the window's layout sets it; an empty
+    /// rectangle (the default) means viewport().
+    void setArea(const PixelRect& r) { area_ = r; }
+    PixelRect area(int fbWidth, int fbHeight) const;
     /// Its camera (framed on the structure when the scene changes), and setting it.
     const Camera& camera() const { return camera_; }
     void setCamera(const Camera& c);
+    /// The scene (its spec) the camera was framed for or moved over; empty before the first.
+    const std::string& cameraScene() const { return cameraScene_; }
+    /// Use `c` instead of framing the first structure, if it is of scene `sceneSpec` (a camera
+    /// saved in the ini for that scene).
+    void restoreCamera(const Camera& c, const std::string& sceneSpec) { restore_ = {c, sceneSpec}; }
 
     /// Once a frame, before input and drawing: the structure on screen, the main view, the
     /// selected region (-1: none). Rebuilds what changed.
@@ -88,10 +98,17 @@ class Inspector {
     InspectorOptions opt_;
     Camera camera_;
     bool cameraFramed_ = false;
+    std::string cameraScene_;
+    struct Restore {
+        Camera camera;
+        std::string scene;
+    };
+    std::optional<Restore> restore_;
     std::shared_ptr<const SceneBuild> structure_;
     std::unique_ptr<StructureView> view_;
     MainView main_;
     int64_t selected_ = -1;
+    PixelRect area_;       ///< setArea()
     int vw_ = 0, vh_ = 0;  ///< viewport size
     InspectorModel model_;
     bool dirtyModel_ = true, dirtyPicture_ = true, dirtyBatch_ = true;

@@ -73,6 +73,7 @@ struct Slab {
     int axis = 0;
     double lo = 0.0, hi = 0.0;
     bool keeps(const Corners& c) const;
+    bool operator==(const Slab&) const = default;
 };
 
 /// What colours a region.

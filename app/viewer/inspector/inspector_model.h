@@ -30,6 +30,7 @@ struct InspectorOptions {
     int levelLo = 0, levelHi = 64;  ///< regular: the level range kept
     Slab slab;                      ///< the slice slab (world axis)
     int cap = 20000;                ///< regions (and blocks, and boxes) drawn at most
+    bool operator==(const InspectorOptions&) const = default;
 };
 
 /// Where the camera's image lies: the main view's camera and image size.

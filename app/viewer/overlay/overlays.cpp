@@ -202,10 +202,6 @@ void Overlays::tooltip(const Camera& view, int width, int height, double x, doub
 }
 
 void Overlays::panel(bool* open) {
-    // Under the View panel, in the right-hand column (the image's middle stays clear).
-    ImGui::SetNextWindowPos(ImVec2(ImGui::GetIO().DisplaySize.x - 348, 484),
-                            ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(340, 230), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Overlays", open)) {
         ImGui::End();
         return;
@@ -298,8 +294,6 @@ void csgTreeNode(const CsgTree& pool, int node, const Scene& scene) {
 }  // namespace
 
 void Overlays::selectionPanel(bool* open) {
-    ImGui::SetNextWindowPos(ImVec2(346, 28), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(360, 420), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Selection", open)) {
         ImGui::End();
         return;

@@ -1,50 +1,69 @@
 #include "app/viewer/panels/panels.h"
 
 #include <imgui.h>
+#include <imgui_internal.h>  // FindWindowByName: the height a panel asked for
 
 #include <algorithm>
+#include <cmath>
 
 namespace lancer::viewer {
 
 namespace {
 
-/// Panels stack in two columns, Polyscope's way: each is as tall as its content (no scrollbar
-/// while the window has room), placed under the one above it, and the columns follow the
-/// window's size, so a smaller window never leaves a panel off-screen.
-constexpr float kMargin = 8.0f, kGap = 8.0f, kMenuBar = 28.0f;
-/// A panel keeps this height at least when its column is full (it scrolls then).
-constexpr float kMinHeight = 90.0f;
+/// The Ray panel's step list fills what it is given: it asks for as much as the column has.
+constexpr float kFillsColumn = 1.0e6f;
 
-struct Column {
-    float x, width, y;
-};
-
-/// Begin a panel at the top of what is left of `col`; false when it is collapsed.
-bool beginPanel(const char* name, bool* open, const Column& col) {
-    const ImVec2 display = ImGui::GetIO().DisplaySize;
-    const float bottom = display.y - kMargin;
-    const float y = std::max(kMenuBar, std::min(col.y, bottom - kMinHeight));
-    ImGui::SetNextWindowPos(ImVec2(std::max(0.0f, col.x), y), ImGuiCond_Always);
-    ImGui::SetNextWindowSizeConstraints(ImVec2(col.width, 0.0f),
-                                        ImVec2(col.width, std::max(kMinHeight, bottom - y)));
-    return ImGui::Begin(name, open, ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoMove);
+/// The settings' flag that shows panel `id`.
+template <class Settings>
+auto openFlag(Settings& s, PanelId id) -> decltype((s.showRay)) {
+    switch (id) {
+        case PanelId::Parameters:
+            return s.showParameters;
+        case PanelId::View:
+            return s.showView;
+        case PanelId::Statistics:
+            return s.showStatistics;
+        case PanelId::Camera:
+            return s.showCamera;
+        case PanelId::Overlays:
+            return s.showOverlays;
+        case PanelId::Inspector:
+            return s.showInspector;
+        case PanelId::Selection:
+            return s.showSelection;
+        case PanelId::Ray:
+            break;
+    }
+    return s.showRay;
 }
 
-/// End the panel Begun last; the next one in `col` goes under it.
-void endPanel(Column& col) {
-    col.y = ImGui::GetWindowPos().y + ImGui::GetWindowHeight() + kGap;
+/// Place the next window at `r`, its size fixed (its content scrolls when taller).
+void placeNext(const Rect& r) {
+    ImGui::SetNextWindowPos(ImVec2(r.x0, r.y0), ImGuiCond_Always);
+    const ImVec2 size(r.width(), r.height());
+    ImGui::SetNextWindowSize(size, ImGuiCond_Always);
+    ImGui::SetNextWindowSizeConstraints(size, size);
+}
+
+/// After a panel's End: the height its content asked for (title bar and padding included) and
+/// whether it is folded, for the next frame's layout.
+void measure(PanelId id, PanelRequest& req) {
+    const ImGuiWindow* w = ImGui::FindWindowByName(panelTitle(id));
+    if (!w) return;
+    req.collapsed = w->Collapsed;
+    if (w->Collapsed) return;  // a folded panel submits nothing: keep the last height
+    const ImGuiStyle& style = ImGui::GetStyle();
+    req.want = id == PanelId::Ray ? kFillsColumn
+                                  : std::ceil(w->DC.CursorMaxPos.y - w->DC.CursorStartPos.y +
+                                              2.0f * style.WindowPadding.y + w->TitleBarHeight());
+}
+
+/// One of panels.h's own panels, in a window of its own.
+void ownPanel(PanelId id, bool& open, ViewerState& st, void (*content)(ViewerState&)) {
+    if (ImGui::Begin(panelTitle(id), &open, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize))
+        content(st);
     ImGui::End();
 }
-
-void panel(const char* name, bool& open, Column& col, void (*content)(ViewerState&),
-           ViewerState& st) {
-    if (!open) return;
-    if (beginPanel(name, &open, col)) content(st);
-    endPanel(col);
-}
-
-/// The column with more room left.
-Column& roomier(Column& a, Column& b) { return a.y <= b.y ? a : b; }
 
 }  // namespace
 
@@ -59,6 +78,7 @@ void menuBar(ViewerState& st) {
         ImGui::MenuItem("Overlays", nullptr, &s.showOverlays);
         ImGui::MenuItem("Selection", nullptr, &s.showSelection);
         ImGui::MenuItem("Ray", nullptr, &s.showRay);
+        ImGui::MenuItem("3D inspector", "I", &s.showInspector);
         ImGui::Separator();
         bool hidden = st.panelsHidden();
         if (ImGui::MenuItem("Hide all", "Tab", &hidden)) st.setPanelsHidden(hidden);
@@ -71,18 +91,62 @@ void menuBar(ViewerState& st) {
     ImGui::EndMainMenuBar();
 }
 
-void drawPanels(ViewerState& st) {
+PanelLayout planPanels(const ViewerState& st, const PanelHeights& heights, float width,
+                       float height) {
+    LayoutInput in;
+    in.width = width;
+    in.height = height;
+    in.panelsHidden = st.panelsHidden();
+    in.inspector = st.settings().showInspector;
+    in.titleHeight = ImGui::GetFrameHeight();
+    in.panels = heights;
+    for (int i = 0; i < kPanelCount; ++i)
+        in.panels[size_t(i)].open = openFlag(st.settings(), PanelId(i));
+    return layoutPanels(in);
+}
+
+void drawPanels(ViewerState& st, const PanelLayout& layout, PanelHeights& heights,
+                const PanelContents& more) {
     if (st.panelsHidden()) return;
     ViewerSettings& s = st.settings();
-    const float width = ImGui::GetIO().DisplaySize.x;
     menuBar(st);
-    Column left{kMargin, 330.0f, kMenuBar};
-    Column right{width - 348.0f, 340.0f, kMenuBar};
-    panel("Parameters", s.showParameters, left, parametersPanel, st);
-    panel("Statistics", s.showStatistics, right, statisticsPanel, st);
-    panel("View", s.showView, right, viewPanel, st);
-    panel("Camera", s.showCamera, roomier(left, right), cameraPanel, st);
-    // An inspector view goes here, in the column with more room (roomier()).
+    for (int i = 0; i < kPanelCount; ++i) {
+        const PanelId id = PanelId(i);
+        bool& open = openFlag(s, id);
+        // A panel opened during this frame (a menu, a pick) is placed from the next one.
+        if (!open || layout[id].empty()) continue;
+        placeNext(layout[id]);
+        switch (id) {
+            case PanelId::Parameters:
+                ownPanel(id, open, st, parametersPanel);
+                break;
+            case PanelId::View:
+                ownPanel(id, open, st, viewPanel);
+                break;
+            case PanelId::Statistics:
+                ownPanel(id, open, st, statisticsPanel);
+                break;
+            case PanelId::Camera:
+                ownPanel(id, open, st, cameraPanel);
+                break;
+            case PanelId::Overlays:
+                // Folded at first (a click on its title opens it), so the panels of a first
+                // run fit a 900 x 720 window whole.
+                ImGui::SetNextWindowCollapsed(true, ImGuiCond_FirstUseEver);
+                if (more.overlays) more.overlays(&open);
+                break;
+            case PanelId::Inspector:
+                if (more.inspector) more.inspector(&open);
+                break;
+            case PanelId::Selection:
+                if (more.selection) more.selection(&open);
+                break;
+            case PanelId::Ray:
+                if (more.ray) more.ray(&open);
+                break;
+        }
+        measure(id, heights[size_t(i)]);
+    }
 }
 
 }  // namespace lancer::viewer

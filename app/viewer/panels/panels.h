@@ -2,14 +2,33 @@
 // and acting on the ViewerState. The frame (viewer_app.cpp) calls drawPanels() once.
 #pragma once
 
+#include <functional>
+
+#include "app/viewer/panels/layout.h"
 #include "app/viewer/playback/ray_player.h"
 #include "app/viewer/viewer_state.h"
 
 namespace lancer::viewer {
 
-/// The main menu bar and every panel the settings show, in two columns (none while the panels
-/// are hidden). The functions below draw a panel's content, between its Begin and End.
-void drawPanels(ViewerState& st);
+/// What the layout remembers of each panel from one frame to the next: the height its content
+/// asked for and whether it is folded.
+using PanelHeights = std::array<PanelRequest, kPanelCount>;
+
+/// The panels of the viewer's other rooms, each drawing its own window (Begin to End) when
+/// called with its open flag: the overlays', the selection's, the inspector's, the ray's.
+struct PanelContents {
+    std::function<void(bool*)> overlays, selection, inspector, ray;
+};
+
+/// This frame's layout (layout.h) of a width x height window (display units): the panels the
+/// settings show, at the heights they asked for last frame.
+PanelLayout planPanels(const ViewerState& st, const PanelHeights& heights, float width,
+                       float height);
+/// The main menu bar and every panel the settings show where `layout` puts them (none while the
+/// panels are hidden), and the heights they ask for next. The functions below draw a panel's
+/// content, between its Begin and End.
+void drawPanels(ViewerState& st, const PanelLayout& layout, PanelHeights& heights,
+                const PanelContents& more);
 
 /// Which panels are shown, the scene, build and error notes.
 void menuBar(ViewerState& st);

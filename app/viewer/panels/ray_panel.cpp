@@ -93,9 +93,6 @@ void csgStrip(const playback::RayPlayback& play) {
 }  // namespace
 
 void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
-    ImGuiIO& io = ImGui::GetIO();
-    ImGui::SetNextWindowPos(ImVec2(8, io.DisplaySize.y - 368), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(560, 360), ImGuiCond_FirstUseEver);
     if (!ImGui::Begin("Ray", open)) {
         ImGui::End();
         return;

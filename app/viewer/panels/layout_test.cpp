@@ -1,0 +1,127 @@
+// The panels' layout without a window: at the sizes users run the viewer at, with the
+// inspector shown or not, no panel overlaps another, the image area or the inspector's view,
+// and every panel stays inside the window.
+#include "app/viewer/panels/layout.h"
+
+#include <gtest/gtest.h>
+
+#include "app/viewer/inspector/inspector.h"
+
+namespace lancer::viewer {
+namespace {
+
+/// Every panel open, asking for the heights their contents take (the first four as measured at
+/// 900 x 720 on builtin:default, and typical ones for the others; the Ray panel asks for all it
+/// can get).
+LayoutInput everyPanel(float w, float h, bool inspector) {
+    LayoutInput in;
+    in.width = w;
+    in.height = h;
+    in.inspector = inspector;
+    const float wants[kPanelCount] = {639, 121, 272, 189, 240, 330, 450, 1.0e6f};
+    for (int i = 0; i < kPanelCount; ++i) in.panels[size_t(i)] = {true, false, wants[i]};
+    return in;
+}
+
+void expectApart(const LayoutInput& in, const PanelLayout& l) {
+    const Rect window{0.0f, kMenuBarHeight, in.width, in.height};
+    EXPECT_FALSE(l.image.empty());
+    EXPECT_FALSE(l.image.overlaps(l.inspector));
+    EXPECT_EQ(l.inspector.empty(), !in.inspector);
+    EXPECT_TRUE(Rect({0.0f, 0.0f, in.width, in.height}).contains(l.image)) << l.image.toString();
+    if (in.inspector) {
+        EXPECT_TRUE(window.contains(l.inspector)) << l.inspector.toString();
+    }
+    for (int i = 0; i < kPanelCount; ++i) {
+        const Rect& r = l.panels[size_t(i)];
+        const char* name = panelTitle(PanelId(i));
+        if (!in.panels[size_t(i)].open) {
+            EXPECT_TRUE(r.empty()) << name;
+            continue;
+        }
+        // On screen, under the menu bar, at least a title bar high (never clipped away).
+        EXPECT_TRUE(window.contains(r)) << name << " " << r.toString();
+        EXPECT_GE(r.height(), in.titleHeight) << name;
+        EXPECT_FALSE(r.overlaps(l.image))
+            << name << " " << r.toString() << " over the image " << l.image.toString();
+        EXPECT_FALSE(r.overlaps(l.inspector))
+            << name << " " << r.toString() << " over the inspector " << l.inspector.toString();
+        for (int j = i + 1; j < kPanelCount; ++j)
+            EXPECT_FALSE(r.overlaps(l.panels[size_t(j)]))
+                << name << " overlaps " << panelTitle(PanelId(j));
+    }
+}
+
+TEST(PanelLayout, NoPanelOverlapsTheImageOrTheInspectorAt1280x720And900x600) {
+    for (const auto& [w, h] : {std::pair{1280.0f, 720.0f}, std::pair{900.0f, 600.0f}})
+        for (bool inspector : {false, true}) {
+            SCOPED_TRACE(testing::Message() << w << " x " << h << (inspector ? ", inspector" : ""));
+            const LayoutInput in = everyPanel(w, h, inspector);
+            const PanelLayout l = layoutPanels(in);
+            expectApart(in, l);
+            // The image keeps a useful part of the window, and so does the inspector.
+            EXPECT_GE(l.image.width(), 0.25f * w);
+            if (inspector) {
+                EXPECT_GE(l.inspector.width(), 0.3f * w);
+            }
+            // Two columns at these sizes without the inspector, one with it.
+            EXPECT_EQ(l.twoColumns, !inspector);
+        }
+}
+
+TEST(PanelLayout, PanelsThatFitGetTheirHeightAndTheRayPanelTakesWhatIsLeft) {
+    LayoutInput in = everyPanel(1280.0f, 720.0f, false);
+    for (PanelId id : {PanelId::Camera, PanelId::Overlays, PanelId::Inspector, PanelId::Selection})
+        in[id].open = false;
+    const PanelLayout l = layoutPanels(in);
+    expectApart(in, l);
+    for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics})
+        EXPECT_EQ(l[id].height(), in[id].want) << panelTitle(id);
+    // The Ray panel goes down to the bottom margin of its column.
+    EXPECT_FLOAT_EQ(l[PanelId::Ray].y1, 720.0f - 8.0f);
+    EXPECT_GT(l[PanelId::Ray].height(), 200.0f);
+
+    // Folding the panels gives the Ray panel their room.
+    LayoutInput folded = in;
+    for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics})
+        folded[id].collapsed = true;
+    const PanelLayout f = layoutPanels(folded);
+    expectApart(folded, f);
+    EXPECT_GT(f[PanelId::Ray].height(), 600.0f);
+    for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics})
+        EXPECT_EQ(f[id].height(), folded.titleHeight) << panelTitle(id);
+}
+
+TEST(PanelLayout, HiddenPanelsLeaveTheWindowToTheImageAndTheInspectorItsRightHalf) {
+    LayoutInput in = everyPanel(1280.0f, 720.0f, false);
+    in.panelsHidden = true;
+    PanelLayout l = layoutPanels(in);
+    EXPECT_EQ(l.image.toString(), Rect({0, 0, 1280, 720}).toString());
+    for (const Rect& r : l.panels) EXPECT_TRUE(r.empty());
+    in.inspector = true;
+    l = layoutPanels(in);
+    // Where the inspector has always drawn with the panels hidden.
+    const PixelRect v = inspector::Inspector::viewport(1280, 720);
+    EXPECT_EQ(l.inspector.toString(),
+              Rect({float(v.x0), float(v.y0), float(v.x1), float(v.y1)}).toString());
+    EXPECT_EQ(l.image.toString(), Rect({0, 0, 640, 720}).toString());
+}
+
+TEST(PanelLayout, ASmallWindowKeepsEveryPanelInside) {
+    for (const auto& [w, h] : {std::pair{640.0f, 400.0f}, std::pair{320.0f, 240.0f}}) {
+        SCOPED_TRACE(testing::Message() << w << " x " << h);
+        const LayoutInput in = everyPanel(w, h, false);
+        const PanelLayout l = layoutPanels(in);
+        EXPECT_FALSE(l.twoColumns);
+        for (int i = 0; i < kPanelCount; ++i) {
+            const Rect& r = l.panels[size_t(i)];
+            EXPECT_GE(r.x0, 0.0f);
+            EXPECT_LE(r.x1, w);
+            EXPECT_GE(r.y0, kMenuBarHeight);
+            EXPECT_LE(r.y1, h);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace lancer::viewer
