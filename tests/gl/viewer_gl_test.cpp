@@ -12,6 +12,7 @@
 #include <chrono>
 #include <thread>
 
+#include "app/viewer/camera_control.h"
 #include "app/viewer/image_view.h"
 #include "app/viewer/panel_cache.h"
 #include "app/viewer/viewer_app.h"
@@ -736,6 +737,51 @@ TEST_F(ViewerFrames, TheErrorLineIsReservedSoTheControlsStayPut) {
     for (int i = 0; i < 3; ++i) app_->frame(kW, kH);
     ASSERT_FALSE(app_->error().empty());
     EXPECT_EQ(panelWindow("Parameters")->Size.y, before);
+}
+
+// The overlays' and the inspector's options and the inspector's camera are written to ImGui's
+// ini and come back in a new viewer that loads it.
+TEST_F(ViewerFrames, OverlayAndInspectorSettingsComeBackFromTheIni) {
+    registerSettingsHandler(&settings_);
+    app_->showInspector(true);
+    runUntilSettled();
+    overlay::OverlayOptions& o = app_->overlays().options;
+    o.leaves = o.grid = true;
+    o.cap = 4321;
+    o.levelMax = 7;
+    app_->overlays().look.lineOpacity = 0.5f;
+    inspector::InspectorOptions& io = app_->inspector().options();
+    io.boxes = true;
+    io.levelHi = 5;
+    io.colorBy = inspector::ColorBy::Level;
+    app_->inspector().changed();
+    Camera ic = app_->inspector().camera();
+    orbit(ic, 0.3, 0.1);
+    app_->inspector().setCamera(ic);
+    app_->frame(kW, kH);
+    const overlay::OverlayOptions savedOverlays = o;
+    const inspector::InspectorOptions savedInspector = io;
+    const std::string ini = ImGui::SaveIniSettingsToMemory();
+
+    // A new run: a new context and settings, the ini loaded before the viewer starts.
+    app_.reset();
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui::DestroyContext();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;
+    ImGui::GetIO().DisplaySize = ImVec2(float(kW), float(kH));
+    ASSERT_TRUE(ImGui_ImplOpenGL3_Init("#version 330 core"));
+    settings_ = ViewerSettings{};
+    registerSettingsHandler(&settings_);
+    ImGui::LoadIniSettingsFromMemory(ini.c_str(), ini.size());
+    app_ = std::make_unique<ViewerApp>(settings_, false);
+    runUntilSettled();
+    EXPECT_TRUE(app_->overlays().options == savedOverlays);
+    EXPECT_EQ(app_->overlays().look.lineOpacity, 0.5f);
+    EXPECT_TRUE(app_->inspector().shown());
+    EXPECT_TRUE(app_->inspector().options() == savedInspector);
+    // The camera the inspector was left with, not one framed afresh on the structure.
+    EXPECT_EQ(app_->inspector().camera().toJson(), ic.toJson());
 }
 
 // Tab hides every panel (and the menu bar): the window shows the render alone; Tab again

@@ -149,6 +149,73 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     EXPECT_EQ(settingsLines(bad), lines);
 }
 
+/// Every line of `lines` read into `r`.
+void readLines(ViewerSettings& r, const std::string& lines) {
+    size_t start = 0;
+    while (start < lines.size()) {
+        size_t end = lines.find('\n', start);
+        readSettingsLine(r, lines.substr(start, end - start));
+        start = end + 1;
+    }
+}
+
+TEST(ViewerSettingsIni, OverlayAndInspectorOptionsRoundTrip) {
+    ViewerSettings s;
+    overlay::OverlayOptions& o = s.overlays;
+    o.bsp = o.slabs = o.grid = true;
+    o.zoneFill = overlay::ZoneFill::Slabs;
+    o.leafColor = overlay::LeafColor::Prims;
+    o.projective = false;
+    o.levelMin = 3;
+    o.levelMax = 9;
+    o.cap = 12345;
+    s.overlayLook.fillOpacity = 0.6f;
+    s.overlayLook.lineOpacity = 0.25f;
+    s.overlayLook.tooltip = false;
+    inspector::InspectorOptions& i = s.inspector;
+    i.regions = false;
+    i.grid = i.boxes = i.zoneSlabsOnly = true;
+    i.frustum = i.surfaces = false;
+    i.colorBy = inspector::ColorBy::Level;
+    i.levelLo = 2;
+    i.levelHi = 11;
+    i.slab = {true, 2, -0.25, 0.75};
+    i.cap = 777;
+    s.showInspector = true;
+    Camera c = sample();
+    c.projection = Projection::Orthographic;
+    c.orthoHeight = 3.25;
+    s.inspectorCamera = c;
+    s.inspectorScene = "assets/spd/balls4.nff";
+
+    ViewerSettings r;
+    const std::string lines = settingsLines(s);
+    readLines(r, lines);
+    EXPECT_EQ(settingsLines(r), lines);
+    EXPECT_TRUE(r.overlays == s.overlays);
+    EXPECT_TRUE(r.overlayLook == s.overlayLook);
+    EXPECT_TRUE(r.inspector == s.inspector);
+    EXPECT_TRUE(r.showInspector);
+    ASSERT_TRUE(r.inspectorCamera);
+    EXPECT_EQ(r.inspectorCamera->toJson(), c.toJson());
+    EXPECT_EQ(r.inspectorScene, s.inspectorScene);
+    // The defaults differ from every value above: nothing was left at its default by chance.
+    const ViewerSettings d;
+    EXPECT_FALSE(d.overlays.bsp || d.overlays.slabs || d.overlays.grid);
+    EXPECT_NE(d.overlays.cap, o.cap);
+    EXPECT_FALSE(d.inspector == i);
+
+    // Bad values leave what was read.
+    ViewerSettings bad = r;
+    for (const char* line :
+         {"overlay_levels=5 2", "overlay_cap=-3", "overlay_opacity=2 0.5", "overlay_fill=area",
+          "overlay_color=", "inspector_slice=1 3 0 1", "inspector_cap=x", "inspector_levels=-1 4",
+          "inspector_color=heat", "inspector_camera=1 2 3 1 2 3 0 0 1 45 fisheye 1",
+          "inspector_camera=0 0 0 0 0 0 0 0 1 45 perspective 1"})
+        readSettingsLine(bad, line);
+    EXPECT_EQ(settingsLines(bad), lines);
+}
+
 }  // namespace
 }  // namespace lancer::viewer
 
