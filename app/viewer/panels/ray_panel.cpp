@@ -108,7 +108,10 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
     ImGui::SameLine();
     if (ImGui::Button("Pick")) player.pick(typed[0], typed[1]);
     ImGui::SameLine();
-    hintText("or Shift+click the image");
+    const char* hint = "or Shift+click the image";
+    // In a narrow column the hint goes under the button rather than a letter a line.
+    if (ImGui::GetContentRegionAvail().x < ImGui::CalcTextSize(hint).x) ImGui::NewLine();
+    hintText(hint);
     errorText(player.note().rfind("pixel", 0) == 0 ? player.note() : "");
     if (play.empty()) {
         ImGui::End();
