@@ -24,7 +24,7 @@ struct ViewerSettings {
     bool showParameters = true, showStatistics = true, showCamera = true, showView = true;
     bool showOverlays = true;
     bool showSelection = false;  ///< opened by a pick or --select
-    /// The 3D inspector over the right half of the window.
+    /// The 3D inspector, beside the image (the right half of what the panels leave).
     bool showInspector = false;
     /// The Ray panel (not saved: it opens with the first pick).
     bool showRay = false;

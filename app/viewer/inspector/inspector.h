@@ -1,9 +1,9 @@
-// The 3D inspector: a view of its own, with its own orbit camera, drawn over the right half of
-// the window. It shows the structure's regions (regular leaves coloured by primitive count or
-// level, with a level range and a slice slab; irregular zones and slabs), the directory's
-// blocks, the minimized boxes, the camera's frustum and image plane, and the scene's surfaces
-// traced from its camera (surface_tracer.h), the lines hidden behind them by the traced depth.
-// A click picks the nearest drawn region. No window needed: a test drives it in OSMesa.
+// The 3D inspector: a view of its own, with its own orbit camera, drawn beside the image where
+// the window's layout puts it. It shows the structure's regions (regular leaves coloured by
+// primitive count or level, with a level range and a slice slab; irregular zones and slabs), the
+// directory's blocks, the minimized boxes, the camera's frustum and image plane, and the scene's
+// surfaces traced from its camera (surface_tracer.h), the lines hidden behind them by the traced
+// depth. A click picks the nearest drawn region. No window needed: a test drives it in OSMesa.
 #pragma once
 
 #include <cstdint>

@@ -95,7 +95,7 @@ void viewPanel(ViewerState& st) {
     ImGui::Separator();
     ImGui::Checkbox("3D inspector (I)", &st.settings().showInspector);
     if (ImGui::IsItemHovered())
-        ImGui::SetTooltip("The structure in 3D, with a camera of its own, over the right half");
+        ImGui::SetTooltip("The structure in 3D, with a camera of its own, beside the image");
     PanelNotes& notes = st.notes();
     if (ImGui::Button("Screenshot")) {
         // Taken once this frame is drawn.
