@@ -87,7 +87,7 @@ int drawStrip(const std::vector<playback::StripRow>& rows,
     const float top = bands.empty() ? 0.0f : rowH;
     const float h = top + rowH * float(rows.size() + 1);
     int clicked = -1;
-    const float childH = std::min(h + 4.0f, 260.0f);
+    const float childH = std::min(h + 4.0f, 170.0f);
     if (!ImGui::BeginChild(id, ImVec2(0, childH), false)) {
         ImGui::EndChild();
         return clicked;
@@ -323,7 +323,8 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
 
     if (ImGui::CollapsingHeader("CSG in this region", ImGuiTreeNodeFlags_DefaultOpen))
         regionCsgStrip(player);
-    if (ImGui::CollapsingHeader("CSG along the whole ray")) rayCsgStrip(player);
+    if (ImGui::CollapsingHeader("CSG along the whole ray", ImGuiTreeNodeFlags_DefaultOpen))
+        rayCsgStrip(player);
 
     // The wasted work (docs/viewer.md): the ray's, this step's, and each wasted test's class in
     // the step list.
