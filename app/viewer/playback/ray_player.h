@@ -44,6 +44,12 @@ class RayPlayer {
         static const std::vector<StepCsg> none;
         return view_ ? csg_.steps(play_, *view_) : none;
     }
+    /// The current step of csgSteps(), or null.
+    const StepCsg* currentStep() {
+        const std::vector<StepCsg>& steps = csgSteps();
+        const int k = play_.state().step;
+        return k >= 0 && size_t(k) < steps.size() ? &steps[size_t(k)] : nullptr;
+    }
     /// The wasted work of the ray csgSteps() analysed.
     const RayWaste& waste() const { return csg_.waste(); }
     /// Why the last pick was refused (outside the image), or empty.
