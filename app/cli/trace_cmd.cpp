@@ -3,6 +3,7 @@
 
 #include "app/cli/commands.h"
 #include "engine/accel/structure_view.h"
+#include "engine/render/ray_csg.h"
 #include "engine/render/ray_tree.h"
 #include "engine/scene/loader.h"
 
@@ -23,10 +24,24 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
                                         std::to_string(w) + "x" + std::to_string(h) + " image");
         const RayTree tree = tracePixel(scene, *accel, o.knobs.shading, cam, t.x, t.y, w, h);
         const TracedRay& primary = tree.rays.front();
+        // Each ray's wasted work (docs/viewer.md, "Wasted work"), from its recorded events.
+        const StructureView view(scene, *accel);
+        std::vector<RayWaste> waste;
+        for (const TracedRay& r : tree.rays)
+            waste.push_back(wastedWork(scene, r, rayCsg(scene, view, r)));
+        // A ray's JSON gains "wasted" (its counts) and each wasted test's event its class.
+        auto addWaste = [](nlohmann::json& ray, const RayWaste& w) {
+            const WasteCounts& c = w.total;
+            ray["wasted"] = {
+                {"tests", c.tests},   {"wasted", c.wasted()},        {"repeats", c.repeats},
+                {"misses", c.misses}, {"beyond_exit", c.beyondExit}, {"no_effect", c.noEffect}};
+            nlohmann::json& ev = ray["events"];
+            for (size_t i = 0; i < w.perEvent.size() && i < ev.size(); ++i)
+                if (w.perEvent[i] != Waste::None) ev[i]["wasted"] = wasteName(w.perEvent[i]);
+        };
 
         if (t.json) {
             // Every region event carries the region's 8 world corners.
-            const StructureView view(scene, *accel);
             const RegionCornersFn corners = [&view](uint32_t id) {
                 const std::array<Vec3, 8> c = view.regionCorners(id);
                 return std::vector<Vec3>(c.begin(), c.end());
@@ -39,7 +54,8 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
             j["height"] = h;
             j["camera"] = nlohmann::json::parse(cam.toJson());
             j["bounces"] = o.knobs.shading.bounces;
-            const nlohmann::json p = toJson(primary, scene, corners);
+            nlohmann::json p = toJson(primary, scene, corners);
+            addWaste(p, waste.front());
             j["ray"] = {{"origin", p["origin"]}, {"direction", p["direction"]}};
             j["events"] = p["events"];
             j["hit"] = p["hit"];
@@ -54,7 +70,10 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
             j["walk_errors"] = tree.counters.walkErrors;
             j["counters"] = toJson(tree.counters);
             nlohmann::json rays = nlohmann::json::array();
-            for (const TracedRay& r : tree.rays) rays.push_back(toJson(r, scene, corners));
+            for (size_t i = 0; i < tree.rays.size(); ++i) {
+                rays.push_back(toJson(tree.rays[i], scene, corners));
+                addWaste(rays.back(), waste[i]);
+            }
             j["rays"] = std::move(rays);
             std::cout << j.dump(2) << "\n";
             return 0;
@@ -66,6 +85,8 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
         std::cout << "primitive tests " << tree.counters.primTests << ", mailbox hits "
                   << tree.counters.mailboxHits << ", regions " << tree.counters.regionVisits
                   << " (the pixel's " << tree.rays.size() << " rays)\n";
+        for (size_t i = 0; i < tree.rays.size(); ++i)
+            std::cout << "wasted work of #" << i << ": " << waste[i].total.toString() << "\n";
         if (primary.hit.valid())
             std::cout << "hit " << primary.hit << " " << scene.prims[primary.hit.prim].toString()
                       << "\n    point " << toString(primary.point) << " normal "

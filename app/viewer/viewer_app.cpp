@@ -157,6 +157,10 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         if (played >= 0 || selectedRegion() == playedRegion_) selectRegion(played);
         playedRegion_ = played;
     }
+    if (const StepCsg* step = player_.currentStep())
+        overlays_->setEvaluatedNodes(step->region, step->pool, step->nodes);
+    else
+        overlays_->setEvaluatedNodes(-1, nullptr, {});
 
     // 3. Panels: each reads and acts on the state (panels/), where the layout puts it. A panel
     // showing a texture of its own drawing calls panels_.invalidate(its window's ID) whenever

@@ -68,6 +68,7 @@ void evalTree(const Scene& scene, const CsgTree& tree, int node, const Ray& ray,
             int n = primitiveSpans(scene, x.prim, ray, ctx, obs, s, local);
             out.assign(s, s + n);
         }
+        if constexpr (Obs::kActive) obs.csgNode(node, out);
         return;
     }
     // Sized by TraceContext::reset from the tree depth: never resized here, since parents hold
@@ -78,6 +79,7 @@ void evalTree(const Scene& scene, const CsgTree& tree, int node, const Ray& ray,
     evalTree<Obs, F>(scene, tree, x.left, ray, ctx, obs, level + 1, a);
     if (a.empty() && x.op != Op::Union) {  // nothing to intersect or to cut from
         out.clear();
+        if constexpr (Obs::kActive) obs.csgNode(node, out);
         return;
     }
     evalTree<Obs, F>(scene, tree, x.right, ray, ctx, obs, level + 1, b);
@@ -94,6 +96,7 @@ void evalTree(const Scene& scene, const CsgTree& tree, int node, const Ray& ray,
         case Op::Primitive:
             break;
     }
+    if constexpr (Obs::kActive) obs.csgNode(node, out);
 }
 
 /// The visible hit of `tree` inside a region the ray crosses on [t0, t1]: the first span

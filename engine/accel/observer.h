@@ -48,6 +48,9 @@ struct NullObserver {
     void primTest(uint32_t prim, const Span* spans, int n) {}
     void mailboxHit(uint32_t prim) {}
     void regionSpans(const SpanList& spans) {}
+    // A node of the tree evaluated (evalTree): its spans along the whole line. Not reached from
+    // the render path (wrapped in `if constexpr (Obs::kActive)`).
+    void csgNode(int node, const SpanList& spans) {}
     void walkError(const char* what) {}
     // From region to region. Irregular: the region a walk starts in, the exit (with the tied
     // axes: face, edge or corner) and each corner pointer followed.
@@ -126,6 +129,9 @@ struct RecordingObserver {
     }
     void mailboxHit(uint32_t prim) { add(WalkEvent::MailboxHit).a = prim; }
     void regionSpans(const SpanList& s) { add(WalkEvent::Spans).spans = s; }
+    /// Not recorded: a walk's events keep the primitives' spans and the tree's, from which
+    /// evalNodes (engine/render/ray_csg.h) gets every node's again with evalTree.
+    void csgNode(int node, const SpanList& spans) {}
     void walkError(const char* what) { add(WalkEvent::Error).what = what; }
     void locate(const Vec3& point, uint32_t region) {
         WalkEvent& e = add(WalkEvent::Locate);

@@ -50,7 +50,17 @@ for r in rays:
 assert regions == j["region_visits"], (regions, j["region_visits"])
 tests = sum(r["counters"]["prim_tests"] for r in rays)
 assert tests == j["prim_tests"], (tests, j["prim_tests"])
+# Each ray's wasted work: its tests, and the wasted ones' events tagged with their class.
+for r in rays:
+    w = r["wasted"]
+    assert w["tests"] == r["counters"]["prim_tests"], (w, r["counters"])
+    assert w["wasted"] == w["repeats"] + w["misses"] + w["beyond_exit"] + w["no_effect"], w
+    tagged = [e["wasted"] for e in r["events"] if "wasted" in e]
+    assert len(tagged) == w["wasted"], (tagged, w)
+    assert all(e["event"] == "prim_test" for e in r["events"] if "wasted" in e)
 EOF
+"$LANCER" trace builtin:default --width 64 --height 40 --pixel 10 30 \
+  | grep -q "^wasted work of #0: [0-9]* tests\?, [0-9]* wasted" || fail "trace text lacks the wasted work"
 
 # Summed over every pixel, trace's counts are render's totals.
 w=6; h=4

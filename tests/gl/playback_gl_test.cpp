@@ -1,6 +1,6 @@
 // The ray playback's drawing (app/viewer/playback/ray_drawing.h) in OSMesa: the region
-// highlighted at step k is drawn where its 8 corners project with the camera, and nowhere else,
-// for both schemes.
+// highlighted at step k, and the minimized boxes of the primitives tested there, are drawn where
+// their 8 corners project with the camera, and nowhere else, for both schemes.
 #include <gtest/gtest.h>
 
 #include "app/viewer/gl/batch.h"
@@ -119,6 +119,127 @@ TEST_P(PlaybackGl, RegionAtStepKIsDrawnWhereItsCornersProject) {
                     const uint8_t* p = &px[(size_t(y) * size_t(w) + size_t(x)) * 4];
                     hit = p[0] == (want & 0xff) && p[1] == ((want >> 8) & 0xff) &&
                           p[2] == ((want >> 16) & 0xff);
+                }
+            if (!hit) ++missed;
+        }
+    EXPECT_GT(onEdges, 5);
+    EXPECT_EQ(missed, 0) << "of " << onEdges << " points on the projected edges";
+}
+
+gl::Rgba8 pixelAt(const std::vector<uint8_t>& px, int w, int x, int y) {
+    const uint8_t* p = &px[(size_t(y) * size_t(w) + size_t(x)) * 4];
+    return gl::Rgba8(p[0]) | gl::Rgba8(p[1]) << 8 | gl::Rgba8(p[2]) << 16 | gl::Rgba8(p[3]) << 24;
+}
+
+TEST_P(PlaybackGl, TestedPrimitivesBoxesAreDrawnWhereTheirCornersProject) {
+    const int w = 160, h = 120;
+    testing::OffscreenGl ctx(w, h);
+    ASSERT_TRUE(ctx.ok());
+    Scene scene = loadScene("builtin:default");
+    BuildParams params;
+    params.scheme = GetParam();
+    auto accel = buildAccelerator(scene, params);
+    const StructureView view(scene, *accel);
+    ShadingOptions sh;
+    const gl::ImageProjector proj(scene.camera, w, h);
+    const Box3 bounds = view.worldBounds();
+    const double eps = 1e-3 * glm::length(bounds.hi - bounds.lo);
+    auto inFront = [&](const Box3& b) {
+        for (int c = 0; c < 8; ++c) {
+            const Vec3 p(c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z);
+            if (proj.depth(p) < eps) return false;
+        }
+        return true;
+    };
+
+    // A step that tests primitives (not only mailbox reads) whose boxes all lie in front of the
+    // eye, after the first step when the ray has several.
+    playback::RayPlayback play;
+    std::vector<playback::TestedBox> boxes;
+    for (int y = 8; y < h && boxes.empty(); y += 16)
+        for (int x = 8; x < w && boxes.empty(); x += 16) {
+            RayTree t = tracePixel(scene, *accel, sh, scene.camera, x, y, w, h);
+            if (t.rays[0].regionSteps().empty()) continue;
+            play.setTree({x, y, w, h}, std::move(t));
+            for (int k = play.stepCount() - 1; k >= 0 && boxes.empty(); --k) {
+                play.seek(k);
+                std::vector<playback::TestedBox> b = playback::testedBoxes(play, scene);
+                const bool tested =
+                    std::any_of(b.begin(), b.end(), [](const auto& t) { return !t.mailbox; });
+                const bool front =
+                    std::all_of(b.begin(), b.end(), [&](const auto& t) { return inFront(t.box); });
+                if (tested && front) boxes = b;
+            }
+        }
+    ASSERT_FALSE(boxes.empty()) << "no step testing primitives in front of the eye";
+    for (const playback::TestedBox& b : boxes) {
+        ASSERT_LT(b.prim, scene.minBox.size());
+        EXPECT_EQ(b.box.lo, scene.minBox[b.prim].lo);
+        EXPECT_EQ(b.box.hi, scene.minBox[b.prim].hi);
+    }
+
+    // rayBatch draws them (in their colours), and drawn alone they land on their edges.
+    const gl::Batch only = playback::testedBoxesBatch(play, view);
+    ASSERT_EQ(only.lines.size(), boxes.size() * 24);
+    const gl::Batch full = playback::rayBatch(play, view);
+    size_t inFull = 0;
+    for (const gl::BatchVertex& v : full.lines)
+        inFull += v.color == gl::rgba8(playback::kTestedColor) ||
+                  v.color == gl::rgba8(playback::kMailboxColor);
+    EXPECT_EQ(inFull, only.lines.size());
+
+    gl::BatchRenderer renderer;
+    ctx.clear(0.0f, 0.0f, 0.0f);
+    renderer.drawNow(only, playback::imageClipMatrix(scene.camera, w, h, play, view));
+    const std::vector<uint8_t> px = ctx.read();
+
+    // Each box's edges projected on the CPU, tested ones apart.
+    std::vector<std::pair<glm::dvec2, glm::dvec2>> tested, all;
+    for (const playback::TestedBox& b : boxes)
+        for (int c = 0; c < 8; ++c)
+            for (int bit : {1, 2, 4})
+                if (!(c & bit)) {
+                    auto corner = [&](int i) {
+                        return Vec3(i & 1 ? b.box.hi.x : b.box.lo.x,
+                                    i & 2 ? b.box.hi.y : b.box.lo.y,
+                                    i & 4 ? b.box.hi.z : b.box.lo.z);
+                    };
+                    std::optional<glm::dvec2> p = proj.toImage(corner(c));
+                    std::optional<glm::dvec2> q = proj.toImage(corner(c | bit));
+                    if (!p || !q) continue;
+                    all.emplace_back(*p, *q);
+                    if (!b.mailbox) tested.emplace_back(*p, *q);
+                }
+    ASSERT_FALSE(tested.empty());
+    const gl::Rgba8 testedColor = gl::rgba8(playback::kTestedColor);
+    const gl::Rgba8 mailColor = gl::rgba8(playback::kMailboxColor);
+    int lit = 0, stray = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const gl::Rgba8 got = pixelAt(px, w, x, y);
+            if (got != testedColor) continue;
+            ++lit;
+            double d = 1e30;
+            for (const auto& [a, b] : tested)
+                d = std::min(d, distanceToSegment({x + 0.5, y + 0.5}, a, b));
+            if (d > 1.5) ++stray;
+        }
+    EXPECT_GT(lit, 10);
+    EXPECT_EQ(stray, 0) << "of " << lit << " pixels of the tested colour";
+    // Every point of a tested box's projected edges inside the image is lit by a box (a
+    // mailbox box drawn later may cover it).
+    int onEdges = 0, missed = 0;
+    for (const auto& [a, b] : tested)
+        for (double s = 0.05; s < 1.0; s += 0.1) {
+            const glm::dvec2 q = a + s * (b - a);
+            if (q.x < 2 || q.y < 2 || q.x > w - 2 || q.y > h - 2) continue;
+            ++onEdges;
+            bool hit = false;
+            for (int dy = -1; dy <= 1 && !hit; ++dy)
+                for (int dx = -1; dx <= 1 && !hit; ++dx) {
+                    const gl::Rgba8 got = pixelAt(px, w, int(q.x) + dx, int(q.y) + dy);
+                    hit = (got & 0xffffff) == (testedColor & 0xffffff) ||
+                          (got & 0xffffff) == (mailColor & 0xffffff);
                 }
             if (!hit) ++missed;
         }

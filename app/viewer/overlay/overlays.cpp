@@ -3,6 +3,7 @@
 #include <imgui.h>
 
 #include <chrono>
+#include <cstdio>
 #include <sstream>
 #include <stdexcept>
 
@@ -276,18 +277,41 @@ void Overlays::panel(bool* open) {
 
 namespace {
 
-void csgTreeNode(const CsgTree& pool, int node, const Scene& scene) {
+/// A node of a restricted tree and its subtrees; with `eval` (the played ray's evaluation of
+/// this tree), the nodes evaluated show their spans and the others are dimmed.
+void csgTreeNode(const CsgTree& pool, int node, const Scene& scene,
+                 const std::vector<NodeSpans>* eval) {
     if (node < 0 || size_t(node) >= pool.nodes.size()) return;
     const CsgNode& n = pool.nodes[size_t(node)];
+    const NodeSpans* e = nullptr;
+    if (eval)
+        for (const NodeSpans& x : *eval)
+            if (x.node == node) e = &x;
+    const bool dim = eval && (!e || !e->evaluated);
+    std::string spans;
+    if (e && e->evaluated) {
+        // Short: t to 4 digits, the spans' ends only.
+        char buf[64];
+        spans = "  {";
+        for (const Span& sp : e->spans) {
+            std::snprintf(buf, sizeof buf, "%s[%.4g, %.4g]", spans.size() > 3 ? " " : "", sp.in.t,
+                          sp.out.t);
+            spans += buf;
+        }
+        spans += "}";
+    }
     ImGui::PushID(node);
+    if (dim) ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
     if (n.op == Op::Primitive) {
         const char* kind = n.prim < scene.prims.size() ? shapeName(scene.prims[n.prim].shape) : "?";
-        ImGui::BulletText("%s %u", kind, n.prim);
-    } else if (ImGui::TreeNodeEx("op", ImGuiTreeNodeFlags_DefaultOpen, "%s", opName(n.op))) {
-        csgTreeNode(pool, n.left, scene);
-        csgTreeNode(pool, n.right, scene);
+        ImGui::BulletText("%s %u%s", kind, n.prim, spans.c_str());
+    } else if (ImGui::TreeNodeEx("op", ImGuiTreeNodeFlags_DefaultOpen, "%s%s", opName(n.op),
+                                 spans.c_str())) {
+        csgTreeNode(pool, n.left, scene, eval);
+        csgTreeNode(pool, n.right, scene, eval);
         ImGui::TreePop();
     }
+    if (dim) ImGui::PopStyleColor();
     ImGui::PopID();
 }
 
@@ -345,8 +369,13 @@ void Overlays::selectionPanel(bool* open) {
     if (ImGui::CollapsingHeader("restricted CSG tree", ImGuiTreeNodeFlags_DefaultOpen)) {
         if (r.root < 0 || !r.pool)
             ImGui::TextDisabled("empty");
-        else
-            csgTreeNode(*r.pool, r.root, scene);
+        else {
+            const bool played =
+                evalRegion_ == int64_t(r.id) && evalPool_ == r.pool && !evalNodes_.empty();
+            if (played)
+                ImGui::TextDisabled("the played ray's evaluation: nodes reached lit, with spans");
+            csgTreeNode(*r.pool, r.root, scene, played ? &evalNodes_ : nullptr);
+        }
     }
     if (ImGui::CollapsingHeader("neighbours", ImGuiTreeNodeFlags_DefaultOpen)) {
         const bool regular = r.kind == RegionKind::Leaf;

@@ -11,6 +11,7 @@
 #include "app/viewer/gl/batch.h"
 #include "app/viewer/overlay/overlay_geometry.h"
 #include "app/viewer/structure_builder.h"
+#include "engine/render/ray_csg.h"
 
 namespace lancer::viewer::overlay {
 
@@ -72,6 +73,16 @@ class Overlays {
     void panel(bool* open);
     /// The Selection panel: the selected region's box, primitives, restricted tree, neighbours.
     void selectionPanel(bool* open);
+    /// The played ray's evaluation of region `region`'s tree (rayCsg's nodes of the current
+    /// step) in `pool`: while that region of the same structure is selected the Selection panel
+    /// lights the nodes evaluated, with their spans, and dims the others. `region` -1: no ray
+    /// played.
+    void setEvaluatedNodes(int64_t region, const CsgTree* pool,
+                           const std::vector<NodeSpans>& nodes) {
+        evalRegion_ = region;
+        evalPool_ = pool;
+        evalNodes_ = nodes;
+    }
     /// The tooltip for the image point (x, y) under the mouse (continuous image coordinates);
     /// `depth` is the primary hit distance there.
     void tooltip(const Camera& view, int width, int height, double x, double y, float depth);
@@ -114,6 +125,9 @@ class Overlays {
     Camera layerCamera_;
     OverlayLook layerLook_;
     std::optional<Selection> selection_;
+    int64_t evalRegion_ = -1;
+    const CsgTree* evalPool_ = nullptr;  ///< the tree's pool (compared, never read)
+    std::vector<NodeSpans> evalNodes_;
     uint32_t pendingSelect_ = 0;
     bool hasPendingSelect_ = false;
 };

@@ -22,72 +22,216 @@ std::string compareCounts(const playback::WalkCounts& a, const playback::WalkCou
            pair("regions", a.regions, b.regions);
 }
 
-/// The CSG along the ray in the current step: one row per primitive tested (mailbox hits
-/// greyed, with the spans of their earlier test) and the region tree's combined spans, on a t
-/// axis covering the region's stretch [t0, t1] (shaded) and every finite span end; the hit, when
-/// it lies on the axis, as a vertical line.
-void csgStrip(const playback::RayPlayback& play) {
-    const std::vector<playback::SpanRow> rows = playback::stepSpans(play);
-    const WalkEvent* region = play.region();
-    if (!region) return;
-    if (rows.empty()) {
-        hintText("No primitive tested in this region.");
-        return;
+/// An operator's sign drawn with lines (the font has no ∪ ∩ −), in a box of side `sz` at `at`.
+void opIcon(ImDrawList* dl, ImVec2 at, float sz, Op op, ImU32 col) {
+    const float l = at.x + 1.0f, r = at.x + sz - 2.0f, t = at.y + 2.0f, b = at.y + sz - 2.0f;
+    const float mx = 0.5f * (l + r), rad = 0.5f * (r - l);
+    switch (op) {
+        case Op::Union:
+            dl->PathLineTo(ImVec2(l, t));
+            dl->PathArcTo(ImVec2(mx, b - rad), rad, 3.14159265f, 0.0f, 10);
+            dl->PathLineTo(ImVec2(r, t));
+            dl->PathStroke(col, 0, 1.5f);
+            break;
+        case Op::Intersection:
+            dl->PathLineTo(ImVec2(l, b));
+            dl->PathArcTo(ImVec2(mx, t + rad), rad, 3.14159265f, 2.0f * 3.14159265f, 10);
+            dl->PathLineTo(ImVec2(r, b));
+            dl->PathStroke(col, 0, 1.5f);
+            break;
+        case Op::Difference:
+            dl->AddLine(ImVec2(l, 0.5f * (t + b)), ImVec2(r, 0.5f * (t + b)), col, 1.5f);
+            break;
+        case Op::Primitive:
+            break;
     }
-    double lo = region->t0, hi = std::isfinite(region->t1) ? region->t1 : region->t0;
-    for (const playback::SpanRow& r : rows)
-        for (const Span& sp : r.spans) {
-            if (std::isfinite(sp.in.t)) lo = std::min(lo, sp.in.t), hi = std::max(hi, sp.in.t);
-            if (std::isfinite(sp.out.t)) lo = std::min(lo, sp.out.t), hi = std::max(hi, sp.out.t);
-        }
-    const TracedRay& ray = play.ray();
+}
+
+/// The t range a strip shows: [lo, hi] widened to every finite span end and the hit, from the
+/// ray's tmin, padded.
+void stripRange(const std::vector<playback::StripRow>& rows, const TracedRay& ray, double& lo,
+                double& hi) {
+    for (const playback::StripRow& r : rows)
+        for (const Span& sp : r.spans)
+            for (double t : {sp.in.t, sp.out.t})
+                if (std::isfinite(t)) lo = std::min(lo, t), hi = std::max(hi, t);
     if (ray.hit.valid()) hi = std::max(hi, ray.hit.t);
     lo = std::max(lo, ray.tmin);
     if (!(hi > lo)) hi = lo + 1.0;
     const double pad = 0.03 * (hi - lo);
     lo -= pad;
     hi += pad;
+}
 
-    const float labelW = 70.0f, rowH = 14.0f;
+/// The label of a strip row: "p3", "p3 mb", "p3 repeat" (waste), a node's operator sign
+/// indented by depth (drawn, its text empty) or a leaf's "p3".
+std::string rowLabel(const playback::StripRow& r) {
+    std::string s;
+    if (r.node && r.op != Op::Primitive) return s;
+    if (r.node && r.prim == kNoPrim) return "result";
+    s = "p" + std::to_string(r.prim);
+    if (!r.node && r.mailbox) s += " mb";
+    if (!r.node && r.waste != Waste::None) s += std::string(" ") + wasteName(r.waste);
+    return s;
+}
+
+/// A strip: rows of spans on a t axis [lo, hi]; `bands` (the whole ray's regions) shaded
+/// alternately under the rows with their ids in a top row, the current one lit, and `stretch`
+/// (the current region's, when no bands) shaded; the hit as a vertical line; flipped boundaries
+/// (a difference's subtrahend exposing its inside) as small ticks. Returns the step of the
+/// band clicked, or -1.
+int drawStrip(const std::vector<playback::StripRow>& rows,
+              const std::vector<playback::StripBand>& bands, const WalkEvent* stretch, double lo,
+              double hi, const TracedRay& ray, int currentStep, const char* id) {
+    const float labelW = 118.0f, rowH = 14.0f;
+    const float top = bands.empty() ? 0.0f : rowH;
+    const float h = top + rowH * float(rows.size() + 1);
+    int clicked = -1;
+    const float childH = std::min(h + 4.0f, 170.0f);
+    if (!ImGui::BeginChild(id, ImVec2(0, childH), false)) {
+        ImGui::EndChild();
+        return clicked;
+    }
     const ImVec2 origin = ImGui::GetCursorScreenPos();
     const float w = std::max(ImGui::GetContentRegionAvail().x - labelW, 50.0f);
-    const float h = rowH * float(rows.size() + 1);
     ImDrawList* dl = ImGui::GetWindowDrawList();
     auto X = [&](double t) {
         return origin.x + labelW + float((std::clamp(t, lo, hi) - lo) / (hi - lo)) * w;
     };
-    // The region's stretch of the ray, shaded behind the rows.
-    const double t1 = std::isfinite(region->t1) ? region->t1 : hi;
-    dl->AddRectFilled(ImVec2(X(region->t0), origin.y), ImVec2(X(t1), origin.y + h),
-                      IM_COL32(255, 216, 26, 40));
+    const float bottom = origin.y + top + rowH * float(rows.size());
+    // The regions' stretches, alternately shaded, the current one lit; their ids on top.
+    for (size_t i = 0; i < bands.size(); ++i) {
+        const playback::StripBand& b = bands[i];
+        const double t1 = std::isfinite(b.t1) ? b.t1 : hi;
+        const float x0 = X(b.t0), x1 = std::max(X(t1), x0 + 1.0f);
+        const bool current = b.step == currentStep;
+        const ImU32 shade = current ? IM_COL32(255, 216, 26, 60)
+                            : i % 2 ? IM_COL32(255, 255, 255, 14)
+                                    : IM_COL32(255, 255, 255, 30);
+        dl->AddRectFilled(ImVec2(x0, origin.y), ImVec2(x1, bottom), shade);
+        const std::string rid = std::to_string(b.region);
+        if (ImGui::CalcTextSize(rid.c_str()).x + 2.0f < x1 - x0)
+            dl->AddText(ImVec2(x0 + 1.0f, origin.y),
+                        current ? IM_COL32(255, 216, 26, 255) : IM_COL32(170, 170, 170, 255),
+                        rid.c_str());
+        const ImVec2 m = ImGui::GetIO().MousePos;
+        if (ImGui::IsWindowHovered() && m.x >= x0 && m.x < x1 && m.y >= origin.y && m.y < bottom) {
+            ImGui::SetTooltip("region %u, step %d: t = [%.6g, %.6g]", b.region, b.step + 1, b.t0,
+                              b.t1);
+            if (ImGui::IsMouseClicked(ImGuiMouseButton_Left)) clicked = b.step;
+        }
+    }
+    if (!bands.empty())
+        dl->AddText(ImVec2(origin.x, origin.y), IM_COL32(170, 170, 170, 255), "regions");
+    if (stretch) {
+        const double t1 = std::isfinite(stretch->t1) ? stretch->t1 : hi;
+        dl->AddRectFilled(ImVec2(X(stretch->t0), origin.y), ImVec2(X(t1), bottom),
+                          IM_COL32(255, 216, 26, 40));
+    }
     for (size_t i = 0; i < rows.size(); ++i) {
-        const playback::SpanRow& r = rows[i];
-        const float y = origin.y + rowH * float(i);
-        const std::string label = r.prim == kNoPrim ? "region" : "p" + std::to_string(r.prim);
-        const ImU32 text = r.mailbox ? IM_COL32(150, 150, 150, 255) : IM_COL32(230, 230, 230, 255);
-        dl->AddText(ImVec2(origin.x, y), text, (label + (r.mailbox ? " (mb)" : "")).c_str());
-        const ImU32 fill = r.prim == kNoPrim ? IM_COL32(255, 60, 220, 255)
-                           : r.mailbox       ? IM_COL32(110, 110, 140, 255)
-                                             : IM_COL32(90, 160, 255, 255);
+        const playback::StripRow& r = rows[i];
+        const float y = origin.y + top + rowH * float(i);
+        const bool dim = !r.evaluated;
+        const float indent = r.node ? 9.0f * float(r.depth) : 0.0f;
+        const ImU32 text = dim || r.mailbox         ? IM_COL32(140, 140, 140, 255)
+                           : r.waste != Waste::None ? IM_COL32(255, 150, 90, 255)
+                                                    : IM_COL32(230, 230, 230, 255);
+        if (r.onHit)
+            dl->AddRectFilled(ImVec2(origin.x, y + 1.0f), ImVec2(origin.x + 3.0f, y + rowH - 1.0f),
+                              IM_COL32(40, 255, 80, 255));
+        const ImVec2 at(origin.x + 5.0f + indent, y);
+        if (r.node && r.op != Op::Primitive)
+            opIcon(dl, at, rowH - 1.0f, r.op, text);
+        else
+            dl->AddText(at, text, rowLabel(r).c_str());
         dl->AddLine(ImVec2(origin.x + labelW, y + rowH * 0.5f),
-                    ImVec2(origin.x + labelW + w, y + rowH * 0.5f), IM_COL32(80, 80, 80, 255));
+                    ImVec2(origin.x + labelW + w, y + rowH * 0.5f),
+                    dim ? IM_COL32(60, 60, 60, 255) : IM_COL32(80, 80, 80, 255));
+        const ImU32 fill =
+            r.node && r.prim == kNoPrim && r.op == Op::Primitive
+                ? IM_COL32(255, 60, 220, 255)  // the whole ray's result
+            : r.node && r.op != Op::Primitive
+                ? (r.depth == 0 ? IM_COL32(255, 60, 220, 255) : IM_COL32(220, 120, 230, 255))
+            : r.mailbox || r.node ? IM_COL32(110, 110, 140, 255)
+                                  : IM_COL32(90, 160, 255, 255);
         for (const Span& sp : r.spans) {
             const float x0 = X(sp.in.t), x1 = std::max(X(sp.out.t), x0 + 2.0f);
-            dl->AddRectFilled(ImVec2(x0, y + 2.0f), ImVec2(x1, y + rowH - 2.0f), fill);
+            dl->AddRectFilled(ImVec2(x0, y + 3.0f), ImVec2(x1, y + rowH - 3.0f), fill);
+            // A boundary a difference turned inside out: the subtrahend's surface exposed.
+            for (const Boundary* bd : {&sp.in, &sp.out})
+                if (bd->flip && bd->t >= lo && bd->t <= hi) {
+                    const float bx = X(bd->t);
+                    dl->AddTriangleFilled(ImVec2(bx - 3.0f, y), ImVec2(bx + 3.0f, y),
+                                          ImVec2(bx, y + 4.0f), IM_COL32(255, 170, 40, 255));
+                }
+        }
+        if (dim)
+            dl->AddText(ImVec2(origin.x + labelW + 4.0f, y), IM_COL32(110, 110, 110, 255),
+                        "not evaluated");
+        const ImVec2 m = ImGui::GetIO().MousePos;
+        if (ImGui::IsWindowHovered() && m.y >= y && m.y < y + rowH && m.x >= origin.x &&
+            m.x < origin.x + labelW + w) {
+            std::string tip = r.node && r.op != Op::Primitive ? opName(r.op) : rowLabel(r);
+            tip += dim ? ": not evaluated (an empty left operand)" : ": " + toString(r.spans);
+            ImGui::SetTooltip("%s", tip.c_str());
         }
     }
     if (ray.hit.valid() && ray.hit.t >= lo && ray.hit.t <= hi)
-        dl->AddLine(ImVec2(X(ray.hit.t), origin.y), ImVec2(X(ray.hit.t), origin.y + h),
+        dl->AddLine(ImVec2(X(ray.hit.t), origin.y + top), ImVec2(X(ray.hit.t), bottom),
                     IM_COL32(40, 255, 80, 255), 2.0f);
     // The axis: its two ends' t.
     char buf[64];
-    const float ya = origin.y + rowH * float(rows.size());
     std::snprintf(buf, sizeof buf, "t %.4g", lo);
-    dl->AddText(ImVec2(origin.x + labelW, ya), IM_COL32(200, 200, 200, 255), buf);
+    dl->AddText(ImVec2(origin.x + labelW, bottom), IM_COL32(200, 200, 200, 255), buf);
     std::snprintf(buf, sizeof buf, "%.4g", hi);
-    dl->AddText(ImVec2(origin.x + labelW + w - ImGui::CalcTextSize(buf).x, ya),
+    dl->AddText(ImVec2(origin.x + labelW + w - ImGui::CalcTextSize(buf).x, bottom),
                 IM_COL32(200, 200, 200, 255), buf);
-    ImGui::Dummy(ImVec2(labelW + w, h + 2.0f));
+    ImGui::Dummy(ImVec2(labelW + w, h));
+    ImGui::EndChild();
+    return clicked;
+}
+
+/// The CSG along the ray in the current step: one row per primitive read (tested, or from the
+/// mailbox greyed, each wasted test tagged), then the region's restricted tree node by node in
+/// pre-order (operators indented by depth, the nodes the evaluator skipped dimmed), on a t axis
+/// covering the region's stretch (shaded) and every finite span end; the hit's chain marked.
+void regionCsgStrip(playback::RayPlayer& player) {
+    const playback::RayPlayback& play = player.playback();
+    const WalkEvent* region = play.region();
+    if (!region) return;
+    const std::vector<StepCsg>& steps = player.csgSteps();
+    const int k = play.state().step;
+    if (k < 0 || size_t(k) >= steps.size()) return;
+    const std::vector<playback::StripRow> rows =
+        playback::regionStrip(steps, player.waste(), play.ray(), k);
+    if (rows.empty()) {
+        hintText("No primitive read in this region.");
+        return;
+    }
+    if (steps[size_t(k)].carried)
+        hintText("The region shares the previous one's restricted tree: its spans are reused.");
+    double lo = region->t0, hi = std::isfinite(region->t1) ? region->t1 : region->t0;
+    stripRange(rows, play.ray(), lo, hi);
+    drawStrip(rows, {}, region, lo, hi, play.ray(), k, "region strip");
+}
+
+/// The whole ray: every region's stretch (alternately shaded, ids on top; a click plays that
+/// step), each primitive read along the ray and the result the walk used in each region.
+void rayCsgStrip(playback::RayPlayer& player) {
+    playback::RayPlayback& play = player.playback();
+    const std::vector<StepCsg>& steps = player.csgSteps();
+    if (steps.empty()) return;
+    const playback::RayStrip strip = playback::rayStrip(steps, player.waste(), play.ray());
+    double lo = strip.bands.front().t0, hi = lo;
+    for (const playback::StripBand& b : strip.bands)
+        if (std::isfinite(b.t1)) hi = std::max(hi, b.t1);
+    stripRange(strip.rows, play.ray(), lo, hi);
+    const int clicked = drawStrip(strip.rows, strip.bands, nullptr, lo, hi, play.ray(),
+                                  play.state().step, "ray strip");
+    if (clicked >= 0) {
+        play.pause();
+        play.seek(clicked);
+    }
 }
 
 }  // namespace
@@ -177,15 +321,34 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
         hintText(player.note().c_str());
     }
 
-    if (ImGui::CollapsingHeader("CSG along the ray (this region)", ImGuiTreeNodeFlags_DefaultOpen))
-        csgStrip(play);
+    if (ImGui::CollapsingHeader("CSG in this region", ImGuiTreeNodeFlags_DefaultOpen))
+        regionCsgStrip(player);
+    if (ImGui::CollapsingHeader("CSG along the whole ray", ImGuiTreeNodeFlags_DefaultOpen))
+        rayCsgStrip(player);
+
+    // The wasted work (docs/viewer.md): the ray's, this step's, and each wasted test's class in
+    // the step list.
+    const bool analysed = !player.csgSteps().empty();
+    const RayWaste& waste = player.waste();
+    const int stepNo = play.state().step;
+    if (analysed) {
+        std::string line = "ray: " + waste.total.toString();
+        if (stepNo >= 0 && size_t(stepNo) < waste.perStep.size())
+            line += "; this step: " + waste.perStep[size_t(stepNo)].toString();
+        ImGui::TextWrapped("%s", line.c_str());
+    }
 
     // The ray's events as `lancer trace` prints them, the current step's lit.
     const playback::PlaybackState& s = play.state();
     if (ImGui::BeginChild("steps", ImVec2(0, 0), true)) {
+        size_t regionNo = 0;
         for (size_t i = 0; i < ray.events.size(); ++i) {
             const bool current = i >= s.eventBegin && i < s.eventEnd;
-            const std::string line = ray.events[i].toString(scene);
+            std::string line = ray.events[i].toString(scene);
+            if (ray.events[i].isRegion() && regionNo < waste.perStep.size())
+                line += "   [" + waste.perStep[regionNo++].toString() + "]";
+            if (i < waste.perEvent.size() && waste.perEvent[i] != Waste::None)
+                line += std::string("   [wasted: ") + wasteName(waste.perEvent[i]) + "]";
             if (current) {
                 ImGui::TextColored(ImVec4(1.0f, 0.85f, 0.1f, 1.0f), "%s", line.c_str());
                 if (i == s.eventBegin && play.playing()) ImGui::SetScrollHereY(0.3f);

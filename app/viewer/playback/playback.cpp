@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <unordered_map>
 
 namespace lancer::viewer::playback {
 
@@ -19,6 +20,7 @@ WalkCounts countsOf(const TracedRay& r) {
 void RayPlayback::setTree(const PickedPixel& pixel, RayTree tree) {
     pixel_ = pixel;
     tree_ = std::move(tree);
+    ++version_;
     previous_.clear();
     playing_ = false;
     carried_ = 0.0;
@@ -30,12 +32,14 @@ void RayPlayback::retrace(RayTree tree) {
     for (const TracedRay& r : tree_.rays) previous_.push_back(countsOf(r));
     const PlaybackState was = state_;
     tree_ = std::move(tree);
+    ++version_;
     if (empty()) return;
     setState(std::min(was.ray, int(tree_.rays.size()) - 1), std::max(was.step, 0));
 }
 
 void RayPlayback::clear() {
     tree_ = RayTree{};
+    ++version_;
     steps_.clear();
     previous_.clear();
     state_ = PlaybackState{};
@@ -144,6 +148,131 @@ std::vector<SpanRow> stepSpans(const RayPlayback& play) {
         }
     }
     return rows;
+}
+
+const std::vector<StepCsg>& RayCsgCache::steps(const RayPlayback& play, const StructureView& view) {
+    const int ray = play.empty() ? -1 : play.state().ray;
+    if (version_ == play.treeVersion() && ray_ == ray && view_ == &view) return steps_;
+    version_ = play.treeVersion();
+    ray_ = ray;
+    view_ = &view;
+    steps_.clear();
+    waste_ = RayWaste{};
+    if (ray >= 0) {
+        steps_ = rayCsg(view.scene(), view, play.ray());
+        waste_ = wastedWork(view.scene(), play.ray(), steps_);
+    }
+    return steps_;
+}
+
+namespace {
+
+/// The spans hold the ray's hit as one of their boundaries.
+bool holdsHit(const SpanList& spans, const Hit& hit) {
+    for (const Span& s : spans)
+        for (const Boundary& b : {s.in, s.out})
+            if (b.t == hit.t && b.prim == hit.prim) return true;
+    return false;
+}
+
+}  // namespace
+
+std::vector<StripRow> regionStrip(const std::vector<StepCsg>& steps, const RayWaste& waste,
+                                  const TracedRay& ray, int k) {
+    std::vector<StripRow> rows;
+    if (k < 0 || size_t(k) >= steps.size()) return rows;
+    const StepCsg& s = steps[size_t(k)];
+    // The step that found the hit: the ray's last, its first boundary the hit.
+    const bool hitHere = size_t(k) + 1 == steps.size() && ray.hit.valid() && s.first &&
+                         s.first->t == ray.hit.t && s.first->prim == ray.hit.prim;
+    // The primitives as read, each test with its class (tests come in event order).
+    size_t next = s.event + 1;
+    for (const PrimSpans& p : s.inputs) {
+        StripRow r;
+        r.prim = p.prim;
+        r.mailbox = p.mailbox || s.carried;
+        r.spans = p.spans;
+        r.onHit = hitHere && p.prim == ray.hit.prim && holdsHit(p.spans, ray.hit);
+        if (!r.mailbox) {
+            while (next < ray.events.size() &&
+                   !(ray.events[next].kind == WalkEvent::PrimTest && ray.events[next].a == p.prim))
+                ++next;
+            if (next < waste.perEvent.size()) r.waste = waste.perEvent[next++];
+        }
+        rows.push_back(std::move(r));
+    }
+    for (const NodeSpans& n : s.nodes) {
+        StripRow r;
+        r.node = true;
+        r.op = n.op;
+        r.prim = n.prim;
+        r.depth = n.depth;
+        r.evaluated = n.evaluated;
+        r.spans = n.spans;
+        r.onHit = hitHere && holdsHit(n.spans, ray.hit);
+        rows.push_back(std::move(r));
+    }
+    return rows;
+}
+
+RayStrip rayStrip(const std::vector<StepCsg>& steps, const RayWaste& waste, const TracedRay& ray) {
+    RayStrip out;
+    std::vector<uint32_t> order;  // primitives in the order first read
+    std::unordered_map<uint32_t, size_t> rowOf;
+    StripRow result;
+    result.node = true;
+    for (size_t k = 0; k < steps.size(); ++k) {
+        const StepCsg& s = steps[k];
+        out.bands.push_back({s.t0, s.t1, s.region, int(k)});
+        for (const PrimSpans& p : s.inputs) {
+            auto [it, fresh] = rowOf.emplace(p.prim, out.rows.size());
+            if (fresh) {
+                StripRow r;
+                r.prim = p.prim;
+                r.mailbox = true;
+                r.spans = p.spans;
+                out.rows.push_back(std::move(r));
+            }
+        }
+        // The result the walk used here: the tree's spans inside the step's window.
+        if (!s.evaluated) continue;
+        for (const Span& sp : s.result) {
+            if (sp.out.t < s.lo || sp.in.t > s.hi) continue;
+            Span c = sp;
+            if (c.in.t < s.lo) c.in.t = s.lo;
+            if (c.out.t > s.hi) c.out.t = s.hi;
+            result.spans.push_back(c);
+        }
+    }
+    // Each primitive's first test: tested (not only read from the mailbox), and its class.
+    for (size_t i = 0; i < ray.events.size(); ++i) {
+        const WalkEvent& e = ray.events[i];
+        if (e.kind != WalkEvent::PrimTest) continue;
+        auto it = rowOf.find(e.a);
+        if (it == rowOf.end()) continue;
+        StripRow& r = out.rows[it->second];
+        if (!r.mailbox) continue;
+        r.mailbox = false;
+        r.waste = i < waste.perEvent.size() ? waste.perEvent[i] : Waste::None;
+    }
+    if (ray.hit.valid())
+        for (StripRow& r : out.rows) r.onHit = r.prim == ray.hit.prim && holdsHit(r.spans, ray.hit);
+    result.onHit = ray.hit.valid() && holdsHit(result.spans, ray.hit);
+    out.rows.push_back(std::move(result));
+    return out;
+}
+
+std::vector<TestedBox> testedBoxes(const RayPlayback& play, const Scene& scene) {
+    std::vector<TestedBox> out;
+    if (play.empty() || play.state().step < 0) return out;
+    const std::vector<WalkEvent>& ev = play.ray().events;
+    for (size_t i = play.state().eventBegin; i < play.state().eventEnd; ++i) {
+        const WalkEvent& e = ev[i];
+        if (e.kind != WalkEvent::PrimTest && e.kind != WalkEvent::MailboxHit) continue;
+        if (e.a >= scene.minBox.size() || scene.minBox[e.a].isEmpty()) continue;
+        out.push_back({e.a, scene.minBox[e.a], e.kind == WalkEvent::MailboxHit});
+    }
+    return out;
 }
 
 namespace {

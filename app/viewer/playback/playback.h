@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/render/ray_csg.h"
 #include "engine/render/ray_tree.h"
 
 namespace lancer::viewer::playback {
@@ -85,6 +86,9 @@ class RayPlayback {
     /// Counts of ray k before the last rebuild (retrace()), when there was one and the tree had
     /// that ray.
     std::optional<WalkCounts> previousCounts(int k) const;
+    /// Changes whenever the tree does (a pick, a retrace, clear): caches of a tree's analysis
+    /// compare it.
+    uint64_t treeVersion() const { return version_; }
 
   private:
     void setState(int ray, int step);
@@ -97,6 +101,7 @@ class RayPlayback {
     bool playing_ = false;
     double speed_ = 2.0;
     double carried_ = 0.0;  ///< seconds played not yet worth a whole step
+    uint64_t version_ = 0;
 };
 
 /// One row of the CSG strip: a primitive's spans along the ray, or the region tree's combined
@@ -111,6 +116,69 @@ struct SpanRow {
 /// with the spans of its earlier test), in order, then the region tree's combined spans when
 /// the walk evaluated it. Read from the step's events.
 std::vector<SpanRow> stepSpans(const RayPlayback& play);
+
+/// The played ray's CSG (rayCsg: each step's node spans) and wasted work, computed once per
+/// ray and tree.
+class RayCsgCache {
+  public:
+    /// The analysis of the ray `play` plays, traced in `view` (computed when the ray or the tree
+    /// changed). Empty steps when nothing is picked.
+    const std::vector<StepCsg>& steps(const RayPlayback& play, const StructureView& view);
+    /// The wasted work of the same ray (after steps()).
+    const RayWaste& waste() const { return waste_; }
+
+  private:
+    uint64_t version_ = ~uint64_t(0);
+    int ray_ = -1;
+    const StructureView* view_ = nullptr;
+    std::vector<StepCsg> steps_;
+    RayWaste waste_;
+};
+
+/// One row of the CSG strip: a primitive's spans as a step read them, or a node of the region's
+/// restricted tree with its spans (item by item as StepCsg has them).
+struct StripRow {
+    bool node = false;          ///< a node of the restricted tree (else a primitive the step read)
+    Op op = Op::Primitive;      ///< nodes: the operator, or Primitive for a leaf
+    uint32_t prim = kNoPrim;    ///< primitives and leaves
+    int depth = 0;              ///< nodes: the root is 0
+    bool mailbox = false;       ///< primitives: read from the mailbox (no test)
+    bool evaluated = true;      ///< nodes: the walk's evaluator reached it
+    bool onHit = false;         ///< holds the ray's visible hit as a boundary (the hit's chain)
+    Waste waste = Waste::None;  ///< primitives tested: why the test was wasted, if it was
+    SpanList spans;
+};
+
+/// The strip of step `k` of `steps`: the primitives read (tested, or from the mailbox, with
+/// the waste class of each test), then the restricted tree's nodes in pre-order; the rows
+/// holding the ray's hit as a boundary marked, in the step that found it.
+std::vector<StripRow> regionStrip(const std::vector<StepCsg>& steps, const RayWaste& waste,
+                                  const TracedRay& ray, int k);
+
+/// A region's stretch on the whole ray's strip.
+struct StripBand {
+    double t0 = 0.0, t1 = 0.0;
+    uint32_t region = 0;
+    int step = 0;  ///< the playback step that region is
+};
+
+/// The whole ray's strip: each region's stretch; one row per primitive the ray read (its
+/// spans, mailbox when it was never tested, its first test's waste class), then the result
+/// row: each step's root spans clipped to the step's window, as `spans` of a row with `node`
+/// set and depth 0.
+struct RayStrip {
+    std::vector<StripBand> bands;
+    std::vector<StripRow> rows;
+};
+RayStrip rayStrip(const std::vector<StepCsg>& steps, const RayWaste& waste, const TracedRay& ray);
+
+/// The minimized boxes of the primitives read in the current step (StructureView's scene).
+struct TestedBox {
+    uint32_t prim = kNoPrim;
+    Box3 box;
+    bool mailbox = false;  ///< read from the mailbox, not tested
+};
+std::vector<TestedBox> testedBoxes(const RayPlayback& play, const Scene& scene);
 
 /// The `lancer trace` line for the picked pixel: scene, --camera FILE (the camera JSON the caller
 /// writes to `cameraFile`), size, scheme and the structure and shading parameters.

@@ -217,6 +217,66 @@ TEST(Playback, StepSpansAreTheStepsTestsAndTheRegionTree) {
     EXPECT_EQ(rows, tests + combined);
 }
 
+// The CSG strips read the steps' analysis (rayCsg): the region strip holds the primitives the
+// step read then its tree's nodes, the root the walk's recorded spans, the hit's chain marked
+// from the root down to the hit primitive's leaf in the step that found it; the whole ray's
+// strip has one band per step and ends with the result row; the analysis is cached per ray.
+TEST(Playback, CsgStripsHoldTheStepsNodesAndTheHitsChain) {
+    for (SchemeKind scheme : {SchemeKind::Regular, SchemeKind::Irregular}) {
+        Scene scene = loadScene("builtin:default");
+        BuildParams b;
+        b.scheme = scheme;
+        auto accel = buildAccelerator(scene, b);
+        const StructureView view(scene, *accel);
+        ShadingOptions sh;
+        size_t chains = 0;
+        for (int y = 4; y < 64; y += 8)
+            for (int x = 4; x < 64; x += 8) {
+                RayPlayback play;
+                play.setTree({x, y, 64, 64},
+                             tracePixel(scene, *accel, sh, scene.camera, x, y, 64, 64));
+                RayCsgCache cache;
+                const std::vector<StepCsg>& steps = cache.steps(play, view);
+                EXPECT_EQ(&cache.steps(play, view), &steps);
+                ASSERT_EQ(int(steps.size()), play.stepCount());
+                const TracedRay& ray = play.ray();
+                for (int k = 0; k < play.stepCount(); ++k) {
+                    const std::vector<StripRow> rows = regionStrip(steps, cache.waste(), ray, k);
+                    const StepCsg& s = steps[size_t(k)];
+                    ASSERT_EQ(rows.size(), s.inputs.size() + s.nodes.size());
+                    if (s.nodes.empty()) continue;
+                    const StripRow& root = rows[s.inputs.size()];
+                    EXPECT_TRUE(root.node);
+                    EXPECT_EQ(root.depth, 0);
+                    EXPECT_EQ(root.spans, s.result);
+                    const bool hitHere = k + 1 == play.stepCount() && ray.hit.valid();
+                    EXPECT_EQ(root.onHit, hitHere);
+                    if (hitHere) {
+                        // The hit primitive's leaf is on the chain, and so is each marked
+                        // node's parent.
+                        bool leaf = false;
+                        for (size_t i = 0; i < s.nodes.size(); ++i) {
+                            const StripRow& r = rows[s.inputs.size() + i];
+                            leaf = leaf ||
+                                   (r.op == Op::Primitive && r.prim == ray.hit.prim && r.onHit);
+                            if (r.onHit && s.nodes[i].parent >= 0)
+                                EXPECT_TRUE(
+                                    rows[s.inputs.size() + size_t(s.nodes[i].parent)].onHit);
+                        }
+                        EXPECT_TRUE(leaf);
+                        ++chains;
+                    }
+                }
+                const RayStrip strip = rayStrip(steps, cache.waste(), ray);
+                EXPECT_EQ(strip.bands.size(), steps.size());
+                ASSERT_FALSE(strip.rows.empty());
+                EXPECT_TRUE(strip.rows.back().node);
+                EXPECT_EQ(strip.rows.back().onHit, ray.hit.valid());
+            }
+        EXPECT_GT(chains, 5u);
+    }
+}
+
 TEST(Playback, TraceCommandNamesEveryParameter) {
     BuildParams b;
     b.scheme = SchemeKind::Irregular;

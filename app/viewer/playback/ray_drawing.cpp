@@ -62,6 +62,13 @@ std::optional<std::array<Vec3, 8>> currentCorners(const RayPlayback& play,
     return view.regionCorners(e->a);
 }
 
+gl::Batch testedBoxesBatch(const RayPlayback& play, const StructureView& view) {
+    gl::Batch b;
+    for (const TestedBox& t : testedBoxes(play, view.scene()))
+        b.box(f(t.box.lo), f(t.box.hi), gl::rgba8(t.mailbox ? kMailboxColor : kTestedColor));
+    return b;
+}
+
 gl::Batch rayBatch(const RayPlayback& play, const StructureView& view) {
     gl::Batch b;
     if (play.empty()) return b;
@@ -90,6 +97,8 @@ gl::Batch rayBatch(const RayPlayback& play, const StructureView& view) {
     std::array<glm::vec3, 8> cf;
     for (int i = 0; i < 8; ++i) cf[size_t(i)] = f((*corners)[size_t(i)]);
     b.box(cf, gl::rgba8(kRegionColor));
+    const gl::Batch tested = testedBoxesBatch(play, view);
+    b.lines.insert(b.lines.end(), tested.lines.begin(), tested.lines.end());
 
     // The ray's stretch inside the region.
     const WalkEvent& region = *play.region();

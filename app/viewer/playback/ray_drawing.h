@@ -16,17 +16,24 @@
 namespace lancer::viewer::playback {
 
 /// Colours of the drawing (tests look for them).
-inline constexpr glm::vec3 kRegionColor{1.0f, 0.85f, 0.1f};  ///< the current region's edges
-inline constexpr glm::vec3 kSegmentColor{1.0f, 0.2f, 0.9f};  ///< the ray inside the region
-inline constexpr glm::vec3 kNormalColor{0.2f, 1.0f, 0.3f};   ///< the hit's normal
-inline constexpr glm::vec3 kPointerColor{0.2f, 0.9f, 1.0f};  ///< the corner pointer used
-inline constexpr glm::vec3 kCellColor{1.0f, 0.5f, 0.1f};     ///< the directory cell looked up
+inline constexpr glm::vec3 kRegionColor{1.0f, 0.85f, 0.1f};    ///< the current region's edges
+inline constexpr glm::vec3 kSegmentColor{1.0f, 0.2f, 0.9f};    ///< the ray inside the region
+inline constexpr glm::vec3 kNormalColor{0.2f, 1.0f, 0.3f};     ///< the hit's normal
+inline constexpr glm::vec3 kPointerColor{0.2f, 0.9f, 1.0f};    ///< the corner pointer used
+inline constexpr glm::vec3 kCellColor{1.0f, 0.5f, 0.1f};       ///< the directory cell looked up
+inline constexpr glm::vec3 kTestedColor{0.35f, 0.63f, 1.0f};   ///< a primitive tested in the step
+inline constexpr glm::vec3 kMailboxColor{0.55f, 0.55f, 0.7f};  ///< one read from its mailbox
 
 /// The current region's 8 corners (empty optional when the ray walks no region).
 std::optional<std::array<Vec3, 8>> currentCorners(const RayPlayback& play,
                                                   const StructureView& view);
 
-/// The batch for the playback's current state; markers are scaled by the structure's extent.
+/// The minimized boxes of the primitives the current step read (testedBoxes): tested ones in
+/// kTestedColor, those read from the mailbox in kMailboxColor.
+gl::Batch testedBoxesBatch(const RayPlayback& play, const StructureView& view);
+
+/// The batch for the playback's current state (the tested boxes included); markers are scaled by
+/// the structure's extent.
 gl::Batch rayBatch(const RayPlayback& play, const StructureView& view);
 
 /// The world-to-clip matrix the image overlay draws rayBatch() with: the viewer's camera on a

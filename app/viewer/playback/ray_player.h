@@ -39,6 +39,19 @@ class RayPlayer {
     const RayPlayback& playback() const { return play_; }
     /// The structure the tree was traced in (null before the first pick).
     const StructureView* view() const { return view_.get(); }
+    /// The played ray's steps with their node spans and its wasted work (empty before a pick).
+    const std::vector<StepCsg>& csgSteps() {
+        static const std::vector<StepCsg> none;
+        return view_ ? csg_.steps(play_, *view_) : none;
+    }
+    /// The current step of csgSteps(), or null.
+    const StepCsg* currentStep() {
+        const std::vector<StepCsg>& steps = csgSteps();
+        const int k = play_.state().step;
+        return k >= 0 && size_t(k) < steps.size() ? &steps[size_t(k)] : nullptr;
+    }
+    /// The wasted work of the ray csgSteps() analysed.
+    const RayWaste& waste() const { return csg_.waste(); }
     /// Why the last pick was refused (outside the image), or empty.
     const std::string& note() const { return note_; }
 
@@ -50,6 +63,7 @@ class RayPlayer {
     RayTree trace(const ViewerState& st, int x, int y) const;
 
     RayPlayback play_;
+    RayCsgCache csg_;
     std::optional<ScriptedPick> pending_;
     bool scripted_ = false;
     std::shared_ptr<const SceneBuild> traced_;  ///< the build the tree was traced in
