@@ -7,6 +7,7 @@
 #include "app/cli/commands.h"
 #include "engine/scene/builtin_scenes.h"
 #ifdef LANCER_WITH_VIEWER
+#include "app/viewer/compare/rebuild_diff.h"
 #include "app/viewer/overlay/overlays.h"
 #include "app/viewer/window.h"
 #endif
@@ -69,6 +70,31 @@ int main(int argc, char** argv) {
             viewer::overlay::OverlayOptions o;
             try {
                 viewer::overlay::applyShowList(list, o);
+            } catch (const std::invalid_argument& e) {
+                return std::string(e.what());
+            }
+            return std::string();
+        });
+    view->add_option("--view", vopt.view,
+                     "What the image shows: color, or the heat map of prim_tests, region_visits "
+                     "or time per pixel")
+        ->check([](const std::string& w) {
+            return viewer::viewModeOf(w) ? std::string()
+                                         : "expected color, prim_tests, region_visits or time";
+        });
+    view->add_option("--ab", vopt.ab,
+                     "With a heat map, after a rebuild: new (the new structure's counter), old "
+                     "(the old one's) or diff (old minus new, per pixel)")
+        ->check([](const std::string& w) {
+            return viewer::compare::abViewOf(w) ? std::string() : "expected new, old or diff";
+        });
+    view->add_option("--change", vopt.change,
+                     "After the first complete image, change parameters as the Parameters panel "
+                     "does: a comma list of NAME=VALUE (max-level=16,max-objects=2)")
+        ->check([](const std::string& list) {
+            cli::Knobs k;
+            try {
+                cli::applyAssignments(list, k);
             } catch (const std::invalid_argument& e) {
                 return std::string(e.what());
             }

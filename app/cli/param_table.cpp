@@ -384,6 +384,30 @@ void copyValue(const ParamDesc& d, const Knobs& from, Knobs& to) {
         d.set(to, d.get(from));
 }
 
+void applyAssignments(const std::string& list, Knobs& k) {
+    Knobs out = k;
+    std::stringstream in(list);
+    std::string item;
+    bool any = false;
+    while (std::getline(in, item, ',')) {
+        const size_t eq = item.find('=');
+        const std::string name = item.substr(0, eq);
+        const ParamDesc* d = findParam("--" + name);
+        for (const ParamDesc& e : paramTable())
+            if (!d && e.iniKey && name == e.iniKey) d = &e;
+        if (eq == std::string::npos || !d)
+            throw std::invalid_argument("'" + item + "' is not NAME=VALUE with NAME an option (" +
+                                        "max-level=16)");
+        if (d->reach != ViewerReach::Panel || d->kind == ParamKind::Path)
+            throw std::invalid_argument("'" + name + "' is not a parameter the viewer changes");
+        if (!parseValue(*d, item.substr(eq + 1), out))
+            throw std::invalid_argument("'" + item + "': not a value of --" + name);
+        any = true;
+    }
+    if (!any) throw std::invalid_argument("no NAME=VALUE given");
+    k = out;
+}
+
 std::string optionsMarkdown() {
     static const char* reach[] = {"panel", "window size", "at start", "batch only"};
     const Knobs defaults;

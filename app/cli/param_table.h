@@ -99,6 +99,13 @@ bool parseValue(const ParamDesc& d, const std::string& text, Knobs& k);
 /// Copy `d`'s value from `from` to `to`.
 void copyValue(const ParamDesc& d, const Knobs& from, Knobs& to);
 
+/// Apply a comma list of assignments NAME=VALUE (NAME an option's flag without its dashes or its
+/// ini key, VALUE as the ini writes it or an enum name: "max-level=16,step=push,mailboxes=0";
+/// a switch's value is its knob's, 1 on) to `k`, for the knobs
+/// the viewer's Parameters panel changes. Throws std::invalid_argument naming the item that is
+/// not one; `k` is then unchanged.
+void applyAssignments(const std::string& list, Knobs& k);
+
 /// The options section of README.md (between `<!-- options:begin -->` and
 /// `<!-- options:end -->`), generated from the table: `lancer help-options` prints it and a test
 /// checks README against it.

@@ -19,6 +19,17 @@ const char* viewModeName(ViewMode m) {
     return "?";
 }
 
+const char* viewModeWord(ViewMode m) {
+    static const char* words[] = {"color", "prim_tests", "region_visits", "time"};
+    return words[int(m)];
+}
+
+std::optional<ViewMode> viewModeOf(const std::string& word) {
+    for (int i = 0; i < kViewModeCount; ++i)
+        if (word == viewModeWord(ViewMode(i))) return ViewMode(i);
+    return std::nullopt;
+}
+
 const std::array<glm::vec3, 8>& colormapStops() {
     static const std::array<glm::vec3, 8> stops = {
         glm::vec3(0, 0, 4) / 255.0f,      glm::vec3(40, 11, 84) / 255.0f,
@@ -69,6 +80,31 @@ float heatValue(float count, float scale, bool logScale) {
     const float v =
         logScale ? std::log1p(std::max(0.0f, count)) / std::log1p(scale) : count / scale;
     return std::clamp(v, 0.0f, 1.0f);
+}
+
+const std::array<glm::vec3, 9>& divergingStops() {
+    static const std::array<glm::vec3, 9> stops = {
+        glm::vec3(178, 24, 43) / 255.0f,   glm::vec3(214, 96, 77) / 255.0f,
+        glm::vec3(244, 165, 130) / 255.0f, glm::vec3(253, 219, 199) / 255.0f,
+        glm::vec3(247, 247, 247) / 255.0f, glm::vec3(209, 229, 240) / 255.0f,
+        glm::vec3(146, 197, 222) / 255.0f, glm::vec3(67, 147, 195) / 255.0f,
+        glm::vec3(33, 102, 172) / 255.0f};
+    return stops;
+}
+
+glm::vec3 divergingColor(float v) {
+    const auto& s = divergingStops();
+    float x = (std::clamp(v, -1.0f, 1.0f) + 1.0f) * 0.5f * float(s.size() - 1);
+    int i = std::min(int(std::floor(x)), int(s.size()) - 2);
+    float f = x - float(i);
+    return s[size_t(i)] * (1.0f - f) + s[size_t(i) + 1] * f;
+}
+
+float diffValue(float d, float scale, bool logScale) {
+    scale = scale > 0.0f ? scale : 1.0f;
+    const float v =
+        logScale ? std::copysign(std::log1p(std::abs(d)) / std::log1p(scale), d) : d / scale;
+    return std::clamp(v, -1.0f, 1.0f);
 }
 
 }  // namespace lancer::viewer

@@ -4,6 +4,8 @@
 #include <array>
 #include <cstdint>
 #include <glm/vec3.hpp>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "engine/render/image.h"
@@ -14,6 +16,10 @@ namespace lancer::viewer {
 enum class ViewMode : uint8_t { Color, PrimTests, RegionVisits, TimeUs };
 inline constexpr int kViewModeCount = 4;
 const char* viewModeName(ViewMode m);
+/// The word naming a mode in the ini and on the command line (`--view`): color, prim_tests,
+/// region_visits, time; and back (nullopt for another word).
+const char* viewModeWord(ViewMode m);
+std::optional<ViewMode> viewModeOf(const std::string& word);
 
 /// Evenly spaced stops of the colour map (black through purple and orange to pale yellow,
 /// like matplotlib's "inferno": monotonic in lightness, so the order of values reads at a glance).
@@ -30,5 +36,20 @@ float autoScale(const std::vector<float>& heat);
 /// Where `count` falls on the colour map of `scale`, in [0, 1]: count / scale, or on a log
 /// scale log(1 + count) / log(1 + scale) (the shader computes the same).
 float heatValue(float count, float scale, bool logScale);
+
+/// A difference channel's value for a pixel with nothing to compare (the new image has not
+/// reached it): drawn as grey stripes, unlike any value of the map. Counters differ by far less.
+inline constexpr float kNoDiff = 1e30f;
+/// Stops of the diverging map of a rebuild's difference (ColorBrewer's RdBu), evenly spaced over
+/// [-1, 1]: red where the new structure does more work, near-white (the middle stop) where
+/// nothing changed, blue where it does less. Red against blue stays apart for the common colour
+/// blindnesses, and both ends are dark so the size of a change reads as the distance from white.
+const std::array<glm::vec3, 9>& divergingStops();
+/// The colour of `v` in [-1, 1] (clamped) on the diverging map, interpolated linearly between
+/// stops as the shader does: -1 the "worse" end (red), 0 the neutral colour, 1 "better" (blue).
+glm::vec3 divergingColor(float v);
+/// Where a difference `d` = old - new falls on the diverging map, in [-1, 1]: d / scale, or on a
+/// log scale sign(d) log(1 + |d|) / log(1 + scale) (the shader computes the same); clamped.
+float diffValue(float d, float scale, bool logScale);
 
 }  // namespace lancer::viewer

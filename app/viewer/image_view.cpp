@@ -28,6 +28,7 @@ ImageView::ImageView() {
     locScale_ = program_->uniform("scale");
     locStops_ = program_->uniform("stops");
     locStopCount_ = program_->uniform("stopCount");
+    locDivStops_ = program_->uniform("divStops");
     locColor_ = program_->uniform("colorTex");
     locHeat_ = program_->uniform("heatTex");
     locOverlay_ = program_->uniform("overlayTex");
@@ -52,7 +53,8 @@ ImageView::~ImageView() {
     glDeleteVertexArrays(1, &vao_);
 }
 
-void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd) {
+void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd,
+                       const std::vector<float>* heat) {
     if (img.width <= 0 || img.height <= 0) return;
     const bool resized = img.width != width_ || img.height != height_;
     if (resized) rowBegin = 0, rowEnd = img.height;
@@ -99,10 +101,16 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
         glTexSubImage2D(GL_TEXTURE_2D, 0, 0, rowBegin, width_, rows, GL_RGBA, GL_UNSIGNED_BYTE,
                         rgba.data());
         if (mode != ViewMode::Color) {
-            std::vector<float> heat = heatChannel(img, mode, rowBegin, rowEnd);
+            std::vector<float> own;
+            if (!heat) own = heatChannel(img, mode, rowBegin, rowEnd);
+            const std::vector<float>& values = heat ? *heat : own;
+            if (values.size() != size_t(width_) * size_t(rows))
+                throw std::invalid_argument("ImageView::upload: " + std::to_string(values.size()) +
+                                            " heat values for " + std::to_string(rows) +
+                                            " rows of " + std::to_string(width_));
             glBindTexture(GL_TEXTURE_2D, heatTex_);
             glTexSubImage2D(GL_TEXTURE_2D, 0, 0, rowBegin, width_, rows, GL_RED, GL_FLOAT,
-                            heat.data());
+                            values.data());
         }
     }
     glBindTexture(GL_TEXTURE_2D, 0);
@@ -156,14 +164,16 @@ std::vector<PixelRect> uncovered(int width, int height, const std::vector<PixelR
 }
 
 void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
-                     const std::vector<PixelRect>& covered, bool logScale) const {
+                     const std::vector<PixelRect>& covered, bool logScale, bool diverging) const {
     if (width_ == 0) return;
     scale = scale > 0.0f ? scale : 1.0f;
+    diverging = diverging && mode != ViewMode::Color;
     if (!shadedValid_ || mode != shadedMode_ ||
-        (mode != ViewMode::Color && (scale != shadedScale_ || logScale != shadedLog_)))
-        shade(mode, scale, logScale, 0, height_);
+        (mode != ViewMode::Color &&
+         (scale != shadedScale_ || logScale != shadedLog_ || diverging != shadedDiverging_)))
+        shade(mode, scale, logScale, diverging, 0, height_);
     else if (!dirty_.empty())
-        shade(mode, scale, logScale, dirty_.begin, dirty_.end);
+        shade(mode, scale, logScale, diverging, dirty_.begin, dirty_.end);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
@@ -180,7 +190,8 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     glViewport(0, 0, fbWidth, fbHeight);
 }
 
-void ImageView::shade(ViewMode mode, float scale, bool logScale, int rowBegin, int rowEnd) const {
+void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging, int rowBegin,
+                      int rowEnd) const {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, width_, height_);
     glDisable(GL_BLEND);
@@ -200,11 +211,13 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, int rowBegin, i
     glBindTexture(GL_TEXTURE_2D, overlayTex_);
     glUniform1i(locOverlay_, 2);
     glUniform1i(locHasOverlay_, overlayTex_ != 0);
-    glUniform1i(locMode_, mode == ViewMode::Color ? 0 : logScale ? 2 : 1);
+    glUniform1i(locMode_, mode == ViewMode::Color ? 0 : (diverging ? 3 : 1) + (logScale ? 1 : 0));
     glUniform1f(locScale_, scale);
     const auto& stops = colormapStops();
     glUniform3fv(locStops_, GLsizei(stops.size()), &stops[0].x);
     glUniform1i(locStopCount_, GLint(stops.size()));
+    const auto& divStops = divergingStops();
+    glUniform3fv(locDivStops_, GLsizei(divStops.size()), &divStops[0].x);
     glBindVertexArray(vao_);
     glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
     glBindVertexArray(0);
@@ -222,6 +235,7 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, int rowBegin, i
     shadedMode_ = mode;
     shadedScale_ = scale;
     shadedLog_ = logScale;
+    shadedDiverging_ = diverging;
 }
 
 std::vector<uint8_t> readFramebuffer(int width, int height) {

@@ -34,16 +34,22 @@ class ImageView {
     /// Upload rows [rowBegin, rowEnd) (-1: to the last) of the colour and of the counter `mode`
     /// shows; the whole image when its size differs from the last upload's. The other rows keep
     /// what earlier uploads put there, so after a change of mode upload the whole image.
-    void upload(const Image& img, ViewMode mode, int rowBegin = 0, int rowEnd = -1);
+    /// `heat` (optional) replaces the counter: the values of those rows (the whole image's when
+    /// its size differs), e.g. an A/B's difference; it must hold one value per pixel of them.
+    void upload(const Image& img, ViewMode mode, int rowBegin = 0, int rowEnd = -1,
+                const std::vector<float>* heat = nullptr);
     /// Draw the uploaded image over the whole viewport of a fbWidth x fbHeight framebuffer
     /// (framebuffer 0); heat maps divide the counter by `scale`. Nothing is drawn before the
     /// first upload. The shader runs once per upload, mode or scale, into a texture; each frame
     /// then only copies that texture (a blit), which software GL does far faster than shading.
     /// Pixels inside `covered` (opaque panels drawn over the image next) are left as they are:
     /// under software GL the copy costs 7 ns a pixel. `logScale`: heat maps show
-    /// heatValue(count, scale, true).
+    /// heatValue(count, scale, true). `diverging`: the heat values are signed differences,
+    /// drawn on the diverging map (divergingColor(diffValue(d, scale, logScale)); kNoDiff as
+    /// grey stripes).
     void draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
-              const std::vector<PixelRect>& covered = {}, bool logScale = false) const;
+              const std::vector<PixelRect>& covered = {}, bool logScale = false,
+              bool diverging = false) const;
     /// Composite a layer over the image when it is shaded: `texture` an RGBA8 texture of
     /// premultiplied colour drawn like the framebuffer (row 0 at the bottom), any size; 0: none.
     /// A new `version` shades the whole image again; otherwise only uploaded rows are, so a
@@ -55,7 +61,8 @@ class ImageView {
 
   private:
     /// Shade image rows [rowBegin, rowEnd) into the FBO (the rest keeps its pixels).
-    void shade(ViewMode mode, float scale, bool logScale, int rowBegin, int rowEnd) const;
+    void shade(ViewMode mode, float scale, bool logScale, bool diverging, int rowBegin,
+               int rowEnd) const;
 
     std::unique_ptr<gl::Program> program_;
     unsigned vao_ = 0, colorTex_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
@@ -63,6 +70,7 @@ class ImageView {
     mutable ViewMode shadedMode_ = ViewMode::Color;
     mutable float shadedScale_ = 0.0f;
     mutable bool shadedLog_ = false;
+    mutable bool shadedDiverging_ = false;
     /// Image rows uploaded since the FBO was last shaded: only they are shaded again (a band of
     /// a progressive pass is a few rows; shading all of them per band cost llvmpipe a full-image
     /// pass each time).
@@ -72,7 +80,7 @@ class ImageView {
     uint64_t overlayVersion_ = 0;
     int locOverlay_ = -1, locHasOverlay_ = -1;
     int locMode_ = -1, locScale_ = -1, locStops_ = -1, locStopCount_ = -1, locColor_ = -1,
-        locHeat_ = -1;
+        locHeat_ = -1, locDivStops_ = -1;
 };
 
 /// Read the current framebuffer's pixels as RGBA8, row 0 on top (as PNG files want).

@@ -44,6 +44,8 @@ void handleKeys(ViewerState& st) {
     for (ImWchar ch : io.InputQueueCharacters) {
         if (ch == 'r' || ch == 'R') {
             st.setCamera(st.home());
+        } else if (ch == 'b' || ch == 'B') {  // the rebuild's A/B: old and new in turn
+            st.flipAb();
         } else if (ch == 'i' || ch == 'I') {
             st.settings().showInspector = !st.settings().showInspector;
         } else if (ch == 'o' || ch == 'O' || ch == 'p' || ch == 'P') {

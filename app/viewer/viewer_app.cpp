@@ -177,8 +177,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // 4. Image: the traced image or a heat map, copied only around the opaque panels drawn over
     // it in step 6. The image covers the whole framebuffer: clear only while there is none (one
     // full-screen fill less per frame, which software GL feels).
-    if (RowRange rows; state_.takeUpload(rows))
-        view_->upload(state_.shown(), s.mode, rows.begin, rows.end);
+    if (RowRange rows; state_.takeUpload(rows)) uploadImage(rows.begin, rows.end);
     prepareOverlays(fbWidth, fbHeight);
     glViewport(0, 0, fbWidth, fbHeight);
     if (view_->width() == 0) {
@@ -187,7 +186,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     }
     std::vector<PixelRect> covered = panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight);
     if (inspector_->shown()) covered.push_back(inspector_->area(fbWidth, fbHeight));
-    view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale);
+    view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale,
+                state_.heatDiverging());
 
     // 4b. The 3D inspector beside the image (the image is not copied under it), with the
     // ray played drawn into its picture.
@@ -254,6 +254,14 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     keepSettings();
 }
 
+void ViewerApp::uploadImage(int rowBegin, int rowEnd) {
+    const Image& shown = state_.shown();
+    if (shown.width != view_->width() || shown.height != view_->height())
+        rowBegin = 0, rowEnd = -1;  // a new size is uploaded whole
+    const std::vector<float> heat = state_.heatRows(rowBegin, rowEnd);
+    view_->upload(shown, state_.settings().mode, rowBegin, rowEnd, heat.empty() ? nullptr : &heat);
+}
+
 std::vector<std::string> ViewerApp::applyInspectorShow(const std::vector<std::string>& items) {
     std::vector<std::string> left;
     inspector::InspectorOptions& o = inspector_->options();
@@ -283,7 +291,7 @@ void ViewerApp::prepareOverlays(int fbWidth, int fbHeight) {
                           overlays_->layerStale(camera, fbWidth, fbHeight);
     const unsigned layer = dragging ? 0 : overlays_->layerTexture(camera, fbWidth, fbHeight);
     if (layer != 0 && !overlayShown_ && view_->width() > 0)
-        view_->upload(state_.shown(), state_.settings().mode);  // colour bands bypass colorTex
+        uploadImage(0, -1);  // colour bands bypass colorTex
     overlayShown_ = layer != 0;
     view_->setOverlay(layer, overlays_->layerVersion());
     if (logTimings_)

@@ -64,6 +64,9 @@ class ViewerApp {
     /// What the image area shows, and its heat scale (turns automatic scaling off).
     void setViewMode(ViewMode mode) { state_.setViewMode(mode); }
     void setHeatScale(float scale) { state_.setHeatScale(scale); }
+    /// What the heat map shows of the last rebuild's A/B: the new image, the old one, or old
+    /// minus new (compare/rebuild_diff.h).
+    void setAbView(compare::AbView v) { state_.setAbView(v); }
     /// The image on screen (the last snapshot taken), the current error, the camera.
     const Image& displayed() const { return state_.shown(); }
     const std::string& error() const { return state_.error(); }
@@ -127,6 +130,9 @@ class ViewerApp {
     const PanelLayout& layout() const { return layout_; }
 
   private:
+    /// Upload rows [rowBegin, rowEnd) (-1: to the last) of the image on screen, with the heat
+    /// values the state gives (a counter, or an A/B's).
+    void uploadImage(int rowBegin, int rowEnd);
     /// The hover tooltip and Ctrl+click picking over the image (mouse not taken by ImGui).
     void overlayInput(int fbWidth, int fbHeight);
     /// Steps 5 of frame(): the overlays' layer handed to the image view, and its timing.

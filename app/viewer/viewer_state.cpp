@@ -54,7 +54,87 @@ void ViewerState::setViewMode(ViewMode mode) {
 }
 
 void ViewerState::updateAutoScale() {
-    if (s_.mode != ViewMode::Color) autoScale_ = autoScale(heatChannel(shown_, s_.mode));
+    if (s_.mode == ViewMode::Color) return;
+    const compare::CounterImage* old = diff_.old();
+    if (abStatus_.comparable && ab_ == compare::AbView::Diff) {
+        autoScale_ = compare::diffAutoScale(
+            compare::diffChannel(*old, shown_, s_.mode, 0, abStatus_.rows, abStatus_.rows));
+        return;
+    }
+    autoScale_ = autoScale(heatChannel(shown_, s_.mode));
+    if (abStatus_.comparable) {
+        // One scale for both images, so flipping between them compares colours.
+        if (oldScaleGeneration_ != diff_.generation()) {
+            for (int m = 1; m < kViewModeCount; ++m)
+                oldScale_[m] = autoScale(compare::counterChannel(*old, ViewMode(m), 0, -1));
+            oldScaleGeneration_ = diff_.generation();
+        }
+        autoScale_ = std::max(autoScale_, oldScale_[int(s_.mode)]);
+    }
+}
+
+void ViewerState::setAbView(compare::AbView v) {
+    ab_ = v;
+    uploadDue_ = true;
+    changed_.add(0, shown_.height);
+    updateAutoScale();
+    if (s_.mode != ViewMode::Color && s_.autoScale) scale_ = autoScale_;
+}
+
+bool ViewerState::heatDiverging() const {
+    return s_.mode != ViewMode::Color &&
+           (ab_ == compare::AbView::Diff || (ab_ == compare::AbView::Old && !abStatus_.comparable));
+}
+
+std::vector<float> ViewerState::heatRows(int rowBegin, int rowEnd) const {
+    if (s_.mode == ViewMode::Color) return {};
+    const compare::CounterImage* old = diff_.old();
+    if (ab_ == compare::AbView::New) return heatChannel(shown_, s_.mode, rowBegin, rowEnd);
+    if (!abStatus_.comparable) {  // nothing to show: every pixel "not compared"
+        size_t first, last;
+        shown_.pixelRange(rowBegin, rowEnd, first, last);
+        return std::vector<float>(last - first, kNoDiff);
+    }
+    if (ab_ == compare::AbView::Old)
+        return compare::counterChannel(*old, s_.mode, rowBegin, rowEnd);
+    return compare::diffChannel(*old, shown_, s_.mode, rowBegin, rowEnd, abStatus_.rows);
+}
+
+bool ViewerState::updateAb() {
+    // Rows of the render on screen done at full resolution, when it is the latest job's (the
+    // new structure's): the rows B has to compare.
+    const bool current = shownJob_ == startedJob_ && startedJob_ != 0 && !renderDirty_;
+    const int done = current && shownStride_ == 1 ? shownRows_ : 0;
+    abStatus_ = diff_.status(jobKey_, done);
+    // What the heat map compares changed: the whole image is uploaded again (within a pass,
+    // the bands uploaded as they come cover the rows that start to compare).
+    uint64_t sig = uint64_t(ab_) | uint64_t(abStatus_.comparable) << 2 | uint64_t(done > 0) << 3 |
+                   uint64_t(s_.mode) << 4 | diff_.generation() << 8;
+    sig = sig * 1000003u ^ startedJob_;
+    const bool changed = sig != abSignature_;
+    if (changed) {
+        abSignature_ = sig;
+        if (ab_ != compare::AbView::New) {
+            uploadDue_ = true;
+            changed_.add(0, shown_.height);
+        }
+    }
+    if (!changed && !snapped_) return false;
+    abTotals_ = {};
+    if (!abStatus_.comparable) return changed;
+    const compare::CounterImage& old = *diff_.old();
+    abTotals_.a = compare::sumRows(old, abStatus_.rows);
+    abTotals_.b = compare::sumRows(shown_, abStatus_.rows);
+    abTotals_.complete = abStatus_.rows == abStatus_.height && shownComplete_;
+    if (abTotals_.complete) {
+        abTotals_.aCounters = old.counters;
+        abTotals_.aRenderMs = old.renderMs;
+        for (const PassRecord& p : renderer_.passes()) {
+            abTotals_.bCounters += p.counters;
+            abTotals_.bRenderMs += p.renderMs;
+        }
+    }
+    return changed;
 }
 
 void ViewerState::setHeatScale(float scale) {
@@ -116,7 +196,10 @@ void ViewerState::restartRender(const char* why) {
     job.options.shading = s_.shading;
     job.options.camera = camera_;
     if (speedup_ && !speedup_->done) speedup_->cancel = true;  // its view is gone
+    jobKey_ = {sceneBuild_->spec, camera_, jobWidth_, jobHeight_, s_.shading};
+    jobParams_ = sceneBuild_->accel->params();
     renderer_.start(std::move(job), changeAt_);
+    startedJob_ = renderer_.job();
     changeWhy_ = why;
     passesLogged_ = 0;
     renderDirty_ = false;
@@ -129,6 +212,10 @@ void ViewerState::poll() {
     builtBefore_ = !builder_.busy();
     pollBuilder();
     takeSnapshot();
+    // The A/B's status follows the job and snapshot; its totals and the scale only change with
+    // a snapshot or what is compared.
+    if (updateAb() || snapped_) updateAutoScale();
+    snapped_ = false;
     if (s_.mode != ViewMode::Color) scale_ = s_.autoScale ? autoScale_ : s_.heatScale;
 }
 
@@ -148,6 +235,16 @@ void ViewerState::pollBuilder() {
         logTiming(buildWhy_ + ": structure ready " + std::to_string(msSince(buildChangeAt_)) +
                   " ms after the change (load " + std::to_string(r->sceneBuild->loadMs) +
                   " ms, build " + std::to_string(r->sceneBuild->accel->info().buildMs) + " ms)");
+        if (newScene) {
+            diff_.clear();
+        } else if (sceneBuild_) {
+            // The image on screen is the old structure's: A, if it is complete (the last band
+            // may still wait in the renderer: take it first).
+            takeSnapshot();
+            const bool complete = shownComplete_ && shownJob_ == startedJob_ && !renderDirty_;
+            diff_.rebuilt(shown_, complete, jobKey_, jobParams_,
+                          complete ? renderer_.passes() : std::vector<PassRecord>{});
+        }
         sceneBuild_ = r->sceneBuild;
         if (newScene) {
             s_.cameraPath.clear();  // --camera is the first scene's, not the next ones'
@@ -183,15 +280,17 @@ void ViewerState::pollBuilder() {
     }
 }
 
-void ViewerState::takeSnapshot() {
+bool ViewerState::takeSnapshot() {
     ProgressiveRenderer::Shown what;
-    if (!renderer_.snapshot(shownVersion_, shown_, &what)) return;
+    if (!renderer_.snapshot(shownVersion_, shown_, &what)) return false;
     uploadDue_ = true;
     changed_.add(what.changedBegin, what.changedEnd < 0 ? shown_.height : what.changedEnd);
     shownJob_ = what.job;
     shownStride_ = what.stride;
-    updateAutoScale();
-    if (!logTimings_) return;
+    shownRows_ = what.rows;
+    shownComplete_ = what.stride == 1 && what.rows >= shown_.height;
+    snapped_ = true;
+    if (!logTimings_) return true;
     // Passes this snapshot holds whole (one may have finished since it was taken), logged once
     // the frame showing them is on screen (presented()).
     std::vector<PassRecord> passes = renderer_.passes();
@@ -207,6 +306,7 @@ void ViewerState::takeSnapshot() {
             pendingLogs_.push_back(
                 {changeWhy_ + ": full image ", " ms after the change", changeAt_});
     }
+    return true;
 }
 
 void ViewerState::startWork(int fbWidth, int fbHeight) {

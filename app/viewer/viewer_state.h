@@ -15,6 +15,7 @@
 
 #include "app/bench/speedup.h"
 #include "app/viewer/colormap.h"
+#include "app/viewer/compare/rebuild_diff.h"
 #include "app/viewer/structure_builder.h"
 #include "app/viewer/viewer_settings.h"
 #include "engine/render/progressive.h"
@@ -31,6 +32,15 @@ struct PanelNotes {
     std::string pendingScreenshot;  ///< taken once the frame is drawn
     int screenshotCount = 0;
     int speedupStride = 4;  ///< the Statistics panel's sample: 1 pixel in stride x stride
+};
+
+/// The totals of an A/B over the rows it compares (ViewerState::abTotals()).
+struct AbTotals {
+    compare::CounterSums a, b;  ///< old and new, over the same rows
+    /// The whole new image compares: its passes' counters and render time are final.
+    bool complete = false;
+    RayCounters aCounters, bCounters;  ///< every ray of each image (when complete)
+    double aRenderMs = 0.0, bRenderMs = 0.0;
 };
 
 /// The speedup over brute force on the current view, as the Statistics panel shows it.
@@ -108,6 +118,29 @@ class ViewerState {
     void setViewMode(ViewMode mode);
     /// A fixed heat scale (turns automatic scaling off).
     void setHeatScale(float scale);
+
+    // The A/B of the last rebuild (compare/rebuild_diff.h): the old structure's complete image
+    // against the new one's, in the heat maps.
+    /// What the heat map shows: the new image's counter, the old one's, or old minus new.
+    compare::AbView abView() const { return ab_; }
+    void setAbView(compare::AbView v);
+    /// Show the old image's counter if the new one's is shown, else the new one's (the B key).
+    void flipAb() {
+        setAbView(ab_ == compare::AbView::Old ? compare::AbView::New : compare::AbView::Old);
+    }
+    /// The old image kept (null: none) and how it compares with the image on screen.
+    const compare::CounterImage* abOld() const { return diff_.old(); }
+    const compare::AbStatus& abStatus() const { return abStatus_; }
+    /// Totals of the rows compared (meaningful when abStatus().comparable).
+    const AbTotals& abTotals() const { return abTotals_; }
+    /// The structure's parameters of the render on screen (B).
+    const BuildParams& shownParams() const { return jobParams_; }
+    /// The heat map's values of rows [rowBegin, rowEnd) (-1: to the last) as the image view
+    /// uploads them: the shown counter, A's, or A minus B (kNoDiff where nothing compares);
+    /// empty in colour mode.
+    std::vector<float> heatRows(int rowBegin, int rowEnd) const;
+    /// The heat map is a signed difference, drawn on the diverging map.
+    bool heatDiverging() const;
     /// Measure the speedup over brute force on the current view, on a worker thread, with one
     /// pixel in `stride` x `stride`. Nothing happens before the first structure.
     void measureSpeedup(int stride);
@@ -129,9 +162,14 @@ class ViewerState {
     };
 
     void pollBuilder();
-    void takeSnapshot();
+    /// Take the renderer's newest image, if any (true then).
+    bool takeSnapshot();
     void restartRender(const char* why);
     void updateAutoScale();
+    /// After the snapshot: the A/B's status and totals, and a whole upload when what the heat
+    /// map compares changed.
+    /// Returns whether what is compared changed.
+    bool updateAb();
     void logTiming(const std::string& line) const;
 
     ViewerSettings& s_;
@@ -170,6 +208,22 @@ class ViewerState {
         Clock::time_point since;
     };
     std::vector<PendingLog> pendingLogs_;
+
+    // The A/B of the last rebuild.
+    compare::RebuildDiff diff_;
+    compare::AbView ab_ = compare::AbView::New;
+    compare::AbStatus abStatus_;
+    AbTotals abTotals_;
+    compare::RenderKey jobKey_;   ///< what the latest job renders
+    BuildParams jobParams_;       ///< with the structure of these parameters
+    uint64_t startedJob_ = 0;     ///< its number (ProgressiveRenderer::job())
+    int shownRows_ = 0;           ///< rows of the shown pass done (Shown::rows)
+    bool shownComplete_ = false;  ///< the shown image has every row at full resolution
+    bool snapped_ = false;        ///< a snapshot was taken in this frame's poll
+    uint64_t abSignature_ = 0;    ///< what the heat map compared at the last upload
+    /// A's automatic scale for a counter, cached per A (a percentile of a million pixels).
+    mutable uint64_t oldScaleGeneration_ = ~uint64_t(0);
+    mutable float oldScale_[kViewModeCount] = {};
 
     std::shared_ptr<SpeedupJob> speedup_;
     std::thread speedupThread_;

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <iostream>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -88,6 +89,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
         ImGui::LoadIniSettingsFromDisk(ini.c_str());
     }
     applyCommandLine(o, given, settings);
+    if (std::optional<ViewMode> m = viewModeOf(v.view)) settings.mode = *m;
     if (v.select >= 0) settings.showSelection = true;
 
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
@@ -148,10 +150,11 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             }
         }
         if (v.select >= 0) app.overlays().select(uint32_t(v.select));
+        if (std::optional<compare::AbView> ab = compare::abViewOf(v.ab)) app.setAbView(*ab);
         if (v.pick.size() == 2) app.pickPixel(v.pick[0], v.pick[1], v.pickRay, v.pickStep);
         using Clock = std::chrono::steady_clock;
         int frames = 0, statFrames = 0;
-        bool replayed = false, droppedScripted = false;
+        bool replayed = false, droppedScripted = false, changedScripted = false;
         double statWorkMs = 0.0, statSwapMs = 0.0;
         Clock::time_point frameStart = Clock::now(), statStart = frameStart, lastDrawn = frameStart;
         // When the next frame may start: frames are paced on a fixed 60 Hz timeline, so a wait
@@ -211,6 +214,18 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             if (v.replayChange && !replayed && app.settled() && app.sceneBuild()) {
                 app.rebuild("replayed parameter change");
                 replayed = true;
+            } else if (!v.change.empty() && !changedScripted && app.settled() && app.sceneBuild()) {
+                // As the Parameters panel applies a change (parameters_panel.cpp).
+                const cli::Knobs before = knobsOf(settings);
+                cli::Knobs after = before;
+                cli::applyAssignments(v.change, after);  // checked when parsed
+                setKnobs(settings, after);
+                const cli::ChangeEffect effect = cli::changeEffect(before, after);
+                if (effect == cli::ChangeEffect::Rebuild)
+                    app.state().requestBuild(false, "--change");
+                else if (effect == cli::ChangeEffect::Rerender)
+                    app.state().markRender("--change");
+                changedScripted = true;
             } else if (!v.drop.empty() && !droppedScripted && app.settled() && app.sceneBuild()) {
                 // Through the callback the window has installed, as a drop from the desktop.
                 GLFWdropfun onDrop = glfwSetDropCallback(window, nullptr);

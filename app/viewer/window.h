@@ -34,6 +34,9 @@ struct ViewOptions {
     /// `--show LIST` (docs/design.md section 6: a comma list, "none" for none); empty: the
     /// saved ones.
     std::string show;
+    std::string view;  ///< `--view MODE`: colour or a heat map (viewModeWord); empty: the saved one
+    std::string ab;    ///< `--ab new|old|diff`: the rebuild A/B the heat map shows
+    std::string change;  ///< `--change LIST`: NAME=VALUE changes applied after the first image
 };
 
 /// What runViewer returns when no window can be opened (no display, no OpenGL 3.3).

@@ -361,11 +361,17 @@ int StructureView::directoryLog2(int axis) const {
 int StructureView::leafLevel(uint32_t leaf) const {
     const RegularGrid* g = regular();
     if (!g) return -1;
-    // A leaf at level l spans 2^(n_a - cuts(l, a)) cells on axis a, and the cuts add up to l.
     const RegularLeaf& L = g->leaves().at(leaf);
+    return cellLevel(L.lo, L.hi);
+}
+
+int StructureView::cellLevel(const uint32_t lo[3], const uint32_t hi[3]) const {
+    const RegularGrid* g = regular();
+    if (!g) return -1;
+    // A node at level l spans 2^(n_a - cuts(l, a)) cells on axis a, and the cuts add up to l.
     int level = 0;
     for (int a = 0; a < 3; ++a)
-        level += std::countr_zero(g->cells(a)) - std::countr_zero(L.hi[a] - L.lo[a]);
+        level += std::countr_zero(g->cells(a)) - std::countr_zero(hi[a] - lo[a]);
     return level;
 }
 
@@ -423,6 +429,7 @@ std::vector<DirectoryBlock> StructureView::directoryBlocks() const {
         b.child = sub ? value : 0;
         b.table = table;
         b.depth = depth;
+        b.level = sub ? cellLevel(b.lo, b.hi) : leafLevel(value);
         out.push_back(b);
     });
     return out;

@@ -90,6 +90,9 @@ struct DirectoryBlock {
     uint32_t child = 0;               ///< the sub-table storing the block (subTable)
     uint32_t table = 0;               ///< the table holding this entry
     int depth = 0;                    ///< tables above it (0: the top table)
+    /// BSP level: an entry's is its leaf's (RegionInfo::level); a sub-table's, the level of the
+    /// BSP node whose cell it stores.
+    int level = 0;
 };
 
 /// Irregular scheme: one node of a screen BSP, in the order the cuts were made.
@@ -211,6 +214,8 @@ class StructureView {
     int directoryLog2(int axis) const;
     /// BSP level of a leaf, from its cell counts and the axis schedule.
     int leafLevel(uint32_t leaf) const;
+    /// BSP level of the node whose cell is directory cells [lo, hi) (each axis cut in halves).
+    int cellLevel(const uint32_t lo[3], const uint32_t hi[3]) const;
     /// The BSP's cut planes, by level (breadth first), derived from the leaves' cells: a node
     /// is an inner node when the directory does not give one leaf covering exactly its cell.
     std::vector<CutPlane> cutPlanes() const;

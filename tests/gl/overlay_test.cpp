@@ -3,6 +3,7 @@
 // project, the level range, a rebuild at another max-level, and the --show list.
 #include <gtest/gtest.h>
 
+#include <map>
 #include <set>
 #include <stdexcept>
 
@@ -246,6 +247,70 @@ TEST(Overlays, TheLevelRangeHidesTheLevelsOutsideIt) {
     EXPECT_EQ(ov.geometry().wires.lineCount(), 0u);
     const std::vector<uint8_t> px = drawn(gl, ov, cam);
     for (size_t i = 0; i < px.size(); i += 4) ASSERT_LE(px[i] + px[i + 1] + px[i + 2], 0);
+}
+
+/// A node's BSP level, independently of the level the description gives: the cuts whose cell
+/// holds cells [lo, hi) and is larger (the nodes above it).
+int cutsAbove(const std::vector<CutPlane>& cuts, const uint32_t lo[3], const uint32_t hi[3]) {
+    int above = 0;
+    for (const CutPlane& c : cuts) {
+        bool holds = true, equal = true;
+        for (int a = 0; a < 3; ++a) {
+            holds = holds && c.cellLo[a] <= lo[a] && hi[a] <= c.cellHi[a];
+            equal = equal && c.cellLo[a] == lo[a] && c.cellHi[a] == hi[a];
+        }
+        above += holds && !equal;
+    }
+    return above;
+}
+
+// The level range is the BSP level, for the leaves (RegionInfo::level) and for the directory
+// grid's blocks (an entry by its leaf's level, a sub-table by its node's), not the depth of the
+// sub-table holding an entry.
+TEST(Overlays, TheLevelRangeSelectsLeavesAndGridBlocksByBspLevel) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Regular);
+    const Camera& cam = s->scene->camera;
+    Overlays ov;
+    ov.options.grid = true;
+    ov.update(s, cam, kW, kH);
+    const StructureView& sv = *ov.view();
+    const std::vector<CutPlane> cuts = sv.cutPlanes();
+    for (uint32_t i = 0; i < sv.regionCount(); ++i) {
+        const RegionInfo r = sv.region(i);
+        EXPECT_EQ(r.level, cutsAbove(cuts, r.cellLo, r.cellHi)) << "leaf " << i;
+        EXPECT_EQ(sv.leafLevel(i), r.level);
+    }
+    const std::vector<DirectoryBlock> blocks = sv.directoryBlocks();
+    std::map<int, size_t> perLevel, perDepth;
+    for (const DirectoryBlock& b : blocks) {
+        if (b.subTable) {
+            EXPECT_EQ(b.level, cutsAbove(cuts, b.lo, b.hi));
+        } else {
+            EXPECT_EQ(b.level, sv.region(b.leaf).level) << "an entry has its leaf's level";
+        }
+        ++perLevel[b.level];
+        ++perDepth[b.depth];
+    }
+    ASSERT_GE(perLevel.size(), 2u) << "the test needs blocks at two levels";
+    bool depthDiffers = false;
+    for (const auto& [level, count] : perLevel) {
+        ov.options.levelMin = ov.options.levelMax = level;
+        ov.update(s, cam, kW, kH);
+        EXPECT_EQ(ov.geometry().regionsTotal, count) << "level " << level;
+        EXPECT_EQ(ov.geometry().wires.lineCount(), 12 * count) << "level " << level;
+        depthDiffers |= perDepth[level] != count;
+    }
+    EXPECT_TRUE(depthDiffers) << "the scene must tell BSP levels from sub-table depths";
+    // Every colouring draws the same blocks.
+    for (GridColor c : {GridColor::Kind, GridColor::Level, GridColor::TableDepth}) {
+        ov.options.gridColor = c;
+        ov.options.levelMin = 0;
+        ov.options.levelMax = 64;
+        ov.update(s, cam, kW, kH);
+        EXPECT_EQ(ov.geometry().regionsTotal, blocks.size());
+    }
 }
 
 TEST(Overlays, ARebuildAtAnotherMaxLevelChangesTheDrawnLeavesAndOnlyThen) {

@@ -123,6 +123,9 @@ void directoryBlocks(InspectorModel& m, const StructureView& view, const Inspect
     const RegularGrid& g = *view.regular();
     size_t drawn = 0;
     for (const DirectoryBlock& b : view.directoryBlocks()) {
+        // The level range as for the leaves: an entry by its leaf's BSP level, a sub-table by
+        // its node's.
+        if (!inLevelRange(b.level, opt.levelLo, opt.levelHi)) continue;
         Box3 box;
         bool single = true;
         for (int a = 0; a < 3; ++a) {

@@ -27,9 +27,10 @@ struct InspectorOptions {
     bool surfaces = true;        ///< the scene traced from the inspector's camera, under the lines
     bool zoneSlabsOnly = false;  ///< irregular: only the selected zone's slabs
     ColorBy colorBy = ColorBy::Prims;
-    int levelLo = 0, levelHi = 64;  ///< regular: the level range kept
-    Slab slab;                      ///< the slice slab (world axis)
-    int cap = 20000;                ///< regions (and blocks, and boxes) drawn at most
+    /// Regular: the BSP levels kept (leaves by their level, directory blocks by theirs).
+    int levelLo = 0, levelHi = 64;
+    Slab slab;        ///< the slice slab (world axis)
+    int cap = 20000;  ///< regions (and blocks, and boxes) drawn at most
     bool operator==(const InspectorOptions&) const = default;
 };
 

@@ -216,8 +216,14 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
         Vec3 cell;
         for (int a = 0; a < 3; ++a)
             cell[a] = (b.hi[a] - b.lo[a]) / double(1u << sv.directoryLog2(a));
-        for (const DirectoryBlock& blk : sv.directoryBlocks()) {
-            if (blk.depth < o.levelMin || blk.depth > o.levelMax) continue;
+        const std::vector<DirectoryBlock> blocks = sv.directoryBlocks();
+        int maxLevel = 0, maxDepth = 0;
+        for (const DirectoryBlock& blk : blocks) {
+            maxLevel = std::max(maxLevel, blk.level);
+            maxDepth = std::max(maxDepth, blk.depth);
+        }
+        for (const DirectoryBlock& blk : blocks) {
+            if (blk.level < o.levelMin || blk.level > o.levelMax) continue;
             ++g.regionsTotal;
             if (g.regionsDrawn >= o.cap) continue;
             Vec3 lo, hi;
@@ -225,9 +231,12 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
                 lo[a] = b.lo[a] + cell[a] * blk.lo[a];
                 hi[a] = b.lo[a] + cell[a] * blk.hi[a];
             }
-            // Sub-table blocks in orange, single entries in grey-blue.
+            // By kind: sub-table blocks in orange, single entries in grey-blue.
             const glm::vec3 col =
-                blk.subTable ? glm::vec3(1.0f, 0.55f, 0.1f) : glm::vec3(0.55f, 0.65f, 0.8f);
+                o.gridColor == GridColor::Level        ? depthColor(blk.level, maxLevel + 1)
+                : o.gridColor == GridColor::TableDepth ? depthColor(blk.depth, maxDepth + 1)
+                : blk.subTable                         ? glm::vec3(1.0f, 0.55f, 0.1f)
+                                                       : glm::vec3(0.55f, 0.65f, 0.8f);
             g.wires.box(toF(lo), toF(hi), gl::rgba8(col));
             ++g.regionsDrawn;
         }

@@ -19,6 +19,9 @@ namespace lancer::viewer::overlay {
 enum class ZoneFill : uint8_t { Prims, Slabs };
 /// What colours a leaf's wireframe.
 enum class LeafColor : uint8_t { Level, Prims };
+/// What colours the directory grid's blocks: sub-table blocks against single entries, the BSP
+/// level (an entry's leaf's, a sub-table's node's), or the depth of the table holding the entry.
+enum class GridColor : uint8_t { Kind, Level, TableDepth };
 
 /// The layers and what selects their geometry; a change rebuilds the batches.
 struct OverlayOptions {
@@ -31,7 +34,10 @@ struct OverlayOptions {
     LeafColor leafColor = LeafColor::Level;
     /// Irregular: the projective zones (when primary rays walk them), else the camera frame.
     bool projective = true;
-    int levelMin = 0, levelMax = 64;  ///< regular: leaves and blocks drawn by BSP level / depth
+    GridColor gridColor = GridColor::Kind;
+    /// Regular: the BSP levels drawn (a leaf's, RegionInfo::level; a directory block's,
+    /// DirectoryBlock::level).
+    int levelMin = 0, levelMax = 64;
     /// Most regions (leaves, slabs, blocks) and cuts drawn; the visible ones first.
     size_t cap = 100000;
     bool operator==(const OverlayOptions&) const = default;

@@ -257,7 +257,18 @@ void Overlays::panel(bool* open) {
         ImGui::DragIntRange2("levels", &o.levelMin, &o.levelMax, 0.1f, 0, top, "from %d", "to %d");
         o.levelMin = std::clamp(o.levelMin, 0, top);
         o.levelMax = std::clamp(o.levelMax, o.levelMin, std::max(top, o.levelMax));
-        ImGui::TextDisabled("grid: the level range selects sub-table depths");
+        if (o.grid) {
+            int gc = int(o.gridColor);
+            ImGui::TextUnformatted("grid by");
+            ImGui::SameLine();
+            ImGui::RadioButton("kind", &gc, int(GridColor::Kind));
+            ImGui::SameLine();
+            ImGui::RadioButton("level", &gc, int(GridColor::Level));
+            ImGui::SameLine();
+            ImGui::RadioButton("table depth", &gc, int(GridColor::TableDepth));
+            o.gridColor = GridColor(gc);
+        }
+        ImGui::TextDisabled("levels: BSP levels (a grid entry's leaf's)");
     } else {
         ImGui::TextDisabled("brute force has no subdivision to draw");
     }

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# The rebuild A/B from the command line: `--view`, `--ab` and `--change` refuse what they do not
+# know with status 2 naming the option, before any window opens; under Xvfb a run that changes
+# max-level after the first image and shows the diff writes its screenshot and succeeds.
+# Usage: ab_diff_cli.sh LANCER SOURCE_DIR
+set -euo pipefail
+lancer=$1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cd "$tmp"
+fails() {  # fails WHAT-THE-MESSAGE-NAMES COMMAND...
+  local want=$1 status=0
+  shift
+  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt" || status=$?
+  if [ "$status" != 2 ]; then
+    echo "expected status 2 from: $* (got $status)" >&2
+    cat "$tmp/err.txt" >&2
+    exit 1
+  fi
+  grep -q -- "$want" "$tmp/err.txt" || { cat "$tmp/err.txt" >&2; exit 1; }
+}
+fails "--view" "$lancer" view builtin:default --view heat --frames 1 --ini none
+fails "--ab" "$lancer" view builtin:default --ab both --frames 1 --ini none
+fails "--change" "$lancer" view builtin:default --change max-level=99 --frames 1 --ini none
+fails "--change" "$lancer" view builtin:default --change depth=x.pfm --frames 1 --ini none
+fails "--change" "$lancer" view builtin:default --change max-level --frames 1 --ini none
+if ! command -v xvfb-run >/dev/null; then
+  echo "xvfb-run is not installed (apt-get install xvfb)" >&2
+  exit 1
+fi
+timeout 240 xvfb-run -a -s "-screen 0 800x600x24" "$lancer" view builtin:balls:1 --width 320 \
+  --height 200 --frames 3 --ini none --max-level 3 --change max-level=8,max-objects=2 \
+  --view prim_tests --ab diff --hide-panels --screenshot "$tmp/diff.png"
+test -s "$tmp/diff.png"
