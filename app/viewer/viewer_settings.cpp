@@ -17,6 +17,19 @@ const char* viewModeKey(ViewMode m) {
 
 /// Flags written as 0/1 separated by spaces, read back in the same order (a short line leaves
 /// the flags after it as they were).
+/// The ini's word for a directory grid colouring.
+const char* gridColorWord(overlay::GridColor c) {
+    switch (c) {
+        case overlay::GridColor::Level:
+            return "level";
+        case overlay::GridColor::TableDepth:
+            return "depth";
+        case overlay::GridColor::Kind:
+            break;
+    }
+    return "kind";
+}
+
 std::string flagsText(std::initializer_list<bool> flags) {
     std::string out;
     for (bool f : flags) out += std::string(out.empty() ? "" : " ") + (f ? "1" : "0");
@@ -80,6 +93,7 @@ std::string settingsLines(const ViewerSettings& s) {
     o << "overlay_layers=" << flagsText({ov.bsp, ov.zones, ov.slabs, ov.leaves, ov.grid}) << "\n"
       << "overlay_fill=" << (ov.zoneFill == overlay::ZoneFill::Slabs ? "slabs" : "prims") << "\n"
       << "overlay_color=" << (ov.leafColor == overlay::LeafColor::Prims ? "prims" : "level") << "\n"
+      << "overlay_grid_color=" << gridColorWord(ov.gridColor) << "\n"
       << "overlay_projective=" << ov.projective << "\n"
       << "overlay_levels=" << ov.levelMin << " " << ov.levelMax << "\n"
       << "overlay_cap=" << ov.cap << "\n"
@@ -156,6 +170,10 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
         if (value == "level" || value == "prims")
             s.overlays.leafColor =
                 value == "prims" ? overlay::LeafColor::Prims : overlay::LeafColor::Level;
+    } else if (key == "overlay_grid_color") {
+        for (overlay::GridColor c :
+             {overlay::GridColor::Kind, overlay::GridColor::Level, overlay::GridColor::TableDepth})
+            if (value == gridColorWord(c)) s.overlays.gridColor = c;
     } else if (key == "overlay_projective") {
         flag(s.overlays.projective);
     } else if (key == "overlay_levels") {

@@ -165,6 +165,7 @@ TEST(ViewerSettingsIni, OverlayAndInspectorOptionsRoundTrip) {
     o.bsp = o.slabs = o.grid = true;
     o.zoneFill = overlay::ZoneFill::Slabs;
     o.leafColor = overlay::LeafColor::Prims;
+    o.gridColor = overlay::GridColor::TableDepth;
     o.projective = false;
     o.levelMin = 3;
     o.levelMax = 9;
@@ -209,8 +210,9 @@ TEST(ViewerSettingsIni, OverlayAndInspectorOptionsRoundTrip) {
     ViewerSettings bad = r;
     for (const char* line :
          {"overlay_levels=5 2", "overlay_cap=-3", "overlay_opacity=2 0.5", "overlay_fill=area",
-          "overlay_color=", "inspector_slice=1 3 0 1", "inspector_cap=x", "inspector_levels=-1 4",
-          "inspector_color=heat", "inspector_camera=1 2 3 1 2 3 0 0 1 45 fisheye 1",
+          "overlay_color=", "overlay_grid_color=blue", "inspector_slice=1 3 0 1", "inspector_cap=x",
+          "inspector_levels=-1 4", "inspector_color=heat",
+          "inspector_camera=1 2 3 1 2 3 0 0 1 45 fisheye 1",
           "inspector_camera=0 0 0 0 0 0 0 0 1 45 perspective 1"})
         readSettingsLine(bad, line);
     EXPECT_EQ(settingsLines(bad), lines);
