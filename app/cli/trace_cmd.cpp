@@ -23,10 +23,11 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
                                         std::to_string(w) + "x" + std::to_string(h) + " image");
         const RayTree tree = tracePixel(scene, *accel, o.knobs.shading, cam, t.x, t.y, w, h);
         const TracedRay& primary = tree.rays.front();
+        // Region corners and each step's reason are read from the structure walked.
+        const StructureView view(scene, *accel);
 
         if (t.json) {
-            // Every region event carries the region's 8 world corners.
-            const StructureView view(scene, *accel);
+            // Every region event carries the region's 8 world corners and its step's reason.
             const RegionCornersFn corners = [&view](uint32_t id) {
                 const std::array<Vec3, 8> c = view.regionCorners(id);
                 return std::vector<Vec3>(c.begin(), c.end());
@@ -39,7 +40,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
             j["height"] = h;
             j["camera"] = nlohmann::json::parse(cam.toJson());
             j["bounces"] = o.knobs.shading.bounces;
-            const nlohmann::json p = toJson(primary, scene, corners);
+            const nlohmann::json p = toJson(primary, scene, corners, &view);
             j["ray"] = {{"origin", p["origin"]}, {"direction", p["direction"]}};
             j["events"] = p["events"];
             j["hit"] = p["hit"];
@@ -54,7 +55,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
             j["walk_errors"] = tree.counters.walkErrors;
             j["counters"] = toJson(tree.counters);
             nlohmann::json rays = nlohmann::json::array();
-            for (const TracedRay& r : tree.rays) rays.push_back(toJson(r, scene, corners));
+            for (const TracedRay& r : tree.rays) rays.push_back(toJson(r, scene, corners, &view));
             j["rays"] = std::move(rays);
             std::cout << j.dump(2) << "\n";
             return 0;
@@ -62,7 +63,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
         std::cout.precision(10);
         std::cout << "scene " << o.scene << ", scheme " << schemeName(o.knobs.build.scheme)
                   << ", bounces " << o.knobs.shading.bounces << "\n"
-                  << tree.toString(&scene);
+                  << tree.toString(&scene, &view);
         std::cout << "primitive tests " << tree.counters.primTests << ", mailbox hits "
                   << tree.counters.mailboxHits << ", regions " << tree.counters.regionVisits
                   << " (the pixel's " << tree.rays.size() << " rays)\n";
