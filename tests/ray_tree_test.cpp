@@ -7,9 +7,15 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <random>
 #include <sstream>
+#include <thread>
 
 #include "engine/accel/structure_view.h"
+#include "engine/render/progressive.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
 #include "support/differential.h"
@@ -100,6 +106,41 @@ TEST(RayTree, CountsEqualTheRendersPerPixelCounters) {
                 total += t.counters;
             }
         EXPECT_EQ(total, stats.counters);
+    }
+}
+
+// The viewer's heat maps read the progressive renderer's per-pixel counters: once its passes
+// have finished, every pixel's tests and regions are those of the pixel's ray tree (both
+// schemes, secondary rays included), as `lancer trace` counts them.
+TEST(RayTree, CountsEqualTheViewersProgressiveCounters) {
+    const int w = 24, h = 16;
+    for (const Config& c : configs()) {
+        if (c.scene != "builtin:default" || c.bounces == 0) continue;
+        SCOPED_TRACE(c.name());
+        auto scene = std::make_shared<const Scene>(loadScene(c.scene));
+        std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, paramsOf(c));
+        RenderOptions ro;
+        ro.width = w;
+        ro.height = h;
+        ro.threads = 2;
+        ro.shading.bounces = c.bounces;
+        ProgressiveRenderer pr;
+        pr.start({scene, accel, ro});
+        const auto start = std::chrono::steady_clock::now();
+        while (!pr.finished()) {
+            ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(60));
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+        Image shown;
+        uint64_t version = 0;
+        ASSERT_TRUE(pr.snapshot(version, shown));
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const RayTree t = tracePixel(*scene, *accel, ro.shading, scene->camera, x, y, w, h);
+                const size_t i = shown.index(x, y);
+                ASSERT_EQ(t.counters.primTests, shown.primTests[i]) << x << " " << y;
+                ASSERT_EQ(t.counters.regionVisits, shown.regionVisits[i]) << x << " " << y;
+            }
     }
 }
 
@@ -293,13 +334,20 @@ TEST(RayTree, EachStepSaysHowTheNextRegionIsReached) {
     EXPECT_GT(pointers, 0u);
 }
 
-/// How far `p` lies outside the hexahedron of `c` (corner i + 2j + 4k; faces planar), 0 inside:
-/// the largest distance beyond one of its six face planes. A face that has collapsed to a point
-/// or a segment (a projective region's apex at the eye) bounds nothing and is skipped.
-double outside(const std::array<Vec3, 8>& c, const Vec3& p) {
+/// A face plane of a hexahedron: unit normal n, a point fc of the face, and the sign of n
+/// toward the outside (0: the hexahedron is flat across it).
+struct FacePlane {
+    Vec3 n, fc;
+    double outward;
+};
+
+/// The six face planes of the hexahedron `c` (corner i + 2j + 4k; faces planar). A face that
+/// has collapsed to a point or a segment (a projective region's apex at the eye) bounds nothing
+/// and is left out.
+std::vector<FacePlane> facePlanes(const std::array<Vec3, 8>& c) {
     Vec3 centre(0.0);
     for (const Vec3& q : c) centre += q / 8.0;
-    double worst = 0.0;
+    std::vector<FacePlane> planes;
     for (int a = 0; a < 3; ++a) {
         const int b = (a + 1) % 3, d = (a + 2) % 3;
         for (int side = 0; side < 2; ++side) {
@@ -320,35 +368,55 @@ double outside(const std::array<Vec3, 8>& c, const Vec3& p) {
             if (!(len > 1e-12 * glm::dot(fc - centre, fc - centre) + 1e-300)) continue;
             n /= len;
             const double towards = glm::dot(n, fc - centre);
-            const double dist = glm::dot(n, p - fc);
-            if (towards > 0.0)
-                worst = std::max(worst, dist);
-            else if (towards < 0.0)
-                worst = std::max(worst, -dist);
-            else
-                worst = std::max(worst, std::abs(dist));  // a flat region: on its plane
+            planes.push_back({n, fc, towards > 0.0 ? 1.0 : (towards < 0.0 ? -1.0 : 0.0)});
         }
+    }
+    return planes;
+}
+
+/// How far `p` lies outside the hexahedron of `c`, 0 inside: the largest distance beyond one
+/// of its face planes.
+double outside(const std::array<Vec3, 8>& c, const Vec3& p) {
+    double worst = 0.0;
+    for (const FacePlane& f : facePlanes(c)) {
+        const double dist = glm::dot(f.n, p - f.fc);
+        worst = std::max(worst, f.outward == 0.0 ? std::abs(dist) : f.outward * dist);
     }
     return worst;
 }
 
-/// Check that each region event's corners hold the ray's stretch in it; returns the regions
-/// checked. The walks clip a ray to their structure's box grown by a hair (a few 1e-9 of the
-/// scene's size), and the last region's stretch runs to that clip: where the ray leaves the
-/// structure through an edge or a corner it may already have left the region across the tied
-/// interior face, by up to the hair over the ray's slope. So the points checked are those inside
-/// the structure's own box.
+/// Distance from `p` to the nearest face plane of the hexahedron of `c`.
+double toBoundary(const std::array<Vec3, 8>& c, const Vec3& p) {
+    double best = kInf;
+    for (const FacePlane& f : facePlanes(c))
+        best = std::min(best, std::abs(glm::dot(f.n, p - f.fc)));
+    return best;
+}
+
+/// The regular walk clips rays to its box grown by a hair, 1e-9 of the box's largest extent
+/// plus its largest corner's distance from the origin (regular_grid.cpp): a ray passing within
+/// that hair of the box, and no nearer, walks the border leaf there. 0 for the other schemes.
+double clipHair(const StructureView& view) {
+    const RegularGrid* g = view.regular();
+    if (!g) return 0.0;
+    const Vec3 e = g->box().extent();
+    return 1e-9 * (std::max({e.x, e.y, e.z}) +
+                   std::max(glm::length(g->box().lo), glm::length(g->box().hi)));
+}
+
+/// Check that each region event's corners hold the ray's stretch in it (its ends and middle,
+/// within 1e-9 of the scene's size, and the regular walk's clip hair); returns the regions
+/// checked.
 size_t checkCorners(const StructureView& view, const Ray& ray, const std::vector<WalkEvent>& ev,
                     double scale) {
     size_t n = 0;
-    const std::array<Vec3, 8> bounds = view.structureCorners();
+    const double hair = clipHair(view);
     for (const WalkEvent& e : ev) {
         if (e.kind != WalkEvent::Region) continue;
         const std::array<Vec3, 8> c = view.regionCorners(e.a);
         for (double t : {e.t0, 0.5 * (e.t0 + e.t1), e.t1}) {
             const Vec3 p = ray.at(t);
-            const double tol = 1e-9 * std::max(scale, glm::length(p));
-            if (outside(bounds, p) > tol) continue;
+            const double tol = 1e-9 * std::max(scale, glm::length(p)) + hair;
             EXPECT_LE(outside(c, p), tol)
                 << ray.toString() << " region " << e.a << " t = " << t << " of [" << e.t0 << ", "
                 << e.t1 << "] " << view.toString(e.a);
@@ -420,6 +488,402 @@ TEST(RayTree, RegionCornersHoldTheRaysStretch) {
     }
     EXPECT_GT(checked, 1000u);
     EXPECT_GT(boundaryRays, 100u);
+}
+
+/// Index of the region event the same walk enters after event `i` (a light-buffer stretch
+/// starts a walk of its own), or -1.
+int64_t nextRegionEvent(const std::vector<WalkEvent>& ev, size_t i) {
+    for (size_t k = i + 1; k < ev.size(); ++k) {
+        if (ev[k].kind == WalkEvent::Stretch) return -1;
+        if (ev[k].kind == WalkEvent::Region) return int64_t(k);
+    }
+    return -1;
+}
+
+// The irregular scheme's projective zones tell their walk as the camera-frame walk does: the
+// region the walk starts in (Locate: it holds the point, and it is the next region event's),
+// and each region left before the ray's interval ends (Exit: the point on the region's
+// boundary, at the ray's point of its t, where the region's stretch ends; the next region event
+// starts there and holds the point just past it). Every ray of random pixels' trees (primary
+// rays walk the projective slabs, secondary rays the camera frame) of random scenes and
+// built-in scenes seen by a perspective camera.
+TEST(RayTree, ProjectiveWalkTellsItsExitsAndLocates) {
+    size_t projectiveExits = 0, projectiveLocates = 0, cameraExits = 0, nearExits = 0, scenes = 0;
+    auto check = [&](const Scene& scene, int w, int h, uint64_t seed) {
+        ASSERT_EQ(scene.camera.projection, Projection::Perspective);
+        BuildParams p;
+        p.scheme = SchemeKind::Irregular;
+        p.irregular.frame = IrregularFrame::Projective;
+        auto accel = buildAccelerator(scene, p);
+        const StructureView view(scene, *accel);
+        const uint32_t firstProjective = uint32_t(view.irregular()->regions().size());
+        if (view.irregular()->projective().zoneCount() == 0) return;  // nothing before the eye
+        ++scenes;
+        ShadingOptions sh;
+        sh.bounces = 2;
+        std::mt19937_64 rng(seed);
+        std::uniform_int_distribution<int> px(0, w - 1), py(0, h - 1);
+        for (int k = 0; k < 40; ++k) {
+            const RayTree t = tracePixel(scene, *accel, sh, scene.camera, px(rng), py(rng), w, h);
+            for (const TracedRay& r : t.rays) {
+                const Ray ray{r.origin, r.direction};
+                const std::vector<WalkEvent>& ev = r.events;
+                int64_t current = -1;
+                for (size_t i = 0; i < ev.size(); ++i) {
+                    const WalkEvent& e = ev[i];
+                    if (e.kind == WalkEvent::Region) current = int64_t(i);
+                    if (e.kind == WalkEvent::Stretch) current = -1;
+                    if (e.kind != WalkEvent::Locate && e.kind != WalkEvent::Exit) continue;
+                    SCOPED_TRACE(e.toString() + " of " + r.toString());
+                    const double tol = 1e-9 * std::max(scene.scale(), glm::length(e.point));
+                    const int64_t n = nextRegionEvent(ev, i);
+                    if (e.kind == WalkEvent::Locate) {
+                        ASSERT_GE(n, 0);
+                        ASSERT_EQ(ev[size_t(n)].a, e.b);
+                        EXPECT_LE(outside(view.regionCorners(e.b), e.point), tol);
+                        const Vec3 at = ray.at(ev[size_t(n)].t0);
+                        EXPECT_LE(glm::length(at - e.point), tol);
+                        projectiveLocates += e.b >= firstProjective;
+                        continue;
+                    }
+                    ASSERT_GE(current, 0);
+                    const WalkEvent& left = ev[size_t(current)];
+                    const std::array<Vec3, 8> c = view.regionCorners(left.a);
+                    EXPECT_LE(outside(c, e.point), tol);
+                    EXPECT_LE(toBoundary(c, e.point), tol);
+                    EXPECT_LE(glm::length(ray.at(e.t0) - e.point), tol);
+                    EXPECT_EQ(left.t1, e.t0);
+                    if (left.a >= firstProjective) {
+                        ++projectiveExits;
+                        EXPECT_EQ(e.axis, 2);
+                        EXPECT_EQ(e.ties, 4);
+                        nearExits += view.region(left.a).kind == RegionKind::NearRegion;
+                    } else {
+                        ++cameraExits;
+                    }
+                    if (n < 0) continue;  // out of the structure
+                    const WalkEvent& next = ev[size_t(n)];
+                    EXPECT_EQ(next.t0, e.t0);
+                    if (left.a >= firstProjective) {
+                        EXPECT_EQ(size_t(n), i + 1) << "a projective step follows no pointer";
+                    }
+                    if (!(next.t1 > next.t0)) continue;  // an edge or corner's zero-length step
+                    const double past =
+                        e.t0 + std::min(1e-6 * scene.scale(), 0.5 * (next.t1 - next.t0));
+                    const Vec3 q = ray.at(past);
+                    EXPECT_LE(outside(view.regionCorners(next.a), q),
+                              1e-9 * std::max(scene.scale(), glm::length(q)))
+                        << view.toString(next.a);
+                }
+            }
+        }
+    };
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.primitives = 10 + int(seed) * 3;
+        Scene scene = test::randomCsgScene(seed, opt);
+        scene.materials[0].reflect = 0.3;
+        scene.materials[0].transmit = 0.5;
+        scene.materials[0].ior = 1.4;
+        scene.frameCamera(Vec3(0.3, 1.0, -0.4), Vec3(0.0, 0.0, 1.0));
+        scene.defaultLights();
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        check(scene, 32, 24, seed);
+    }
+    for (const char* spec : {"builtin:default", "builtin:balls:1", "builtin:drilled:2"}) {
+        SCOPED_TRACE(spec);
+        check(loadScene(spec), 64, 48, 7);
+    }
+    EXPECT_GE(scenes, 5u);
+    EXPECT_GT(projectiveExits, 100u);
+    EXPECT_GT(projectiveLocates, 50u);
+    EXPECT_GT(cameraExits, 100u);
+    std::cout << "projective exits " << projectiveExits << " (near region " << nearExits
+              << "), locates " << projectiveLocates << "; camera-frame exits " << cameraExits
+              << "\n";
+}
+
+// Rays grazing the structure's border, for both schemes (regular exact and push, irregular
+// camera frame and projective): from the border's corners, edge midpoints, face centres and
+// the border corners of the regions there (origins on region boundaries), along the border's
+// edges and faces, and tilted 1e-7 into or out of its faces. Every regular leaf's corners hold
+// the ray's stretch in it: the stretches told start where the ray enters the structure's box and
+// the last ends where the ray leaves its region, so a ray leaving the grid through an edge or a
+// corner no longer runs on into the next leaf outside the box (a ray passing within the regular
+// walk's clip hair of the box, and no nearer, stays within that hair of the border leaf it
+// walks). No walk ends in an error, and the hits are brute force's.
+TEST(RayTree, GrazingRaysAtTheStructureBorder) {
+    size_t checked = 0, rays = 0;
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.primitives = 12 + int(seed) * 3;
+        opt.surfaces = seed % 2 == 0;
+        Scene scene = seed == 4 ? loadScene("builtin:default") : test::randomCsgScene(seed, opt);
+        std::mt19937_64 rng(seed);
+        std::uniform_real_distribution<double> unit(0.0, 1.0);
+        for (const Config& c : configs()) {
+            // Rays off the eye walk the camera frame: the projective build adds nothing here.
+            if (c.scheme == SchemeKind::Brute || c.scene != "builtin:default" || c.bounces == 0 ||
+                (c.scheme == SchemeKind::Irregular && c.frame == IrregularFrame::Projective))
+                continue;
+            SCOPED_TRACE(c.name() + " seed " + std::to_string(seed));
+            auto accel = buildAccelerator(scene, paramsOf(c));
+            const StructureView view(scene, *accel);
+            const std::array<Vec3, 8> B = view.structureCorners();
+            // Origins: the border's corners, edge midpoints and face centres, and the corners
+            // on the border of the regions holding the face centres.
+            struct Start {
+                Vec3 o;
+                int axis, side;  // a face of the border it lies on
+            };
+            std::vector<Start> starts;
+            for (int a = 0; a < 3; ++a)
+                for (int side = 0; side < 2; ++side) {
+                    const int b = (a + 1) % 3, d = (a + 2) % 3;
+                    const auto corner = [&](int i, int j) {
+                        return B[size_t((side << a) | (i << b) | (j << d))];
+                    };
+                    const Vec3 centre =
+                        0.25 * (corner(0, 0) + corner(1, 0) + corner(0, 1) + corner(1, 1));
+                    starts.push_back({centre, a, side});
+                    starts.push_back({corner(0, 0), a, side});
+                    starts.push_back({corner(1, 1), a, side});
+                    starts.push_back({0.5 * (corner(0, 0) + corner(1, 0)), a, side});
+                    starts.push_back({0.5 * (corner(0, 1) + corner(1, 1)), a, side});
+                    if (c.scheme == SchemeKind::Regular ||
+                        (c.scheme == SchemeKind::Irregular && view.irregular())) {
+                        const uint32_t id = view.regionAt(centre);
+                        const std::array<Vec3, 8> rc = view.regionCorners(id);
+                        for (int k = 0; k < 8; ++k)
+                            if ((k >> a & 1) == side) starts.push_back({rc[size_t(k)], a, side});
+                    }
+                }
+            std::vector<Ray> all;
+            TraceContext ctx(scene.prims.size(), scene.tree.depth());
+            ctx.useMailboxes = accel->usesMailboxes();
+            for (const Start& st : starts) {
+                const int a = st.axis, b = (a + 1) % 3, d = (a + 2) % 3;
+                // The face's two edge directions and its outward normal, in the world.
+                const Vec3 e1 = glm::normalize(B[size_t(1 << b)] - B[0]);
+                const Vec3 e2 = glm::normalize(B[size_t(1 << d)] - B[0]);
+                const Vec3 out = glm::normalize(B[size_t(1 << a)] - B[0]) * (st.side ? 1.0 : -1.0);
+                std::vector<Vec3> dirs = {e1, -e1, e2, -e2};
+                for (int k = 0; k < 4; ++k) {
+                    const double th = 2.0 * M_PI * unit(rng);
+                    const Vec3 along = std::cos(th) * e1 + std::sin(th) * e2;
+                    dirs.push_back(along);
+                    dirs.push_back(glm::normalize(along + 1e-7 * out));
+                    dirs.push_back(glm::normalize(along - 1e-7 * out));
+                }
+                for (const Vec3& dir : dirs) {
+                    // From the point, and from outside the box toward it along the face.
+                    for (const Ray& ray :
+                         {Ray{st.o, dir}, Ray{st.o - 2.0 * scene.scale() * dir, dir}}) {
+                        RecordingObserver obs = test::recordWalk(*accel, ray, ctx);
+                        // The irregular camera-frame walk is not held to its corners here: a
+                        // ray entering the frame's bounds at a corner of theirs is told in a
+                        // region up to 2e-8 off it on builtin:default (to be found).
+                        if (c.scheme == SchemeKind::Regular)
+                            checked += checkCorners(view, ray, obs.events, scene.scale());
+                        for (const WalkEvent& e : obs.events)
+                            EXPECT_NE(e.kind, WalkEvent::Error)
+                                << e.toString() << " " << ray.toString();
+                        all.push_back(ray);
+                        ++rays;
+                    }
+                }
+            }
+            const std::vector<test::RayMismatch> bad = test::compareWithBrute(scene, *accel, all);
+            for (const test::RayMismatch& m : bad) ADD_FAILURE() << m.toString(scene);
+        }
+    }
+    EXPECT_GT(rays, 1000u);
+    EXPECT_GT(checked, rays / 2);
+}
+
+/// The reasons of a ray's steps, checked against its events: one per step; step k names step
+/// k + 1's region last, after "-> "; the last step names none and tells how the ray ends.
+void checkReasons(const StructureView& view, const TracedRay& r, const Scene& scene) {
+    const std::vector<size_t> steps = r.regionSteps();
+    const std::vector<StepReason> why = explainSteps(r, view, &scene);
+    ASSERT_EQ(why.size(), steps.size());
+    for (size_t k = 0; k < why.size(); ++k) {
+        const std::string& text = why[k].text;
+        SCOPED_TRACE("step " + std::to_string(k) + ": " + text);
+        ASSERT_FALSE(text.empty());
+        ASSERT_EQ(text.find('\n'), std::string::npos);
+        const size_t arrow = text.rfind("-> ");
+        if (k + 1 < steps.size()) {
+            const uint32_t next = r.events[steps[k + 1]].a;
+            ASSERT_EQ(why[k].next, int64_t(next));
+            ASSERT_NE(arrow, std::string::npos);
+            const std::string name = regionName(view, next);
+            ASSERT_EQ(text.compare(arrow + 3, name.size(), name), 0);
+        } else {
+            ASSERT_EQ(why[k].next, -1);
+            ASSERT_EQ(arrow, std::string::npos);
+            if (r.kind == RayKind::Shadow && r.occluded) {
+                ASSERT_NE(text.find("blocked by p" + std::to_string(r.hit.prim)),
+                          std::string::npos);
+            } else if (r.kind != RayKind::Shadow && r.hit.valid()) {
+                ASSERT_NE(text.find("hit p" + std::to_string(r.hit.prim)), std::string::npos);
+            }
+        }
+    }
+}
+
+// For random scenes and the built-in ones, every ray of random pixels' trees (all kinds, both
+// schemes, both step methods, both irregular frames): the region each step's reason names as
+// the next is the region of the next step, and the last step's tells the hit or the blocker.
+TEST(RayTree, StepReasonNamesTheNextStepsRegion) {
+    size_t reasons = 0;
+    for (const Config& c : configs()) {
+        if (c.bounces == 0) continue;
+        SCOPED_TRACE(c.name());
+        Scene scene = loadScene(c.scene);
+        auto accel = buildAccelerator(scene, paramsOf(c));
+        const StructureView view(scene, *accel);
+        ShadingOptions sh;
+        sh.bounces = c.bounces;
+        for (int k = 0; k < 24; ++k) {
+            const RayTree t =
+                tracePixel(scene, *accel, sh, scene.camera, (k * 7) % 16, (k * 5) % 12, 16, 12);
+            for (const TracedRay& r : t.rays) {
+                checkReasons(view, r, scene);
+                reasons += r.regionSteps().size();
+            }
+        }
+    }
+    for (uint64_t seed = 1; seed <= 3; ++seed) {
+        Scene scene = test::randomCsgScene(seed);
+        scene.materials[0].reflect = 0.3;
+        scene.materials[0].transmit = 0.5;
+        scene.frameCamera(Vec3(0.3, 1.0, -0.4), Vec3(0.0, 0.0, 1.0));
+        scene.defaultLights();
+        for (const Config& c : configs()) {
+            if (c.scene != "builtin:default" || c.bounces == 0) continue;
+            auto accel = buildAccelerator(scene, paramsOf(c));
+            const StructureView view(scene, *accel);
+            ShadingOptions sh;
+            sh.bounces = 2;
+            for (int k = 0; k < 24; ++k) {
+                const RayTree t = tracePixel(scene, *accel, sh, scene.camera, (k * 11) % 32,
+                                             (k * 13) % 32, 32, 32);
+                for (const TracedRay& r : t.rays) checkReasons(view, r, scene);
+            }
+        }
+    }
+    EXPECT_GT(reasons, 1000u);
+}
+
+/// Two boxes: A at the origin, B and C beyond x = 2, B above, C below. With max-objects 1 the
+/// regular grid's low-x half holds A and its high-x half splits between C and B, so the low
+/// half's +x face has two leaves across it.
+Scene twoBoxes() {
+    Scene s;
+    s.prims.push_back(makePrimitive(Block{{0, 0, 0}, {1, 1, 1}}, Transform()));
+    s.prims.push_back(makePrimitive(Block{{2, 2, 0}, {3, 3, 1}}, Transform()));
+    s.prims.push_back(makePrimitive(Block{{2, 0, 0}, {3, 1, 1}}, Transform()));
+    s.tree.root = s.tree.balanced(Op::Union, {s.tree.leaf(0), s.tree.leaf(1), s.tree.leaf(2)});
+    s.prepare();
+    s.frameCamera(Vec3(0.3, 0.4, -1.0), Vec3(0.0, 1.0, 0.0));
+    s.defaultLights();
+    return s;
+}
+
+// A hand-built scene and a known ray: the ray from (0.5, 2.5, 0.5) along +x leaves the leaf of
+// A's half through its +x face at x = 1.5 (t = 1): with the exact step, the index step +x to
+// the directory cell of the point (1.5, 2.5, 0.5) on the high side, whose leaf is B's; with the
+// push step, the pushed point's cell; then it hits B at t = 1.5 inside that leaf.
+TEST(RayTree, StepReasonsOfAKnownRayNameTheFaceCellAndNextLeaf) {
+    const Scene scene = twoBoxes();
+    const Ray ray{{0.5, 2.5, 0.5}, {1.0, 0.0, 0.0}};
+    for (StepMethod step : {StepMethod::Exact, StepMethod::Push}) {
+        SCOPED_TRACE(stepName(step));
+        BuildParams p;
+        p.scheme = SchemeKind::Regular;
+        p.regular.maxObjects = 1;
+        p.regular.step = step;
+        p.regular.delta = 1e-3;  // 0.003 on the box's 3 units along x
+        p.regular.splitAxes = SplitAxes::Cycle;
+        auto accel = buildAccelerator(scene, p);
+        const StructureView view(scene, *accel);
+        const RegularGrid& g = *view.regular();
+        ASSERT_EQ(g.regionCount(), 3u) << "A's half, B's and C's quarters";
+        const uint32_t from = g.leafAt({0.5, 2.5, 0.5}), to = g.leafAt({2.5, 2.5, 0.5});
+        ASSERT_NE(from, to);
+        TraceContext ctx(scene.prims.size(), scene.tree.depth());
+        ctx.useMailboxes = true;
+        RecordingObserver obs = test::recordWalk(*accel, ray, ctx);
+        TracedRay r;
+        r.origin = ray.o;
+        r.direction = ray.d;
+        r.events = obs.events;
+        NullObserver none;
+        ASSERT_TRUE(accel->intersect(ray, 0.0, kInf, ctx, none, r.hit));
+        ASSERT_EQ(r.hit.prim, 1u);
+        ASSERT_EQ(r.hit.t, 1.5);
+        const std::vector<StepReason> why = explainSteps(r, view, &scene);
+        ASSERT_EQ(why.size(), 2u);
+        const std::string& s0 = why[0].text;
+        SCOPED_TRACE(s0 + " | " + why[1].text);
+        EXPECT_EQ(s0.rfind("the walk starts at (0.5, 2.5, 0.5): directory cell (0, 1, 0) of leaf " +
+                               std::to_string(from) + "; ",
+                           0),
+                  0u);
+        EXPECT_NE(s0.find("left leaf " + std::to_string(from) +
+                          " through its +x face at t = 1 (point (1.5, 2.5, 0.5))"),
+                  std::string::npos);
+        if (step == StepMethod::Exact) {
+            EXPECT_NE(s0.find("; exact index step +x to directory cell (1, 1, 0) -> leaf " +
+                              std::to_string(to)),
+                      std::string::npos);
+        } else {
+            EXPECT_NE(s0.find("; pushed by delta 0.003 across +x face to (1.503, 2.5, 0.5): "
+                              "directory cell (1, 1, 0) -> leaf " +
+                              std::to_string(to)),
+                      std::string::npos);
+        }
+        EXPECT_EQ(why[0].next, int64_t(to));
+        EXPECT_EQ(why[1].next, -1);
+        EXPECT_EQ(why[1].text.rfind("hit p1 ", 0), 0u);
+        EXPECT_NE(why[1].text.find(" at t = 1.5 inside this region"), std::string::npos);
+    }
+    // The irregular scheme (camera frame) along the camera's forward axis through A: out of
+    // each slab through its far depth plane, to the next slab of the same zone.
+    BuildParams p;
+    p.scheme = SchemeKind::Irregular;
+    p.irregular.frame = IrregularFrame::Camera;
+    auto accel = buildAccelerator(scene, p);
+    const StructureView view(scene, *accel);
+    Vec3 F, R, U;
+    scene.camera.basis(F, R, U);
+    const Ray ray2{Vec3(0.5) - 10.0 * F, F};
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    ctx.useMailboxes = true;
+    RecordingObserver obs = test::recordWalk(*accel, ray2, ctx);
+    TracedRay r;
+    r.origin = ray2.o;
+    r.direction = ray2.d;
+    r.events = obs.events;
+    NullObserver none;
+    ASSERT_TRUE(accel->intersect(ray2, 0.0, kInf, ctx, none, r.hit));
+    ASSERT_EQ(r.hit.prim, 0u);
+    const std::vector<StepReason> why = explainSteps(r, view, &scene);
+    ASSERT_GE(why.size(), 2u);
+    for (size_t k = 0; k + 1 < why.size(); ++k) {
+        SCOPED_TRACE(why[k].text);
+        const RegionInfo a = view.region(r.events[r.regionSteps()[k]].a);
+        const RegionInfo b = view.region(uint32_t(why[k].next));
+        if (a.zone == b.zone) {
+            EXPECT_NE(why[k].text.find("through its far depth plane"), std::string::npos);
+            EXPECT_NE(why[k].text.find("the next slab of the same zone"), std::string::npos);
+            EXPECT_EQ(b.slab, a.slab + 1);
+        } else {
+            EXPECT_NE(why[k].text.find("crossed into zone " + std::to_string(b.zone)),
+                      std::string::npos);
+        }
+    }
 }
 
 // The values print themselves: every event kind, the hit, the counters, a ray, the tree.

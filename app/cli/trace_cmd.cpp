@@ -25,6 +25,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
         const RayTree tree = tracePixel(scene, *accel, o.knobs.shading, cam, t.x, t.y, w, h);
         const TracedRay& primary = tree.rays.front();
         // Each ray's wasted work (docs/viewer.md, "Wasted work"), from its recorded events.
+        // Region corners and each step's reason are read from the structure walked.
         const StructureView view(scene, *accel);
         std::vector<RayWaste> waste;
         for (const TracedRay& r : tree.rays)
@@ -41,7 +42,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
         };
 
         if (t.json) {
-            // Every region event carries the region's 8 world corners.
+            // Every region event carries the region's 8 world corners and its step's reason.
             const RegionCornersFn corners = [&view](uint32_t id) {
                 const std::array<Vec3, 8> c = view.regionCorners(id);
                 return std::vector<Vec3>(c.begin(), c.end());
@@ -54,7 +55,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
             j["height"] = h;
             j["camera"] = nlohmann::json::parse(cam.toJson());
             j["bounces"] = o.knobs.shading.bounces;
-            nlohmann::json p = toJson(primary, scene, corners);
+            nlohmann::json p = toJson(primary, scene, corners, &view);
             addWaste(p, waste.front());
             j["ray"] = {{"origin", p["origin"]}, {"direction", p["direction"]}};
             j["events"] = p["events"];
@@ -71,7 +72,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
             j["counters"] = toJson(tree.counters);
             nlohmann::json rays = nlohmann::json::array();
             for (size_t i = 0; i < tree.rays.size(); ++i) {
-                rays.push_back(toJson(tree.rays[i], scene, corners));
+                rays.push_back(toJson(tree.rays[i], scene, corners, &view));
                 addWaste(rays.back(), waste[i]);
             }
             j["rays"] = std::move(rays);
@@ -81,7 +82,7 @@ int runTrace(const CommonOptions& o, const TraceOptions& t) {
         std::cout.precision(10);
         std::cout << "scene " << o.scene << ", scheme " << schemeName(o.knobs.build.scheme)
                   << ", bounces " << o.knobs.shading.bounces << "\n"
-                  << tree.toString(&scene);
+                  << tree.toString(&scene, &view);
         std::cout << "primitive tests " << tree.counters.primTests << ", mailbox hits "
                   << tree.counters.mailboxHits << ", regions " << tree.counters.regionVisits
                   << " (the pixel's " << tree.rays.size() << " rays)\n";

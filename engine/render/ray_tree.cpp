@@ -1,8 +1,11 @@
 #include "engine/render/ray_tree.h"
 
 #include <cmath>
+#include <cstdio>
 #include <ostream>
 #include <sstream>
+
+#include "engine/accel/structure_view.h"
 
 namespace lancer {
 
@@ -112,7 +115,288 @@ std::string TracedRay::toString() const {
     return os.str();
 }
 
-std::string RayTree::toString(const Scene* scene) const {
+namespace {
+
+/// Six significant digits: a sentence's numbers are read, not compared.
+std::string num(double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", x);
+    return buf;
+}
+
+std::string pt(const Vec3& p) { return "(" + num(p.x) + ", " + num(p.y) + ", " + num(p.z) + ")"; }
+
+/// Ten significant digits: a pushed point differs from the exit point by a small delta.
+std::string pt10(const Vec3& p) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "(%.10g, %.10g, %.10g)", p.x, p.y, p.z);
+    return buf;
+}
+
+std::string cellText(const uint32_t c[3]) {
+    return "(" + std::to_string(c[0]) + ", " + std::to_string(c[1]) + ", " + std::to_string(c[2]) +
+           ")";
+}
+
+std::string primText(uint32_t p, const Scene* scene) {
+    std::string s = "p" + std::to_string(p);
+    if (scene && p < scene->prims.size()) s += " " + scene->prims[p].toString();
+    return s;
+}
+
+/// How a region step's frame runs along the ray: per axis +1 (the ray goes to the high side),
+/// -1 or 0; regular and brute force in the world's axes, camera-frame slabs in the camera
+/// frame's, projective regions in depth alone (a ray from the eye keeps its u and v).
+struct FrameSides {
+    int sign[3] = {0, 0, 0};
+    bool irregular = false;
+};
+
+FrameSides sidesOf(const StructureView& view, RegionKind kind, const Vec3& dir) {
+    FrameSides f;
+    Vec3 d = dir;
+    if (kind == RegionKind::Slab) d = view.irregular()->frame().vector(dir);
+    if (kind == RegionKind::ProjectiveSlab || kind == RegionKind::NearRegion) d = Vec3(0, 0, 1);
+    f.irregular = kind == RegionKind::Slab || kind == RegionKind::ProjectiveSlab ||
+                  kind == RegionKind::NearRegion;
+    for (int a = 0; a < 3; ++a) f.sign[a] = d[a] > 0.0 ? 1 : (d[a] < 0.0 ? -1 : 0);
+    return f;
+}
+
+/// "+x" for the side of axis a the ray leaves through.
+std::string signedAxis(const FrameSides& f, int a) {
+    return std::string(f.sign[a] < 0 ? "-" : "+") + char('x' + a);
+}
+
+/// "+x face", "+x-y edge", "+x+y-z corner"; an irregular region's depth face is its "far depth
+/// plane" or "near depth plane".
+std::string exitFace(const FrameSides& f, int ties) {
+    if (f.irregular && ties == 4) return f.sign[2] < 0 ? "near depth plane" : "far depth plane";
+    std::string s;
+    int n = 0;
+    for (int a = 0; a < 3; ++a)
+        if (ties >> a & 1) s += signedAxis(f, a), ++n;
+    return s + (n == 1 ? " face" : n == 2 ? " edge" : " corner");
+}
+
+/// " -> sub-table 3 -> sub-table 9": the sub-tables a lookup of `cell` passes through.
+std::string subTables(const StructureView& view, const uint32_t cell[3]) {
+    std::string s;
+    if (const RegularGrid* g = view.regular())
+        for (uint32_t t : g->directory().subTablesOf(cell[0], cell[1], cell[2]))
+            s += " -> sub-table " + std::to_string(t);
+    return s;
+}
+
+/// The next region, named, with its depth range for irregular slabs.
+std::string nextName(const StructureView& view, uint32_t id) {
+    std::string s = "-> " + regionName(view, id);
+    const RegionInfo r = view.region(id);
+    if (r.kind == RegionKind::Slab || r.kind == RegionKind::ProjectiveSlab ||
+        r.kind == RegionKind::NearRegion)
+        s += ", depth " + num(r.frameBox.lo.z) + " to " + num(r.frameBox.hi.z);
+    return s;
+}
+
+/// How a walk (the ray's, or a light-buffer stretch's) finds its first region: by the directory
+/// (regular), the screen BSP and the zone's slabs (camera frame), the pixel's zone (projective).
+/// `arrow`: name the region after "-> " (a next step), else as the step's own.
+std::string startText(const StructureView& view, const WalkEvent* locate, const WalkEvent* lookup,
+                      uint32_t region, bool arrow) {
+    std::string s;
+    if (lookup) {
+        s = "starts at " + pt(lookup->point) + ": directory cell " + cellText(lookup->cell);
+        if (arrow) return s + subTables(view, lookup->cell) + " " + nextName(view, region);
+        const std::string via = subTables(view, lookup->cell);
+        return s + (via.empty() ? "" : " (through" + via.substr(3) + ")") + " of " +
+               regionName(view, region);
+    }
+    if (locate) {
+        const RegionKind k = view.region(locate->b).kind;
+        s = "starts at " + pt(locate->point) +
+            (k == RegionKind::Slab ? ", located by the screen BSP and the zone's depth slabs"
+                                   : " in its pixel's projective zone");
+        return s + (arrow ? " " + nextName(view, region) : ", in " + regionName(view, region));
+    }
+    return arrow ? "starts " + nextName(view, region)
+                 : "starts in " + regionName(view, region) + ", which holds every primitive";
+}
+
+}  // namespace
+
+std::string regionName(const StructureView& view, uint32_t region) {
+    const RegionInfo r = view.region(region);
+    const std::string id = " (region " + std::to_string(region) + ")";
+    switch (r.kind) {
+        case RegionKind::SceneBox:
+            return "the scene box";
+        case RegionKind::Leaf:
+            return "leaf " + std::to_string(region);
+        case RegionKind::Slab:
+            return "slab " + std::to_string(r.slab) + " of zone " + std::to_string(r.zone) + id;
+        case RegionKind::ProjectiveSlab:
+            return "projective slab " + std::to_string(r.slab) + " of zone " +
+                   std::to_string(r.zone) + id;
+        case RegionKind::NearRegion:
+            return "the near region" + id;
+    }
+    return "region " + std::to_string(region);
+}
+
+std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& view,
+                                     const Scene* scene) {
+    const std::vector<WalkEvent>& ev = r.events;
+    const std::vector<size_t> steps = r.regionSteps();
+    std::vector<StepReason> out(steps.size());
+    for (size_t k = 0; k < steps.size(); ++k) {
+        const WalkEvent& reg = ev[steps[k]];
+        const size_t end = k + 1 < steps.size() ? steps[k + 1] : ev.size();
+        const RegionInfo info = view.region(reg.a);
+        const FrameSides sides = sidesOf(view, info.kind, r.direction);
+        const std::string here = regionName(view, reg.a);
+        std::string s;
+
+        // The walk's start: what came before its first region.
+        if (k == 0) {
+            const WalkEvent *locate = nullptr, *lookup = nullptr, *stretch = nullptr;
+            for (size_t i = 0; i < steps[0]; ++i) {
+                if (ev[i].kind == WalkEvent::Locate) locate = &ev[i];
+                if (ev[i].kind == WalkEvent::Lookup) lookup = &ev[i];
+                if (ev[i].kind == WalkEvent::Stretch) stretch = &ev[i];
+            }
+            if (stretch)
+                s += "light-buffer stretch " + std::to_string(stretch->a) + " t = [" +
+                     num(stretch->t0) + ", " + num(stretch->t1) + "] ";
+            else
+                s += "the walk ";
+            s += startText(view, locate, lookup, reg.a, false) + "; ";
+        }
+
+        // What follows the region's own events: its exit and the way to the next region, or
+        // the ray's end; then, for a shadow ray, the next light-buffer stretch's start.
+        const WalkEvent *exit = nullptr, *rope = nullptr, *index = nullptr, *push = nullptr,
+                        *lookup = nullptr, *error = nullptr, *blocker = nullptr, *stretch = nullptr,
+                        *locate = nullptr;
+        std::vector<const WalkEvent*> pointers;
+        for (size_t i = steps[k] + 1; i < end; ++i) {
+            const WalkEvent& e = ev[i];
+            switch (e.kind) {
+                case WalkEvent::Exit:
+                    exit = &e;
+                    break;
+                case WalkEvent::Rope:
+                    rope = &e;
+                    break;
+                case WalkEvent::IndexStep:
+                    index = &e;
+                    break;
+                case WalkEvent::Push:
+                    push = &e;
+                    break;
+                case WalkEvent::Lookup:
+                    lookup = &e;
+                    break;
+                case WalkEvent::Pointer:
+                    pointers.push_back(&e);
+                    break;
+                case WalkEvent::Error:
+                    error = &e;
+                    break;
+                case WalkEvent::Blocker:
+                    blocker = &e;
+                    break;
+                case WalkEvent::Stretch:
+                    stretch = &e;
+                    lookup = locate = nullptr;  // one after it starts the stretch's walk
+                    break;
+                case WalkEvent::Locate:
+                    locate = &e;
+                    break;
+                default:
+                    break;
+            }
+        }
+        const bool hasNext = k + 1 < steps.size();
+        const uint32_t next = hasNext ? ev[steps[k + 1]].a : 0;
+        const bool nextInWalk = hasNext && !stretch;
+        StepReason& reason = out[k];
+        reason.next = hasNext ? int64_t(next) : -1;
+
+        if (exit) {
+            s += "left " + here + " through its " + exitFace(sides, exit->ties) +
+                 " at t = " + num(exit->t0) + " (point " + pt(exit->point) + ")";
+            if (rope) {
+                s += "; the leaf's rope across that face " + nextName(view, rope->b);
+            } else if (index && lookup) {
+                s += "; exact index step " + signedAxis(sides, index->axis) +
+                     " to directory cell " + cellText(lookup->cell) +
+                     subTables(view, lookup->cell) + " " + nextName(view, lookup->b);
+            } else if (push && lookup) {
+                const int a = exit->axis;
+                s += "; pushed by delta " + num(std::abs(push->point[a] - exit->point[a])) +
+                     " across " + exitFace(sides, push->ties) + " to " + pt10(push->point) +
+                     ": directory cell " + cellText(lookup->cell) + subTables(view, lookup->cell) +
+                     " " + nextName(view, lookup->b);
+            } else if (!pointers.empty() && !error) {
+                const RegionInfo to = view.region(pointers.back()->b);
+                if (exit->ties == 4 && pointers.size() == 1) {
+                    s += ": the next slab of the same zone, by corner pointer " +
+                         std::to_string(pointers[0]->corner);
+                } else {
+                    s += ": crossed into zone " + std::to_string(to.zone) + " from zone " +
+                         std::to_string(info.zone) + " by corner pointer";
+                    if (pointers.size() > 1) s += "s";
+                    for (size_t i = 0; i < pointers.size(); ++i) {
+                        const WalkEvent& p = *pointers[i];
+                        const Box3 b = view.region(p.a).frameBox;
+                        const int c = p.corner;
+                        s += std::string(i ? "," : "") + " " + std::to_string(c) + " of region " +
+                             std::to_string(p.a) + " (its corner at screen (" +
+                             num(c & 1 ? b.hi.x : b.lo.x) + ", " + num(c & 2 ? b.hi.y : b.lo.y) +
+                             "), depth " + num(c & 4 ? b.hi.z : b.lo.z) + ")";
+                    }
+                }
+                s += " " + nextName(view, pointers.back()->b);
+            } else if (nextInWalk) {
+                s += info.kind == RegionKind::NearRegion
+                         ? ": the first slab of the pixel's zone " + nextName(view, next)
+                         : ": the next slab of the same zone " + nextName(view, next);
+            } else if (!error) {
+                s += ", on the structure's border: the ray leaves the structure's box there";
+            }
+        }
+        if (error) s += std::string(exit ? "; " : "") + "walk error: " + error->what;
+        if (!exit && !error) {
+            const bool last = k + 1 == steps.size();
+            if (blocker && !stretch) {
+                s += "blocked by " + primText(blocker->a, scene) + " at t = " + num(blocker->t0) +
+                     " inside this region: the light is hidden";
+            } else if (last && r.kind != RayKind::Shadow && r.hit.valid()) {
+                s += "hit " + primText(r.hit.prim, scene) + " at t = " + num(r.hit.t) +
+                     " inside this region";
+            } else if (stretch) {
+                s += "the light-buffer stretch ends at t = " + num(reg.t1) + " inside this region";
+            } else if (r.kind == RayKind::Shadow) {
+                s += "the ray reaches its light at t = " + num(reg.t1) +
+                     " inside this region: nothing blocks it";
+            } else if (std::isfinite(reg.t1) && reg.t1 < r.tmax) {
+                s += "the ray leaves the structure's box at t = " + num(reg.t1) + ": nothing hit";
+            } else {
+                s += "the ray's interval ends inside this region: nothing hit";
+            }
+        }
+        if (stretch) {
+            s += "; light-buffer stretch " + std::to_string(stretch->a) + " t = [" +
+                 num(stretch->t0) + ", " + num(stretch->t1) + "] ";
+            s += hasNext ? startText(view, locate, lookup, next, true)
+                         : std::string("meets no region");
+        }
+        reason.text = std::move(s);
+    }
+    return out;
+}
+
+std::string RayTree::toString(const Scene* scene, const StructureView* view) const {
     std::ostringstream os;
     os << "pixel (" << x << ", " << y << ") of " << width << "x" << height << ": "
        << counters.toString() << "\n";
@@ -122,10 +406,15 @@ std::string RayTree::toString(const Scene* scene) const {
         if (r.parent >= 0) generation[i] = generation[size_t(r.parent)] + 1;
         const std::string indent(size_t(2 * generation[i]), ' ');
         os << indent << "#" << i << " " << r.toString() << "\n";
+        const std::vector<StepReason> why =
+            view ? explainSteps(r, *view, scene) : std::vector<StepReason>();
+        size_t step = 0;
         for (const WalkEvent& e : r.events) {
             const bool inRegion = e.kind == WalkEvent::PrimTest ||
                                   e.kind == WalkEvent::MailboxHit || e.kind == WalkEvent::Spans;
             os << indent << (inRegion ? "    " : "  ") << e.toString(scene) << "\n";
+            if (e.isRegion() && step < why.size())
+                os << indent << "    why: " << why[step++].text << "\n";
         }
     }
     return os.str();
@@ -269,7 +558,8 @@ nlohmann::json toJson(const WalkEvent& e, const RegionCornersFn& corners) {
     return j;
 }
 
-nlohmann::json toJson(const TracedRay& r, const Scene& scene, const RegionCornersFn& corners) {
+nlohmann::json toJson(const TracedRay& r, const Scene& scene, const RegionCornersFn& corners,
+                      const StructureView* view) {
     nlohmann::json j = {{"kind", rayKindName(r.kind)},
                         {"parent", r.parent},
                         {"depth", r.depth},
@@ -282,7 +572,13 @@ nlohmann::json toJson(const TracedRay& r, const Scene& scene, const RegionCorner
         j["occluded"] = r.occluded;
     }
     nlohmann::json ev = nlohmann::json::array();
-    for (const WalkEvent& e : r.events) ev.push_back(toJson(e, corners));
+    const std::vector<StepReason> why =
+        view ? explainSteps(r, *view, &scene) : std::vector<StepReason>();
+    size_t step = 0;
+    for (const WalkEvent& e : r.events) {
+        ev.push_back(toJson(e, corners));
+        if (e.isRegion() && step < why.size()) ev.back()["why"] = why[step++].text;
+    }
     j["events"] = std::move(ev);
     if (r.hit.valid()) {
         j["hit"] = {{"t", r.hit.t},

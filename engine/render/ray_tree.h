@@ -38,6 +38,31 @@ struct TracedRay {
     std::string toString() const;
 };
 
+class StructureView;  // engine/accel/structure_view.h
+
+/// Why the walk goes on from one region step: a sentence, and the region it names as the next
+/// step's region.
+struct StepReason {
+    /// "left leaf 812 through its +x face at t = 3.21 (point (..)); exact index step +x to
+    /// directory cell (12, 4, 7) -> leaf 977", "hit p17 sphere .. at t = 4.5 inside this region".
+    /// The region the walk goes on to is named last, after "-> ".
+    std::string text;
+    int64_t next = -1;  ///< the next step's region; -1 when the ray ends in this region
+};
+
+/// One reason per region step of `r` (regionSteps() order), built from its recorded events and
+/// the structure they were recorded in (region names, zones and slabs, directory sub-tables):
+/// how the walk reached its first region; how it leaves each region and reaches the next (the
+/// exit face, edge or corner; the rope, the exact index step or the pushed point and the
+/// directory cell; the corner pointers; the next slab in depth; the next light-buffer stretch);
+/// or how the ray ends there (the hit, the blocker, the structure's border, the end of its
+/// interval, a walk error). With a scene, primitives are described.
+std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& view,
+                                     const Scene* scene = nullptr);
+/// A region as the reasons name it: "leaf 977", "slab 0 of zone 12 (region 81)", "projective
+/// slab 3 of zone 40 (region 900)", "the near region (region 1200)", "the scene box".
+std::string regionName(const StructureView& view, uint32_t region);
+
 /// The rays of one pixel, in the order traced (the primary first; a ray's children after it).
 struct RayTree {
     int x = 0, y = 0, width = 0, height = 0;
@@ -46,8 +71,9 @@ struct RayTree {
     std::vector<TracedRay> rays;
 
     /// Indented text: each ray's line (indented by its generation), then its events below it.
-    /// With a scene, primitive tests name the primitive.
-    std::string toString(const Scene* scene = nullptr) const;
+    /// With a scene, primitive tests name the primitive; with the structure the rays were
+    /// walked in, each region step is followed by its reason ("why: ...", explainSteps).
+    std::string toString(const Scene* scene = nullptr, const StructureView* view = nullptr) const;
 };
 
 /// The observer that builds a RayTree: a RecordingObserver whose events are split per ray.
@@ -74,8 +100,10 @@ using RegionCornersFn = std::function<std::vector<Vec3>(uint32_t region)>;
 /// region events carry "corners" when `corners` gives them.
 nlohmann::json toJson(const WalkEvent& e, const RegionCornersFn& corners = {});
 /// A ray as the trace JSON's "rays" lists it: kind, parent, light (shadow rays), origin,
-/// direction, tmin, tmax, events, hit (null when none), occluded (shadow rays).
-nlohmann::json toJson(const TracedRay& r, const Scene& scene, const RegionCornersFn& corners = {});
+/// direction, tmin, tmax, events, hit (null when none), occluded (shadow rays). With the
+/// structure, each region event also carries "why": its step's reason (explainSteps).
+nlohmann::json toJson(const TracedRay& r, const Scene& scene, const RegionCornersFn& corners = {},
+                      const StructureView* view = nullptr);
 /// The trace JSON's counters: prim_tests, mailbox_hits, region_visits, ...
 nlohmann::json toJson(const RayCounters& c);
 

@@ -35,6 +35,11 @@ out=$("$LANCER" trace builtin:default --scheme irregular --pixel 40 30 --width 6
   || fail "projective trace exited non-zero"
 echo "$out" | grep -q "^  region [0-9]*  t = \[" || fail "no region in the projective walk"
 echo "$out" | grep -q "^  pointer" && fail "a corner pointer in a projective primary walk: $out"
+# Its events: where it starts, where it leaves each slab (its far depth plane), and why.
+echo "$out" | grep -q "^  start at (.*) in region [0-9]*" || fail "no start in the projective walk"
+echo "$out" | grep -q "^  exit at t = .* through face z" || fail "no exit in the projective walk"
+echo "$out" | grep -q "^    why: left projective slab [0-9]* of zone [0-9]* (region [0-9]*) through its far depth plane" \
+  || fail "no why line of a projective slab: $out"
 for f in camera projective; do
   "$LANCER" render builtin:lattice:3 --scheme irregular --irregular-frame $f --width 48 --height 40 \
     --threads 2 -o "$tmp/f.png" --depth "$tmp/f_$f.pfm" --stats "$tmp/f.json" >/dev/null \

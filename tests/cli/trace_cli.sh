@@ -20,6 +20,8 @@ grep -q "^  #[0-9]* shadow of #0 to light 0" "$tmp/t.txt" || fail "no shadow ray
 grep -q "^  region [0-9]*  t = \[" "$tmp/t.txt" || fail "no region under the primary"
 grep -q "^    test p[0-9]* " "$tmp/t.txt" || fail "no primitive test inside a region"
 grep -q "^  exit at t = " "$tmp/t.txt" || fail "no exit"
+grep -q "^    why: .* -> leaf [0-9]*" "$tmp/t.txt" || fail "no why line naming the next leaf"
+grep -q "^    why: hit p[0-9]* .* inside this region" "$tmp/t.txt" || fail "no why line telling the hit"
 grep -q "^hit t = " "$tmp/t.txt" || fail "no hit line"
 
 # The JSON form: "rays", the primary first, each with its events.
@@ -46,6 +48,7 @@ for r in rays:
     for e in r["events"]:
         if e["event"] == "region":
             assert len(e["corners"]) == 8 and all(len(c) == 3 for c in e["corners"]), e
+            assert isinstance(e["why"], str) and e["why"], e
             regions += 1
 assert regions == j["region_visits"], (regions, j["region_visits"])
 tests = sum(r["counters"]["prim_tests"] for r in rays)

@@ -338,10 +338,17 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
         ImGui::TextWrapped("%s", line.c_str());
     }
 
-    // The ray's events as `lancer trace` prints them, the current step's lit.
+    // The ray's events as `lancer trace` prints them, the current step's lit; each region
+    // step's reason (explainSteps: how the walk goes on from it) as its line's tooltip, and the
+    // current step's under the list.
     const playback::PlaybackState& s = play.state();
-    if (ImGui::BeginChild("steps", ImVec2(0, 0), true)) {
-        size_t regionNo = 0;
+    const std::vector<StepReason> why =
+        player.view() ? explainSteps(ray, *player.view(), &player.view()->scene())
+                      : std::vector<StepReason>();
+    const float whyLines = 3.0f;
+    if (ImGui::BeginChild("steps", ImVec2(0, -ImGui::GetTextLineHeightWithSpacing() * whyLines),
+                          true)) {
+        size_t step = 0, regionNo = 0;
         for (size_t i = 0; i < ray.events.size(); ++i) {
             const bool current = i >= s.eventBegin && i < s.eventEnd;
             std::string line = ray.events[i].toString(scene);
@@ -355,9 +362,21 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
             } else {
                 ImGui::TextDisabled("%s", line.c_str());
             }
+            if (ray.events[i].isRegion() && step < why.size()) {
+                if (ImGui::IsItemHovered()) {
+                    ImGui::BeginTooltip();
+                    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 40.0f);
+                    ImGui::TextUnformatted(why[step].text.c_str());
+                    ImGui::PopTextWrapPos();
+                    ImGui::EndTooltip();
+                }
+                ++step;
+            }
         }
     }
     ImGui::EndChild();
+    if (s.step >= 0 && size_t(s.step) < why.size())
+        ImGui::TextWrapped("why: %s", why[size_t(s.step)].text.c_str());
     ImGui::End();
 }
 

@@ -37,8 +37,8 @@ struct Picked {
 /// region; the first such pixel.
 std::optional<Picked> findPixel(const Scene& scene, const Accelerator& accel,
                                 const ShadingOptions& sh, int w, int h, RayKind kind) {
-    for (int y = h / 16; y < h; y += h / 8)
-        for (int x = w / 16; x < w; x += w / 8) {
+    for (int y = h / 32; y < h; y += h / 16)
+        for (int x = w / 32; x < w; x += w / 16) {
             RayTree t = tracePixel(scene, accel, sh, scene.camera, x, y, w, h);
             for (const TracedRay& r : t.rays)
                 if (r.kind == kind && r.regionSteps().size() > 1) return Picked{x, y, std::move(t)};
@@ -46,27 +46,52 @@ std::optional<Picked> findPixel(const Scene& scene, const Accelerator& accel,
     return std::nullopt;
 }
 
-class PlaybackTrace : public ::testing::TestWithParam<SchemeKind> {};
+/// A structure configuration: the scheme and, for each, its walk's variant.
+struct Walk {
+    SchemeKind scheme;
+    StepMethod step = StepMethod::Exact;
+    IrregularFrame frame = IrregularFrame::Projective;
+};
 
+std::string walkName(const Walk& c) {
+    std::string s = schemeName(c.scheme);
+    if (c.scheme == SchemeKind::Regular) s += std::string("_") + stepName(c.step);
+    if (c.scheme == SchemeKind::Irregular) s += std::string("_") + irregularFrameName(c.frame);
+    return s;
+}
+
+std::string walkOptions(const Walk& c) {
+    return std::string(" --scheme ") + schemeName(c.scheme) + " --step " + stepName(c.step) +
+           " --irregular-frame " + irregularFrameName(c.frame);
+}
+
+class PlaybackTrace : public ::testing::TestWithParam<Walk> {};
+
+// Every ray kind (primary, shadow, reflection, refraction): step k of the playback is the k-th
+// region event of `lancer trace --json` (region, interval, corners), and the event's "why" is
+// the reason the engine gives for that step (explainSteps), the one the Ray panel shows.
 TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
     const std::string spec = "builtin:default";
     cli::CommonOptions o;
     o.scene = spec;
-    o.knobs.build.scheme = GetParam();
+    o.knobs.build.scheme = GetParam().scheme;
+    o.knobs.build.regular.step = GetParam().step;
+    o.knobs.build.irregular.frame = GetParam().frame;
     Scene scene = loadScene(spec);
     auto accel = buildAccelerator(scene, o.knobs.build);
     int w, h;
     cli::resolveSize(o, scene, w, h);
     const StructureView view(scene, *accel);
     int compared = 0;
-    for (RayKind kind : {RayKind::Primary, RayKind::Shadow, RayKind::Reflection}) {
+    for (RayKind kind :
+         {RayKind::Primary, RayKind::Shadow, RayKind::Reflection, RayKind::Refraction}) {
         std::optional<Picked> p = findPixel(scene, *accel, o.knobs.shading, w, h, kind);
         ASSERT_TRUE(p) << "no pixel with a " << rayKindName(kind) << " ray that walks";
         RayPlayback play;
         play.setTree({p->x, p->y, w, h}, std::move(p->tree));
-        const nlohmann::json j = nlohmann::json::parse(run(
-            std::string(LANCER_BINARY) + " trace " + spec + " --scheme " + schemeName(GetParam()) +
-            " --pixel " + std::to_string(p->x) + " " + std::to_string(p->y) + " --json"));
+        const nlohmann::json j = nlohmann::json::parse(
+            run(std::string(LANCER_BINARY) + " trace " + spec + walkOptions(GetParam()) +
+                " --pixel " + std::to_string(p->x) + " " + std::to_string(p->y) + " --json"));
         ASSERT_EQ(j["width"].get<int>(), w);
         ASSERT_EQ(j["rays"].size(), play.tree().rays.size());
         for (size_t k = 0; k < play.tree().rays.size(); ++k) {
@@ -77,6 +102,7 @@ TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
             for (const nlohmann::json& e : jr["events"])
                 if (e["event"] == "region") regions.push_back(e);
             ASSERT_EQ(int(regions.size()), play.stepCount()) << "ray " << k;
+            const std::vector<StepReason> why = explainSteps(play.ray(), view, &scene);
             for (int s = 0; s < play.stepCount(); ++s) {
                 play.seek(s);
                 const WalkEvent* e = play.region();
@@ -85,6 +111,7 @@ TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
                 EXPECT_EQ(e->t0, regions[size_t(s)]["t0"].get<double>());
                 if (!regions[size_t(s)]["t1"].is_null())
                     EXPECT_EQ(e->t1, regions[size_t(s)]["t1"].get<double>());
+                EXPECT_EQ(why[size_t(s)].text, regions[size_t(s)]["why"].get<std::string>());
                 // The region drawn is the one the trace describes: the same 8 corners.
                 const std::array<Vec3, 8> c = view.regionCorners(e->a);
                 const nlohmann::json& jc = regions[size_t(s)]["corners"];
@@ -98,9 +125,13 @@ TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
     EXPECT_GT(compared, 3);
 }
 
-INSTANTIATE_TEST_SUITE_P(Schemes, PlaybackTrace,
-                         ::testing::Values(SchemeKind::Regular, SchemeKind::Irregular),
-                         [](const auto& info) { return std::string(schemeName(info.param)); });
+INSTANTIATE_TEST_SUITE_P(
+    Schemes, PlaybackTrace,
+    ::testing::Values(Walk{SchemeKind::Regular, StepMethod::Exact},
+                      Walk{SchemeKind::Regular, StepMethod::Push},
+                      Walk{SchemeKind::Irregular, StepMethod::Exact, IrregularFrame::Projective},
+                      Walk{SchemeKind::Irregular, StepMethod::Exact, IrregularFrame::Camera}),
+    [](const auto& info) { return walkName(info.param); });
 
 /// A pixel's tree on the irregular scheme (whose primary rays walk several slabs), with a
 /// primary ray of several steps.
@@ -123,10 +154,9 @@ RayPlayback someRay() {
     return play;
 }
 
-TEST(Playback, SteppingBackAndForthReturnsTheSameStates) {
-    RayPlayback play = someRay();
-    ASSERT_FALSE(play.empty());
-    ASSERT_GT(play.stepCount(), 2);
+/// Step forward to the end and back to the start on the ray played: the states met going back
+/// are those met going forward; the steps tile the ray's events.
+void backAndForth(RayPlayback& play) {
     std::vector<PlaybackState> forward{play.state()};
     while (play.forward()) forward.push_back(play.state());
     EXPECT_EQ(int(forward.size()), play.stepCount());
@@ -147,6 +177,53 @@ TEST(Playback, SteppingBackAndForthReturnsTheSameStates) {
     EXPECT_EQ(play.state(), forward.back());
     play.first();
     EXPECT_EQ(play.state(), forward.front());
+    // Seeking anywhere gives the state stepping there gave.
+    for (size_t k = 0; k < forward.size(); k += 3) {
+        play.seek(int(k));
+        EXPECT_EQ(play.state(), forward[k]);
+    }
+}
+
+TEST(Playback, SteppingBackAndForthReturnsTheSameStates) {
+    RayPlayback play = someRay();
+    ASSERT_FALSE(play.empty());
+    ASSERT_GT(play.stepCount(), 2);
+    backAndForth(play);
+}
+
+// Both schemes (and their walks' variants), every ray of trees holding every ray kind: stepping
+// back and forth returns the same states.
+TEST(Playback, SteppingBackAndForthReturnsTheSameStatesOnEveryRay) {
+    int rays = 0;
+    for (const Walk& c :
+         {Walk{SchemeKind::Regular, StepMethod::Exact}, Walk{SchemeKind::Regular, StepMethod::Push},
+          Walk{SchemeKind::Irregular, StepMethod::Exact, IrregularFrame::Projective},
+          Walk{SchemeKind::Irregular, StepMethod::Exact, IrregularFrame::Camera}}) {
+        SCOPED_TRACE(walkName(c));
+        cli::CommonOptions o;
+        o.scene = "builtin:default";
+        o.knobs.build.scheme = c.scheme;
+        o.knobs.build.regular.step = c.step;
+        o.knobs.build.irregular.frame = c.frame;
+        Scene scene = loadScene(o.scene);
+        auto accel = buildAccelerator(scene, o.knobs.build);
+        int w, h;
+        cli::resolveSize(o, scene, w, h);
+        for (RayKind kind : {RayKind::Shadow, RayKind::Refraction}) {
+            std::optional<Picked> p = findPixel(scene, *accel, o.knobs.shading, w, h, kind);
+            ASSERT_TRUE(p) << rayKindName(kind);
+            RayPlayback play;
+            play.setTree({p->x, p->y, w, h}, std::move(p->tree));
+            for (int k = 0; k < int(play.tree().rays.size()); ++k) {
+                play.selectRay(k);
+                if (play.stepCount() == 0) continue;
+                SCOPED_TRACE("ray " + std::to_string(k));
+                backAndForth(play);
+                ++rays;
+            }
+        }
+    }
+    EXPECT_GT(rays, 8);
 }
 
 TEST(Playback, PlayTakesSpeedStepsASecondAndStopsAtTheLast) {

@@ -112,6 +112,18 @@ gl::Batch rayBatch(const RayPlayback& play, const StructureView& view) {
         const WalkEvent& e = ray.events[i];
         if (e.kind == WalkEvent::Exit) {
             cross(b, e.point, mark, gl::rgba8(kPointerColor));
+            // A projective slab follows no pointer: its next region is the next slab of the
+            // pixel's zone, the next step's region.
+            const RegionKind kind = view.region(region.a).kind;
+            const std::vector<size_t>& steps = play.steps();
+            if ((kind == RegionKind::ProjectiveSlab || kind == RegionKind::NearRegion) &&
+                s.step >= 0 && size_t(s.step) + 1 < steps.size()) {
+                const std::array<Vec3, 8> next =
+                    view.regionCorners(ray.events[steps[size_t(s.step) + 1]].a);
+                Vec3 centre(0.0);
+                for (const Vec3& p : next) centre += p / 8.0;
+                b.line(f(e.point), f(centre), gl::rgba8(kPointerColor, 0.8f));
+            }
         } else if (e.kind == WalkEvent::Pointer && e.corner >= 0 && e.corner < 8) {
             // The corner whose pointer the walk followed, and the step to the next region.
             const Vec3 c = (*corners)[size_t(e.corner)];

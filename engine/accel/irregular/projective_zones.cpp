@@ -14,6 +14,7 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
                                        nlohmann::json& extra, size_t maxSlabBytes) {
     ProjectiveZones s;
     s.scene_ = &scene;
+    s.frame_ = frame;
     s.eye_ = frame.origin;
     const Camera& cam = scene.camera;
     if (cam.projection != Projection::Perspective) return s;

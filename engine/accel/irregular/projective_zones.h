@@ -82,6 +82,7 @@ class ProjectiveZones {
 
   private:
     const Scene* scene_ = nullptr;
+    CameraFrame frame_;  ///< the camera frame the walk's events are told in the world from
     Vec3 eye_{0.0};
     glm::dvec2 lo_{0.0}, hi_{0.0};     ///< the screen rectangle in (u, v)
     double zNear_ = 0.0, zFar_ = 0.0;  ///< depth range of the slabs
@@ -105,13 +106,33 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
                                 Hit& hit) const {
     const Scene& scene = *scene_;
     const double dz = rc.d.z;
+    // The walk's events as the camera-frame walk tells them: the region the walk starts in
+    // (Locate), then each region left before tmax through its far depth plane (Exit: axis 2,
+    // the high side), the point exactly on that plane. The next region is the next slab of the
+    // zone (the near region's next is the zone's first slab): no pointer to follow.
+    [[maybe_unused]] bool located = false;
+    [[maybe_unused]] auto enter = [&](uint32_t id, double t0) {
+        if constexpr (Obs::kActive) {
+            if (!located) obs.locate(frame_.toWorld(rc.at(t0)), id);
+            located = true;
+        }
+    };
+    [[maybe_unused]] auto leave = [&](double z) {
+        if constexpr (Obs::kActive) {
+            const double te = z / dz;
+            if (te < tmax) obs.regionExit(te, frame_.toWorld({u * z, v * z, z}), 2, 4);
+        }
+    };
     double t = tmin;
     if (nearRoot_ >= 0) {
         double t1 = std::min(zNear_ / dz, tmax);
         if (t <= t1) {
+            const uint32_t id = firstId + uint32_t(slabRoot_.size());
+            enter(id, t);
             ++ctx.counters.regionVisits;
-            obs.region(firstId + uint32_t(slabRoot_.size()), t, t1);
+            obs.region(id, t, t1);
             if (hitInRegion(scene, pool_, nearRoot_, ray, tmin, t, t1, ctx, obs, hit)) return true;
+            leave(zNear_);
         }
     }
     uint32_t zone = bsp_.locate(u, v, 0, 0);
@@ -125,19 +146,22 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         double t1 = std::min(z1 / dz, tmax);
         if (t0 > tmax) return false;
         int root = slabRoot_[i];
+        enter(firstId + i, t0);
         ++ctx.counters.regionVisits;
         obs.region(firstId + i, t0, t1);
-        if (root < 0) continue;
-        if (root != lastRoot) {
-            if (hitInRegion(scene, pool_, root, ray, tmin, t0, t1, ctx, obs, hit)) return true;
-            lastRoot = root;
-        } else {
-            if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
-            if (const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1)) {
-                hit = {b->t, b->prim, b->part, b->flip};
-                return true;
+        if (root >= 0) {
+            if (root != lastRoot) {
+                if (hitInRegion(scene, pool_, root, ray, tmin, t0, t1, ctx, obs, hit)) return true;
+                lastRoot = root;
+            } else {
+                if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
+                if (const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1)) {
+                    hit = {b->t, b->prim, b->part, b->flip};
+                    return true;
+                }
             }
         }
+        leave(z1);
     }
     return false;
 }

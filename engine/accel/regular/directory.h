@@ -75,6 +75,21 @@ class Directory {
         }
     }
 
+    /// The sub-tables a lookup of cell (i, j, k) passes through, in order (empty: an entry of
+    /// the top table names the leaf), as lookup() follows them.
+    std::vector<uint32_t> subTablesOf(uint32_t i, uint32_t j, uint32_t k) const {
+        std::vector<uint32_t> path;
+        const Table* t = &tables_[0];
+        for (;;) {
+            uint32_t e = entries_[t->offset + (((i >> t->shift[0]) & t->mask[0]) << t->lowBits) +
+                                  (((j >> t->shift[1]) & t->mask[1]) << t->bits[2]) +
+                                  ((k >> t->shift[2]) & t->mask[2])];
+            if (!(e & kSubTable)) return path;
+            path.push_back(e & ~kSubTable);
+            t = &tables_[e & ~kSubTable];
+        }
+    }
+
     size_t memoryBytes() const {
         return entries_.size() * sizeof(uint32_t) + tables_.size() * sizeof(Table);
     }

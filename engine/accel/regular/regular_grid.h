@@ -181,6 +181,13 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
     // inside the grid, so this only admits hits that rounding puts a hair outside the box.
     double t0 = tmin, tIn = tStart;
+    // The stretches told start where the ray enters the grid's own box: the clip of the grown
+    // box comes a hair before it, and a grazing ray runs outside the box for that hair.
+    [[maybe_unused]] double tShown = tStart;
+    if constexpr (Obs::kActive) {
+        double a, b;
+        if (clipLine(ray, box_, a, b)) tShown = std::max(tStart, a);
+    }
     ctx.pending.clear();
     const size_t maxSteps = maxSteps_;
     for (size_t step = 0;; ++step) {
@@ -253,7 +260,13 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         }
         const double t1 = last ? tmax : std::max(tExit, tIn);
         ++ctx.counters.regionVisits;
-        obs.region(leaf, tIn, last ? tEnd : t1);
+        // The stretch told ends where the ray leaves the leaf: at the clip of the grown box only
+        // when that comes first. A ray leaving the grid through an edge or a corner may cross
+        // the tied interior face as it leaves, so past the leaf's exit it is outside the leaf.
+        if constexpr (Obs::kActive) {
+            const double shownEnd = last ? std::min(tEnd, std::max(tExit, tIn)) : t1;
+            obs.region(leaf, std::min(std::max(tIn, tShown), shownEnd), shownEnd);
+        }
         if (hitInLeaf(*scene_, pool_, L.root, L.primitives(primList), L.prims, ray, tmin, t0, t1,
                       ctx, obs, hit))
             return true;
