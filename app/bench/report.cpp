@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "app/bench/embree_peer.h"
+#include "app/bench/image_error.h"
 #include "app/bench/speedup.h"
 #include "engine/render/progressive.h"
 #include "engine/render/renderer.h"
@@ -25,36 +26,6 @@ struct Config {
     BuildParams build;
     ShadingOptions shading;
 };
-
-/// Difference of an image against the reference.
-struct ImageError {
-    size_t hitDiff = 0;    ///< pixels whose primary hit (primitive or distance) differs
-    size_t colorDiff = 0;  ///< pixels whose colour differs by more than 2/255
-    double maxDepthDiff = 0.0;
-};
-
-ImageError compare(const Image& ref, const Image& img) {
-    ImageError e;
-    std::vector<uint8_t> a = ref.rgba8(), b = img.rgba8();
-    for (size_t i = 0; i < ref.depth.size(); ++i) {
-        float da = ref.depth[i], db = img.depth[i];
-        bool bothMiss = std::isinf(da) && std::isinf(db);
-        double dd = bothMiss                             ? 0.0
-                    : (std::isinf(da) || std::isinf(db)) ? kInf
-                                                         : std::abs(double(da) - double(db));
-        if (ref.hitPrim[i] != img.hitPrim[i] || dd > 1e-6 * std::max(1.0, double(da))) ++e.hitDiff;
-        if (std::isfinite(dd))
-            e.maxDepthDiff = std::max(e.maxDepthDiff, dd);
-        else
-            e.maxDepthDiff = kInf;
-        for (int c = 0; c < 3; ++c)
-            if (std::abs(int(a[4 * i + size_t(c)]) - int(b[4 * i + size_t(c)])) > 2) {
-                ++e.colorDiff;
-                break;
-            }
-    }
-    return e;
-}
 
 std::string num(double v) {
     if (std::isinf(v)) return "inf";
@@ -270,7 +241,8 @@ int runBench(const BenchOptions& opt) {
             const Speedup s = r.shading.offsetScale == ro.shading.offsetScale
                                   ? baseline.measure(*accel, img)
                                   : baseline.against(render(scene, *accel, r, img));
-            row(schemeName(c.build.scheme), c.knob, c.value, accel->info(), s, compare(ref, img));
+            row(schemeName(c.build.scheme), c.knob, c.value, accel->info(), s,
+                compareImages(ref, img));
             std::cerr << spec << ": " << c.knob << " = " << c.value << ": "
                       << int(s.scheme.renderMs) << " ms\n";
         }
@@ -292,7 +264,7 @@ int runBench(const BenchOptions& opt) {
                     auto a = buildAccelerator(scene, b);
                     Image img(ro.width, ro.height);
                     row(schemeName(k), "peer (bounces 0)", schemeName(k), a->info(),
-                        base0.measure(*a, img), compare(ref0, img));
+                        base0.measure(*a, img), compareImages(ref0, img));
                 } catch (const std::invalid_argument&) {
                 }
             }
@@ -302,7 +274,7 @@ int runBench(const BenchOptions& opt) {
             AccelInfo info;
             info.buildMs = peer.buildMs();
             info.regions = 0;
-            row("embree", "peer (bounces 0)", "embree", info, s, compare(ref0, img));
+            row("embree", "peer (bounces 0)", "embree", info, s, compareImages(ref0, img));
             std::cerr << spec << ": embree " << int(s.scheme.renderMs)
                       << " ms (brute force at --bounces 0: " << int(base0.brute().renderMs)
                       << " ms)\n";
@@ -333,7 +305,7 @@ int runBench(const BenchOptions& opt) {
             s.renderMs = elapsed;
             Image shown;  // what the viewer shows after this pass
             fillBlocks(prog, stride, shown);
-            ImageError e = compare(ref, shown);
+            ImageError e = compareImages(ref, shown);
             // Speedup of the time to this pass, over brute force on the whole image.
             row(schemeName(best->params().scheme), "progressive pass", std::to_string(stride),
                 best->info(), baseline.against(s), e);
