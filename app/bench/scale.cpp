@@ -40,9 +40,11 @@ double msSince(Clock::time_point start) {
 
 /// The warm-up render of the schemes: one pixel in kWarmStride^2 (it starts the thread pool).
 constexpr int kWarmStride = 32;
-/// Brute force's first timed render (after a one-pixel warm-up) has about this many pixels, so
-/// the render's fixed costs weigh little in the estimate of the whole image.
-constexpr double kProbePixels = 1024.0;
+/// Brute force's timed probes (after a one-pixel warm-up): about this many pixels first, then,
+/// when that is estimated to be quick, about kProbePixels, so that the render's fixed costs weigh
+/// little in the estimate of the whole image and a scene of 600,000 spheres is not probed for
+/// minutes.
+constexpr double kFirstProbePixels = 64.0, kProbePixels = 1024.0;
 
 /// What a child process sent back, and how it ended.
 struct ChildResult {
@@ -201,8 +203,18 @@ Scene loadTimed(const std::string& spec, const ScaleOptions& opt, RenderOptions&
     return scene;
 }
 
-void putStats(json& j, const RenderStats& s) {
+/// CPU time of the process so far, every thread, in milliseconds: on a loaded machine the wall
+/// time of a step also counts the time other processes ran, its CPU time does not.
+double cpuMs() {
+    rusage ru{};
+    ::getrusage(RUSAGE_SELF, &ru);
+    return 1e3 * double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+           1e-3 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+void putStats(json& j, const RenderStats& s, double cpu) {
     j["render_ms"] = s.renderMs;
+    j["render_cpu_ms"] = cpu;
     j["rays"] = s.counters.rays;
     j["prim_tests"] = s.counters.primTests;
     j["region_visits"] = s.counters.regionVisits;
@@ -216,18 +228,33 @@ json bruteWork(const std::string& spec, const ScaleOptions& opt, Image& img) {
     json j;
     RenderOptions ro;
     Scene scene = loadTimed(spec, opt, ro, j);
+    double cpu = cpuMs();
     auto brute = buildAccelerator(scene, BuildParams{});
     j["build_ms"] = brute->info().buildMs;
+    j["build_cpu_ms"] = cpuMs() - cpu;
     j["structure_bytes"] = brute->info().memoryBytes;
     img.resize(ro.width, ro.height);
     const size_t all = size_t(ro.width) * size_t(ro.height);
     render(scene, *brute, ro, img, PassLattice{std::max(ro.width, ro.height), 0});
-    const int probeStride = std::max(1, int(std::sqrt(double(all) / kProbePixels)));
-    const PassLattice probe{probeStride, 0};
-    const RenderStats probeStats = render(scene, *brute, ro, img, probe);
-    const double estimateMs =
-        probeStats.renderMs * double(all) / double(latticePixels(ro.width, ro.height, probe));
+    double probeCpu = 0.0, estimateMs = 0.0, estimateCpu = 0.0;
+    auto probeAt = [&](double pixels, RenderStats& stats) {
+        const int stride = std::max(1, int(std::sqrt(double(all) / pixels)));
+        const PassLattice probe{stride, 0};
+        img = Image(ro.width, ro.height);
+        cpu = cpuMs();
+        stats = render(scene, *brute, ro, img, probe);
+        probeCpu = cpuMs() - cpu;
+        const double scale = double(all) / double(latticePixels(ro.width, ro.height, probe));
+        estimateMs = stats.renderMs * scale;
+        estimateCpu = probeCpu * scale;
+        return stride;
+    };
+    RenderStats probeStats;
+    int probeStride = probeAt(kFirstProbePixels, probeStats);
+    if (estimateMs * kProbePixels / double(all) <= 1000.0 * opt.bruteLimitS / 8.0)
+        probeStride = probeAt(kProbePixels, probeStats);
     j["estimated_ms"] = estimateMs;
+    j["estimated_cpu_ms"] = estimateCpu;
     int stride = probeStride;
     for (int s = 1; s < probeStride; s *= 2)
         if (estimateMs / double(s * s) <= 1000.0 * opt.bruteLimitS / (s == 1 ? 1.0 : 4.0)) {
@@ -235,12 +262,16 @@ json bruteWork(const std::string& spec, const ScaleOptions& opt, Image& img) {
             break;
         }
     RenderStats stats = probeStats;
+    double statsCpu = probeCpu;
     if (stride != probeStride) {
         img = Image(ro.width, ro.height);
+        cpu = cpuMs();
         stats = render(scene, *brute, ro, img, PassLattice{stride, 0});
+        statsCpu = cpuMs() - cpu;
     }
     j["stride"] = stride;
-    putStats(j, stats);
+    if (stride == 1) j["estimated_cpu_ms"] = statsCpu;  // measured, not estimated
+    putStats(j, stats, statsCpu);
     return j;
 }
 
@@ -253,6 +284,7 @@ json schemeWork(const std::string& spec, SchemeKind kind, const ScaleOptions& op
     params.scheme = kind;
     params.memoryBudget = opt.memoryBudget;
     std::unique_ptr<Accelerator> accel;
+    double cpu = cpuMs();
     try {
         accel = buildAccelerator(scene, params);
     } catch (const std::invalid_argument& e) {
@@ -261,13 +293,16 @@ json schemeWork(const std::string& spec, SchemeKind kind, const ScaleOptions& op
     }
     const AccelInfo& info = accel->info();
     j["build_ms"] = info.buildMs;
+    j["build_cpu_ms"] = cpuMs() - cpu;
     j["structure_bytes"] = info.memoryBytes;
     j["regions"] = info.regions;
     j["params"] = toString(accel->params());
     Image warm(ro.width, ro.height);
     render(scene, *accel, ro, warm, PassLattice{kWarmStride, 0});
     img.resize(ro.width, ro.height);
-    putStats(j, render(scene, *accel, ro, img));
+    cpu = cpuMs();
+    const RenderStats stats = render(scene, *accel, ro, img);
+    putStats(j, stats, cpuMs() - cpu);
     return j;
 }
 
@@ -283,12 +318,16 @@ json embreeWork(const std::string& spec, const ScaleOptions& opt, Image& img) {
     }
     // The first device of the process starts TBB's threads: its build is not the one timed.
     EmbreePeer(scene).buildMs();
+    double cpu = cpuMs();
     EmbreePeer peer(scene);
     j["build_ms"] = peer.buildMs();
+    j["build_cpu_ms"] = cpuMs() - cpu;
     img.resize(ro.width, ro.height);
     peer.render(ro, img);
     img = Image(ro.width, ro.height);
-    putStats(j, peer.render(ro, img));
+    cpu = cpuMs();
+    const RenderStats stats = peer.render(ro, img);
+    putStats(j, stats, cpuMs() - cpu);
     return j;
 }
 
@@ -341,18 +380,19 @@ int runScale(const ScaleOptions& opt) {
             return 2;
         }
     }
-    // A child is killed well past the time limit, so a slow scheme's time is still measured.
-    const double killAfterS = std::max(4.0 * opt.timeLimitS, opt.bruteLimitS + 120.0);
+    // A child is killed past twice the time limit, so a slow scheme's time is still measured
+    // (and brute force, whose renders are estimated within its own limit, has time to load).
+    const double killAfterS = std::max(2.0 * opt.timeLimitS, opt.bruteLimitS + 60.0);
     const size_t addressSpace = opt.memoryLimit + (size_t(1) << 30);
     const bool withPeer = opt.peer && opt.bounces == 0 && EmbreePeer::available();
 
     json rows = json::array();
     std::vector<std::string> failures;
     std::ostringstream table;
-    table << "| scene | primitives | scheme | build ms | structure MiB | peak RSS MiB | render ms "
-             "| tests/ray | visits/ray | speedup | hits differing | render / Embree | build / "
-             "Embree |\n"
-          << "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    table << "| scene | primitives | scheme | build ms | build CPU ms | structure MiB | peak RSS "
+             "MiB | render ms | render CPU ms | tests/ray | visits/ray | speedup | hits differing "
+             "| render / Embree | build / Embree |\n"
+          << "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const std::string& spec : opt.scenes) {
         ChildResult bruteR = runChild([&](Image& img) { return bruteWork(spec, opt, img); },
                                       killAfterS, addressSpace);
@@ -418,7 +458,8 @@ int runScale(const ScaleOptions& opt) {
                 const double totalS = (loadMs + buildMs + renderMs) / 1000.0;
                 row["total_s"] = totalS;
                 if (totalS > opt.timeLimitS)
-                    over.push_back("load, build and render took " + fixed(totalS, 1) + " s");
+                    over.push_back("load, build and render took " + fixed(totalS, 1) +
+                                   " s (CPU time of the process: " + fixed(r.cpuS, 1) + " s)");
                 if (compared && err.hitDiff > 0)
                     over.push_back(std::to_string(err.hitDiff) + " of " +
                                    std::to_string(err.compared) + " hits differ from brute force");
@@ -433,41 +474,52 @@ int runScale(const ScaleOptions& opt) {
                 row["failure"] = all;
             }
             // The table's row.
-            std::string cells[13];
-            cells[0] = spec;
+            std::string cells[15];
+            cells[0] = parseBuiltinSpec(spec) ? spec : fs::path(spec).filename().string();
             cells[1] =
                 f.contains("primitives") ? std::to_string(f["primitives"].get<size_t>()) : "";
             cells[2] = scheme;
+            const double buildCpu = f.value("build_cpu_ms", 0.0),
+                         renderCpu = f.value("render_cpu_ms", 0.0);
             if (!problem.empty()) {
                 cells[3] = problem;
             } else {
                 const bool sampled = scheme == std::string("brute") && stride > 1;
+                const std::string part =
+                    " (est., 1/" + std::to_string(stride * stride) + " of the pixels)";
                 cells[3] = fixed(buildMs, 0);
-                cells[4] = f.contains("structure_bytes") ? mib(f["structure_bytes"]) : "";
-                cells[5] = mib(double(r.peakRssBytes));
-                cells[6] = sampled ? "~" + fixed(f.value("estimated_ms", 0.0), 0) + " (est., 1/" +
-                                         std::to_string(stride * stride) + " of the pixels)"
+                cells[4] = fixed(buildCpu, 0);
+                cells[5] = f.contains("structure_bytes") ? mib(f["structure_bytes"]) : "";
+                cells[6] = mib(double(r.peakRssBytes));
+                cells[7] = sampled ? "~" + fixed(f.value("estimated_ms", 0.0), 0) + part
                                    : fixed(renderMs, 0);
+                cells[8] = sampled ? "~" + fixed(f.value("estimated_cpu_ms", 0.0), 0)
+                                   : fixed(renderCpu, 0);
                 if (scheme != std::string("embree")) {
-                    cells[7] = fixed(f.value("prim_tests", 0.0) / rays, 1);
-                    cells[8] = fixed(f.value("region_visits", 0.0) / rays, 1);
+                    cells[9] = fixed(f.value("prim_tests", 0.0) / rays, 1);
+                    cells[10] = fixed(f.value("region_visits", 0.0) / rays, 1);
                 }
+                // Ratios of CPU times: the machine's load weighs on them less than on wall times.
                 const ChildResult& b = results.at("brute");
-                if (scheme != std::string("brute") && b.measured()) {
-                    const double bruteMs =
-                        b.figures.value(stride > 1 ? "estimated_ms" : "render_ms", 0.0);
-                    cells[9] = (stride > 1 ? "~" : "") + fixed(bruteMs / renderMs, 1) + "x";
+                if (scheme != std::string("brute") && b.measured() && renderCpu > 0.0) {
+                    const double bruteCpu = b.figures.value("estimated_cpu_ms", 0.0);
+                    cells[11] = (stride > 1 ? "~" : "") + fixed(bruteCpu / renderCpu, 1) + "x";
+                    row["speedup_cpu"] = bruteCpu / renderCpu;
                 }
                 if (compared)
-                    cells[10] = std::to_string(err.hitDiff) +
+                    cells[12] = std::to_string(err.hitDiff) +
                                 (stride > 1 ? " of " + std::to_string(err.compared) : "");
                 if (isScheme && embree) {
-                    const double eb = embree->figures.value("build_ms", 0.0),
-                                 er = embree->figures.value("render_ms", 0.0);
-                    cells[11] = fixed(renderMs / er, 2);
-                    cells[12] = eb > 0.0 ? fixed(buildMs / eb, 1) : "";
-                    row["render_over_embree"] = renderMs / er;
-                    if (eb > 0.0) row["build_over_embree"] = buildMs / eb;
+                    const double eb = embree->figures.value("build_cpu_ms", 0.0),
+                                 er = embree->figures.value("render_cpu_ms", 0.0);
+                    if (er > 0.0) {
+                        cells[13] = fixed(renderCpu / er, 2);
+                        row["render_over_embree_cpu"] = renderCpu / er;
+                    }
+                    if (eb > 0.0) {
+                        cells[14] = fixed(buildCpu / eb, 1);
+                        row["build_over_embree_cpu"] = buildCpu / eb;
+                    }
                 }
             }
             std::cerr << spec << " " << scheme << ": "
@@ -485,8 +537,8 @@ int runScale(const ScaleOptions& opt) {
 
     // Growth with the primitive count: per family of scenes and scheme, the fitted exponent.
     std::ostringstream growth;
-    growth << "| scenes | scheme | sizes | primitives | build ms | structure | peak RSS | render "
-              "ms | tests/ray | visits/ray |\n"
+    growth << "| scenes | scheme | sizes | primitives | build CPU | structure | peak RSS | "
+              "render CPU | tests/ray | visits/ray |\n"
            << "|---|---|---:|---|---:|---:|---:|---:|---:|---:|\n";
     std::map<std::pair<std::string, std::string>, std::vector<const json*>> groups;
     std::vector<std::pair<std::string, std::string>> order;
@@ -513,12 +565,12 @@ int runScale(const ScaleOptions& opt) {
         const bool brute = key.second == "brute", peer = key.second == "embree";
         // Brute force's sampled renders are times of part of the image: its estimate scales.
         auto renderTime = [brute](const json& r) {
-            return r.value(brute && r.value("stride", 1) > 1 ? "estimated_ms" : "render_ms", 0.0);
+            return r.value(brute ? "estimated_cpu_ms" : "render_cpu_ms", 0.0);
         };
         growth << "| " << key.first << " | " << key.second << " | " << g.size() << " | "
                << (*g.front())["primitives"].get<size_t>() << " to "
                << (*g.back())["primitives"].get<size_t>() << " | "
-               << (brute ? "" : fit([](const json& r) { return r.value("build_ms", 0.0); }))
+               << (brute ? "" : fit([](const json& r) { return r.value("build_cpu_ms", 0.0); }))
                << " | "
                << (peer ? "" : fit([](const json& r) { return r.value("structure_bytes", 0.0); }))
                << " | " << fit([](const json& r) { return r.value("peak_rss_bytes", 0.0); })
