@@ -432,7 +432,8 @@ int runScale(const ScaleOptions& opt) {
             const bool isScheme = scheme != std::string("brute") && scheme != std::string("embree");
             std::string problem;
             if (r.killed)
-                problem = "killed after " + fixed(killAfterS, 0) + " s";
+                problem = "killed after " + fixed(killAfterS, 0) + " s (peak RSS " +
+                          formatSize(r.peakRssBytes) + ")";
             else if (!r.crash.empty())
                 problem = r.crash;
             else if (f.contains("error"))
