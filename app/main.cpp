@@ -145,6 +145,11 @@ int main(int argc, char** argv) {
     benchCmd->add_flag("--no-plots{false}", bopt.plots, "Write the CSV only");
     benchCmd->add_flag("--schemes-only", bopt.schemesOnly,
                        "Each scheme at its defaults, and the peer: the comparison table");
+    benchCmd
+        ->add_option("--schemes", bopt.schemes,
+                     "Schemes measured; without brute (--schemes-only only) no speedup or error")
+        ->check(CLI::IsMember({"brute", "regular", "irregular"}))
+        ->capture_default_str();
 
     // Hidden: the README's option section, generated from the parameter table.
     CLI::App* helpOptions = app.add_subcommand("help-options", "")->group("");

@@ -408,6 +408,7 @@ TEST(RegularRefusal, AbsurdLevelAndObjectsAreRefusedWithAMessage) {
     BuildParams p = regular();
     p.regular.maxLevel = 48;
     p.regular.maxObjects = 1;
+    p.regular.costStop = false;  // the cost rule stops these cells (RegularCost below)
     try {
         buildAccelerator(s, p);
         FAIL() << "not refused";
@@ -489,6 +490,86 @@ TEST(RegularAxes, CostOrderIsTheReportsOnACubeAndCubicCellsOnAFlatScene) {
     EXPECT_LE(c.primTests, r.primTests);
 }
 
+/// Spheres of radius `r` at `n` random centres in the unit cube, in a union.
+Scene randomSpheres(int n, double r, uint64_t seed) {
+    Scene s;
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int root = -1;
+    for (int i = 0; i < n; ++i) {
+        s.prims.push_back(makePrimitive(Sphere{{u(rng), u(rng), u(rng)}, r}, {}));
+        int leaf = s.tree.leaf(uint32_t(i));
+        root = root < 0 ? leaf : s.tree.combine(Op::Union, root, leaf);
+    }
+    s.tree.root = root;
+    s.prepare();
+    return s;
+}
+
+TEST(RegularCost, CellOfOverlappingPrimitivesIsNotSplitAtAnyMaxLevel) {
+    // Eight unit spheres whose centres are 0.2 apart: every half, quarter and eighth of the
+    // scene box overlaps all eight boxes, though no cell lies inside all of them, so no split
+    // lowers the cost. The report's rule alone (max-objects 1) splits down to max-level.
+    Scene s;
+    int root = -1;
+    for (int i = 0; i < 8; ++i) {
+        const Vec3 c{i & 1 ? 0.1 : -0.1, i & 2 ? 0.1 : -0.1, i & 4 ? 0.1 : -0.1};
+        s.prims.push_back(makePrimitive(Sphere{c, 1.0}, {}));
+        int leaf = s.tree.leaf(uint32_t(i));
+        root = root < 0 ? leaf : s.tree.combine(Op::Union, root, leaf);
+    }
+    s.tree.root = root;
+    s.prepare();
+    BuildParams p = regular();
+    p.regular.maxObjects = 1;
+    for (int level : {12, 30, 48}) {
+        p.regular.maxLevel = level;
+        auto a = buildAccelerator(s, p);
+        EXPECT_EQ(a->regionCount(), 1u) << "max-level " << level;
+        EXPECT_EQ(int(a->info().extra["cost_leaves"]), 1);
+        auto bad = test::compareWithBrute(s, *a, test::randomRays(s, 3, 2000));
+        EXPECT_TRUE(bad.empty()) << describe(s, bad);
+    }
+    p.regular.maxLevel = 12;
+    p.regular.costStop = false;
+    EXPECT_GT(buildAccelerator(s, p)->regionCount(), 1000u);
+}
+
+TEST(RegularCost, ManySmallSeparatedPrimitivesAreSplitDeeply) {
+    // 200 spheres of radius 0.002 in a unit cube: isolating each one in a cell of its own size
+    // takes about 8 cuts per axis, and every one of those splits pays.
+    Scene s = randomSpheres(200, 0.002, 11);
+    BuildParams p = regular();
+    p.regular.maxObjects = 1;
+    auto a = buildAccelerator(s, p);
+    const auto& x = a->info().extra;
+    EXPECT_EQ(int(x["effective_max_level"]), automaticMaxLevel(200));
+    EXPECT_GE(int(x["finest_level"]), 18);
+    EXPECT_EQ(int(x["max_prims_per_leaf"]), 1);
+    std::vector<Ray> rays = test::randomRays(s, 4, 3000);
+    const auto more = test::raysThroughPoints(gridPoints(gridOf(*a), 4), s.bounds, 5);
+    rays.insert(rays.end(), more.begin(), more.end());
+    auto bad = test::compareWithBrute(s, *a, rays);
+    EXPECT_TRUE(bad.empty()) << describe(s, bad);
+    EXPECT_EQ(walkErrors(s, *a, rays), 0u);
+    // An explicit max-level is a cap the build keeps.
+    p.regular.maxLevel = 9;
+    EXPECT_EQ(int(buildAccelerator(s, p)->info().extra["finest_level"]), 9);
+}
+
+TEST(RegularCost, AutomaticMaxLevelGrowsWithThePrimitiveCount) {
+    EXPECT_EQ(automaticMaxLevel(0), 16);
+    EXPECT_EQ(automaticMaxLevel(1), 16);
+    EXPECT_EQ(automaticMaxLevel(221), 21);     // the sponge
+    EXPECT_EQ(automaticMaxLevel(7382), 24);    // balls4
+    EXPECT_EQ(automaticMaxLevel(597871), 28);  // balls:6
+    EXPECT_EQ(automaticMaxLevel(size_t(1) << 62), 48);
+    RegularConfig c;
+    EXPECT_EQ(effectiveMaxLevel(c, 7382), 24);
+    c.maxLevel = 7;
+    EXPECT_EQ(effectiveMaxLevel(c, 7382), 7);
+}
+
 TEST(RegularBuild, LeavesHoldTheirOverlappingPrimitivesAndShareTrees) {
     Scene s = loadScene("builtin:lattice:4");
     auto accel = buildAccelerator(s, regular());
@@ -496,7 +577,7 @@ TEST(RegularBuild, LeavesHoldTheirOverlappingPrimitivesAndShareTrees) {
     const auto& x = accel->info().extra;
     EXPECT_EQ(size_t(x["leaves"]), g.regionCount());
     EXPECT_LT(size_t(x["distinct_trees"]), g.regionCount());  // shared, not copied
-    EXPECT_LE(int(x["finest_level"]), BuildParams{}.regular.maxLevel);
+    EXPECT_LE(int(x["finest_level"]), int(x["effective_max_level"]));
     CsgTree t = g.treePool();
     for (const RegularLeaf& L : g.leaves()) {
         Box3 cell;
