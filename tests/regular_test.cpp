@@ -148,8 +148,10 @@ void randomScenesMatchBrute(StepMethod step, int seeds) {
             p.regular.maxObjects = 1 + int(seed % 3);
             p.regular.maxLevel = 9 + int(seed % 10);
             p.regular.splitAxes = seed % 2 ? SplitAxes::Cycle : SplitAxes::Cost;  // both orders
+            // Both stop rules: the report's makes many thin cells, the cost rule fewer.
+            p.regular.costStop = seed > uint64_t(seeds) / 2;
             auto accel = buildAccelerator(s, p);
-            auto rays = hardRays(s, gridOf(*accel), seed, 1500);
+            auto rays = hardRays(s, gridOf(*accel), seed, 2500);
             total += rays.size();
             auto bad = test::compareWithBrute(s, *accel, rays);
             ASSERT_TRUE(bad.empty())
@@ -182,6 +184,7 @@ TEST(RegularPush, WrongForDeltaTooLargeOrTooSmallWhereExactIsRight) {
         BuildParams p = regular(StepMethod::Exact);
         p.regular.maxLevel = 18;  // cells 1/64 of the box
         p.regular.maxObjects = 1;
+        p.regular.costStop = false;  // the report's rule: thin cells, where push goes wrong
         auto exact = buildAccelerator(s, p);
         auto rays = hardRays(s, gridOf(*exact), seed, 3000);
         ASSERT_TRUE(test::compareWithBrute(s, *exact, rays).empty());
@@ -289,6 +292,7 @@ TEST(RegularSubTables, SameLeafAsFullTableInLessMemory) {
         BuildParams pf = regular();
         pf.regular.maxLevel = 18;  // deeper than the top table, so sub-tables appear
         pf.regular.maxObjects = 1;
+        pf.regular.costStop = false;  // the report's rule: deep where boxes meet
         BuildParams ps = pf;
         pf.regular.fullTable = true;
         auto full = buildAccelerator(s, pf), sub = buildAccelerator(s, ps);
@@ -326,6 +330,7 @@ TEST(RegularRopes, EveryRopeIsTheLeafTheDirectoryGivesAcrossTheFace) {
         BuildParams p = regular();
         p.regular.maxLevel = 15;
         p.regular.maxObjects = 1;
+        p.regular.costStop = false;  // the report's rule: leaves of many sizes, split faces
         auto accel = buildAccelerator(s, p);
         const RegularGrid& g = gridOf(*accel);
         size_t roped = 0, split = 0, border = 0;
@@ -378,6 +383,7 @@ TEST(RegularSubTables, DeepLevelBuiltWhereTheFullTableWouldNotFit) {
     BuildParams p = regular();
     p.regular.maxLevel = 40;
     p.regular.maxObjects = 1;
+    p.regular.costStop = false;  // the report's rule splits the gap down to level 40
     auto accel = buildAccelerator(s, p);
     const RegularGrid& g = gridOf(*accel);
     int finest = accel->info().extra["finest_level"];
