@@ -52,7 +52,7 @@ struct RegularConfig {
 };
 
 /// The max-level of `--max-level 0` for a scene of `primitives` live primitives:
-/// 8 + 1.3 log2 N, within 8..48 (docs/regular.md, "Cost-driven splits").
+/// 16 + 0.65 log2 N, rounded, within 8..48 (docs/regular.md, "Cost-driven splits").
 int automaticMaxLevel(size_t primitives);
 /// The max-level a build over `primitives` uses: the configured one, or the automatic one.
 int effectiveMaxLevel(const RegularConfig& config, size_t primitives);
@@ -82,9 +82,9 @@ struct BuildParams {
     IrregularConfig irregular;  ///< read by the irregular scheme only
 };
 
-/// The knobs the scheme in use reads, as command-line options: "regular --max-level 24
-/// --max-objects 4 --step exact --split-axes cost" (and --delta, --full-table, --no-mailbox,
-/// --no-light-buffer where they apply and differ from the defaults).
+/// The knobs the scheme in use reads, as command-line options: "regular --max-level 0
+/// --max-objects 4 --step exact --split-axes cost" (and --delta, --full-table, --no-cost-stop,
+/// --no-mailbox, --no-light-buffer where they apply and differ from the defaults).
 std::string toString(const BuildParams& p);
 std::ostream& operator<<(std::ostream& os, const BuildParams& p);
 
