@@ -154,6 +154,11 @@ int main(int argc, char** argv) {
     benchCmd->add_flag("--no-plots{false}", bopt.plots, "Write the CSV only");
     benchCmd->add_flag("--schemes-only", bopt.schemesOnly,
                        "Each scheme at its defaults, and the peer: the comparison table");
+    benchCmd
+        ->add_option("--schemes", bopt.schemes,
+                     "Schemes measured; without brute (--schemes-only only) no speedup or error")
+        ->check(CLI::IsMember({"brute", "regular", "irregular"}))
+        ->capture_default_str();
     bool scale = false;
     std::string memoryLimit = "4G", memoryBudget = "0";
     bench::ScaleOptions scaleOpt;
@@ -211,6 +216,7 @@ int main(int argc, char** argv) {
         scaleOpt.threads = bopt.threads;
         scaleOpt.bounces = bopt.bounces;
         scaleOpt.outDir = bopt.outDir;
+        scaleOpt.schemes = bopt.schemes;
         // Sizes as --memory-budget takes them, the error naming the option given.
         auto size = [](const char* option, const std::string& text, bool zero) -> size_t {
             if (zero && text == "0") return 0;

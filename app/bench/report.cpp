@@ -6,6 +6,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "app/bench/embree_peer.h"
@@ -35,7 +36,7 @@ std::string num(double v) {
     return os.str();
 }
 
-std::vector<Config> sweep(bool quick, bool schemesOnly) {
+std::vector<Config> sweep(bool quick, bool schemesOnly, bool regularOn, bool irregularOn) {
     std::vector<Config> out;
     auto add = [&](const std::string& knob, const std::string& value, BuildParams b,
                    ShadingOptions s = {}) {
@@ -45,8 +46,8 @@ std::vector<Config> sweep(bool quick, bool schemesOnly) {
     regular.scheme = SchemeKind::Regular;
     BuildParams irregular;
     irregular.scheme = SchemeKind::Irregular;
-    add("scheme", "regular", regular);
-    add("scheme", "irregular", irregular);
+    if (regularOn) add("scheme", "regular", regular);
+    if (irregularOn) add("scheme", "irregular", irregular);
     if (schemesOnly) return out;
     std::vector<int> levels =
         quick ? std::vector<int>{6, 12} : std::vector<int>{3, 6, 9, 12, 15, 18, 21, 24};
@@ -172,6 +173,16 @@ int runBench(const BenchOptions& opt) {
         std::cerr << "error: --out " << opt.outDir << ": " << ec.message() << "\n";
         return 2;
     }
+    auto wanted = [&](SchemeKind k) {
+        return std::find(opt.schemes.begin(), opt.schemes.end(), schemeName(k)) !=
+               opt.schemes.end();
+    };
+    const bool withBrute = wanted(SchemeKind::Brute);
+    if (!withBrute && !opt.schemesOnly) {
+        std::cerr << "error: --schemes without brute: the sweeps measure error against brute "
+                     "force; add --schemes-only\n";
+        return 2;
+    }
     std::ostringstream csv, table;
     csv << kHeader;
     table << "| scene | scheme | build ms | regions | memory | render ms | us/ray | prim tests/ray "
@@ -193,27 +204,41 @@ int runBench(const BenchOptions& opt) {
         ro.shading.bounces = opt.bounces;
 
         // The reference of this run (after a small warm-up render that starts the thread pool).
+        // Without brute force, renders are timed alone, with no speedup and no error.
         BuildParams bruteParams;
         auto brute = buildAccelerator(scene, bruteParams);
         Image ref(ro.width, ro.height);
-        render(scene, *brute, ro, ref, PassLattice{16, 0});
-        const SpeedupBaseline baseline(scene, *brute, ro, PassLattice{}, ref);
-        const double bruteMs = baseline.brute().renderMs;
+        std::optional<SpeedupBaseline> baseline;
+        if (withBrute) {
+            render(scene, *brute, ro, ref, PassLattice{16, 0});
+            baseline.emplace(scene, *brute, ro, PassLattice{}, ref);
+        }
+        auto alone = [&](const RenderStats& s) {
+            Speedup sp;
+            sp.scheme = s;
+            sp.pixels = size_t(ro.width) * size_t(ro.height);
+            return sp;
+        };
         auto row = [&](const char* scheme, const std::string& knob, const std::string& value,
                        const AccelInfo& info, const Speedup& sp, const ImageError& e) {
             const RenderStats& s = sp.scheme;
             const RayCounters& c = s.counters;
             double rays = c.rays ? double(c.rays) : 1.0;
             if (knob == "scheme" || knob == "peer (bounces 0)") {
+                char speedup[32] = "-", differing[32] = "-";
+                if (withBrute) {
+                    std::snprintf(speedup, sizeof speedup, "%.1fx", sp.ratio());
+                    std::snprintf(differing, sizeof differing, "%zu", e.hitDiff);
+                }
                 char line[512];
                 std::snprintf(line, sizeof line,
                               "| %s | %s%s | %.0f | %zu | %s | %.0f | %.2f | %.1f | %.1f | "
-                              "%.1fx | %zu |\n",
+                              "%s | %s |\n",
                               spec.c_str(), scheme, knob == "scheme" ? "" : " (bounces 0)",
                               info.buildMs, info.regions,
                               formatBytes(info.memoryBytes, ByteUnit::MiB).c_str(), s.renderMs,
                               1000.0 * s.renderMs / rays, double(c.primTests) / rays,
-                              double(c.regionVisits) / rays, sp.ratio(), e.hitDiff);
+                              double(c.regionVisits) / rays, speedup, differing);
                 table << line;
             }
             csv << spec << "," << scheme << "," << knob << "," << value << "," << num(info.buildMs)
@@ -222,10 +247,14 @@ int runBench(const BenchOptions& opt) {
                 << num(double(c.regionVisits) / rays) << "," << c.mailboxHits << "," << c.walkErrors
                 << "," << e.hitDiff << "," << e.colorDiff << "," << num(e.maxDepthDiff) << "\n";
         };
-        row("brute", "scheme", "brute", brute->info(), baseline.against(baseline.brute()), {});
-        std::cerr << spec << ": brute force " << int(bruteMs) << " ms\n";
+        if (baseline) {
+            row("brute", "scheme", "brute", brute->info(), baseline->against(baseline->brute()),
+                {});
+            std::cerr << spec << ": brute force " << int(baseline->brute().renderMs) << " ms\n";
+        }
 
-        for (const Config& c : sweep(opt.quick, opt.schemesOnly)) {
+        for (const Config& c : sweep(opt.quick, opt.schemesOnly, wanted(SchemeKind::Regular),
+                                     wanted(SchemeKind::Irregular))) {
             std::unique_ptr<Accelerator> accel;
             try {
                 accel = buildAccelerator(scene, c.build);
@@ -238,11 +267,12 @@ int runBench(const BenchOptions& opt) {
             r.shading.offsetScale = c.shading.offsetScale;
             Image img(ro.width, ro.height);
             // The offset sweep changes the options: timed against the same brute-force render.
-            const Speedup s = r.shading.offsetScale == ro.shading.offsetScale
-                                  ? baseline.measure(*accel, img)
-                                  : baseline.against(render(scene, *accel, r, img));
+            const Speedup s = !baseline ? alone(render(scene, *accel, r, img))
+                              : r.shading.offsetScale == ro.shading.offsetScale
+                                  ? baseline->measure(*accel, img)
+                                  : baseline->against(render(scene, *accel, r, img));
             row(schemeName(c.build.scheme), c.knob, c.value, accel->info(), s,
-                compareImages(ref, img));
+                baseline ? compareImages(ref, img) : ImageError{});
             std::cerr << spec << ": " << c.knob << " = " << c.value << ": "
                       << int(s.scheme.renderMs) << " ms\n";
         }
@@ -254,30 +284,41 @@ int runBench(const BenchOptions& opt) {
             r0.shading.bounces = 0;
             Image ref0(ro.width, ro.height);
             // Speedups of these rows are over brute force at --bounces 0.
-            const SpeedupBaseline base0(scene, *brute, r0, PassLattice{}, ref0);
-            row("brute", "peer (bounces 0)", "brute", brute->info(), base0.against(base0.brute()),
-                {});
+            std::optional<SpeedupBaseline> base0;
+            if (withBrute) {
+                base0.emplace(scene, *brute, r0, PassLattice{}, ref0);
+                row("brute", "peer (bounces 0)", "brute", brute->info(),
+                    base0->against(base0->brute()), {});
+            }
+            auto against0 = [&](const RenderStats& s) {
+                return base0 ? base0->against(s) : alone(s);
+            };
             for (SchemeKind k : {SchemeKind::Regular, SchemeKind::Irregular}) {
+                if (!wanted(k)) continue;
                 BuildParams b;
                 b.scheme = k;
                 try {
                     auto a = buildAccelerator(scene, b);
                     Image img(ro.width, ro.height);
                     row(schemeName(k), "peer (bounces 0)", schemeName(k), a->info(),
-                        base0.measure(*a, img), compareImages(ref0, img));
+                        against0(render(scene, *a, r0, img)),
+                        base0 ? compareImages(ref0, img) : ImageError{});
                 } catch (const std::invalid_argument&) {
                 }
             }
             EmbreePeer peer(scene);
             Image img(ro.width, ro.height);
-            const Speedup s = base0.against(peer.render(r0, img));
+            const Speedup s = against0(peer.render(r0, img));
             AccelInfo info;
             info.buildMs = peer.buildMs();
             info.regions = 0;
-            row("embree", "peer (bounces 0)", "embree", info, s, compareImages(ref0, img));
-            std::cerr << spec << ": embree " << int(s.scheme.renderMs)
-                      << " ms (brute force at --bounces 0: " << int(base0.brute().renderMs)
-                      << " ms)\n";
+            row("embree", "peer (bounces 0)", "embree", info, s,
+                base0 ? compareImages(ref0, img) : ImageError{});
+            std::cerr << spec << ": embree " << int(s.scheme.renderMs) << " ms";
+            if (base0)
+                std::cerr << " (brute force at --bounces 0: " << int(base0->brute().renderMs)
+                          << " ms)";
+            std::cerr << "\n";
         }
 
         if (opt.schemesOnly) {
@@ -308,7 +349,7 @@ int runBench(const BenchOptions& opt) {
             ImageError e = compareImages(ref, shown);
             // Speedup of the time to this pass, over brute force on the whole image.
             row(schemeName(best->params().scheme), "progressive pass", std::to_string(stride),
-                best->info(), baseline.against(s), e);
+                best->info(), baseline->against(s), e);
             prev = stride;
         }
         done.push_back(spec);

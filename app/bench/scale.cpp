@@ -394,8 +394,15 @@ int runScale(const ScaleOptions& opt) {
              "| render / Embree | build / Embree |\n"
           << "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     for (const std::string& spec : opt.scenes) {
-        ChildResult bruteR = runChild([&](Image& img) { return bruteWork(spec, opt, img); },
-                                      killAfterS, addressSpace);
+        auto wanted = [&](const char* scheme) {
+            return std::find(opt.schemes.begin(), opt.schemes.end(), scheme) != opt.schemes.end();
+        };
+        ChildResult bruteR;
+        if (wanted("brute"))
+            bruteR = runChild([&](Image& img) { return bruteWork(spec, opt, img); }, killAfterS,
+                              addressSpace);
+        else
+            bruteR.figures["skipped"] = "not in --schemes";
         const json& bf = bruteR.figures;
         const bool haveBrute = bruteR.measured() && !bruteR.depth.empty();
         const int width = bf.value("width", 0), height = bf.value("height", 0);
@@ -409,9 +416,10 @@ int runScale(const ScaleOptions& opt) {
         std::map<std::string, ChildResult> results;
         results.emplace("brute", std::move(bruteR));
         for (SchemeKind k : {SchemeKind::Regular, SchemeKind::Irregular})
-            results.emplace(schemeName(k),
-                            runChild([&](Image& img) { return schemeWork(spec, k, opt, img); },
-                                     killAfterS, addressSpace));
+            if (wanted(schemeName(k)))
+                results.emplace(schemeName(k),
+                                runChild([&](Image& img) { return schemeWork(spec, k, opt, img); },
+                                         killAfterS, addressSpace));
         if (withPeer)
             results.emplace("embree",
                             runChild([&](Image& img) { return embreeWork(spec, opt, img); },

@@ -24,6 +24,8 @@ struct ScaleOptions {
     size_t memoryLimit = size_t(4) << 30;  ///< and its peak resident memory stay below it
     double bruteLimitS = 60.0;  ///< brute force renders every pixel when estimated below this
     bool peer = true;           ///< Embree on union-only scenes (at --bounces 0 only)
+    /// The schemes measured (--schemes); without brute force no hits are compared.
+    std::vector<std::string> schemes{"brute", "regular", "irregular"};
 };
 
 /// Measure every scene, write OUT/scale.md and OUT/scale.json, print the table and the list of
