@@ -4,7 +4,9 @@
 #include <iostream>
 
 #include "app/bench/report.h"
+#include "app/bench/scale.h"
 #include "app/cli/commands.h"
+#include "engine/accel/build_guard.h"
 #include "engine/scene/builtin_scenes.h"
 #ifdef LANCER_WITH_VIEWER
 #include "app/viewer/compare/rebuild_diff.h"
@@ -151,26 +153,69 @@ int main(int argc, char** argv) {
     structure->add_flag("-q,--quiet", sopt.quiet, "Print nothing on success");
     cli::addCommonOptions(*structure, structureOpt);
 
+    // A value given twice takes the last, so scripts' defaults can be overridden after them.
     bench::BenchOptions bopt;
     CLI::App* benchCmd =
         app.add_subcommand("bench", "Write the speed-against-error report (CSV and plots)");
     benchCmd->add_option("--scenes", bopt.scenes, "Scenes to measure")->capture_default_str();
     benchCmd->add_option("--width", bopt.width, "Image width")
         ->check(CLI::Range(1, 16384))
-        ->capture_default_str();
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     benchCmd->add_option("--height", bopt.height, "Image height")
         ->check(CLI::Range(1, 16384))
-        ->capture_default_str();
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     benchCmd->add_option("--threads", bopt.threads, "Worker threads (0: all cores)")
-        ->check(CLI::Range(0, 1024));
+        ->check(CLI::Range(0, 1024))
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     benchCmd->add_option("--bounces", bopt.bounces, "Reflection/refraction depth")
         ->check(CLI::Range(0, 64))
-        ->capture_default_str();
-    benchCmd->add_option("--out", bopt.outDir, "Output directory")->capture_default_str();
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    benchCmd->add_option("--out", bopt.outDir, "Output directory")
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     benchCmd->add_flag("--quick", bopt.quick, "Fewer knob values (a smoke run)");
     benchCmd->add_flag("--no-plots{false}", bopt.plots, "Write the CSV only");
     benchCmd->add_flag("--schemes-only", bopt.schemesOnly,
                        "Each scheme at its defaults, and the peer: the comparison table");
+    benchCmd
+        ->add_option("--schemes", bopt.schemes,
+                     "Schemes measured; without brute (--schemes-only only) no speedup or error")
+        ->check(CLI::IsMember({"brute", "regular", "irregular"}))
+        ->capture_default_str();
+    bool scale = false;
+    std::string memoryLimit = "4G", memoryBudget = "0";
+    bench::ScaleOptions scaleOpt;
+    benchCmd->add_flag("--scale", scale,
+                       "The scale table: each scheme at its defaults in a child process (peak "
+                       "memory, limits, hits against brute force); see docs/scale.md");
+    benchCmd->add_flag("--scene-size", scaleOpt.sceneSize,
+                       "--scale: each scene's own image size instead of --width x --height");
+    benchCmd
+        ->add_option("--time-limit", scaleOpt.timeLimitS,
+                     "--scale: seconds a scheme may take to load, build and render")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    benchCmd
+        ->add_option("--memory-limit", memoryLimit,
+                     "--scale: peak resident memory a scheme may take (K, M, G, T)")
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    benchCmd
+        ->add_option("--brute-limit", scaleOpt.bruteLimitS,
+                     "--scale: seconds over which brute force renders a lattice of pixels")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    benchCmd
+        ->add_option("--memory-budget", memoryBudget,
+                     "--scale: the builds' --memory-budget (0: an eighth of physical memory)")
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    benchCmd->add_flag("--no-peer{false}", scaleOpt.peer, "--scale: without Embree");
 
     // Hidden: the README's option section, generated from the parameter table.
     CLI::App* helpOptions = app.add_subcommand("help-options", "")->group("");
@@ -190,6 +235,33 @@ int main(int argc, char** argv) {
         return 0;
     }
 
+    if (*benchCmd && scale) {
+        scaleOpt.scenes = bopt.scenes;
+        scaleOpt.width = bopt.width;
+        scaleOpt.height = bopt.height;
+        scaleOpt.threads = bopt.threads;
+        scaleOpt.bounces = bopt.bounces;
+        scaleOpt.outDir = bopt.outDir;
+        scaleOpt.schemes = bopt.schemes;
+        // Sizes as --memory-budget takes them, the error naming the option given.
+        auto size = [](const char* option, const std::string& text, bool zero) -> size_t {
+            if (zero && text == "0") return 0;
+            try {
+                return parseMemoryBudget(text);
+            } catch (const std::invalid_argument&) {
+                throw std::invalid_argument(std::string(option) + " " + text +
+                                            ": expected a size such as 512M, 2G or 1.5GiB");
+            }
+        };
+        try {
+            scaleOpt.memoryLimit = size("--memory-limit", memoryLimit, false);
+            scaleOpt.memoryBudget = size("--memory-budget", memoryBudget, true);
+        } catch (const std::invalid_argument& e) {
+            std::cerr << "error: " << e.what() << "\n";
+            return 2;
+        }
+        return bench::runScale(scaleOpt);
+    }
     if (*benchCmd) return bench::runBench(bopt);
 
     if (*render) return cli::runRender(renderOpt, out, quiet);

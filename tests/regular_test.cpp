@@ -148,8 +148,10 @@ void randomScenesMatchBrute(StepMethod step, int seeds) {
             p.regular.maxObjects = 1 + int(seed % 3);
             p.regular.maxLevel = 9 + int(seed % 10);
             p.regular.splitAxes = seed % 2 ? SplitAxes::Cycle : SplitAxes::Cost;  // both orders
+            // Both stop rules: the report's makes many thin cells, the cost rule fewer.
+            p.regular.costStop = seed > uint64_t(seeds) / 2;
             auto accel = buildAccelerator(s, p);
-            auto rays = hardRays(s, gridOf(*accel), seed, 1500);
+            auto rays = hardRays(s, gridOf(*accel), seed, 2500);
             total += rays.size();
             auto bad = test::compareWithBrute(s, *accel, rays);
             ASSERT_TRUE(bad.empty())
@@ -182,6 +184,7 @@ TEST(RegularPush, WrongForDeltaTooLargeOrTooSmallWhereExactIsRight) {
         BuildParams p = regular(StepMethod::Exact);
         p.regular.maxLevel = 18;  // cells 1/64 of the box
         p.regular.maxObjects = 1;
+        p.regular.costStop = false;  // the report's rule: thin cells, where push goes wrong
         auto exact = buildAccelerator(s, p);
         auto rays = hardRays(s, gridOf(*exact), seed, 3000);
         ASSERT_TRUE(test::compareWithBrute(s, *exact, rays).empty());
@@ -289,6 +292,7 @@ TEST(RegularSubTables, SameLeafAsFullTableInLessMemory) {
         BuildParams pf = regular();
         pf.regular.maxLevel = 18;  // deeper than the top table, so sub-tables appear
         pf.regular.maxObjects = 1;
+        pf.regular.costStop = false;  // the report's rule: deep where boxes meet
         BuildParams ps = pf;
         pf.regular.fullTable = true;
         auto full = buildAccelerator(s, pf), sub = buildAccelerator(s, ps);
@@ -326,6 +330,7 @@ TEST(RegularRopes, EveryRopeIsTheLeafTheDirectoryGivesAcrossTheFace) {
         BuildParams p = regular();
         p.regular.maxLevel = 15;
         p.regular.maxObjects = 1;
+        p.regular.costStop = false;  // the report's rule: leaves of many sizes, split faces
         auto accel = buildAccelerator(s, p);
         const RegularGrid& g = gridOf(*accel);
         size_t roped = 0, split = 0, border = 0;
@@ -378,6 +383,7 @@ TEST(RegularSubTables, DeepLevelBuiltWhereTheFullTableWouldNotFit) {
     BuildParams p = regular();
     p.regular.maxLevel = 40;
     p.regular.maxObjects = 1;
+    p.regular.costStop = false;  // the report's rule splits the gap down to level 40
     auto accel = buildAccelerator(s, p);
     const RegularGrid& g = gridOf(*accel);
     int finest = accel->info().extra["finest_level"];
@@ -408,6 +414,7 @@ TEST(RegularRefusal, AbsurdLevelAndObjectsAreRefusedWithAMessage) {
     BuildParams p = regular();
     p.regular.maxLevel = 48;
     p.regular.maxObjects = 1;
+    p.regular.costStop = false;  // the cost rule stops these cells (RegularCost below)
     try {
         buildAccelerator(s, p);
         FAIL() << "not refused";
@@ -489,23 +496,113 @@ TEST(RegularAxes, CostOrderIsTheReportsOnACubeAndCubicCellsOnAFlatScene) {
     EXPECT_LE(c.primTests, r.primTests);
 }
 
+/// Spheres of radius `r` at `n` random centres in the unit cube, in a union.
+Scene randomSpheres(int n, double r, uint64_t seed) {
+    Scene s;
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int root = -1;
+    for (int i = 0; i < n; ++i) {
+        s.prims.push_back(makePrimitive(Sphere{{u(rng), u(rng), u(rng)}, r}, {}));
+        int leaf = s.tree.leaf(uint32_t(i));
+        root = root < 0 ? leaf : s.tree.combine(Op::Union, root, leaf);
+    }
+    s.tree.root = root;
+    s.prepare();
+    return s;
+}
+
+TEST(RegularCost, CellOfOverlappingPrimitivesIsNotSplitAtAnyMaxLevel) {
+    // Eight unit spheres whose centres are 0.2 apart: every half, quarter and eighth of the
+    // scene box overlaps all eight boxes, though no cell lies inside all of them, so no split
+    // lowers the cost. The report's rule alone (max-objects 1) splits down to max-level.
+    Scene s;
+    int root = -1;
+    for (int i = 0; i < 8; ++i) {
+        const Vec3 c{i & 1 ? 0.1 : -0.1, i & 2 ? 0.1 : -0.1, i & 4 ? 0.1 : -0.1};
+        s.prims.push_back(makePrimitive(Sphere{c, 1.0}, {}));
+        int leaf = s.tree.leaf(uint32_t(i));
+        root = root < 0 ? leaf : s.tree.combine(Op::Union, root, leaf);
+    }
+    s.tree.root = root;
+    s.prepare();
+    BuildParams p = regular();
+    p.regular.maxObjects = 1;
+    for (int level : {12, 30, 48}) {
+        p.regular.maxLevel = level;
+        auto a = buildAccelerator(s, p);
+        EXPECT_EQ(a->info().regions, 1u) << "max-level " << level;
+        EXPECT_EQ(int(a->info().extra["cost_leaves"]), 1);
+        auto bad = test::compareWithBrute(s, *a, test::randomRays(s, 3, 2000));
+        EXPECT_TRUE(bad.empty()) << describe(s, bad);
+    }
+    p.regular.maxLevel = 12;
+    p.regular.costStop = false;
+    EXPECT_GT(buildAccelerator(s, p)->info().regions, 1000u);
+}
+
+TEST(RegularCost, ManySmallSeparatedPrimitivesAreSplitDeeply) {
+    // 200 spheres of radius 0.002 in a unit cube, about 0.17 apart: 3 cuts per axis (level 9)
+    // separate most of them, and splits keep paying around the closest ones, whose cells are
+    // cut 5 times per axis and more.
+    Scene s = randomSpheres(200, 0.002, 11);
+    BuildParams p = regular();
+    p.regular.maxObjects = 1;
+    auto a = buildAccelerator(s, p);
+    const auto& x = a->info().extra;
+    EXPECT_EQ(int(x["effective_max_level"]), automaticMaxLevel(200));
+    EXPECT_GE(int(x["finest_level"]), 15);
+    EXPECT_LE(int(x["max_prims_per_leaf"]), 2);
+    EXPECT_LT(double(x["prims_per_leaf"]), 1.0);  // empty space cut away: more leaves than spheres
+    std::vector<Ray> rays = test::randomRays(s, 4, 3000);
+    const auto more = test::raysThroughPoints(gridPoints(gridOf(*a), 4), s.bounds, 5);
+    rays.insert(rays.end(), more.begin(), more.end());
+    auto bad = test::compareWithBrute(s, *a, rays);
+    EXPECT_TRUE(bad.empty()) << describe(s, bad);
+    EXPECT_EQ(walkErrors(s, *a, rays), 0u);
+    // An explicit max-level is a cap the build keeps.
+    p.regular.maxLevel = 9;
+    EXPECT_EQ(int(buildAccelerator(s, p)->info().extra["finest_level"]), 9);
+}
+
+TEST(RegularCost, AutomaticMaxLevelGrowsWithThePrimitiveCount) {
+    EXPECT_EQ(automaticMaxLevel(0), 16);
+    EXPECT_EQ(automaticMaxLevel(1), 16);
+    EXPECT_EQ(automaticMaxLevel(221), 21);     // the sponge
+    EXPECT_EQ(automaticMaxLevel(7382), 24);    // balls4
+    EXPECT_EQ(automaticMaxLevel(597871), 28);  // balls:6
+    EXPECT_EQ(automaticMaxLevel(size_t(1) << 62), 48);
+    RegularConfig c;
+    EXPECT_EQ(effectiveMaxLevel(c, 7382), 24);
+    c.maxLevel = 7;
+    EXPECT_EQ(effectiveMaxLevel(c, 7382), 7);
+}
+
 TEST(RegularBuild, LeavesHoldTheirOverlappingPrimitivesAndShareTrees) {
     Scene s = loadScene("builtin:lattice:4");
-    auto accel = buildAccelerator(s, regular());
-    const RegularGrid& g = gridOf(*accel);
-    const auto& x = accel->info().extra;
-    EXPECT_EQ(size_t(x["leaves"]), g.regionCount());
-    EXPECT_LT(size_t(x["distinct_trees"]), g.regionCount());  // shared, not copied
-    EXPECT_LE(int(x["finest_level"]), BuildParams{}.regular.maxLevel);
-    CsgTree t = g.treePool();
-    for (const RegularLeaf& L : g.leaves()) {
-        Box3 cell;
-        for (int a = 0; a < 3; ++a)
-            cell.lo[a] = g.plane(a, L.lo[a]), cell.hi[a] = g.plane(a, L.hi[a]);
-        t.root = L.root;
-        std::vector<uint32_t> ps = L.root < 0 ? std::vector<uint32_t>{} : t.primitives();
-        EXPECT_EQ(ps.size(), L.prims);
-        for (uint32_t p : ps) ASSERT_TRUE(s.minBox[p].overlaps(cell));
+    // At the defaults the cost rule leaves 32 leaves with 32 distinct sets; the report's rule
+    // alone makes many leaves with the same set, which must share one tree.
+    for (bool costStop : {true, false}) {
+        SCOPED_TRACE(costStop ? "cost stop" : "report's rule");
+        BuildParams p = regular();
+        p.regular.costStop = costStop;
+        auto accel = buildAccelerator(s, p);
+        const RegularGrid& g = gridOf(*accel);
+        const auto& x = accel->info().extra;
+        EXPECT_EQ(size_t(x["leaves"]), g.regionCount());
+        if (!costStop) EXPECT_LT(size_t(x["distinct_trees"]), g.regionCount());  // shared
+        EXPECT_LE(size_t(x["distinct_trees"]), g.regionCount());
+        EXPECT_LE(int(x["finest_level"]), int(x["effective_max_level"]));
+        CsgTree t = g.treePool();
+        for (const RegularLeaf& L : g.leaves()) {
+            Box3 cell;
+            for (int a = 0; a < 3; ++a)
+                cell.lo[a] = g.plane(a, L.lo[a]), cell.hi[a] = g.plane(a, L.hi[a]);
+            t.root = L.root;
+            std::vector<uint32_t> ps = L.root < 0 ? std::vector<uint32_t>{} : t.primitives();
+            EXPECT_EQ(ps.size(), L.prims);
+            for (uint32_t p : ps) ASSERT_TRUE(s.minBox[p].overlaps(cell));
+        }
     }
 }
 

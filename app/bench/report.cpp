@@ -6,9 +6,11 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "app/bench/embree_peer.h"
+#include "app/bench/image_error.h"
 #include "app/bench/speedup.h"
 #include "engine/render/progressive.h"
 #include "engine/render/renderer.h"
@@ -26,36 +28,6 @@ struct Config {
     ShadingOptions shading;
 };
 
-/// Difference of an image against the reference.
-struct ImageError {
-    size_t hitDiff = 0;    ///< pixels whose primary hit (primitive or distance) differs
-    size_t colorDiff = 0;  ///< pixels whose colour differs by more than 2/255
-    double maxDepthDiff = 0.0;
-};
-
-ImageError compare(const Image& ref, const Image& img) {
-    ImageError e;
-    std::vector<uint8_t> a = ref.rgba8(), b = img.rgba8();
-    for (size_t i = 0; i < ref.depth.size(); ++i) {
-        float da = ref.depth[i], db = img.depth[i];
-        bool bothMiss = std::isinf(da) && std::isinf(db);
-        double dd = bothMiss                             ? 0.0
-                    : (std::isinf(da) || std::isinf(db)) ? kInf
-                                                         : std::abs(double(da) - double(db));
-        if (ref.hitPrim[i] != img.hitPrim[i] || dd > 1e-6 * std::max(1.0, double(da))) ++e.hitDiff;
-        if (std::isfinite(dd))
-            e.maxDepthDiff = std::max(e.maxDepthDiff, dd);
-        else
-            e.maxDepthDiff = kInf;
-        for (int c = 0; c < 3; ++c)
-            if (std::abs(int(a[4 * i + size_t(c)]) - int(b[4 * i + size_t(c)])) > 2) {
-                ++e.colorDiff;
-                break;
-            }
-    }
-    return e;
-}
-
 std::string num(double v) {
     if (std::isinf(v)) return "inf";
     std::ostringstream os;
@@ -64,7 +36,7 @@ std::string num(double v) {
     return os.str();
 }
 
-std::vector<Config> sweep(bool quick, bool schemesOnly) {
+std::vector<Config> sweep(bool quick, bool schemesOnly, bool regularOn, bool irregularOn) {
     std::vector<Config> out;
     auto add = [&](const std::string& knob, const std::string& value, BuildParams b,
                    ShadingOptions s = {}) {
@@ -74,8 +46,8 @@ std::vector<Config> sweep(bool quick, bool schemesOnly) {
     regular.scheme = SchemeKind::Regular;
     BuildParams irregular;
     irregular.scheme = SchemeKind::Irregular;
-    add("scheme", "regular", regular);
-    add("scheme", "irregular", irregular);
+    if (regularOn) add("scheme", "regular", regular);
+    if (irregularOn) add("scheme", "irregular", irregular);
     if (schemesOnly) return out;
     std::vector<int> levels =
         quick ? std::vector<int>{6, 12} : std::vector<int>{3, 6, 9, 12, 15, 18, 21, 24};
@@ -201,6 +173,16 @@ int runBench(const BenchOptions& opt) {
         std::cerr << "error: --out " << opt.outDir << ": " << ec.message() << "\n";
         return 2;
     }
+    auto wanted = [&](SchemeKind k) {
+        return std::find(opt.schemes.begin(), opt.schemes.end(), schemeName(k)) !=
+               opt.schemes.end();
+    };
+    const bool withBrute = wanted(SchemeKind::Brute);
+    if (!withBrute && !opt.schemesOnly) {
+        std::cerr << "error: --schemes without brute: the sweeps measure error against brute "
+                     "force; add --schemes-only\n";
+        return 2;
+    }
     std::ostringstream csv, table;
     csv << kHeader;
     table << "| scene | scheme | build ms | regions | memory | render ms | us/ray | prim tests/ray "
@@ -222,27 +204,41 @@ int runBench(const BenchOptions& opt) {
         ro.shading.bounces = opt.bounces;
 
         // The reference of this run (after a small warm-up render that starts the thread pool).
+        // Without brute force, renders are timed alone, with no speedup and no error.
         BuildParams bruteParams;
         auto brute = buildAccelerator(scene, bruteParams);
         Image ref(ro.width, ro.height);
-        render(scene, *brute, ro, ref, PassLattice{16, 0});
-        const SpeedupBaseline baseline(scene, *brute, ro, PassLattice{}, ref);
-        const double bruteMs = baseline.brute().renderMs;
+        std::optional<SpeedupBaseline> baseline;
+        if (withBrute) {
+            render(scene, *brute, ro, ref, PassLattice{16, 0});
+            baseline.emplace(scene, *brute, ro, PassLattice{}, ref);
+        }
+        auto alone = [&](const RenderStats& s) {
+            Speedup sp;
+            sp.scheme = s;
+            sp.pixels = size_t(ro.width) * size_t(ro.height);
+            return sp;
+        };
         auto row = [&](const char* scheme, const std::string& knob, const std::string& value,
                        const AccelInfo& info, const Speedup& sp, const ImageError& e) {
             const RenderStats& s = sp.scheme;
             const RayCounters& c = s.counters;
             double rays = c.rays ? double(c.rays) : 1.0;
             if (knob == "scheme" || knob == "peer (bounces 0)") {
+                char speedup[32] = "-", differing[32] = "-";
+                if (withBrute) {
+                    std::snprintf(speedup, sizeof speedup, "%.1fx", sp.ratio());
+                    std::snprintf(differing, sizeof differing, "%zu", e.hitDiff);
+                }
                 char line[512];
                 std::snprintf(line, sizeof line,
                               "| %s | %s%s | %.0f | %zu | %s | %.0f | %.2f | %.1f | %.1f | "
-                              "%.1fx | %zu |\n",
+                              "%s | %s |\n",
                               spec.c_str(), scheme, knob == "scheme" ? "" : " (bounces 0)",
                               info.buildMs, info.regions,
                               formatBytes(info.memoryBytes, ByteUnit::MiB).c_str(), s.renderMs,
                               1000.0 * s.renderMs / rays, double(c.primTests) / rays,
-                              double(c.regionVisits) / rays, sp.ratio(), e.hitDiff);
+                              double(c.regionVisits) / rays, speedup, differing);
                 table << line;
             }
             csv << spec << "," << scheme << "," << knob << "," << value << "," << num(info.buildMs)
@@ -251,10 +247,14 @@ int runBench(const BenchOptions& opt) {
                 << num(double(c.regionVisits) / rays) << "," << c.mailboxHits << "," << c.walkErrors
                 << "," << e.hitDiff << "," << e.colorDiff << "," << num(e.maxDepthDiff) << "\n";
         };
-        row("brute", "scheme", "brute", brute->info(), baseline.against(baseline.brute()), {});
-        std::cerr << spec << ": brute force " << int(bruteMs) << " ms\n";
+        if (baseline) {
+            row("brute", "scheme", "brute", brute->info(), baseline->against(baseline->brute()),
+                {});
+            std::cerr << spec << ": brute force " << int(baseline->brute().renderMs) << " ms\n";
+        }
 
-        for (const Config& c : sweep(opt.quick, opt.schemesOnly)) {
+        for (const Config& c : sweep(opt.quick, opt.schemesOnly, wanted(SchemeKind::Regular),
+                                     wanted(SchemeKind::Irregular))) {
             std::unique_ptr<Accelerator> accel;
             try {
                 accel = buildAccelerator(scene, c.build);
@@ -267,10 +267,12 @@ int runBench(const BenchOptions& opt) {
             r.shading.offsetScale = c.shading.offsetScale;
             Image img(ro.width, ro.height);
             // The offset sweep changes the options: timed against the same brute-force render.
-            const Speedup s = r.shading.offsetScale == ro.shading.offsetScale
-                                  ? baseline.measure(*accel, img)
-                                  : baseline.against(render(scene, *accel, r, img));
-            row(schemeName(c.build.scheme), c.knob, c.value, accel->info(), s, compare(ref, img));
+            const Speedup s = !baseline ? alone(render(scene, *accel, r, img))
+                              : r.shading.offsetScale == ro.shading.offsetScale
+                                  ? baseline->measure(*accel, img)
+                                  : baseline->against(render(scene, *accel, r, img));
+            row(schemeName(c.build.scheme), c.knob, c.value, accel->info(), s,
+                baseline ? compareImages(ref, img) : ImageError{});
             std::cerr << spec << ": " << c.knob << " = " << c.value << ": "
                       << int(s.scheme.renderMs) << " ms\n";
         }
@@ -282,30 +284,41 @@ int runBench(const BenchOptions& opt) {
             r0.shading.bounces = 0;
             Image ref0(ro.width, ro.height);
             // Speedups of these rows are over brute force at --bounces 0.
-            const SpeedupBaseline base0(scene, *brute, r0, PassLattice{}, ref0);
-            row("brute", "peer (bounces 0)", "brute", brute->info(), base0.against(base0.brute()),
-                {});
+            std::optional<SpeedupBaseline> base0;
+            if (withBrute) {
+                base0.emplace(scene, *brute, r0, PassLattice{}, ref0);
+                row("brute", "peer (bounces 0)", "brute", brute->info(),
+                    base0->against(base0->brute()), {});
+            }
+            auto against0 = [&](const RenderStats& s) {
+                return base0 ? base0->against(s) : alone(s);
+            };
             for (SchemeKind k : {SchemeKind::Regular, SchemeKind::Irregular}) {
+                if (!wanted(k)) continue;
                 BuildParams b;
                 b.scheme = k;
                 try {
                     auto a = buildAccelerator(scene, b);
                     Image img(ro.width, ro.height);
                     row(schemeName(k), "peer (bounces 0)", schemeName(k), a->info(),
-                        base0.measure(*a, img), compare(ref0, img));
+                        against0(render(scene, *a, r0, img)),
+                        base0 ? compareImages(ref0, img) : ImageError{});
                 } catch (const std::invalid_argument&) {
                 }
             }
             EmbreePeer peer(scene);
             Image img(ro.width, ro.height);
-            const Speedup s = base0.against(peer.render(r0, img));
+            const Speedup s = against0(peer.render(r0, img));
             AccelInfo info;
             info.buildMs = peer.buildMs();
             info.regions = 0;
-            row("embree", "peer (bounces 0)", "embree", info, s, compare(ref0, img));
-            std::cerr << spec << ": embree " << int(s.scheme.renderMs)
-                      << " ms (brute force at --bounces 0: " << int(base0.brute().renderMs)
-                      << " ms)\n";
+            row("embree", "peer (bounces 0)", "embree", info, s,
+                base0 ? compareImages(ref0, img) : ImageError{});
+            std::cerr << spec << ": embree " << int(s.scheme.renderMs) << " ms";
+            if (base0)
+                std::cerr << " (brute force at --bounces 0: " << int(base0->brute().renderMs)
+                          << " ms)";
+            std::cerr << "\n";
         }
 
         if (opt.schemesOnly) {
@@ -333,10 +346,10 @@ int runBench(const BenchOptions& opt) {
             s.renderMs = elapsed;
             Image shown;  // what the viewer shows after this pass
             fillBlocks(prog, stride, shown);
-            ImageError e = compare(ref, shown);
+            ImageError e = compareImages(ref, shown);
             // Speedup of the time to this pass, over brute force on the whole image.
             row(schemeName(best->params().scheme), "progressive pass", std::to_string(stride),
-                best->info(), baseline.against(s), e);
+                best->info(), baseline->against(s), e);
             prev = stride;
         }
         done.push_back(spec);

@@ -45,7 +45,8 @@ std::vector<ParamDesc> makeTable() {
          "N",
          "max_level",
          "max-level",
-         "Deepest subdivision level (one axis cut per level)",
+         "Deepest subdivision level (one axis cut per level); 0: automatic, 16 + 0.65 log2 of the "
+         "primitive count",
          ParamKind::Int,
          0,
          48};
@@ -120,6 +121,19 @@ std::vector<ParamDesc> makeTable() {
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.regular.fullTable); };
     d.set = [](K& k, double v) { k.build.regular.fullTable = v != 0.0; };
+    add(d);
+    d = {"--no-cost-stop",
+         "",
+         "cost_stop",
+         "cost stop",
+         "Split cells down to max-objects or max-level even where the cost estimate says a split "
+         "does not pay (the report's rule)",
+         ParamKind::Switch};
+    d.flagValue = false;
+    d.schemes = kRegular;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.regular.costStop); };
+    d.set = [](K& k, double v) { k.build.regular.costStop = v != 0.0; };
     add(d);
     d = {"--bsp-heuristic",
          "H",

@@ -1,5 +1,7 @@
 #include "engine/accel/build_params.h"
 
+#include <algorithm>
+#include <cmath>
 #include <ostream>
 #include <sstream>
 
@@ -37,6 +39,15 @@ const char* irregularFrameName(IrregularFrame f) {
     return f == IrregularFrame::Camera ? "camera" : "projective";
 }
 
+int automaticMaxLevel(size_t primitives) {
+    const double n = double(std::max<size_t>(primitives, 1));
+    return std::clamp(int(std::lround(16.0 + 0.65 * std::log2(n))), 8, 48);
+}
+
+int effectiveMaxLevel(const RegularConfig& config, size_t primitives) {
+    return config.maxLevel > 0 ? config.maxLevel : automaticMaxLevel(primitives);
+}
+
 std::string toString(const BuildParams& p) {
     std::ostringstream os;
     os.precision(17);
@@ -48,6 +59,7 @@ std::string toString(const BuildParams& p) {
         if (r.step == StepMethod::Push) os << " --delta " << r.delta;
         os << " --split-axes " << splitAxesName(r.splitAxes);
         if (r.fullTable) os << " --full-table";
+        if (!r.costStop) os << " --no-cost-stop";
     } else if (p.scheme == SchemeKind::Irregular) {
         const IrregularConfig& i = p.irregular;
         os << " --max-objects " << i.maxObjects << " --bsp-heuristic " << heuristicName(i.heuristic)

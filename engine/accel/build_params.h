@@ -28,19 +28,34 @@ const char* splitAxesName(SplitAxes s);
 const char* irregularFrameName(IrregularFrame f);
 
 /// The regular scheme's knobs (report, section 3). Defaults measured in docs/regular.md
-/// ("Defaults", "Axis order", "Where push goes wrong"):
-/// at max-level 24 / max-objects 4 balls4 makes 11.7 primitive tests per ray (at 18 / 2: 65) and
-/// no built-in CSG scene explodes (at 24 / 2 lattice does); split axes `cost` takes 25% fewer
-/// render instructions than `cycle` on balls4, at most 4% more on the SPD scenes; push matches
-/// brute force on every test ray at delta 1e-6, 0.05 skips thin cells, 1e-19 stalls.
+/// ("Cost-driven splits", "Axis order", "Where push goes wrong"): a cell is split while the
+/// split lowers the estimated cost of the rays crossing it, down to a depth that grows with the
+/// scene; split axes `cost` takes 25% fewer render instructions than `cycle` on balls4, at most
+/// 4% more on the SPD scenes; push matches brute force on every test ray at delta 1e-6, 0.05
+/// skips thin cells, 1e-19 stalls.
 struct RegularConfig {
-    int maxLevel = 24;                      ///< deepest BSP level (one axis cut per level)
+    /// Deepest BSP level (one axis cut per level); 0: automaticMaxLevel() of the primitive count.
+    int maxLevel = 0;
     int maxObjects = 4;                     ///< a cell with at most this many primitives stops
     StepMethod step = StepMethod::Exact;    ///< next-leaf method: exact, or the report's push
     double delta = 1e-6;                    ///< push distance, relative to the box's extent
     SplitAxes splitAxes = SplitAxes::Cost;  ///< the axis each BSP level cuts
     bool fullTable = false;                 ///< one full directory instead of sub-tables
+    /// Stop a cell where no split lowers the estimated cost (false: the report's rule alone,
+    /// max-objects and max-level, with cells inside all their primitives' boxes kept whole).
+    bool costStop = true;
+    /// Cost of a leaf the walk crosses, in primitive tests: callgrind instructions per region
+    /// visit over those per sphere test, fitted on balls4 (docs/regular.md, "Cost-driven splits").
+    double stepCost = 1.5;
+    /// Cost of one primitive test (a sphere's; a polygon's weighs 1 + vertices / 4 of it).
+    double testCost = 1.0;
 };
+
+/// The max-level of `--max-level 0` for a scene of `primitives` live primitives:
+/// 16 + 0.65 log2 N, rounded, within 8..48 (docs/regular.md, "Cost-driven splits").
+int automaticMaxLevel(size_t primitives);
+/// The max-level a build over `primitives` uses: the configured one, or the automatic one.
+int effectiveMaxLevel(const RegularConfig& config, size_t primitives);
 
 /// The irregular scheme's knobs (report, section 2). Defaults measured in docs/irregular.md
 /// ("Growth", "Segment heuristics", "Projective zones for primary rays"):
@@ -67,9 +82,9 @@ struct BuildParams {
     IrregularConfig irregular;  ///< read by the irregular scheme only
 };
 
-/// The knobs the scheme in use reads, as command-line options: "regular --max-level 24
-/// --max-objects 4 --step exact --split-axes cost" (and --delta, --full-table, --no-mailbox,
-/// --no-light-buffer where they apply and differ from the defaults).
+/// The knobs the scheme in use reads, as command-line options: "regular --max-level 0
+/// --max-objects 4 --step exact --split-axes cost" (and --delta, --full-table, --no-cost-stop,
+/// --no-mailbox, --no-light-buffer where they apply and differ from the defaults).
 std::string toString(const BuildParams& p);
 std::ostream& operator<<(std::ostream& os, const BuildParams& p);
 

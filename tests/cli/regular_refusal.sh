@@ -7,7 +7,7 @@ LANCER="$1"; SRC="$2"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 
-out=$("$LANCER" render builtin:lattice --scheme regular --max-level 30 --max-objects 2 \
+out=$("$LANCER" render builtin:lattice --scheme regular --max-level 30 --max-objects 2 --no-cost-stop \
       --width 8 --height 8 -o "$tmp/x.png" 2>&1) && fail "absurd parameters accepted"
 echo "$out" | grep -q -- "--max-level 30 --max-objects 2" || fail "message does not name the options: $out"
 echo "$out" | grep -q "memory budget" || fail "message does not say why: $out"

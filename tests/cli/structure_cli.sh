@@ -91,7 +91,7 @@ out=$("$LANCER" structure builtin:default -o "$tmp/no/such/dir/x.json" 2>&1); [ 
 echo "$out" | grep -q -- "-o " || fail "unwritable -o: message does not name the option: $out"
 out=$("$LANCER" structure builtin:default --max-level x -o "$tmp/x.json" 2>&1); [ $? -eq 2 ] || fail "bad --max-level: not exit 2"
 echo "$out" | grep -q -- "--max-level" || fail "bad --max-level: message does not name it: $out"
-out=$("$LANCER" structure builtin:lattice --scheme regular --max-level 30 --max-objects 2 -o "$tmp/x.json" 2>&1) \
+out=$("$LANCER" structure builtin:lattice --scheme regular --max-level 30 --max-objects 2 --no-cost-stop -o "$tmp/x.json" 2>&1) \
   && fail "absurd build accepted"
 [ -e "$tmp/x.json" ] || [ -e "$tmp/x.json.tmp" ] && fail "a file was left by a failed dump"
 out=$("$LANCER" structure "$tmp/missing.nff" -o "$tmp/x.json" 2>&1); [ $? -eq 2 ] || fail "missing scene: not exit 2"

@@ -253,7 +253,8 @@ void Overlays::panel(bool* open) {
         ImGui::SameLine();
         ImGui::RadioButton("by primitives", &color, int(LeafColor::Prims));
         o.leafColor = LeafColor(color);
-        const int top = std::max(1, view_->accelerator().params().regular.maxLevel);
+        const auto& extra = view_->accelerator().info().extra;
+        const int top = std::max(1, extra.value("effective_max_level", 1));
         ImGui::DragIntRange2("levels", &o.levelMin, &o.levelMax, 0.1f, 0, top, "from %d", "to %d");
         o.levelMin = std::clamp(o.levelMin, 0, top);
         o.levelMax = std::clamp(o.levelMax, o.levelMin, std::max(top, o.levelMax));

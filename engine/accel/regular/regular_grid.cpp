@@ -28,6 +28,24 @@ bool coveredByAll(const Scene& scene, std::span<const uint32_t> prims, const Box
     return true;
 }
 
+/// What testing each primitive costs, in sphere tests: a polygon's inside test loops over its
+/// edges, so it weighs 1 + vertices / 4 (on gears, whose faces have up to 144 vertices, weighing
+/// every test alike made the planner cut x and y first, for 34% more instructions than x, y, z in
+/// turn).
+std::vector<double> testWeights(const Scene& scene) {
+    std::vector<double> w(scene.prims.size(), 1.0);
+    for (size_t i = 0; i < w.size(); ++i)
+        if (const Polygon* pg = std::get_if<Polygon>(&scene.prims[i].shape))
+            w[i] = 1.0 + double(pg->p.size()) / 4.0;
+    return w;
+}
+
+/// Surface area of a box.
+double area(const Box3& b) {
+    const Vec3 e = b.extent();
+    return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
+}
+
 /// Levels --split-axes cost plans (4 cuts per axis on a cube: they fix the cells' shape); deeper
 /// ones cut the longest axis of the level's cells, as the report's order
 /// does on a cube. Planning every level cost up to 40% more build time on scenes of thousands of
@@ -39,19 +57,14 @@ constexpr int kPlannedLevels = 12;
 /// alone (no CSG restriction, so a little pessimistic). Every cell of a level has the same
 /// surface area A(axis) once cut on `axis`, so with the surface area heuristic the next level
 /// costs A(axis) x (2 visits + the tests of the primitive references) per cut cell; the cheapest
-/// axis is cut, ties going to x, then y. A test costs 1, a polygon's 1 + vertices / 4 (its
-/// inside test loops over the edges: on gears, whose faces have up to 144 vertices, counting
-/// them alike cut x and y first and cost 34% more instructions than x, y, z in turn). Cells stop
-/// as in the build: at most max-objects primitives, or covered by all their boxes. On a cube of
+/// axis is cut, ties going to x, then y; a test weighs as testWeights() says. Cells stop as in
+/// the build: at most max-objects primitives, or covered by all their boxes. On a cube of
 /// evenly spread primitives this is the report's x, y, z; on a flat scene (balls4: 24 x 24 x 1.5)
 /// it cuts x and y until the cells are about cubes, where the report's order makes them 16 times
 /// flatter than wide.
 AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector<uint32_t>& live,
-                          const RegularConfig& params, const BuildGuard& guard) {
-    std::vector<double> cost(scene.prims.size(), 1.0);
-    for (size_t i = 0; i < cost.size(); ++i)
-        if (const Polygon* pg = std::get_if<Polygon>(&scene.prims[i].shape))
-            cost[i] = 1.0 + double(pg->p.size()) / 4.0;
+                          const std::vector<double>& cost, int maxLevel, int maxObjects,
+                          const BuildGuard& guard) {
     // The cells of a level, their primitives in one array: cell c holds refs[begin, end).
     struct Cell {
         Box3 box;
@@ -61,7 +74,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
     std::vector<uint32_t> refs(live), nextRefs;
     Vec3 size = box.extent();
     std::vector<int> axes;
-    for (int level = 0; level < params.maxLevel; ++level) {
+    for (int level = 0; level < maxLevel; ++level) {
         if (level >= kPlannedLevels) {  // the longest axis of the level's cells
             int a = 0;
             if (size.y > size[a]) a = 1;
@@ -74,7 +87,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
         // Drop the cells that stop here.
         size_t open = 0;
         for (const Cell& c : cells)
-            if (c.end - c.begin > size_t(params.maxObjects) &&
+            if (c.end - c.begin > size_t(maxObjects) &&
                 !coveredByAll(scene, {refs.data() + c.begin, c.end - c.begin}, c.box))
                 cells[open++] = c;
         cells.resize(open);
@@ -126,10 +139,17 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
 /// (restriction composes: restricting to P then to Q ⊆ P equals restricting to Q), so a node
 /// costs the size of its parent's small tree, not of the scene's tree.
 struct RegularBuilder {
+    /// Levels the split decision looks ahead: one cut per axis. A cut through a cell crossed by
+    /// bars parallel to it (the sponge's) separates nothing, while the cuts across them do; a
+    /// decision on one level would stop there.
+    static constexpr int kLookahead = 3;
+
     const Scene& scene;
     const RegularConfig& params;
     RegularGrid& grid;
     BuildGuard& guard;
+    int maxLevel;                ///< params.maxLevel, or the automatic one
+    std::vector<double> weight;  ///< each primitive's test, in sphere tests (testWeights)
     BspNodes bsp;
     std::vector<char> keep;  ///< membership marks, all 0 between uses
     struct SharedTree {
@@ -149,10 +169,12 @@ struct RegularBuilder {
         CsgTree sub;
     };
     std::vector<Scratch> scratch = {};  ///< per level, for the children of a node there
+    std::vector<uint32_t> look[kLookahead + 1] = {};  ///< the cost estimate's lists, per depth
     uint64_t primRefs = 0;
     uint32_t maxPrims = 0;
     size_t emptyLeaves = 0;
     size_t coveredLeaves = 0;  ///< leaves stopped because every box holds the whole cell
+    size_t costLeaves = 0;     ///< leaves stopped because no split lowered the estimated cost
 
     /// Plane `i` of `level`-cut grid on `axis` (i in 0..2^cuts); equal to grid.plane() at the
     /// finest level, since i / 2^c == (i 2^(n-c)) / 2^n exactly in floating point.
@@ -163,7 +185,7 @@ struct RegularBuilder {
     }
 
     std::string options() const {
-        return "--max-level " + std::to_string(params.maxLevel) + " --max-objects " +
+        return "--max-level " + std::to_string(maxLevel) + " --max-objects " +
                std::to_string(params.maxObjects);
     }
 
@@ -196,6 +218,59 @@ struct RegularBuilder {
                 std::to_string(bsp.nodes.size()) +
                 " BSP nodes, with room to grow); lower --max-level, raise --max-objects or raise "
                 "--memory-budget");
+    }
+
+    /// Estimated cost of a ray crossing a leaf over `prims`: one step of the walk and a test of
+    /// each primitive.
+    double leafCost(std::span<const uint32_t> prims) const {
+        double tests = 0.0;
+        for (uint32_t p : prims) tests += weight[p];
+        return params.stepCost + params.testCost * tests;
+    }
+
+    /// Estimated cost of a ray crossing the cell `box` at `level` that holds `prims`, split on
+    /// the level's axis, its children then split as far as `depth` more levels pay. The surface
+    /// area heuristic over the minimized boxes: a ray crossing the cell crosses a child with
+    /// the chance of their areas' ratio, and a child holds the primitives whose boxes overlap
+    /// it. The walk goes from leaf to leaf without descending the BSP, so a split costs nothing
+    /// of its own: its price is the extra leaves a ray crosses, each one a step.
+    double splitCost(const Box3& box, std::span<const uint32_t> prims, int level, int depth) {
+        const int axis = grid.schedule_.axis(level);
+        const double mid = 0.5 * (box.lo[axis] + box.hi[axis]);
+        Box3 child[2] = {box, box};
+        child[0].hi[axis] = child[1].lo[axis] = mid;
+        // The primitives overlap the cell, so a child's test is on the cut axis alone.
+        double tests[2] = {0.0, 0.0};
+        size_t count[2] = {0, 0};
+        for (uint32_t p : prims) {
+            const Box3& b = scene.minBox[p];
+            if (b.lo[axis] <= mid) tests[0] += weight[p], ++count[0];
+            if (b.hi[axis] >= mid) tests[1] += weight[p], ++count[1];
+        }
+        const double parentArea = area(box);
+        double cost = 0.0;
+        for (int side = 0; side < 2; ++side) {
+            double c = params.stepCost + params.testCost * tests[side];
+            if (depth > 1 && level + 1 < maxLevel && count[side] > size_t(params.maxObjects)) {
+                std::vector<uint32_t>& in = look[depth];
+                in.clear();
+                for (uint32_t p : prims)
+                    if (side ? scene.minBox[p].hi[axis] >= mid : scene.minBox[p].lo[axis] <= mid)
+                        in.push_back(p);
+                if (!coveredByAll(scene, in, child[side]))
+                    c = std::min(c, splitCost(child[side], in, level + 1, depth - 1));
+            }
+            cost += area(child[side]) / parentArea * c;
+        }
+        return cost;
+    }
+
+    /// Whether splitting the cell lowers the estimated cost: at once with its children as
+    /// leaves (most cells), else with kLookahead levels of splits below.
+    bool splitPays(const Box3& box, std::span<const uint32_t> prims, int level) {
+        const double leaf = leafCost(prims);
+        return splitCost(box, prims, level, 1) < leaf ||
+               splitCost(box, prims, level, kLookahead) < leaf;
     }
 
     /// The tree restricted to `prims` in the shared pool, and their list, added once per set.
@@ -231,7 +306,7 @@ struct RegularBuilder {
     /// `tree` is the scene's tree restricted to `prims` (sorted), the primitives that matter here.
     void build(int id, int level, const uint32_t pos[3], const Box3& box, const CsgTree& tree,
                const std::vector<uint32_t>& prims) {
-        if (prims.size() <= size_t(params.maxObjects) || level >= params.maxLevel) {
+        if (prims.size() <= size_t(params.maxObjects) || level >= maxLevel) {
             makeLeaf(id, level, pos, treeFor(tree, prims), uint32_t(prims.size()));
             return;
         }
@@ -244,6 +319,12 @@ struct RegularBuilder {
         // max-objects boxes would then split down to max-level: millions of identical leaves.)
         if (coveredByAll(scene, prims, box)) {
             ++coveredLeaves;
+            makeLeaf(id, level, pos, treeFor(tree, prims), uint32_t(prims.size()));
+            return;
+        }
+        // A split that does not lower the estimated cost within kLookahead levels is not made.
+        if (params.costStop && !splitPays(box, prims, level)) {
+            ++costLeaves;
             makeLeaf(id, level, pos, treeFor(tree, prims), uint32_t(prims.size()));
             return;
         }
@@ -298,7 +379,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     BuildGuard& guard = guardIn ? *guardIn : ownGuard;
     if (params.maxLevel < 0 || params.maxLevel > 48)
         throw std::invalid_argument("--max-level " + std::to_string(params.maxLevel) +
-                                    ": must be in 0..48 for the regular scheme");
+                                    ": must be in 0..48 for the regular scheme (0: automatic)");
     if (params.maxObjects < 1)
         throw std::invalid_argument("--max-objects " + std::to_string(params.maxObjects) +
                                     ": must be at least 1");
@@ -321,18 +402,26 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     delta_ = params.delta * std::max({ext_.x, ext_.y, ext_.z});
 
     // Build the BSP.
-    RegularBuilder b{scene, params, *this, guard, {}, std::vector<char>(scene.prims.size(), 0),
-                     {},    {}};
+    std::vector<uint32_t> live =
+        scene.tree.empty() ? std::vector<uint32_t>{} : scene.tree.primitives();
+    sortedUnique(live);
+    RegularBuilder b{scene,
+                     params,
+                     *this,
+                     guard,
+                     effectiveMaxLevel(params, live.size()),
+                     testWeights(scene),
+                     {},
+                     std::vector<char>(scene.prims.size(), 0),
+                     {},
+                     {}};
     b.bsp.nodes.resize(1);
     b.unionOnly =
         std::all_of(scene.tree.nodes.begin(), scene.tree.nodes.end(),
                     [](const CsgNode& n) { return n.op == Op::Primitive || n.op == Op::Union; });
-    b.scratch.resize(size_t(std::max(0, params.maxLevel)) + 2);
-    std::vector<uint32_t> live =
-        scene.tree.empty() ? std::vector<uint32_t>{} : scene.tree.primitives();
-    sortedUnique(live);
+    b.scratch.resize(size_t(b.maxLevel) + 2);
     if (params.splitAxes == SplitAxes::Cost)
-        schedule_ = planSchedule(scene, box_, live, params, guard);
+        schedule_ = planSchedule(scene, box_, live, b.weight, b.maxLevel, params.maxObjects, guard);
     const uint32_t origin[3] = {0, 0, 0};
     b.build(0, 0, origin, box_, scene.tree, live);
 
@@ -368,7 +457,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     const size_t otherBytes = memoryBytes();  // everything but the directory, not built yet
     const size_t budget = guard.budget();
     if (dirBytes > budget || dirBytes + otherBytes > budget) {
-        std::string what = full ? "--full-table" : "--max-level " + std::to_string(params.maxLevel);
+        std::string what = full ? "--full-table" : "--max-level " + std::to_string(b.maxLevel);
         throw std::invalid_argument(
             what + ": the regular directory at level " + std::to_string(finest) + " would take " +
             (dirBytes == SIZE_MAX ? std::string("2^") + std::to_string(finest + 2) + " bytes"
@@ -411,6 +500,8 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         {"leaves", leaves_.size()},
         {"empty_leaves", b.emptyLeaves},
         {"covered_leaves", b.coveredLeaves},
+        {"cost_leaves", b.costLeaves},
+        {"effective_max_level", b.maxLevel},
         {"bsp_nodes", b.bsp.nodes.size()},
         {"finest_level", finest},
         {"depth_xyz", {depth[0], depth[1], depth[2]}},

@@ -1,0 +1,37 @@
+#include "app/bench/image_error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace lancer::bench {
+
+ImageError compareImages(const Image& ref, const Image& img, const PassLattice& on) {
+    ImageError e;
+    std::vector<uint8_t> a = ref.rgba8(), b = img.rgba8();
+    for (int y = 0; y < ref.height; ++y)
+        for (int x = 0; x < ref.width; ++x) {
+            if (!on.contains(x, y)) continue;
+            const size_t i = ref.index(x, y);
+            ++e.compared;
+            float da = ref.depth[i], db = img.depth[i];
+            bool bothMiss = std::isinf(da) && std::isinf(db);
+            double dd = bothMiss                             ? 0.0
+                        : (std::isinf(da) || std::isinf(db)) ? kInf
+                                                             : std::abs(double(da) - double(db));
+            if (ref.hitPrim[i] != img.hitPrim[i] || dd > 1e-6 * std::max(1.0, double(da)))
+                ++e.hitDiff;
+            if (std::isfinite(dd))
+                e.maxDepthDiff = std::max(e.maxDepthDiff, dd);
+            else
+                e.maxDepthDiff = kInf;
+            for (int c = 0; c < 3; ++c)
+                if (std::abs(int(a[4 * i + size_t(c)]) - int(b[4 * i + size_t(c)])) > 2) {
+                    ++e.colorDiff;
+                    break;
+                }
+        }
+    return e;
+}
+
+}  // namespace lancer::bench

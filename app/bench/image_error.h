@@ -1,0 +1,22 @@
+// How far an image is from the reference of the same run: the measure of error of `lancer bench`
+// (the report and the scale table), on every pixel or on a lattice of them.
+#pragma once
+
+#include <cstddef>
+
+#include "engine/render/renderer.h"
+
+namespace lancer::bench {
+
+/// Difference of an image against the reference.
+struct ImageError {
+    size_t hitDiff = 0;    ///< pixels whose primary hit (primitive or distance) differs
+    size_t colorDiff = 0;  ///< pixels whose colour differs by more than 2/255
+    double maxDepthDiff = 0.0;
+    size_t compared = 0;  ///< pixels compared
+};
+
+/// `img` against `ref` on the pixels of `on` (default: every pixel); both are sized alike.
+ImageError compareImages(const Image& ref, const Image& img, const PassLattice& on = {});
+
+}  // namespace lancer::bench

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# scripts/scale-check on one small scene: each scheme is measured in a child process (peak
+# memory, time), its hits equal brute force's on every pixel, the table and JSON are written; a
+# limit broken is listed as a failure with exit status 1; a bad limit is refused naming it.
+set -u
+LANCER="$1"; SRC="$2"
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+export LANCER
+"$SRC/scripts/scale-check" "$tmp/ok" --scenes builtin:balls:1 >"$tmp/out" 2>"$tmp/err" \
+  || { cat "$tmp/out" "$tmp/err"; fail "scale-check exited non-zero on balls:1"; }
+grep -q "^| builtin:balls:1 | 11 | regular |" "$tmp/out" || fail "no regular row: $(cat "$tmp/out")"
+grep -q "^No failures" "$tmp/ok/scale.md" || fail "scale.md reports failures"
+python3 - "$tmp/ok/scale.json" <<'PY' || fail "scale.json contents"
+import json, sys
+j = json.load(open(sys.argv[1]))
+rows = {r["scheme"]: r for r in j["rows"]}
+assert set(rows) == {"brute", "regular", "irregular"}, rows.keys()  # --no-peer: no Embree
+b = rows["brute"]
+assert b["stride"] == 1 and b["primitives"] == 11
+for s in ("regular", "irregular"):
+    r = rows[s]
+    # Every pixel compared with brute force, none differing; the figures of a measured run.
+    assert r["pixels_compared"] == b["width"] * b["height"] and r["hits_differing"] == 0, r
+    assert r["peak_rss_bytes"] > r["structure_bytes"] > 0 and r["rays"] > 0, r
+    assert 0 < r["total_s"] <= j["time_limit_s"], r
+assert j["failures"] == []
+PY
+# A memory limit no process keeps to: every scheme is listed, with its peak, and exit status 1.
+"$SRC/scripts/scale-check" "$tmp/low" --scenes builtin:balls:1 --memory-limit 1M >"$tmp/out" 2>&1
+[ $? -eq 1 ] || fail "a broken limit did not exit 1"
+grep -q "^- builtin:balls:1 regular: peak resident memory" "$tmp/out" || fail "regular not listed: $(cat "$tmp/out")"
+grep -q "^- builtin:balls:1 irregular: peak resident memory" "$tmp/out" || fail "irregular not listed"
+out=$("$LANCER" bench --scale --scenes builtin:balls:1 --memory-limit lots --out "$tmp/bad" 2>&1)
+[ $? -eq 2 ] || fail "a bad --memory-limit was accepted"
+echo "$out" | grep -q "^error: --memory-limit lots" || fail "message: $out"
+out=$("$LANCER" bench --scale --scenes builtin:nosuch --out "$tmp/bad" 2>&1)
+[ $? -eq 2 ] && echo "$out" | grep -q "builtin:nosuch: unknown built-in scene" || fail "unknown scene: $out"
+echo ok
