@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "engine/accel/eval.h"
+#include "engine/model/restriction.h"
 #include "tests/support/differential.h"
 
 namespace lancer {
@@ -57,6 +58,79 @@ TEST(Restriction, NestedTree) {
     CsgTree r2;
     r2.root = restrictTree(t, t.root, {1, 0, 1, 1}, r2);
     EXPECT_EQ(r2.toString(), "(p0 − (p2 ∩ p3))");
+}
+
+// ((p0 ∪ p1) − (p2 ∩ p3)), the tree of the pool's tests.
+CsgTree differenceOfUnionAndIntersection() {
+    CsgTree t;
+    int u = t.combine(Op::Union, t.leaf(0), t.leaf(1));
+    int i = t.combine(Op::Intersection, t.leaf(2), t.leaf(3));
+    t.root = t.combine(Op::Difference, u, i);
+    return t;
+}
+
+TEST(Restriction, ToAListLeavesTheMarksClearAndComposes) {
+    const CsgTree t = differenceOfUnionAndIntersection();
+    std::vector<char> marks(4, 0);
+    CsgTree r, rr, direct;
+    // {p0, p1, p2}: the intersection loses p3, so the difference keeps its minuend alone.
+    r.root = restrictTreeTo(t, {0, 1, 2}, marks, r);
+    EXPECT_EQ(r.toString(), "(p0 ∪ p1)");
+    EXPECT_EQ(marks, std::vector<char>(4, 0));
+    // Restricting to P then to Q ⊆ P is restricting to Q (the regular builder relies on it).
+    rr.root = restrictTreeTo(r, {1}, marks, rr);
+    direct.root = restrictTreeTo(t, {1}, marks, direct);
+    EXPECT_EQ(rr.toString(), "p1");
+    EXPECT_EQ(direct.toString(), "p1");
+    // The ancestors-only restriction builds the same nodes.
+    TreeRestrictor restrictor(t);
+    CsgTree sparse;
+    sparse.root = restrictor.restrict({0, 1, 2}, sparse);
+    EXPECT_EQ(sparse.toString(), r.toString());
+    EXPECT_EQ(sparse.nodes.size(), r.nodes.size());
+}
+
+TEST(RestrictedTreePool, EachSetStoredOnceEqualSetsShareIt) {
+    const CsgTree t = differenceOfUnionAndIntersection();
+    TreeRestrictor restrictor(t);
+    RestrictedTreePool pool;
+    int restrictions = 0;
+    auto share = [&](const std::vector<uint32_t>& prims) {
+        return pool.share(prims, [&](CsgTree& dst) {
+            ++restrictions;
+            return restrictor.restrict(prims, dst);
+        });
+    };
+    // The empty set is list 0 with the empty tree, there from the start.
+    EXPECT_EQ(pool.size(), 1u);
+    RestrictedTreePool::Entry empty = share({});
+    EXPECT_EQ(empty.list, 0u);
+    EXPECT_EQ(empty.root, -1);
+    EXPECT_EQ(restrictions, 0);
+
+    RestrictedTreePool::Entry a = share({0, 3});
+    EXPECT_EQ(a.list, 1u);
+    CsgTree view = pool.trees;
+    view.root = a.root;
+    EXPECT_EQ(view.toString(), "p0");  // p3 alone: the intersection is empty
+    const size_t nodes = pool.trees.nodes.size();
+
+    // The subtrahend's primitives alone restrict to the empty tree, yet the set has its list.
+    RestrictedTreePool::Entry b = share({2, 3});
+    EXPECT_EQ(b.list, 2u);
+    EXPECT_EQ(b.root, -1);
+    EXPECT_EQ(pool.trees.nodes.size(), nodes);
+
+    // The same set again: the same root and list, nothing restricted or stored again.
+    RestrictedTreePool::Entry again = share({0, 3});
+    EXPECT_EQ(again.root, a.root);
+    EXPECT_EQ(again.list, a.list);
+    EXPECT_EQ(restrictions, 2);
+    EXPECT_EQ(pool.size(), 3u);
+    EXPECT_EQ(pool.trees.nodes.size(), nodes);
+    EXPECT_EQ(pool.listFirst, (std::vector<uint32_t>{0, 0, 2, 4}));
+    EXPECT_EQ(pool.lists, (std::vector<uint32_t>{0, 3, 2, 3}));
+    EXPECT_GE(pool.bytes(), pool.size() * RestrictedTreePool::kEntryBytes);
 }
 
 TEST(MinimizedBoxes, IntersectionClipsBothSides) {

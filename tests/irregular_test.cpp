@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <random>
 
-#include "engine/accel/irregular/tree_restrictor.h"
+#include "engine/model/restriction.h"
 #include "engine/scene/loader.h"
 #include "tests/support/differential.h"
 

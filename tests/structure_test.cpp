@@ -10,6 +10,7 @@
 
 #include "engine/accel/structure_dump.h"
 #include "engine/accel/structure_view.h"
+#include "engine/model/restriction.h"
 #include "tests/support/differential.h"
 
 namespace lancer {

@@ -10,13 +10,16 @@
 namespace lancer {
 namespace {
 
-TEST(FormatBytes, TakesTheLargestUnitOfWhichThereAreTen) {
+// The unit --memory-budget takes and its messages name: a budget of 4M reads "4.0 MiB".
+TEST(FormatBytes, TakesTheLargestUnitReached) {
     EXPECT_EQ(formatBytes(0), "0 B");
-    EXPECT_EQ(formatBytes(10 * 1024 - 1), "10239 B");
-    EXPECT_EQ(formatBytes(10 * 1024), "10.0 KiB");
-    EXPECT_EQ(formatBytes(3'880'000), "3789.1 KiB");
-    EXPECT_EQ(formatBytes(10 * 1024 * 1024), "10.0 MiB");
+    EXPECT_EQ(formatBytes(1023), "1023 B");
+    EXPECT_EQ(formatBytes(1024), "1.0 KiB");
+    EXPECT_EQ(formatBytes(3'880'000), "3.7 MiB");
     EXPECT_EQ(formatBytes(size_t(512) << 20), "512.0 MiB");
+    EXPECT_EQ(formatBytes(size_t(3) << 29), "1.5 GiB");
+    EXPECT_EQ(formatBytes(size_t(2) << 40), "2.0 TiB");
+    EXPECT_EQ(formatBytes(size_t(4096) << 40), "4096.0 TiB");  // no unit above TiB
 }
 
 TEST(FormatBytes, AGivenUnitHoldsForEveryCount) {
@@ -24,6 +27,7 @@ TEST(FormatBytes, AGivenUnitHoldsForEveryCount) {
     EXPECT_EQ(formatBytes(3'880'000, ByteUnit::MiB), "3.7 MiB");
     EXPECT_EQ(formatBytes(1536, ByteUnit::KiB), "1.5 KiB");
     EXPECT_EQ(formatBytes(size_t(20) << 20, ByteUnit::B), "20971520 B");
+    EXPECT_EQ(formatBytes(size_t(512) << 20, ByteUnit::GiB), "0.5 GiB");
 }
 
 TEST(Hash, BytesAreFnv1a64) {

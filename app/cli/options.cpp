@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "engine/scene/loader.h"
+#include "engine/util/format.h"
 
 namespace lancer::cli {
 
@@ -51,7 +52,7 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
             case ParamKind::Size:
                 opt = app.add_option_function<std::string>(
                              d.flag, [p, k](const std::string& v) { parseValue(*p, v, *k); },
-                             help + " (here: " + formatSize(defaultMemoryBudget()) + ")")
+                             help + " (here: " + formatBytes(defaultMemoryBudget()) + ")")
                           ->check(CLI::Validator(
                               [](std::string& v) {
                                   if (v == "0") return std::string();
@@ -79,8 +80,8 @@ BuildControl buildProgressOnStderr() {
     BuildControl c;
     c.progress = [](const BuildProgress& p) {
         std::fprintf(stderr, "building: %s, %.0f s, %s of the %s memory budget, %zu so far\n",
-                     p.stage, p.seconds, formatSize(p.bytes).c_str(), formatSize(p.budget).c_str(),
-                     p.items);
+                     p.stage, p.seconds, formatBytes(p.bytes).c_str(),
+                     formatBytes(p.budget).c_str(), p.items);
     };
     return c;
 }

@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "app/viewer/camera_control.h"
+#include "engine/scene/builtin_scenes.h"
 
 namespace lancer::viewer {
 
@@ -23,7 +24,7 @@ ViewerState::ViewerState(ViewerSettings& settings, bool logTimings, std::functio
         renderer_.setOnPass(wake);
         builder_.setOnReady(wake);
     }
-    notes_.pathInput = s_.scene.rfind("builtin:", 0) == 0 ? "" : s_.scene;
+    notes_.pathInput = isBuiltinSpec(s_.scene) ? "" : s_.scene;
     requestBuild(true, "open scene");
 }
 
@@ -39,7 +40,7 @@ void ViewerState::logTiming(const std::string& line) const {
 
 void ViewerState::openScene(const std::string& spec) {
     s_.scene = spec;
-    if (spec.rfind("builtin:", 0) != 0) notes_.pathInput = spec;  // a dropped file shows
+    if (!isBuiltinSpec(spec)) notes_.pathInput = spec;  // a dropped file shows
     ImGui::MarkIniSettingsDirty();
     requestBuild(true, "open scene");
 }

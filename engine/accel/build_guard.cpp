@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstdio>
 
 namespace lancer {
 
@@ -18,16 +17,6 @@ size_t defaultMemoryBudget() {
     const size_t phys = physicalMemoryBytes();
     if (phys == 0) return size_t(1) << 30;
     return std::max(phys / 8, size_t(256) << 20);
-}
-
-std::string formatSize(size_t bytes) {
-    static const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
-    double v = double(bytes);
-    int u = 0;
-    while (v >= 1024.0 && u < 4) v /= 1024.0, ++u;
-    char buf[64];
-    std::snprintf(buf, sizeof buf, u ? "%.1f %s" : "%.0f %s", v, units[u]);
-    return buf;
 }
 
 size_t parseMemoryBudget(const std::string& text) {

@@ -23,9 +23,6 @@ size_t physicalMemoryBytes();
 /// The budget of a build that names none: an eighth of physical memory (at least 256 MiB, and
 /// 1 GiB when the system does not say), so a build never takes the machine's memory.
 size_t defaultMemoryBudget();
-/// A memory size the way --memory-budget takes it, in the largest binary unit it reaches:
-/// "1.5 GiB", "4.0 MiB" (formatBytes of engine/util/format.h stays below GiB, for tables).
-std::string formatSize(size_t bytes);
 /// Parse a --memory-budget value: bytes, or a number with K, M, G or T (powers of 1024), an
 /// optional "iB"/"B" after it. Throws std::invalid_argument naming the option.
 size_t parseMemoryBudget(const std::string& text);

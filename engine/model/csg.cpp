@@ -183,20 +183,6 @@ MinimizedBoxes minimizeBoxes(const CsgTree& tree, const std::vector<Primitive>& 
     return r;
 }
 
-int restrictTree(const CsgTree& src, int node, const std::vector<char>& keep, CsgTree& dst) {
-    if (node < 0) return -1;
-    const CsgNode& x = src.nodes[node];
-    if (x.op == Op::Primitive) return keep[x.prim] ? dst.leaf(x.prim) : -1;
-    int a = restrictTree(src, x.left, keep, dst);
-    // Short cut: with A empty, intersection and difference are empty whatever B is.
-    if (a < 0 && x.op != Op::Union) return -1;
-    int b = restrictTree(src, x.right, keep, dst);
-    if (a >= 0 && b >= 0) return dst.combine(x.op, a, b);
-    if (a < 0 && b < 0) return -1;
-    if (a < 0) return b;                       // only B: union gives B
-    return x.op == Op::Intersection ? -1 : a;  // only A: union and difference give A
-}
-
 std::string checkSurfacesUnderUnions(const CsgTree& tree, const std::vector<Primitive>& prims) {
     if (tree.root < 0) return "";
     std::string err;

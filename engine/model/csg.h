@@ -1,5 +1,5 @@
-// CSG trees of primitives: the scene model, its minimized bounding boxes (report, Fig. 1) and
-// its restriction to a set of primitives (report, section 2).
+// CSG trees of primitives: the scene model and its minimized bounding boxes (report, Fig. 1).
+// Their restriction to a set of primitives (report, section 2) is in restriction.h.
 #pragma once
 
 #include <cstdint>
@@ -70,10 +70,6 @@ MinimizedBoxes minimizeBoxes(const CsgTree& tree, const std::vector<Primitive>& 
 
 /// Node boxes bottom-up from primitive boxes: union hull, intersection overlap, difference box(A).
 Box3 nodeBox(const CsgTree& tree, int node, const std::vector<Box3>& primBox);
-
-/// The report's restriction of `src` (from node `node`) to the primitives for which keep[p] is
-/// true, appended to `dst`. Returns the new root in dst, or -1 for the empty tree.
-int restrictTree(const CsgTree& src, int node, const std::vector<char>& keep, CsgTree& dst);
 
 /// Check that surfaces occur only under unions; returns an error naming the node, or "".
 std::string checkSurfacesUnderUnions(const CsgTree& tree, const std::vector<Primitive>& prims);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "engine/model/restriction.h"
+
 namespace lancer {
 
 void Scene::prepare() {

@@ -5,16 +5,19 @@
 namespace lancer {
 
 std::string formatBytes(size_t bytes, ByteUnit unit) {
-    constexpr size_t kKiB = 1024, kMiB = 1024 * 1024;
-    if (unit == ByteUnit::Auto)
-        unit = bytes < 10 * kKiB ? ByteUnit::B : bytes < 10 * kMiB ? ByteUnit::KiB : ByteUnit::MiB;
+    static const char* const kNames[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+    int u = int(unit) - int(ByteUnit::B);
+    double v = double(bytes);
+    if (unit == ByteUnit::Auto) {
+        for (u = 0; v >= 1024.0 && u < 4; ++u) v /= 1024.0;
+    } else {
+        for (int i = 0; i < u; ++i) v /= 1024.0;
+    }
     char buf[64];
-    if (unit == ByteUnit::B)
+    if (u == 0)
         std::snprintf(buf, sizeof buf, "%zu B", bytes);
-    else if (unit == ByteUnit::KiB)
-        std::snprintf(buf, sizeof buf, "%.1f KiB", double(bytes) / double(kKiB));
     else
-        std::snprintf(buf, sizeof buf, "%.1f MiB", double(bytes) / double(kMiB));
+        std::snprintf(buf, sizeof buf, "%.1f %s", v, kNames[u]);
     return buf;
 }
 

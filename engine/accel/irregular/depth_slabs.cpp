@@ -1,54 +1,30 @@
 #include "engine/accel/irregular/depth_slabs.h"
 
 #include <algorithm>
-#include <unordered_map>
 
 #include "engine/accel/build_guard.h"
-#include "engine/accel/irregular/tree_restrictor.h"
-#include "engine/util/hash.h"
+#include "engine/model/restriction.h"
 
 namespace lancer {
-
-namespace {
-
-/// Primitive sets keyed by their FNV-1a (the map is only looked up, never iterated, so the
-/// hash values cannot change what is built).
-struct ListHash {
-    size_t operator()(const std::vector<uint32_t>& v) const { return size_t(hashWords(v)); }
-};
-
-}  // namespace
 
 DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
                            double zlo, double zhi, BuildGuard* guard, size_t maxBytes) {
     DepthSlabs out;
     TreeRestrictor restrictor(scene.tree);
     // One tree and one list per distinct primitive set; list 0 is the empty set.
-    std::unordered_map<std::vector<uint32_t>, std::pair<uint32_t, int>, ListHash> shared;
-    out.listFirst = {0, 0};
-    shared[{}] = {0, -1};
+    RestrictedTreePool pool;
     auto share = [&](std::vector<uint32_t>& prims, IrregularRegion& r) {
         std::sort(prims.begin(), prims.end());
-        auto it = shared.find(prims);
-        if (it == shared.end()) {
-            uint32_t list = uint32_t(out.listFirst.size() - 1);
-            int root = restrictor.restrict(prims, out.pool);
-            out.listPrims.insert(out.listPrims.end(), prims.begin(), prims.end());
-            out.listFirst.push_back(uint32_t(out.listPrims.size()));
-            it = shared.emplace(prims, std::make_pair(list, root)).first;
-        }
-        r.list = it->second.first;
-        r.root = it->second.second;
+        const RestrictedTreePool::Entry e =
+            pool.share(prims, [&](CsgTree& dst) { return restrictor.restrict(prims, dst); });
+        r.list = e.list;
+        r.root = e.root;
     };
 
-    // What the slabs hold so far: vectors by capacity; the map keeps each list again, in a node
-    // (64 bytes with malloc's rounding), a key allocation (32 at least) and a bucket.
+    // What the slabs hold so far: vectors by capacity, and the pool.
     auto bytes = [&] {
         return out.regions.capacity() * sizeof(IrregularRegion) +
-               out.zoneFirstRegion.capacity() * sizeof(uint32_t) +
-               out.pool.nodes.capacity() * sizeof(CsgNode) +
-               (out.listFirst.capacity() + 2 * out.listPrims.capacity()) * sizeof(uint32_t) +
-               shared.size() * 112 + shared.bucket_count() * sizeof(void*);
+               out.zoneFirstRegion.capacity() * sizeof(uint32_t) + pool.bytes();
     };
     // What the zones not cut yet cost at least (merged): kept free for them.
     size_t reserve = bsp.zoneCount() * kMergedZoneBytes + bsp.zonePrims.size() * kMergedRefBytes;
@@ -100,6 +76,9 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
         }
         out.zoneFirstRegion.push_back(uint32_t(out.regions.size()));
     }
+    out.pool = std::move(pool.trees);
+    out.listFirst = std::move(pool.listFirst);
+    out.listPrims = std::move(pool.lists);
     return out;
 }
 

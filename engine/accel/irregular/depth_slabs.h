@@ -10,6 +10,7 @@
 
 #include "engine/accel/irregular/region.h"
 #include "engine/accel/irregular/screen_bsp.h"
+#include "engine/model/restriction.h"
 #include "engine/scene/scene.h"
 
 namespace lancer {
@@ -28,9 +29,10 @@ struct DepthSlabs {
 
 class BuildGuard;  // build_guard.h
 
-/// Bytes a zone's slabs cost at least, merged into one: a region, a map entry, and per primitive
+/// Bytes a zone's slabs cost at least, merged into one: a region, a pool entry, and per primitive
 /// its list entry (kept twice) and about two tree nodes.
-inline constexpr size_t kMergedZoneBytes = sizeof(IrregularRegion) + 112;
+inline constexpr size_t kMergedZoneBytes =
+    sizeof(IrregularRegion) + RestrictedTreePool::kEntryBytes;
 inline constexpr size_t kMergedRefBytes = 2 * sizeof(uint32_t) + 2 * sizeof(CsgNode);
 
 /// Cut every zone of `bsp` along depth inside [zlo, zhi]; box[p] is primitive p's camera box.

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "engine/accel/irregular/depth_slabs.h"
-#include "engine/accel/irregular/tree_restrictor.h"
+#include "engine/model/restriction.h"
 
 namespace lancer {
 

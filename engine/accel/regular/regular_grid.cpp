@@ -1,11 +1,12 @@
 #include "engine/accel/regular/regular_grid.h"
 
-#include <map>
 #include <span>
 #include <stdexcept>
 
 #include "engine/accel/accelerator.h"
 #include "engine/accel/build_guard.h"
+#include "engine/model/restriction.h"
+#include "engine/util/format.h"
 
 namespace lancer {
 
@@ -151,12 +152,8 @@ struct RegularBuilder {
     int maxLevel;                ///< params.maxLevel, or the automatic one
     std::vector<double> weight;  ///< each primitive's test, in sphere tests (testWeights)
     BspNodes bsp;
-    std::vector<char> keep;  ///< membership marks, all 0 between uses
-    struct SharedTree {
-        int32_t root = -1;
-        uint32_t first = 0;  ///< in grid.primList_
-    };
-    std::map<std::vector<uint32_t>, SharedTree> trees;  ///< leaf primitive set -> its tree
+    std::vector<char> keep;   ///< membership marks, all 0 between uses
+    RestrictedTreePool pool;  ///< the leaves' trees and lists, moved to the grid at the end
     struct LeafPlace {
         int level;
         uint32_t pos[3];
@@ -197,14 +194,11 @@ struct RegularBuilder {
     }
 
     /// The structure's size so far: what the build has allocated and keeps (vectors by their
-    /// capacity; the pool's map holds each distinct set again, in a node of 80 bytes with
-    /// malloc's rounding and a key allocation of 32 at least).
+    /// capacity) and the pool.
     size_t bytes() const {
         return bsp.nodes.capacity() * sizeof(BspNodes::Node) +
                grid.leaves_.capacity() * sizeof(RegularLeaf) +
-               places.capacity() * sizeof(LeafPlace) +
-               grid.pool_.nodes.capacity() * sizeof(CsgNode) +
-               2 * grid.primList_.capacity() * sizeof(uint32_t) + trees.size() * 112;
+               places.capacity() * sizeof(LeafPlace) + pool.bytes();
     }
 
     /// Cancelled or over the budget: both end the build now.
@@ -213,8 +207,8 @@ struct RegularBuilder {
         guard.poll("regular BSP", b, bsp.nodes.size());
         if (!guard.fits(b))
             throw std::invalid_argument(
-                "--memory-budget " + formatSize(guard.budget()) + ": the regular subdivision at " +
-                options() + " passes its memory budget (" + formatSize(b) + " after " +
+                "--memory-budget " + formatBytes(guard.budget()) + ": the regular subdivision at " +
+                options() + " passes its memory budget (" + formatBytes(b) + " after " +
                 std::to_string(bsp.nodes.size()) +
                 " BSP nodes, with room to grow); lower --max-level, raise --max-objects or raise "
                 "--memory-budget");
@@ -274,28 +268,21 @@ struct RegularBuilder {
     }
 
     /// The tree restricted to `prims` in the shared pool, and their list, added once per set.
-    SharedTree treeFor(const CsgTree& tree, const std::vector<uint32_t>& prims) {
-        if (prims.empty()) return {};
-        auto [it, fresh] = trees.try_emplace(prims);
-        if (fresh) {
-            for (uint32_t p : prims) keep[p] = 1;
-            it->second.root = restrictTree(tree, tree.root, keep, grid.pool_);
-            for (uint32_t p : prims) keep[p] = 0;
-            it->second.first = uint32_t(grid.primList_.size());
-            grid.primList_.insert(grid.primList_.end(), prims.begin(), prims.end());
-        }
-        return it->second;
+    RestrictedTreePool::Entry treeFor(const CsgTree& tree, const std::vector<uint32_t>& prims) {
+        return pool.share(prims,
+                          [&](CsgTree& dst) { return restrictTreeTo(tree, prims, keep, dst); });
     }
 
-    void makeLeaf(int id, int level, const uint32_t pos[3], SharedTree tree, uint32_t nprims) {
+    void makeLeaf(int id, int level, const uint32_t pos[3], RestrictedTreePool::Entry tree,
+                  uint32_t nprims) {
         emptyLeaves += nprims == 0;
         bsp.nodes[size_t(id)].leaf = uint32_t(grid.leaves_.size());
         RegularLeaf leaf;
         leaf.root = tree.root;
         leaf.prims = nprims;
-        leaf.first = tree.first;
+        leaf.first = pool.listFirst[tree.list];
         if (nprims <= RegularLeaf::kInline)
-            std::copy_n(grid.primList_.begin() + tree.first, nprims, leaf.inlined);
+            std::copy_n(pool.lists.begin() + leaf.first, nprims, leaf.inlined);
         grid.leaves_.push_back(leaf);
         places.push_back({level, {pos[0], pos[1], pos[2]}});
         primRefs += nprims;
@@ -355,9 +342,7 @@ struct RegularBuilder {
                 build(first + side, level + 1, cpos, child, tree, prims);
             } else {
                 sc.sub.nodes.clear();
-                for (uint32_t p : sc.in) keep[p] = 1;
-                sc.sub.root = restrictTree(tree, tree.root, keep, sc.sub);
-                for (uint32_t p : sc.in) keep[p] = 0;
+                sc.sub.root = restrictTreeTo(tree, sc.in, keep, sc.sub);
                 if (unionOnly) {
                     // Restricting a union drops no primitive it keeps: all of them are live.
                     build(first + side, level + 1, cpos, child, sc.sub, sc.in);
@@ -424,6 +409,8 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         schedule_ = planSchedule(scene, box_, live, b.weight, b.maxLevel, params.maxObjects, guard);
     const uint32_t origin[3] = {0, 0, 0};
     b.build(0, 0, origin, box_, scene.tree, live);
+    pool_ = std::move(b.pool.trees);
+    primList_ = std::move(b.pool.lists);
 
     // The finest level reached fixes the directory's resolution, 2^n per axis.
     const int finest = b.bsp.nodes[0].height;
@@ -461,8 +448,8 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         throw std::invalid_argument(
             what + ": the regular directory at level " + std::to_string(finest) + " would take " +
             (dirBytes == SIZE_MAX ? std::string("2^") + std::to_string(finest + 2) + " bytes"
-                                  : formatSize(dirBytes)) +
-            ", over the memory budget of " + formatSize(budget) + " (--memory-budget)" +
+                                  : formatBytes(dirBytes)) +
+            ", over the memory budget of " + formatBytes(budget) + " (--memory-budget)" +
             (full ? "; use sub-tables (drop --full-table)" : "; lower --max-level"));
     }
     guard.poll();
@@ -507,7 +494,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         {"depth_xyz", {depth[0], depth[1], depth[2]}},
         {"split_axes", splitAxesName(params.splitAxes)},
         {"axis_schedule", schedule_.toString(finest)},
-        {"distinct_trees", b.trees.size()},
+        {"distinct_trees", b.pool.size() - 1},  // the empty set has no tree
         {"tree_pool_nodes", pool_.nodes.size()},
         {"prims_per_leaf", leaves_.empty() ? 0.0 : double(b.primRefs) / double(leaves_.size())},
         {"max_prims_per_leaf", b.maxPrims},

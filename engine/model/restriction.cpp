@@ -1,0 +1,99 @@
+#include "engine/model/restriction.h"
+
+#include "engine/util/hash.h"
+
+namespace lancer {
+
+namespace {
+
+/// The report's rules from `node` down, the walk entering only nodes for which live(node) holds
+/// (a primitive's leaf: it is kept; an operator: it may hold a kept primitive). Both
+/// restrictions are this walk, so they build the same nodes in the same order.
+template <class Live>
+int restrictWalk(const CsgTree& src, int node, const Live& live, CsgTree& dst) {
+    if (node < 0 || !live(node)) return -1;
+    const CsgNode& x = src.nodes[size_t(node)];
+    if (x.op == Op::Primitive) return dst.leaf(x.prim);
+    int a = restrictWalk(src, x.left, live, dst);
+    // Short cut: with A empty, intersection and difference are empty whatever B is.
+    if (a < 0 && x.op != Op::Union) return -1;
+    int b = restrictWalk(src, x.right, live, dst);
+    if (a >= 0 && b >= 0) return dst.combine(x.op, a, b);
+    if (a < 0 && b < 0) return -1;
+    if (a < 0) return b;                       // only B: union gives B
+    return x.op == Op::Intersection ? -1 : a;  // only A: union and difference give A
+}
+
+}  // namespace
+
+int restrictTree(const CsgTree& src, int node, const std::vector<char>& keep, CsgTree& dst) {
+    return restrictWalk(
+        src, node,
+        [&](int n) {
+            const CsgNode& x = src.nodes[size_t(n)];
+            return x.op != Op::Primitive || keep[x.prim];
+        },
+        dst);
+}
+
+int restrictTreeTo(const CsgTree& src, const std::vector<uint32_t>& prims, std::vector<char>& marks,
+                   CsgTree& dst) {
+    for (uint32_t p : prims) marks[p] = 1;
+    const int root = restrictTree(src, src.root, marks, dst);
+    for (uint32_t p : prims) marks[p] = 0;
+    return root;
+}
+
+TreeRestrictor::TreeRestrictor(const CsgTree& tree)
+    : tree_(&tree), parent_(tree.nodes.size(), -1), live_(tree.nodes.size(), 0) {
+    for (size_t n = 0; n < tree.nodes.size(); ++n) {
+        const CsgNode& x = tree.nodes[n];
+        if (x.op == Op::Primitive) {
+            if (leaves_.size() <= x.prim) leaves_.resize(x.prim + 1);
+            leaves_[x.prim].push_back(int(n));
+        } else {
+            parent_[size_t(x.left)] = int(n);
+            parent_[size_t(x.right)] = int(n);
+        }
+    }
+}
+
+void TreeRestrictor::mark(const std::vector<uint32_t>& prims, char value) {
+    for (uint32_t p : prims) {
+        if (p >= leaves_.size()) continue;
+        for (int n : leaves_[p])
+            for (; n >= 0 && live_[size_t(n)] != value; n = parent_[size_t(n)])
+                live_[size_t(n)] = value;
+    }
+}
+
+int TreeRestrictor::restrict(const std::vector<uint32_t>& prims, CsgTree& dst) {
+    mark(prims, 1);
+    const int root = restrictWalk(
+        *tree_, tree_->root, [&](int n) { return live_[size_t(n)] != 0; }, dst);
+    mark(prims, 0);
+    return root;
+}
+
+size_t RestrictedTreePool::Hash::operator()(const std::vector<uint32_t>& v) const {
+    return size_t(hashWords(v));
+}
+
+RestrictedTreePool::RestrictedTreePool() : listFirst{0, 0} {
+    index_.emplace(std::vector<uint32_t>{}, Entry{});
+}
+
+RestrictedTreePool::Entry RestrictedTreePool::add(const std::vector<uint32_t>& prims, int root) {
+    const uint32_t list = uint32_t(listFirst.size() - 1);
+    lists.insert(lists.end(), prims.begin(), prims.end());
+    listFirst.push_back(uint32_t(lists.size()));
+    return {root, list};
+}
+
+size_t RestrictedTreePool::bytes() const {
+    return trees.nodes.capacity() * sizeof(CsgNode) +
+           (listFirst.capacity() + 2 * lists.capacity()) * sizeof(uint32_t) +
+           index_.size() * kEntryBytes + index_.bucket_count() * sizeof(void*);
+}
+
+}  // namespace lancer

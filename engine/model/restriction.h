@@ -1,0 +1,88 @@
+// The report's restriction of a CSG tree to a set of primitives (section 2), and the pool of
+// restricted trees both subdivision schemes share between regions holding the same primitives.
+// Two ways to restrict, with the same rules and the same nodes: restrictTree walks the whole
+// tree (no set-up: for small trees, as the regular builder restricts each cell's tree for its
+// children), TreeRestrictor walks only the ancestors of the kept primitives (for thousands of
+// small sets over one large tree, where a walk of the whole tree per set is quadratic).
+#pragma once
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "engine/model/csg.h"
+
+namespace lancer {
+
+/// The restriction of `src` (from node `node`) to the primitives for which keep[p] is true,
+/// appended to `dst`. Returns the new root in dst, or -1 for the empty tree.
+int restrictTree(const CsgTree& src, int node, const std::vector<char>& keep, CsgTree& dst);
+
+/// restrictTree of `src`'s root to the list `prims`; `marks` (one per primitive) is all 0 before
+/// and after, set for `prims` meanwhile.
+int restrictTreeTo(const CsgTree& src, const std::vector<uint32_t>& prims, std::vector<char>& marks,
+                   CsgTree& dst);
+
+/// The restriction of one tree to many sets, visiting only the ancestors of each set's leaves.
+class TreeRestrictor {
+  public:
+    explicit TreeRestrictor(const CsgTree& tree);
+    /// Same result as restrictTree(tree, tree.root, keep, dst) with keep = `prims`.
+    int restrict(const std::vector<uint32_t>& prims, CsgTree& dst);
+
+  private:
+    void mark(const std::vector<uint32_t>& prims, char value);
+
+    const CsgTree* tree_;
+    std::vector<int> parent_;
+    std::vector<std::vector<int>> leaves_;  ///< leaves of each primitive
+    std::vector<char> live_;                ///< node is an ancestor of a kept primitive
+};
+
+/// Restricted trees keyed by sorted primitive set: each distinct set's tree (in `trees`) and
+/// primitive list (in `lists`) are stored once, and regions with equal sets share them. List 0
+/// is the empty set, with the empty tree.
+class RestrictedTreePool {
+  public:
+    /// A set's tree and list.
+    struct Entry {
+        int root = -1;      ///< in trees; -1 for the empty tree
+        uint32_t list = 0;  ///< lists[listFirst[list] .. listFirst[list + 1])
+    };
+
+    RestrictedTreePool();
+
+    /// The entry of `prims` (sorted, distinct). A set not seen before gets the tree
+    /// restrict(dst), which appends the restriction to `prims` to dst (= trees) and returns its
+    /// root; lists and trees then grow in the order sets first arrive.
+    template <class Restrict>
+    Entry share(const std::vector<uint32_t>& prims, Restrict&& restrict) {
+        auto it = index_.find(prims);
+        if (it == index_.end()) it = index_.emplace(prims, add(prims, restrict(trees))).first;
+        return it->second;
+    }
+
+    /// Bytes of one index entry beside its key's elements (see bytes()).
+    static constexpr size_t kEntryBytes = 112;
+
+    /// Distinct sets, the empty one included.
+    size_t size() const { return index_.size(); }
+    /// Heap bytes held: vectors by capacity; the index keeps each set again, in a node (64 bytes
+    /// with malloc's rounding), a key allocation (32 at least) and a bucket.
+    size_t bytes() const;
+
+    CsgTree trees;                    ///< every set's restricted tree
+    std::vector<uint32_t> listFirst;  ///< list l: lists[listFirst[l] .. [l + 1])
+    std::vector<uint32_t> lists;      ///< every set's primitives, set after set
+
+  private:
+    struct Hash {
+        size_t operator()(const std::vector<uint32_t>& v) const;
+    };
+    Entry add(const std::vector<uint32_t>& prims, int root);
+
+    /// Only looked up, never iterated: the hash values cannot change what is built.
+    std::unordered_map<std::vector<uint32_t>, Entry, Hash> index_;
+};
+
+}  // namespace lancer
