@@ -26,6 +26,7 @@
 #include "engine/render/renderer.h"
 #include "engine/scene/builtin_scenes.h"
 #include "engine/scene/loader.h"
+#include "engine/util/format.h"
 
 namespace lancer::bench {
 
@@ -105,7 +106,7 @@ ChildResult runChild(const std::function<json(Image&)>& work, double killAfterS,
             j = work(img);
         } catch (const std::bad_alloc&) {
             j = {{"error",
-                  "out of memory (address space limited to " + formatSize(addressSpace) + ")"}};
+                  "out of memory (address space limited to " + formatBytes(addressSpace) + ")"}};
         } catch (const std::exception& e) {
             j = {{"error", e.what()}};
         }
@@ -441,7 +442,7 @@ int runScale(const ScaleOptions& opt) {
             std::string problem;
             if (r.killed)
                 problem = "killed after " + fixed(killAfterS, 0) + " s (peak RSS " +
-                          formatSize(r.peakRssBytes) + ")";
+                          formatBytes(r.peakRssBytes) + ")";
             else if (!r.crash.empty())
                 problem = r.crash;
             else if (f.contains("error"))
@@ -474,7 +475,7 @@ int runScale(const ScaleOptions& opt) {
                                    std::to_string(err.compared) + " hits differ from brute force");
             }
             if (isScheme && r.peakRssBytes > opt.memoryLimit)
-                over.push_back("peak resident memory " + formatSize(r.peakRssBytes));
+                over.push_back("peak resident memory " + formatBytes(r.peakRssBytes));
             if (!problem.empty()) over.insert(over.begin(), problem);
             if ((isScheme || scheme == std::string("brute")) && !over.empty()) {
                 std::string all;
@@ -534,7 +535,7 @@ int runScale(const ScaleOptions& opt) {
             std::cerr << spec << " " << scheme << ": "
                       << (problem.empty()
                               ? "build " + fixed(buildMs, 0) + " ms, render " + fixed(renderMs, 0) +
-                                    " ms, peak " + formatSize(r.peakRssBytes)
+                                    " ms, peak " + formatBytes(r.peakRssBytes)
                               : problem)
                       << "\n";
             table << "|";
@@ -593,11 +594,11 @@ int runScale(const ScaleOptions& opt) {
        << growth.str() << "\n";
     if (failures.empty()) {
         md << "No failures: every scheme built and rendered every scene within "
-           << fixed(opt.timeLimitS, 0) << " s and " << formatSize(opt.memoryLimit)
+           << fixed(opt.timeLimitS, 0) << " s and " << formatBytes(opt.memoryLimit)
            << ", with brute force's hits where compared.\n";
     } else {
         md << "Failures (limits: " << fixed(opt.timeLimitS, 0) << " s, "
-           << formatSize(opt.memoryLimit) << ", brute force's hits):\n\n";
+           << formatBytes(opt.memoryLimit) << ", brute force's hits):\n\n";
         for (const std::string& f : failures) md << "- " << f << "\n";
     }
     json out = {{"width", opt.sceneSize ? json("scene") : json(opt.width)},
