@@ -182,6 +182,10 @@ void viewPanel(ViewerState& st) {
                            : i == 2 ? "regions"
                                     : "time",
                            &mode, i);
+        if (i > 0 && ImGui::IsItemHovered())
+            ImGui::SetTooltip(
+                "A heat map; after a rebuild it also compares the old and new structures, pixel "
+                "by pixel (A/B)");
     }
     if (mode != int(s.mode)) {
         st.setViewMode(ViewMode(mode));
@@ -206,10 +210,6 @@ void viewPanel(ViewerState& st) {
         else
             colourBar(st.heatScale(), s.mode, s.logScale);
         abSection(st);
-    } else {
-        hintText(
-            "A heat map (prim tests, regions, time) compares a rebuild's old and new "
-            "structures, pixel by pixel");
     }
     // The pixel under the cursor, from the same per-pixel counters as --stats.
     const Image& shown = st.shown();
