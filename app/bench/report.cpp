@@ -165,14 +165,16 @@ void writePlots(const std::string& dir, const std::vector<std::string>& scenes) 
 
 }  // namespace
 
+bool createOutDir(const std::string& dir) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) std::cerr << "error: --out " << dir << ": " << ec.message() << "\n";
+    return !ec;
+}
+
 int runBench(const BenchOptions& opt) {
     namespace fs = std::filesystem;
-    std::error_code ec;
-    fs::create_directories(opt.outDir, ec);
-    if (ec) {
-        std::cerr << "error: --out " << opt.outDir << ": " << ec.message() << "\n";
-        return 2;
-    }
+    if (!createOutDir(opt.outDir)) return 2;
     auto wanted = [&](SchemeKind k) {
         return std::find(opt.schemes.begin(), opt.schemes.end(), schemeName(k)) !=
                opt.schemes.end();

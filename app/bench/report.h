@@ -22,6 +22,10 @@ struct BenchOptions {
     std::vector<std::string> schemes{"brute", "regular", "irregular"};
 };
 
+/// Create the output directory `dir` (and its parents); false, with an error naming --out on
+/// stderr, when it cannot be made.
+bool createOutDir(const std::string& dir);
+
 /// Run the sweeps, write OUT/report.csv, OUT/*.gp and OUT/*.png. Returns the exit status.
 int runBench(const BenchOptions& opt);
 

@@ -22,6 +22,7 @@
 
 #include "app/bench/embree_peer.h"
 #include "app/bench/image_error.h"
+#include "app/bench/report.h"
 #include "engine/accel/build_guard.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/builtin_scenes.h"
@@ -367,12 +368,7 @@ std::string family(const std::string& spec) {
 
 int runScale(const ScaleOptions& opt) {
     namespace fs = std::filesystem;
-    std::error_code ec;
-    fs::create_directories(opt.outDir, ec);
-    if (ec) {
-        std::cerr << "error: --out " << opt.outDir << ": " << ec.message() << "\n";
-        return 2;
-    }
+    if (!createOutDir(opt.outDir)) return 2;
     for (const std::string& spec : opt.scenes) {
         // A misspelt scene is an input error before minutes of measuring, not a failure row.
         if (auto b = parseBuiltinSpec(spec); b ? !findBuiltin(b->name) : !fs::exists(spec)) {
