@@ -16,6 +16,17 @@ grep ',progressive pass,1,' "$csv" | awk -F, '{ if ($15 != 0 || $16 != 0) exit 1
 # Every scheme row that was measured agrees with brute force at default settings.
 awk -F, '$3=="scheme" && $15 != 0 { exit 1 }' "$csv" || fail "a scheme differs from brute force at defaults"
 [ -s "$tmp/b/speed_vs_error.png" ] || fail "no speed_vs_error plot"
+# The comparison table on a union-only scene: with the peer (Embree, when built in) come the
+# schemes at --bounces 0, each compared with brute force at --bounces 0 after it was rendered.
+"$LANCER" bench --schemes-only --no-plots --scenes builtin:balls:1 --width 48 --height 32 \
+  --threads 2 --out "$tmp/s" 2>"$tmp/log" || { cat "$tmp/log"; fail "bench --schemes-only exited non-zero"; }
+csv="$tmp/s/report.csv"
+awk -F, '$3=="scheme" && $15 != 0 { exit 1 }' "$csv" || fail "--schemes-only: a scheme differs from brute force"
+if grep -q ',embree,peer (bounces 0),' "$csv"; then
+  [ "$(grep -c -E ',(regular|irregular),peer \(bounces 0\),' "$csv")" -eq 2 ] || fail "no scheme rows at --bounces 0"
+  awk -F, '$3=="peer (bounces 0)" && $2!="embree" && $15 != 0 { exit 1 }' "$csv" \
+    || fail "a scheme at --bounces 0 differs from brute force at --bounces 0"
+fi
 out=$("$LANCER" bench --quick --scenes builtin:nosuch --out "$tmp/c" 2>&1) && fail "unknown scene accepted"
 echo "$out" | grep -q "unknown built-in scene" || fail "bench error message: $out"
 echo ok
