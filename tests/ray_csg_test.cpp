@@ -33,12 +33,7 @@ TEST(RayCsg, RootRowIsTheWalksResultAndGivesTheHit) {
     for (uint64_t seed = 1; seed <= 5; ++seed) {
         test::RandomSceneOptions opt;
         opt.primitives = 8 + int(seed) * 3;
-        Scene scene = test::randomCsgScene(seed, opt);
-        scene.materials[0].reflect = 0.3;
-        scene.materials[0].transmit = 0.5;
-        scene.materials[0].ior = 1.4;
-        scene.frameCamera(Vec3(0.3, 1.0, -0.4), Vec3(0.0, 0.0, 1.0));
-        scene.defaultLights();
+        Scene scene = test::randomGlassyCsgScene(seed, opt);
         const BuildParams configs[] = {
             params(SchemeKind::Brute, StepMethod::Exact, IrregularFrame::Projective, true),
             params(SchemeKind::Regular, StepMethod::Exact, IrregularFrame::Projective, true),

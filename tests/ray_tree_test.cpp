@@ -436,12 +436,7 @@ TEST(RayTree, RegionCornersHoldTheRaysStretch) {
         test::RandomSceneOptions opt;
         opt.primitives = 10 + int(seed) * 3;
         opt.surfaces = seed % 2 == 0;
-        Scene scene = test::randomCsgScene(seed, opt);
-        scene.materials[0].reflect = 0.3;
-        scene.materials[0].transmit = 0.5;
-        scene.materials[0].ior = 1.4;
-        scene.frameCamera(Vec3(0.3, 1.0, -0.4), Vec3(0.0, 0.0, 1.0));
-        scene.defaultLights();
+        Scene scene = test::randomGlassyCsgScene(seed, opt);
         std::mt19937_64 rng(seed);
         std::uniform_int_distribution<int> px(0, 31);
         for (const Config& c : configs()) {
@@ -581,12 +576,7 @@ TEST(RayTree, ProjectiveWalkTellsItsExitsAndLocates) {
     for (uint64_t seed = 1; seed <= 4; ++seed) {
         test::RandomSceneOptions opt;
         opt.primitives = 10 + int(seed) * 3;
-        Scene scene = test::randomCsgScene(seed, opt);
-        scene.materials[0].reflect = 0.3;
-        scene.materials[0].transmit = 0.5;
-        scene.materials[0].ior = 1.4;
-        scene.frameCamera(Vec3(0.3, 1.0, -0.4), Vec3(0.0, 0.0, 1.0));
-        scene.defaultLights();
+        Scene scene = test::randomGlassyCsgScene(seed, opt);
         SCOPED_TRACE("seed " + std::to_string(seed));
         check(scene, 32, 24, seed);
     }
@@ -755,11 +745,7 @@ TEST(RayTree, StepReasonNamesTheNextStepsRegion) {
         }
     }
     for (uint64_t seed = 1; seed <= 3; ++seed) {
-        Scene scene = test::randomCsgScene(seed);
-        scene.materials[0].reflect = 0.3;
-        scene.materials[0].transmit = 0.5;
-        scene.frameCamera(Vec3(0.3, 1.0, -0.4), Vec3(0.0, 0.0, 1.0));
-        scene.defaultLights();
+        Scene scene = test::randomGlassyCsgScene(seed);
         for (const Config& c : configs()) {
             if (c.scene != "builtin:default" || c.bounces == 0) continue;
             auto accel = buildAccelerator(scene, paramsOf(c));

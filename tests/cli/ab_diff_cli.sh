@@ -8,17 +8,7 @@ lancer=$1
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
-fails() {  # fails WHAT-THE-MESSAGE-NAMES COMMAND...
-  local want=$1 status=0
-  shift
-  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt" || status=$?
-  if [ "$status" != 2 ]; then
-    echo "expected status 2 from: $* (got $status)" >&2
-    cat "$tmp/err.txt" >&2
-    exit 1
-  fi
-  grep -q -- "$want" "$tmp/err.txt" || { cat "$tmp/err.txt" >&2; exit 1; }
-}
+source "$2/tests/support/cli_lib.sh"
 fails "--view" "$lancer" view builtin:default --view heat --frames 1 --ini none
 fails "--ab" "$lancer" view builtin:default --ab both --frames 1 --ini none
 fails "--change" "$lancer" view builtin:default --change max-level=99 --frames 1 --ini none

@@ -9,17 +9,7 @@ lancer=$1
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
-fails() {  # fails WHAT-THE-MESSAGE-NAMES COMMAND...
-  local want=$1 status=0
-  shift
-  "$@" >"$tmp/out.txt" 2>"$tmp/err.txt" || status=$?
-  if [ "$status" != 2 ]; then
-    echo "expected status 2 from: $* (got $status)" >&2
-    cat "$tmp/err.txt" >&2
-    exit 1
-  fi
-  grep -q -- "$want" "$tmp/err.txt" || { cat "$tmp/err.txt" >&2; exit 1; }
-}
+source "$2/tests/support/cli_lib.sh"
 # Checked before any window opens.
 fails "--step 3" "$lancer" view builtin:default --step 3 --frames 1 --ini none
 fails "--step sideways" "$lancer" view builtin:default --step sideways --frames 1 --ini none

@@ -72,6 +72,16 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
     return s;
 }
 
+Scene randomGlassyCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
+    Scene scene = randomCsgScene(seed, opt);
+    scene.materials[0].reflect = 0.3;
+    scene.materials[0].transmit = 0.5;
+    scene.materials[0].ior = 1.4;
+    scene.frameCamera(Vec3(0.3, 1.0, -0.4), Vec3(0.0, 0.0, 1.0));
+    scene.defaultLights();
+    return scene;
+}
+
 std::vector<Ray> randomRays(const Scene& scene, uint64_t seed, int count) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);

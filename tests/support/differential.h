@@ -23,6 +23,10 @@ struct RandomSceneOptions {
 /// A random binary CSG tree over random solids (spheres, boxes, cylinders, cones), prepared.
 Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt = {});
 
+/// randomCsgScene with a material that reflects and refracts, a framed camera and the default
+/// lights: a pixel's ray tree holds every ray kind (primary, shadow, reflection, refraction).
+Scene randomGlassyCsgScene(uint64_t seed, const RandomSceneOptions& opt = {});
+
 /// Random rays aimed at the scene: through random points of the bounds, from outside and
 /// inside, plus axis-parallel rays. Directions are unit length.
 std::vector<Ray> randomRays(const Scene& scene, uint64_t seed, int count);
