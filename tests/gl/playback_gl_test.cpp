@@ -21,6 +21,52 @@ double distanceToSegment(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {
 
 class PlaybackGl : public ::testing::TestWithParam<SchemeKind> {};
 
+gl::Rgba8 pixelAt(const std::vector<uint8_t>& px, int w, int x, int y) {
+    const uint8_t* p = &px[(size_t(y) * size_t(w) + size_t(x)) * 4];
+    return gl::Rgba8(p[0]) | gl::Rgba8(p[1]) << 8 | gl::Rgba8(p[2]) << 16 | gl::Rgba8(p[3]) << 24;
+}
+
+/// Projected edges, in image pixels.
+using ImageEdges = std::vector<std::pair<glm::dvec2, glm::dvec2>>;
+
+/// The pixels of colour `want`, and how many of them lie farther than 1.5 px from every edge.
+std::pair<int, int> litAndStray(const std::vector<uint8_t>& px, int w, int h, gl::Rgba8 want,
+                                const ImageEdges& edges) {
+    int lit = 0, stray = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            if (pixelAt(px, w, x, y) != want) continue;
+            ++lit;
+            double d = 1e30;
+            for (const auto& [a, b] : edges)
+                d = std::min(d, distanceToSegment({x + 0.5, y + 0.5}, a, b));
+            if (d > 1.5) ++stray;
+        }
+    return {lit, stray};
+}
+
+/// Points along the edges inside the image, and how many of them have no pixel within one of a
+/// colour of `accept` (compared on RGB).
+std::pair<int, int> edgePointsMissed(const std::vector<uint8_t>& px, int w, int h,
+                                     const ImageEdges& edges,
+                                     std::initializer_list<gl::Rgba8> accept) {
+    int onEdges = 0, missed = 0;
+    for (const auto& [a, b] : edges)
+        for (double s = 0.05; s < 1.0; s += 0.1) {
+            const glm::dvec2 q = a + s * (b - a);
+            if (q.x < 2 || q.y < 2 || q.x > w - 2 || q.y > h - 2) continue;
+            ++onEdges;
+            bool hit = false;
+            for (int dy = -1; dy <= 1 && !hit; ++dy)
+                for (int dx = -1; dx <= 1 && !hit; ++dx) {
+                    const gl::Rgba8 got = pixelAt(px, w, int(q.x) + dx, int(q.y) + dy);
+                    for (gl::Rgba8 c : accept) hit = hit || (got & 0xffffff) == (c & 0xffffff);
+                }
+            if (!hit) ++missed;
+        }
+    return {onEdges, missed};
+}
+
 TEST_P(PlaybackGl, RegionAtStepKIsDrawnWhereItsCornersProject) {
     const int w = 160, h = 120;
     testing::OffscreenGl ctx(w, h);
@@ -79,7 +125,7 @@ TEST_P(PlaybackGl, RegionAtStepKIsDrawnWhereItsCornersProject) {
     const std::vector<uint8_t> px = ctx.read();
 
     // The edges projected on the CPU.
-    std::vector<std::pair<glm::dvec2, glm::dvec2>> edges;
+    ImageEdges edges;
     for (int c = 0; c < 8; ++c)
         for (int bit : {1, 2, 4})
             if (!(c & bit)) {
@@ -89,46 +135,14 @@ TEST_P(PlaybackGl, RegionAtStepKIsDrawnWhereItsCornersProject) {
             }
     ASSERT_FALSE(edges.empty());
     const gl::Rgba8 want = gl::rgba8(playback::kRegionColor);
-    int lit = 0, stray = 0;
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const uint8_t* p = &px[(size_t(y) * size_t(w) + size_t(x)) * 4];
-            const gl::Rgba8 got = gl::Rgba8(p[0]) | gl::Rgba8(p[1]) << 8 | gl::Rgba8(p[2]) << 16 |
-                                  gl::Rgba8(p[3]) << 24;
-            if (got != want) continue;
-            ++lit;
-            double d = 1e30;
-            for (const auto& [a, b] : edges)
-                d = std::min(d, distanceToSegment({x + 0.5, y + 0.5}, a, b));
-            if (d > 1.5) ++stray;
-        }
+    const auto [lit, stray] = litAndStray(px, w, h, want, edges);
     EXPECT_GT(lit, 10);
     EXPECT_EQ(stray, 0) << "of " << lit << " pixels of the region's colour";
 
     // And every projected edge point inside the image is lit (within a pixel).
-    int onEdges = 0, missed = 0;
-    for (const auto& [a, b] : edges)
-        for (double s = 0.05; s < 1.0; s += 0.1) {
-            const glm::dvec2 q = a + s * (b - a);
-            if (q.x < 2 || q.y < 2 || q.x > w - 2 || q.y > h - 2) continue;
-            ++onEdges;
-            bool hit = false;
-            for (int dy = -1; dy <= 1 && !hit; ++dy)
-                for (int dx = -1; dx <= 1 && !hit; ++dx) {
-                    const int x = int(q.x) + dx, y = int(q.y) + dy;
-                    const uint8_t* p = &px[(size_t(y) * size_t(w) + size_t(x)) * 4];
-                    hit = p[0] == (want & 0xff) && p[1] == ((want >> 8) & 0xff) &&
-                          p[2] == ((want >> 16) & 0xff);
-                }
-            if (!hit) ++missed;
-        }
+    const auto [onEdges, missed] = edgePointsMissed(px, w, h, edges, {want});
     EXPECT_GT(onEdges, 5);
     EXPECT_EQ(missed, 0) << "of " << onEdges << " points on the projected edges";
-}
-
-gl::Rgba8 pixelAt(const std::vector<uint8_t>& px, int w, int x, int y) {
-    const uint8_t* p = &px[(size_t(y) * size_t(w) + size_t(x)) * 4];
-    return gl::Rgba8(p[0]) | gl::Rgba8(p[1]) << 8 | gl::Rgba8(p[2]) << 16 | gl::Rgba8(p[3]) << 24;
 }
 
 TEST_P(PlaybackGl, TestedPrimitivesBoxesAreDrawnWhereTheirCornersProject) {
@@ -194,7 +208,7 @@ TEST_P(PlaybackGl, TestedPrimitivesBoxesAreDrawnWhereTheirCornersProject) {
     const std::vector<uint8_t> px = ctx.read();
 
     // Each box's edges projected on the CPU, tested ones apart.
-    std::vector<std::pair<glm::dvec2, glm::dvec2>> tested, all;
+    ImageEdges tested, all;
     for (const playback::TestedBox& b : boxes)
         for (int c = 0; c < 8; ++c)
             for (int bit : {1, 2, 4})
@@ -213,36 +227,12 @@ TEST_P(PlaybackGl, TestedPrimitivesBoxesAreDrawnWhereTheirCornersProject) {
     ASSERT_FALSE(tested.empty());
     const gl::Rgba8 testedColor = gl::rgba8(playback::kTestedColor);
     const gl::Rgba8 mailColor = gl::rgba8(playback::kMailboxColor);
-    int lit = 0, stray = 0;
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const gl::Rgba8 got = pixelAt(px, w, x, y);
-            if (got != testedColor) continue;
-            ++lit;
-            double d = 1e30;
-            for (const auto& [a, b] : tested)
-                d = std::min(d, distanceToSegment({x + 0.5, y + 0.5}, a, b));
-            if (d > 1.5) ++stray;
-        }
+    const auto [lit, stray] = litAndStray(px, w, h, testedColor, tested);
     EXPECT_GT(lit, 10);
     EXPECT_EQ(stray, 0) << "of " << lit << " pixels of the tested colour";
     // Every point of a tested box's projected edges inside the image is lit by a box (a
     // mailbox box drawn later may cover it).
-    int onEdges = 0, missed = 0;
-    for (const auto& [a, b] : tested)
-        for (double s = 0.05; s < 1.0; s += 0.1) {
-            const glm::dvec2 q = a + s * (b - a);
-            if (q.x < 2 || q.y < 2 || q.x > w - 2 || q.y > h - 2) continue;
-            ++onEdges;
-            bool hit = false;
-            for (int dy = -1; dy <= 1 && !hit; ++dy)
-                for (int dx = -1; dx <= 1 && !hit; ++dx) {
-                    const gl::Rgba8 got = pixelAt(px, w, int(q.x) + dx, int(q.y) + dy);
-                    hit = (got & 0xffffff) == (testedColor & 0xffffff) ||
-                          (got & 0xffffff) == (mailColor & 0xffffff);
-                }
-            if (!hit) ++missed;
-        }
+    const auto [onEdges, missed] = edgePointsMissed(px, w, h, tested, {testedColor, mailColor});
     EXPECT_GT(onEdges, 5);
     EXPECT_EQ(missed, 0) << "of " << onEdges << " points on the projected edges";
 }
