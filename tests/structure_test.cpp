@@ -12,21 +12,12 @@
 #include "engine/accel/structure_view.h"
 #include "engine/model/restriction.h"
 #include "tests/support/differential.h"
+#include "tests/support/hexahedron.h"
 
 namespace lancer {
 namespace {
 
 constexpr int kW = 40, kH = 30;  // the image the pixel units refer to
-
-/// An orthographic camera on the same eye and axes, framing the scene's bounds.
-void makeOrthographic(Scene& scene) {
-    CameraFrame f = CameraFrame::of(scene.camera);
-    Box3 b = f.box(scene.bounds);
-    scene.camera.projection = Projection::Orthographic;
-    scene.camera.orthoHeight = 1.1 * std::max(b.extent().x, b.extent().y);
-    scene.camera.from = f.toWorld({0.5 * (b.lo.x + b.hi.x), 0.5 * (b.lo.y + b.hi.y), b.lo.z - 1.0});
-    scene.camera.at = scene.camera.from + f.z;
-}
 
 /// One configuration: a random scene seen by one camera, built by one scheme.
 struct Case {
@@ -78,7 +69,7 @@ Built build(const Case& c) {
     b.scene = test::randomCsgScene(c.seed, ro);
     b.scene.width = kW;
     b.scene.height = kH;
-    if (c.ortho) makeOrthographic(b.scene);
+    if (c.ortho) test::makeOrthographic(b.scene);
     BuildParams p;
     p.scheme = c.scheme;
     p.regular.maxLevel = 12;  // 4096 directory cells at most: every cell can be checked
@@ -106,31 +97,6 @@ bool inRect(const std::vector<glm::dvec2>& poly, glm::dvec2 p) {
         hi = glm::max(hi, q);
     }
     return p.x >= lo.x && p.x < hi.x && p.y >= lo.y && p.y < hi.y;
-}
-
-/// p inside the convex hull of a region's corners (a hexahedron with planar faces, possibly
-/// with a face shrunk to a point: the near region's apex), within `tol`.
-bool insideCorners(const std::array<Vec3, 8>& c, const Vec3& p, double tol) {
-    Vec3 centre(0.0);
-    for (const Vec3& q : c) centre += q / 8.0;
-    for (int a = 0; a < 3; ++a)
-        for (int s = 0; s < 2; ++s) {
-            Vec3 f[4];
-            int n = 0;
-            for (int i = 0; i < 8; ++i)
-                if (((i >> a) & 1) == s) f[n++] = c[i];
-            // The face's plane from its diagonals. A face shrunk to a point (the near region's
-            // apex) or a sliver (a zone 1e-8 wide) has no well-conditioned plane: the faces
-            // across it bound the region on their own.
-            const Vec3 d1 = f[3] - f[0], d2 = f[2] - f[1];
-            Vec3 nrm = glm::cross(d1, d2);
-            if (!(glm::length(nrm) > 1e-6 * glm::length(d1) * glm::length(d2))) continue;
-            nrm = glm::normalize(nrm);
-            const Vec3 o = 0.25 * (f[0] + f[1] + f[2] + f[3]);
-            if (glm::dot(centre - o, nrm) > 0.0) nrm = -nrm;  // outward
-            if (glm::dot(p - o, nrm) > tol) return false;
-        }
-    return true;
 }
 
 /// Open overlap of two boxes shrunk by `margin`: they share volume beyond rounding.
@@ -209,7 +175,7 @@ TEST(StructureView, ZonesTileTheScreenRectangle) {
                 const std::array<Vec3, 8> col = f.zoneCorners(z);
                 for (const SlabInfo& sl : f.slabs(z))
                     for (const Vec3& p : v.regionCorners(sl.region))
-                        EXPECT_TRUE(insideCorners(col, p, 1e-9 * b.scene.scale()))
+                        EXPECT_LE(test::outside(col, p), 1e-9 * b.scene.scale())
                             << v.toString(sl.region);
             }
             // Every cut lies inside the rectangle and on its own line.
@@ -408,7 +374,7 @@ TEST(StructureView, CornersHoldTheStretchOfRayTheWalkReports) {
                 const std::array<Vec3, 8> corners = v.regionCorners(e.a);
                 for (double f : {0.0, 0.3, 0.7, 1.0}) {
                     Vec3 p = ray.at(e.t0 + f * (e.t1 - e.t0));
-                    ASSERT_TRUE(insideCorners(corners, p, tol))
+                    ASSERT_LE(test::outside(corners, p), tol)
                         << v.toString(e.a) << " t " << e.t0 << ".." << e.t1 << " "
                         << ray.toString();
                     ++checked;
@@ -422,9 +388,9 @@ TEST(StructureView, CornersHoldTheStretchOfRayTheWalkReports) {
         const Box3 wb = v.worldBounds();
         for (int k = 0; k < 100; ++k) {
             Vec3 p = wb.lo + Vec3(u(rng), u(rng), u(rng)) * wb.extent();
-            if (!insideCorners(v.structureCorners(), p, 0.0)) continue;
+            if (test::outside(v.structureCorners(), p) > 0.0) continue;
             uint32_t id = v.regionAt(p);
-            EXPECT_TRUE(insideCorners(v.regionCorners(id), p, tol)) << v.toString(id);
+            EXPECT_LE(test::outside(v.regionCorners(id), p), tol) << v.toString(id);
         }
     }
 }

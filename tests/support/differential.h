@@ -27,6 +27,10 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt = {});
 /// lights: a pixel's ray tree holds every ray kind (primary, shadow, reflection, refraction).
 Scene randomGlassyCsgScene(uint64_t seed, const RandomSceneOptions& opt = {});
 
+/// An orthographic camera on the scene camera's axes, framing the scene's bounds, its eye plane
+/// in front of them (so that primary rays see the whole scene).
+void makeOrthographic(Scene& scene);
+
 /// Random rays aimed at the scene: through random points of the bounds, from outside and
 /// inside, plus axis-parallel rays. Directions are unit length.
 std::vector<Ray> randomRays(const Scene& scene, uint64_t seed, int count);
