@@ -303,9 +303,12 @@ void ViewerApp::logOverlayTiming(double ms, bool layerDrawn) {
     // The overlays' UI work, per frame, apart from frames that drew the layers again (a
     // change): those are logged one by one.
     if (layerDrawn) {
+        const overlay::OverlayGeometry& g = overlays_->geometry();
         std::fprintf(stderr,
-                     "timing: overlays: layers drawn again in %.2f ms (batches built in %.2f ms)\n",
-                     overlays_->lastLayerMs(), overlays_->lastBuildMs());
+                     "timing: overlays: layers drawn again in %.2f ms (%zu lines, %zu "
+                     "triangles; batches built in %.2f ms)\n",
+                     overlays_->lastLayerMs(), g.cuts.lineCount() + g.wires.lineCount(),
+                     g.fills.triangleCount(), overlays_->lastBuildMs());
         return;
     }
     overlayStat_.ms += ms;
