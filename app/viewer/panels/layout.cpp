@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <vector>
 
 namespace lancer::viewer {
@@ -54,44 +55,73 @@ void waterFill(const std::vector<float>& want, float room, float floor, std::vec
 }
 
 /// Stack `ids` (open panels, top to bottom) in column `col`. A folded panel takes its title
-/// bar. The expanded ones get what they ask for while all fit; else the Ray and Selection
-/// panels first get up to kUsablePanelHeight (leaving each other panel a title bar and two
-/// lines), the others share what is left at a common height (water filling), and what they do
-/// not take goes back to the Ray and Selection panels.
+/// bar. The expanded ones get what they ask for while all fit; else each keeps a title bar and
+/// two lines, the Ray panel then the Selection panel grow to kUsablePanelHeight, the others
+/// share what is left at a common height (water filling), and what they do not take goes to
+/// the Selection panel then the Ray panel, which fills the column.
 void stack(const std::vector<PanelId>& ids, const Rect& col, const LayoutInput& in,
            PanelLayout& out) {
     if (ids.empty()) return;
-    const float title = in.titleHeight, keep = 3.0f * title;
+    const float title = in.titleHeight, keep = std::ceil(3.0f * title);
     std::vector<float> h(ids.size(), title);
     float room = col.height() - kGap * float(ids.size() - 1);
-    std::vector<size_t> first, others;  // expanded panels: cut last, cut first
+    std::vector<size_t> expanded, others;
     for (size_t i = 0; i < ids.size(); ++i) {
-        const PanelRequest& p = in.panels[size_t(ids[i])];
-        if (p.collapsed)
+        if (in.panels[size_t(ids[i])].collapsed) {
             room -= title;
-        else
-            (cutLast(ids[i]) ? first : others).push_back(i);
+            continue;
+        }
+        expanded.push_back(i);
+        if (!cutLast(ids[i])) others.push_back(i);
     }
-    auto wants = [&](const std::vector<size_t>& which, float cap) {
+    auto want = [&](size_t i) {
+        return std::ceil(std::max(in.panels[size_t(ids[i])].want, title));
+    };
+    auto wantsOf = [&](const std::vector<size_t>& which) {
         std::vector<float> w;
-        for (size_t i : which) w.push_back(std::min(in.panels[size_t(ids[i])].want, cap));
+        for (size_t i : which) w.push_back(want(i));
         return w;
     };
-    std::vector<float> hf, ho;
-    float keepOthers = 0.0f;
-    for (float w : wants(others, keep)) keepOthers += std::max(w, title);
-    // 1. The panels cut last, up to a usable height, the others keeping a few lines.
-    waterFill(wants(first, kUsablePanelHeight), room - keepOthers, title, hf);
-    float firstRoom = 0.0f;
-    for (float x : hf) firstRoom += x;
-    // 2. The others share the rest; 3. what they leave goes to the panels cut last.
-    waterFill(wants(others, 1.0e30f), room - firstRoom, title, ho);
-    float used = 0.0f;
-    for (float x : ho) used += x;
-    if (!first.empty() && room - used > firstRoom)
-        waterFill(wants(first, 1.0e30f), room - used, title, hf);
-    for (size_t k = 0; k < first.size(); ++k) h[first[k]] = hf[k];
-    for (size_t k = 0; k < others.size(); ++k) h[others[k]] = ho[k];
+    float extra = room;
+    for (size_t i : expanded) {
+        h[i] = std::min(want(i), keep);
+        extra -= h[i];
+    }
+    std::vector<float> shared;
+    if (extra < 0.0f) {
+        // Not even a few lines each: all share the column alike.
+        waterFill(wantsOf(expanded), room, title, shared);
+        for (size_t k = 0; k < expanded.size(); ++k) h[expanded[k]] = shared[k];
+    } else {
+        // The Ray panel, then the Selection panel, up to a usable height.
+        auto find = [&](PanelId id) -> std::optional<size_t> {
+            for (size_t i : expanded)
+                if (ids[i] == id) return i;
+            return std::nullopt;
+        };
+        for (PanelId id : {PanelId::Ray, PanelId::Selection})
+            if (const auto i = find(id)) {
+                const float add =
+                    std::clamp(std::min(want(*i), kUsablePanelHeight) - h[*i], 0.0f, extra);
+                h[*i] += add;
+                extra -= add;
+            }
+        // The others share theirs and the rest (each keeps at least what it had).
+        float othersRoom = extra;
+        for (size_t i : others) othersRoom += h[i];
+        waterFill(wantsOf(others), othersRoom, title, shared);
+        for (size_t k = 0; k < others.size(); ++k) {
+            extra -= shared[k] - h[others[k]];
+            h[others[k]] = shared[k];
+        }
+        // What they leave: the Selection panel to what it asks, the Ray panel the rest.
+        for (PanelId id : {PanelId::Selection, PanelId::Ray})
+            if (const auto i = find(id)) {
+                const float add = std::clamp(want(*i) - h[*i], 0.0f, std::max(extra, 0.0f));
+                h[*i] += add;
+                extra -= add;
+            }
+    }
     float y = col.y0;
     for (size_t i = 0; i < ids.size(); ++i) {
         // A window too small for every title bar: the last ones stay inside it, overlapping.

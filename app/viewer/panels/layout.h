@@ -69,8 +69,8 @@ struct PanelLayout {
     const Rect& operator[](PanelId id) const { return panels[size_t(id)]; }
 };
 
-/// The height the Ray and Selection panels get before the others when a column's panels do not
-/// fit (the Ray panel's header, transport and a few steps), room permitting.
+/// The height the Ray panel, then the Selection panel, get before the others when a column's
+/// panels do not fit (the Ray panel's pixel, counts, rays and transport), room permitting.
 inline constexpr float kUsablePanelHeight = 260.0f;
 
 /// The menu bar's height the panels stay under.
@@ -82,10 +82,11 @@ inline constexpr float kMenuBarHeight = 28.0f;
 /// inspector shown, the inspector takes the right half of what the panels leave, and a second
 /// column (the Inspector, Selection and Ray panels) stands right of it only when one column
 /// cannot hold the open panels and the image and the inspector keep 400 units each. A column's
-/// panels share its height: each gets what its content asks for while they all fit; else the
-/// Ray and Selection panels get kUsablePanelHeight first, the others are cut down to a common
-/// height and scroll, and the Ray panel (whose step list fills what it is given) takes the
-/// rest. A folded panel takes its title bar. Nothing overlaps, and everything stays inside the
+/// panels share its height: each gets what its content asks for while they all fit; else each
+/// keeps a title bar and two lines, the Ray panel then the Selection panel grow to
+/// kUsablePanelHeight, the others are cut down to a common height and scroll, and what they
+/// leave goes to the Selection panel, then the Ray panel (whose step list fills what it is
+/// given). A folded panel takes its title bar. Nothing overlaps, and everything stays inside the
 /// window at any size.
 PanelLayout layoutPanels(const LayoutInput& in);
 

@@ -147,13 +147,21 @@ TEST(PanelLayout, WithTheInspectorTheRayPanelKeepsAUsableHeight) {
             EXPECT_GE(l[id].height(), 3.0f * in.titleHeight) << panelTitle(id);
         EXPECT_EQ(l[PanelId::Overlays].height(), in.titleHeight) << "folded: its title bar";
     }
-    // Every panel open and expanded at 1280 x 720: the Ray and Selection panels are cut last.
+    // A ray played selects its region, which opens the Selection panel: the Ray panel still
+    // gets a usable height first.
+    LayoutInput playing = inspectingARay(1280.0f, 720.0f);
+    playing[PanelId::Selection].open = true;
+    PanelLayout l = layoutPanels(playing);
+    expectApart(playing, l);
+    EXPECT_GE(l[PanelId::Ray].height(), kUsablePanelHeight);
+    EXPECT_GE(l[PanelId::Selection].height(), 3.0f * playing.titleHeight);
+    // Every panel open and expanded at 1280 x 720: the Ray panel is cut last, and more than
+    // three times as tall as any other.
     LayoutInput all = everyPanel(1280.0f, 720.0f, true);
-    PanelLayout l = layoutPanels(all);
+    l = layoutPanels(all);
     expectApart(all, l);
-    const float others = tallestOther(all, l, {PanelId::Ray, PanelId::Selection});
-    EXPECT_GT(l[PanelId::Ray].height(), 2.0f * others);
-    EXPECT_GT(l[PanelId::Selection].height(), 2.0f * others);
+    EXPECT_GT(l[PanelId::Ray].height(), 3.0f * tallestOther(all, l, {PanelId::Ray}));
+    EXPECT_GE(l[PanelId::Selection].height(), 3.0f * all.titleHeight);
     // Folding the other panels gives the Ray panel the column.
     for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics, PanelId::Camera,
                        PanelId::Overlays, PanelId::Inspector, PanelId::Selection})
@@ -180,15 +188,21 @@ TEST(PanelLayout, AWideWindowPutsTheRayPanelBesideTheInspectorWhenOneColumnCanno
         EXPECT_GE(l.inspector.width(), 400.0f);
         EXPECT_GE(l[PanelId::Ray].height(), kUsablePanelHeight);
         EXPECT_GE(l[PanelId::Selection].height(), kUsablePanelHeight);
-        // Each panel has more room than one column gives it.
+        // No panel has less room than one column of the same height gives it, and together
+        // they have more.
         LayoutInput narrow = in;
         narrow.width = 1280.0f;
         const PanelLayout one = layoutPanels(narrow);
         ASSERT_FALSE(one.twoColumns);
+        float two = 0.0f, single = 0.0f;
         for (int i = 0; i < kPanelCount; ++i)
-            if (in.panels[size_t(i)].open && !in.panels[size_t(i)].collapsed)
-                EXPECT_GT(l.panels[size_t(i)].height(), one.panels[size_t(i)].height())
+            if (in.panels[size_t(i)].open && !in.panels[size_t(i)].collapsed) {
+                EXPECT_GE(l.panels[size_t(i)].height(), one.panels[size_t(i)].height())
                     << panelTitle(PanelId(i));
+                two += l.panels[size_t(i)].height();
+                single += one.panels[size_t(i)].height();
+            }
+        EXPECT_GT(two, single + 200.0f);
 
         // The other panels folded: one column holds them, and the image and the inspector
         // keep the width.
