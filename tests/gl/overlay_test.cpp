@@ -432,6 +432,65 @@ TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShow
     for (size_t i = 0; i < plain.size(); i += 4) ASSERT_NEAR(plain[i + 2], 102, 1);
 }
 
+TEST(Overlays, WhileTheCameraMovesTheLayerHoldsTheLongestLinesAndAllOnceItRests) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Regular);
+    Camera cam = s->scene->camera;
+    Overlays ov;
+    ov.options.leaves = true;
+    ov.look.lineOpacity = 1.0f;
+    ov.update(s, cam, kW, kH);
+    const OverlayGeometry& g = ov.geometry();
+    // The same lines, longest first.
+    const gl::Batch& longest = g.wiresLongestFirst;
+    EXPECT_EQ(longest.lineCount(), g.wires.lineCount());
+    EXPECT_TRUE(viewer::testing::sameLineCover(g.wires, longest));
+    for (size_t k = 1; k < longest.lineCount(); ++k)
+        EXPECT_GE(
+            glm::distance(longest.lines[2 * k - 2].position, longest.lines[2 * k - 1].position),
+            glm::distance(longest.lines[2 * k].position, longest.lines[2 * k + 1].position));
+    // Capped: fewer pixels, all of them lit by the whole layer too.
+    const size_t cap = 4;
+    ASSERT_GT(g.wires.lineCount(), 3 * cap);
+    ov.look.movingLines = cap;
+    gl.clear(0, 0, 0);
+    ov.drawLayers(cam, kW, kH, cap);
+    const std::vector<uint8_t> capped = gl.read();
+    gl.clear(0, 0, 0);
+    ov.drawLayers(cam, kW, kH);
+    const std::vector<uint8_t> whole = gl.read();
+    size_t litCapped = 0, litWhole = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            litCapped += lit(capped, x, y);
+            litWhole += lit(whole, x, y);
+            if (lit(capped, x, y)) EXPECT_TRUE(lit(whole, x, y)) << x << "," << y;
+        }
+    EXPECT_GT(litCapped, 0u);
+    EXPECT_LT(litCapped, litWhole);
+    // The texture: capped while moving, once for one view; whole at the first call at rest.
+    const unsigned tex = ov.layerTexture(cam, kW, kH, true);
+    ASSERT_NE(tex, 0u);
+    EXPECT_TRUE(ov.layerPartial());
+    EXPECT_TRUE(ov.layerStale(cam, kW, kH)) << "a capped layer is drawn again at rest";
+    const uint64_t v = ov.layerVersion();
+    EXPECT_EQ(ov.layerTexture(cam, kW, kH, true), tex);
+    EXPECT_EQ(ov.layerVersion(), v) << "the same view while moving: not drawn again";
+    cam.from.x += 0.5;
+    ov.layerTexture(cam, kW, kH, true);
+    EXPECT_EQ(ov.layerVersion(), v + 1) << "the camera moved: the capped layer again";
+    ov.layerTexture(cam, kW, kH, false);
+    EXPECT_EQ(ov.layerVersion(), v + 2);
+    EXPECT_FALSE(ov.layerPartial());
+    EXPECT_FALSE(ov.layerStale(cam, kW, kH));
+    EXPECT_EQ(ov.layerTexture(cam, kW, kH, true), tex) << "at rest and whole: kept while moving";
+    // No line while moving: no layer.
+    ov.look.movingLines = 0;
+    cam.from.y += 0.5;
+    EXPECT_EQ(ov.layerTexture(cam, kW, kH, true), 0u);
+}
+
 TEST(Overlays, TheShowListTurnsLayersOnAndNamesWhatItDoesNotDraw) {
     OverlayOptions o;
     EXPECT_TRUE(applyShowList("bsp,zones", o).empty());
