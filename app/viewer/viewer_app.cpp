@@ -285,11 +285,12 @@ void ViewerApp::prepareOverlays(int fbWidth, int fbHeight) {
     const uint64_t version = overlays_->layerVersion();
     const Camera& camera = state_.camera();
     overlays_->update(state_.sceneBuild(), camera, fbWidth, fbHeight);
-    // While a drag moves the camera the layers are left out rather than drawn again each
-    // frame (balls4's regular leaves take llvmpipe about 0.9 s); they return when it ends.
+    // While a drag moves the camera the layers are drawn capped (the longest lines; none if
+    // the cap is 0) rather than whole each frame: all of balls4's regular leaves take llvmpipe
+    // a quarter of a second. They are drawn whole when the drag ends.
     const bool dragging = ImGui::IsAnyMouseDown() && !ImGui::GetIO().WantCaptureMouse &&
                           overlays_->layerStale(camera, fbWidth, fbHeight);
-    const unsigned layer = dragging ? 0 : overlays_->layerTexture(camera, fbWidth, fbHeight);
+    const unsigned layer = overlays_->layerTexture(camera, fbWidth, fbHeight, dragging);
     if (layer != 0 && !overlayShown_ && view_->width() > 0)
         uploadImage(0, -1);  // colour bands bypass colorTex
     overlayShown_ = layer != 0;
@@ -303,9 +304,17 @@ void ViewerApp::logOverlayTiming(double ms, bool layerDrawn) {
     // The overlays' UI work, per frame, apart from frames that drew the layers again (a
     // change): those are logged one by one.
     if (layerDrawn) {
+        const overlay::OverlayGeometry& g = overlays_->geometry();
+        size_t lines = g.cuts.lineCount() + g.wires.lineCount();
+        if (overlays_->layerPartial())
+            lines = std::min(g.cuts.lineCount(), overlays_->look.movingLines) +
+                    std::min(g.wires.lineCount(), overlays_->look.movingLines);
         std::fprintf(stderr,
-                     "timing: overlays: layers drawn again in %.2f ms (batches built in %.2f ms)\n",
-                     overlays_->lastLayerMs(), overlays_->lastBuildMs());
+                     "timing: overlays: layers drawn again%s in %.2f ms (%zu lines, %zu "
+                     "triangles; batches built in %.2f ms)\n",
+                     overlays_->layerPartial() ? " while the camera moves" : "",
+                     overlays_->lastLayerMs(), lines, g.fills.triangleCount(),
+                     overlays_->lastBuildMs());
         return;
     }
     overlayStat_.ms += ms;

@@ -98,7 +98,8 @@ std::string settingsLines(const ViewerSettings& s) {
       << "overlay_levels=" << ov.levelMin << " " << ov.levelMax << "\n"
       << "overlay_cap=" << ov.cap << "\n"
       << "overlay_opacity=" << s.overlayLook.fillOpacity << " " << s.overlayLook.lineOpacity << "\n"
-      << "overlay_tooltip=" << s.overlayLook.tooltip << "\n";
+      << "overlay_tooltip=" << s.overlayLook.tooltip << "\n"
+      << "overlay_moving_lines=" << s.overlayLook.movingLines << "\n";
     const inspector::InspectorOptions& in = s.inspector;
     o << "inspector_layers="
       << flagsText(
@@ -192,6 +193,8 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
         }
     } else if (key == "overlay_tooltip") {
         flag(s.overlayLook.tooltip);
+    } else if (key == "overlay_moving_lines") {
+        readIn(in, s.overlayLook.movingLines, size_t(0), size_t(1) << 40);
     } else if (key == "inspector_layers") {
         inspector::InspectorOptions& o = s.inspector;
         readFlags(in, {&o.regions, &o.zones, &o.grid, &o.boxes, &o.frustum, &o.surfaces,

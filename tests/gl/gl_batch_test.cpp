@@ -8,6 +8,7 @@
 #include "app/viewer/gl/batch.h"
 #include "app/viewer/gl/program.h"
 #include "app/viewer/gl/transforms.h"
+#include "tests/gl/line_cover.h"
 #include "tests/gl/offscreen_gl.h"
 
 namespace lancer::viewer::gl {
@@ -162,6 +163,126 @@ TEST(GlRoom, WorldSpaceBoxesProjectAsTheTracersRays) {
         EXPECT_TRUE(isColor(at(px, w, x, 60), 255, 255, 0)) << x;
         EXPECT_TRUE(isColor(at(px, w, x, 40), 0, 0, 0)) << x;
     }
+}
+
+/// The boxes of a random BSP of [0, 16)^3 cut at integer planes (faces shared, edges lying
+/// partly on longer ones), coloured by depth among three colours, as Batch::box draws them.
+void randomBsp(std::mt19937& rng, glm::vec3 lo, glm::vec3 hi, int depth, Batch& out) {
+    std::uniform_int_distribution<int> axisOf(0, 2);
+    const int a = axisOf(rng);
+    const int span = int(hi[a] - lo[a]);
+    if (depth == 0 || span < 2 || (depth < 5 && rng() % 4 == 0)) {
+        const glm::vec3 palette[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+        out.box(lo, hi, rgba8(palette[depth % 3]));
+        return;
+    }
+    const int cut = std::uniform_int_distribution<int>(1, span - 1)(rng);
+    glm::vec3 mid = hi;
+    mid[a] = lo[a] + float(cut);
+    randomBsp(rng, lo, mid, depth - 1, out);
+    mid = lo;
+    mid[a] = lo[a] + float(cut);
+    randomBsp(rng, mid, hi, depth - 1, out);
+}
+
+TEST(GlRoom, MergedLinesCoverExactlyTheSegmentsTheyReplace) {
+    for (uint32_t seed = 1; seed <= 20; ++seed) {
+        SCOPED_TRACE(seed);
+        std::mt19937 rng(seed);
+        Batch b;
+        randomBsp(rng, glm::vec3(0.0f), glm::vec3(16.0f), 7, b);
+        const size_t edges = b.lineCount();
+        // Segments that are not merged: oblique, two-coloured, of no length; and a fill.
+        b.line(glm::vec3(0, 0, 0), glm::vec3(3, 4, 0), rgba8(glm::vec3(1, 0, 0)));
+        b.lines.push_back({glm::vec3(0, 0, 0), rgba8(glm::vec3(1, 0, 0))});
+        b.lines.push_back({glm::vec3(16, 0, 0), rgba8(glm::vec3(0, 1, 0))});
+        b.line(glm::vec3(5, 5, 5), glm::vec3(5, 5, 5), rgba8(glm::vec3(1, 0, 0)));
+        b.fillRect({0.0f, 0.0f}, {1.0f, 1.0f}, rgba8(glm::vec3(1, 1, 1), 0.5f));
+        const Batch m = mergeCollinearLines(b);
+        EXPECT_TRUE(viewer::testing::sameLineCover(b, m));
+        // Shared faces: far fewer lines.
+        if (edges > 12 * 8) EXPECT_LT(m.lineCount(), edges * 3 / 4) << edges << " edges";
+        // Merging again changes nothing.
+        const Batch again = mergeCollinearLines(m);
+        EXPECT_EQ(again.lineCount(), m.lineCount());
+        EXPECT_TRUE(viewer::testing::sameLineCover(m, again));
+    }
+    // The checker itself tells a gap and a colour apart.
+    Batch two, gap, recoloured;
+    two.line(glm::vec3(0, 0, 0), glm::vec3(2, 0, 0), rgba8(glm::vec3(1, 0, 0)));
+    two.line(glm::vec3(1, 0, 0), glm::vec3(3, 0, 0), rgba8(glm::vec3(1, 0, 0)));
+    gap.line(glm::vec3(0, 0, 0), glm::vec3(1, 0, 0), rgba8(glm::vec3(1, 0, 0)));
+    gap.line(glm::vec3(1.5f, 0, 0), glm::vec3(3, 0, 0), rgba8(glm::vec3(1, 0, 0)));
+    recoloured.line(glm::vec3(0, 0, 0), glm::vec3(3, 0, 0), rgba8(glm::vec3(0, 1, 0)));
+    const Batch merged = mergeCollinearLines(two);
+    ASSERT_EQ(merged.lineCount(), 1u);
+    EXPECT_EQ(merged.lines[0].position, glm::vec3(0, 0, 0));
+    EXPECT_EQ(merged.lines[1].position, glm::vec3(3, 0, 0));
+    EXPECT_TRUE(viewer::testing::sameLineCover(two, merged));
+    EXPECT_FALSE(viewer::testing::sameLineCover(two, gap));
+    EXPECT_FALSE(viewer::testing::sameLineCover(two, recoloured));
+    EXPECT_FALSE(viewer::testing::sameLineCover(two, two)) << "two is not maximal";
+}
+
+TEST(GlRoom, MergedBoxEdgesDrawThePixelsOfEveryEdge) {
+    // Boxes of a BSP seen obliquely in perspective, drawn opaque. Colour by colour, the merged
+    // lines light the pixels the twelve edges of every box light, but for a line's end pixel
+    // where two segments that touched are now one. Together, each pixel shows one of the
+    // colours drawn there: only which colour lands on top where two overlap may differ (the
+    // order changed).
+    const int w = 160, h = 120;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    std::mt19937 rng(3);
+    Batch b;
+    randomBsp(rng, glm::vec3(0.0f), glm::vec3(16.0f), 8, b);
+    const Batch m = mergeCollinearLines(b);
+    ASSERT_LT(m.lineCount(), b.lineCount() * 2 / 3);
+    Camera cam;
+    cam.from = {30.0, -22.0, 26.0};
+    cam.at = {8.0, 8.0, 8.0};
+    cam.up = {0.0, 0.0, 1.0};
+    cam.fov = 45.0;
+    const glm::mat4 toClip = worldToClip(cam, w, h, 1.0, 100.0);
+    BatchRenderer renderer;
+    auto draw = [&](const Batch& batch) {
+        gl.clear(0, 0, 0);
+        renderer.drawNow(batch, toClip);
+        return gl.read();
+    };
+    auto isLit = [](const std::vector<uint8_t>& px, size_t i) {
+        return (px[i] | px[i + 1] | px[i + 2]) != 0;
+    };
+    auto only = [](const Batch& batch, Rgba8 c) {
+        Batch out;
+        for (size_t k = 0; k < batch.lineCount(); ++k)
+            if (batch.lines[2 * k].color == c)
+                out.line(batch.lines[2 * k].position, batch.lines[2 * k + 1].position, c);
+        return out;
+    };
+    const std::vector<uint8_t> before = draw(b), after = draw(m);
+    std::vector<std::vector<uint8_t>> colourLit;
+    for (const glm::vec3& c : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1)}) {
+        const std::vector<uint8_t> x = draw(only(b, rgba8(c))), y = draw(only(m, rgba8(c)));
+        size_t lit = 0, differ = 0;
+        for (size_t i = 0; i < x.size(); i += 4) {
+            lit += isLit(x, i);
+            differ += isLit(x, i) != isLit(y, i);
+        }
+        EXPECT_GT(lit, 100u) << "colour " << c.x << c.y << c.z;
+        EXPECT_LE(differ, lit / 200) << "colour " << c.x << c.y << c.z << ": " << differ << " of "
+                                     << lit << " pixels lit by one drawing only";
+        colourLit.push_back(x);
+    }
+    size_t foreign = 0;
+    for (size_t i = 0; i < after.size(); i += 4) {
+        if (!isLit(after, i) || std::equal(&before[i], &before[i + 3], &after[i])) continue;
+        bool drawnThere = false;
+        for (const auto& x : colourLit)
+            drawnThere |= isLit(x, i) && std::equal(&x[i], &x[i + 3], &after[i]);
+        foreign += !drawnThere;
+    }
+    EXPECT_EQ(foreign, 0u) << "pixels of a colour no edge there had";
 }
 
 }  // namespace

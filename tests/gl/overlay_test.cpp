@@ -12,6 +12,7 @@
 #include "app/viewer/overlay/overlays.h"
 #include "engine/accel/irregular/irregular.h"
 #include "engine/accel/regular/regular_grid.h"
+#include "tests/gl/line_cover.h"
 #include "tests/gl/offscreen_gl.h"
 
 namespace lancer::viewer::overlay {
@@ -57,6 +58,40 @@ std::shared_ptr<SceneBuild> twoBoxes(SchemeKind scheme, int maxLevel = 24) {
     s->scene = scene;
     s->accel = buildAccelerator(*scene, p);
     return s;
+}
+
+/// The twelve edges of every leaf of levels [lo, hi], coloured by level as the overlay colours
+/// them: what the merged wireframe must cover, point for point.
+gl::Batch leafEdges(const StructureView& sv, int lo = 0, int hi = 64) {
+    int maxLevel = 0;
+    for (uint32_t i = 0; i < sv.regionCount(); ++i) maxLevel = std::max(maxLevel, sv.leafLevel(i));
+    gl::Batch b;
+    for (uint32_t i = 0; i < sv.regionCount(); ++i) {
+        const int level = sv.leafLevel(i);
+        if (level < lo || level > hi) continue;
+        const std::array<Vec3, 8> c = sv.regionCorners(i);
+        b.box(glm::vec3(c[0]), glm::vec3(c[7]), gl::rgba8(depthColor(level, maxLevel + 1)));
+    }
+    return b;
+}
+
+/// The same for the directory grid's blocks of levels [lo, hi], coloured by kind.
+gl::Batch blockEdges(const StructureView& sv, int lo, int hi) {
+    const Box3 box = sv.worldBounds();
+    gl::Batch b;
+    for (const DirectoryBlock& blk : sv.directoryBlocks()) {
+        if (blk.level < lo || blk.level > hi) continue;
+        glm::vec3 a, z;
+        for (int k = 0; k < 3; ++k) {
+            const double cell = (box.hi[k] - box.lo[k]) / double(1u << sv.directoryLog2(k));
+            a[k] = float(box.lo[k] + cell * blk.lo[k]);
+            z[k] = float(box.lo[k] + cell * blk.hi[k]);
+        }
+        b.box(
+            a, z,
+            gl::rgba8(blk.subTable ? glm::vec3(1.0f, 0.55f, 0.1f) : glm::vec3(0.55f, 0.65f, 0.8f)));
+    }
+    return b;
 }
 
 bool lit(const std::vector<uint8_t>& px, int x, int y) {
@@ -206,12 +241,17 @@ TEST(Overlays, TheLevelRangeHidesTheLevelsOutsideIt) {
     std::map<int, size_t> perLevel;
     for (uint32_t i = 0; i < n; ++i) ++perLevel[sv.leafLevel(i)];
     ASSERT_GE(perLevel.size(), 2u) << "the test needs leaves at two levels";
-    EXPECT_EQ(ov.geometry().wires.lineCount(), 12 * n);
+    // The leaves' edges, each drawn once: neighbours share them.
+    EXPECT_TRUE(viewer::testing::sameLineCover(leafEdges(sv), ov.geometry().wires));
+    EXPECT_LT(ov.geometry().wires.lineCount(), 12 * n);
     const gl::ImageProjector proj(cam, kW, kH);
     for (const auto& [level, count] : perLevel) {
         ov.options.levelMin = ov.options.levelMax = level;
         ov.update(s, cam, kW, kH);
-        EXPECT_EQ(ov.geometry().wires.lineCount(), 12 * count) << "level " << level;
+        EXPECT_EQ(ov.geometry().regionsDrawn, count) << "level " << level;
+        EXPECT_TRUE(
+            viewer::testing::sameLineCover(leafEdges(sv, level, level), ov.geometry().wires))
+            << "level " << level;
         // Every lit pixel lies on the outline of a leaf of this level (a pixel of slack).
         std::vector<uint8_t> mask(size_t(kW) * kH, 0);
         for (uint32_t i = 0; i < n; ++i) {
@@ -299,7 +339,9 @@ TEST(Overlays, TheLevelRangeSelectsLeavesAndGridBlocksByBspLevel) {
         ov.options.levelMin = ov.options.levelMax = level;
         ov.update(s, cam, kW, kH);
         EXPECT_EQ(ov.geometry().regionsTotal, count) << "level " << level;
-        EXPECT_EQ(ov.geometry().wires.lineCount(), 12 * count) << "level " << level;
+        EXPECT_TRUE(
+            viewer::testing::sameLineCover(blockEdges(sv, level, level), ov.geometry().wires))
+            << "level " << level;
         depthDiffers |= perDepth[level] != count;
     }
     EXPECT_TRUE(depthDiffers) << "the scene must tell BSP levels from sub-table depths";
@@ -335,7 +377,7 @@ TEST(Overlays, ARebuildAtAnotherMaxLevelChangesTheDrawnLeavesAndOnlyThen) {
     ov.update(fine, cam, kW, kH);
     EXPECT_EQ(ov.rebuilds(), builds + 1);
     EXPECT_GT(ov.geometry().wires.lineCount(), coarseLines);
-    EXPECT_EQ(ov.geometry().wires.lineCount(), 12 * ov.view()->regionCount());
+    EXPECT_TRUE(viewer::testing::sameLineCover(leafEdges(*ov.view()), ov.geometry().wires));
     const std::vector<uint8_t> after = drawn(gl, ov, cam);
     size_t changed = 0;
     for (size_t i = 0; i < after.size(); i += 4)
@@ -388,6 +430,65 @@ TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShow
     view.draw(kW, kH, ViewMode::Color, 1.0f);
     const std::vector<uint8_t> plain = gl.read();
     for (size_t i = 0; i < plain.size(); i += 4) ASSERT_NEAR(plain[i + 2], 102, 1);
+}
+
+TEST(Overlays, WhileTheCameraMovesTheLayerHoldsTheLongestLinesAndAllOnceItRests) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Regular);
+    Camera cam = s->scene->camera;
+    Overlays ov;
+    ov.options.leaves = true;
+    ov.look.lineOpacity = 1.0f;
+    ov.update(s, cam, kW, kH);
+    const OverlayGeometry& g = ov.geometry();
+    // The same lines, longest first.
+    const gl::Batch& longest = g.wiresLongestFirst;
+    EXPECT_EQ(longest.lineCount(), g.wires.lineCount());
+    EXPECT_TRUE(viewer::testing::sameLineCover(g.wires, longest));
+    for (size_t k = 1; k < longest.lineCount(); ++k)
+        EXPECT_GE(
+            glm::distance(longest.lines[2 * k - 2].position, longest.lines[2 * k - 1].position),
+            glm::distance(longest.lines[2 * k].position, longest.lines[2 * k + 1].position));
+    // Capped: fewer pixels, all of them lit by the whole layer too.
+    const size_t cap = 4;
+    ASSERT_GT(g.wires.lineCount(), 3 * cap);
+    ov.look.movingLines = cap;
+    gl.clear(0, 0, 0);
+    ov.drawLayers(cam, kW, kH, cap);
+    const std::vector<uint8_t> capped = gl.read();
+    gl.clear(0, 0, 0);
+    ov.drawLayers(cam, kW, kH);
+    const std::vector<uint8_t> whole = gl.read();
+    size_t litCapped = 0, litWhole = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            litCapped += lit(capped, x, y);
+            litWhole += lit(whole, x, y);
+            if (lit(capped, x, y)) EXPECT_TRUE(lit(whole, x, y)) << x << "," << y;
+        }
+    EXPECT_GT(litCapped, 0u);
+    EXPECT_LT(litCapped, litWhole);
+    // The texture: capped while moving, once for one view; whole at the first call at rest.
+    const unsigned tex = ov.layerTexture(cam, kW, kH, true);
+    ASSERT_NE(tex, 0u);
+    EXPECT_TRUE(ov.layerPartial());
+    EXPECT_TRUE(ov.layerStale(cam, kW, kH)) << "a capped layer is drawn again at rest";
+    const uint64_t v = ov.layerVersion();
+    EXPECT_EQ(ov.layerTexture(cam, kW, kH, true), tex);
+    EXPECT_EQ(ov.layerVersion(), v) << "the same view while moving: not drawn again";
+    cam.from.x += 0.5;
+    ov.layerTexture(cam, kW, kH, true);
+    EXPECT_EQ(ov.layerVersion(), v + 1) << "the camera moved: the capped layer again";
+    ov.layerTexture(cam, kW, kH, false);
+    EXPECT_EQ(ov.layerVersion(), v + 2);
+    EXPECT_FALSE(ov.layerPartial());
+    EXPECT_FALSE(ov.layerStale(cam, kW, kH));
+    EXPECT_EQ(ov.layerTexture(cam, kW, kH, true), tex) << "at rest and whole: kept while moving";
+    // No line while moving: no layer.
+    ov.look.movingLines = 0;
+    cam.from.y += 0.5;
+    EXPECT_EQ(ov.layerTexture(cam, kW, kH, true), 0u);
 }
 
 TEST(Overlays, TheShowListTurnsLayersOnAndNamesWhatItDoesNotDraw) {

@@ -173,6 +173,7 @@ TEST(ViewerSettingsIni, OverlayAndInspectorOptionsRoundTrip) {
     s.overlayLook.fillOpacity = 0.6f;
     s.overlayLook.lineOpacity = 0.25f;
     s.overlayLook.tooltip = false;
+    s.overlayLook.movingLines = 750;
     inspector::InspectorOptions& i = s.inspector;
     i.regions = false;
     i.grid = i.boxes = i.zoneSlabsOnly = true;

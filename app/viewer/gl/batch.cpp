@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <glm/gtc/type_ptr.hpp>
+#include <tuple>
 
 #include "app/viewer/gl.h"
 #include "app/viewer/gl/program.h"
@@ -91,6 +92,88 @@ void Batch::append(const Batch& o) {
 void Batch::clear() {
     lines.clear();
     triangles.clear();
+}
+
+Batch mergeCollinearLines(const Batch& in) {
+    // One record per segment along an axis: its line (axis, the two other coordinates, the
+    // colour) and its interval on it; sorted by line then start, runs that overlap or touch are
+    // joined by one sweep.
+    struct Piece {
+        int axis;
+        float u, v;  // the other two coordinates, in axis order
+        Rgba8 color;
+        float lo, hi;
+        size_t at;  // the index of the segment, then of the last one a run replaces
+    };
+    std::vector<Piece> pieces;
+    std::vector<size_t> kept;  // segments left as they are
+    const size_t n = in.lineCount();
+    pieces.reserve(n);
+    for (size_t k = 0; k < n; ++k) {
+        const BatchVertex& a = in.lines[2 * k];
+        const BatchVertex& b = in.lines[2 * k + 1];
+        int axis = -1, differing = 0;
+        for (int c = 0; c < 3; ++c)
+            if (a.position[c] != b.position[c]) {  // NaN differs: such a segment is kept
+                axis = c;
+                ++differing;
+            }
+        bool finite = true;
+        for (int c = 0; c < 3; ++c)
+            finite = finite && std::isfinite(a.position[c]) && std::isfinite(b.position[c]);
+        if (differing != 1 || a.color != b.color || !finite) {
+            kept.push_back(k);
+            continue;
+        }
+        const int c1 = (axis + 1) % 3, c2 = (axis + 2) % 3;
+        const int ua = std::min(c1, c2), va = std::max(c1, c2);
+        pieces.push_back({axis, a.position[ua], a.position[va], a.color,
+                          std::min(a.position[axis], b.position[axis]),
+                          std::max(a.position[axis], b.position[axis]), k});
+    }
+    auto lineKey = [](const Piece& p) { return std::tuple(p.axis, p.u, p.v, p.color); };
+    std::sort(pieces.begin(), pieces.end(), [&](const Piece& a, const Piece& b) {
+        return std::tuple(lineKey(a), a.lo) < std::tuple(lineKey(b), b.lo);
+    });
+    std::vector<Piece> runs;
+    for (const Piece& p : pieces) {
+        Piece* last = runs.empty() ? nullptr : &runs.back();
+        if (last && lineKey(*last) == lineKey(p) && p.lo <= last->hi) {
+            last->hi = std::max(last->hi, p.hi);
+            last->at = std::max(last->at, p.at);
+        } else {
+            runs.push_back(p);
+        }
+    }
+    // In the order of the last segment each run replaces, with the kept ones.
+    struct Out {
+        size_t at;
+        const Piece* run;  // null: segment `at` as it was
+    };
+    std::vector<Out> order;
+    order.reserve(runs.size() + kept.size());
+    for (const Piece& r : runs) order.push_back({r.at, &r});
+    for (size_t k : kept) order.push_back({k, nullptr});
+    std::sort(order.begin(), order.end(), [](const Out& a, const Out& b) { return a.at < b.at; });
+    Batch out;
+    out.triangles = in.triangles;
+    out.lines.reserve(2 * order.size());
+    for (const Out& o : order) {
+        if (!o.run) {
+            out.lines.push_back(in.lines[2 * o.at]);
+            out.lines.push_back(in.lines[2 * o.at + 1]);
+            continue;
+        }
+        const Piece& r = *o.run;
+        const int c1 = (r.axis + 1) % 3, c2 = (r.axis + 2) % 3;
+        glm::vec3 a, b;
+        a[std::min(c1, c2)] = b[std::min(c1, c2)] = r.u;
+        a[std::max(c1, c2)] = b[std::max(c1, c2)] = r.v;
+        a[r.axis] = r.lo;
+        b[r.axis] = r.hi;
+        out.line(a, b, r.color);
+    }
+    return out;
 }
 
 GpuBatch::GpuBatch() {

@@ -65,6 +65,15 @@ class Batch {
     std::vector<BatchVertex> triangles;  ///< triples of vertices, one triangle each
 };
 
+/// The same segments drawn with fewer lines: segments along a coordinate axis (both ends equal
+/// in the other two coordinates, both ends of one colour) that lie on one line and have one
+/// colour are replaced by the union of their intervals, overlapping or touching intervals made
+/// one segment; every other segment is kept as it is. The boxes of a subdivision share faces,
+/// so most of their edges lie on their neighbours': fewer and shorter lines to rasterize, over
+/// the same pixels. The triangles are kept; a segment takes the place of the last one it
+/// replaces, so where lines of two colours overlap, which one lands on top may change.
+Batch mergeCollinearLines(const Batch& batch);
+
 /// How a batch is drawn.
 struct DrawOptions {
     float opacity = 1.0f;    ///< multiplies every vertex's alpha

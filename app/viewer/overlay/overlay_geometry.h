@@ -52,7 +52,11 @@ struct OverlayGeometry {
     size_t cutsTotal = 0;    ///< cuts of the BSP (cuts.lineCount() / linesPerCut drawn)
     int maxCutDepth = 0;
     gl::Batch fills;  ///< zones, filled (alpha 1: the draw's opacity makes them translucent)
-    gl::Batch wires;  ///< leaves, blocks, slabs
+    /// Leaves, blocks, slabs; the regular scheme's edges merged (gl::mergeCollinearLines).
+    gl::Batch wires;
+    /// The same lines, longest first (in world units): a prefix of it is what the layer draws
+    /// while the camera moves (OverlayLook::movingLines).
+    gl::Batch wiresLongestFirst;
     size_t regionsTotal = 0;  ///< regions (or blocks) the options select
     size_t regionsDrawn = 0;  ///< of them, drawn (visible, under the cap)
     size_t zonesTotal = 0, zonesDrawn = 0;

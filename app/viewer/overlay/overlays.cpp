@@ -33,7 +33,8 @@ Overlays::Overlays()
     : renderer_(std::make_unique<gl::BatchRenderer>()),
       cuts_(std::make_unique<gl::GpuBatch>()),
       fills_(std::make_unique<gl::GpuBatch>()),
-      wires_(std::make_unique<gl::GpuBatch>()) {}
+      wires_(std::make_unique<gl::GpuBatch>()),
+      wiresLongestFirst_(std::make_unique<gl::GpuBatch>()) {}
 
 Overlays::~Overlays() {
     glDeleteFramebuffers(1, &layerFbo_);
@@ -85,6 +86,7 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
     cuts_->upload(geometry_.cuts);
     fills_->upload(geometry_.fills);
     wires_->upload(geometry_.wires);
+    wiresLongestFirst_->upload(geometry_.wiresLongestFirst);
     lastBuildMs_ =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     builtOptions_ = options;
@@ -95,21 +97,30 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
     ++rebuilds_;
 }
 
-void Overlays::drawLayers(const Camera& view, int width, int height) {
+void Overlays::drawLayers(const Camera& view, int width, int height, size_t lines) {
     if (!view_ || width <= 0 || height <= 0 || !options.any()) return;
     const auto [nearDepth, farDepth] = clipDepths(*view_, view);
     const glm::mat4 toClip = gl::worldToClip(view, width, height, nearDepth, farDepth);
     glViewport(0, 0, width, height);
+    const bool capped = lines < geometry_.wires.lineCount() || lines < geometry_.cuts.lineCount();
     gl::DrawOptions fill;
     fill.opacity = look.fillOpacity;
     fill.lines = false;
+    if (capped) fill.triangleLimit = 2 * lines;  // a zone is two triangles
     renderer_->draw(*fills_, toClip, fill);
     gl::DrawOptions wire;
     wire.opacity = look.lineOpacity;
     wire.triangles = false;
-    renderer_->draw(*wires_, toClip, wire);
+    if (capped) {
+        wire.lineLimit = lines;
+        renderer_->draw(*wiresLongestFirst_, toClip, wire);
+    } else {
+        renderer_->draw(*wires_, toClip, wire);
+    }
     gl::DrawOptions cuts = wire;
-    if (look.replayCuts >= 0) cuts.lineLimit = size_t(look.replayCuts) * geometry_.linesPerCut;
+    cuts.lineLimit =
+        look.replayCuts >= 0 ? size_t(look.replayCuts) * geometry_.linesPerCut : SIZE_MAX;
+    cuts.lineLimit = std::min(cuts.lineLimit, lines);  // the cuts are in cut order: shallow first
     renderer_->draw(*cuts_, toClip, cuts);
 }
 
@@ -130,13 +141,19 @@ void Overlays::drawSelection(const Camera& view, int width, int height) {
 }
 
 bool Overlays::layerStale(const Camera& view, int width, int height) const {
-    return !(layerTex_ != 0 && layerRebuild_ == rebuilds_ && layerWidth_ == width &&
-             layerHeight_ == height && layerLook_ == look && sameCamera(layerCamera_, view));
+    return !(layerTex_ != 0 && !layerPartial_ && layerRebuild_ == rebuilds_ &&
+             layerWidth_ == width && layerHeight_ == height && layerLook_ == look &&
+             sameCamera(layerCamera_, view));
 }
 
-unsigned Overlays::layerTexture(const Camera& view, int width, int height) {
+unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool moving) {
     if (!view_ || !options.any() || width <= 0 || height <= 0) return 0;
     if (!layerStale(view, width, height)) return layerTex_;
+    if (moving && look.movingLines == 0) return 0;
+    if (moving && layerTex_ != 0 && layerPartial_ && layerRebuild_ == rebuilds_ &&
+        layerWidth_ == width && layerHeight_ == height && layerLook_ == look &&
+        sameCamera(layerCamera_, view))
+        return layerTex_;  // the capped layer of this very view
     if (layerTex_ == 0) {
         glGenTextures(1, &layerTex_);
         glGenFramebuffers(1, &layerFbo_);
@@ -161,7 +178,7 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height) {
     glViewport(0, 0, width, height);
     glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
     glClear(GL_COLOR_BUFFER_BIT);
-    drawLayers(view, width, height);
+    drawLayers(view, width, height, moving ? look.movingLines : SIZE_MAX);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     // Finished here, so the time is the drawing's (it happens on a change only).
     glFinish();
@@ -170,6 +187,7 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height) {
     layerRebuild_ = rebuilds_;
     layerLook_ = look;
     layerCamera_ = view;
+    layerPartial_ = moving;
     ++layerVersion_;
     return layerTex_;
 }
@@ -274,6 +292,13 @@ void Overlays::panel(bool* open) {
         ImGui::TextDisabled("brute force has no subdivision to draw");
     }
     ImGui::SliderFloat("line opacity", &look.lineOpacity, 0.0f, 1.0f);
+    int moving = int(std::min<size_t>(look.movingLines, 10000000));
+    if (ImGui::InputInt("lines while moving", &moving, 500, 5000))
+        look.movingLines = size_t(std::max(0, moving));
+    const size_t lines = geometry_.wires.lineCount();
+    if (lines > 0)
+        ImGui::TextDisabled("%zu lines; %zu drawn while the camera moves", lines,
+                            std::min(lines, look.movingLines));
     int cap = int(std::min<size_t>(o.cap, 10000000));
     if (ImGui::InputInt("cap (regions drawn)", &cap, 1000, 100000))
         o.cap = size_t(std::max(0, cap));

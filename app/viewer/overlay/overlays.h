@@ -4,6 +4,7 @@
 // highlight the same region).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -22,6 +23,9 @@ struct OverlayLook {
     float fillOpacity = 0.35f;  ///< zones' fills
     float lineOpacity = 0.9f;   ///< cut lines and wireframes
     bool tooltip = true;        ///< the hover tooltip over the image
+    /// Wireframe lines drawn while the camera moves (the longest first; cut lines and fills
+    /// capped alike): the whole layer is drawn again when it rests. 0: none while it moves.
+    size_t movingLines = 2000;
 };
 
 /// The region picked in the image (or set by --select, or by the inspector).
@@ -54,16 +58,26 @@ class Overlays {
         drawSelection(view, width, height);
     }
     /// The layers alone (cut lines, fills, wireframes), blended into the current framebuffer.
-    void drawLayers(const Camera& view, int width, int height);
+    void drawLayers(const Camera& view, int width, int height) {
+        drawLayers(view, width, height, SIZE_MAX);
+    }
+    /// The layers with at most `lines` wireframe lines (the longest), cut lines and fills.
+    void drawLayers(const Camera& view, int width, int height, size_t lines);
     /// The selection's highlight alone (a few lines and faces: cheap to draw every frame).
     void drawSelection(const Camera& view, int width, int height);
     /// The layers drawn into a texture of their own (premultiplied RGBA, framebuffer rows),
     /// again only when the batches, the camera, the size or the look changed: the image view
     /// composites it when it shades the image (ImageView::setOverlay), so layers of a million
     /// lines cost nothing in a frame where nothing changed. 0 when no layer is on.
-    unsigned layerTexture(const Camera& view, int width, int height);
-    /// layerTexture() would draw the texture again (or has none to give).
+    /// With `moving` (the camera is being moved), the texture holds only the first
+    /// look.movingLines lines (OverlayGeometry::wiresLongestFirst) and is drawn whole again
+    /// at the first call without; 0 while moving when look.movingLines is 0.
+    unsigned layerTexture(const Camera& view, int width, int height, bool moving = false);
+    /// layerTexture() would draw the texture again (or has none to give); a texture drawn
+    /// while moving is stale once the camera rests.
     bool layerStale(const Camera& view, int width, int height) const;
+    /// The texture holds a moving camera's capped layer.
+    bool layerPartial() const { return layerPartial_; }
     /// Milliseconds the last drawing of the layers' texture took (to the end of GL's work).
     double lastLayerMs() const { return lastLayerMs_; }
     /// Incremented each time layerTexture() draws the texture again.
@@ -108,7 +122,7 @@ class Overlays {
     std::shared_ptr<const SceneBuild> structure_;
     std::unique_ptr<StructureView> view_;
     std::unique_ptr<gl::BatchRenderer> renderer_;
-    std::unique_ptr<gl::GpuBatch> cuts_, fills_, wires_;
+    std::unique_ptr<gl::GpuBatch> cuts_, fills_, wires_, wiresLongestFirst_;
     OverlayGeometry geometry_;
     // What the batches were built for.
     OverlayOptions builtOptions_;
@@ -122,6 +136,7 @@ class Overlays {
     int layerWidth_ = 0, layerHeight_ = 0;
     uint64_t layerVersion_ = 0, layerRebuild_ = ~uint64_t(0);
     double lastLayerMs_ = 0.0;
+    bool layerPartial_ = false;
     Camera layerCamera_;
     OverlayLook layerLook_;
     std::optional<Selection> selection_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <vector>
 
 namespace lancer::viewer {
@@ -15,6 +16,9 @@ constexpr float kColumnMin = 290.0f, kColumnMax = 340.0f;
 /// The image keeps at least this width between two columns, else the second column's panels
 /// join the first.
 constexpr float kMinImageWidth = 260.0f;
+/// With the inspector shown, a second column only when the image and the inspector's view
+/// each keep this width.
+constexpr float kMinViewWidth = 400.0f;
 
 /// Which column a panel goes to when there are two: the parameters on the left, the view and
 /// statistics on the right, the others where there is more room. The room is counted with
@@ -23,36 +27,100 @@ constexpr float kMinImageWidth = 260.0f;
 enum class Side : uint8_t { Left, Right, Roomier };
 constexpr Side kSide[kPanelCount] = {Side::Left,    Side::Right,   Side::Right,   Side::Roomier,
                                      Side::Roomier, Side::Roomier, Side::Roomier, Side::Roomier};
+/// With the inspector shown, the second column stands right of the inspector's view and holds
+/// the panels about what the inspector shows: its own, the selection's, the ray's.
+constexpr Side kSideBesideInspector[kPanelCount] = {Side::Left,  Side::Left, Side::Left,
+                                                    Side::Left,  Side::Left, Side::Right,
+                                                    Side::Right, Side::Right};
 constexpr float kTypical[kPanelCount] = {640, 110, 300, 180, 240, 320, 420, 400};
 
-/// Stack `ids` (open panels, top to bottom) in column `col`; each gets its wanted height while
-/// all fit, else the tallest share what is left at a common height (water filling).
+/// The panels a column cuts last: the Ray panel's step list and the Selection panel's lists
+/// are what a user reads while the others are set once.
+bool cutLast(PanelId id) { return id == PanelId::Ray || id == PanelId::Selection; }
+
+/// Water filling: heights min(want, L) for a common L, filling `room` when the wants do not
+/// fit; `floor` is the least height given.
+void waterFill(const std::vector<float>& want, float room, float floor, std::vector<float>& h) {
+    std::vector<size_t> order(want.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return want[a] < want[b]; });
+    float left = std::max(room, 0.0f);
+    h.assign(want.size(), 0.0f);
+    for (size_t k = 0; k < order.size(); ++k) {
+        const float share = std::floor(left / float(order.size() - k));
+        // Whole units: the panels' edges add up exactly.
+        h[order[k]] = std::max(floor, std::min(std::ceil(std::max(want[order[k]], floor)), share));
+        left -= h[order[k]];
+    }
+}
+
+/// Stack `ids` (open panels, top to bottom) in column `col`. A folded panel takes its title
+/// bar. The expanded ones get what they ask for while all fit; else each keeps a title bar and
+/// two lines, the Ray panel then the Selection panel grow to kUsablePanelHeight, the others
+/// share what is left at a common height (water filling), and what they do not take goes to
+/// the Selection panel then the Ray panel, which fills the column.
 void stack(const std::vector<PanelId>& ids, const Rect& col, const LayoutInput& in,
            PanelLayout& out) {
     if (ids.empty()) return;
-    const float title = in.titleHeight;
-    std::vector<float> h(ids.size());
+    const float title = in.titleHeight, keep = std::ceil(3.0f * title);
+    std::vector<float> h(ids.size(), title);
     float room = col.height() - kGap * float(ids.size() - 1);
-    std::vector<size_t> growing;
+    std::vector<size_t> expanded, others;
     for (size_t i = 0; i < ids.size(); ++i) {
-        const PanelRequest& p = in.panels[size_t(ids[i])];
-        if (p.collapsed) {
-            h[i] = title;
+        if (in.panels[size_t(ids[i])].collapsed) {
             room -= title;
-        } else {
-            growing.push_back(i);
+            continue;
         }
+        expanded.push_back(i);
+        if (!cutLast(ids[i])) others.push_back(i);
     }
-    // The common height L: every expanded panel gets min(want, L), all of them filling `room`.
-    std::sort(growing.begin(), growing.end(), [&](size_t a, size_t b) {
-        return in.panels[size_t(ids[a])].want < in.panels[size_t(ids[b])].want;
-    });
-    float left = std::max(room, 0.0f);
-    for (size_t k = 0; k < growing.size(); ++k) {
-        const float want = std::max(in.panels[size_t(ids[growing[k]])].want, title);
-        const float share = std::floor(left / float(growing.size() - k));
-        h[growing[k]] = std::max(title, std::min(want, share));
-        left -= h[growing[k]];
+    auto want = [&](size_t i) {
+        return std::ceil(std::max(in.panels[size_t(ids[i])].want, title));
+    };
+    auto wantsOf = [&](const std::vector<size_t>& which) {
+        std::vector<float> w;
+        for (size_t i : which) w.push_back(want(i));
+        return w;
+    };
+    float extra = room;
+    for (size_t i : expanded) {
+        h[i] = std::min(want(i), keep);
+        extra -= h[i];
+    }
+    std::vector<float> shared;
+    if (extra < 0.0f) {
+        // Not even a few lines each: all share the column alike.
+        waterFill(wantsOf(expanded), room, title, shared);
+        for (size_t k = 0; k < expanded.size(); ++k) h[expanded[k]] = shared[k];
+    } else {
+        // The Ray panel, then the Selection panel, up to a usable height.
+        auto find = [&](PanelId id) -> std::optional<size_t> {
+            for (size_t i : expanded)
+                if (ids[i] == id) return i;
+            return std::nullopt;
+        };
+        for (PanelId id : {PanelId::Ray, PanelId::Selection})
+            if (const auto i = find(id)) {
+                const float add =
+                    std::clamp(std::min(want(*i), kUsablePanelHeight) - h[*i], 0.0f, extra);
+                h[*i] += add;
+                extra -= add;
+            }
+        // The others share theirs and the rest (each keeps at least what it had).
+        float othersRoom = extra;
+        for (size_t i : others) othersRoom += h[i];
+        waterFill(wantsOf(others), othersRoom, title, shared);
+        for (size_t k = 0; k < others.size(); ++k) {
+            extra -= shared[k] - h[others[k]];
+            h[others[k]] = shared[k];
+        }
+        // What they leave: the Selection panel to what it asks, the Ray panel the rest.
+        for (PanelId id : {PanelId::Selection, PanelId::Ray})
+            if (const auto i = find(id)) {
+                const float add = std::clamp(want(*i) - h[*i], 0.0f, std::max(extra, 0.0f));
+                h[*i] += add;
+                extra -= add;
+            }
     }
     float y = col.y0;
     for (size_t i = 0; i < ids.size(); ++i) {
@@ -85,16 +153,28 @@ PanelLayout layoutPanels(const LayoutInput& in) {
         imageTop = std::min(kMenuBarHeight, h);
         const float colW = std::max(
             0.0f, std::min(std::clamp(0.27f * w, kColumnMin, kColumnMax), w - 2 * kMargin));
-        out.twoColumns = !in.inspector && w - 2.0f * (colW + 2.0f * kMargin) >= kMinImageWidth;
         const float top = imageTop, bottom = std::max(top, h - kMargin);
+        const float between = w - 2.0f * (colW + 2.0f * kMargin);
+        if (!in.inspector) {
+            out.twoColumns = between >= kMinImageWidth;
+        } else if (between >= 2.0f * kMinViewWidth) {
+            // Beside the inspector only when one column cannot hold the open panels at their
+            // typical heights: the image and the inspector keep the width otherwise.
+            float need = 0.0f;
+            for (int i = 0; i < kPanelCount; ++i) {
+                const PanelRequest& p = in.panels[size_t(i)];
+                if (p.open) need += (p.collapsed ? in.titleHeight : kTypical[i]) + kGap;
+            }
+            out.twoColumns = need - kGap > bottom - top;
+        }
         std::vector<PanelId> left, right;
         float leftUsed = 0.0f, rightUsed = 0.0f;
         for (int i = 0; i < kPanelCount; ++i) {
             const PanelRequest& p = in.panels[size_t(i)];
             if (!p.open) continue;
-            const Side side = kSide[i] == Side::Roomier
-                                  ? (rightUsed < leftUsed ? Side::Right : Side::Left)
-                                  : kSide[i];
+            const Side fixed = in.inspector ? kSideBesideInspector[i] : kSide[i];
+            const Side side =
+                fixed == Side::Roomier ? (rightUsed < leftUsed ? Side::Right : Side::Left) : fixed;
             const bool toRight = out.twoColumns && side == Side::Right;
             (toRight ? right : left).push_back(PanelId(i));
             (toRight ? rightUsed : leftUsed) += (p.collapsed ? in.titleHeight : kTypical[i]) + kGap;
@@ -106,10 +186,12 @@ PanelLayout layoutPanels(const LayoutInput& in) {
     }
     out.image = {imageLeft, imageTop, imageRight, h};
     if (in.inspector) {
-        // The inspector's view takes the right half of what the panels leave, to the edge.
-        const float mid = std::floor(imageLeft + 0.5f * (w - imageLeft));
+        // The inspector's view takes the right half of what the panels leave, to the window's
+        // edge or to the second column.
+        const float end = imageRight < w ? imageRight : w;
+        const float mid = std::floor(imageLeft + 0.5f * (end - imageLeft));
         out.image.x1 = mid;
-        out.inspector = {mid, imageTop, w, h};
+        out.inspector = {mid, imageTop, end, h};
     }
     return out;
 }

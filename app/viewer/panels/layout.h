@@ -69,17 +69,25 @@ struct PanelLayout {
     const Rect& operator[](PanelId id) const { return panels[size_t(id)]; }
 };
 
+/// The height the Ray panel, then the Selection panel, get before the others when a column's
+/// panels do not fit (the Ray panel's pixel, counts, rays and transport), room permitting.
+inline constexpr float kUsablePanelHeight = 260.0f;
+
 /// The menu bar's height the panels stay under.
 inline constexpr float kMenuBarHeight = 28.0f;
 
 /// Polyscope's arrangement: the panels stack in a column on the left and, when the window is
-/// wide enough and the inspector is not shown, a second on the right (the parameters on the
-/// left, the view and statistics on the right, the others in the column with more room), so
-/// the image keeps the middle. A column's panels share its height: each gets what its content
-/// asks for while they all fit, else the tallest are cut down to a common height and scroll
-/// (the Ray panel, whose step list fills what it is given, asks for the most). The inspector
-/// takes the right half of what the panels leave. Nothing overlaps, and everything stays inside
-/// the window at any size.
+/// wide enough, a second on the right (the parameters on the left, the view and statistics on
+/// the right, the others in the column with more room), so the image keeps the middle. With the
+/// inspector shown, the inspector takes the right half of what the panels leave, and a second
+/// column (the Inspector, Selection and Ray panels) stands right of it only when one column
+/// cannot hold the open panels and the image and the inspector keep 400 units each. A column's
+/// panels share its height: each gets what its content asks for while they all fit; else each
+/// keeps a title bar and two lines, the Ray panel then the Selection panel grow to
+/// kUsablePanelHeight, the others are cut down to a common height and scroll, and what they
+/// leave goes to the Selection panel, then the Ray panel (whose step list fills what it is
+/// given). A folded panel takes its title bar. Nothing overlaps, and everything stays inside the
+/// window at any size.
 PanelLayout layoutPanels(const LayoutInput& in);
 
 }  // namespace lancer::viewer

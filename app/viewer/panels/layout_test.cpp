@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "app/viewer/inspector/inspector.h"
 
 namespace lancer::viewer {
@@ -105,6 +107,142 @@ TEST(PanelLayout, HiddenPanelsLeaveTheWindowToTheImageAndTheInspectorItsRightHal
     EXPECT_EQ(l.inspector.toString(),
               Rect({float(v.x0), float(v.y0), float(v.x1), float(v.y1)}).toString());
     EXPECT_EQ(l.image.toString(), Rect({0, 0, 640, 720}).toString());
+}
+
+/// The panels a first run shows (Overlays folded), with the inspector and a ray picked.
+LayoutInput inspectingARay(float w, float h) {
+    LayoutInput in = everyPanel(w, h, true);
+    in[PanelId::Overlays].collapsed = true;
+    in[PanelId::Selection].open = false;
+    return in;
+}
+
+/// The height of the tallest open, expanded panel other than those of `skip`.
+float tallestOther(const LayoutInput& in, const PanelLayout& l,
+                   std::initializer_list<PanelId> skip) {
+    float most = 0.0f;
+    for (int i = 0; i < kPanelCount; ++i) {
+        if (!in.panels[size_t(i)].open ||
+            std::find(skip.begin(), skip.end(), PanelId(i)) != skip.end())
+            continue;
+        most = std::max(most, l.panels[size_t(i)].height());
+    }
+    return most;
+}
+
+TEST(PanelLayout, WithTheInspectorTheRayPanelKeepsAUsableHeight) {
+    // One column holds every panel beside the image and the inspector: the Ray panel gets a
+    // usable height before the others, which keep a title bar and two lines each.
+    for (const auto& [w, h, least] :
+         {std::tuple{1280.0f, 720.0f, kUsablePanelHeight}, std::tuple{900.0f, 600.0f, 200.0f}}) {
+        SCOPED_TRACE(testing::Message() << w << " x " << h);
+        const LayoutInput in = inspectingARay(w, h);
+        const PanelLayout l = layoutPanels(in);
+        expectApart(in, l);
+        EXPECT_FALSE(l.twoColumns);
+        EXPECT_GE(l[PanelId::Ray].height(), least);
+        EXPECT_FLOAT_EQ(l[PanelId::Ray].y1, h - 8.0f) << "down to the bottom margin";
+        for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics, PanelId::Camera,
+                           PanelId::Inspector})
+            EXPECT_GE(l[id].height(), 3.0f * in.titleHeight) << panelTitle(id);
+        EXPECT_EQ(l[PanelId::Overlays].height(), in.titleHeight) << "folded: its title bar";
+    }
+    // A ray played selects its region, which opens the Selection panel: the Ray panel still
+    // gets a usable height first.
+    LayoutInput playing = inspectingARay(1280.0f, 720.0f);
+    playing[PanelId::Selection].open = true;
+    PanelLayout l = layoutPanels(playing);
+    expectApart(playing, l);
+    EXPECT_GE(l[PanelId::Ray].height(), kUsablePanelHeight);
+    EXPECT_GE(l[PanelId::Selection].height(), 3.0f * playing.titleHeight);
+    // Every panel open and expanded at 1280 x 720: the Ray panel is cut last, and more than
+    // three times as tall as any other.
+    LayoutInput all = everyPanel(1280.0f, 720.0f, true);
+    l = layoutPanels(all);
+    expectApart(all, l);
+    EXPECT_GT(l[PanelId::Ray].height(), 3.0f * tallestOther(all, l, {PanelId::Ray}));
+    EXPECT_GE(l[PanelId::Selection].height(), 3.0f * all.titleHeight);
+    // Folding the other panels gives the Ray panel the column.
+    for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics, PanelId::Camera,
+                       PanelId::Overlays, PanelId::Inspector, PanelId::Selection})
+        all[id].collapsed = true;
+    l = layoutPanels(all);
+    expectApart(all, l);
+    EXPECT_GT(l[PanelId::Ray].height(),
+              720.0f - kMenuBarHeight - 8.0f - 7.0f * (19.0f + 8.0f) - 1.0f);
+}
+
+TEST(PanelLayout, AWideWindowPutsTheRayPanelBesideTheInspectorWhenOneColumnCannotHoldThePanels) {
+    for (const auto& [w, h] : {std::pair{1600.0f, 900.0f}, std::pair{1920.0f, 1080.0f}}) {
+        SCOPED_TRACE(testing::Message() << w << " x " << h);
+        LayoutInput in = inspectingARay(w, h);
+        in[PanelId::Selection].open = true;
+        const PanelLayout l = layoutPanels(in);
+        expectApart(in, l);
+        EXPECT_TRUE(l.twoColumns);
+        for (PanelId id : {PanelId::Inspector, PanelId::Selection, PanelId::Ray})
+            EXPECT_GE(l[id].x0, l.inspector.x1) << panelTitle(id) << " right of the inspector";
+        for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics})
+            EXPECT_LE(l[id].x1, l.image.x0) << panelTitle(id) << " left of the image";
+        EXPECT_GE(l.image.width(), 400.0f);
+        EXPECT_GE(l.inspector.width(), 400.0f);
+        EXPECT_GE(l[PanelId::Ray].height(), kUsablePanelHeight);
+        EXPECT_GE(l[PanelId::Selection].height(), kUsablePanelHeight);
+        // No panel has less room than one column of the same height gives it, and together
+        // they have more.
+        LayoutInput narrow = in;
+        narrow.width = 1280.0f;
+        const PanelLayout one = layoutPanels(narrow);
+        ASSERT_FALSE(one.twoColumns);
+        float two = 0.0f, single = 0.0f;
+        for (int i = 0; i < kPanelCount; ++i)
+            if (in.panels[size_t(i)].open && !in.panels[size_t(i)].collapsed) {
+                EXPECT_GE(l.panels[size_t(i)].height(), one.panels[size_t(i)].height())
+                    << panelTitle(PanelId(i));
+                two += l.panels[size_t(i)].height();
+                single += one.panels[size_t(i)].height();
+            }
+        EXPECT_GT(two, single + 200.0f);
+
+        // The other panels folded: one column holds them, and the image and the inspector
+        // keep the width.
+        LayoutInput folded = in;
+        for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics, PanelId::Camera,
+                           PanelId::Inspector, PanelId::Selection})
+            folded[id].collapsed = true;
+        const PanelLayout f = layoutPanels(folded);
+        expectApart(folded, f);
+        EXPECT_FALSE(f.twoColumns);
+        EXPECT_GT(f.inspector.width(), l.inspector.width());
+        EXPECT_GE(f[PanelId::Ray].height(), 0.6f * h);
+    }
+}
+
+TEST(PanelLayout, NoPanelOverlapsOrLeavesTheWindowAtAnySizeAndChoiceOfPanels) {
+    std::mt19937 rng(16);
+    std::uniform_real_distribution<float> wantOf(40.0f, 900.0f);
+    for (float w : {640.0f, 800.0f, 900.0f, 1024.0f, 1280.0f, 1440.0f, 1600.0f, 1920.0f, 2560.0f})
+        for (float h : {480.0f, 600.0f, 720.0f, 900.0f, 1080.0f, 1440.0f})
+            for (int k = 0; k < 40; ++k) {
+                LayoutInput in;
+                in.width = w;
+                in.height = h;
+                in.inspector = rng() % 2;
+                for (int i = 0; i < kPanelCount; ++i) {
+                    const bool open = rng() % 3 != 0, folded = rng() % 3 == 0;
+                    const float want = PanelId(i) == PanelId::Ray ? 1.0e6f : wantOf(rng);
+                    in.panels[size_t(i)] = {open, folded, want};
+                }
+                SCOPED_TRACE(testing::Message() << w << " x " << h << " case " << k
+                                                << (in.inspector ? ", inspector" : ""));
+                const PanelLayout l = layoutPanels(in);
+                expectApart(in, l);
+                EXPECT_GE(l.image.width(), std::min(260.0f, 0.2f * w));
+                const PanelRequest& ray = in[PanelId::Ray];
+                if (ray.open && !ray.collapsed && h >= 600.0f)
+                    EXPECT_GE(l[PanelId::Ray].height(), 2.0f * in.titleHeight);
+                if (::testing::Test::HasFailure()) return;
+            }
 }
 
 TEST(PanelLayout, ASmallWindowKeepsEveryPanelInside) {
