@@ -17,15 +17,14 @@ namespace lancer {
 template <class Obs>
 inline const Mailbox& mailboxSpans(const Scene& scene, uint32_t p, const Ray& ray,
                                    TraceContext& ctx, Obs& obs, bool* fresh = nullptr) {
-    Mailbox& m = ctx.mail[p];
-    if (ctx.stamp[p] == ctx.rayId) {
+    if (const Mailbox* held = ctx.heldMailbox(p)) {
         ++ctx.counters.mailboxHits;
         obs.mailboxHit(p);
         if (fresh) *fresh = false;
-        return m;
+        return *held;
     }
+    Mailbox& m = ctx.takeMailbox(p);
     m.count = uint8_t(scene.primSpans(p, ray, m.spans));
-    ctx.stamp[p] = ctx.rayId;
     ++ctx.counters.primTests;
     obs.primTest(p, m.spans, m.count);
     if (fresh) *fresh = true;
@@ -59,9 +58,9 @@ void evalTree(const Scene& scene, const CsgTree& tree, int node, const Ray& ray,
     const CsgNode& x = tree.nodes[node];
     if (x.op == Op::Primitive) {
         if constexpr (F == Fetch::Fresh) {
-            const Mailbox& m = ctx.mail[x.prim];
-            assert(ctx.stamp[x.prim] == ctx.rayId);
-            out.assign(m.spans, m.spans + m.count);
+            const Mailbox* m = ctx.heldMailbox(x.prim);
+            assert(m);
+            out.assign(m->spans, m->spans + m->count);
         } else {
             Span local[2];
             const Span* s;
@@ -133,7 +132,7 @@ template <class Obs>
     if (root < 0) return false;
     PendingBoundaries& pend = ctx.pending;
     if (!ctx.useMailboxes) {
-        ++ctx.rayId;
+        ctx.newStamp();
         pend.clear();
     } else if (pend.next < t0) {
         pend.advance(t0);
