@@ -83,6 +83,7 @@ struct TraceContext {
     PendingBoundaries pending;      ///< of the ray the regular walk is on
     std::vector<SpanList> scratch;  ///< two buffers per tree level, reused without allocation
     SpanList result;                ///< spans of the tree evaluated last
+    SpanList leafSpans;             ///< the spans of a region's primitives (hitInLeaf's union)
     uint32_t rayId = 0;
     bool useMailboxes = true;
     RayCounters counters;

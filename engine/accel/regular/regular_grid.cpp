@@ -404,6 +404,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     b.unionOnly =
         std::all_of(scene.tree.nodes.begin(), scene.tree.nodes.end(),
                     [](const CsgNode& n) { return n.op == Op::Primitive || n.op == Op::Union; });
+    unionOnly_ = b.unionOnly;
     b.scratch.resize(size_t(b.maxLevel) + 2);
     if (params.splitAxes == SplitAxes::Cost)
         schedule_ = planSchedule(scene, box_, live, b.weight, b.maxLevel, params.maxObjects, guard);
