@@ -3,9 +3,12 @@
 // both walks (exact and push), push's failure modes, sub-tables, mailboxes and refusals.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <random>
 #include <set>
 
+#include "engine/accel/eval.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
 #include "tests/support/differential.h"
@@ -170,6 +173,68 @@ void randomScenesMatchBrute(StepMethod step, int seeds) {
 TEST(RegularExact, RandomCsgScenesRayForRay) { randomScenesMatchBrute(StepMethod::Exact, 6); }
 TEST(RegularPush, RandomCsgScenesRayForRayAtDefaultDelta) {
     randomScenesMatchBrute(StepMethod::Push, 6);
+}
+
+// A union-only scene's leaves are evaluated by merging their primitives' spans (flatUnion), not
+// by walking their trees: the same spans as the tree of unions, the same hits as brute force.
+TEST(RegularUnion, FlatUnionIsTheTreeOfUnions) {
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<double> u(-10.0, 10.0);
+    for (int trial = 0; trial < 3000; ++trial) {
+        const int n = 1 + int(rng() % 24);
+        SpanList tree, flat, next;
+        for (int p = 0; p < n; ++p) {
+            // A primitive's spans: sorted and disjoint, a surface's of zero length.
+            const int count = int(rng() % 3);
+            std::vector<double> t(size_t(2 * count));
+            for (double& x : t) x = u(rng);
+            std::sort(t.begin(), t.end());
+            SpanList spans;
+            for (int k = 0; k < count; ++k) {
+                const bool surface = rng() % 5 == 0;
+                const double out = surface ? t[size_t(2 * k)] : t[size_t(2 * k + 1)];
+                spans.push_back(
+                    {{t[size_t(2 * k)], uint32_t(p), 0, false}, {out, uint32_t(p), 1, false}});
+            }
+            spanUnion(tree, spans, next);
+            tree.swap(next);
+            flat.insert(flat.end(), spans.begin(), spans.end());
+        }
+        SpanList merged;
+        flatUnion(flat, merged);
+        ASSERT_EQ(merged, tree) << "trial " << trial << ": " << toString(merged) << " against "
+                                << toString(tree);
+    }
+}
+
+TEST(RegularUnion, UnionOnlyScenesRayForRay) {
+    size_t total = 0;
+    for (uint64_t seed = 1; seed <= 6; ++seed) {
+        // Random solids, densely overlapping, under one union.
+        test::RandomSceneOptions opt;
+        opt.primitives = 24;
+        opt.spread = 2.0;
+        opt.surfaces = seed % 2 == 0;
+        Scene s = test::randomCsgScene(seed * 13 + 5, opt);
+        std::vector<int> leaves;
+        CsgTree t;
+        for (uint32_t p = 0; p < s.prims.size(); ++p) leaves.push_back(t.leaf(p));
+        t.root = t.balanced(Op::Union, leaves);
+        s.tree = std::move(t);
+        s.prepare();
+        BuildParams p = regular();
+        p.regular.maxObjects = 1 + int(seed % 3);
+        p.regular.costStop = seed > 3;
+        auto accel = buildAccelerator(s, p);
+        auto rays = hardRays(s, gridOf(*accel), seed, 2500);
+        total += rays.size();
+        auto bad = test::compareWithBrute(s, *accel, rays);
+        ASSERT_TRUE(bad.empty()) << s.name << ": " << bad.size() << " rays differ\n"
+                                 << describe(s, bad);
+        auto secondary = test::compareWithBrute(s, *accel, rays, 1e-3 * s.scale());
+        ASSERT_TRUE(secondary.empty()) << s.name << " tmin > 0\n" << describe(s, secondary);
+    }
+    EXPECT_GE(total, 20000u);
 }
 
 // The report's push has an error: a delta larger than a thin cell jumps over it (wrong hits);

@@ -123,25 +123,28 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
         // stretch the bins over its whole image, the object getting few of them. Outside it,
         // coarse bins over the whole image hold the large boxes.
         const double largeArea = kLargeShare * (u1 - u0) * (v1 - v0);
-        std::vector<BoxImage> images;
-        images.reserve(boxes.size());
-        double wu0 = kInf, wu1 = -kInf, wv0 = kInf, wv1 = -kInf;
-        bool anyLarge = false;
-        for (const Box3& mb : boxes) {
-            if ((images.size() & 255) == 0 && stop.stop_requested()) {
-                maps_.clear();
-                return;
-            }
-            if (mb.isEmpty()) continue;                      // a dropped primitive
+        // A box's image, computed in each of the two passes below rather than kept: on a scene of
+        // 600k primitives an array of them took 52 MB, whose page faults cost more than
+        // projecting every box twice.
+        auto imageOf = [&](const Box3& mb, BoxImage& im) {
             Box3 x{mb.lo - Vec3(side), mb.hi + Vec3(side)};  // widened across the view axis only
             x.lo[m.a] = mb.lo[m.a], x.hi[m.a] = mb.hi[m.a];
-            BoxImage im;
             m.project(x, im.dn, im.u0, im.u1, im.v0, im.v1);
             im.df = m.s > 0.0 ? m.L[m.a] - x.lo[m.a] : x.hi[m.a] - m.L[m.a];
             im.b0 = x.lo[m.b] - m.L[m.b], im.b1 = x.hi[m.b] - m.L[m.b];
             im.c0 = x.lo[m.c] - m.L[m.c], im.c1 = x.hi[m.c] - m.L[m.c];
             im.large = (im.u1 - im.u0) * (im.v1 - im.v0) > largeArea;
-            images.push_back(im);
+        };
+        double wu0 = kInf, wu1 = -kInf, wv0 = kInf, wv1 = -kInf;
+        bool anyLarge = false;
+        for (size_t i = 0; i < boxes.size(); ++i) {
+            if ((i & 255) == 0 && stop.stop_requested()) {
+                maps_.clear();
+                return;
+            }
+            if (boxes[i].isEmpty()) continue;  // a dropped primitive
+            BoxImage im;
+            imageOf(boxes[i], im);
             anyLarge |= im.large;
             if (!im.large) {
                 wu0 = std::min(wu0, im.u0), wu1 = std::max(wu1, im.u1);
@@ -156,11 +159,14 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
             m.fine.cover(u0, u1, v0, v1, n, k);
         }
         std::vector<double> colLo, colHi;  // scratch of Grid::add
-        for (const BoxImage& im : images) {
-            if ((&im - images.data()) % 256 == 0 && stop.stop_requested()) {
+        for (size_t i = 0; i < boxes.size(); ++i) {
+            if ((i & 255) == 0 && stop.stop_requested()) {
                 maps_.clear();
                 return;
             }
+            if (boxes[i].isEmpty()) continue;
+            BoxImage im;
+            imageOf(boxes[i], im);
             m.fine.add(im, colLo, colHi);
             if (window && im.large) m.coarse.add(im, colLo, colHi);
         }

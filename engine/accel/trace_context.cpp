@@ -1,5 +1,6 @@
 #include "engine/accel/trace_context.h"
 
+#include <algorithm>
 #include <ostream>
 
 namespace lancer {
@@ -43,10 +44,16 @@ std::string RayCounters::toString() const {
 std::ostream& operator<<(std::ostream& os, const RayCounters& c) { return os << c.toString(); }
 
 void TraceContext::reset(size_t primitives, int treeDepth) {
-    stamp.assign(primitives, 0);
-    mail.assign(primitives, Mailbox{});
+    tags.assign(primitives, Tag{});
+    held.clear();
+    held.reserve(64);
     scratch.resize(size_t(2 * treeDepth + 4));
     rayId = 0;
+}
+
+void TraceContext::wrap() {
+    std::fill(tags.begin(), tags.end(), Tag{});
+    rayId = 1;
 }
 
 }  // namespace lancer

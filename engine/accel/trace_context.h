@@ -31,9 +31,8 @@ struct RayCounters {
 
 std::ostream& operator<<(std::ostream& os, const RayCounters& c);
 
-/// The report's "boîte aux lettres": the spans of the last ray tested against a primitive, the
-/// ray's id being TraceContext::stamp. Each thread owns its own arrays, so no mailbox is ever
-/// shared between threads.
+/// The report's "boîte aux lettres": the spans of a primitive for the current ray id
+/// (TraceContext::rayId). Each thread owns its own, so no mailbox is ever shared between threads.
 struct Mailbox {
     uint8_t count = 0;
     Span spans[2];
@@ -66,15 +65,26 @@ struct PendingBoundaries {
     }
 };
 
-/// One per thread. Ray ids start at 1 and are unique within the context, so mailboxes never
-/// need clearing between rays.
+/// One per thread. Ray ids start at 1 and are unique within the context until they wrap (after
+/// 2^32 ids, when every tag is cleared once), so mailboxes never need clearing between rays.
+///
+/// A primitive's mailbox is found through its tag: the ray id it was filled for and where it is
+/// held. Only the current ray id's mailboxes are held, in the order they were filled; a new id
+/// drops them. A scene's primitives thus cost 8 bytes each per thread (a mailbox per primitive,
+/// 80 bytes with its stamp, took 48 MB per thread on a 598k-sphere scene: 0.3 s of page faults
+/// per render of 2 threads), and the mailboxes a ray fills lie together in a few cache lines.
 struct TraceContext {
-    std::vector<uint64_t> stamp;  ///< per primitive: the ray id its mailbox holds spans for
-    std::vector<Mailbox> mail;
+    struct Tag {
+        uint32_t stamp = 0;  ///< the ray id its mailbox was filled for; 0: none
+        uint32_t slot = 0;   ///< the mailbox's index in `held`
+    };
+    std::vector<Tag> tags;          ///< per primitive
+    std::vector<Mailbox> held;      ///< the current ray id's mailboxes, as filled
     PendingBoundaries pending;      ///< of the ray the regular walk is on
     std::vector<SpanList> scratch;  ///< two buffers per tree level, reused without allocation
     SpanList result;                ///< spans of the tree evaluated last
-    uint64_t rayId = 0;
+    SpanList leafSpans;             ///< the spans of a region's primitives (hitInLeaf's union)
+    uint32_t rayId = 0;
     bool useMailboxes = true;
     RayCounters counters;
 
@@ -83,11 +93,29 @@ struct TraceContext {
     void reset(size_t primitives, int treeDepth);
     /// Start a new ray: a fresh id for the mailboxes.
     void beginRay() {
-        ++rayId;
+        newStamp();
         ++counters.rays;
     }
     /// A fresh mailbox id for the same ray (a walk over another stretch of it).
-    void newStamp() { ++rayId; }
+    void newStamp() {
+        held.clear();
+        if (++rayId == 0) wrap();
+    }
+    /// The mailbox primitive `p` holds for the current ray id, or null when none was filled.
+    Mailbox* heldMailbox(uint32_t p) {
+        const Tag t = tags[p];
+        return t.stamp == rayId ? &held[t.slot] : nullptr;
+    }
+    /// A mailbox for primitive `p` for the current ray id, to fill: valid until the next one is
+    /// taken (they are held in one growing array).
+    Mailbox& takeMailbox(uint32_t p) {
+        tags[p] = {rayId, uint32_t(held.size())};
+        return held.emplace_back();
+    }
+
+  private:
+    /// The ray ids ran out: every tag cleared, ids start again at 1.
+    void wrap();
 };
 
 }  // namespace lancer

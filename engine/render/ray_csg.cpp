@@ -52,10 +52,9 @@ struct Evaluator {
         ctx.useMailboxes = true;
         for (const PrimSpans& p : inputs) {
             if (p.prim >= scene.prims.size()) continue;
-            Mailbox& m = ctx.mail[p.prim];
+            Mailbox& m = ctx.takeMailbox(p.prim);
             m.count = uint8_t(std::min<size_t>(p.spans.size(), 2));
             std::copy_n(p.spans.begin(), m.count, m.spans);
-            ctx.stamp[p.prim] = ctx.rayId;
         }
         NodeRecorder rec;
         SpanList out;

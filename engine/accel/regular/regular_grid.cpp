@@ -360,6 +360,10 @@ struct RegularBuilder {
 
 RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildGuard* guardIn)
     : scene_(&scene), exact_(params.step == StepMethod::Exact) {
+    // A union-only tree restricts to unions: every leaf's spans are its primitives' merged.
+    unionOnly_ =
+        std::all_of(scene.tree.nodes.begin(), scene.tree.nodes.end(),
+                    [](const CsgNode& n) { return n.op == Op::Primitive || n.op == Op::Union; });
     BuildGuard ownGuard;
     BuildGuard& guard = guardIn ? *guardIn : ownGuard;
     if (params.maxLevel < 0 || params.maxLevel > 48)

@@ -119,8 +119,9 @@ class RegularGrid {
               Hit& hit) const;
 
     const Scene* scene_;
-    bool exact_ = true;   ///< --step exact (else push)
-    double delta_ = 0.0;  ///< absolute push distance
+    bool exact_ = true;       ///< --step exact (else push)
+    bool unionOnly_ = false;  ///< the scene's tree has only unions: so has every leaf's
+    double delta_ = 0.0;      ///< absolute push distance
     Box3 box_;
     Box3 clipBox_;  ///< box_ grown by a hair: a grazing ray whose hit rounds outside still enters
     Vec3 ext_{0.0};
@@ -268,7 +269,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
             obs.region(leaf, std::min(std::max(tIn, tShown), shownEnd), shownEnd);
         }
         if (hitInLeaf(*scene_, pool_, L.root, L.primitives(primList), L.prims, ray, tmin, t0, t1,
-                      ctx, obs, hit))
+                      ctx, obs, hit, unionOnly_))
             return true;
         if constexpr (Obs::kActive) {
             int ties = 0;
