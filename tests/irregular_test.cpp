@@ -38,17 +38,6 @@ void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<
                              << (bad.empty() ? "" : bad[0].toString(scene));
 }
 
-/// An orthographic camera on the same eye and axes, framing the scene's bounds.
-void makeOrthographic(Scene& scene) {
-    CameraFrame f = CameraFrame::of(scene.camera);
-    Box3 b = f.box(scene.bounds);
-    scene.camera.projection = Projection::Orthographic;
-    scene.camera.orthoHeight = 1.1 * std::max(b.extent().x, b.extent().y);
-    // The orthographic eye plane must stand in front of the scene for primary rays to see it all.
-    scene.camera.from = f.toWorld({0.5 * (b.lo.x + b.hi.x), 0.5 * (b.lo.y + b.hi.y), b.lo.z - 1.0});
-    scene.camera.at = scene.camera.from + f.z;
-}
-
 /// World points at the corners, edge midpoints and face centres of some regions.
 std::vector<Vec3> regionPoints(const IrregularSubdivision& s, size_t maxRegions, uint64_t seed) {
     std::mt19937_64 rng(seed);
@@ -151,7 +140,7 @@ void spdPixelForPixel(IrregularFrame frame) {
         Scene scene = loadScene(path.string());
         int n = path.filename() == "balls4.nff" ? 24 : 40;
         for (int ortho = 0; ortho < 2; ++ortho) {
-            if (ortho) makeOrthographic(scene);
+            if (ortho) test::makeOrthographic(scene);
             auto accel = buildIrregular(scene, BspHeuristic::Balanced, 0, frame);
             std::string what = path.filename().string() +
                                (ortho ? " orthographic " : " perspective ") +
@@ -173,7 +162,7 @@ TEST(Irregular, BuiltinCsgScenesPixelForPixel) {
     for (const char* spec : {"builtin:default", "builtin:drilled:4", "builtin:lattice:4"}) {
         Scene scene = loadScene(spec);
         for (int ortho = 0; ortho < 2; ++ortho) {
-            if (ortho) makeOrthographic(scene);
+            if (ortho) test::makeOrthographic(scene);
             for (BspHeuristic h :
                  {BspHeuristic::First, BspHeuristic::Balanced, BspHeuristic::FewestCuts}) {
                 // Primary rays on the projective zones with one heuristic in two.

@@ -18,16 +18,6 @@ namespace {
 
 constexpr int kW = 40, kH = 30;  // the image the pixel units refer to
 
-/// An orthographic camera on the same eye and axes, framing the scene's bounds.
-void makeOrthographic(Scene& scene) {
-    CameraFrame f = CameraFrame::of(scene.camera);
-    Box3 b = f.box(scene.bounds);
-    scene.camera.projection = Projection::Orthographic;
-    scene.camera.orthoHeight = 1.1 * std::max(b.extent().x, b.extent().y);
-    scene.camera.from = f.toWorld({0.5 * (b.lo.x + b.hi.x), 0.5 * (b.lo.y + b.hi.y), b.lo.z - 1.0});
-    scene.camera.at = scene.camera.from + f.z;
-}
-
 /// One configuration: a random scene seen by one camera, built by one scheme.
 struct Case {
     uint64_t seed;
@@ -78,7 +68,7 @@ Built build(const Case& c) {
     b.scene = test::randomCsgScene(c.seed, ro);
     b.scene.width = kW;
     b.scene.height = kH;
-    if (c.ortho) makeOrthographic(b.scene);
+    if (c.ortho) test::makeOrthographic(b.scene);
     BuildParams p;
     p.scheme = c.scheme;
     p.regular.maxLevel = 12;  // 4096 directory cells at most: every cell can be checked

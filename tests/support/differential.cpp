@@ -1,6 +1,9 @@
 #include "tests/support/differential.h"
 
+#include <algorithm>
 #include <sstream>
+
+#include "engine/accel/irregular/camera_frame.h"
 
 namespace lancer::test {
 
@@ -80,6 +83,16 @@ Scene randomGlassyCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
     scene.frameCamera(Vec3(0.3, 1.0, -0.4), Vec3(0.0, 0.0, 1.0));
     scene.defaultLights();
     return scene;
+}
+
+void makeOrthographic(Scene& scene) {
+    CameraFrame f = CameraFrame::of(scene.camera);
+    Box3 b = f.box(scene.bounds);
+    scene.camera.projection = Projection::Orthographic;
+    scene.camera.orthoHeight = 1.1 * std::max(b.extent().x, b.extent().y);
+    // The orthographic eye plane must stand in front of the scene for primary rays to see it all.
+    scene.camera.from = f.toWorld({0.5 * (b.lo.x + b.hi.x), 0.5 * (b.lo.y + b.hi.y), b.lo.z - 1.0});
+    scene.camera.at = scene.camera.from + f.z;
 }
 
 std::vector<Ray> randomRays(const Scene& scene, uint64_t seed, int count) {

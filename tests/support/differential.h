@@ -27,6 +27,9 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt = {});
 /// lights: a pixel's ray tree holds every ray kind (primary, shadow, reflection, refraction).
 Scene randomGlassyCsgScene(uint64_t seed, const RandomSceneOptions& opt = {});
 
+/// An orthographic camera on the same eye and axes as the scene's, framing its bounds.
+void makeOrthographic(Scene& scene);
+
 /// Random rays aimed at the scene: through random points of the bounds, from outside and
 /// inside, plus axis-parallel rays. Directions are unit length.
 std::vector<Ray> randomRays(const Scene& scene, uint64_t seed, int count);
