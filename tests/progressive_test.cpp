@@ -9,11 +9,13 @@
 #include <thread>
 
 #include "engine/scene/loader.h"
+#include "tests/support/instrumented.h"
 
 namespace lancer {
 namespace {
 
-bool waitFor(const std::function<bool()>& done, double seconds = 30.0) {
+/// Poll `done` until it holds (true) or `seconds` pass (false).
+bool waitFor(const std::function<bool()>& done, double seconds) {
     auto start = std::chrono::steady_clock::now();
     while (!done()) {
         if (std::chrono::steady_clock::now() - start > std::chrono::duration<double>(seconds))
@@ -31,9 +33,10 @@ std::vector<int> followJob(ProgressiveRenderer& pr, uint64_t job, const Image& d
     std::vector<int> seenStrides;
     const int w = direct.width, h = direct.height;
     auto start = std::chrono::steady_clock::now();
+    const auto limit = std::chrono::duration<double>(30.0 * test::kInstrumented);
     for (;;) {
-        EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
-        if (std::chrono::steady_clock::now() - start > std::chrono::seconds(30)) break;
+        EXPECT_LT(std::chrono::steady_clock::now() - start, limit);
+        if (std::chrono::steady_clock::now() - start > limit) break;
         const bool finished = pr.finished();  // read first: then the snapshot below is the last
         ProgressiveRenderer::Shown what;
         const Image before = shown;
@@ -148,14 +151,15 @@ TEST(Progressive, ANewJobCancelsTheOneInFlight) {
     auto t0 = std::chrono::steady_clock::now();
     pr.start({scene, accel, small});
     // Waiting for the first pass of the new job: it comes, and a job never started does not.
-    ASSERT_TRUE(waitFor([&] { return pr.latest().job == 2; }, 20.0));
+    ASSERT_TRUE(waitFor([&] { return pr.latest().job == 2; }, 20.0 * test::kInstrumented));
     EXPECT_FALSE(waitFor([&] { return pr.latest().job == 3; }, 0.02));
     Image shown;
     uint64_t version = 0;
-    ASSERT_TRUE(waitFor([&] { return pr.finished(); }, 20.0)) << "the big job was not cancelled";
+    ASSERT_TRUE(waitFor([&] { return pr.finished(); }, 20.0 * test::kInstrumented))
+        << "the big job was not cancelled";
     double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    EXPECT_LT(ms, 10000.0);
+    EXPECT_LT(ms, 10000.0 * test::kInstrumented);
     EXPECT_EQ(pr.job(), 2u);
     ProgressiveRenderer::Shown what;
     ASSERT_TRUE(pr.snapshot(version, shown, &what));
@@ -163,7 +167,7 @@ TEST(Progressive, ANewJobCancelsTheOneInFlight) {
     EXPECT_EQ(shown.width, 24);
     EXPECT_EQ(shown.height, 16);
     pr.cancel();
-    EXPECT_TRUE(waitFor([&] { return pr.idle(); }, 20.0));
+    EXPECT_TRUE(waitFor([&] { return pr.idle(); }, 20.0 * test::kInstrumented));
 }
 
 }  // namespace

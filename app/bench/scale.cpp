@@ -182,14 +182,6 @@ ChildResult runChild(const std::function<json(Image&)>& work, double killAfterS,
     return r;
 }
 
-/// Pixels of a width x height image on `lattice`.
-size_t latticePixels(int width, int height, const PassLattice& lattice) {
-    size_t n = 0;
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x) n += lattice.contains(x, y);
-    return n;
-}
-
 /// Load the scene, time it, and fill the figures every child reports.
 Scene loadTimed(const std::string& spec, const ScaleOptions& opt, RenderOptions& ro, json& j) {
     const auto start = Clock::now();
@@ -246,7 +238,7 @@ json bruteWork(const std::string& spec, const ScaleOptions& opt, Image& img) {
         cpu = cpuMs();
         stats = render(scene, *brute, ro, img, probe);
         probeCpu = cpuMs() - cpu;
-        const double scale = double(all) / double(latticePixels(ro.width, ro.height, probe));
+        const double scale = double(all) / double(probe.pixels(ro.width, ro.height));
         estimateMs = stats.renderMs * scale;
         estimateCpu = probeCpu * scale;
         return stride;

@@ -118,13 +118,15 @@ std::string TracedRay::toString() const {
 namespace {
 
 /// Six significant digits: a sentence's numbers are read, not compared.
-std::string num(double x) {
+std::string num6(double x) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.6g", x);
     return buf;
 }
 
-std::string pt(const Vec3& p) { return "(" + num(p.x) + ", " + num(p.y) + ", " + num(p.z) + ")"; }
+std::string pt6(const Vec3& p) {
+    return "(" + num6(p.x) + ", " + num6(p.y) + ", " + num6(p.z) + ")";
+}
 
 /// Ten significant digits: a pushed point differs from the exit point by a small delta.
 std::string pt10(const Vec3& p) {
@@ -194,7 +196,7 @@ std::string nextName(const StructureView& view, uint32_t id) {
     const RegionInfo r = view.region(id);
     if (r.kind == RegionKind::Slab || r.kind == RegionKind::ProjectiveSlab ||
         r.kind == RegionKind::NearRegion)
-        s += ", depth " + num(r.frameBox.lo.z) + " to " + num(r.frameBox.hi.z);
+        s += ", depth " + num6(r.frameBox.lo.z) + " to " + num6(r.frameBox.hi.z);
     return s;
 }
 
@@ -205,7 +207,7 @@ std::string startText(const StructureView& view, const WalkEvent* locate, const 
                       uint32_t region, bool arrow) {
     std::string s;
     if (lookup) {
-        s = "starts at " + pt(lookup->point) + ": directory cell " + cellText(lookup->cell);
+        s = "starts at " + pt6(lookup->point) + ": directory cell " + cellText(lookup->cell);
         if (arrow) return s + subTables(view, lookup->cell) + " " + nextName(view, region);
         const std::string via = subTables(view, lookup->cell);
         return s + (via.empty() ? "" : " (through" + via.substr(3) + ")") + " of " +
@@ -213,7 +215,7 @@ std::string startText(const StructureView& view, const WalkEvent* locate, const 
     }
     if (locate) {
         const RegionKind k = view.region(locate->b).kind;
-        s = "starts at " + pt(locate->point) +
+        s = "starts at " + pt6(locate->point) +
             (k == RegionKind::Slab ? ", located by the screen BSP and the zone's depth slabs"
                                    : " in its pixel's projective zone");
         return s + (arrow ? " " + nextName(view, region) : ", in " + regionName(view, region));
@@ -266,7 +268,7 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
             }
             if (stretch)
                 s += "light-buffer stretch " + std::to_string(stretch->a) + " t = [" +
-                     num(stretch->t0) + ", " + num(stretch->t1) + "] ";
+                     num6(stretch->t0) + ", " + num6(stretch->t1) + "] ";
             else
                 s += "the walk ";
             s += startText(view, locate, lookup, reg.a, false) + "; ";
@@ -324,7 +326,7 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
 
         if (exit) {
             s += "left " + here + " through its " + exitFace(sides, exit->ties) +
-                 " at t = " + num(exit->t0) + " (point " + pt(exit->point) + ")";
+                 " at t = " + num6(exit->t0) + " (point " + pt6(exit->point) + ")";
             if (rope) {
                 s += "; the leaf's rope across that face " + nextName(view, rope->b);
             } else if (index && lookup) {
@@ -333,7 +335,7 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
                      subTables(view, lookup->cell) + " " + nextName(view, lookup->b);
             } else if (push && lookup) {
                 const int a = exit->axis;
-                s += "; pushed by delta " + num(std::abs(push->point[a] - exit->point[a])) +
+                s += "; pushed by delta " + num6(std::abs(push->point[a] - exit->point[a])) +
                      " across " + exitFace(sides, push->ties) + " to " + pt10(push->point) +
                      ": directory cell " + cellText(lookup->cell) + subTables(view, lookup->cell) +
                      " " + nextName(view, lookup->b);
@@ -352,8 +354,8 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
                         const int c = p.corner;
                         s += std::string(i ? "," : "") + " " + std::to_string(c) + " of region " +
                              std::to_string(p.a) + " (its corner at screen (" +
-                             num(c & 1 ? b.hi.x : b.lo.x) + ", " + num(c & 2 ? b.hi.y : b.lo.y) +
-                             "), depth " + num(c & 4 ? b.hi.z : b.lo.z) + ")";
+                             num6(c & 1 ? b.hi.x : b.lo.x) + ", " + num6(c & 2 ? b.hi.y : b.lo.y) +
+                             "), depth " + num6(c & 4 ? b.hi.z : b.lo.z) + ")";
                     }
                 }
                 s += " " + nextName(view, pointers.back()->b);
@@ -369,25 +371,25 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
         if (!exit && !error) {
             const bool last = k + 1 == steps.size();
             if (blocker && !stretch) {
-                s += "blocked by " + primText(blocker->a, scene) + " at t = " + num(blocker->t0) +
+                s += "blocked by " + primText(blocker->a, scene) + " at t = " + num6(blocker->t0) +
                      " inside this region: the light is hidden";
             } else if (last && r.kind != RayKind::Shadow && r.hit.valid()) {
-                s += "hit " + primText(r.hit.prim, scene) + " at t = " + num(r.hit.t) +
+                s += "hit " + primText(r.hit.prim, scene) + " at t = " + num6(r.hit.t) +
                      " inside this region";
             } else if (stretch) {
-                s += "the light-buffer stretch ends at t = " + num(reg.t1) + " inside this region";
+                s += "the light-buffer stretch ends at t = " + num6(reg.t1) + " inside this region";
             } else if (r.kind == RayKind::Shadow) {
-                s += "the ray reaches its light at t = " + num(reg.t1) +
+                s += "the ray reaches its light at t = " + num6(reg.t1) +
                      " inside this region: nothing blocks it";
             } else if (std::isfinite(reg.t1) && reg.t1 < r.tmax) {
-                s += "the ray leaves the structure's box at t = " + num(reg.t1) + ": nothing hit";
+                s += "the ray leaves the structure's box at t = " + num6(reg.t1) + ": nothing hit";
             } else {
                 s += "the ray's interval ends inside this region: nothing hit";
             }
         }
         if (stretch) {
             s += "; light-buffer stretch " + std::to_string(stretch->a) + " t = [" +
-                 num(stretch->t0) + ", " + num(stretch->t1) + "] ";
+                 num6(stretch->t0) + ", " + num6(stretch->t1) + "] ";
             s += hasNext ? startText(view, locate, lookup, next, true)
                          : std::string("meets no region");
         }

@@ -1,7 +1,9 @@
 // Multithreaded rendering over tiles (oneTBB), with per-pixel counters and cancellation.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <optional>
 
 #include "engine/render/image.h"
@@ -34,6 +36,14 @@ struct PassLattice {
     bool contains(int x, int y) const {
         if (x % stride || y % stride) return false;
         return previousStride == 0 || (x % previousStride) || (y % previousStride);
+    }
+    /// Pixels of a width x height image in this pass.
+    size_t pixels(int width, int height) const {
+        const int end = rowEnd < 0 ? height : std::min(rowEnd, height);
+        size_t n = 0;
+        for (int y = std::max(0, rowBegin); y < end; ++y)
+            for (int x = 0; x < width; ++x) n += contains(x, y);
+        return n;
     }
 };
 

@@ -13,6 +13,7 @@
 #include "engine/accel/accelerator.h"
 #include "engine/scene/loader.h"
 #include "tests/support/differential.h"
+#include "tests/support/instrumented.h"
 
 namespace {
 
@@ -130,15 +131,6 @@ TEST(BoundedBuild, BudgetOptionValues) {
     EXPECT_GE(defaultMemoryBudget(), size_t(256) << 20);
 }
 
-/// How many times slower instrumented code runs (the sanitized runs of scripts/test): between two
-/// polls a build does the same work, 2 to 15 times slower under ASan or TSan, so a bound on
-/// wall time scales with it.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr double kInstrumented = 10.0;
-#else
-constexpr double kInstrumented = 1.0;
-#endif
-
 /// Start a build on another thread, cancel it once it has run `after`, and return the time from
 /// the cancel request to the build's return; `cancelled` tells whether it ended by the request.
 double cancelAfter(const Scene& scene, const BuildParams& p, std::chrono::milliseconds after,
@@ -188,7 +180,7 @@ TEST(CancelledBuild, ReturnsWithin100Ms) {
             EXPECT_TRUE(cancelled) << "the build finished before the cancel at " << ms << " ms";
             // The contract is 100 ms (measured 1-70 ms under a load of 18 on two cores); a
             // loaded machine gets 3 times that.
-            EXPECT_LT(latency, 300.0 * kInstrumented) << "cancelled at " << ms << " ms";
+            EXPECT_LT(latency, 300.0 * test::kInstrumented) << "cancelled at " << ms << " ms";
             std::printf("%s cancelled after %d ms: returned in %.1f ms\n", schemeName(scheme), ms,
                         latency);
         }
