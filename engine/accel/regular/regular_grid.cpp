@@ -219,7 +219,7 @@ struct RegularBuilder {
         uint32_t pos[3];
     };
     struct Scratch {
-        std::vector<uint32_t> in, live;
+        std::vector<uint32_t> in[2], live;  ///< the children's primitives, a child's live ones
         CsgTree sub;
     };
     /// What one task builds. Node 0 is the fragment's root (the BSP's root in the first one).
@@ -375,6 +375,18 @@ struct RegularBuilder {
         return cost;
     }
 
+    /// splitCost() at depth 1 from the tests of the children's primitives, the cut at `mid`.
+    double splitCostOf(const Box3& box, int axis, double mid, const double tests[2]) const {
+        Box3 child[2] = {box, box};
+        child[0].hi[axis] = child[1].lo[axis] = mid;
+        const double parentArea = area(box);
+        double cost = 0.0;
+        for (int side = 0; side < 2; ++side)
+            cost +=
+                area(child[side]) / parentArea * (params.stepCost + params.testCost * tests[side]);
+        return cost;
+    }
+
     /// Whether splitting the cell lowers the estimated cost: at once with its children as
     /// leaves (most cells), else with kLookahead levels of splits below.
     bool splitPays(Fragment& f, const Box3& box, std::span<const uint32_t> prims, int level) {
@@ -479,8 +491,38 @@ struct RegularBuilder {
             makeLeaf(f, id, level, pos, tree, prims);
             return;
         }
-        // A split that does not lower the estimated cost within kLookahead levels is not made.
-        if (params.costStop && !splitPays(f, box, prims, level)) {
+        // Middle cut on the level's axis, in the grid's own plane coordinates.
+        const int axis = grid.schedule_.axis(level);
+        const int cuts = grid.schedule_.cuts(level, axis);
+        const double mid = planeAt(axis, 2 * pos[axis] + 1, cuts + 1);
+        // The children's lists and trees, kept per level so that their memory is reused: a
+        // child's own children use the next level's.
+        Scratch& sc = f.scratch[size_t(level) + 1];
+        // Below the root, where the cost estimate's middle (the box's) is the grid plane, one
+        // pass over the primitives makes both children's lists and the estimate's sums (the
+        // same comparisons, the same sums); elsewhere the estimate and the lists are made apart.
+        const bool onePass = level > 0 && 0.5 * (box.lo[axis] + box.hi[axis]) == mid;
+        if (onePass) {
+            double tests[2] = {0.0, 0.0}, all = 0.0;
+            sc.in[0].clear();
+            sc.in[1].clear();
+            for (uint32_t p : prims) {
+                const Box3& b = scene.minBox[p];
+                const double w = weight[p];
+                all += w;
+                if (b.lo[axis] <= mid) sc.in[0].push_back(p), tests[0] += w;
+                if (b.hi[axis] >= mid) sc.in[1].push_back(p), tests[1] += w;
+            }
+            // A split that does not lower the estimated cost within kLookahead levels is not
+            // made (splitPays(), its first estimate from these sums).
+            const double leaf = params.stepCost + params.testCost * all;
+            if (params.costStop && !(splitCostOf(box, axis, mid, tests) < leaf ||
+                                     splitCost(f, box, prims, level, kLookahead) < leaf)) {
+                ++f.costLeaves;
+                makeLeaf(f, id, level, pos, tree, prims);
+                return;
+            }
+        } else if (params.costStop && !splitPays(f, box, prims, level)) {
             ++f.costLeaves;
             makeLeaf(f, id, level, pos, tree, prims);
             return;
@@ -489,10 +531,6 @@ struct RegularBuilder {
         // the order the tasks make them in.
         if (nodes.fetch_add(2, std::memory_order_relaxed) + 2 > RegularGrid::kMaxBspNodes)
             throw std::invalid_argument(refusal());
-        // Middle cut on the level's axis, in the grid's own plane coordinates.
-        const int axis = grid.schedule_.axis(level);
-        const int cuts = grid.schedule_.cuts(level, axis);
-        const double mid = planeAt(axis, 2 * pos[axis] + 1, cuts + 1);
         const int first = int(f.bsp.nodes.size());
         f.bsp.nodes.resize(f.bsp.nodes.size() + 2);
         f.bsp.nodes[size_t(id)].first = first;
@@ -514,20 +552,17 @@ struct RegularBuilder {
             for (int side = 0; side < 2; ++side)
                 tasks.run([&, side] {
                     Fragment& k = *kid[side];
-                    half(prims, level, child[side], axis, mid, side, k.in);
-                    buildChild(k, 0, level + 1, cpos[side], child[side], tree, prims, k.in, k.sub,
-                               k.live);
+                    if (!onePass) half(prims, level, child[side], axis, mid, side, k.in);
+                    buildChild(k, 0, level + 1, cpos[side], child[side], tree, prims,
+                               onePass ? sc.in[side] : k.in, k.sub, k.live);
                 });
             tasks.wait();
             for (Fragment* k : kid) height = std::max<uint8_t>(height, k->bsp.nodes[0].height + 1);
         } else {
-            // The children's lists and trees, kept per level so that their memory is reused: a
-            // child's own children use the next level's.
-            Scratch& sc = f.scratch[size_t(level) + 1];
             for (int side = 0; side < 2; ++side) {
-                half(prims, level, child[side], axis, mid, side, sc.in);
-                buildChild(f, first + side, level + 1, cpos[side], child[side], tree, prims, sc.in,
-                           sc.sub, sc.live);
+                if (!onePass) half(prims, level, child[side], axis, mid, side, sc.in[side]);
+                buildChild(f, first + side, level + 1, cpos[side], child[side], tree, prims,
+                           sc.in[side], sc.sub, sc.live);
                 height = std::max<uint8_t>(height, f.bsp.nodes[size_t(first + side)].height + 1);
             }
         }
