@@ -620,6 +620,29 @@ struct RegularBuilder {
         out.places.push_back(f.places[n.leaf]);
     }
 
+    /// Room in the layout for what the fragments under `f` hold (an upper bound for the pool,
+    /// whose sets the fragments may share): a vector grown by doubling touches twice its final
+    /// memory, and on the machines measured a first touch of a page costs more than the copy.
+    static void reserve(Layout& out, const Fragment& f, size_t& leaves, size_t& nodes,
+                        size_t& trees, size_t& lists, size_t& sets) {
+        leaves += f.leaves.size();
+        nodes += f.bsp.nodes.size();
+        trees += f.pool.trees.nodes.size();
+        lists += f.pool.lists.size();
+        sets += f.pool.listFirst.size();
+        for (const auto& k : f.children) reserve(out, *k, leaves, nodes, trees, lists, sets);
+    }
+    static void reserve(Layout& out, const Fragment& root) {
+        size_t leaves = 0, nodes = 0, trees = 0, lists = 0, sets = 0;
+        reserve(out, root, leaves, nodes, trees, lists, sets);
+        out.leaves.reserve(leaves);
+        out.places.reserve(leaves);
+        out.bsp.nodes.reserve(nodes);
+        out.pool.trees.nodes.reserve(trees);
+        out.pool.lists.reserve(lists);
+        out.pool.listFirst.reserve(sets);
+    }
+
     /// Every fragment's counters added into `f`'s.
     static void addCounters(Fragment& f, const Fragment& from) {
         for (const auto& k : from.children) {
@@ -680,6 +703,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         out.places = std::move(root.places);
         out.pool = std::move(root.pool);
     } else {
+        RegularBuilder::reserve(out, root);
         out.bsp.nodes.resize(1);
         b.layOut(out, root, 0, 0);
     }
