@@ -244,6 +244,16 @@ struct RegularBuilder {
         size_t emptyLeaves = 0, coveredLeaves = 0, costLeaves = 0;
 
         explicit Fragment(int maxLevel) : scratch(size_t(maxLevel) + 2) { bsp.nodes.resize(1); }
+        /// Free the working lists once the fragment is built, for the tasks still running to
+        /// reuse: fresh pages cost more than the building does (balls:6's fragments' lists
+        /// alone would take tens of MB).
+        void releaseScratch() {
+            std::vector<Scratch>().swap(scratch);
+            for (std::vector<uint32_t>& l : look) std::vector<uint32_t>().swap(l);
+            std::vector<uint32_t>().swap(in);
+            std::vector<uint32_t>().swap(live);
+            CsgTree().nodes.swap(sub.nodes);
+        }
         /// Heap bytes it keeps: vectors by capacity, and its pool.
         size_t bytes() const {
             return bsp.nodes.capacity() * sizeof(BspNodes::Node) +
@@ -555,6 +565,7 @@ struct RegularBuilder {
                     if (!onePass) half(prims, level, child[side], axis, mid, side, k.in);
                     buildChild(k, 0, level + 1, cpos[side], child[side], tree, prims,
                                onePass ? sc.in[side] : k.in, k.sub, k.live);
+                    k.releaseScratch();
                 });
             tasks.wait();
             for (Fragment* k : kid) height = std::max<uint8_t>(height, k->bsp.nodes[0].height + 1);
