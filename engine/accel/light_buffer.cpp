@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "engine/scene/scene.h"
+#include "engine/util/task_fence.h"
 
 namespace lancer {
 
@@ -105,9 +106,12 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
     // The maps are independent: one task each. A light's boxes go into its bins in their
     // order (insert() depends on it), so each map is the same whatever the threads.
     std::atomic<bool> stopped{false};
+    TaskFence fence;
     tbb::parallel_for(size_t(0), points.size(), [&](size_t l) {
+        const TaskFence::Done done(fence);
         if (!buildMap(maps_[l], points[l], boxes, bins, slots, side, largest, stop)) stopped = true;
     });
+    fence.acquire();
     if (stopped) maps_.clear();
 }
 

@@ -14,6 +14,7 @@
 #include "engine/accel/build_guard.h"
 #include "engine/model/restriction.h"
 #include "engine/util/format.h"
+#include "engine/util/task_fence.h"
 
 namespace lancer {
 
@@ -110,11 +111,14 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
         guard.poll();
         // Drop the cells that stop here.
         open.assign(cells.size(), 0);
+        TaskFence fence;
         tbb::parallel_for(size_t(0), cells.size(), [&](size_t k) {
+            const TaskFence::Done done(fence);
             const Cell& c = cells[k];
             open[k] = c.end - c.begin > size_t(maxObjects) &&
                       !coveredByAll(scene, {refs.data() + c.begin, c.end - c.begin}, c.box);
         });
+        fence.acquire();
         size_t kept = 0;
         for (size_t k = 0; k < cells.size(); ++k)
             if (open[k]) cells[kept++] = cells[k];
@@ -127,6 +131,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
             for (size_t b = cells[k].begin; b < cells[k].end; b += kChunk)
                 chunks.push_back({k, b, std::min(cells[k].end, b + kChunk), {}, {}, {}});
         tbb::parallel_for(size_t(0), chunks.size(), [&](size_t k) {
+            const TaskFence::Done done(fence);
             Chunk& ch = chunks[k];
             const Box3& cb = cells[ch.cell].box;
             const double mid[3] = {0.5 * (cb.lo.x + cb.hi.x), 0.5 * (cb.lo.y + cb.hi.y),
@@ -142,6 +147,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
                 }
             }
         });
+        fence.acquire();
         double best = kInf;
         int axis = 0;
         for (int a = 0; a < 3; ++a) {
@@ -176,6 +182,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
         }
         nextRefs.resize(total);
         tbb::parallel_for(size_t(0), chunks.size(), [&](size_t k) {
+            const TaskFence::Done done(fence);
             Chunk& ch = chunks[k];
             const Box3& cb = cells[ch.cell].box;
             const double mid = 0.5 * (cb.lo[axis] + cb.hi[axis]);
@@ -185,6 +192,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
                 if (b.hi[axis] >= mid) nextRefs[ch.out[1]++] = refs[i];
             }
         });
+        fence.acquire();
         cells.swap(next);
         refs.swap(nextRefs);
     }
@@ -559,15 +567,23 @@ struct RegularBuilder {
                 kid[side] = f.children.back().get();
             }
             tbb::task_group tasks;
+            TaskFence fence;
             for (int side = 0; side < 2; ++side)
                 tasks.run([&, side] {
+                    const TaskFence::Done done(fence);
                     Fragment& k = *kid[side];
                     if (!onePass) half(prims, level, child[side], axis, mid, side, k.in);
                     buildChild(k, 0, level + 1, cpos[side], child[side], tree, prims,
                                onePass ? sc.in[side] : k.in, k.sub, k.live);
                     k.releaseScratch();
                 });
-            tasks.wait();
+            try {
+                tasks.wait();
+            } catch (...) {
+                fence.acquire();  // the fragments are freed as the exception unwinds
+                throw;
+            }
+            fence.acquire();
             for (Fragment* k : kid) height = std::max<uint8_t>(height, k->bsp.nodes[0].height + 1);
         } else {
             for (int side = 0; side < 2; ++side) {
@@ -769,29 +785,37 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     // Ropes: across each face, the cell at the face's low corner names the neighbour leaf; it is
     // the only one when it covers the face on the other two axes.
     // Each leaf's own ropes, from the directory: independent, so in parallel.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves_.size(), 4096), [&](const auto& r) {
-        guard.poll();
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-            RegularLeaf& L = leaves_[i];
-            for (int a = 0; a < 3; ++a) {
-                for (int side = 0; side < 2; ++side) {
-                    uint32_t& rope = L.rope[2 * a + side];
-                    if (side ? L.hi[a] == n_[a] : L.lo[a] == 0) {
-                        rope = kBorder;
-                        continue;
+    TaskFence fence;
+    try {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves_.size(), 4096), [&](const auto& r) {
+            const TaskFence::Done done(fence);
+            guard.poll();
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                RegularLeaf& L = leaves_[i];
+                for (int a = 0; a < 3; ++a) {
+                    for (int side = 0; side < 2; ++side) {
+                        uint32_t& rope = L.rope[2 * a + side];
+                        if (side ? L.hi[a] == n_[a] : L.lo[a] == 0) {
+                            rope = kBorder;
+                            continue;
+                        }
+                        uint32_t c[3] = {L.lo[0], L.lo[1], L.lo[2]};
+                        c[a] = side ? L.hi[a] : L.lo[a] - 1;
+                        const uint32_t nb = dir_.lookup(c[0], c[1], c[2]);
+                        const RegularLeaf& N = leaves_[nb];
+                        bool covers = true;
+                        for (int o = 0; o < 3; ++o)
+                            if (o != a && (N.lo[o] > L.lo[o] || N.hi[o] < L.hi[o])) covers = false;
+                        rope = covers ? nb : kSplitFace;
                     }
-                    uint32_t c[3] = {L.lo[0], L.lo[1], L.lo[2]};
-                    c[a] = side ? L.hi[a] : L.lo[a] - 1;
-                    const uint32_t nb = dir_.lookup(c[0], c[1], c[2]);
-                    const RegularLeaf& N = leaves_[nb];
-                    bool covers = true;
-                    for (int o = 0; o < 3; ++o)
-                        if (o != a && (N.lo[o] > L.lo[o] || N.hi[o] < L.hi[o])) covers = false;
-                    rope = covers ? nb : kSplitFace;
                 }
             }
-        }
-    });
+        });
+    } catch (...) {
+        fence.acquire();
+        throw;
+    }
+    fence.acquire();
 
     extra_ = {
         {"directory", full ? "full" : "sub-tables"},
