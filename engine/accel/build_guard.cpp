@@ -58,6 +58,8 @@ BuildGuard::BuildGuard(size_t budget, BuildControl control)
       last_(start_) {}
 
 void BuildGuard::report(const char* stage, size_t bytes, size_t items) {
+    const std::unique_lock lock(reporting_, std::try_to_lock);
+    if (!lock.owns_lock()) return;
     const auto now = std::chrono::steady_clock::now();
     const double secs = std::chrono::duration<double>(now - start_).count();
     if (secs < 1.0 || now - last_ < std::chrono::seconds(1)) return;

@@ -3,9 +3,11 @@
 // command line) controls a running build through BuildControl.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <functional>
+#include <mutex>
 #include <stdexcept>
 #include <stop_token>
 #include <string>
@@ -57,9 +59,11 @@ class BuildGuard {
     static bool fits(size_t bytes, size_t limit) { return bytes <= limit / 3; }
     bool fits(size_t bytes) const { return fits(bytes, budget_); }
     /// Throws BuildCancelled once a stop is requested; reports progress when the build is long.
+    /// Threads of one build may call it at once: one of them reports.
     void poll(const char* stage, size_t bytes, size_t items) {
         if (control_.stop.stop_requested()) throw BuildCancelled();
-        if (control_.progress && (++calls_ & 255) == 0) report(stage, bytes, items);
+        if (control_.progress && (calls_.fetch_add(1, std::memory_order_relaxed) & 255) == 255)
+            report(stage, bytes, items);
     }
     /// Throws BuildCancelled once a stop is requested.
     void poll() const {
@@ -72,8 +76,9 @@ class BuildGuard {
 
     size_t budget_;
     BuildControl control_;
-    std::chrono::steady_clock::time_point start_, last_;
-    unsigned calls_ = 0;
+    std::chrono::steady_clock::time_point start_, last_;  ///< last_: under reporting_
+    std::atomic<unsigned> calls_{0};
+    std::mutex reporting_;  ///< one report at a time; a thread finding it taken skips its own
 };
 
 }  // namespace lancer

@@ -1,9 +1,13 @@
 #include "engine/accel/light_buffer.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "engine/scene/scene.h"
+#include "engine/util/task_fence.h"
 
 namespace lancer {
 
@@ -99,78 +103,84 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
     const double side = 1e-9 * size;
     box_ = {bounds.lo - Vec3(hair_), bounds.hi + Vec3(hair_)};
     maps_.resize(points.size());
-    for (size_t l = 0; l < points.size(); ++l) {
-        Map& m = maps_[l];
-        m.L = points[l];
-        // The face of the box the light is farthest beyond; a light inside gets no map.
-        double gap = 0.0;
-        for (int a = 0; a < 3; ++a)
-            for (double s : {1.0, -1.0}) {
-                const double x = s > 0.0 ? m.L[a] - box_.hi[a] : box_.lo[a] - m.L[a];
-                if (x > gap) gap = x, m.a = a, m.s = s;
-            }
-        // Well outside: a ray from the point that meets the box then runs steeply enough along the
-        // axis that rounding of a grazing hit stays inside its box's depth range.
-        if (!(gap > 1e-3 * largest) || !std::isfinite(gap)) continue;
-        m.b = (m.a + 1) % 3;
-        m.c = (m.a + 2) % 3;
-        const int n = std::max(1, bins), k = std::clamp(slots, 1, kSlots);
-        double dn, u0, u1, v0, v1;
-        m.project(box_, dn, u0, u1, v0, v1);
-        if (!(u1 > u0) || !(v1 > v0)) continue;
-        // The boxes' images. The fine bins cover the rectangle of the small ones (whose image
-        // is at most kLargeShare of the scene's): a floor under an object would otherwise
-        // stretch the bins over its whole image, the object getting few of them. Outside it,
-        // coarse bins over the whole image hold the large boxes.
-        const double largeArea = kLargeShare * (u1 - u0) * (v1 - v0);
-        // A box's image, computed in each of the two passes below rather than kept: on a scene of
-        // 600k primitives an array of them took 52 MB, whose page faults cost more than
-        // projecting every box twice.
-        auto imageOf = [&](const Box3& mb, BoxImage& im) {
-            Box3 x{mb.lo - Vec3(side), mb.hi + Vec3(side)};  // widened across the view axis only
-            x.lo[m.a] = mb.lo[m.a], x.hi[m.a] = mb.hi[m.a];
-            m.project(x, im.dn, im.u0, im.u1, im.v0, im.v1);
-            im.df = m.s > 0.0 ? m.L[m.a] - x.lo[m.a] : x.hi[m.a] - m.L[m.a];
-            im.b0 = x.lo[m.b] - m.L[m.b], im.b1 = x.hi[m.b] - m.L[m.b];
-            im.c0 = x.lo[m.c] - m.L[m.c], im.c1 = x.hi[m.c] - m.L[m.c];
-            im.large = (im.u1 - im.u0) * (im.v1 - im.v0) > largeArea;
-        };
-        double wu0 = kInf, wu1 = -kInf, wv0 = kInf, wv1 = -kInf;
-        bool anyLarge = false;
-        for (size_t i = 0; i < boxes.size(); ++i) {
-            if ((i & 255) == 0 && stop.stop_requested()) {
-                maps_.clear();
-                return;
-            }
-            if (boxes[i].isEmpty()) continue;  // a dropped primitive
-            BoxImage im;
-            imageOf(boxes[i], im);
-            anyLarge |= im.large;
-            if (!im.large) {
-                wu0 = std::min(wu0, im.u0), wu1 = std::max(wu1, im.u1);
-                wv0 = std::min(wv0, im.v0), wv1 = std::max(wv1, im.v1);
-            }
+    // The maps are independent: one task each. A light's boxes go into its bins in their
+    // order (insert() depends on it), so each map is the same whatever the threads.
+    std::atomic<bool> stopped{false};
+    TaskFence fence;
+    tbb::parallel_for(size_t(0), points.size(), [&](size_t l) {
+        const TaskFence::Done done(fence);
+        if (!buildMap(maps_[l], points[l], boxes, bins, slots, side, largest, stop)) stopped = true;
+    });
+    fence.acquire();
+    if (stopped) maps_.clear();
+}
+
+bool LightBuffer::buildMap(Map& m, const Vec3& point, const std::vector<Box3>& boxes, int bins,
+                           int slots, double side, double largest, const std::stop_token& stop) {
+    m.L = point;
+    // The face of the box the light is farthest beyond; a light inside gets no map.
+    double gap = 0.0;
+    for (int a = 0; a < 3; ++a)
+        for (double s : {1.0, -1.0}) {
+            const double x = s > 0.0 ? m.L[a] - box_.hi[a] : box_.lo[a] - m.L[a];
+            if (x > gap) gap = x, m.a = a, m.s = s;
         }
-        const bool window = anyLarge && wu1 > wu0 && wv1 > wv0;
-        if (window) {
-            m.fine.cover(wu0, wu1, wv0, wv1, n, k);
-            m.coarse.cover(u0, u1, v0, v1, std::max(1, n / 4), k);
-        } else {
-            m.fine.cover(u0, u1, v0, v1, n, k);
-        }
-        std::vector<double> colLo, colHi;  // scratch of Grid::add
-        for (size_t i = 0; i < boxes.size(); ++i) {
-            if ((i & 255) == 0 && stop.stop_requested()) {
-                maps_.clear();
-                return;
-            }
-            if (boxes[i].isEmpty()) continue;
-            BoxImage im;
-            imageOf(boxes[i], im);
-            m.fine.add(im, colLo, colHi);
-            if (window && im.large) m.coarse.add(im, colLo, colHi);
+    // Well outside: a ray from the point that meets the box then runs steeply enough along the
+    // axis that rounding of a grazing hit stays inside its box's depth range.
+    if (!(gap > 1e-3 * largest) || !std::isfinite(gap)) return true;
+    m.b = (m.a + 1) % 3;
+    m.c = (m.a + 2) % 3;
+    const int n = std::max(1, bins), k = std::clamp(slots, 1, kSlots);
+    double dn, u0, u1, v0, v1;
+    m.project(box_, dn, u0, u1, v0, v1);
+    if (!(u1 > u0) || !(v1 > v0)) return true;
+    // The boxes' images. The fine bins cover the rectangle of the small ones (whose image
+    // is at most kLargeShare of the scene's): a floor under an object would otherwise
+    // stretch the bins over its whole image, the object getting few of them. Outside it,
+    // coarse bins over the whole image hold the large boxes. The images are made twice, for
+    // the rectangle and then for the bins, rather than kept: on 600,000 spheres a list of them
+    // took 50 MB per light, whose first touch cost more than making them again.
+    const double largeArea = kLargeShare * (u1 - u0) * (v1 - v0);
+    double wu0 = kInf, wu1 = -kInf, wv0 = kInf, wv1 = -kInf;
+    bool anyLarge = false;
+    for (size_t i = 0; i < boxes.size(); ++i) {
+        if ((i & 255) == 0 && stop.stop_requested()) return false;
+        BoxImage im;
+        if (!image(m, boxes[i], side, largeArea, im)) continue;
+        anyLarge |= im.large;
+        if (!im.large) {
+            wu0 = std::min(wu0, im.u0), wu1 = std::max(wu1, im.u1);
+            wv0 = std::min(wv0, im.v0), wv1 = std::max(wv1, im.v1);
         }
     }
+    const bool window = anyLarge && wu1 > wu0 && wv1 > wv0;
+    if (window) {
+        m.fine.cover(wu0, wu1, wv0, wv1, n, k);
+        m.coarse.cover(u0, u1, v0, v1, std::max(1, n / 4), k);
+    } else {
+        m.fine.cover(u0, u1, v0, v1, n, k);
+    }
+    std::vector<double> colLo, colHi;  // scratch of Grid::add
+    for (size_t i = 0; i < boxes.size(); ++i) {
+        if ((i & 255) == 0 && stop.stop_requested()) return false;
+        BoxImage im;
+        if (!image(m, boxes[i], side, largeArea, im)) continue;
+        m.fine.add(im, colLo, colHi);
+        if (window && im.large) m.coarse.add(im, colLo, colHi);
+    }
+    return true;
+}
+
+bool LightBuffer::image(const Map& m, const Box3& mb, double side, double largeArea, BoxImage& im) {
+    if (mb.isEmpty()) return false;                  // a dropped primitive
+    Box3 x{mb.lo - Vec3(side), mb.hi + Vec3(side)};  // widened across the view axis only
+    x.lo[m.a] = mb.lo[m.a], x.hi[m.a] = mb.hi[m.a];
+    m.project(x, im.dn, im.u0, im.u1, im.v0, im.v1);
+    im.df = m.s > 0.0 ? m.L[m.a] - x.lo[m.a] : x.hi[m.a] - m.L[m.a];
+    im.b0 = x.lo[m.b] - m.L[m.b], im.b1 = x.hi[m.b] - m.L[m.b];
+    im.c0 = x.lo[m.c] - m.L[m.c], im.c1 = x.hi[m.c] - m.L[m.c];
+    im.large = (im.u1 - im.u0) * (im.v1 - im.v0) > largeArea;
+    return true;
 }
 
 void LightBuffer::Grid::cover(double uLo, double uHi, double vLo, double vHi, int bins,

@@ -172,6 +172,11 @@ class LightBuffer {
         if (!(rate > 0.0)) return nullptr;
         return m.bin((o[m.b] - m.L[m.b]) / d, (o[m.c] - m.L[m.c]) / d);
     }
+    /// Map `m` of the light at `point`; false when `stop` ended it.
+    bool buildMap(Map& m, const Vec3& point, const std::vector<Box3>& boxes, int bins, int slots,
+                  double side, double largest, const std::stop_token& stop);
+    /// The image of box `mb` in map `m` (widened sideways by `side`); false for an empty box.
+    static bool image(const Map& m, const Box3& mb, double side, double largeArea, BoxImage& im);
     /// Add depth interval x to a bin of k (1 or 2) intervals.
     static void insert(Slot* bin, int k, Slot x);
     Box3 box_;               ///< the scene bounds, widened by hair_

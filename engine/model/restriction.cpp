@@ -46,32 +46,40 @@ int restrictTreeTo(const CsgTree& src, const std::vector<uint32_t>& prims, std::
 
 TreeRestrictor::TreeRestrictor(const CsgTree& tree)
     : tree_(&tree), parent_(tree.nodes.size(), -1), live_(tree.nodes.size(), 0) {
+    // Count each primitive's leaves, then place them: leaves in node order per primitive.
     for (size_t n = 0; n < tree.nodes.size(); ++n) {
         const CsgNode& x = tree.nodes[n];
         if (x.op == Op::Primitive) {
-            if (leaves_.size() <= x.prim) leaves_.resize(x.prim + 1);
-            leaves_[x.prim].push_back(int(n));
+            if (leafFirst_.size() < size_t(x.prim) + 2) leafFirst_.resize(size_t(x.prim) + 2, 0);
+            ++leafFirst_[size_t(x.prim) + 1];
         } else {
             parent_[size_t(x.left)] = int(n);
             parent_[size_t(x.right)] = int(n);
         }
     }
+    for (size_t p = 1; p < leafFirst_.size(); ++p) leafFirst_[p] += leafFirst_[p - 1];
+    leafNodes_.resize(leafFirst_.empty() ? 0 : leafFirst_.back());
+    std::vector<uint32_t> next(leafFirst_);
+    for (size_t n = 0; n < tree.nodes.size(); ++n)
+        if (tree.nodes[n].op == Op::Primitive) leafNodes_[next[tree.nodes[n].prim]++] = int(n);
 }
 
-void TreeRestrictor::mark(const std::vector<uint32_t>& prims, char value) {
+void TreeRestrictor::mark(const std::vector<uint32_t>& prims, char value,
+                          std::vector<char>& live) const {
     for (uint32_t p : prims) {
-        if (p >= leaves_.size()) continue;
-        for (int n : leaves_[p])
-            for (; n >= 0 && live_[size_t(n)] != value; n = parent_[size_t(n)])
-                live_[size_t(n)] = value;
+        if (size_t(p) + 1 >= leafFirst_.size()) continue;
+        for (uint32_t l = leafFirst_[p]; l < leafFirst_[size_t(p) + 1]; ++l)
+            for (int n = leafNodes_[l]; n >= 0 && live[size_t(n)] != value; n = parent_[size_t(n)])
+                live[size_t(n)] = value;
     }
 }
 
-int TreeRestrictor::restrict(const std::vector<uint32_t>& prims, CsgTree& dst) {
-    mark(prims, 1);
+int TreeRestrictor::restrict(const std::vector<uint32_t>& prims, CsgTree& dst,
+                             std::vector<char>& live) const {
+    mark(prims, 1, live);
     const int root = restrictWalk(
-        *tree_, tree_->root, [&](int n) { return live_[size_t(n)] != 0; }, dst);
-    mark(prims, 0);
+        *tree_, tree_->root, [&](int n) { return live[size_t(n)] != 0; }, dst);
+    mark(prims, 0, live);
     return root;
 }
 

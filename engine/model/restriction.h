@@ -28,15 +28,25 @@ class TreeRestrictor {
   public:
     explicit TreeRestrictor(const CsgTree& tree);
     /// Same result as restrictTree(tree, tree.root, keep, dst) with keep = `prims`.
-    int restrict(const std::vector<uint32_t>& prims, CsgTree& dst);
+    int restrict(const std::vector<uint32_t>& prims, CsgTree& dst) {
+        return restrict(prims, dst, live_);
+    }
+    /// The same with the caller's marks (one per node of the tree, all 0 before and after):
+    /// threads restricting at once each bring their own.
+    int restrict(const std::vector<uint32_t>& prims, CsgTree& dst, std::vector<char>& live) const;
+    /// Nodes of the tree: the size of the marks.
+    size_t nodeCount() const { return parent_.size(); }
 
   private:
-    void mark(const std::vector<uint32_t>& prims, char value);
+    void mark(const std::vector<uint32_t>& prims, char value, std::vector<char>& live) const;
 
     const CsgTree* tree_;
     std::vector<int> parent_;
-    std::vector<std::vector<int>> leaves_;  ///< leaves of each primitive
-    std::vector<char> live_;                ///< node is an ancestor of a kept primitive
+    /// Leaves of primitive p: leafNodes_[leafFirst_[p] .. leafFirst_[p + 1]) (one array rather
+    /// than a list per primitive: 600,000 small allocations on the largest scenes).
+    std::vector<uint32_t> leafFirst_;
+    std::vector<int> leafNodes_;
+    std::vector<char> live_;  ///< node is an ancestor of a kept primitive
 };
 
 /// Restricted trees keyed by sorted primitive set: each distinct set's tree (in `trees`) and

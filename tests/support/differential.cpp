@@ -12,8 +12,17 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
     Scene s;
     s.name = "random:" + std::to_string(seed);
     std::vector<int> nodes;
+    const int groups = std::max(1, opt.groups);
+    const int perGroup = (opt.primitives + groups - 1) / groups;
+    Vec3 centre(0.0);
     for (int i = 0; i < opt.primitives; ++i) {
-        Vec3 c = opt.spread * Vec3(u(rng), u(rng), u(rng));
+        Vec3 c;
+        if (groups == 1) {
+            c = opt.spread * Vec3(u(rng), u(rng), u(rng));
+        } else {
+            if (i % perGroup == 0) centre = opt.spread * Vec3(u(rng), u(rng), u(rng));
+            c = centre + 1.5 * Vec3(u(rng), u(rng), u(rng));
+        }
         Shape shape;
         Transform xf = Transform::translate(c + opt.offset);
         switch (rng() % 4) {
@@ -40,18 +49,25 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
         s.prims.push_back(makePrimitive(shape, xf, 0));
         nodes.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
     }
-    // Random binary tree: repeatedly combine two random nodes with a random operator.
-    while (nodes.size() > 1) {
-        size_t i = rng() % nodes.size();
-        int a = nodes[i];
-        nodes.erase(nodes.begin() + long(i));
-        size_t j = rng() % nodes.size();
-        int b = nodes[j];
-        Op op =
-            std::array<Op, 4>{Op::Union, Op::Union, Op::Intersection, Op::Difference}[rng() % 4];
-        nodes[j] = s.tree.combine(op, a, b);
+    // Random binary trees, one per group: repeatedly combine two random nodes of the group with
+    // a random operator.
+    std::vector<int> roots;
+    for (size_t g0 = 0; g0 < nodes.size(); g0 += size_t(perGroup)) {
+        std::vector<int> group(nodes.begin() + long(g0),
+                               nodes.begin() + long(std::min(nodes.size(), g0 + size_t(perGroup))));
+        while (group.size() > 1) {
+            size_t i = rng() % group.size();
+            int a = group[i];
+            group.erase(group.begin() + long(i));
+            size_t j = rng() % group.size();
+            int b = group[j];
+            Op op = std::array<Op, 4>{Op::Union, Op::Union, Op::Intersection,
+                                      Op::Difference}[rng() % 4];
+            group[j] = s.tree.combine(op, a, b);
+        }
+        roots.push_back(group[0]);
     }
-    int root = nodes.empty() ? -1 : nodes[0];
+    int root = roots.empty() ? -1 : s.tree.balanced(Op::Union, roots);
     if (opt.surfaces) {
         std::vector<int> top{root};
         for (int i = 0; i < 4; ++i) {

@@ -18,6 +18,9 @@ struct RandomSceneOptions {
     bool surfaces = false;   ///< add triangles/polygons/open cones under a top-level union
     Vec3 offset{0.0};        ///< translate everything (far-from-origin scenes)
     double spread = 4.0;     ///< primitives' centres in [-spread, spread]^3
+    /// Independent random trees under one union, each over primitives within 1.5 of its centre
+    /// (1: one tree over primitives anywhere in the spread).
+    int groups = 1;
 };
 
 /// A random binary CSG tree over random solids (spheres, boxes, cylinders, cones), prepared.

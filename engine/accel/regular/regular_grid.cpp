@@ -1,5 +1,12 @@
 #include "engine/accel/regular/regular_grid.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
+
+#include <atomic>
+#include <memory>
 #include <span>
 #include <stdexcept>
 
@@ -7,6 +14,7 @@
 #include "engine/accel/build_guard.h"
 #include "engine/model/restriction.h"
 #include "engine/util/format.h"
+#include "engine/util/task_fence.h"
 
 namespace lancer {
 
@@ -54,6 +62,10 @@ double area(const Box3& b) {
 /// within 2%; 12 levels cost 1-3% more build instructions, and balls4 14% fewer.
 constexpr int kPlannedLevels = 12;
 
+/// Deepest union-only tree whose leaves are restricted from the scene's tree (64: a balanced
+/// union of 2^63 primitives; a chain of unions goes back to the cells' own trees).
+constexpr int kRestrictorDepth = 64;
+
 /// The axes of --split-axes cost, planned level by level over the primitives' minimized boxes
 /// alone (no CSG restriction, so a little pessimistic). Every cell of a level has the same
 /// surface area A(axis) once cut on `axis`, so with the surface area heuristic the next level
@@ -71,8 +83,20 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
         Box3 box;
         size_t begin, end;
     };
+    // A stretch of one cell's references, the unit of parallel work: for each axis, the tests
+    // its references make in the cell's children and how many go to each child; then where in
+    // the next level's array it writes each child's references.
+    struct Chunk {
+        size_t cell, begin, end;
+        double tests[3];
+        size_t count[3][2];
+        size_t out[2];
+    };
+    constexpr size_t kChunk = 16384;
     std::vector<Cell> cells{{box, 0, live.size()}}, next;
     std::vector<uint32_t> refs(live), nextRefs;
+    std::vector<Chunk> chunks;
+    std::vector<char> open;
     Vec3 size = box.extent();
     std::vector<int> axes;
     for (int level = 0; level < maxLevel; ++level) {
@@ -86,13 +110,44 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
         }
         guard.poll();
         // Drop the cells that stop here.
-        size_t open = 0;
-        for (const Cell& c : cells)
-            if (c.end - c.begin > size_t(maxObjects) &&
-                !coveredByAll(scene, {refs.data() + c.begin, c.end - c.begin}, c.box))
-                cells[open++] = c;
-        cells.resize(open);
+        open.assign(cells.size(), 0);
+        TaskFence fence;
+        tbb::parallel_for(size_t(0), cells.size(), [&](size_t k) {
+            const TaskFence::Done done(fence);
+            const Cell& c = cells[k];
+            open[k] = c.end - c.begin > size_t(maxObjects) &&
+                      !coveredByAll(scene, {refs.data() + c.begin, c.end - c.begin}, c.box);
+        });
+        fence.acquire();
+        size_t kept = 0;
+        for (size_t k = 0; k < cells.size(); ++k)
+            if (open[k]) cells[kept++] = cells[k];
+        cells.resize(kept);
         if (cells.empty()) break;
+        // Every axis in one pass over the references. The tests are sums of multiples of a
+        // quarter (testWeights()), exact in any order: the chunks' sums are the serial sums.
+        chunks.clear();
+        for (size_t k = 0; k < cells.size(); ++k)
+            for (size_t b = cells[k].begin; b < cells[k].end; b += kChunk)
+                chunks.push_back({k, b, std::min(cells[k].end, b + kChunk), {}, {}, {}});
+        tbb::parallel_for(size_t(0), chunks.size(), [&](size_t k) {
+            const TaskFence::Done done(fence);
+            Chunk& ch = chunks[k];
+            const Box3& cb = cells[ch.cell].box;
+            const double mid[3] = {0.5 * (cb.lo.x + cb.hi.x), 0.5 * (cb.lo.y + cb.hi.y),
+                                   0.5 * (cb.lo.z + cb.hi.z)};
+            for (size_t i = ch.begin; i < ch.end; ++i) {
+                const Box3& b = scene.minBox[refs[i]];
+                const double w = cost[refs[i]];
+                for (int a = 0; a < 3; ++a) {
+                    const int lo = b.lo[a] <= mid[a], hi = b.hi[a] >= mid[a];
+                    ch.count[a][0] += size_t(lo);
+                    ch.count[a][1] += size_t(hi);
+                    ch.tests[a] += w * double(lo + hi);
+                }
+            }
+        });
+        fence.acquire();
         double best = kInf;
         int axis = 0;
         for (int a = 0; a < 3; ++a) {
@@ -100,34 +155,44 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
             child[a] *= 0.5;
             const double area = child.x * child.y + child.y * child.z + child.z * child.x;
             double tests = 0.0;
-            guard.poll();
-            for (const Cell& c : cells) {
-                const double mid = 0.5 * (c.box.lo[a] + c.box.hi[a]);
-                for (size_t i = c.begin; i < c.end; ++i) {
-                    const Box3& b = scene.minBox[refs[i]];
-                    tests += cost[refs[i]] * double(int(b.lo[a] <= mid) + int(b.hi[a] >= mid));
-                }
-            }
+            for (const Chunk& ch : chunks) tests += ch.tests[a];
             const double total = area * (2.0 * double(cells.size()) + tests);
             if (total < best) best = total, axis = a;
         }
         axes.push_back(axis);
         size[axis] *= 0.5;
+        // The children, cell by cell, low then high: each child's references in their order,
+        // written by the chunks at offsets summed in that order.
         next.clear();
-        nextRefs.clear();
-        for (const Cell& c : cells) {
+        size_t total = 0;
+        for (size_t k = 0, first = 0; k < cells.size(); ++k) {
+            const Cell& c = cells[k];
             const double mid = 0.5 * (c.box.lo[axis] + c.box.hi[axis]);
+            size_t last = first;
+            while (last < chunks.size() && chunks[last].cell == k) ++last;
             for (int side = 0; side < 2; ++side) {
-                Cell child{c.box, nextRefs.size(), 0};
+                Cell child{c.box, total, 0};
                 (side ? child.box.lo : child.box.hi)[axis] = mid;
-                for (size_t i = c.begin; i < c.end; ++i) {
-                    const Box3& b = scene.minBox[refs[i]];
-                    if (side ? b.hi[axis] >= mid : b.lo[axis] <= mid) nextRefs.push_back(refs[i]);
-                }
-                child.end = nextRefs.size();
+                for (size_t h = first; h < last; ++h)
+                    chunks[h].out[side] = total, total += chunks[h].count[axis][side];
+                child.end = total;
                 next.push_back(child);
             }
+            first = last;
         }
+        nextRefs.resize(total);
+        tbb::parallel_for(size_t(0), chunks.size(), [&](size_t k) {
+            const TaskFence::Done done(fence);
+            Chunk& ch = chunks[k];
+            const Box3& cb = cells[ch.cell].box;
+            const double mid = 0.5 * (cb.lo[axis] + cb.hi[axis]);
+            for (size_t i = ch.begin; i < ch.end; ++i) {
+                const Box3& b = scene.minBox[refs[i]];
+                if (b.lo[axis] <= mid) nextRefs[ch.out[0]++] = refs[i];
+                if (b.hi[axis] >= mid) nextRefs[ch.out[1]++] = refs[i];
+            }
+        });
+        fence.acquire();
         cells.swap(next);
         refs.swap(nextRefs);
     }
@@ -138,12 +203,72 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
 
 /// Builds the BSP depth first. Each node's restricted tree is restricted again for its children
 /// (restriction composes: restricting to P then to Q ⊆ P equals restricting to Q), so a node
-/// costs the size of its parent's small tree, not of the scene's tree.
+/// costs the size of its parent's small tree, not of the scene's tree; in a union-only scene the
+/// leaves restrict the scene's tree instead (see `restrictor`).
+///
+/// In parallel: a cell of at least RegularGrid::kTaskPrims primitives builds its two halves as
+/// tasks, each into a Fragment of its own (nodes, leaves, restricted trees, in the order a
+/// depth-first build makes them). The fragments are then laid out in the order of the serial build:
+/// the pairs of nodes, the leaves and the trees' first appearances in depth-first order. Nothing a
+/// task decides depends on another task, so the structure is the serial build's whatever the
+/// threads.
 struct RegularBuilder {
     /// Levels the split decision looks ahead: one cut per axis. A cut through a cell crossed by
     /// bars parallel to it (the sponge's) separates nothing, while the cuts across them do; a
     /// decision on one level would stop there.
     static constexpr int kLookahead = 3;
+    /// BspNodes::Node::first of a node whose subtree is another fragment's root (node 0 there):
+    /// fragment `leaf` among the children of the fragment holding the node.
+    static constexpr int32_t kLinked = -2;
+    static constexpr uint32_t kUnplaced = 0xffffffffu;
+
+    struct LeafPlace {
+        int level;
+        uint32_t pos[3];
+    };
+    struct Scratch {
+        std::vector<uint32_t> in[2], live;  ///< the children's primitives, a child's live ones
+        CsgTree sub;
+    };
+    /// What one task builds. Node 0 is the fragment's root (the BSP's root in the first one).
+    struct Fragment {
+        BspNodes bsp;
+        std::vector<RegularLeaf> leaves;
+        std::vector<LeafPlace> places;
+        std::vector<uint32_t> leafList;       ///< each leaf's primitive set in `pool`
+        RestrictedTreePool pool;              ///< the leaves' trees and lists
+        std::vector<size_t> treeStart = {0};  ///< set l's tree: pool.trees.nodes[treeStart[l]..)
+        std::vector<std::unique_ptr<Fragment>> children;  ///< fragments of kLinked nodes
+        /// Each set's entry in the layout's pool (list kUnplaced: not yet placed).
+        std::vector<RestrictedTreePool::Entry> placed;
+        std::vector<Scratch> scratch;                     ///< per level, for a node's children
+        std::vector<uint32_t> look[kLookahead + 1] = {};  ///< the cost estimate's lists, per depth
+        // A task's own inputs: its cell's primitives and tree, when not its parent's.
+        std::vector<uint32_t> in, live;
+        CsgTree sub;
+        size_t reported = 0;  ///< bytes() last added to RegularBuilder::bytes
+        uint64_t primRefs = 0;
+        uint32_t maxPrims = 0;
+        size_t emptyLeaves = 0, coveredLeaves = 0, costLeaves = 0;
+
+        explicit Fragment(int maxLevel) : scratch(size_t(maxLevel) + 2) { bsp.nodes.resize(1); }
+        /// Free the working lists once the fragment is built, for the tasks still running to
+        /// reuse: fresh pages cost more than the building does (balls:6's fragments' lists
+        /// alone would take tens of MB).
+        void releaseScratch() {
+            std::vector<Scratch>().swap(scratch);
+            for (std::vector<uint32_t>& l : look) std::vector<uint32_t>().swap(l);
+            std::vector<uint32_t>().swap(in);
+            std::vector<uint32_t>().swap(live);
+            CsgTree().nodes.swap(sub.nodes);
+        }
+        /// Heap bytes it keeps: vectors by capacity, and its pool.
+        size_t bytes() const {
+            return bsp.nodes.capacity() * sizeof(BspNodes::Node) +
+                   leaves.capacity() * sizeof(RegularLeaf) + places.capacity() * sizeof(LeafPlace) +
+                   leafList.capacity() * sizeof(uint32_t) + pool.bytes();
+        }
+    };
 
     const Scene& scene;
     const RegularConfig& params;
@@ -151,27 +276,39 @@ struct RegularBuilder {
     BuildGuard& guard;
     int maxLevel;                ///< params.maxLevel, or the automatic one
     std::vector<double> weight;  ///< each primitive's test, in sphere tests (testWeights)
-    BspNodes bsp;
-    std::vector<char> keep;   ///< membership marks, all 0 between uses
-    RestrictedTreePool pool;  ///< the leaves' trees and lists, moved to the grid at the end
-    struct LeafPlace {
-        int level;
-        uint32_t pos[3];
-    };
-    std::vector<LeafPlace> places;
     /// The scene's tree has only unions: a restriction then keeps every primitive it is given.
     bool unionOnly = false;
-    struct Scratch {
-        std::vector<uint32_t> in, live;
-        CsgTree sub;
-    };
-    std::vector<Scratch> scratch = {};  ///< per level, for the children of a node there
-    std::vector<uint32_t> look[kLookahead + 1] = {};  ///< the cost estimate's lists, per depth
-    uint64_t primRefs = 0;
-    uint32_t maxPrims = 0;
-    size_t emptyLeaves = 0;
-    size_t coveredLeaves = 0;  ///< leaves stopped because every box holds the whole cell
-    size_t costLeaves = 0;     ///< leaves stopped because no split lowered the estimated cost
+    /// A union-only scene's tree of small depth: the leaves restrict it, visiting only their
+    /// primitives' ancestors, and cells keep no tree (restricting each cell's tree for its
+    /// children took half of the build on balls:5). Null: each cell restricts its tree.
+    std::unique_ptr<TreeRestrictor> restrictor;
+    /// Per thread: membership marks of restrictTreeTo (one per primitive) and the restrictor's
+    /// (one per node of the scene's tree), all 0 between uses; a use never waits for a task.
+    tbb::enumerable_thread_specific<std::vector<char>> keep, restrictorMarks;
+    std::atomic<size_t> nodes{1};  ///< BSP nodes made by every fragment
+    std::atomic<size_t> bytes{0};  ///< the fragments' bytes(), as last reported
+
+    RegularBuilder(const Scene& s, const RegularConfig& p, RegularGrid& g, BuildGuard& gd,
+                   size_t livePrims)
+        : scene(s),
+          params(p),
+          grid(g),
+          guard(gd),
+          maxLevel(effectiveMaxLevel(p, livePrims)),
+          weight(testWeights(s)),
+          unionOnly(std::all_of(
+              s.tree.nodes.begin(), s.tree.nodes.end(),
+              [](const CsgNode& n) { return n.op == Op::Primitive || n.op == Op::Union; })),
+          keep([n = s.prims.size()] { return std::vector<char>(n, 0); }) {
+        // A leaf's restriction climbs from its primitives to the root: a cost of the tree's
+        // depth per primitive, which a balanced union (every scene format makes one) keeps to
+        // log2 N.
+        if (unionOnly && s.tree.depth() <= kRestrictorDepth) {
+            restrictor = std::make_unique<TreeRestrictor>(s.tree);
+            restrictorMarks = tbb::enumerable_thread_specific<std::vector<char>>(
+                [n = restrictor->nodeCount()] { return std::vector<char>(n, 0); });
+        }
+    }
 
     /// Plane `i` of `level`-cut grid on `axis` (i in 0..2^cuts); equal to grid.plane() at the
     /// finest level, since i / 2^c == (i 2^(n-c)) / 2^n exactly in floating point.
@@ -193,23 +330,19 @@ struct RegularBuilder {
                "memory budget); lower --max-level or raise --max-objects";
     }
 
-    /// The structure's size so far: what the build has allocated and keeps (vectors by their
-    /// capacity) and the pool.
-    size_t bytes() const {
-        return bsp.nodes.capacity() * sizeof(BspNodes::Node) +
-               grid.leaves_.capacity() * sizeof(RegularLeaf) +
-               places.capacity() * sizeof(LeafPlace) + pool.bytes();
-    }
-
-    /// Cancelled or over the budget: both end the build now.
-    void check() {
-        const size_t b = bytes();
-        guard.poll("regular BSP", b, bsp.nodes.size());
+    /// Cancelled or over the budget: both end the build now. The structure's size is every
+    /// fragment's bytes(), each adding its change since it last reported.
+    void check(Fragment& f) {
+        const size_t mine = f.bytes();
+        const size_t b = bytes.fetch_add(mine - f.reported) + (mine - f.reported);
+        f.reported = mine;
+        const size_t made = nodes.load(std::memory_order_relaxed);
+        guard.poll("regular BSP", b, made);
         if (!guard.fits(b))
             throw std::invalid_argument(
                 "--memory-budget " + formatBytes(guard.budget()) + ": the regular subdivision at " +
                 options() + " passes its memory budget (" + formatBytes(b) + " after " +
-                std::to_string(bsp.nodes.size()) +
+                std::to_string(made) +
                 " BSP nodes, with room to grow); lower --max-level, raise --max-objects or raise "
                 "--memory-budget");
     }
@@ -228,7 +361,8 @@ struct RegularBuilder {
     /// the chance of their areas' ratio, and a child holds the primitives whose boxes overlap
     /// it. The walk goes from leaf to leaf without descending the BSP, so a split costs nothing
     /// of its own: its price is the extra leaves a ray crosses, each one a step.
-    double splitCost(const Box3& box, std::span<const uint32_t> prims, int level, int depth) {
+    double splitCost(Fragment& f, const Box3& box, std::span<const uint32_t> prims, int level,
+                     int depth) {
         const int axis = grid.schedule_.axis(level);
         const double mid = 0.5 * (box.lo[axis] + box.hi[axis]);
         Box3 child[2] = {box, box};
@@ -246,115 +380,306 @@ struct RegularBuilder {
         for (int side = 0; side < 2; ++side) {
             double c = params.stepCost + params.testCost * tests[side];
             if (depth > 1 && level + 1 < maxLevel && count[side] > size_t(params.maxObjects)) {
-                std::vector<uint32_t>& in = look[depth];
+                std::vector<uint32_t>& in = f.look[depth];
                 in.clear();
                 for (uint32_t p : prims)
                     if (side ? scene.minBox[p].hi[axis] >= mid : scene.minBox[p].lo[axis] <= mid)
                         in.push_back(p);
                 if (!coveredByAll(scene, in, child[side]))
-                    c = std::min(c, splitCost(child[side], in, level + 1, depth - 1));
+                    c = std::min(c, splitCost(f, child[side], in, level + 1, depth - 1));
             }
             cost += area(child[side]) / parentArea * c;
         }
         return cost;
     }
 
+    /// splitCost() at depth 1 from the tests of the children's primitives, the cut at `mid`.
+    double splitCostOf(const Box3& box, int axis, double mid, const double tests[2]) const {
+        Box3 child[2] = {box, box};
+        child[0].hi[axis] = child[1].lo[axis] = mid;
+        const double parentArea = area(box);
+        double cost = 0.0;
+        for (int side = 0; side < 2; ++side)
+            cost +=
+                area(child[side]) / parentArea * (params.stepCost + params.testCost * tests[side]);
+        return cost;
+    }
+
     /// Whether splitting the cell lowers the estimated cost: at once with its children as
     /// leaves (most cells), else with kLookahead levels of splits below.
-    bool splitPays(const Box3& box, std::span<const uint32_t> prims, int level) {
+    bool splitPays(Fragment& f, const Box3& box, std::span<const uint32_t> prims, int level) {
         const double leaf = leafCost(prims);
-        return splitCost(box, prims, level, 1) < leaf ||
-               splitCost(box, prims, level, kLookahead) < leaf;
+        return splitCost(f, box, prims, level, 1) < leaf ||
+               splitCost(f, box, prims, level, kLookahead) < leaf;
     }
 
-    /// The tree restricted to `prims` in the shared pool, and their list, added once per set.
-    RestrictedTreePool::Entry treeFor(const CsgTree& tree, const std::vector<uint32_t>& prims) {
-        return pool.share(prims,
-                          [&](CsgTree& dst) { return restrictTreeTo(tree, prims, keep, dst); });
+    /// The tree restricted to `prims` in the fragment's pool, and their list, added once per
+    /// set; where each set's tree starts is kept for the layout.
+    RestrictedTreePool::Entry treeFor(Fragment& f, const CsgTree& tree,
+                                      const std::vector<uint32_t>& prims) {
+        return f.pool.share(prims, [&](CsgTree& dst) {
+            f.treeStart.push_back(dst.nodes.size());
+            return restrictor ? restrictor->restrict(prims, dst, restrictorMarks.local())
+                              : restrictTreeTo(tree, prims, keep.local(), dst);
+        });
     }
 
-    void makeLeaf(int id, int level, const uint32_t pos[3], RestrictedTreePool::Entry tree,
-                  uint32_t nprims) {
-        emptyLeaves += nprims == 0;
-        bsp.nodes[size_t(id)].leaf = uint32_t(grid.leaves_.size());
+    void makeLeaf(Fragment& f, int id, int level, const uint32_t pos[3], const CsgTree& tree,
+                  const std::vector<uint32_t>& prims) {
+        const RestrictedTreePool::Entry entry = treeFor(f, tree, prims);
+        const uint32_t nprims = uint32_t(prims.size());
+        f.emptyLeaves += nprims == 0;
+        f.bsp.nodes[size_t(id)].leaf = uint32_t(f.leaves.size());
         RegularLeaf leaf;
-        leaf.root = tree.root;
+        leaf.root = entry.root;
         leaf.prims = nprims;
-        leaf.first = pool.listFirst[tree.list];
-        if (nprims <= RegularLeaf::kInline)
-            std::copy_n(pool.lists.begin() + leaf.first, nprims, leaf.inlined);
-        grid.leaves_.push_back(leaf);
-        places.push_back({level, {pos[0], pos[1], pos[2]}});
-        primRefs += nprims;
-        maxPrims = std::max(maxPrims, nprims);
+        leaf.first = f.pool.listFirst[entry.list];
+        if (nprims <= RegularLeaf::kInline) std::copy_n(prims.begin(), nprims, leaf.inlined);
+        f.leaves.push_back(leaf);
+        f.leafList.push_back(entry.list);
+        f.places.push_back({level, {pos[0], pos[1], pos[2]}});
+        f.primRefs += nprims;
+        f.maxPrims = std::max(f.maxPrims, nprims);
     }
 
-    /// Node `id` at `level`, at index pos[a] of its level's grid on each axis, covering `box`;
-    /// `tree` is the scene's tree restricted to `prims` (sorted), the primitives that matter here.
-    void build(int id, int level, const uint32_t pos[3], const Box3& box, const CsgTree& tree,
-               const std::vector<uint32_t>& prims) {
+    /// The primitives of `prims` (overlapping `box`) whose boxes overlap the half of `box` on
+    /// side `side` of `mid` on `axis`, into `out`.
+    void half(const std::vector<uint32_t>& prims, int level, const Box3& child, int axis,
+              double mid, int side, std::vector<uint32_t>& out) const {
+        // Below the root every primitive overlaps the cell, which differs from the child on the
+        // cut axis alone: the test there is the whole test.
+        out.clear();
+        if (level == 0) {
+            for (uint32_t p : prims)
+                if (scene.minBox[p].overlaps(child)) out.push_back(p);
+        } else if (side == 0) {
+            for (uint32_t p : prims)
+                if (scene.minBox[p].lo[axis] <= mid) out.push_back(p);
+        } else {
+            for (uint32_t p : prims)
+                if (scene.minBox[p].hi[axis] >= mid) out.push_back(p);
+        }
+    }
+
+    /// Build child `id` at `level` over the primitives `in` of its cell, restricting `tree` (its
+    /// parent's, over `parentPrims`) to them where needed; `sc` holds the child's tree and list.
+    void buildChild(Fragment& f, int id, int level, const uint32_t pos[3], const Box3& box,
+                    const CsgTree& tree, const std::vector<uint32_t>& parentPrims,
+                    const std::vector<uint32_t>& in, CsgTree& sub, std::vector<uint32_t>& live) {
+        if (in.size() == parentPrims.size()) {
+            // Every primitive overlaps the child: the restriction is this tree, whose
+            // primitives all count (`prims` are the live ones).
+            build(f, id, level, pos, box, tree, parentPrims);
+        } else if (restrictor) {
+            // A union's restriction drops no primitive it keeps, so the child needs no tree of
+            // its own: its leaves restrict the scene's.
+            build(f, id, level, pos, box, tree, in);
+        } else {
+            sub.nodes.clear();
+            sub.root = restrictTreeTo(tree, in, keep.local(), sub);
+            if (unionOnly) {
+                // Restricting a union drops no primitive it keeps: all of them are live.
+                build(f, id, level, pos, box, sub, in);
+            } else {
+                live = sub.primitives();
+                sortedUnique(live);
+                build(f, id, level, pos, box, sub, live);
+            }
+        }
+    }
+
+    /// Node `id` of fragment `f` at `level`, at index pos[a] of its level's grid on each axis,
+    /// covering `box`; `prims` (sorted) are the primitives that matter here, `tree` the scene's
+    /// tree restricted to them (unused with a restrictor).
+    void build(Fragment& f, int id, int level, const uint32_t pos[3], const Box3& box,
+               const CsgTree& tree, const std::vector<uint32_t>& prims) {
         if (prims.size() <= size_t(params.maxObjects) || level >= maxLevel) {
-            makeLeaf(id, level, pos, treeFor(tree, prims), uint32_t(prims.size()));
+            makeLeaf(f, id, level, pos, tree, prims);
             return;
         }
-        if (bsp.nodes.size() + 2 > RegularGrid::kMaxBspNodes)
+        if (nodes.load(std::memory_order_relaxed) + 2 > RegularGrid::kMaxBspNodes)
             throw std::invalid_argument(refusal());
-        check();
+        check(f);
         // A cell inside every one of its primitives' boxes is not split: every sub-cell would
         // hold the same primitives, hence the same tree, so splitting only adds leaves. (The
         // report stops at max-objects or max-level only; cells inside the overlap of more than
         // max-objects boxes would then split down to max-level: millions of identical leaves.)
         if (coveredByAll(scene, prims, box)) {
-            ++coveredLeaves;
-            makeLeaf(id, level, pos, treeFor(tree, prims), uint32_t(prims.size()));
-            return;
-        }
-        // A split that does not lower the estimated cost within kLookahead levels is not made.
-        if (params.costStop && !splitPays(box, prims, level)) {
-            ++costLeaves;
-            makeLeaf(id, level, pos, treeFor(tree, prims), uint32_t(prims.size()));
+            ++f.coveredLeaves;
+            makeLeaf(f, id, level, pos, tree, prims);
             return;
         }
         // Middle cut on the level's axis, in the grid's own plane coordinates.
         const int axis = grid.schedule_.axis(level);
         const int cuts = grid.schedule_.cuts(level, axis);
-        double mid = planeAt(axis, 2 * pos[axis] + 1, cuts + 1);
-        int first = int(bsp.nodes.size());
-        bsp.nodes.resize(bsp.nodes.size() + 2);
-        bsp.nodes[size_t(id)].first = first;
-        uint8_t height = 0;
+        const double mid = planeAt(axis, 2 * pos[axis] + 1, cuts + 1);
         // The children's lists and trees, kept per level so that their memory is reused: a
         // child's own children use the next level's.
-        Scratch& sc = scratch[size_t(level) + 1];
-        for (int side = 0; side < 2; ++side) {
-            Box3 child = box;
-            (side ? child.lo : child.hi)[axis] = mid;
-            // Primitives whose minimized boxes overlap the closed child box, then the tree
-            // restricted to them; a primitive the restriction drops cannot contribute here.
-            sc.in.clear();
-            for (uint32_t p : prims)
-                if (scene.minBox[p].overlaps(child)) sc.in.push_back(p);
-            uint32_t cpos[3] = {pos[0], pos[1], pos[2]};
-            cpos[axis] = 2 * pos[axis] + uint32_t(side);
-            if (sc.in.size() == prims.size()) {
-                // Every primitive overlaps the child: the restriction is this tree, whose
-                // primitives all count (`prims` are the live ones).
-                build(first + side, level + 1, cpos, child, tree, prims);
-            } else {
-                sc.sub.nodes.clear();
-                sc.sub.root = restrictTreeTo(tree, sc.in, keep, sc.sub);
-                if (unionOnly) {
-                    // Restricting a union drops no primitive it keeps: all of them are live.
-                    build(first + side, level + 1, cpos, child, sc.sub, sc.in);
-                } else {
-                    sc.live = sc.sub.primitives();
-                    sortedUnique(sc.live);
-                    build(first + side, level + 1, cpos, child, sc.sub, sc.live);
-                }
+        Scratch& sc = f.scratch[size_t(level) + 1];
+        // Below the root, where the cost estimate's middle (the box's) is the grid plane, one
+        // pass over the primitives makes both children's lists and the estimate's sums (the
+        // same comparisons, the same sums); elsewhere the estimate and the lists are made apart.
+        const bool onePass = level > 0 && 0.5 * (box.lo[axis] + box.hi[axis]) == mid;
+        if (onePass) {
+            double tests[2] = {0.0, 0.0}, all = 0.0;
+            sc.in[0].clear();
+            sc.in[1].clear();
+            for (uint32_t p : prims) {
+                const Box3& b = scene.minBox[p];
+                const double w = weight[p];
+                all += w;
+                if (b.lo[axis] <= mid) sc.in[0].push_back(p), tests[0] += w;
+                if (b.hi[axis] >= mid) sc.in[1].push_back(p), tests[1] += w;
             }
-            height = std::max<uint8_t>(height, bsp.nodes[size_t(first + side)].height + 1);
+            // A split that does not lower the estimated cost within kLookahead levels is not
+            // made (splitPays(), its first estimate from these sums).
+            const double leaf = params.stepCost + params.testCost * all;
+            if (params.costStop && !(splitCostOf(box, axis, mid, tests) < leaf ||
+                                     splitCost(f, box, prims, level, kLookahead) < leaf)) {
+                ++f.costLeaves;
+                makeLeaf(f, id, level, pos, tree, prims);
+                return;
+            }
+        } else if (params.costStop && !splitPays(f, box, prims, level)) {
+            ++f.costLeaves;
+            makeLeaf(f, id, level, pos, tree, prims);
+            return;
         }
-        bsp.nodes[size_t(id)].height = height;
+        // The node count only grows: a build over the limit passes it at some split whatever
+        // the order the tasks make them in.
+        if (nodes.fetch_add(2, std::memory_order_relaxed) + 2 > RegularGrid::kMaxBspNodes)
+            throw std::invalid_argument(refusal());
+        const int first = int(f.bsp.nodes.size());
+        f.bsp.nodes.resize(f.bsp.nodes.size() + 2);
+        f.bsp.nodes[size_t(id)].first = first;
+        Box3 child[2] = {box, box};
+        child[0].hi[axis] = child[1].lo[axis] = mid;
+        uint32_t cpos[2][3] = {{pos[0], pos[1], pos[2]}, {pos[0], pos[1], pos[2]}};
+        cpos[0][axis] = 2 * pos[axis];
+        cpos[1][axis] = 2 * pos[axis] + 1;
+        uint8_t height = 0;
+        if (prims.size() >= RegularGrid::kTaskPrims) {
+            // The halves as tasks, each into a fragment of its own linked from its node.
+            Fragment* kid[2];
+            for (int side = 0; side < 2; ++side) {
+                f.bsp.nodes[size_t(first + side)] = {kLinked, uint32_t(f.children.size()), 0};
+                f.children.push_back(std::make_unique<Fragment>(maxLevel));
+                kid[side] = f.children.back().get();
+            }
+            tbb::task_group tasks;
+            TaskFence fence;
+            for (int side = 0; side < 2; ++side)
+                tasks.run([&, side] {
+                    const TaskFence::Done done(fence);
+                    Fragment& k = *kid[side];
+                    if (!onePass) half(prims, level, child[side], axis, mid, side, k.in);
+                    buildChild(k, 0, level + 1, cpos[side], child[side], tree, prims,
+                               onePass ? sc.in[side] : k.in, k.sub, k.live);
+                    k.releaseScratch();
+                });
+            try {
+                tasks.wait();
+            } catch (...) {
+                fence.acquire();  // the fragments are freed as the exception unwinds
+                throw;
+            }
+            fence.acquire();
+            for (Fragment* k : kid) height = std::max<uint8_t>(height, k->bsp.nodes[0].height + 1);
+        } else {
+            for (int side = 0; side < 2; ++side) {
+                if (!onePass) half(prims, level, child[side], axis, mid, side, sc.in[side]);
+                buildChild(f, first + side, level + 1, cpos[side], child[side], tree, prims,
+                           sc.in[side], sc.sub, sc.live);
+                height = std::max<uint8_t>(height, f.bsp.nodes[size_t(first + side)].height + 1);
+            }
+        }
+        f.bsp.nodes[size_t(id)].height = height;
+    }
+
+    /// The structure laid out from the fragments, in the serial build's order.
+    struct Layout {
+        BspNodes bsp;
+        std::vector<RegularLeaf> leaves;
+        std::vector<LeafPlace> places;
+        RestrictedTreePool pool;
+        std::vector<uint32_t> key;  ///< scratch: a set's primitives
+    };
+
+    /// Node `i` of fragment `f` as node `g` of the layout, and its subtree.
+    void layOut(Layout& out, Fragment& f, size_t i, size_t g) {
+        const BspNodes::Node n = f.bsp.nodes[i];
+        if (n.first == kLinked) return layOut(out, *f.children[n.leaf], 0, g);
+        if (n.first >= 0) {
+            const size_t first = out.bsp.nodes.size();
+            out.bsp.nodes.resize(first + 2);
+            out.bsp.nodes[g] = {int32_t(first), 0, n.height};
+            layOut(out, f, size_t(n.first), first);
+            layOut(out, f, size_t(n.first) + 1, first + 1);
+            return;
+        }
+        if (out.leaves.size() % 4096 == 0) guard.poll();
+        // The leaf's set: placed in the layout's pool where the serial build first met it,
+        // its tree moved to the end of the layout's trees.
+        if (f.placed.empty()) f.placed.assign(f.pool.listFirst.size() - 1, {-1, kUnplaced});
+        const RegularLeaf& local = f.leaves[n.leaf];
+        const uint32_t set = f.leafList[n.leaf];
+        if (f.placed[set].list == kUnplaced) {
+            const uint32_t* p = f.pool.lists.data();
+            out.key.assign(p + f.pool.listFirst[set], p + f.pool.listFirst[set + 1]);
+            f.placed[set] = out.pool.share(out.key, [&](CsgTree& dst) {
+                const size_t begin = f.treeStart[set];
+                const size_t end =
+                    set + 1 < f.treeStart.size() ? f.treeStart[set + 1] : f.pool.trees.nodes.size();
+                const int shift = int(dst.nodes.size()) - int(begin);
+                for (size_t k = begin; k < end; ++k) {
+                    CsgNode c = f.pool.trees.nodes[k];
+                    if (c.op != Op::Primitive) c.left += shift, c.right += shift;
+                    dst.nodes.push_back(c);
+                }
+                return local.root < 0 ? -1 : local.root + shift;
+            });
+        }
+        RegularLeaf leaf = local;
+        leaf.root = f.placed[set].root;
+        leaf.first = out.pool.listFirst[f.placed[set].list];
+        out.bsp.nodes[g] = {-1, uint32_t(out.leaves.size()), 0};
+        out.leaves.push_back(leaf);
+        out.places.push_back(f.places[n.leaf]);
+    }
+
+    /// Room in the layout for what the fragments under `f` hold (an upper bound for the pool,
+    /// whose sets the fragments may share): a vector grown by doubling touches twice its final
+    /// memory, and on the machines measured a first touch of a page costs more than the copy.
+    static void reserve(Layout& out, const Fragment& f, size_t& leaves, size_t& nodes,
+                        size_t& trees, size_t& lists, size_t& sets) {
+        leaves += f.leaves.size();
+        nodes += f.bsp.nodes.size();
+        trees += f.pool.trees.nodes.size();
+        lists += f.pool.lists.size();
+        sets += f.pool.listFirst.size();
+        for (const auto& k : f.children) reserve(out, *k, leaves, nodes, trees, lists, sets);
+    }
+    static void reserve(Layout& out, const Fragment& root) {
+        size_t leaves = 0, nodes = 0, trees = 0, lists = 0, sets = 0;
+        reserve(out, root, leaves, nodes, trees, lists, sets);
+        out.leaves.reserve(leaves);
+        out.places.reserve(leaves);
+        out.bsp.nodes.reserve(nodes);
+        out.pool.trees.nodes.reserve(trees);
+        out.pool.lists.reserve(lists);
+        out.pool.listFirst.reserve(sets);
+    }
+
+    /// Every fragment's counters added into `f`'s.
+    static void addCounters(Fragment& f, const Fragment& from) {
+        for (const auto& k : from.children) {
+            addCounters(f, *k);
+            f.primRefs += k->primRefs;
+            f.maxPrims = std::max(f.maxPrims, k->maxPrims);
+            f.emptyLeaves += k->emptyLeaves;
+            f.coveredLeaves += k->coveredLeaves;
+            f.costLeaves += k->costLeaves;
+        }
     }
 };
 
@@ -394,30 +719,32 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     std::vector<uint32_t> live =
         scene.tree.empty() ? std::vector<uint32_t>{} : scene.tree.primitives();
     sortedUnique(live);
-    RegularBuilder b{scene,
-                     params,
-                     *this,
-                     guard,
-                     effectiveMaxLevel(params, live.size()),
-                     testWeights(scene),
-                     {},
-                     std::vector<char>(scene.prims.size(), 0),
-                     {},
-                     {}};
-    b.bsp.nodes.resize(1);
-    b.unionOnly =
-        std::all_of(scene.tree.nodes.begin(), scene.tree.nodes.end(),
-                    [](const CsgNode& n) { return n.op == Op::Primitive || n.op == Op::Union; });
-    b.scratch.resize(size_t(b.maxLevel) + 2);
+    RegularBuilder b(scene, params, *this, guard, live.size());
     if (params.splitAxes == SplitAxes::Cost)
         schedule_ = planSchedule(scene, box_, live, b.weight, b.maxLevel, params.maxObjects, guard);
     const uint32_t origin[3] = {0, 0, 0};
-    b.build(0, 0, origin, box_, scene.tree, live);
-    pool_ = std::move(b.pool.trees);
-    primList_ = std::move(b.pool.lists);
+    RegularBuilder::Fragment root(b.maxLevel);
+    b.build(root, 0, 0, origin, box_, scene.tree, live);
+    RegularBuilder::addCounters(root, root);
+    // One fragment is the serial build's structure as it is; several are laid out in its order.
+    RegularBuilder::Layout out;
+    if (root.children.empty()) {
+        out.bsp = std::move(root.bsp);
+        out.leaves = std::move(root.leaves);
+        out.places = std::move(root.places);
+        out.pool = std::move(root.pool);
+    } else {
+        RegularBuilder::reserve(out, root);
+        out.bsp.nodes.resize(1);
+        b.layOut(out, root, 0, 0);
+    }
+    leaves_ = std::move(out.leaves);
+    pool_ = std::move(out.pool.trees);
+    primList_ = std::move(out.pool.lists);
+    const BspNodes& bsp = out.bsp;
 
     // The finest level reached fixes the directory's resolution, 2^n per axis.
-    const int finest = b.bsp.nodes[0].height;
+    const int finest = bsp.nodes[0].height;
     int depth[3];
     for (int a = 0; a < 3; ++a) {
         depth[a] = schedule_.cuts(finest, a);
@@ -428,7 +755,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         for (uint32_t k = 0; k <= n_[a]; ++k) planes_[a][k] = b.planeAt(a, k, depth[a]);
     }
     for (size_t i = 0; i < leaves_.size(); ++i) {
-        const RegularBuilder::LeafPlace& pl = b.places[i];
+        const RegularBuilder::LeafPlace& pl = out.places[i];
         for (int a = 0; a < 3; ++a) {
             int shift = depth[a] - schedule_.cuts(pl.level, a);
             RegularLeaf& L = leaves_[i];
@@ -443,8 +770,8 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
 
     // The directory: estimated before it is allocated.
     const bool full = params.fullTable;
-    const size_t fullBytes = Directory::estimateBytes(b.bsp, finest, true);
-    const size_t dirBytes = full ? fullBytes : Directory::estimateBytes(b.bsp, finest, false);
+    const size_t fullBytes = Directory::estimateBytes(bsp, finest, true);
+    const size_t dirBytes = full ? fullBytes : Directory::estimateBytes(bsp, finest, false);
     const size_t otherBytes = memoryBytes();  // everything but the directory, not built yet
     const size_t budget = guard.budget();
     if (dirBytes > budget || dirBytes + otherBytes > budget) {
@@ -457,30 +784,42 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
             (full ? "; use sub-tables (drop --full-table)" : "; lower --max-level"));
     }
     guard.poll();
-    dir_.build(b.bsp, schedule_, finest, full);
+    dir_.build(bsp, schedule_, finest, full);
 
     // Ropes: across each face, the cell at the face's low corner names the neighbour leaf; it is
     // the only one when it covers the face on the other two axes.
-    for (RegularLeaf& L : leaves_) {
-        if ((&L - leaves_.data()) % 4096 == 0) guard.poll();
-        for (int a = 0; a < 3; ++a) {
-            for (int side = 0; side < 2; ++side) {
-                uint32_t& rope = L.rope[2 * a + side];
-                if (side ? L.hi[a] == n_[a] : L.lo[a] == 0) {
-                    rope = kBorder;
-                    continue;
+    // Each leaf's own ropes, from the directory: independent, so in parallel.
+    TaskFence fence;
+    try {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves_.size(), 4096), [&](const auto& r) {
+            const TaskFence::Done done(fence);
+            guard.poll();
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                RegularLeaf& L = leaves_[i];
+                for (int a = 0; a < 3; ++a) {
+                    for (int side = 0; side < 2; ++side) {
+                        uint32_t& rope = L.rope[2 * a + side];
+                        if (side ? L.hi[a] == n_[a] : L.lo[a] == 0) {
+                            rope = kBorder;
+                            continue;
+                        }
+                        uint32_t c[3] = {L.lo[0], L.lo[1], L.lo[2]};
+                        c[a] = side ? L.hi[a] : L.lo[a] - 1;
+                        const uint32_t nb = dir_.lookup(c[0], c[1], c[2]);
+                        const RegularLeaf& N = leaves_[nb];
+                        bool covers = true;
+                        for (int o = 0; o < 3; ++o)
+                            if (o != a && (N.lo[o] > L.lo[o] || N.hi[o] < L.hi[o])) covers = false;
+                        rope = covers ? nb : kSplitFace;
+                    }
                 }
-                uint32_t c[3] = {L.lo[0], L.lo[1], L.lo[2]};
-                c[a] = side ? L.hi[a] : L.lo[a] - 1;
-                const uint32_t nb = dir_.lookup(c[0], c[1], c[2]);
-                const RegularLeaf& N = leaves_[nb];
-                bool covers = true;
-                for (int o = 0; o < 3; ++o)
-                    if (o != a && (N.lo[o] > L.lo[o] || N.hi[o] < L.hi[o])) covers = false;
-                rope = covers ? nb : kSplitFace;
             }
-        }
+        });
+    } catch (...) {
+        fence.acquire();
+        throw;
     }
+    fence.acquire();
 
     extra_ = {
         {"directory", full ? "full" : "sub-tables"},
@@ -489,19 +828,19 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
          fullBytes == SIZE_MAX ? nlohmann::json(nullptr) : nlohmann::json(fullBytes)},
         {"sub_tables", dir_.tableCount()},
         {"leaves", leaves_.size()},
-        {"empty_leaves", b.emptyLeaves},
-        {"covered_leaves", b.coveredLeaves},
-        {"cost_leaves", b.costLeaves},
+        {"empty_leaves", root.emptyLeaves},
+        {"covered_leaves", root.coveredLeaves},
+        {"cost_leaves", root.costLeaves},
         {"effective_max_level", b.maxLevel},
-        {"bsp_nodes", b.bsp.nodes.size()},
+        {"bsp_nodes", bsp.nodes.size()},
         {"finest_level", finest},
         {"depth_xyz", {depth[0], depth[1], depth[2]}},
         {"split_axes", splitAxesName(params.splitAxes)},
         {"axis_schedule", schedule_.toString(finest)},
-        {"distinct_trees", b.pool.size() - 1},  // the empty set has no tree
+        {"distinct_trees", out.pool.size() - 1},  // the empty set has no tree
         {"tree_pool_nodes", pool_.nodes.size()},
-        {"prims_per_leaf", leaves_.empty() ? 0.0 : double(b.primRefs) / double(leaves_.size())},
-        {"max_prims_per_leaf", b.maxPrims},
+        {"prims_per_leaf", leaves_.empty() ? 0.0 : double(root.primRefs) / double(leaves_.size())},
+        {"max_prims_per_leaf", root.maxPrims},
     };
 }
 
