@@ -66,6 +66,11 @@ struct IrregularConfig {
     int maxObjects = 4;  ///< a screen cell over at most this many rectangles is a zone (0: never)
     BspHeuristic heuristic = BspHeuristic::Balanced;    ///< choice of the splitting segment
     IrregularFrame frame = IrregularFrame::Projective;  ///< what primary rays walk
+    /// Leave a screen cell whole where no split lowers the estimated tests per ray (false: the
+    /// report's rule alone, max-objects).
+    bool costStop = true;
+    /// Cost of the zone a screen split adds, in primitive tests.
+    double stepCost = 4.0;
 };
 
 /// Builder parameters: the scheme, the knobs every scheme reads, and each scheme's Config.

@@ -36,10 +36,11 @@ inline constexpr size_t kMergedZoneBytes =
 inline constexpr size_t kMergedRefBytes = 2 * sizeof(uint32_t) + 2 * sizeof(CsgNode);
 
 /// Cut every zone of `bsp` along depth inside [zlo, zhi]; box[p] is primitive p's camera box.
-/// A zone whose slabs would take the structure past `maxBytes` (0: no limit) is one slab holding
-/// all its primitives: its slabs merge. `guard` (may be null) is polled for cancellation.
+/// A zone whose slabs would take the structure past `maxBytes` bytes or `maxRegions` regions
+/// (0: no limit) is one slab holding all its primitives: its slabs merge. `guard` (may be null)
+/// is polled for cancellation.
 DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
-                           double zlo, double zhi, BuildGuard* guard = nullptr,
-                           size_t maxBytes = 0);
+                           double zlo, double zhi, BuildGuard* guard = nullptr, size_t maxBytes = 0,
+                           size_t maxRegions = 0);
 
 }  // namespace lancer
