@@ -147,6 +147,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["region_budget"] = maxRegions;
     extra["bsp_stopped"] = s.bsp_.stopped;
     extra["merged_zones"] = slabs.mergedZones;
+    extra["coarse_zones"] = slabs.coarseZones;
     extra["distinct_trees"] = s.listFirst_.size() - 1;
     extra["pool_nodes"] = s.pool_.nodes.size();
     extra["prims_per_region"] = double(refs) / double(s.regions_.size());

@@ -93,6 +93,7 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     extra["projective_empty_slabs"] = slabs.emptySlabs + slabs.emptyZones;
     extra["projective_bsp_stopped"] = s.bsp_.stopped;
     extra["projective_merged_zones"] = slabs.mergedZones;
+    extra["projective_coarse_zones"] = slabs.coarseZones;
     extra["projective_near_primitives"] = nearPrims.size();
     extra["projective_znear"] = zNear;
     return s;
