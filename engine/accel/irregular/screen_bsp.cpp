@@ -28,6 +28,9 @@ struct Cell {
     int depth;
 };
 
+/// Levels of the screen BSP split whatever the cost estimate says.
+constexpr int kAlwaysSplitLevels = 4;
+
 struct Split {
     uint8_t axis;
     double c;
@@ -178,7 +181,9 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
             if (overlapsOpen(rect[p], below.lo, below.hi)) below.prims.push_back(p);
             if (overlapsOpen(rect[p], above.lo, above.hi)) above.prims.push_back(p);
         }
-        if (params.stepCost > 0.0) {
+        // The first levels always split (at most 16 cells): with a handful of primitives the
+        // estimate would leave one zone, and the scheme would have no screen structure at all.
+        if (params.stepCost > 0.0 && cell.depth >= kAlwaysSplitLevels) {
             // A ray through the cell (the area of a side is its share of the rays) tests its
             // rectangles; split, it crosses one more zone and tests one side's.
             const double area = (cell.hi.x - cell.lo.x) * (cell.hi.y - cell.lo.y);
