@@ -126,14 +126,19 @@ std::vector<ParamDesc> makeTable() {
          "",
          "cost_stop",
          "cost stop",
-         "Split cells down to max-objects or max-level even where the cost estimate says a split "
-         "does not pay (the report's rule)",
+         "Split cells (irregular: screen cells) down to max-objects or max-level even where the "
+         "cost estimate says a split does not pay (the report's rule)",
          ParamKind::Switch};
     d.flagValue = false;
-    d.schemes = kRegular;
+    d.schemes = kAccelerated;
     d.effect = ChangeEffect::Rebuild;
-    d.get = [](const K& k) { return double(k.build.regular.costStop); };
-    d.set = [](K& k, double v) { k.build.regular.costStop = v != 0.0; };
+    d.get = [](const K& k) {
+        return double(k.build.scheme == SchemeKind::Irregular ? k.build.irregular.costStop
+                                                              : k.build.regular.costStop);
+    };
+    d.set = [](K& k, double v) {
+        k.build.regular.costStop = k.build.irregular.costStop = v != 0.0;
+    };
     add(d);
     d = {"--bsp-heuristic",
          "H",

@@ -64,6 +64,7 @@ std::string toString(const BuildParams& p) {
         const IrregularConfig& i = p.irregular;
         os << " --max-objects " << i.maxObjects << " --bsp-heuristic " << heuristicName(i.heuristic)
            << " --irregular-frame " << irregularFrameName(i.frame);
+        if (!i.costStop) os << " --no-cost-stop";
     }
     if (p.scheme != SchemeKind::Brute) {
         if (!p.mailboxes) os << " --no-mailbox";

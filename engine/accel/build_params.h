@@ -61,11 +61,18 @@ int effectiveMaxLevel(const RegularConfig& config, size_t primitives);
 /// ("Growth", "Segment heuristics", "Projective zones for primary rays"):
 /// `balanced` makes 30% fewer zones than `first` and fewer region visits per ray than `first` or
 /// `fewest-cuts`; the projective zones save 2-26% of the instructions per ray. max-objects 4 is
-/// the regular scheme's value; on balls4, 32 renders in the same time with a 28th of the memory.
+/// the regular scheme's value; the cost stop (stepCost 4, "Budget and stopping rule") leaves
+/// balls4 a tenth of the zones and halves its region visits per ray.
 struct IrregularConfig {
     int maxObjects = 4;  ///< a screen cell over at most this many rectangles is a zone (0: never)
     BspHeuristic heuristic = BspHeuristic::Balanced;    ///< choice of the splitting segment
     IrregularFrame frame = IrregularFrame::Projective;  ///< what primary rays walk
+    /// Leave a screen cell whole where no split lowers the estimated tests per ray (false: the
+    /// report's rule alone, max-objects).
+    bool costStop = true;
+    /// Cost of the zone a screen split adds, in primitive tests (2, 4 and 8 measured: 4 renders
+    /// balls4 and lattice:12 fastest for their build).
+    double stepCost = 4.0;
 };
 
 /// Builder parameters: the scheme, the knobs every scheme reads, and each scheme's Config.

@@ -88,12 +88,54 @@ TEST(BoundedBuild, IrregularOverItsBudgetStopsWithinIt) {
             << bounded->info().extra.dump();
         EXPECT_LE(bounded->info().memoryBytes, p.memoryBudget);
         const nlohmann::json& x = bounded->info().extra;
-        EXPECT_TRUE(x["bsp_stopped"].get<bool>() || x["merged_zones"].get<size_t>() > 0)
+        EXPECT_TRUE(x["bsp_stopped"].get<bool>() || x["merged_zones"].get<size_t>() > 0 ||
+                    x["coarse_zones"].get<size_t>() > 0)
             << x.dump();
         // Fewer regions, the same picture.
         auto bad = test::compareWithBrute(scene, *bounded, test::pixelRays(scene, 48, 48));
         EXPECT_TRUE(bad.empty()) << bad.size() << " rays differ from brute force";
         bad = test::compareWithBrute(scene, *bounded, test::randomRays(scene, 7, 2000));
+        EXPECT_TRUE(bad.empty()) << bad.size() << " rays differ from brute force";
+    }
+}
+
+TEST(BoundedBuild, IrregularRuleFitsTheMeasuredPeak) {
+    // The rule charges each zone the slabs it makes (not the worst case of its primitive count):
+    // a budget a few times the heap an unbounded build peaks at lets the build run unbounded,
+    // and half that peak stops it within the budget, with brute force's hits either way.
+    Scene scene = loadScene("builtin:balls:3");
+    BuildParams p;
+    p.scheme = SchemeKind::Irregular;
+    p.lightBuffer = false;
+    p.memoryBudget = size_t(64) << 30;  // no stop
+    std::unique_ptr<Accelerator> free;
+    const size_t peak = peakOf([&] { free = buildAccelerator(scene, p); });
+    const nlohmann::json& fx = free->info().extra;
+    ASSERT_FALSE(fx["bsp_stopped"].get<bool>()) << fx.dump();
+    ASSERT_EQ(fx["merged_zones"].get<size_t>(), 0u) << fx.dump();
+    std::printf("unbounded: peak heap %zu bytes, structure %zu, %zu regions\n", peak,
+                free->info().memoryBytes, free->info().regions);
+    for (size_t budget : {4 * peak, peak / 2}) {
+        SCOPED_TRACE(budget);
+        p.memoryBudget = budget;
+        std::unique_ptr<Accelerator> b;
+        const size_t used = peakOf([&] { b = buildAccelerator(scene, p); });
+        const nlohmann::json& x = b->info().extra;
+        const bool stopped = x["bsp_stopped"].get<bool>() || x["merged_zones"].get<size_t>() > 0 ||
+                             x.value("projective_merged_zones", size_t(0)) > 0 ||
+                             x.value("projective_bsp_stopped", false);
+        std::printf("budget %zu: peak heap %zu, %zu regions%s\n", budget, used, b->info().regions,
+                    stopped ? " (stopped)" : "");
+        EXPECT_LE(used, budget);
+        if (budget > peak) {
+            EXPECT_FALSE(stopped) << x.dump();
+            EXPECT_EQ(b->info().regions, free->info().regions);
+        } else {
+            EXPECT_TRUE(stopped) << x.dump();
+        }
+        auto bad = test::compareWithBrute(scene, *b, test::pixelRays(scene, 32, 32));
+        EXPECT_TRUE(bad.empty()) << bad.size() << " rays differ from brute force";
+        bad = test::compareWithBrute(scene, *b, test::randomRays(scene, 11, 1000));
         EXPECT_TRUE(bad.empty()) << bad.size() << " rays differ from brute force";
     }
 }

@@ -78,8 +78,9 @@ TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
     o.knobs.build.regular.step = GetParam().step;
     o.knobs.build.irregular.frame = GetParam().frame;
     // The report's split rule: the cost rule leaves builtin:default 2 leaves, too few for rays
-    // of every kind to cross a region boundary.
+    // of every kind to cross a region boundary (--no-cost-stop sets both schemes').
     o.knobs.build.regular.costStop = false;
+    o.knobs.build.irregular.costStop = false;
     Scene scene = loadScene(spec);
     auto accel = buildAccelerator(scene, o.knobs.build);
     int w, h;

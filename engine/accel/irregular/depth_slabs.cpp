@@ -8,7 +8,8 @@
 namespace lancer {
 
 DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
-                           double zlo, double zhi, BuildGuard* guard, size_t maxBytes) {
+                           double zlo, double zhi, BuildGuard* guard, size_t maxBytes,
+                           size_t maxRegions) {
     DepthSlabs out;
     TreeRestrictor restrictor(scene.tree);
     // One tree and one list per distinct primitive set; list 0 is the empty set.
@@ -28,14 +29,51 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
     };
     // What the zones not cut yet cost at least (merged): kept free for them.
     size_t reserve = bsp.zoneCount() * kMergedZoneBytes + bsp.zonePrims.size() * kMergedRefBytes;
-    std::vector<double> cuts;
-    std::vector<uint32_t> inSlab;
+    // Slabs still to make at least: one per zone not cut yet.
+    size_t regionsLeft = bsp.zoneCount();
+    std::vector<double> cuts, allCuts;
+    std::vector<uint32_t> inSlab, slabFirst, slabPrims, span, fill;
+    // Whether every zone's full slabs fit (bytes and regions): then no zone is held to its share.
+    bool ample = true;
+    if (maxBytes || maxRegions) {
+        size_t allBytes = 0, allSlabs = 0;
+        for (uint32_t z = 0; z < bsp.zoneCount(); ++z) {
+            if (guard) guard->poll();
+            const uint32_t* first = bsp.zonePrims.data() + bsp.zoneFirst[z];
+            const uint32_t* last = bsp.zonePrims.data() + bsp.zoneFirst[z + 1];
+            cuts = {zlo, zhi};
+            for (const uint32_t* p = first; p != last; ++p) {
+                cuts.push_back(std::clamp(box[*p].lo.z, zlo, zhi));
+                cuts.push_back(std::clamp(box[*p].hi.z, zlo, zhi));
+            }
+            std::sort(cuts.begin(), cuts.end());
+            cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+            size_t refs = 0;
+            for (const uint32_t* p = first; p != last; ++p) {
+                auto at = [&](double v) {
+                    return std::lower_bound(cuts.begin(), cuts.end(), std::clamp(v, zlo, zhi));
+                };
+                refs += size_t(at(box[*p].hi.z) - at(box[*p].lo.z));
+            }
+            const size_t slabs = first == last ? 1 : cuts.size() - 1;
+            allSlabs += slabs;
+            allBytes += slabs * kMergedZoneBytes + refs * kMergedRefBytes;
+        }
+        // The charge counts every reference's list entry and tree, which lists shared between
+        // slabs make about half (balls:3, lattice:12): the per-zone check below holds each zone
+        // to the limit whatever this says.
+        ample = (!maxBytes || allBytes / 2 + bytes() <= maxBytes) &&
+                (!maxRegions || allSlabs <= maxRegions);
+    }
     out.zoneFirstRegion.push_back(0);
     for (uint32_t z = 0; z < bsp.zoneCount(); ++z) {
         const uint32_t* first = bsp.zonePrims.data() + bsp.zoneFirst[z];
         const uint32_t* last = bsp.zonePrims.data() + bsp.zoneFirst[z + 1];
         const size_t now = guard || maxBytes ? bytes() : 0;
-        reserve -= kMergedZoneBytes + size_t(last - first) * kMergedRefBytes;
+        const size_t k = size_t(last - first);
+        const size_t refsLeft = bsp.zonePrims.size() - bsp.zoneFirst[z];
+        reserve -= kMergedZoneBytes + k * kMergedRefBytes;
+        --regionsLeft;
         if (guard) guard->poll("depth slabs", now, out.regions.size());
         IrregularRegion r;
         r.zone = z;
@@ -47,28 +85,78 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
             out.zoneFirstRegion.push_back(uint32_t(out.regions.size()));
             continue;
         }
-        // Depth cuts: the structure's ends and every box's zmin and zmax, unless the zone's
-        // slabs could pass the limit: up to 2k + 1 regions, lists of k / 2 on average, and
-        // their trees (a bound: lists shared between slabs and zones cost nothing more).
-        const size_t k = size_t(last - first);
-        const size_t worst = (2 * k + 1) * (kMergedZoneBytes + k * kMergedRefBytes / 2);
+        // Depth cuts: the structure's ends and every box's zmin and zmax.
         cuts = {zlo, zhi};
-        if (maxBytes && now + worst + reserve > maxBytes) {
-            ++out.mergedZones;
-        } else {
-            for (const uint32_t* p = first; p != last; ++p) {
-                cuts.push_back(std::clamp(box[*p].lo.z, zlo, zhi));
-                cuts.push_back(std::clamp(box[*p].hi.z, zlo, zhi));
-            }
+        for (const uint32_t* p = first; p != last; ++p) {
+            cuts.push_back(std::clamp(box[*p].lo.z, zlo, zhi));
+            cuts.push_back(std::clamp(box[*p].hi.z, zlo, zhi));
         }
         std::sort(cuts.begin(), cuts.end());
         cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+        // Each box spans the slabs from the one holding its zmin to the one holding its zmax
+        // (a box overlaps a slab's interior); the lists are filled by those spans (a sweep, not
+        // a scan of the zone per slab).
+        auto spans = [&] {
+            const size_t n = cuts.size() - 1;
+            slabFirst.assign(n + 1, 0);
+            span.clear();
+            for (const uint32_t* p = first; p != last; ++p) {
+                const double lo = std::clamp(box[*p].lo.z, zlo, zhi);
+                const double hi = std::clamp(box[*p].hi.z, zlo, zhi);
+                size_t a = size_t(std::upper_bound(cuts.begin(), cuts.end(), lo) - cuts.begin());
+                a = std::min(a == 0 ? 0 : a - 1, n - 1);
+                const size_t b = std::min(
+                    size_t(std::lower_bound(cuts.begin(), cuts.end(), hi) - cuts.begin()), n);
+                span.push_back(uint32_t(a));
+                span.push_back(uint32_t(std::max(a, b)));
+                for (size_t i = a; i < b; ++i) ++slabFirst[i + 1];
+            }
+            for (size_t i = 0; i < n; ++i) slabFirst[i + 1] += slabFirst[i];
+            return size_t(slabFirst[n]);
+        };
+        // The zone's slabs cost at most a region each and, per reference, a list entry and its
+        // tree (lists shared with earlier slabs cost nothing more). Past the byte limit (what is
+        // held, this zone, and the least the zones after it take) or the region limit, the zone
+        // keeps every fourth cut, then every sixteenth, .., down to one slab (its slabs merge).
+        allCuts = cuts;
+        for (size_t step = 1;; step *= 4) {
+            if (step > 1) {
+                cuts.clear();
+                for (size_t i = 0; i + 1 < allCuts.size(); i += step) cuts.push_back(allCuts[i]);
+                cuts.push_back(allCuts.back());
+            }
+            const size_t slabs = cuts.size() - 1;
+            const size_t refs = spans();
+            const size_t cost = slabs * kMergedZoneBytes + refs * kMergedRefBytes;
+            // Within the limits, and within twice the zone's share of what is left beyond every
+            // zone's least (its references over theirs), so the first zones do not take it all.
+            const double share = ample ? 1e300 : 2.0 * double(k) / double(refsLeft);
+            const size_t least = kMergedZoneBytes + k * kMergedRefBytes;
+            const bool fits =
+                (!maxBytes ||
+                 (now + cost + reserve <= maxBytes &&
+                  double(cost - std::min(cost, least)) <=
+                      share * double(maxBytes - std::min(maxBytes, now + reserve + least)))) &&
+                (!maxRegions ||
+                 (out.regions.size() + slabs + regionsLeft <= maxRegions &&
+                  double(slabs - 1) <=
+                      share * double(maxRegions - out.regions.size() - regionsLeft - 1)));
+            if (fits || slabs == 1) {
+                if (slabs == 1 && allCuts.size() > 2)
+                    ++out.mergedZones;
+                else if (step > 1)
+                    ++out.coarseZones;
+                break;
+            }
+        }
+        slabPrims.resize(slabFirst.back());
+        fill.assign(slabFirst.begin(), slabFirst.end() - 1);
+        for (size_t j = 0; j < span.size(); j += 2)
+            for (uint32_t i = span[j]; i < span[j + 1]; ++i) slabPrims[fill[i]++] = first[j / 2];
         for (size_t i = 0; i + 1 < cuts.size(); ++i) {
             r.box.lo.z = cuts[i];
             r.box.hi.z = cuts[i + 1];
-            inSlab.clear();
-            for (const uint32_t* p = first; p != last; ++p)
-                if (box[*p].lo.z < cuts[i + 1] && box[*p].hi.z > cuts[i]) inSlab.push_back(*p);
+            inSlab.assign(slabPrims.begin() + slabFirst[i], slabPrims.begin() + slabFirst[i + 1]);
             if (inSlab.empty()) ++out.emptySlabs;
             share(inSlab, r);
             out.regions.push_back(r);

@@ -25,6 +25,7 @@ struct DepthSlabs {
     size_t emptyZones = 0;   ///< zones no rectangle touches (one region each)
     size_t emptySlabs = 0;   ///< slabs of non-empty zones that hold no primitive
     size_t mergedZones = 0;  ///< zones left as one slab to keep within the byte limit
+    size_t coarseZones = 0;  ///< zones cut at a subset of their cuts to keep within the limits
 };
 
 class BuildGuard;  // build_guard.h
@@ -36,10 +37,12 @@ inline constexpr size_t kMergedZoneBytes =
 inline constexpr size_t kMergedRefBytes = 2 * sizeof(uint32_t) + 2 * sizeof(CsgNode);
 
 /// Cut every zone of `bsp` along depth inside [zlo, zhi]; box[p] is primitive p's camera box.
-/// A zone whose slabs would take the structure past `maxBytes` (0: no limit) is one slab holding
-/// all its primitives: its slabs merge. `guard` (may be null) is polled for cancellation.
+/// A zone whose slabs would take the structure past `maxBytes` bytes or `maxRegions` regions
+/// (0: no limit) keeps every fourth cut (then every sixteenth, ..) until they fit, or is one slab
+/// holding all its primitives: its slabs merge. `guard` (may be null)
+/// is polled for cancellation.
 DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
-                           double zlo, double zhi, BuildGuard* guard = nullptr,
-                           size_t maxBytes = 0);
+                           double zlo, double zhi, BuildGuard* guard = nullptr, size_t maxBytes = 0,
+                           size_t maxRegions = 0);
 
 }  // namespace lancer

@@ -1,5 +1,6 @@
 #include "engine/accel/irregular/irregular.h"
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -19,6 +20,13 @@ double maxAbs(const Vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), st
 /// The screen BSP stops at about this many zones: a BSP that large means the 2D step should stop
 /// earlier (see docs/irregular.md, "Growth").
 constexpr size_t kMaxZones = 4'000'000;
+/// The regions one frame's slabs may make (camera frame, projective zones): a work bound, so a
+/// build's time stays within seconds at the defaults; past it further zones keep one slab.
+/// Primary rays need about a zone per pixel, secondary rays about a region per primitive:
+/// 16 times their sum, within 2^20..2^23 (docs/irregular.md, "Budget and stopping rule").
+size_t regionBudget(size_t prims, size_t pixels) {
+    return std::clamp<size_t>(16 * (prims + pixels), size_t(1) << 20, size_t(1) << 23);
+}
 /// Regions beyond this many are refused: pointers are 32-bit and memory would run out first.
 constexpr size_t kMaxRegions = 50'000'000;
 
@@ -66,6 +74,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     }
     s.bounds_ = {cam.lo - 2.0 * eps, cam.hi + 2.0 * eps};
 
+    const size_t pixels = size_t(std::max(scene.width, 1)) * size_t(std::max(scene.height, 1));
+    const size_t maxRegions = regionBudget(live.size(), pixels);
     // 2D step. The memory budget is shared by the camera-frame structure and the projective
     // zones (when built). Of each share, the screen BSP may take a ninth (then it stops) and the
     // slabs two ninths (then each further zone's slabs merge into one): a third in all, so the
@@ -74,6 +84,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     ScreenBspParams sp;
     sp.heuristic = params.heuristic;
     sp.stopObjects = params.maxObjects;
+    sp.stepCost = params.costStop ? params.stepCost : 0.0;
     sp.maxZones = kMaxZones;
     sp.maxBytes = share / 9;
     sp.zoneBytes = kMergedZoneBytes;
@@ -86,8 +97,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     // 3D step.
     guard.poll();
     auto t1 = Clock::now();
-    DepthSlabs slabs =
-        buildDepthSlabs(scene, s.bsp_, box, s.bounds_.lo.z, s.bounds_.hi.z, &guard, 2 * share / 9);
+    DepthSlabs slabs = buildDepthSlabs(scene, s.bsp_, box, s.bounds_.lo.z, s.bounds_.hi.z, &guard,
+                                       2 * share / 9, maxRegions);
     if (slabs.regions.size() > kMaxRegions)
         throw std::invalid_argument("--scheme irregular: " + std::to_string(slabs.regions.size()) +
                                     " regions is over the limit of " + std::to_string(kMaxRegions) +
@@ -111,7 +122,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["frame"] = irregularFrameName(params.frame);
     if (params.frame == IrregularFrame::Projective) {
         auto t3 = Clock::now();
-        s.eye_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, extra, 2 * share / 9);
+        s.eye_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, extra, 2 * share / 9,
+                                        maxRegions);
         eyeMs = ms(t3);
     }
 
@@ -124,6 +136,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["zones"] = s.bsp_.zoneCount();
     extra["segments"] = s.bsp_.segments;
     extra["cut_segments"] = s.bsp_.cuts;
+    extra["cost_stops"] = s.bsp_.costStops;
     extra["bsp_nodes"] = s.bsp_.nodes.size();
     extra["bsp_depth"] = s.bsp_.depth;
     extra["slabs"] = slabs.slabs;
@@ -131,8 +144,10 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["empty_slabs"] = slabs.emptySlabs;
     // Where the memory budget stopped the 2D step or merged slabs (README, "Bounded builds").
     extra["memory_budget"] = guard.budget();
+    extra["region_budget"] = maxRegions;
     extra["bsp_stopped"] = s.bsp_.stopped;
     extra["merged_zones"] = slabs.mergedZones;
+    extra["coarse_zones"] = slabs.coarseZones;
     extra["distinct_trees"] = s.listFirst_.size() - 1;
     extra["pool_nodes"] = s.pool_.nodes.size();
     extra["prims_per_region"] = double(refs) / double(s.regions_.size());

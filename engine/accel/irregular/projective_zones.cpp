@@ -11,7 +11,8 @@ namespace lancer {
 ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& frame,
                                        const std::vector<Box3>& box,
                                        const std::vector<uint32_t>& live, const ScreenBspParams& sp,
-                                       nlohmann::json& extra, size_t maxSlabBytes) {
+                                       nlohmann::json& extra, size_t maxSlabBytes,
+                                       size_t maxRegions) {
     ProjectiveZones s;
     s.scene_ = &scene;
     s.frame_ = frame;
@@ -68,11 +69,13 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     s.zNear_ = zNear;
     s.zFar_ = zFar;
     s.bsp_ = ScreenBsp::build(pbox, inside, lo, hi, sp);
-    DepthSlabs slabs = buildDepthSlabs(scene, s.bsp_, pbox, zNear, zFar, sp.guard, maxSlabBytes);
+    DepthSlabs slabs =
+        buildDepthSlabs(scene, s.bsp_, pbox, zNear, zFar, sp.guard, maxSlabBytes, maxRegions);
     s.zones_ = s.bsp_.zoneCount();
     s.zoneFirst_ = std::move(slabs.zoneFirstRegion);
     s.slabLo_.reserve(slabs.regions.size());
     s.slabRoot_.reserve(slabs.regions.size());
+    s.slabList_.reserve(slabs.regions.size());
     for (const IrregularRegion& r : slabs.regions) {
         s.slabLo_.push_back(r.box.lo.z);
         s.slabRoot_.push_back(r.root);
@@ -90,6 +93,7 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     extra["projective_empty_slabs"] = slabs.emptySlabs + slabs.emptyZones;
     extra["projective_bsp_stopped"] = s.bsp_.stopped;
     extra["projective_merged_zones"] = slabs.mergedZones;
+    extra["projective_coarse_zones"] = slabs.coarseZones;
     extra["projective_near_primitives"] = nearPrims.size();
     extra["projective_znear"] = zNear;
     return s;

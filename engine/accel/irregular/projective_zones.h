@@ -34,7 +34,7 @@ class ProjectiveZones {
     static ProjectiveZones build(const Scene& scene, const CameraFrame& frame,
                                  const std::vector<Box3>& box, const std::vector<uint32_t>& live,
                                  const ScreenBspParams& sp, nlohmann::json& extra,
-                                 size_t maxSlabBytes = 0);
+                                 size_t maxSlabBytes = 0, size_t maxRegions = 0);
 
     /// This structure answers the ray: it starts exactly at the eye and its (u, v) is inside the
     /// screen rectangle. `rc` is the ray in the camera frame.

@@ -28,6 +28,9 @@ struct Cell {
     int depth;
 };
 
+/// Levels of the screen BSP split whatever the cost estimate says.
+constexpr int kAlwaysSplitLevels = 4;
+
 struct Split {
     uint8_t axis;
     double c;
@@ -165,18 +168,44 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
             continue;
         }
         Split sp = chooseSplit(cell.segs, params.heuristic, params.guard);
-        int32_t node = int32_t(bsp.nodes.size());
-        slot = node;
-        bsp.nodes.push_back({sp.axis, sp.c, {0, 0}});
-
         // Children: segments on the line are used up, segments across it are cut in two.
-        Cell below{cell.lo, cell.hi, {}, {}, node, 0, cell.depth + 1};
-        Cell above{cell.lo, cell.hi, {}, {}, node, 1, cell.depth + 1};
+        Cell below{cell.lo, cell.hi, {}, {}, -1, 0, cell.depth + 1};
+        Cell above{cell.lo, cell.hi, {}, {}, -1, 1, cell.depth + 1};
         below.hi[sp.axis] = sp.c;
         above.lo[sp.axis] = sp.c;
         // Large cells take a while here (their children's lists grow by copies, and fresh pages
         // fault in): poll as in the loop.
         size_t polled = 0;
+        for (uint32_t p : cell.prims) {
+            if (params.guard && (++polled & 32767) == 0) params.guard->poll();
+            if (overlapsOpen(rect[p], below.lo, below.hi)) below.prims.push_back(p);
+            if (overlapsOpen(rect[p], above.lo, above.hi)) above.prims.push_back(p);
+        }
+        // The first levels always split (at most 16 cells): with a handful of primitives the
+        // estimate would leave one zone, and the scheme would have no screen structure at all.
+        if (params.stepCost > 0.0 && cell.depth >= kAlwaysSplitLevels) {
+            // A ray through the cell (the area of a side is its share of the rays) tests its
+            // rectangles; split, it crosses one more zone and tests one side's.
+            const double area = (cell.hi.x - cell.lo.x) * (cell.hi.y - cell.lo.y);
+            const double aBelow = (below.hi.x - below.lo.x) * (below.hi.y - below.lo.y);
+            const double aAbove = (above.hi.x - above.lo.x) * (above.hi.y - above.lo.y);
+            const double split =
+                params.stepCost +
+                (aBelow * double(below.prims.size()) + aAbove * double(above.prims.size())) / area;
+            if (area > 0.0 && !(split < double(cell.prims.size()))) {
+                ++bsp.costStops;
+                slot = ~int32_t(bsp.zoneLo.size());
+                bsp.zoneLo.push_back(cell.lo);
+                bsp.zoneHi.push_back(cell.hi);
+                bsp.zonePrims.insert(bsp.zonePrims.end(), cell.prims.begin(), cell.prims.end());
+                bsp.zoneFirst.push_back(uint32_t(bsp.zonePrims.size()));
+                continue;
+            }
+        }
+        int32_t node = int32_t(bsp.nodes.size());
+        slot = node;
+        bsp.nodes.push_back({sp.axis, sp.c, {0, 0}});
+        below.parent = above.parent = node;
         for (const Segment& s : cell.segs) {
             if (params.guard && (++polled & 32767) == 0) params.guard->poll();
             if (s.axis == sp.axis) {
@@ -193,11 +222,6 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
                 below.segs.push_back({s.c, s.lo, sp.c, s.axis});
                 above.segs.push_back({s.c, sp.c, s.hi, s.axis});
             }
-        }
-        for (uint32_t p : cell.prims) {
-            if (params.guard && (++polled & 32767) == 0) params.guard->poll();
-            if (overlapsOpen(rect[p], below.lo, below.hi)) below.prims.push_back(p);
-            if (overlapsOpen(rect[p], above.lo, above.hi)) above.prims.push_back(p);
         }
         cell = Cell{};  // free the parent's lists before descending
         if (below.segs.size() < above.segs.size()) std::swap(below, above);

@@ -17,6 +17,9 @@ class BuildGuard;                   // build_guard.h
 struct ScreenBspParams {
     BspHeuristic heuristic{};  ///< the choice of splitting line
     int stopObjects = 0;  ///< a cell overlapping at most this many rectangles is a zone (0: never)
+    /// Cost of the zone a split adds, in primitive tests (0: no cost stop). A cell is split only
+    /// where stepCost + (area-weighted rectangles of the two children) is below its own count.
+    double stepCost = 0.0;
     /// Stop splitting at about this many zones (0: no limit): the cells left become zones.
     size_t maxZones = 0;
     /// Stop splitting once the BSP (with the cells waiting) and what its zones will cost at
@@ -39,9 +42,10 @@ struct ScreenBsp {
     std::vector<glm::dvec2> zoneLo, zoneHi;
     std::vector<uint32_t> zoneFirst;  ///< zone z holds zonePrims[zoneFirst[z] .. zoneFirst[z + 1])
     std::vector<uint32_t> zonePrims;
-    size_t segments = 0;  ///< rectangle edges fed to the BSP
-    size_t cuts = 0;      ///< segments cut in two by a splitting line
-    int depth = 0;        ///< deepest node
+    size_t segments = 0;   ///< rectangle edges fed to the BSP
+    size_t cuts = 0;       ///< segments cut in two by a splitting line
+    size_t costStops = 0;  ///< cells left whole because no split paid (stepCost)
+    int depth = 0;         ///< deepest node
     bool stopped =
         false;  ///< the zone or byte limit stopped the splitting before the segments ran out
 
