@@ -132,12 +132,14 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     }
     EXPECT_EQ(settingsLines(r), lines);
     // Every ini key of the parameter table is written, with the value set above.
-    for (const cli::ParamDesc& d : cli::paramTable())
-        if (d.iniKey)
+    for (const cli::ParamDesc& d : cli::paramTable()) {
+        if (d.iniKey) {
             EXPECT_NE(lines.find(std::string("\n") + d.iniKey + "=" +
                                  cli::formatValue(d, knobsOf(s)) + "\n"),
                       std::string::npos)
                 << d.iniKey;
+        }
+    }
     EXPECT_TRUE(r.build.regular.fullTable);
     EXPECT_EQ(r.build.irregular.frame, IrregularFrame::Camera);
     EXPECT_EQ(r.shading.offsetScale, 2.5e-8);
