@@ -33,6 +33,16 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
     size_t regionsLeft = bsp.zoneCount();
     std::vector<double> cuts, allCuts;
     std::vector<uint32_t> inSlab, slabFirst, slabPrims, span, fill;
+    // A zone's depth cuts: the structure's ends and every box's zmin and zmax, sorted, unique.
+    auto zoneCuts = [&](const uint32_t* first, const uint32_t* last) {
+        cuts = {zlo, zhi};
+        for (const uint32_t* p = first; p != last; ++p) {
+            cuts.push_back(std::clamp(box[*p].lo.z, zlo, zhi));
+            cuts.push_back(std::clamp(box[*p].hi.z, zlo, zhi));
+        }
+        std::sort(cuts.begin(), cuts.end());
+        cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+    };
     // Whether every zone's full slabs fit (bytes and regions): then no zone is held to its share.
     bool ample = true;
     if (maxBytes || maxRegions) {
@@ -41,13 +51,7 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
             if (guard) guard->poll();
             const uint32_t* first = bsp.zonePrims.data() + bsp.zoneFirst[z];
             const uint32_t* last = bsp.zonePrims.data() + bsp.zoneFirst[z + 1];
-            cuts = {zlo, zhi};
-            for (const uint32_t* p = first; p != last; ++p) {
-                cuts.push_back(std::clamp(box[*p].lo.z, zlo, zhi));
-                cuts.push_back(std::clamp(box[*p].hi.z, zlo, zhi));
-            }
-            std::sort(cuts.begin(), cuts.end());
-            cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+            zoneCuts(first, last);
             size_t refs = 0;
             for (const uint32_t* p = first; p != last; ++p) {
                 auto at = [&](double v) {
@@ -85,14 +89,7 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
             out.zoneFirstRegion.push_back(uint32_t(out.regions.size()));
             continue;
         }
-        // Depth cuts: the structure's ends and every box's zmin and zmax.
-        cuts = {zlo, zhi};
-        for (const uint32_t* p = first; p != last; ++p) {
-            cuts.push_back(std::clamp(box[*p].lo.z, zlo, zhi));
-            cuts.push_back(std::clamp(box[*p].hi.z, zlo, zhi));
-        }
-        std::sort(cuts.begin(), cuts.end());
-        cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+        zoneCuts(first, last);
         // Each box spans the slabs from the one holding its zmin to the one holding its zmax
         // (a box overlaps a slab's interior); the lists are filled by those spans (a sweep, not
         // a scan of the zone per slab).

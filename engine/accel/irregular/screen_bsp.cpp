@@ -159,12 +159,16 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
             stop = true;
             bsp.stopped = true;
         }
-        if (stop) {
+        // The cell becomes a zone: its rectangle and its primitives.
+        auto makeZone = [&] {
             slot = ~int32_t(bsp.zoneLo.size());
             bsp.zoneLo.push_back(cell.lo);
             bsp.zoneHi.push_back(cell.hi);
             bsp.zonePrims.insert(bsp.zonePrims.end(), cell.prims.begin(), cell.prims.end());
             bsp.zoneFirst.push_back(uint32_t(bsp.zonePrims.size()));
+        };
+        if (stop) {
+            makeZone();
             continue;
         }
         Split sp = chooseSplit(cell.segs, params.heuristic, params.guard);
@@ -194,11 +198,7 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
                 (aBelow * double(below.prims.size()) + aAbove * double(above.prims.size())) / area;
             if (area > 0.0 && !(split < double(cell.prims.size()))) {
                 ++bsp.costStops;
-                slot = ~int32_t(bsp.zoneLo.size());
-                bsp.zoneLo.push_back(cell.lo);
-                bsp.zoneHi.push_back(cell.hi);
-                bsp.zonePrims.insert(bsp.zonePrims.end(), cell.prims.begin(), cell.prims.end());
-                bsp.zoneFirst.push_back(uint32_t(bsp.zonePrims.size()));
+                makeZone();
                 continue;
             }
         }
