@@ -115,7 +115,9 @@ TEST(BoundedBuild, IrregularRuleFitsTheMeasuredPeak) {
     ASSERT_EQ(fx["merged_zones"].get<size_t>(), 0u) << fx.dump();
     std::printf("unbounded: peak heap %zu bytes, structure %zu, %zu regions\n", peak,
                 free->info().memoryBytes, free->info().regions);
-    for (size_t budget : {4 * peak, peak / 2}) {
+    // 8 x the peak: at 4 x, the projective frame's pre-pass (do all zones fit?) is at its
+    // threshold on this scene, and the sanitized builds (engine at -O1) coarsen one zone there.
+    for (size_t budget : {8 * peak, peak / 2}) {
         SCOPED_TRACE(budget);
         p.memoryBudget = budget;
         std::unique_ptr<Accelerator> b;
@@ -123,6 +125,8 @@ TEST(BoundedBuild, IrregularRuleFitsTheMeasuredPeak) {
         const nlohmann::json& x = b->info().extra;
         const bool stopped = x["bsp_stopped"].get<bool>() || x["merged_zones"].get<size_t>() > 0 ||
                              x.value("projective_merged_zones", size_t(0)) > 0 ||
+                             x.value("coarse_zones", size_t(0)) > 0 ||
+                             x.value("projective_coarse_zones", size_t(0)) > 0 ||
                              x.value("projective_bsp_stopped", false);
         std::printf("budget %zu: peak heap %zu, %zu regions%s\n", budget, used, b->info().regions,
                     stopped ? " (stopped)" : "");
