@@ -1,5 +1,6 @@
 #include "engine/model/csg.h"
 
+#include <algorithm>
 #include <functional>
 
 namespace lancer {
@@ -59,6 +60,11 @@ int CsgTree::balanced(Op op, const std::vector<int>& items) {
         return combine(op, a, b);
     };
     return build(0, items.size());
+}
+
+bool CsgTree::unionOnly() const {
+    return std::all_of(nodes.begin(), nodes.end(),
+                       [](const CsgNode& n) { return n.op == Op::Primitive || n.op == Op::Union; });
 }
 
 int CsgTree::depth() const {

@@ -52,6 +52,8 @@ struct CsgTree {
     /// Balanced tree over `items` (node indices) with an associative operator; -1 if none.
     int balanced(Op op, const std::vector<int>& items);
     int depth() const;
+    /// Whether every node is a primitive or a union (then every restriction of it is too).
+    bool unionOnly() const;
     /// Primitives reachable from the root, in leaf order.
     std::vector<uint32_t> primitives() const;
     std::string toString() const;

@@ -296,9 +296,7 @@ struct RegularBuilder {
           guard(gd),
           maxLevel(effectiveMaxLevel(p, livePrims)),
           weight(testWeights(s)),
-          unionOnly(std::all_of(
-              s.tree.nodes.begin(), s.tree.nodes.end(),
-              [](const CsgNode& n) { return n.op == Op::Primitive || n.op == Op::Union; })),
+          unionOnly(s.tree.unionOnly()),
           keep([n = s.prims.size()] { return std::vector<char>(n, 0); }) {
         // A leaf's restriction climbs from its primitives to the root: a cost of the tree's
         // depth per primitive, which a balanced union (every scene format makes one) keeps to
@@ -686,9 +684,7 @@ struct RegularBuilder {
 RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildGuard* guardIn)
     : scene_(&scene), exact_(params.step == StepMethod::Exact) {
     // A union-only tree restricts to unions: every leaf's spans are its primitives' merged.
-    unionOnly_ =
-        std::all_of(scene.tree.nodes.begin(), scene.tree.nodes.end(),
-                    [](const CsgNode& n) { return n.op == Op::Primitive || n.op == Op::Union; });
+    unionOnly_ = scene.tree.unionOnly();
     BuildGuard ownGuard;
     BuildGuard& guard = guardIn ? *guardIn : ownGuard;
     if (params.maxLevel < 0 || params.maxLevel > 48)
