@@ -9,8 +9,23 @@ namespace {
 /// The report's rules from `node` down, the walk entering only nodes for which live(node) holds
 /// (a primitive's leaf: it is kept; an operator: it may hold a kept primitive). Both
 /// restrictions are this walk, so they build the same nodes in the same order.
-template <class Live>
-int restrictWalk(const CsgTree& src, int node, const Live& live, CsgTree& dst) {
+/// Nodes written to an array of room enough, numbered from `base`: the same calls as a CsgTree's.
+struct ArrayDst {
+    CsgNode* out;
+    int base;
+    int n = 0;
+    int leaf(uint32_t prim) {
+        out[n] = {Op::Primitive, -1, -1, prim};
+        return base + n++;
+    }
+    int combine(Op op, int a, int b) {
+        out[n] = {op, a, b, kNoPrim};
+        return base + n++;
+    }
+};
+
+template <class Live, class Dst>
+int restrictWalk(const CsgTree& src, int node, const Live& live, Dst& dst) {
     if (node < 0 || !live(node)) return -1;
     const CsgNode& x = src.nodes[size_t(node)];
     if (x.op == Op::Primitive) return dst.leaf(x.prim);
@@ -64,7 +79,7 @@ TreeRestrictor::TreeRestrictor(const CsgTree& tree)
         if (tree.nodes[n].op == Op::Primitive) leafNodes_[next[tree.nodes[n].prim]++] = int(n);
 }
 
-void TreeRestrictor::mark(const std::vector<uint32_t>& prims, char value,
+void TreeRestrictor::mark(std::span<const uint32_t> prims, char value,
                           std::vector<char>& live) const {
     for (uint32_t p : prims) {
         if (size_t(p) + 1 >= leafFirst_.size()) continue;
@@ -77,6 +92,16 @@ void TreeRestrictor::mark(const std::vector<uint32_t>& prims, char value,
 int TreeRestrictor::restrict(const std::vector<uint32_t>& prims, CsgTree& dst,
                              std::vector<char>& live) const {
     mark(prims, 1, live);
+    const int root = restrictWalk(
+        *tree_, tree_->root, [&](int n) { return live[size_t(n)] != 0; }, dst);
+    mark(prims, 0, live);
+    return root;
+}
+
+int TreeRestrictor::restrict(std::span<const uint32_t> prims, CsgNode* out, int base,
+                             std::vector<char>& live) const {
+    mark(prims, 1, live);
+    ArrayDst dst{out, base};
     const int root = restrictWalk(
         *tree_, tree_->root, [&](int n) { return live[size_t(n)] != 0; }, dst);
     mark(prims, 0, live);
