@@ -59,13 +59,18 @@ int restrictTreeTo(const CsgTree& src, const std::vector<uint32_t>& prims, std::
     return root;
 }
 
-TreeRestrictor::TreeRestrictor(const CsgTree& tree)
-    : tree_(&tree), parent_(tree.nodes.size(), -1), live_(tree.nodes.size(), 0) {
-    // Count each primitive's leaves, then place them: leaves in node order per primitive.
+TreeRestrictor::TreeRestrictor(const CsgTree& tree) : tree_(&tree), parent_(tree.nodes.size(), -1) {
+    // Count each primitive's leaves, then place them: leaves in node order per primitive. The
+    // arrays are sized once and placing moves each start to the next one's, shifted back after
+    // (on a million nodes, growing them and a copy for the cursors were thousands of fresh
+    // pages).
+    uint32_t prims = 0;
+    for (const CsgNode& x : tree.nodes)
+        if (x.op == Op::Primitive) prims = std::max(prims, x.prim + 1);
+    if (prims) leafFirst_.assign(size_t(prims) + 1, 0);
     for (size_t n = 0; n < tree.nodes.size(); ++n) {
         const CsgNode& x = tree.nodes[n];
         if (x.op == Op::Primitive) {
-            if (leafFirst_.size() < size_t(x.prim) + 2) leafFirst_.resize(size_t(x.prim) + 2, 0);
             ++leafFirst_[size_t(x.prim) + 1];
         } else {
             parent_[size_t(x.left)] = int(n);
@@ -74,9 +79,11 @@ TreeRestrictor::TreeRestrictor(const CsgTree& tree)
     }
     for (size_t p = 1; p < leafFirst_.size(); ++p) leafFirst_[p] += leafFirst_[p - 1];
     leafNodes_.resize(leafFirst_.empty() ? 0 : leafFirst_.back());
-    std::vector<uint32_t> next(leafFirst_);
     for (size_t n = 0; n < tree.nodes.size(); ++n)
-        if (tree.nodes[n].op == Op::Primitive) leafNodes_[next[tree.nodes[n].prim]++] = int(n);
+        if (tree.nodes[n].op == Op::Primitive)
+            leafNodes_[leafFirst_[tree.nodes[n].prim]++] = int(n);
+    for (size_t p = leafFirst_.size(); p-- > 1;) leafFirst_[p] = leafFirst_[p - 1];
+    if (!leafFirst_.empty()) leafFirst_[0] = 0;
 }
 
 void TreeRestrictor::mark(std::span<const uint32_t> prims, char value,

@@ -30,6 +30,7 @@ class TreeRestrictor {
     explicit TreeRestrictor(const CsgTree& tree);
     /// Same result as restrictTree(tree, tree.root, keep, dst) with keep = `prims`.
     int restrict(const std::vector<uint32_t>& prims, CsgTree& dst) {
+        if (live_.size() != parent_.size()) live_.assign(parent_.size(), 0);  // on first use
         return restrict(prims, dst, live_);
     }
     /// The same with the caller's marks (one per node of the tree, all 0 before and after):
