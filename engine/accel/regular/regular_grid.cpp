@@ -20,6 +20,30 @@ namespace lancer {
 
 namespace {
 
+/// An allocator whose resize() leaves the new elements uninitialised: a cell's pass sizes its
+/// children's lists to hold every primitive and then writes them (zeroing them first took a
+/// twentieth of the build's time on balls:6).
+template <class T>
+struct NoInit : std::allocator<T> {
+    template <class U>
+    struct rebind {
+        using other = NoInit<U>;
+    };
+    NoInit() = default;
+    template <class U>
+    NoInit(const NoInit<U>&) {}
+    template <class U>
+    void construct(U* p) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... A>
+    void construct(U* p, A&&... a) {
+        ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+    }
+};
+/// The builder's lists of primitives.
+using PrimList = std::vector<uint32_t, NoInit<uint32_t>>;
+
 void sortedUnique(std::vector<uint32_t>& v) {
     // A scene's union lists its primitives in order (every format's balanced union): sorting
     // 600,000 of them again took 30 M instructions.
@@ -245,7 +269,7 @@ struct RegularBuilder {
         uint32_t pos[3];
     };
     struct Scratch {
-        std::vector<uint32_t> in[2], live;  ///< the children's primitives, a child's live ones
+        PrimList in[2], live;  ///< the children's primitives, a child's live ones
         CsgTree sub;
     };
     /// What one task builds. Node 0 is the fragment's root (the BSP's root in the first one).
@@ -262,10 +286,11 @@ struct RegularBuilder {
         std::vector<std::unique_ptr<Fragment>> children;  ///< fragments of kLinked nodes
         /// Each set's entry in the layout's pool (list kUnplaced: not yet placed).
         std::vector<RestrictedTreePool::Entry> placed;
-        std::vector<Scratch> scratch;                     ///< per level, for a node's children
-        std::vector<uint32_t> look[kLookahead + 1] = {};  ///< the cost estimate's lists, per depth
+        std::vector<Scratch> scratch;        ///< per level, for a node's children
+        PrimList look[kLookahead + 1] = {};  ///< the cost estimate's lists, per depth
         // A task's own inputs: its cell's primitives and tree, when not its parent's.
-        std::vector<uint32_t> in, live;
+        PrimList in, live;
+        std::vector<uint32_t> key;  ///< a leaf's set, as the pool's index keeps it
         CsgTree sub;
         size_t reported = 0;  ///< bytes() last added to RegularBuilder::bytes
         uint64_t primRefs = 0;
@@ -278,9 +303,9 @@ struct RegularBuilder {
         /// alone would take tens of MB).
         void releaseScratch() {
             std::vector<Scratch>().swap(scratch);
-            for (std::vector<uint32_t>& l : look) std::vector<uint32_t>().swap(l);
-            std::vector<uint32_t>().swap(in);
-            std::vector<uint32_t>().swap(live);
+            for (PrimList& l : look) PrimList().swap(l);
+            PrimList().swap(in);
+            PrimList().swap(live);
             CsgTree().nodes.swap(sub.nodes);
         }
         /// Heap bytes it keeps: vectors by capacity, and its pool with the trees still to make.
@@ -402,7 +427,7 @@ struct RegularBuilder {
         for (int side = 0; side < 2; ++side) {
             double c = params.stepCost + params.testCost * tests[side];
             if (depth > 1 && level + 1 < maxLevel && count[side] > size_t(params.maxObjects)) {
-                std::vector<uint32_t>& in = f.look[depth];
+                PrimList& in = f.look[depth];
                 in.clear();
                 for (uint32_t p : prims)
                     if (side ? scene.minBox[p].hi[axis] >= mid : scene.minBox[p].lo[axis] <= mid)
@@ -437,7 +462,7 @@ struct RegularBuilder {
 
     /// With a restrictor, a place for the tree of a new set of `prims` after the `count` nodes
     /// of the trees before it: its root (the walk's last node), -1 for the empty tree.
-    int reserveTree(const std::vector<uint32_t>& prims, size_t& count) const {
+    int reserveTree(std::span<const uint32_t> prims, size_t& count) const {
         const size_t size = restrictor->unionSize(prims);
         count += size;
         return size ? int(count - 1) : -1;
@@ -448,12 +473,12 @@ struct RegularBuilder {
     /// place is reserved: the trees are made after the layout (makeTrees), written straight
     /// where they belong, rather than made in each fragment and copied (on balls:6 1.8 million
     /// nodes, made and copied in fresh pages).
-    RestrictedTreePool::Entry treeFor(Fragment& f, const CsgTree& tree,
-                                      const std::vector<uint32_t>& prims) {
-        return f.pool.share(prims, [&](CsgTree& dst) {
-            if (restrictor) return reserveTree(prims, f.treeNodes);
+    RestrictedTreePool::Entry treeFor(Fragment& f, const CsgTree& tree, const PrimList& prims) {
+        f.key.assign(prims.begin(), prims.end());
+        return f.pool.share(f.key, [&](CsgTree& dst) {
+            if (restrictor) return reserveTree(f.key, f.treeNodes);
             f.treeStart.push_back(dst.nodes.size());
-            return restrictTreeTo(tree, prims, keep.local(), dst);
+            return restrictTreeTo(tree, f.key, keep.local(), dst);
         });
     }
 
@@ -489,7 +514,7 @@ struct RegularBuilder {
     }
 
     void makeLeaf(Fragment& f, int id, int level, const uint32_t pos[3], const CsgTree& tree,
-                  const std::vector<uint32_t>& prims) {
+                  const PrimList& prims) {
         const RestrictedTreePool::Entry entry = treeFor(f, tree, prims);
         const uint32_t nprims = uint32_t(prims.size());
         f.emptyLeaves += nprims == 0;
@@ -508,8 +533,8 @@ struct RegularBuilder {
 
     /// The primitives of `prims` (overlapping `box`) whose boxes overlap the half of `box` on
     /// side `side` of `mid` on `axis`, into `out`.
-    void half(const std::vector<uint32_t>& prims, int level, const Box3& child, int axis,
-              double mid, int side, std::vector<uint32_t>& out) const {
+    void half(const PrimList& prims, int level, const Box3& child, int axis, double mid, int side,
+              PrimList& out) const {
         // Below the root every primitive overlaps the cell, which differs from the child on the
         // cut axis alone: the test there is the whole test.
         out.clear();
@@ -528,8 +553,8 @@ struct RegularBuilder {
     /// Build child `id` at `level` over the primitives `in` of its cell, restricting `tree` (its
     /// parent's, over `parentPrims`) to them where needed; `sc` holds the child's tree and list.
     void buildChild(Fragment& f, int id, int level, const uint32_t pos[3], const Box3& box,
-                    const CsgTree& tree, const std::vector<uint32_t>& parentPrims,
-                    const std::vector<uint32_t>& in, CsgTree& sub, std::vector<uint32_t>& live) {
+                    const CsgTree& tree, const PrimList& parentPrims, const PrimList& in,
+                    CsgTree& sub, PrimList& live) {
         if (in.size() == parentPrims.size()) {
             // Every primitive overlaps the child: the restriction is this tree, whose
             // primitives all count (`prims` are the live ones).
@@ -540,13 +565,15 @@ struct RegularBuilder {
             build(f, id, level, pos, box, tree, in);
         } else {
             sub.nodes.clear();
-            sub.root = restrictTreeTo(tree, in, keep.local(), sub);
+            f.key.assign(in.begin(), in.end());
+            sub.root = restrictTreeTo(tree, f.key, keep.local(), sub);
             if (unionOnly) {
                 // Restricting a union drops no primitive it keeps: all of them are live.
                 build(f, id, level, pos, box, sub, in);
             } else {
-                live = sub.primitives();
-                sortedUnique(live);
+                f.key = sub.primitives();
+                sortedUnique(f.key);
+                live.assign(f.key.begin(), f.key.end());
                 build(f, id, level, pos, box, sub, live);
             }
         }
@@ -556,7 +583,7 @@ struct RegularBuilder {
     /// covering `box`; `prims` (sorted) are the primitives that matter here, `tree` the scene's
     /// tree restricted to them (unused with a restrictor).
     void build(Fragment& f, int id, int level, const uint32_t pos[3], const Box3& box,
-               const CsgTree& tree, const std::vector<uint32_t>& prims) {
+               const CsgTree& tree, const PrimList& prims) {
         if (prims.size() <= size_t(params.maxObjects) || level >= maxLevel) {
             makeLeaf(f, id, level, pos, tree, prims);
             return;
@@ -590,7 +617,7 @@ struct RegularBuilder {
             // predictor): each primitive is written to both lists, each list's end moving past
             // it when it belongs there, and its weight added, or +0, which leaves a sum of
             // non-negative weights bit for bit as it was. Weights all 1 (spheres) sum to counts.
-            std::vector<uint32_t>&in0 = sc.in[0], &in1 = sc.in[1];
+            PrimList &in0 = sc.in[0], &in1 = sc.in[1];
             in0.resize(prims.size());
             in1.resize(prims.size());
             uint32_t *lo = in0.data(), *hi = in1.data();
@@ -811,7 +838,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         schedule_ = planSchedule(scene, box_, live, b.weight, b.maxLevel, params.maxObjects, guard);
     const uint32_t origin[3] = {0, 0, 0};
     RegularBuilder::Fragment root(b.maxLevel);
-    b.build(root, 0, 0, origin, box_, scene.tree, live);
+    b.build(root, 0, 0, origin, box_, scene.tree, PrimList(live.begin(), live.end()));
     RegularBuilder::addCounters(root, root);
     // One fragment is the serial build's structure as it is; several are laid out in its order.
     RegularBuilder::Layout out;
