@@ -119,10 +119,9 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
     // order (insert() depends on it), so each map is the same whatever the threads.
     std::atomic<bool> stopped{false};
     TaskFence fence;
-    tbb::parallel_for(size_t(0), points.size(), [&](size_t l) {
-        const TaskFence::Done done(fence);
+    tbb::parallel_for(size_t(0), points.size(), fence.task([&](size_t l) {
         if (!buildMap(maps_[l], points[l], boxes, bins, slots, side, largest, stop)) stopped = true;
-    });
+    }));
     fence.acquire();
     if (stopped) maps_.clear();
 }
