@@ -18,7 +18,9 @@
 
 namespace lancer {
 
-namespace {
+// Outside the anonymous namespace: RegularBuilder, a friend of RegularGrid and so of namespace
+// lancer, holds these lists (a unity build would warn of a field of an internal type).
+namespace regular_build {
 
 /// An allocator whose resize() leaves the new elements uninitialised: a cell's pass sizes its
 /// children's lists to hold every primitive and then writes them (zeroing them first took a
@@ -43,6 +45,12 @@ struct NoInit : std::allocator<T> {
 };
 /// The builder's lists of primitives.
 using PrimList = std::vector<uint32_t, NoInit<uint32_t>>;
+
+}  // namespace regular_build
+
+using regular_build::PrimList;
+
+namespace {
 
 void sortedUnique(std::vector<uint32_t>& v) {
     // A scene's union lists its primitives in order (every format's balanced union): sorting
