@@ -85,7 +85,7 @@ void sortValues(std::vector<double>& v, std::vector<uint64_t>& key, std::vector<
     }
 }
 
-/// Cells of more segments than twice this many choose their line from a sample of them.
+/// Cells of twice this many segments or more choose their line from a sample of them.
 constexpr size_t kSplitSample = 32768;
 
 /// chooseSplit's arrays, kept from one cell to the next: allocated afresh, the large ones of the
@@ -99,16 +99,17 @@ struct SplitScratch {
 /// segment", read literally). `balanced`: the line that minimizes the larger side (segments on
 /// it plus the pieces cut), then the cuts. `fewest-cuts`: the line that cuts fewest segments,
 /// then the larger side. Each axis is scored in O(n log n) from sorted endpoints, a cell of
-/// more than 2 kSplitSample segments from a sample of them.
+/// 2 kSplitSample segments or more from a sample of them.
 Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h, const BuildGuard* guard,
                   SplitScratch& scratch) {
     if (h == BspHeuristic::First) return {segs[0].axis, segs[0].c};
     Split best{segs[0].axis, segs[0].c};
     size_t bestMain = SIZE_MAX, bestTie = SIZE_MAX;
     auto& [lines, lo, hi, key, tmp] = scratch;
-    // A cell of more segments than kSplitSample is scored on every stride-th of them: the
-    // line is then about as good (the counts are proportional), and the first levels of a
-    // large scene no longer sort millions of endpoints each.
+    // A cell of 2 kSplitSample segments or more is scored on every stride-th of them (between
+    // kSplitSample and 2 kSplitSample of them): the line is then about as good (the counts are
+    // proportional), and the first levels of a large scene no longer sort millions of
+    // endpoints each.
     const size_t stride = std::max<size_t>(1, segs.size() / kSplitSample);
     for (uint8_t a = 0; a < 2; ++a) {
         lines.clear();
