@@ -211,6 +211,13 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     benchCmd
+        ->add_option("--kill-after", scaleOpt.killAfterS,
+                     "--scale: seconds after which a child is killed (0: twice --time-limit, at "
+                     "least --brute-limit + 60)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    benchCmd
         ->add_option("--memory-budget", memoryBudget,
                      "--scale: the builds' --memory-budget (0: an eighth of physical memory)")
         ->capture_default_str()

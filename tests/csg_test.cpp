@@ -2,6 +2,8 @@
 // agreement with the full tree inside a region.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "engine/accel/eval.h"
 #include "engine/model/restriction.h"
 #include "tests/support/differential.h"
@@ -88,6 +90,61 @@ TEST(Restriction, ToAListLeavesTheMarksClearAndComposes) {
     sparse.root = restrictor.restrict({0, 1, 2}, sparse);
     EXPECT_EQ(sparse.toString(), r.toString());
     EXPECT_EQ(sparse.nodes.size(), r.nodes.size());
+}
+
+TEST(Restriction, InPlaceWritesTheAppendedNodesAndUnionSizeCountsThem) {
+    // A union of 40 primitives, balanced over a shuffled order, p7 in two leaves: the regular
+    // builder reserves unionSize() nodes per set and writes each restriction there, in parallel.
+    CsgTree t;
+    std::vector<int> leaves;
+    std::vector<uint32_t> order(40);
+    for (uint32_t p = 0; p < 40; ++p) order[p] = (p * 17) % 40;
+    for (uint32_t p : order) leaves.push_back(t.leaf(p));
+    leaves.push_back(t.leaf(7));
+    t.root = t.balanced(Op::Union, leaves);
+    const TreeRestrictor restrictor(t);
+    std::vector<char> marks(restrictor.nodeCount(), 0);
+    std::mt19937 rng(5);
+    for (int trial = 0; trial < 200; ++trial) {
+        std::vector<uint32_t> prims;
+        for (uint32_t p = 0; p < 40; ++p)
+            if (rng() % 4 == 0) prims.push_back(p);
+        if (trial == 0) prims = {7};  // two leaves: a union of p7 with itself
+        CsgTree appended;
+        appended.nodes.resize(3);  // as if after other trees: the roots are numbered from 3
+        appended.root = restrictor.restrict(prims, appended, marks);
+        const size_t size = appended.nodes.size() - 3;
+        EXPECT_EQ(restrictor.unionSize(prims), size);
+        std::vector<CsgNode> out(size + 1);
+        out[size].prim = 12345;  // a guard past the room: must stay untouched
+        const int root = restrictor.restrict(prims, out.data(), 3, marks);
+        EXPECT_EQ(root, appended.root);
+        for (size_t i = 0; i < size; ++i) {
+            const CsgNode &a = appended.nodes[3 + i], &b = out[i];
+            EXPECT_TRUE(a.op == b.op && a.left == b.left && a.right == b.right && a.prim == b.prim)
+                << "node " << i << " of the restriction to " << prims.size() << " primitives";
+        }
+        EXPECT_EQ(out[size].prim, 12345u);
+        EXPECT_EQ(marks, std::vector<char>(marks.size(), 0));
+    }
+    EXPECT_EQ(restrictor.unionSize(std::vector<uint32_t>{7}), 3u);
+    EXPECT_EQ(restrictor.unionSize(std::vector<uint32_t>{}), 0u);
+}
+
+TEST(CsgTree, DepthOfALongChainAndABalancedUnion) {
+    // Iterative: a chain of 200,000 differences is measured without a deep recursion.
+    CsgTree chain;
+    int node = chain.leaf(0);
+    for (uint32_t p = 1; p <= 200000; ++p)
+        node = chain.combine(Op::Difference, node, chain.leaf(p));
+    chain.root = node;
+    EXPECT_EQ(chain.depth(), 200001);
+    CsgTree balanced;
+    std::vector<int> leaves;
+    for (uint32_t p = 0; p < 1000; ++p) leaves.push_back(balanced.leaf(p));
+    balanced.root = balanced.balanced(Op::Union, leaves);
+    EXPECT_EQ(balanced.depth(), 11);  // 1000 leaves: 10 levels of unions above them
+    EXPECT_EQ(CsgTree{}.depth(), 0);
 }
 
 TEST(RestrictedTreePool, EachSetStoredOnceEqualSetsShareIt) {

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/mman.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -17,6 +18,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <new>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -48,15 +50,40 @@ constexpr int kWarmStride = 32;
 /// minutes.
 constexpr double kFirstProbePixels = 64.0, kProbePixels = 1024.0;
 
+/// The steps of a child, in order.
+enum ChildStep : int { kLoading, kBuilding, kRendering };
+const char* const kStepNames[] = {"loading", "building", "rendering"};
+
+/// What a child has done so far, in a page shared with the parent (mapped before the fork): a
+/// child killed at the deadline sends nothing, and this says which step ran long. The parent
+/// reads it after the child is reaped.
+struct ChildProgress {
+    int step = kLoading;                   ///< the step under way
+    size_t primitives = 0;                 ///< the scene's, once loaded
+    double loadMs = -1.0, buildMs = -1.0;  ///< wall times of the steps ended (-1: not ended)
+};
+
+/// The child's progress page (null in the parent, or when it could not be mapped).
+ChildProgress* gProgress = nullptr;
+
+/// In the child: `ended` took `ms` of wall time, the next step begins.
+void stepEnded(ChildStep ended, double ms) {
+    if (!gProgress) return;
+    if (ended == kLoading) gProgress->loadMs = ms;
+    if (ended == kBuilding) gProgress->buildMs = ms;
+    gProgress->step = ended + 1;
+}
+
 /// What a child process sent back, and how it ended.
 struct ChildResult {
     json figures = json::object();  ///< "error" or "refused" when it did not measure
     std::vector<float> depth;
     std::vector<uint32_t> hitPrim;
     size_t peakRssBytes = 0;
-    double cpuS = 0.0;    ///< user and system time of the child, every thread
-    bool killed = false;  ///< past the deadline
-    std::string crash;    ///< how it ended when it did not exit cleanly
+    double cpuS = 0.0;       ///< user and system time of the child, every thread
+    bool killed = false;     ///< past the deadline
+    ChildProgress progress;  ///< how far it got (for a killed child, the step that ran long)
+    std::string crash;       ///< how it ended when it did not exit cleanly
     /// The child measured (no error, refusal, kill or crash).
     bool measured() const {
         return !killed && crash.empty() && !figures.contains("error") &&
@@ -88,6 +115,15 @@ ChildResult runChild(const std::function<json(Image&)>& work, double killAfterS,
         r.crash = std::string("pipe: ") + std::strerror(errno);
         return r;
     }
+    void* page = ::mmap(nullptr, sizeof(ChildProgress), PROT_READ | PROT_WRITE,
+                        MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+    ChildProgress* progress = page == MAP_FAILED ? nullptr : new (page) ChildProgress{};
+    struct Unmap {
+        ChildProgress* p;
+        ~Unmap() {
+            if (p) ::munmap(p, sizeof(ChildProgress));
+        }
+    } unmap{progress};
     std::cout.flush();
     std::cerr.flush();
     const pid_t pid = ::fork();
@@ -99,6 +135,7 @@ ChildResult runChild(const std::function<json(Image&)>& work, double killAfterS,
     }
     if (pid == 0) {
         ::close(fds[0]);
+        gProgress = progress;
         rlimit lim{addressSpace, addressSpace};
         ::setrlimit(RLIMIT_AS, &lim);
         json j;
@@ -150,6 +187,7 @@ ChildResult runChild(const std::function<json(Image&)>& work, double killAfterS,
     r.peakRssBytes = size_t(ru.ru_maxrss) * 1024;  // kilobytes on Linux
     r.cpuS = double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
              1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+    if (progress) r.progress = *progress;
     if (r.killed) return r;
     if (WIFSIGNALED(status)) {
         r.crash = std::string("killed by signal ") + strsignal(WTERMSIG(status));
@@ -186,8 +224,11 @@ ChildResult runChild(const std::function<json(Image&)>& work, double killAfterS,
 Scene loadTimed(const std::string& spec, const ScaleOptions& opt, RenderOptions& ro, json& j) {
     const auto start = Clock::now();
     Scene scene = loadScene(spec);
-    j["load_ms"] = msSince(start);
+    const double loadMs = msSince(start);
+    j["load_ms"] = loadMs;
     j["primitives"] = scene.prims.size();
+    if (gProgress) gProgress->primitives = scene.prims.size();
+    stepEnded(kLoading, loadMs);
     ro.width = opt.sceneSize ? scene.width : opt.width;
     ro.height = opt.sceneSize ? scene.height : opt.height;
     ro.threads = opt.threads;
@@ -226,6 +267,7 @@ json bruteWork(const std::string& spec, const ScaleOptions& opt, Image& img) {
     auto brute = buildAccelerator(scene, BuildParams{});
     j["build_ms"] = brute->info().buildMs;
     j["build_cpu_ms"] = cpuMs() - cpu;
+    stepEnded(kBuilding, brute->info().buildMs);
     j["structure_bytes"] = brute->info().memoryBytes;
     img.resize(ro.width, ro.height);
     const size_t all = size_t(ro.width) * size_t(ro.height);
@@ -287,6 +329,7 @@ json schemeWork(const std::string& spec, SchemeKind kind, const ScaleOptions& op
     }
     const AccelInfo& info = accel->info();
     j["build_ms"] = info.buildMs;
+    stepEnded(kBuilding, info.buildMs);
     j["build_cpu_ms"] = cpuMs() - cpu;
     j["structure_bytes"] = info.memoryBytes;
     j["regions"] = info.regions;
@@ -316,6 +359,7 @@ json embreeWork(const std::string& spec, const ScaleOptions& opt, Image& img) {
     EmbreePeer peer(scene);
     j["build_ms"] = peer.buildMs();
     j["build_cpu_ms"] = cpuMs() - cpu;
+    stepEnded(kBuilding, peer.buildMs());
     img.resize(ro.width, ro.height);
     peer.render(ro, img);
     img = Image(ro.width, ro.height);
@@ -371,7 +415,9 @@ int runScale(const ScaleOptions& opt) {
     }
     // A child is killed past twice the time limit, so a slow scheme's time is still measured
     // (and brute force, whose renders are estimated within its own limit, has time to load).
-    const double killAfterS = std::max(2.0 * opt.timeLimitS, opt.bruteLimitS + 60.0);
+    const double killAfterS = opt.killAfterS > 0.0
+                                  ? opt.killAfterS
+                                  : std::max(2.0 * opt.timeLimitS, opt.bruteLimitS + 60.0);
     const size_t addressSpace = opt.memoryLimit + (size_t(1) << 30);
     const bool withPeer = opt.peer && opt.bounces == 0 && EmbreePeer::available();
 
@@ -428,10 +474,20 @@ int runScale(const ScaleOptions& opt) {
             row["cpu_s"] = r.cpuS;
             const bool isScheme = scheme != std::string("brute") && scheme != std::string("embree");
             std::string problem;
-            if (r.killed)
-                problem = "killed after " + fixed(killAfterS, 0) + " s (peak RSS " +
-                          formatBytes(r.peakRssBytes) + ")";
-            else if (!r.crash.empty())
+            if (r.killed) {
+                // The steps it ended, then the one under way when the deadline came.
+                const ChildProgress& p = r.progress;
+                std::string ended;
+                if (p.loadMs >= 0.0) ended += "loaded in " + fixed(p.loadMs / 1000.0, 1) + " s";
+                if (p.buildMs >= 0.0) ended += ", built in " + fixed(p.buildMs / 1000.0, 1) + " s";
+                problem = "killed after " +
+                          fixed(killAfterS, killAfterS == std::floor(killAfterS) ? 0 : 1) +
+                          " s while " + kStepNames[std::clamp(p.step, 0, 2)] + " (" +
+                          (ended.empty() ? "" : ended + "; ") + "CPU time " + fixed(r.cpuS, 1) +
+                          " s, peak RSS " + formatBytes(r.peakRssBytes) + ")";
+                row["killed_while"] = kStepNames[std::clamp(p.step, 0, 2)];
+                if (p.primitives > 0) row["primitives"] = p.primitives;
+            } else if (!r.crash.empty())
                 problem = r.crash;
             else if (f.contains("error"))
                 problem = f["error"].get<std::string>();
@@ -475,7 +531,7 @@ int runScale(const ScaleOptions& opt) {
             std::string cells[15];
             cells[0] = parseBuiltinSpec(spec) ? spec : fs::path(spec).filename().string();
             cells[1] =
-                f.contains("primitives") ? std::to_string(f["primitives"].get<size_t>()) : "";
+                row.contains("primitives") ? std::to_string(row["primitives"].get<size_t>()) : "";
             cells[2] = scheme;
             const double buildCpu = f.value("build_cpu_ms", 0.0),
                          renderCpu = f.value("render_cpu_ms", 0.0);

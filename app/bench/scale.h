@@ -23,7 +23,9 @@ struct ScaleOptions {
     double timeLimitS = 60.0;  ///< a scheme's load, build and render must end within it
     size_t memoryLimit = size_t(4) << 30;  ///< and its peak resident memory stay below it
     double bruteLimitS = 60.0;  ///< brute force renders every pixel when estimated below this
-    bool peer = true;           ///< Embree on union-only scenes (at --bounces 0 only)
+    /// A child is killed past this many seconds (0: max(2 x timeLimitS, bruteLimitS + 60)).
+    double killAfterS = 0.0;
+    bool peer = true;  ///< Embree on union-only scenes (at --bounces 0 only)
     /// The schemes measured (--schemes); without brute force no hits are compared.
     std::vector<std::string> schemes{"brute", "regular", "irregular"};
 };

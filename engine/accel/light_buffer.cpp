@@ -15,9 +15,21 @@ void LightBuffer::Map::project(const Box3& x, double& dNear, double& uLo, double
                                double& vHi) const {
     dNear = s > 0.0 ? L[a] - x.hi[a] : x.lo[a] - L[a];
     const double dFar = s > 0.0 ? L[a] - x.lo[a] : x.hi[a] - L[a];
+    // n / d is monotone in n and in d (d > 0): the extremes are at the box's corners, and which
+    // corner is known from the numerator's sign (a correctly rounded division is monotone too):
+    // n >= 0 is least over the farthest depth, n < 0 over the nearest. Four divisions instead of
+    // eight, the same quotients (a box of 600,000 is projected twice per light).
+    if (dNear > 0.0 && dFar >= dNear) {
+        const double b0 = x.lo[b] - L[b], b1 = x.hi[b] - L[b];
+        const double c0 = x.lo[c] - L[c], c1 = x.hi[c] - L[c];
+        uLo = b0 / (b0 >= 0.0 ? dFar : dNear);
+        uHi = b1 / (b1 >= 0.0 ? dNear : dFar);
+        vLo = c0 / (c0 >= 0.0 ? dFar : dNear);
+        vHi = c1 / (c1 >= 0.0 ? dNear : dFar);
+        return;
+    }
     uLo = vLo = kInf;
     uHi = vHi = -kInf;
-    // n / d is monotone in n and in d (d > 0): the extremes are at the box's corners.
     for (double d : {dNear, dFar})
         for (int k = 0; k < 2; ++k) {
             const double u = ((k ? x.hi[b] : x.lo[b]) - L[b]) / d;
@@ -107,10 +119,9 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
     // order (insert() depends on it), so each map is the same whatever the threads.
     std::atomic<bool> stopped{false};
     TaskFence fence;
-    tbb::parallel_for(size_t(0), points.size(), [&](size_t l) {
-        const TaskFence::Done done(fence);
+    tbb::parallel_for(size_t(0), points.size(), fence.task([&](size_t l) {
         if (!buildMap(maps_[l], points[l], boxes, bins, slots, side, largest, stop)) stopped = true;
-    });
+    }));
     fence.acquire();
     if (stopped) maps_.clear();
 }
@@ -229,8 +240,12 @@ void LightBuffer::Grid::add(const BoxImage& im, std::vector<double>& colLo,
     // unbounded on that side. The constraint of a column of bins is the same on every row.
     const double rel = 1e-12;
     const double du = 1.0 / su, dv = 1.0 / sv;
-    colLo.resize(size_t(i1 - i0 + 1));
-    colHi.resize(size_t(i1 - i0 + 1));
+    // Grown only: every column used is written below (a resize per box, most of them a bin or
+    // two wide, was a tenth of the light buffer's instructions).
+    if (colLo.size() < size_t(i1 - i0 + 1)) {
+        colLo.resize(size_t(i1 - i0 + 1));
+        colHi.resize(size_t(i1 - i0 + 1));
+    }
     for (int i = i0; i <= i1; ++i) {
         const double ua = i == 0 ? -kInf : u0 + i * du - pad;
         const double ub = i == n - 1 ? kInf : u0 + (i + 1) * du + pad;

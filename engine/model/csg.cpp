@@ -68,12 +68,22 @@ bool CsgTree::unionOnly() const {
 }
 
 int CsgTree::depth() const {
+    // Iterative: a recursion through std::function took 35 M instructions on a union of
+    // 600,000 primitives, and a chain of thousands of operations could overflow the stack.
     if (root < 0) return 0;
-    std::function<int(int)> d = [&](int n) -> int {
-        const CsgNode& x = nodes[n];
-        return x.op == Op::Primitive ? 1 : 1 + std::max(d(x.left), d(x.right));
-    };
-    return d(root);
+    int deepest = 0;
+    std::vector<std::pair<int, int>> stack{{root, 1}};
+    while (!stack.empty()) {
+        const auto [n, d] = stack.back();
+        stack.pop_back();
+        const CsgNode& x = nodes[size_t(n)];
+        deepest = std::max(deepest, d);
+        if (x.op != Op::Primitive) {
+            stack.push_back({x.right, d + 1});
+            stack.push_back({x.left, d + 1});
+        }
+    }
+    return deepest;
 }
 
 std::vector<uint32_t> CsgTree::primitives() const {

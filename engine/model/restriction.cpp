@@ -9,8 +9,23 @@ namespace {
 /// The report's rules from `node` down, the walk entering only nodes for which live(node) holds
 /// (a primitive's leaf: it is kept; an operator: it may hold a kept primitive). Both
 /// restrictions are this walk, so they build the same nodes in the same order.
-template <class Live>
-int restrictWalk(const CsgTree& src, int node, const Live& live, CsgTree& dst) {
+/// Nodes written to an array of room enough, numbered from `base`: the same calls as a CsgTree's.
+struct ArrayDst {
+    CsgNode* out;
+    int base;
+    int n = 0;
+    int leaf(uint32_t prim) {
+        out[n] = {Op::Primitive, -1, -1, prim};
+        return base + n++;
+    }
+    int combine(Op op, int a, int b) {
+        out[n] = {op, a, b, kNoPrim};
+        return base + n++;
+    }
+};
+
+template <class Live, class Dst>
+int restrictWalk(const CsgTree& src, int node, const Live& live, Dst& dst) {
     if (node < 0 || !live(node)) return -1;
     const CsgNode& x = src.nodes[size_t(node)];
     if (x.op == Op::Primitive) return dst.leaf(x.prim);
@@ -44,13 +59,18 @@ int restrictTreeTo(const CsgTree& src, const std::vector<uint32_t>& prims, std::
     return root;
 }
 
-TreeRestrictor::TreeRestrictor(const CsgTree& tree)
-    : tree_(&tree), parent_(tree.nodes.size(), -1), live_(tree.nodes.size(), 0) {
-    // Count each primitive's leaves, then place them: leaves in node order per primitive.
+TreeRestrictor::TreeRestrictor(const CsgTree& tree) : tree_(&tree), parent_(tree.nodes.size(), -1) {
+    // Count each primitive's leaves, then place them: leaves in node order per primitive. The
+    // arrays are sized once and placing moves each start to the next one's, shifted back after
+    // (on a million nodes, growing them and a copy for the cursors were thousands of fresh
+    // pages).
+    uint32_t prims = 0;
+    for (const CsgNode& x : tree.nodes)
+        if (x.op == Op::Primitive) prims = std::max(prims, x.prim + 1);
+    if (prims) leafFirst_.assign(size_t(prims) + 1, 0);
     for (size_t n = 0; n < tree.nodes.size(); ++n) {
         const CsgNode& x = tree.nodes[n];
         if (x.op == Op::Primitive) {
-            if (leafFirst_.size() < size_t(x.prim) + 2) leafFirst_.resize(size_t(x.prim) + 2, 0);
             ++leafFirst_[size_t(x.prim) + 1];
         } else {
             parent_[size_t(x.left)] = int(n);
@@ -59,12 +79,14 @@ TreeRestrictor::TreeRestrictor(const CsgTree& tree)
     }
     for (size_t p = 1; p < leafFirst_.size(); ++p) leafFirst_[p] += leafFirst_[p - 1];
     leafNodes_.resize(leafFirst_.empty() ? 0 : leafFirst_.back());
-    std::vector<uint32_t> next(leafFirst_);
     for (size_t n = 0; n < tree.nodes.size(); ++n)
-        if (tree.nodes[n].op == Op::Primitive) leafNodes_[next[tree.nodes[n].prim]++] = int(n);
+        if (tree.nodes[n].op == Op::Primitive)
+            leafNodes_[leafFirst_[tree.nodes[n].prim]++] = int(n);
+    for (size_t p = leafFirst_.size(); p-- > 1;) leafFirst_[p] = leafFirst_[p - 1];
+    if (!leafFirst_.empty()) leafFirst_[0] = 0;
 }
 
-void TreeRestrictor::mark(const std::vector<uint32_t>& prims, char value,
+void TreeRestrictor::mark(std::span<const uint32_t> prims, char value,
                           std::vector<char>& live) const {
     for (uint32_t p : prims) {
         if (size_t(p) + 1 >= leafFirst_.size()) continue;
@@ -77,6 +99,16 @@ void TreeRestrictor::mark(const std::vector<uint32_t>& prims, char value,
 int TreeRestrictor::restrict(const std::vector<uint32_t>& prims, CsgTree& dst,
                              std::vector<char>& live) const {
     mark(prims, 1, live);
+    const int root = restrictWalk(
+        *tree_, tree_->root, [&](int n) { return live[size_t(n)] != 0; }, dst);
+    mark(prims, 0, live);
+    return root;
+}
+
+int TreeRestrictor::restrict(std::span<const uint32_t> prims, CsgNode* out, int base,
+                             std::vector<char>& live) const {
+    mark(prims, 1, live);
+    ArrayDst dst{out, base};
     const int root = restrictWalk(
         *tree_, tree_->root, [&](int n) { return live[size_t(n)] != 0; }, dst);
     mark(prims, 0, live);

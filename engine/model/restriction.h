@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
@@ -29,16 +30,31 @@ class TreeRestrictor {
     explicit TreeRestrictor(const CsgTree& tree);
     /// Same result as restrictTree(tree, tree.root, keep, dst) with keep = `prims`.
     int restrict(const std::vector<uint32_t>& prims, CsgTree& dst) {
+        if (live_.size() != parent_.size()) live_.assign(parent_.size(), 0);  // on first use
         return restrict(prims, dst, live_);
     }
     /// The same with the caller's marks (one per node of the tree, all 0 before and after):
     /// threads restricting at once each bring their own.
     int restrict(const std::vector<uint32_t>& prims, CsgTree& dst, std::vector<char>& live) const;
+    /// The same nodes written to out[0..) instead of appended, numbered from `base` (as if
+    /// appended to a tree of `base` nodes); returns the root. `out` has room for them: for a
+    /// tree of unions, unionSize(prims).
+    int restrict(std::span<const uint32_t> prims, CsgNode* out, int base,
+                 std::vector<char>& live) const;
+    /// Nodes of the restriction to `prims` when the tree has only unions: each kept leaf and
+    /// each union over two kept subtrees, 2 m - 1 for the m leaves of `prims` (0 for none).
+    /// Known before restricting, so restrictions can be written in parallel into one array.
+    size_t unionSize(std::span<const uint32_t> prims) const {
+        size_t m = 0;
+        for (uint32_t p : prims)
+            if (size_t(p) + 1 < leafFirst_.size()) m += leafFirst_[size_t(p) + 1] - leafFirst_[p];
+        return m ? 2 * m - 1 : 0;
+    }
     /// Nodes of the tree: the size of the marks.
     size_t nodeCount() const { return parent_.size(); }
 
   private:
-    void mark(const std::vector<uint32_t>& prims, char value, std::vector<char>& live) const;
+    void mark(std::span<const uint32_t> prims, char value, std::vector<char>& live) const;
 
     const CsgTree* tree_;
     std::vector<int> parent_;

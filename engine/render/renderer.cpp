@@ -12,6 +12,8 @@
 #include <x86intrin.h>
 #endif
 
+#include "engine/util/task_fence.h"
+
 namespace lancer {
 
 namespace {
@@ -56,10 +58,9 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     });
     auto start = Clock::now();
     std::atomic<bool> stopped{false};
-    // oneTBB's join orders the tiles' writes (pixels, counters) before what follows the loop,
-    // but ThreadSanitizer does not see inside oneTBB: a release per tile and one acquire after
-    // the loop state that order where it can see it, for one atomic add per tile.
-    std::atomic<size_t> tilesDone{0};
+    // oneTBB orders what is written here before the tiles, and the tiles' writes (pixels,
+    // counters) before what follows the loop, where ThreadSanitizer does not see it.
+    TaskFence fence;
     // A tile holds about tile x tile pixels of the pass's lattice, however sparse it is.
     const int tile = std::max(1, opt.tile) * std::max(1, pass.stride);
     tbb::task_arena arena(stats.threads);
@@ -68,7 +69,7 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
             tbb::blocked_range2d<int>(std::clamp(pass.rowBegin, 0, h),
                                       pass.rowEnd < 0 ? h : std::clamp(pass.rowEnd, 0, h), tile, 0,
                                       w, tile),
-            [&](const tbb::blocked_range2d<int>& r) {
+            fence.task([&](const tbb::blocked_range2d<int>& r) {
                 if (stopped.load(std::memory_order_relaxed)) return;
                 if (cancel && cancel->load(std::memory_order_relaxed)) {
                     stopped = true;
@@ -116,13 +117,12 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                     for (int x = r.cols().begin(); x < r.cols().end(); ++x)
                         if (pass.contains(x, y)) img.timeUs[img.index(x, y)] *= usPerTick;
                 if (progress) progress->fetch_add(done, std::memory_order_relaxed);
-                tilesDone.fetch_add(1, std::memory_order_release);
-            },
+            }),
             tbb::simple_partitioner());
     });
     stats.renderMs = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     stats.cancelled = stopped.load();
-    tilesDone.load(std::memory_order_acquire);
+    fence.acquire();
     for (const TraceContext& c : contexts) stats.counters += c.counters;
     return stats;
 }

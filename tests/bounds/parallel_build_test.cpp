@@ -5,8 +5,10 @@
 #include <tbb/global_control.h>
 
 #include <cstring>
+#include <set>
 
 #include "engine/accel/regular/regular_grid.h"
+#include "engine/model/restriction.h"
 #include "engine/scene/loader.h"
 #include "tests/support/differential.h"
 
@@ -65,6 +67,40 @@ void expectSameStructure(const Scene& scene) {
 TEST(ParallelBuild, SameStructureWhateverTheThreadsOnASphereflake) {
     // balls:4: 7,382 primitives under one union, its leaves restricting the scene's tree.
     expectSameStructure(loadScene("builtin:balls:4"));
+}
+
+TEST(ParallelBuild, EachLeafsTreeIsTheScenesRestrictedToItsPrimitivesStoredOnceInOrder) {
+    // A union's leaves get their trees after the layout, each written at a place reserved for
+    // it (RegularBuilder::makeTrees): every leaf's tree must be the scene's tree restricted to
+    // its primitives, each distinct set's tree stored once, in the order the leaves first meet
+    // them, and nothing else in the pool.
+    const Scene scene = loadScene("builtin:balls:4");
+    const tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
+    nlohmann::json extra;
+    const RegularGrid g = RegularGrid::build(scene, RegularConfig{}, extra);
+    CsgTree view = g.treePool();
+    std::vector<char> marks(scene.prims.size(), 0);
+    std::set<int> seen;
+    size_t nodes = 0;
+    int lastNew = -1;
+    size_t differing = 0, outOfOrder = 0;
+    for (const RegularLeaf& L : g.leaves()) {
+        const uint32_t* p = L.primitives(g.primList().data());
+        const std::vector<uint32_t> prims(p, p + L.prims);
+        CsgTree expected;
+        expected.root = restrictTreeTo(scene.tree, prims, marks, expected);
+        view.root = L.root;
+        differing += view.toString() != expected.toString();
+        if (L.root >= 0 && seen.insert(L.root).second) {
+            nodes += expected.nodes.size();
+            outOfOrder += L.root < lastNew;
+            lastNew = L.root;
+        }
+    }
+    EXPECT_EQ(differing, 0u);
+    EXPECT_EQ(outOfOrder, 0u);
+    EXPECT_EQ(g.treePool().nodes.size(), nodes);
+    EXPECT_EQ(size_t(extra["distinct_trees"]), seen.size());
 }
 
 TEST(ParallelBuild, SameStructureWhateverTheThreadsOnARandomCsgScene) {

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # scripts/scale-check on one small scene: each scheme is measured in a child process (peak
 # memory, time), its hits equal brute force's on every pixel, the table and JSON are written; a
-# limit broken is listed as a failure with exit status 1; a bad limit is refused naming it.
+# limit broken is listed as a failure with exit status 1, a child killed with the step it was in;
+# a bad limit is refused naming it.
 set -u
 LANCER="$1"; SRC="$2"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
@@ -31,6 +32,21 @@ PY
 [ $? -eq 1 ] || fail "a broken limit did not exit 1"
 grep -q "^- builtin:balls:1 regular: peak resident memory" "$tmp/out" || fail "regular not listed: $(cat "$tmp/out")"
 grep -q "^- builtin:balls:1 irregular: peak resident memory" "$tmp/out" || fail "irregular not listed"
+# A child past --kill-after is killed and listed with the step it was in (balls:5 takes longer
+# than 0.1 s to load anywhere), its CPU time and peak; the JSON row names the step.
+"$LANCER" bench --scale --scenes builtin:balls:5 --schemes regular --no-peer --kill-after 0.1 \
+  --out "$tmp/kill" >"$tmp/out" 2>&1
+[ $? -eq 1 ] || fail "a killed child did not exit 1: $(cat "$tmp/out")"
+grep -q "^- builtin:balls:5 regular: killed after 0.1 s while loading (CPU time .* s, peak RSS " \
+  "$tmp/out" || fail "kill not listed with its step: $(cat "$tmp/out")"
+python3 - "$tmp/kill/scale.json" <<'PY2' || fail "scale.json of the kill"
+import json, sys
+rows = json.load(open(sys.argv[1]))["rows"]
+assert len(rows) == 1 and rows[0]["killed_while"] == "loading", rows
+assert "primitives" not in rows[0] and rows[0]["failure"].startswith("killed after 0.1 s"), rows
+PY2
+out=$("$LANCER" bench --scale --scenes builtin:balls:1 --kill-after -1 --out "$tmp/bad" 2>&1)
+[ $? -eq 2 ] && echo "$out" | grep -q "^error: --kill-after" || fail "bad --kill-after: $out"
 out=$("$LANCER" bench --scale --scenes builtin:balls:1 --memory-limit lots --out "$tmp/bad" 2>&1)
 [ $? -eq 2 ] || fail "a bad --memory-limit was accepted"
 echo "$out" | grep -q "^error: --memory-limit lots" || fail "message: $out"

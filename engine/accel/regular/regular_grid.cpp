@@ -20,8 +20,34 @@ namespace lancer {
 
 namespace {
 
+/// An allocator whose resize() leaves the new elements uninitialised: a cell's pass sizes its
+/// children's lists to hold every primitive and then writes them (zeroing them first took a
+/// twentieth of the build's time on balls:6).
+template <class T>
+struct NoInit : std::allocator<T> {
+    template <class U>
+    struct rebind {
+        using other = NoInit<U>;
+    };
+    NoInit() = default;
+    template <class U>
+    NoInit(const NoInit<U>&) {}
+    template <class U>
+    void construct(U* p) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... A>
+    void construct(U* p, A&&... a) {
+        ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+    }
+};
+/// The builder's lists of primitives.
+using PrimList = std::vector<uint32_t, NoInit<uint32_t>>;
+
 void sortedUnique(std::vector<uint32_t>& v) {
-    std::sort(v.begin(), v.end());
+    // A scene's union lists its primitives in order (every format's balanced union): sorting
+    // 600,000 of them again took 30 M instructions.
+    if (!std::is_sorted(v.begin(), v.end())) std::sort(v.begin(), v.end());
     v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
@@ -40,12 +66,13 @@ bool coveredByAll(const Scene& scene, std::span<const uint32_t> prims, const Box
 /// What testing each primitive costs, in sphere tests: a polygon's inside test loops over its
 /// edges, so it weighs 1 + vertices / 4 (on gears, whose faces have up to 144 vertices, weighing
 /// every test alike made the planner cut x and y first, for 34% more instructions than x, y, z in
-/// turn).
-std::vector<double> testWeights(const Scene& scene) {
-    std::vector<double> w(scene.prims.size(), 1.0);
+/// turn). Floats: 1 + n / 4 is exact in one, and half the bytes of a double are read at random
+/// (and touched first) for each of up to a million primitives.
+std::vector<float> testWeights(const Scene& scene) {
+    std::vector<float> w(scene.prims.size(), 1.0f);
     for (size_t i = 0; i < w.size(); ++i)
         if (const Polygon* pg = std::get_if<Polygon>(&scene.prims[i].shape))
-            w[i] = 1.0 + double(pg->p.size()) / 4.0;
+            w[i] = float(1.0 + double(pg->p.size()) / 4.0);
     return w;
 }
 
@@ -76,7 +103,7 @@ constexpr int kRestrictorDepth = 64;
 /// it cuts x and y until the cells are about cubes, where the report's order makes them 16 times
 /// flatter than wide.
 AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector<uint32_t>& live,
-                          const std::vector<double>& cost, int maxLevel, int maxObjects,
+                          const std::vector<float>& cost, int maxLevel, int maxObjects,
                           const BuildGuard& guard) {
     // The cells of a level, their primitives in one array: cell c holds refs[begin, end).
     struct Cell {
@@ -112,12 +139,14 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
         // Drop the cells that stop here.
         open.assign(cells.size(), 0);
         TaskFence fence;
-        tbb::parallel_for(size_t(0), cells.size(), [&](size_t k) {
-            const TaskFence::Done done(fence);
+        // Polled per cell and per chunk: a level's passes over the references take a quarter
+        // of a second on balls:5 at --max-objects 1 under ThreadSanitizer.
+        tbb::parallel_for(size_t(0), cells.size(), fence.task([&](size_t k) {
+            guard.poll();
             const Cell& c = cells[k];
             open[k] = c.end - c.begin > size_t(maxObjects) &&
                       !coveredByAll(scene, {refs.data() + c.begin, c.end - c.begin}, c.box);
-        });
+        }));
         fence.acquire();
         size_t kept = 0;
         for (size_t k = 0; k < cells.size(); ++k)
@@ -130,23 +159,34 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
         for (size_t k = 0; k < cells.size(); ++k)
             for (size_t b = cells[k].begin; b < cells[k].end; b += kChunk)
                 chunks.push_back({k, b, std::min(cells[k].end, b + kChunk), {}, {}, {}});
-        tbb::parallel_for(size_t(0), chunks.size(), [&](size_t k) {
-            const TaskFence::Done done(fence);
+        tbb::parallel_for(size_t(0), chunks.size(), fence.task([&](size_t k) {
+            guard.poll();
             Chunk& ch = chunks[k];
             const Box3& cb = cells[ch.cell].box;
             const double mid[3] = {0.5 * (cb.lo.x + cb.hi.x), 0.5 * (cb.lo.y + cb.hi.y),
                                    0.5 * (cb.lo.z + cb.hi.z)};
+            // Sums held locally: stored to the chunk each time, they would be reloaded after
+            // every store (a double in the chunk may alias the boxes' doubles).
+            double tests[3] = {0.0, 0.0, 0.0};
+            size_t count[3][2] = {};
+            const Box3* const boxes = scene.minBox.data();
+            const float* const weights = cost.data();
             for (size_t i = ch.begin; i < ch.end; ++i) {
-                const Box3& b = scene.minBox[refs[i]];
-                const double w = cost[refs[i]];
+                const Box3& b = boxes[refs[i]];
+                const double w = weights[refs[i]];
                 for (int a = 0; a < 3; ++a) {
                     const int lo = b.lo[a] <= mid[a], hi = b.hi[a] >= mid[a];
-                    ch.count[a][0] += size_t(lo);
-                    ch.count[a][1] += size_t(hi);
-                    ch.tests[a] += w * double(lo + hi);
+                    count[a][0] += size_t(lo);
+                    count[a][1] += size_t(hi);
+                    tests[a] += w * double(lo + hi);
                 }
             }
-        });
+            for (int a = 0; a < 3; ++a) {
+                ch.tests[a] = tests[a];
+                ch.count[a][0] = count[a][0];
+                ch.count[a][1] = count[a][1];
+            }
+        }));
         fence.acquire();
         double best = kInf;
         int axis = 0;
@@ -181,17 +221,21 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
             first = last;
         }
         nextRefs.resize(total);
-        tbb::parallel_for(size_t(0), chunks.size(), [&](size_t k) {
-            const TaskFence::Done done(fence);
+        tbb::parallel_for(size_t(0), chunks.size(), fence.task([&](size_t k) {
+            guard.poll();
             Chunk& ch = chunks[k];
             const Box3& cb = cells[ch.cell].box;
             const double mid = 0.5 * (cb.lo[axis] + cb.hi[axis]);
+            const Box3* const boxes = scene.minBox.data();
+            uint32_t* lo = nextRefs.data() + ch.out[0];
+            uint32_t* hi = nextRefs.data() + ch.out[1];
             for (size_t i = ch.begin; i < ch.end; ++i) {
-                const Box3& b = scene.minBox[refs[i]];
-                if (b.lo[axis] <= mid) nextRefs[ch.out[0]++] = refs[i];
-                if (b.hi[axis] >= mid) nextRefs[ch.out[1]++] = refs[i];
+                const uint32_t r = refs[i];
+                const Box3& b = boxes[r];
+                if (b.lo[axis] <= mid) *lo++ = r;
+                if (b.hi[axis] >= mid) *hi++ = r;
             }
-        });
+        }));
         fence.acquire();
         cells.swap(next);
         refs.swap(nextRefs);
@@ -227,7 +271,7 @@ struct RegularBuilder {
         uint32_t pos[3];
     };
     struct Scratch {
-        std::vector<uint32_t> in[2], live;  ///< the children's primitives, a child's live ones
+        PrimList in[2], live;  ///< the children's primitives, a child's live ones
         CsgTree sub;
     };
     /// What one task builds. Node 0 is the fragment's root (the BSP's root in the first one).
@@ -238,13 +282,17 @@ struct RegularBuilder {
         std::vector<uint32_t> leafList;       ///< each leaf's primitive set in `pool`
         RestrictedTreePool pool;              ///< the leaves' trees and lists
         std::vector<size_t> treeStart = {0};  ///< set l's tree: pool.trees.nodes[treeStart[l]..)
+        /// With a restrictor, the nodes the sets' trees will take: the trees are made once the
+        /// sets have their final order (RegularBuilder::makeTrees), not in the fragments.
+        size_t treeNodes = 0;
         std::vector<std::unique_ptr<Fragment>> children;  ///< fragments of kLinked nodes
         /// Each set's entry in the layout's pool (list kUnplaced: not yet placed).
         std::vector<RestrictedTreePool::Entry> placed;
-        std::vector<Scratch> scratch;                     ///< per level, for a node's children
-        std::vector<uint32_t> look[kLookahead + 1] = {};  ///< the cost estimate's lists, per depth
+        std::vector<Scratch> scratch;        ///< per level, for a node's children
+        PrimList look[kLookahead + 1] = {};  ///< the cost estimate's lists, per depth
         // A task's own inputs: its cell's primitives and tree, when not its parent's.
-        std::vector<uint32_t> in, live;
+        PrimList in, live;
+        std::vector<uint32_t> key;  ///< a leaf's set, as the pool's index keeps it
         CsgTree sub;
         size_t reported = 0;  ///< bytes() last added to RegularBuilder::bytes
         uint64_t primRefs = 0;
@@ -257,16 +305,17 @@ struct RegularBuilder {
         /// alone would take tens of MB).
         void releaseScratch() {
             std::vector<Scratch>().swap(scratch);
-            for (std::vector<uint32_t>& l : look) std::vector<uint32_t>().swap(l);
-            std::vector<uint32_t>().swap(in);
-            std::vector<uint32_t>().swap(live);
+            for (PrimList& l : look) PrimList().swap(l);
+            PrimList().swap(in);
+            PrimList().swap(live);
             CsgTree().nodes.swap(sub.nodes);
         }
-        /// Heap bytes it keeps: vectors by capacity, and its pool.
+        /// Heap bytes it keeps: vectors by capacity, and its pool with the trees still to make.
         size_t bytes() const {
             return bsp.nodes.capacity() * sizeof(BspNodes::Node) +
                    leaves.capacity() * sizeof(RegularLeaf) + places.capacity() * sizeof(LeafPlace) +
-                   leafList.capacity() * sizeof(uint32_t) + pool.bytes();
+                   leafList.capacity() * sizeof(uint32_t) + pool.bytes() +
+                   treeNodes * sizeof(CsgNode);
         }
     };
 
@@ -274,8 +323,9 @@ struct RegularBuilder {
     const RegularConfig& params;
     RegularGrid& grid;
     BuildGuard& guard;
-    int maxLevel;                ///< params.maxLevel, or the automatic one
-    std::vector<double> weight;  ///< each primitive's test, in sphere tests (testWeights)
+    int maxLevel;               ///< params.maxLevel, or the automatic one
+    std::vector<float> weight;  ///< each primitive's test, in sphere tests (testWeights)
+    bool unitWeights = false;   ///< every weight is 1: their sums are counts
     /// The scene's tree has only unions: a restriction then keeps every primitive it is given.
     bool unionOnly = false;
     /// A union-only scene's tree of small depth: the leaves restrict it, visiting only their
@@ -296,6 +346,7 @@ struct RegularBuilder {
           guard(gd),
           maxLevel(effectiveMaxLevel(p, livePrims)),
           weight(testWeights(s)),
+          unitWeights(std::all_of(weight.begin(), weight.end(), [](float w) { return w == 1.0f; })),
           unionOnly(s.tree.unionOnly()),
           keep([n = s.prims.size()] { return std::vector<char>(n, 0); }) {
         // A leaf's restriction climbs from its primitives to the root: a cost of the tree's
@@ -378,7 +429,7 @@ struct RegularBuilder {
         for (int side = 0; side < 2; ++side) {
             double c = params.stepCost + params.testCost * tests[side];
             if (depth > 1 && level + 1 < maxLevel && count[side] > size_t(params.maxObjects)) {
-                std::vector<uint32_t>& in = f.look[depth];
+                PrimList& in = f.look[depth];
                 in.clear();
                 for (uint32_t p : prims)
                     if (side ? scene.minBox[p].hi[axis] >= mid : scene.minBox[p].lo[axis] <= mid)
@@ -411,19 +462,61 @@ struct RegularBuilder {
                splitCost(f, box, prims, level, kLookahead) < leaf;
     }
 
+    /// With a restrictor, a place for the tree of a new set of `prims` after the `count` nodes
+    /// of the trees before it: its root (the walk's last node), -1 for the empty tree.
+    int reserveTree(std::span<const uint32_t> prims, size_t& count) const {
+        const size_t size = restrictor->unionSize(prims);
+        count += size;
+        return size ? int(count - 1) : -1;
+    }
+
     /// The tree restricted to `prims` in the fragment's pool, and their list, added once per
-    /// set; where each set's tree starts is kept for the layout.
-    RestrictedTreePool::Entry treeFor(Fragment& f, const CsgTree& tree,
-                                      const std::vector<uint32_t>& prims) {
-        return f.pool.share(prims, [&](CsgTree& dst) {
+    /// set; where each set's tree starts is kept for the layout. With a restrictor only its
+    /// place is reserved: the trees are made after the layout (makeTrees), written straight
+    /// where they belong, rather than made in each fragment and copied (on balls:6 1.8 million
+    /// nodes, made and copied in fresh pages).
+    RestrictedTreePool::Entry treeFor(Fragment& f, const CsgTree& tree, const PrimList& prims) {
+        f.key.assign(prims.begin(), prims.end());
+        return f.pool.share(f.key, [&](CsgTree& dst) {
+            if (restrictor) return reserveTree(f.key, f.treeNodes);
             f.treeStart.push_back(dst.nodes.size());
-            return restrictor ? restrictor->restrict(prims, dst, restrictorMarks.local())
-                              : restrictTreeTo(tree, prims, keep.local(), dst);
+            return restrictTreeTo(tree, f.key, keep.local(), dst);
         });
     }
 
+    /// The trees of `pool`'s sets, `count` nodes reserved by reserveTree() in the sets' order,
+    /// made in parallel: each set's restriction is written at its place, so the nodes are
+    /// those that restricting the sets one after the other would append.
+    void makeTrees(RestrictedTreePool& pool, size_t count) {
+        std::vector<CsgNode>& nodes = pool.trees.nodes;
+        nodes.resize(count);
+        const size_t sets = pool.listFirst.size() - 1;
+        const uint32_t* lists = pool.lists.data();
+        const auto setOf = [&](size_t s) {
+            return std::span<const uint32_t>(lists + pool.listFirst[s],
+                                             pool.listFirst[s + 1] - pool.listFirst[s]);
+        };
+        std::vector<size_t> at(sets + 1, 0);
+        for (size_t s = 0; s < sets; ++s) at[s + 1] = at[s] + restrictor->unionSize(setOf(s));
+        TaskFence fence;
+        try {
+            tbb::parallel_for(
+                tbb::blocked_range<size_t>(0, sets, 1024), fence.task([&](const auto& r) {
+                    guard.poll();
+                    std::vector<char>& marks = restrictorMarks.local();
+                    for (size_t s = r.begin(); s != r.end(); ++s)
+                        if (at[s + 1] > at[s])
+                            restrictor->restrict(setOf(s), nodes.data() + at[s], int(at[s]), marks);
+                }));
+        } catch (...) {
+            fence.acquire();
+            throw;
+        }
+        fence.acquire();
+    }
+
     void makeLeaf(Fragment& f, int id, int level, const uint32_t pos[3], const CsgTree& tree,
-                  const std::vector<uint32_t>& prims) {
+                  const PrimList& prims) {
         const RestrictedTreePool::Entry entry = treeFor(f, tree, prims);
         const uint32_t nprims = uint32_t(prims.size());
         f.emptyLeaves += nprims == 0;
@@ -442,8 +535,8 @@ struct RegularBuilder {
 
     /// The primitives of `prims` (overlapping `box`) whose boxes overlap the half of `box` on
     /// side `side` of `mid` on `axis`, into `out`.
-    void half(const std::vector<uint32_t>& prims, int level, const Box3& child, int axis,
-              double mid, int side, std::vector<uint32_t>& out) const {
+    void half(const PrimList& prims, int level, const Box3& child, int axis, double mid, int side,
+              PrimList& out) const {
         // Below the root every primitive overlaps the cell, which differs from the child on the
         // cut axis alone: the test there is the whole test.
         out.clear();
@@ -462,8 +555,8 @@ struct RegularBuilder {
     /// Build child `id` at `level` over the primitives `in` of its cell, restricting `tree` (its
     /// parent's, over `parentPrims`) to them where needed; `sc` holds the child's tree and list.
     void buildChild(Fragment& f, int id, int level, const uint32_t pos[3], const Box3& box,
-                    const CsgTree& tree, const std::vector<uint32_t>& parentPrims,
-                    const std::vector<uint32_t>& in, CsgTree& sub, std::vector<uint32_t>& live) {
+                    const CsgTree& tree, const PrimList& parentPrims, const PrimList& in,
+                    CsgTree& sub, PrimList& live) {
         if (in.size() == parentPrims.size()) {
             // Every primitive overlaps the child: the restriction is this tree, whose
             // primitives all count (`prims` are the live ones).
@@ -474,13 +567,15 @@ struct RegularBuilder {
             build(f, id, level, pos, box, tree, in);
         } else {
             sub.nodes.clear();
-            sub.root = restrictTreeTo(tree, in, keep.local(), sub);
+            f.key.assign(in.begin(), in.end());
+            sub.root = restrictTreeTo(tree, f.key, keep.local(), sub);
             if (unionOnly) {
                 // Restricting a union drops no primitive it keeps: all of them are live.
                 build(f, id, level, pos, box, sub, in);
             } else {
-                live = sub.primitives();
-                sortedUnique(live);
+                f.key = sub.primitives();
+                sortedUnique(f.key);
+                live.assign(f.key.begin(), f.key.end());
                 build(f, id, level, pos, box, sub, live);
             }
         }
@@ -490,7 +585,7 @@ struct RegularBuilder {
     /// covering `box`; `prims` (sorted) are the primitives that matter here, `tree` the scene's
     /// tree restricted to them (unused with a restrictor).
     void build(Fragment& f, int id, int level, const uint32_t pos[3], const Box3& box,
-               const CsgTree& tree, const std::vector<uint32_t>& prims) {
+               const CsgTree& tree, const PrimList& prims) {
         if (prims.size() <= size_t(params.maxObjects) || level >= maxLevel) {
             makeLeaf(f, id, level, pos, tree, prims);
             return;
@@ -520,15 +615,38 @@ struct RegularBuilder {
         const bool onePass = level > 0 && 0.5 * (box.lo[axis] + box.hi[axis]) == mid;
         if (onePass) {
             double tests[2] = {0.0, 0.0}, all = 0.0;
-            sc.in[0].clear();
-            sc.in[1].clear();
-            for (uint32_t p : prims) {
-                const Box3& b = scene.minBox[p];
-                const double w = weight[p];
-                all += w;
-                if (b.lo[axis] <= mid) sc.in[0].push_back(p), tests[0] += w;
-                if (b.hi[axis] >= mid) sc.in[1].push_back(p), tests[1] += w;
+            // Without branches (a primitive's side of the cut is a coin toss for the branch
+            // predictor): each primitive is written to both lists, each list's end moving past
+            // it when it belongs there, and its weight added, or +0, which leaves a sum of
+            // non-negative weights bit for bit as it was. Weights all 1 (spheres) sum to counts.
+            PrimList &in0 = sc.in[0], &in1 = sc.in[1];
+            in0.resize(prims.size());
+            in1.resize(prims.size());
+            uint32_t *lo = in0.data(), *hi = in1.data();
+            const Box3* const boxes = scene.minBox.data();
+            if (unitWeights) {
+                for (uint32_t p : prims) {
+                    const Box3& b = boxes[p];
+                    *lo = p, lo += b.lo[axis] <= mid;
+                    *hi = p, hi += b.hi[axis] >= mid;
+                }
+                all = double(prims.size());
+                tests[0] = double(lo - in0.data());
+                tests[1] = double(hi - in1.data());
+            } else {
+                for (uint32_t p : prims) {
+                    const Box3& b = boxes[p];
+                    const double w = weight[p];
+                    const bool l = b.lo[axis] <= mid, h = b.hi[axis] >= mid;
+                    all += w;
+                    *lo = p, lo += l;
+                    *hi = p, hi += h;
+                    tests[0] += l ? w : 0.0;
+                    tests[1] += h ? w : 0.0;
+                }
             }
+            in0.resize(size_t(lo - in0.data()));
+            in1.resize(size_t(hi - in1.data()));
             // A split that does not lower the estimated cost within kLookahead levels is not
             // made (splitPays(), its first estimate from these sums).
             const double leaf = params.stepCost + params.testCost * all;
@@ -567,14 +685,13 @@ struct RegularBuilder {
             tbb::task_group tasks;
             TaskFence fence;
             for (int side = 0; side < 2; ++side)
-                tasks.run([&, side] {
-                    const TaskFence::Done done(fence);
+                tasks.run(fence.task([&, side] {
                     Fragment& k = *kid[side];
                     if (!onePass) half(prims, level, child[side], axis, mid, side, k.in);
                     buildChild(k, 0, level + 1, cpos[side], child[side], tree, prims,
                                onePass ? sc.in[side] : k.in, k.sub, k.live);
                     k.releaseScratch();
-                });
+                }));
             try {
                 tasks.wait();
             } catch (...) {
@@ -600,6 +717,7 @@ struct RegularBuilder {
         std::vector<RegularLeaf> leaves;
         std::vector<LeafPlace> places;
         RestrictedTreePool pool;
+        size_t treeNodes = 0;       ///< with a restrictor, the trees' nodes (see makeTrees)
         std::vector<uint32_t> key;  ///< scratch: a set's primitives
     };
 
@@ -625,6 +743,7 @@ struct RegularBuilder {
             const uint32_t* p = f.pool.lists.data();
             out.key.assign(p + f.pool.listFirst[set], p + f.pool.listFirst[set + 1]);
             f.placed[set] = out.pool.share(out.key, [&](CsgTree& dst) {
+                if (restrictor) return reserveTree(out.key, out.treeNodes);
                 const size_t begin = f.treeStart[set];
                 const size_t end =
                     set + 1 < f.treeStart.size() ? f.treeStart[set + 1] : f.pool.trees.nodes.size();
@@ -720,7 +839,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         schedule_ = planSchedule(scene, box_, live, b.weight, b.maxLevel, params.maxObjects, guard);
     const uint32_t origin[3] = {0, 0, 0};
     RegularBuilder::Fragment root(b.maxLevel);
-    b.build(root, 0, 0, origin, box_, scene.tree, live);
+    b.build(root, 0, 0, origin, box_, scene.tree, PrimList(live.begin(), live.end()));
     RegularBuilder::addCounters(root, root);
     // One fragment is the serial build's structure as it is; several are laid out in its order.
     RegularBuilder::Layout out;
@@ -729,11 +848,14 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         out.leaves = std::move(root.leaves);
         out.places = std::move(root.places);
         out.pool = std::move(root.pool);
+        out.treeNodes = root.treeNodes;
     } else {
         RegularBuilder::reserve(out, root);
         out.bsp.nodes.resize(1);
         b.layOut(out, root, 0, 0);
+        root.children.clear();  // laid out: their memory is free for what follows
     }
+    if (b.restrictor) b.makeTrees(out.pool, out.treeNodes);
     leaves_ = std::move(out.leaves);
     pool_ = std::move(out.pool.trees);
     primList_ = std::move(out.pool.lists);
@@ -785,32 +907,32 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     // Ropes: across each face, the cell at the face's low corner names the neighbour leaf; it is
     // the only one when it covers the face on the other two axes.
     // Each leaf's own ropes, from the directory: independent, so in parallel.
-    TaskFence fence;
-    try {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves_.size(), 4096), [&](const auto& r) {
-            const TaskFence::Done done(fence);
-            guard.poll();
-            for (size_t i = r.begin(); i != r.end(); ++i) {
-                RegularLeaf& L = leaves_[i];
-                for (int a = 0; a < 3; ++a) {
-                    for (int side = 0; side < 2; ++side) {
-                        uint32_t& rope = L.rope[2 * a + side];
-                        if (side ? L.hi[a] == n_[a] : L.lo[a] == 0) {
-                            rope = kBorder;
-                            continue;
-                        }
-                        uint32_t c[3] = {L.lo[0], L.lo[1], L.lo[2]};
-                        c[a] = side ? L.hi[a] : L.lo[a] - 1;
-                        const uint32_t nb = dir_.lookup(c[0], c[1], c[2]);
-                        const RegularLeaf& N = leaves_[nb];
-                        bool covers = true;
-                        for (int o = 0; o < 3; ++o)
-                            if (o != a && (N.lo[o] > L.lo[o] || N.hi[o] < L.hi[o])) covers = false;
-                        rope = covers ? nb : kSplitFace;
+    const auto ropes = [&](const tbb::blocked_range<size_t>& r) {
+        guard.poll();
+        for (size_t i = r.begin(); i != r.end(); ++i) {
+            RegularLeaf& L = leaves_[i];
+            for (int a = 0; a < 3; ++a) {
+                for (int side = 0; side < 2; ++side) {
+                    uint32_t& rope = L.rope[2 * a + side];
+                    if (side ? L.hi[a] == n_[a] : L.lo[a] == 0) {
+                        rope = kBorder;
+                        continue;
                     }
+                    uint32_t c[3] = {L.lo[0], L.lo[1], L.lo[2]};
+                    c[a] = side ? L.hi[a] : L.lo[a] - 1;
+                    const uint32_t nb = dir_.lookup(c[0], c[1], c[2]);
+                    const RegularLeaf& N = leaves_[nb];
+                    bool covers = true;
+                    for (int o = 0; o < 3; ++o)
+                        if (o != a && (N.lo[o] > L.lo[o] || N.hi[o] < L.hi[o])) covers = false;
+                    rope = covers ? nb : kSplitFace;
                 }
             }
-        });
+        }
+    };
+    TaskFence fence;
+    try {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves_.size(), 4096), fence.task(ropes));
     } catch (...) {
         fence.acquire();
         throw;
