@@ -1,6 +1,7 @@
 #include "engine/accel/irregular/screen_bsp.h"
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -17,8 +18,13 @@ struct Segment {
     uint8_t axis;
 };
 
+struct Split {
+    uint8_t axis;
+    double c;
+};
+
 /// A cell still to be split: its rectangle, the segments strictly inside it and the primitives
-/// whose rectangle touches it.
+/// whose rectangle touches it, and once it waits, the line it is to be split on.
 struct Cell {
     glm::dvec2 lo, hi;
     std::vector<Segment> segs;
@@ -26,30 +32,91 @@ struct Cell {
     int32_t parent;  ///< node whose child this cell becomes (-1: the root); nodes may reallocate
     int side;
     int depth;
+    Split split{};
+    size_t primsBelow = 0, primsAbove = 0;  ///< the split's children's primitive counts
+};
+
+/// A cell waiting in the best-first queue: the larger gain first, then the older cell.
+struct Waiting {
+    double gain;
+    uint64_t order;
+    uint32_t cell;
+    bool operator<(const Waiting& o) const {
+        return gain < o.gain || (gain == o.gain && order > o.order);
+    }
 };
 
 /// Levels of the screen BSP split whatever the cost estimate says.
 constexpr int kAlwaysSplitLevels = 4;
 
-struct Split {
-    uint8_t axis;
-    double c;
+/// Sort v in increasing order (key, tmp: scratch). Large arrays by a radix sort of the doubles'
+/// bits, six passes of 11 bits over keys mapped to unsigned integers in the doubles' order (the
+/// screen BSP's root sorts millions of endpoints, which std::sort took a fifth of a build on);
+/// NaN does not occur (boxes are finite).
+void sortValues(std::vector<double>& v, std::vector<uint64_t>& key, std::vector<uint64_t>& tmp) {
+    if (v.size() < 4096) {
+        std::sort(v.begin(), v.end());
+        return;
+    }
+    const size_t n = v.size();
+    key.resize(n);
+    tmp.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+        uint64_t u;
+        std::memcpy(&u, &v[i], sizeof u);
+        key[i] = u >> 63 ? ~u : u | (uint64_t(1) << 63);  // negatives reversed, below positives
+    }
+    std::vector<uint32_t> count(2048);
+    for (int shift = 0; shift < 64; shift += 11) {
+        std::fill(count.begin(), count.end(), 0u);
+        for (uint64_t k : key) ++count[(k >> shift) & 2047];
+        uint32_t sum = 0;
+        for (uint32_t& c : count) {
+            const uint32_t here = c;
+            c = sum;
+            sum += here;
+        }
+        for (uint64_t k : key) tmp[count[(k >> shift) & 2047]++] = k;
+        key.swap(tmp);
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const uint64_t u = key[i] >> 63 ? key[i] & ~(uint64_t(1) << 63) : ~key[i];
+        std::memcpy(&v[i], &u, sizeof u);
+    }
+}
+
+/// Cells of twice this many segments or more choose their line from a sample of them.
+constexpr size_t kSplitSample = 32768;
+
+/// chooseSplit's arrays, kept from one cell to the next: allocated afresh, the large ones of the
+/// first levels came from the system each time and every page faulted in again.
+struct SplitScratch {
+    std::vector<double> lines, lo, hi;
+    std::vector<uint64_t> key, tmp;
 };
 
 /// The line to split on. `first`: the first segment's line (the report's "on choisit un
 /// segment", read literally). `balanced`: the line that minimizes the larger side (segments on
 /// it plus the pieces cut), then the cuts. `fewest-cuts`: the line that cuts fewest segments,
-/// then the larger side. Each axis is scored in O(n log n) from sorted endpoints.
-Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h, const BuildGuard* guard) {
+/// then the larger side. Each axis is scored in O(n log n) from sorted endpoints, a cell of
+/// 2 kSplitSample segments or more from a sample of them.
+Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h, const BuildGuard* guard,
+                  SplitScratch& scratch) {
     if (h == BspHeuristic::First) return {segs[0].axis, segs[0].c};
     Split best{segs[0].axis, segs[0].c};
     size_t bestMain = SIZE_MAX, bestTie = SIZE_MAX;
-    std::vector<double> lines, lo, hi;
+    auto& [lines, lo, hi, key, tmp] = scratch;
+    // A cell of 2 kSplitSample segments or more is scored on every stride-th of them (between
+    // kSplitSample and 2 kSplitSample of them): the line is then about as good (the counts are
+    // proportional), and the first levels of a large scene no longer sort millions of
+    // endpoints each.
+    const size_t stride = std::max<size_t>(1, segs.size() / kSplitSample);
     for (uint8_t a = 0; a < 2; ++a) {
         lines.clear();
         lo.clear();
         hi.clear();
-        for (const Segment& s : segs) {
+        for (size_t j = 0; j < segs.size(); j += stride) {
+            const Segment& s = segs[j];
             if (s.axis == a) {
                 lines.push_back(s.c);
             } else {
@@ -59,20 +126,26 @@ Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h, const BuildG
         }
         if (lines.empty()) continue;
         if (guard) guard->poll();  // a root cell of millions of segments sorts for a while
-        std::sort(lines.begin(), lines.end());
+        sortValues(lines, key, tmp);
         if (guard) guard->poll();
-        std::sort(lo.begin(), lo.end());
+        sortValues(lo, key, tmp);
         if (guard) guard->poll();
-        std::sort(hi.begin(), hi.end());
+        sortValues(hi, key, tmp);
         if (guard) guard->poll();
-        for (size_t i = 0; i < lines.size(); ++i) {
-            if (guard && (i & 8191) == 0) guard->poll();
-            if (i > 0 && lines[i] == lines[i - 1]) continue;
-            double c = lines[i];
+        // The lines in increasing order, each count by a pointer that only moves forward: the
+        // end of the run of lines at c, the segments ending at or before c, those starting
+        // before c.
+        size_t next = 0, ending = 0, starting = 0;
+        for (size_t i = 0, polled = 0; i < lines.size(); i = next) {
+            if (guard && (++polled & 8191) == 0) guard->poll();
+            const double c = lines[i];
+            while (next < lines.size() && lines[next] == c) ++next;
+            while (ending < hi.size() && hi[ending] <= c) ++ending;
+            while (starting < lo.size() && lo[starting] < c) ++starting;
             size_t below = i;
-            size_t above = size_t(lines.end() - std::upper_bound(lines.begin(), lines.end(), c));
-            size_t crossLow = size_t(std::upper_bound(hi.begin(), hi.end(), c) - hi.begin());
-            size_t crossHigh = size_t(lo.end() - std::lower_bound(lo.begin(), lo.end(), c));
+            size_t above = lines.size() - next;
+            size_t crossLow = ending;
+            size_t crossHigh = lo.size() - starting;
             size_t cut = lo.size() - crossLow - crossHigh;
             size_t larger = std::max(below + crossLow, above + crossHigh) + cut;
             size_t mainCost = h == BspHeuristic::Balanced ? larger : cut;
@@ -92,6 +165,54 @@ Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h, const BuildG
 /// and no hit within the cell; including it would add every neighbour across an edge.
 bool overlapsOpen(const Box3& r, glm::dvec2 lo, glm::dvec2 hi) {
     return r.lo.x < hi.x && lo.x < r.hi.x && r.lo.y < hi.y && lo.y < r.hi.y;
+}
+
+/// Number the nodes and zones of a BSP built best first as a depth-first build numbers them
+/// (preorder, the child `firstSide[node]` first): a build that no limit stops is then the same
+/// structure, ids included, whatever the order its cells were split in.
+void renumber(ScreenBsp& bsp, const std::vector<uint8_t>& firstSide) {
+    if (bsp.root < 0) return;  // a single zone
+    std::vector<ScreenBsp::Node> nodes;
+    std::vector<glm::dvec2> zoneLo, zoneHi;
+    std::vector<uint32_t> zoneFirst{0}, zonePrims;
+    nodes.reserve(bsp.nodes.size());
+    zoneLo.reserve(bsp.zoneLo.size());
+    zoneHi.reserve(bsp.zoneHi.size());
+    zoneFirst.reserve(bsp.zoneFirst.size());
+    zonePrims.reserve(bsp.zonePrims.size());
+    struct Item {
+        int32_t ref;     ///< a node, or ~zone, of the build's numbering
+        int32_t parent;  ///< its parent in the new numbering (-1: the root)
+        int side;
+    };
+    std::vector<Item> stack{{bsp.root, -1, 0}};
+    while (!stack.empty()) {
+        const Item it = stack.back();
+        stack.pop_back();
+        int32_t ref;
+        if (it.ref >= 0) {
+            const ScreenBsp::Node& n = bsp.nodes[it.ref];
+            ref = int32_t(nodes.size());
+            nodes.push_back({n.axis, n.value, {0, 0}});
+            const int first = firstSide[it.ref];
+            stack.push_back({n.child[1 - first], ref, 1 - first});
+            stack.push_back({n.child[first], ref, first});
+        } else {
+            const uint32_t z = uint32_t(~it.ref);
+            ref = ~int32_t(zoneLo.size());
+            zoneLo.push_back(bsp.zoneLo[z]);
+            zoneHi.push_back(bsp.zoneHi[z]);
+            zonePrims.insert(zonePrims.end(), bsp.zonePrims.begin() + bsp.zoneFirst[z],
+                             bsp.zonePrims.begin() + bsp.zoneFirst[z + 1]);
+            zoneFirst.push_back(uint32_t(zonePrims.size()));
+        }
+        (it.parent < 0 ? bsp.root : nodes[it.parent].child[it.side]) = ref;
+    }
+    bsp.nodes = std::move(nodes);
+    bsp.zoneLo = std::move(zoneLo);
+    bsp.zoneHi = std::move(zoneHi);
+    bsp.zoneFirst = std::move(zoneFirst);
+    bsp.zonePrims = std::move(zonePrims);
 }
 
 }  // namespace
@@ -119,11 +240,22 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
     }
     bsp.segments = top.segs.size();
 
-    // Depth first, smaller child first, so at most O(log n) large cells wait on the stack.
-    std::vector<Cell> stack;
-    // Bytes of the cells waiting on the stack, and their primitive references. The lists are
-    // transient, about as large as the input at any time (the root's, then halves): splitting
-    // is stopped by what it adds, the BSP and the least its zones will cost.
+    // Best first: the cells waiting to be split are taken in order of the cost estimate's gain
+    // (the area-weighted tests a split saves), so a limit that stops the splitting stops it
+    // across the whole screen at once, every waiting cell about as coarse as the others. Taken
+    // depth first, the first cells split to the end and, once the limit is reached, the cells
+    // still waiting became zones however large (lattice:30: 2,726 tests per ray).
+    std::vector<Cell> cells;          // the waiting cells (a moved-from cell is a free slot)
+    std::vector<uint32_t> freeSlots;  // free slots of `cells`
+    std::vector<Waiting> queue;       // a max-heap of the waiting cells by gain
+    uint64_t order = 0;
+    SplitScratch scratch;
+    // Which child of each node was split first in depth-first order (the one with fewer
+    // segments, the upper one on a tie): the final numbering follows it (see below).
+    std::vector<uint8_t> firstSide;
+    // Bytes of the waiting cells' lists, and their primitive references. Splitting is stopped
+    // by what it adds (the BSP and the least its zones will cost) and by those lists, which
+    // hold every segment piece of the waiting cells.
     size_t waiting = 0, waitingRefs = 0;
     auto cellBytes = [](const Cell& c) {
         return sizeof(Cell) + c.segs.capacity() * sizeof(Segment) +
@@ -134,76 +266,120 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
                bsp.zoneLo.capacity() * 2 * sizeof(glm::dvec2) +
                bsp.zoneFirst.capacity() * sizeof(uint32_t) +
                bsp.zonePrims.capacity() * sizeof(uint32_t) +
-               (bsp.zoneLo.size() + stack.size()) * params.zoneBytes +
+               (bsp.zoneLo.size() + queue.size()) * params.zoneBytes +
                (bsp.zonePrims.size() + waitingRefs) * params.refBytes;
     };
-    waiting += cellBytes(top);
-    waitingRefs += top.prims.size();
-    stack.push_back(std::move(top));
-    while (!stack.empty()) {
-        Cell cell = std::move(stack.back());
-        stack.pop_back();
-        const size_t bytes = bspBytes();  // what splitting adds (not the transient lists)
+    // The cell becomes a zone: its rectangle and its primitives.
+    auto makeZone = [&](const Cell& cell) {
+        int32_t& slot = cell.parent < 0 ? bsp.root : bsp.nodes[cell.parent].child[cell.side];
+        slot = ~int32_t(bsp.zoneLo.size());
+        bsp.zoneLo.push_back(cell.lo);
+        bsp.zoneHi.push_back(cell.hi);
+        bsp.zonePrims.insert(bsp.zonePrims.end(), cell.prims.begin(), cell.prims.end());
+        bsp.zoneFirst.push_back(uint32_t(bsp.zonePrims.size()));
+    };
+    // A new cell: a zone now when nothing splits it or no split pays, else it waits with its
+    // split and the split's gain.
+    auto add = [&](Cell&& cell) {
+        bsp.depth = std::max(bsp.depth, cell.depth);
+        if (cell.segs.empty() ||
+            (params.stopObjects > 0 && cell.prims.size() <= size_t(params.stopObjects))) {
+            makeZone(cell);
+            return;
+        }
+        cell.split = chooseSplit(cell.segs, params.heuristic, params.guard, scratch);
+        glm::dvec2 bHi = cell.hi, aLo = cell.lo;
+        bHi[cell.split.axis] = cell.split.c;
+        aLo[cell.split.axis] = cell.split.c;
+        size_t nBelow = 0, nAbove = 0, polled = 0;
+        for (uint32_t p : cell.prims) {
+            if (params.guard && (++polled & 32767) == 0) params.guard->poll();
+            nBelow += overlapsOpen(rect[p], cell.lo, bHi);
+            nAbove += overlapsOpen(rect[p], aLo, cell.hi);
+        }
+        // A ray through the cell (the area of a side is its share of the rays) tests its
+        // rectangles; split, it crosses one more zone and tests one side's. The gain is the
+        // tests saved, over the cell's area.
+        const double area = (cell.hi.x - cell.lo.x) * (cell.hi.y - cell.lo.y);
+        const double aBelow = (bHi.x - cell.lo.x) * (bHi.y - cell.lo.y);
+        const double aAbove = (cell.hi.x - aLo.x) * (cell.hi.y - aLo.y);
+        const double split =
+            params.stepCost + (aBelow * double(nBelow) + aAbove * double(nAbove)) / area;
+        const double gain = area > 0.0 ? area * (double(cell.prims.size()) - split) : 0.0;
+        cell.primsBelow = nBelow;
+        cell.primsAbove = nAbove;
+        // The first levels always split (at most 16 cells): with a handful of primitives the
+        // estimate would leave one zone, and the scheme would have no screen structure at all.
+        const bool always = cell.depth < kAlwaysSplitLevels;
+        if (params.stepCost > 0.0 && !always && area > 0.0 &&
+            !(split < double(cell.prims.size()))) {
+            ++bsp.costStops;
+            makeZone(cell);
+            return;
+        }
+        uint32_t slot;
+        if (freeSlots.empty()) {
+            slot = uint32_t(cells.size());
+            cells.emplace_back();
+        } else {
+            slot = freeSlots.back();
+            freeSlots.pop_back();
+        }
+        waiting += cellBytes(cell);
+        waitingRefs += cell.prims.size();
+        cells[slot] = std::move(cell);
+        queue.push_back({always ? kInf : gain, order++, slot});
+        std::push_heap(queue.begin(), queue.end());
+    };
+    add(std::move(top));
+    while (!queue.empty()) {
+        const size_t bytes = bspBytes();  // what splitting adds, with the waiting lists
+        if (params.guard) params.guard->poll("screen BSP", bytes + waiting, bsp.zoneLo.size());
+        std::pop_heap(queue.begin(), queue.end());
+        const uint32_t slot = queue.back().cell;
+        queue.pop_back();
+        Cell cell = std::move(cells[slot]);
+        cells[slot] = Cell{};
+        freeSlots.push_back(slot);
         waiting -= cellBytes(cell);
         waitingRefs -= cell.prims.size();
-        if (params.guard) params.guard->poll("screen BSP", bytes + waiting, bsp.zoneLo.size());
-        int32_t& slot = cell.parent < 0 ? bsp.root : bsp.nodes[cell.parent].child[cell.side];
-        bsp.depth = std::max(bsp.depth, cell.depth);
-        bool stop = cell.segs.empty() ||
-                    (params.stopObjects > 0 && cell.prims.size() <= size_t(params.stopObjects));
-        // Over a limit, the BSP stops: this cell and every one still waiting become zones
-        // (the waiting ones are at most O(log n), each a zone once popped).
-        if (!stop &&
-            ((params.maxZones && bsp.zoneLo.size() + stack.size() + 1 >= params.maxZones) ||
-             (params.maxBytes && bytes >= params.maxBytes))) {
-            stop = true;
+        // Over a limit, the BSP stops: this cell and every one still waiting become zones.
+        if ((params.maxZones && bsp.zoneLo.size() + queue.size() + 1 >= params.maxZones) ||
+            (params.maxBytes && bytes + waiting >= params.maxBytes)) {
             bsp.stopped = true;
-        }
-        // The cell becomes a zone: its rectangle and its primitives.
-        auto makeZone = [&] {
-            slot = ~int32_t(bsp.zoneLo.size());
-            bsp.zoneLo.push_back(cell.lo);
-            bsp.zoneHi.push_back(cell.hi);
-            bsp.zonePrims.insert(bsp.zonePrims.end(), cell.prims.begin(), cell.prims.end());
-            bsp.zoneFirst.push_back(uint32_t(bsp.zonePrims.size()));
-        };
-        if (stop) {
-            makeZone();
+            makeZone(cell);
             continue;
         }
-        Split sp = chooseSplit(cell.segs, params.heuristic, params.guard);
+        const Split sp = cell.split;
         // Children: segments on the line are used up, segments across it are cut in two.
         Cell below{cell.lo, cell.hi, {}, {}, -1, 0, cell.depth + 1};
         Cell above{cell.lo, cell.hi, {}, {}, -1, 1, cell.depth + 1};
         below.hi[sp.axis] = sp.c;
         above.lo[sp.axis] = sp.c;
-        // Large cells take a while here (their children's lists grow by copies, and fresh pages
-        // fault in): poll as in the loop.
-        size_t polled = 0;
+        // The children's lists are sized first: grown by doubling, the large ones were copied
+        // and faulted in again at each step. Large cells take a while here: poll as in the loop.
+        size_t polled = 0, segsBelow = 0, segsAbove = 0;
+        for (const Segment& s : cell.segs) {
+            if (params.guard && (++polled & 32767) == 0) params.guard->poll();
+            if (s.axis == sp.axis) {
+                segsBelow += s.c < sp.c;
+                segsAbove += s.c > sp.c;
+            } else {
+                segsBelow += s.lo < sp.c;
+                segsAbove += s.hi > sp.c;
+            }
+        }
+        below.segs.reserve(segsBelow);
+        above.segs.reserve(segsAbove);
+        below.prims.reserve(cell.primsBelow);
+        above.prims.reserve(cell.primsAbove);
         for (uint32_t p : cell.prims) {
             if (params.guard && (++polled & 32767) == 0) params.guard->poll();
             if (overlapsOpen(rect[p], below.lo, below.hi)) below.prims.push_back(p);
             if (overlapsOpen(rect[p], above.lo, above.hi)) above.prims.push_back(p);
         }
-        // The first levels always split (at most 16 cells): with a handful of primitives the
-        // estimate would leave one zone, and the scheme would have no screen structure at all.
-        if (params.stepCost > 0.0 && cell.depth >= kAlwaysSplitLevels) {
-            // A ray through the cell (the area of a side is its share of the rays) tests its
-            // rectangles; split, it crosses one more zone and tests one side's.
-            const double area = (cell.hi.x - cell.lo.x) * (cell.hi.y - cell.lo.y);
-            const double aBelow = (below.hi.x - below.lo.x) * (below.hi.y - below.lo.y);
-            const double aAbove = (above.hi.x - above.lo.x) * (above.hi.y - above.lo.y);
-            const double split =
-                params.stepCost +
-                (aBelow * double(below.prims.size()) + aAbove * double(above.prims.size())) / area;
-            if (area > 0.0 && !(split < double(cell.prims.size()))) {
-                ++bsp.costStops;
-                makeZone();
-                continue;
-            }
-        }
         int32_t node = int32_t(bsp.nodes.size());
-        slot = node;
+        (cell.parent < 0 ? bsp.root : bsp.nodes[cell.parent].child[cell.side]) = node;
         bsp.nodes.push_back({sp.axis, sp.c, {0, 0}});
         below.parent = above.parent = node;
         for (const Segment& s : cell.segs) {
@@ -223,13 +399,12 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
                 above.segs.push_back({s.c, sp.c, s.hi, s.axis});
             }
         }
-        cell = Cell{};  // free the parent's lists before descending
-        if (below.segs.size() < above.segs.size()) std::swap(below, above);
-        waiting += cellBytes(below) + cellBytes(above);
-        waitingRefs += below.prims.size() + above.prims.size();
-        stack.push_back(std::move(below));  // the larger one waits
-        stack.push_back(std::move(above));
+        cell = Cell{};  // free the parent's lists
+        firstSide.push_back(below.segs.size() < above.segs.size() ? 0 : 1);
+        add(std::move(below));
+        add(std::move(above));
     }
+    renumber(bsp, firstSide);
     return bsp;
 }
 

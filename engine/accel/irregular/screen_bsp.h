@@ -22,9 +22,10 @@ struct ScreenBspParams {
     double stepCost = 0.0;
     /// Stop splitting at about this many zones (0: no limit): the cells left become zones.
     size_t maxZones = 0;
-    /// Stop splitting once the BSP (with the cells waiting) and what its zones will cost at
-    /// least, `zoneBytes` a zone and `refBytes` a primitive reference, take this many bytes
-    /// (0: no limit).
+    /// Stop splitting once the BSP, the lists of the cells waiting and what its zones will cost
+    /// at least, `zoneBytes` a zone and `refBytes` a primitive reference, take this many bytes
+    /// (0: no limit). Cells are split best first (the largest gain of the cost estimate), so
+    /// the cells the limit leaves whole are spread over the whole screen.
     size_t maxBytes = 0;
     size_t zoneBytes = 0, refBytes = 0;
     BuildGuard* guard = nullptr;  ///< polled for cancellation and progress (null: never)
