@@ -207,6 +207,122 @@ TEST(RegularUnion, FlatUnionIsTheTreeOfUnions) {
     }
 }
 
+// hitInUnionLeaf (the walk's leaf of a union-only scene, without an active observer) against
+// the merge it stands for: random primitives' spans in a region, random windows [t0, t1] and
+// tmin (starting before, inside and after spans, on their ends), the same hit (t, primitive,
+// part) as flatUnion then firstBoundary, or none; each primitive tested once, then taken from
+// its mailbox.
+TEST(RegularUnion, UnionLeafIsFlatUnion) {
+    std::mt19937_64 rng(23);
+    std::uniform_real_distribution<double> u(-10.0, 10.0);
+    struct Table {
+        const std::vector<SpanList>* spans;
+        uint32_t prim(uint32_t k) const { return k; }
+        void prefetch(uint32_t) const {}
+        int operator()(uint32_t k, Span* out) const {
+            std::copy((*spans)[k].begin(), (*spans)[k].end(), out);
+            return int((*spans)[k].size());
+        }
+    };
+    size_t hits = 0, inside = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const int n = 1 + int(rng() % 12);
+        std::vector<SpanList> spans(static_cast<size_t>(n));
+        std::vector<double> ends;
+        for (int p = 0; p < n; ++p) {
+            const int count = int(rng() % 3);
+            std::vector<double> t(size_t(2 * count));
+            for (double& x : t) x = rng() % 4 == 0 ? double(int(u(rng))) : u(rng);  // ties
+            std::sort(t.begin(), t.end());
+            for (int k = 0; k < count; ++k) {
+                const bool surface = rng() % 5 == 0;
+                const double in = t[size_t(2 * k)], out = surface ? in : t[size_t(2 * k + 1)];
+                if (k > 0 && !(in > spans[size_t(p)].back().out.t)) continue;  // disjoint
+                spans[size_t(p)].push_back(
+                    {{in, uint32_t(p), 0, false}, {out, uint32_t(p), 1, false}});
+                ends.push_back(in);
+                ends.push_back(out);
+            }
+        }
+        auto pick = [&] {
+            return !ends.empty() && rng() % 3 == 0 ? ends[rng() % ends.size()] : u(rng);
+        };
+        double t0 = pick(), t1 = pick(), tmin = rng() % 2 ? pick() : -kInf;
+        if (t0 > t1) std::swap(t0, t1);
+        SpanList merged;
+        std::vector<uint32_t> keys(static_cast<size_t>(n));
+        for (int p = 0; p < n; ++p) keys[size_t(p)] = uint32_t(p);
+        std::shuffle(keys.begin(), keys.end(), rng);  // the leaf's order is any
+        // The tie rule is the leaf's order: flatUnion's stable sort over the spans listed so.
+        SpanList listed;
+        for (uint32_t k : keys) listed.insert(listed.end(), spans[k].begin(), spans[k].end());
+        flatUnion(listed, merged);
+        const Boundary* want = firstBoundary(merged, tmin, t0, t1);
+        TraceContext ctx(size_t(n), 1);
+        ctx.beginRay();
+        NullObserver obs;
+        Hit hit;
+        const Table table{&spans};
+        const bool got =
+            hitInUnionLeaf(keys.data(), uint32_t(n), table, tmin, t0, t1, ctx, obs, hit);
+        ASSERT_EQ(got, want != nullptr) << "trial " << trial;
+        if (want) {
+            ASSERT_EQ(hit.t, want->t) << "trial " << trial;
+            ASSERT_EQ(hit.prim, want->prim) << "trial " << trial;
+            ASSERT_EQ(hit.part, want->part) << "trial " << trial;
+            ++hits;
+        }
+        for (const Span& sp : merged) inside += sp.in.t < t0 && sp.out.t > t1;
+        ASSERT_EQ(ctx.counters.primTests, uint64_t(n));
+        ASSERT_EQ(ctx.counters.mailboxHits, 0u);
+        // The same region again for the same ray: every primitive from its mailbox.
+        Hit again;
+        ASSERT_EQ(hitInUnionLeaf(keys.data(), uint32_t(n), table, tmin, t0, t1, ctx, obs, again),
+                  got);
+        if (got) ASSERT_EQ(again.t, hit.t);
+        ASSERT_EQ(ctx.counters.primTests, uint64_t(n));
+        ASSERT_EQ(ctx.counters.mailboxHits, uint64_t(n));
+    }
+    EXPECT_GT(hits, 5000u);
+    EXPECT_GT(inside, 500u);  // windows inside a merged span: the merge's way
+}
+
+// A sphereflake on a floor rendered with shadows and mirror bounces (shadow rays on the light
+// buffer's stretches, reflected rays from surfaces): the regular scheme's image, pixel for pixel,
+// is brute force's, and its walk makes the same tests, mailbox hits and visits as the walk seen
+// by an observer (which evaluates every leaf's tree of unions).
+TEST(RegularUnion, SphereflakeRenderEqualsBruteForce) {
+    Scene s = loadScene("builtin:balls:3");
+    s.prepare();
+    ASSERT_TRUE(s.tree.unionOnly());
+    auto accel = buildAccelerator(s, regular());
+    BuildParams bp;
+    bp.scheme = SchemeKind::Brute;
+    auto brute = buildAccelerator(s, bp);
+    for (int bounces : {0, 2}) {
+        RenderOptions ro;
+        ro.width = ro.height = 96;
+        ro.threads = 1;
+        ro.shading.bounces = bounces;
+        Image a(ro.width, ro.height), b(ro.width, ro.height);
+        const RenderStats sa = render(s, *accel, ro, a);
+        render(s, *brute, ro, b);
+        ASSERT_GT(sa.counters.shadowRays, 0u);
+        for (size_t i = 0; i < a.color.size(); ++i) {
+            ASSERT_EQ(a.hitPrim[i], b.hitPrim[i]) << "pixel " << i << ", bounces " << bounces;
+            ASSERT_EQ(a.color[i], b.color[i]) << "pixel " << i << ", bounces " << bounces;
+        }
+    }
+    auto rays = test::pixelRays(s, 48, 48);
+    const RayCounters fast = test::traceCounters(s, *accel, rays);
+    TraceContext ctx(s.prims.size(), s.tree.depth());
+    for (const Ray& r : rays) test::recordWalk(*accel, r, ctx);
+    EXPECT_EQ(fast.primTests, ctx.counters.primTests);
+    EXPECT_EQ(fast.mailboxHits, ctx.counters.mailboxHits);
+    EXPECT_EQ(fast.regionVisits, ctx.counters.regionVisits);
+    EXPECT_GT(fast.primTests, rays.size());
+}
+
 TEST(RegularUnion, UnionOnlyScenesRayForRay) {
     size_t total = 0;
     for (uint64_t seed = 1; seed <= 6; ++seed) {

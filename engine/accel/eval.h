@@ -16,19 +16,27 @@ namespace lancer {
 /// The primitive's mailbox holding its spans for the current ray id: filled by a test (counted
 /// as one) unless this ray id already filled it (counted as a mailbox hit). `fresh` says which.
 template <class Obs>
-inline const Mailbox& mailboxSpans(const Scene& scene, uint32_t p, const Ray& ray,
-                                   TraceContext& ctx, Obs& obs, bool* fresh = nullptr) {
+[[gnu::always_inline]] inline const Mailbox& mailboxSpans(const Scene& scene, uint32_t p,
+                                                          const Ray& ray, TraceContext& ctx,
+                                                          Obs& obs, bool* fresh = nullptr) {
     if (const Mailbox* held = ctx.heldMailbox(p)) {
         ++ctx.counters.mailboxHits;
         obs.mailboxHit(p);
         if (fresh) *fresh = false;
         return *held;
     }
-    Mailbox& m = ctx.takeMailbox(p);
-    m.count = uint8_t(scene.primSpans(p, ray, m.spans));
+    Span spans[2];
+    const int n = scene.primSpans(p, ray, spans);
     ++ctx.counters.primTests;
-    obs.primTest(p, m.spans, m.count);
+    obs.primTest(p, spans, n);
     if (fresh) *fresh = true;
+    if (n == 0) {  // a miss, most tests: no mailbox of its own
+        ctx.heldEmpty(p);
+        return ctx.held[0];
+    }
+    Mailbox& m = ctx.takeMailbox(p);
+    m.count = uint8_t(n);
+    std::copy_n(spans, n, m.spans);
     return m;
 }
 
@@ -153,6 +161,87 @@ inline void flatUnion(SpanList& spans, SpanList& out) {
 /// unions, so its spans are those of its primitives merged (flatUnion), without walking it:
 /// a fifth of the render of a 598k-sphere union went to evaluating trees of unions (an active
 /// observer is still shown the tree's evaluation).
+/// hitInUnionLeaf's `test` for regions that list the scene's primitives: Scene::primSpans.
+struct ScenePrimTest {
+    const Scene* scene;
+    const Ray* ray;
+    uint32_t prim(uint32_t p) const { return p; }
+    void prefetch(uint32_t p) const {
+        if (p < scene->packedSpheres.size()) __builtin_prefetch(&scene->packedSpheres[p]);
+    }
+    int operator()(uint32_t p, Span* out) const { return scene->primSpans(p, *ray, out); }
+};
+
+/// The visible hit in a region whose tree is a union of its primitives, without an active
+/// observer (hitInLeaf's answer, the same tests and mailbox hits): straight from the primitives'
+/// spans, without the pending boundaries or a merge. `keys` name the region's `count`
+/// primitives for `test` and the mailboxes: `test(key, spans)` puts the spans of the primitive
+/// `test.prim(key)` in `spans` and returns how many (the regular walk numbers the primitives in
+/// an order of its own, for locality). Only the spans reaching into the window count (out >= t0
+/// and > tmin, in <= t1): a span wholly before the window or after it changes no boundary that
+/// the merged union (flatUnion) has inside it, nor whose it is. The first of them to start (the
+/// first listed on a tie, as flatUnion's stable sort keeps it) begins the union's first stretch
+/// reaching into the window; when it starts inside the window (t >= t0 and > tmin), its start
+/// is the hit. Otherwise the ray is inside that stretch at the window's start, and its end needs
+/// the merge: the region's spans are merged as flatUnion merges them (test
+/// `RegularUnion.UnionLeafIsFlatUnion`).
+template <class Obs, class Test>
+[[gnu::always_inline]] inline bool hitInUnionLeaf(const uint32_t* keys, uint32_t count,
+                                                  const Test& test, double tmin, double t0,
+                                                  double t1, TraceContext& ctx, Obs& obs,
+                                                  Hit& hit) {
+    if (!ctx.useMailboxes) ctx.newStamp();
+    // The tags and spheres the loop reads, fetched together rather than one miss at a time.
+    for (uint32_t i = 0; i < count; ++i) {
+        __builtin_prefetch(ctx.tags.data() + keys[i]);
+        test.prefetch(keys[i]);
+    }
+    Boundary first;
+    first.t = kInf;
+    bool found = false;
+    for (uint32_t i = 0; i < count; ++i) {
+        const uint32_t key = keys[i];
+        const Mailbox* m = ctx.heldMailbox(key);
+        if (m) {
+            ++ctx.counters.mailboxHits;
+            obs.mailboxHit(test.prim(key));
+        } else {
+            Span spans[2];
+            const int n = test(key, spans);
+            ++ctx.counters.primTests;
+            obs.primTest(test.prim(key), spans, n);
+            if (n == 0) {  // a miss, most tests: no mailbox of its own
+                ctx.heldEmpty(key);
+                continue;
+            }
+            Mailbox& fill = ctx.takeMailbox(key);
+            fill.count = uint8_t(n);
+            std::copy_n(spans, n, fill.spans);
+            m = &fill;
+        }
+        for (int k = 0; k < m->count; ++k) {
+            const Span& s = m->spans[k];
+            if (s.out.t < t0 || !(s.out.t > tmin) || s.in.t > t1) continue;
+            if (s.in.t < first.t) first = s.in, found = true;
+        }
+    }
+    if (!found) return false;
+    if (first.t >= t0 && first.t > tmin) {
+        hit = {first.t, first.prim, first.part, first.flip};
+        return true;
+    }
+    SpanList& spans = ctx.leafSpans;
+    spans.clear();
+    for (uint32_t i = 0; i < count; ++i) {
+        const Mailbox* m = ctx.heldMailbox(keys[i]);
+        spans.insert(spans.end(), m->spans, m->spans + m->count);
+    }
+    flatUnion(spans, ctx.result);
+    const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
+    if (b) hit = {b->t, b->prim, b->part, b->flip};
+    return b != nullptr;
+}
+
 template <class Obs>
 [[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree& tree, int root,
                                              const uint32_t* prims, uint32_t count, const Ray& ray,

@@ -45,8 +45,8 @@ std::ostream& operator<<(std::ostream& os, const RayCounters& c) { return os << 
 
 void TraceContext::reset(size_t primitives, int treeDepth) {
     tags.assign(primitives, Tag{});
-    held.clear();
     held.reserve(64);
+    held.assign(1, Mailbox{});
     scratch.resize(size_t(2 * treeDepth + 4));
     rayId = 0;
 }

@@ -79,7 +79,7 @@ struct TraceContext {
         uint32_t slot = 0;   ///< the mailbox's index in `held`
     };
     std::vector<Tag> tags;          ///< per primitive
-    std::vector<Mailbox> held;      ///< the current ray id's mailboxes, as filled
+    std::vector<Mailbox> held;      ///< [0] empty; then the current ray id's mailboxes, as filled
     PendingBoundaries pending;      ///< of the ray the regular walk is on
     std::vector<SpanList> scratch;  ///< two buffers per tree level, reused without allocation
     SpanList result;                ///< spans of the tree evaluated last
@@ -98,7 +98,7 @@ struct TraceContext {
     }
     /// A fresh mailbox id for the same ray (a walk over another stretch of it).
     void newStamp() {
-        held.clear();
+        held.resize(1);  // held[0], the empty mailbox, stays
         if (++rayId == 0) wrap();
     }
     /// The mailbox primitive `p` holds for the current ray id, or null when none was filled.
@@ -112,6 +112,9 @@ struct TraceContext {
         tags[p] = {rayId, uint32_t(held.size())};
         return held.emplace_back();
     }
+    /// Primitive `p` tested for the current ray id and missed: its tag names the empty mailbox
+    /// (held[0]), so a miss, most tests, writes no mailbox of its own.
+    void heldEmpty(uint32_t p) { tags[p] = {rayId, 0}; }
 
   private:
     /// The ray ids ran out: every tag cleared, ids start again at 1.

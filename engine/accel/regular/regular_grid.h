@@ -272,9 +272,20 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
             const double shownEnd = last ? std::min(tEnd, std::max(tExit, tIn)) : t1;
             obs.region(leaf, std::min(std::max(tIn, tShown), shownEnd), shownEnd);
         }
-        if (hitInLeaf(*scene_, pool_, L.root, L.primitives(primList), L.prims, ray, tmin, t0, t1,
-                      ctx, obs, hit, unionOnly_))
-            return true;
+        // A union-only scene's leaf without an active observer: its hit straight from its
+        // primitives' spans (hitInUnionLeaf); the observer is shown the tree's evaluation.
+        bool found;
+        if constexpr (!Obs::kActive) {
+            found = unionOnly_
+                        ? hitInUnionLeaf(L.primitives(primList), L.prims,
+                                         ScenePrimTest{scene_, &ray}, tmin, t0, t1, ctx, obs, hit)
+                        : hitInLeaf(*scene_, pool_, L.root, L.primitives(primList), L.prims, ray,
+                                    tmin, t0, t1, ctx, obs, hit);
+        } else {
+            found = hitInLeaf(*scene_, pool_, L.root, L.primitives(primList), L.prims, ray, tmin,
+                              t0, t1, ctx, obs, hit, unionOnly_);
+        }
+        if (found) return true;
         if constexpr (Obs::kActive) {
             int ties = 0;
             for (int a = 0; a < 3; ++a) ties |= int(tAxis[a] == tExit) << a;
