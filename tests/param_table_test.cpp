@@ -79,13 +79,17 @@ TEST(ParamTable, EveryOptionHasAnIniKeyAndAControlOrIsBatchOnly) {
                 EXPECT_EQ(d.iniKey, nullptr) << "a file is not a setting to remember";
                 break;
         }
-        if (d.iniKey) EXPECT_TRUE(keys.insert(d.iniKey).second) << "ini key twice";
+        if (d.iniKey) {
+            EXPECT_TRUE(keys.insert(d.iniKey).second) << "ini key twice";
+        }
         if (d.kind != ParamKind::Path) {
             EXPECT_TRUE(d.get && d.set);
         } else {
             EXPECT_NE(d.path, nullptr);
         }
-        if (d.kind == ParamKind::Enum) EXPECT_GE(d.names.size(), 2u);
+        if (d.kind == ParamKind::Enum) {
+            EXPECT_GE(d.names.size(), 2u);
+        }
     }
     // Every option the command line registers is an entry of the table.
     Parsed p({"render", "builtin:default"});

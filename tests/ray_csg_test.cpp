@@ -96,8 +96,9 @@ TEST(RayCsg, RootRowIsTheWalksResultAndGivesTheHit) {
                                 break;
                             }
                         ASSERT_NE(ahead, nullptr);
-                        if (ahead->in.t > r.tmin && ahead->in.t >= last.lo)
+                        if (ahead->in.t > r.tmin && ahead->in.t >= last.lo) {
                             EXPECT_EQ(ahead->in.t, r.hit.t);
+                        }
                         ++hits;
                     }
                     const RayWaste w = wastedWork(scene, r, csg);

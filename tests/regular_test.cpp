@@ -279,7 +279,9 @@ TEST(RegularUnion, UnionLeafIsFlatUnion) {
         Hit again;
         ASSERT_EQ(hitInUnionLeaf(keys.data(), uint32_t(n), table, tmin, t0, t1, ctx, obs, again),
                   got);
-        if (got) ASSERT_EQ(again.t, hit.t);
+        if (got) {
+            ASSERT_EQ(again.t, hit.t);
+        }
         ASSERT_EQ(ctx.counters.primTests, uint64_t(n));
         ASSERT_EQ(ctx.counters.mailboxHits, uint64_t(n));
     }
@@ -771,7 +773,9 @@ TEST(RegularBuild, LeavesHoldTheirOverlappingPrimitivesAndShareTrees) {
         const RegularGrid& g = gridOf(*accel);
         const auto& x = accel->info().extra;
         EXPECT_EQ(size_t(x["leaves"]), g.regionCount());
-        if (!costStop) EXPECT_LT(size_t(x["distinct_trees"]), g.regionCount());  // shared
+        if (!costStop) {
+            EXPECT_LT(size_t(x["distinct_trees"]), g.regionCount());  // shared
+        }
         EXPECT_LE(size_t(x["distinct_trees"]), g.regionCount());
         EXPECT_LE(int(x["finest_level"]), int(x["effective_max_level"]));
         CsgTree t = g.treePool();

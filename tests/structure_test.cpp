@@ -167,8 +167,9 @@ TEST(StructureView, ZonesTileTheScreenRectangle) {
                 ASSERT_EQ(owners, 1) << "point " << p.x << ", " << p.y;
                 glm::dvec2 q = f.units() == FrameUnits::Pixels ? f.fromPixel(p, kW, kH) : p;
                 EXPECT_EQ(f.zoneAt(q), owner);
-                if (f.units() == FrameUnits::Pixels)
+                if (f.units() == FrameUnits::Pixels) {
                     EXPECT_EQ(f.zoneAtPixel(p.x, p.y, kW, kH), owner);
+                }
             }
             // A zone's column holds each of its slabs.
             for (uint32_t z = 0; z < f.zoneCount(); z += 7) {
@@ -261,7 +262,9 @@ TEST(StructureView, LeavesTileTheBounds) {
             EXPECT_GT(p.value, p.cell.lo[p.axis]);
             EXPECT_LT(p.value, p.cell.hi[p.axis]);
             EXPECT_EQ(p.axis, g.schedule().axis(p.level));
-            if (i) EXPECT_GE(p.level, cuts[i - 1].level);
+            if (i) {
+                EXPECT_GE(p.level, cuts[i - 1].level);
+            }
         }
         // The directory's blocks: its entries cover every cell once, each inside its leaf.
         uint64_t covered = 0;
@@ -381,7 +384,9 @@ TEST(StructureView, CornersHoldTheStretchOfRayTheWalkReports) {
                 }
             }
         }
-        if (c.scheme != SchemeKind::Brute) EXPECT_GT(checked, 0u);
+        if (c.scheme != SchemeKind::Brute) {
+            EXPECT_GT(checked, 0u);
+        }
         // Picking in 3D: the region holding a point holds it.
         std::mt19937_64 rng(c.seed);
         std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -404,10 +409,12 @@ TEST(StructureView, NeighboursShareAFace) {
         for (uint32_t id = 0; id < v.regionCount(); ++id) {
             RegionInfo r = v.region(id);
             for (int a = 0; a < 3; ++a) {
-                if (r.lo[a] >= 0)
+                if (r.lo[a] >= 0) {
                     EXPECT_EQ(v.region(uint32_t(r.lo[a])).frameBox.hi[a], r.frameBox.lo[a]);
-                if (r.hi[a] >= 0)
+                }
+                if (r.hi[a] >= 0) {
                     EXPECT_EQ(v.region(uint32_t(r.hi[a])).frameBox.lo[a], r.frameBox.hi[a]);
+                }
             }
         }
     }
@@ -425,7 +432,9 @@ TEST(StructureView, EmptyScene) {
         auto accel = buildAccelerator(scene, p);
         StructureView v(scene, *accel);
         EXPECT_EQ(v.regionCount(), accel->info().regions) << schemeName(k);
-        if (k == SchemeKind::Irregular) EXPECT_TRUE(v.frames().empty() || v.regionCount() > 0);
+        if (k == SchemeKind::Irregular) {
+            EXPECT_TRUE(v.frames().empty() || v.regionCount() > 0);
+        }
         StructureDumpOptions o;
         o.width = kW;
         o.height = kH;
@@ -526,7 +535,9 @@ TEST(StructureDump, RoundTripsTheDescription) {
                     EXPECT_EQ(sj["z0"], slabs[i].z0);
                     EXPECT_EQ(sj["z1"], slabs[i].z1);
                     EXPECT_EQ(sj["prims"].get<std::vector<uint32_t>>(), vecOf(slabs[i].prims));
-                    if (i) EXPECT_EQ(slabs[i].z0, slabs[i - 1].z1);
+                    if (i) {
+                        EXPECT_EQ(slabs[i].z0, slabs[i - 1].z1);
+                    }
                     RegionInfo r = v.region(slabs[i].region);
                     EXPECT_EQ(r.zone, z);
                     EXPECT_EQ(r.frameBox.lo.z, slabs[i].z0);

@@ -201,7 +201,9 @@ TEST(GlRoom, MergedLinesCoverExactlyTheSegmentsTheyReplace) {
         const Batch m = mergeCollinearLines(b);
         EXPECT_TRUE(viewer::testing::sameLineCover(b, m));
         // Shared faces: far fewer lines.
-        if (edges > 12 * 8) EXPECT_LT(m.lineCount(), edges * 3 / 4) << edges << " edges";
+        if (edges > 12 * 8) {
+            EXPECT_LT(m.lineCount(), edges * 3 / 4) << edges << " edges";
+        }
         // Merging again changes nothing.
         const Batch again = mergeCollinearLines(m);
         EXPECT_EQ(again.lineCount(), m.lineCount());

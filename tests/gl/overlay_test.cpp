@@ -213,8 +213,9 @@ TEST(Overlays, TheSelectionIsHighlightedWhereItsCornersProject) {
     for (int y = 0; y < kH; ++y)
         for (int x = 0; x < kW; ++x)
             if (x + 0.5 < lo.x - 2 || x + 0.5 > hi.x + 2 || y + 0.5 < lo.y - 2 ||
-                y + 0.5 > hi.y + 2)
+                y + 0.5 > hi.y + 2) {
                 ASSERT_FALSE(lit(px, x, y)) << x << "," << y << " outside the selection";
+            }
     // A region id the structure does not have selects nothing.
     EXPECT_FALSE(ov.select(uint32_t(ov.view()->regionCount())));
     EXPECT_FALSE(ov.selection().has_value());
@@ -465,7 +466,9 @@ TEST(Overlays, WhileTheCameraMovesTheLayerHoldsTheLongestLinesAndAllOnceItRests)
         for (int x = 0; x < kW; ++x) {
             litCapped += lit(capped, x, y);
             litWhole += lit(whole, x, y);
-            if (lit(capped, x, y)) EXPECT_TRUE(lit(whole, x, y)) << x << "," << y;
+            if (lit(capped, x, y)) {
+                EXPECT_TRUE(lit(whole, x, y)) << x << "," << y;
+            }
         }
     EXPECT_GT(litCapped, 0u);
     EXPECT_LT(litCapped, litWhole);

@@ -239,8 +239,9 @@ TEST(PanelLayout, NoPanelOverlapsOrLeavesTheWindowAtAnySizeAndChoiceOfPanels) {
                 expectApart(in, l);
                 EXPECT_GE(l.image.width(), std::min(260.0f, 0.2f * w));
                 const PanelRequest& ray = in[PanelId::Ray];
-                if (ray.open && !ray.collapsed && h >= 600.0f)
+                if (ray.open && !ray.collapsed && h >= 600.0f) {
                     EXPECT_GE(l[PanelId::Ray].height(), 2.0f * in.titleHeight);
+                }
                 if (::testing::Test::HasFailure()) return;
             }
 }

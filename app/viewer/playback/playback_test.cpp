@@ -113,8 +113,9 @@ TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
                 ASSERT_NE(e, nullptr);
                 EXPECT_EQ(e->a, regions[size_t(s)]["region"].get<uint32_t>());
                 EXPECT_EQ(e->t0, regions[size_t(s)]["t0"].get<double>());
-                if (!regions[size_t(s)]["t1"].is_null())
+                if (!regions[size_t(s)]["t1"].is_null()) {
                     EXPECT_EQ(e->t1, regions[size_t(s)]["t1"].get<double>());
+                }
                 EXPECT_EQ(why[size_t(s)].text, regions[size_t(s)]["why"].get<std::string>());
                 // The region drawn is the one the trace describes: the same 8 corners.
                 const std::array<Vec3, 8> c = view.regionCorners(e->a);
@@ -168,13 +169,17 @@ void backAndForth(RayPlayback& play) {
     EXPECT_EQ(play.state(), forward.back());
     for (int k = int(forward.size()) - 1; k >= 0; --k) {
         EXPECT_EQ(play.state(), forward[size_t(k)]) << "step " << k;
-        if (k > 0) EXPECT_TRUE(play.back());
+        if (k > 0) {
+            EXPECT_TRUE(play.back());
+        }
     }
     EXPECT_FALSE(play.back());
     // Steps tile the ray's events from its first region on, each opening with its Region event.
     for (size_t k = 0; k < forward.size(); ++k) {
         EXPECT_EQ(play.ray().events[forward[k].eventBegin].kind, WalkEvent::Region);
-        if (k + 1 < forward.size()) EXPECT_EQ(forward[k].eventEnd, forward[k + 1].eventBegin);
+        if (k + 1 < forward.size()) {
+            EXPECT_EQ(forward[k].eventEnd, forward[k + 1].eventBegin);
+        }
     }
     EXPECT_EQ(forward.back().eventEnd, play.ray().events.size());
     play.last();
@@ -340,9 +345,10 @@ TEST(Playback, CsgStripsHoldTheStepsNodesAndTheHitsChain) {
                             const StripRow& r = rows[s.inputs.size() + i];
                             leaf = leaf ||
                                    (r.op == Op::Primitive && r.prim == ray.hit.prim && r.onHit);
-                            if (r.onHit && s.nodes[i].parent >= 0)
+                            if (r.onHit && s.nodes[i].parent >= 0) {
                                 EXPECT_TRUE(
                                     rows[s.inputs.size() + size_t(s.nodes[i].parent)].onHit);
+                            }
                         }
                         EXPECT_TRUE(leaf);
                         ++chains;
