@@ -152,13 +152,15 @@ inline void flatUnion(SpanList& spans, SpanList& out) {
 /// again. Unlike hitInRegion, ctx.result is left unspecified. `unionOnly`: the tree has only
 /// unions, so its spans are those of its primitives merged (flatUnion), without walking it:
 /// a fifth of the render of a 598k-sphere union went to evaluating trees of unions (an active
-/// observer is still shown the tree's evaluation).
+/// observer is still shown the tree's evaluation). `tree` null: the region keeps no tree, only
+/// its primitives, of a union-only scene (the irregular scheme's regions there); they are
+/// merged by flatUnion for every observer, and the region is empty when `count` is 0.
 template <class Obs>
-[[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree& tree, int root,
+[[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree* tree, int root,
                                              const uint32_t* prims, uint32_t count, const Ray& ray,
                                              double tmin, double t0, double t1, TraceContext& ctx,
                                              Obs& obs, Hit& hit, bool unionOnly = false) {
-    if (root < 0) return false;
+    if (tree ? root < 0 : count == 0) return false;
     PendingBoundaries& pend = ctx.pending;
     if (!ctx.useMailboxes) {
         ctx.newStamp();
@@ -179,7 +181,7 @@ template <class Obs>
     }
     if (!(pend.next <= t1) && !Obs::kActive)
         return false;  // the observer is shown the spans anyway
-    if (unionOnly && !Obs::kActive) {
+    if (!tree || (unionOnly && !Obs::kActive)) {
         SpanList& spans = ctx.leafSpans;
         spans.clear();
         for (uint32_t i = 0; i < count; ++i) {
@@ -188,7 +190,7 @@ template <class Obs>
         }
         flatUnion(spans, ctx.result);
     } else {
-        evalTree<Obs, Fetch::Fresh>(scene, tree, root, ray, ctx, obs, 0, ctx.result);
+        evalTree<Obs, Fetch::Fresh>(scene, *tree, root, ray, ctx, obs, 0, ctx.result);
     }
     if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
     const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);

@@ -272,7 +272,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
             const double shownEnd = last ? std::min(tEnd, std::max(tExit, tIn)) : t1;
             obs.region(leaf, std::min(std::max(tIn, tShown), shownEnd), shownEnd);
         }
-        if (hitInLeaf(*scene_, pool_, L.root, L.primitives(primList), L.prims, ray, tmin, t0, t1,
+        if (hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList), L.prims, ray, tmin, t0, t1,
                       ctx, obs, hit, unionOnly_))
             return true;
         if constexpr (Obs::kActive) {
