@@ -453,6 +453,66 @@ TEST(Irregular, ObserverSeesRegionsPointersAndMailboxes) {
     EXPECT_EQ(ctx.counters.walkErrors, 0u);
 }
 
+// A union-only scene's regions keep their primitive lists and no restricted tree: every root is
+// -1 and the pools are empty, in both frames; the walk merges the listed primitives' spans
+// (hitInLeaf) and finds brute force's hits ray for ray, primary and secondary, and the observer
+// is told every region visit and primitive test the counters count. A CSG scene keeps its trees.
+TEST(Irregular, UnionOnlyRegionsKeepListsNotTrees) {
+    Scene scene = loadScene(std::string(LANCER_SPD_DIR) + "/balls2.nff");
+    ASSERT_TRUE(scene.tree.unionOnly());
+    auto accel = buildIrregular(scene);
+    const IrregularSubdivision& s = irregularOf(*accel);
+    EXPECT_TRUE(s.flat());
+    EXPECT_TRUE(s.projective().flat());
+    EXPECT_TRUE(s.treePool().nodes.empty());
+    EXPECT_TRUE(s.projective().treePool().nodes.empty());
+    EXPECT_EQ(accel->info().extra["distinct_trees"].get<size_t>(), 0u);
+    size_t listed = 0;
+    for (uint32_t r = 0; r < s.regions().size(); ++r) {
+        EXPECT_EQ(s.regions()[r].root, -1);
+        listed += s.primitives(r).empty() ? 0 : 1;
+    }
+    EXPECT_GT(listed, 0u);
+    for (uint32_t i = 0; i < s.projective().zoneFirst().back(); ++i)
+        EXPECT_EQ(s.projective().slabRoot(i), -1);
+    EXPECT_TRUE(s.projective().hasNearRegion());  // the eye stands among the balls' boxes
+    EXPECT_EQ(s.projective().nearRoot(), -1);
+    std::vector<Ray> rays = test::pixelRays(scene, 40, 40);
+    expectSame(scene, *accel, rays, "balls2 union-only");
+    expectSame(scene, *accel, secondaryRays(scene, rays, 3), "balls2 union-only secondary",
+               1e-9 * scene.scale());
+    test::makeOrthographic(scene);
+    auto ortho = buildIrregular(scene);
+    expectSame(scene, *ortho, test::pixelRays(scene, 40, 40), "balls2 union-only orthographic");
+
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    ctx.useMailboxes = accel->usesMailboxes();
+    uint64_t tests = 0;
+    for (const Ray& ray : test::pixelRays(scene, 12, 12)) {
+        const RayCounters before = ctx.counters;
+        RecordingObserver obs = test::recordWalk(*ortho, ray, ctx);
+        uint64_t regions = 0, prims = 0;
+        for (const WalkEvent& e : obs.events) {
+            regions += e.kind == WalkEvent::Region;
+            prims += e.kind == WalkEvent::PrimTest;
+        }
+        EXPECT_EQ(regions, ctx.counters.regionVisits - before.regionVisits);
+        EXPECT_EQ(prims, ctx.counters.primTests - before.primTests);
+        tests += prims;
+    }
+    EXPECT_GT(tests, 0u);
+
+    Scene csg = loadScene("builtin:drilled:4");
+    ASSERT_FALSE(csg.tree.unionOnly());
+    auto withTrees = buildIrregular(csg);
+    const IrregularSubdivision& t = irregularOf(*withTrees);
+    EXPECT_FALSE(t.flat());
+    EXPECT_FALSE(t.treePool().nodes.empty());
+    EXPECT_TRUE(std::any_of(t.regions().begin(), t.regions().end(),
+                            [](const IrregularRegion& r) { return r.root >= 0; }));
+    EXPECT_GT(withTrees->info().extra["distinct_trees"].get<size_t>(), 0u);
+}
+
 // Primary rays on the projective zones: regions in depth order with contiguous intervals, no
 // corner pointer, the near region first when the eye stands among the boxes.
 TEST(Irregular, ProjectiveWalkIsADepthRun) {

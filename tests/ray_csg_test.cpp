@@ -90,7 +90,7 @@ TEST(RayCsg, RootRowIsTheWalksResultAndGivesTheHit) {
                         EXPECT_EQ(last.first->t, r.hit.t);
                         EXPECT_EQ(last.first->prim, r.hit.prim);
                         const Span* ahead = nullptr;
-                        for (const Span& sp : last.nodes[0].spans)
+                        for (const Span& sp : last.result)
                             if (sp.out.t > r.tmin) {
                                 ahead = &sp;
                                 break;

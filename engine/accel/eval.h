@@ -146,21 +146,6 @@ inline void flatUnion(SpanList& spans, SpanList& out) {
     }
 }
 
-/// hitInRegion for a region that lists its tree's primitives (`prims`, `count`), walked in ray
-/// order from the ray's first region, ctx.pending cleared for it. Every boundary of a CSG result
-/// is a boundary of one of its primitives, with the same t; so when no primitive boundary lies
-/// in [t0, t1] after tmin, the region holds no hit and its tree is not evaluated. Most regions a
-/// ray crosses are like that: their primitives are hit elsewhere or not at all. The check costs
-/// one comparison: ctx.pending keeps the boundaries after tmin of every primitive this ray has
-/// tested, so a primitive taken from its mailbox adds nothing new. (A tested primitive outside
-/// this region cannot have a boundary inside it unless its box was trimmed by the CSG; then the
-/// tree is evaluated for nothing, never wrongly.) The spans are fetched once into the mailboxes
-/// (counted as tests or mailbox hits); the tree then reads them there. Without mailboxes, each
-/// region gets a fresh stamp and an empty pending list, so every region tests its primitives
-/// again. Unlike hitInRegion, ctx.result is left unspecified. `unionOnly`: the tree has only
-/// unions, so its spans are those of its primitives merged (flatUnion), without walking it:
-/// a fifth of the render of a 598k-sphere union went to evaluating trees of unions (an active
-/// observer is still shown the tree's evaluation).
 /// hitInUnionLeaf's `test` for regions that list the scene's primitives: Scene::primSpans.
 struct ScenePrimTest {
     const Scene* scene;
@@ -242,12 +227,29 @@ template <class Obs, class Test>
     return b != nullptr;
 }
 
+/// hitInRegion for a region that lists its tree's primitives (`prims`, `count`), walked in ray
+/// order from the ray's first region, ctx.pending cleared for it. Every boundary of a CSG result
+/// is a boundary of one of its primitives, with the same t; so when no primitive boundary lies
+/// in [t0, t1] after tmin, the region holds no hit and its tree is not evaluated. Most regions a
+/// ray crosses are like that: their primitives are hit elsewhere or not at all. The check costs
+/// one comparison: ctx.pending keeps the boundaries after tmin of every primitive this ray has
+/// tested, so a primitive taken from its mailbox adds nothing new. (A tested primitive outside
+/// this region cannot have a boundary inside it unless its box was trimmed by the CSG; then the
+/// tree is evaluated for nothing, never wrongly.) The spans are fetched once into the mailboxes
+/// (counted as tests or mailbox hits); the tree then reads them there. Without mailboxes, each
+/// region gets a fresh stamp and an empty pending list, so every region tests its primitives
+/// again. Unlike hitInRegion, ctx.result is left unspecified. `unionOnly`: the tree has only
+/// unions, so its spans are those of its primitives merged (flatUnion), without walking it:
+/// a fifth of the render of a 598k-sphere union went to evaluating trees of unions (an active
+/// observer is still shown the tree's evaluation). `tree` null: the region keeps no tree, only
+/// its primitives, of a union-only scene (the irregular scheme's regions there); they are
+/// merged by flatUnion for every observer, and the region is empty when `count` is 0.
 template <class Obs>
-[[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree& tree, int root,
+[[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree* tree, int root,
                                              const uint32_t* prims, uint32_t count, const Ray& ray,
                                              double tmin, double t0, double t1, TraceContext& ctx,
                                              Obs& obs, Hit& hit, bool unionOnly = false) {
-    if (root < 0) return false;
+    if (tree ? root < 0 : count == 0) return false;
     PendingBoundaries& pend = ctx.pending;
     if (!ctx.useMailboxes) {
         ctx.newStamp();
@@ -268,7 +270,7 @@ template <class Obs>
     }
     if (!(pend.next <= t1) && !Obs::kActive)
         return false;  // the observer is shown the spans anyway
-    if (unionOnly && !Obs::kActive) {
+    if (!tree || (unionOnly && !Obs::kActive)) {
         SpanList& spans = ctx.leafSpans;
         spans.clear();
         for (uint32_t i = 0; i < count; ++i) {
@@ -277,7 +279,7 @@ template <class Obs>
         }
         flatUnion(spans, ctx.result);
     } else {
-        evalTree<Obs, Fetch::Fresh>(scene, tree, root, ray, ctx, obs, 0, ctx.result);
+        evalTree<Obs, Fetch::Fresh>(scene, *tree, root, ray, ctx, obs, 0, ctx.result);
     }
     if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
     const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);

@@ -139,10 +139,11 @@ std::vector<StepCsg> rayCsg(const Scene& scene, const TracedRay& ray, const Regi
             s.carried = true;
             s.inputs = steps[size_t(lastEvaluated)].inputs;
         }
-        if (s.evaluated && s.pool) {
+        // A region without a tree (the irregular scheme's, in a union-only scene) shows its
+        // primitives' inputs and merged result only.
+        if (s.evaluated && s.pool && s.root >= 0)
             s.nodes = eval.run(*s.pool, s.root, line, s.inputs);
-            s.first = firstIn(s.result, ray.tmin, s.lo, s.hi);
-        }
+        if (s.evaluated && s.pool) s.first = firstIn(s.result, ray.tmin, s.lo, s.hi);
         if (s.evaluated && !s.carried) lastEvaluated = int(steps.size());
         steps.push_back(std::move(s));
     }
@@ -214,7 +215,14 @@ RayWaste wastedWork(const Scene& scene, const TracedRay& ray, const std::vector<
     // Does step k's first boundary change when `prim`'s spans are taken as empty?
     auto matters = [&](size_t k, uint32_t prim) {
         const StepCsg& s = steps[k];
-        if (!s.evaluated || !s.pool || s.root < 0) return false;
+        if (!s.evaluated || !s.pool) return false;
+        if (s.root < 0) {  // no tree (union-only, irregular): the others' spans merged, as the walk
+            SpanList spans, merged;
+            for (const PrimSpans& p : s.inputs)
+                if (p.prim != prim) spans.insert(spans.end(), p.spans.begin(), p.spans.end());
+            flatUnion(spans, merged);
+            return !sameOutcome(firstIn(merged, ray.tmin, s.lo, s.hi), s.first);
+        }
         std::vector<PrimSpans> without = s.inputs;
         for (PrimSpans& p : without)
             if (p.prim == prim) p.spans.clear();

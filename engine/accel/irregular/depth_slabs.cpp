@@ -1,6 +1,7 @@
 #include "engine/accel/irregular/depth_slabs.h"
 
 #include <algorithm>
+#include <optional>
 
 #include "engine/accel/build_guard.h"
 #include "engine/model/restriction.h"
@@ -11,13 +12,19 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
                            double zlo, double zhi, BuildGuard* guard, size_t maxBytes,
                            size_t maxRegions) {
     DepthSlabs out;
-    TreeRestrictor restrictor(scene.tree);
+    // A union-only scene's region is the union of its primitives: the walk merges their spans
+    // (hitInLeaf), so no tree is made, and each reference costs its list entries alone.
+    out.flat = scene.tree.unionOnly();
+    const size_t refBytes = mergedRefBytes(out.flat);
+    std::optional<TreeRestrictor> restrictor;
+    if (!out.flat) restrictor.emplace(scene.tree);
     // One tree and one list per distinct primitive set; list 0 is the empty set.
     RestrictedTreePool pool;
     auto share = [&](std::vector<uint32_t>& prims, IrregularRegion& r) {
         std::sort(prims.begin(), prims.end());
-        const RestrictedTreePool::Entry e =
-            pool.share(prims, [&](CsgTree& dst) { return restrictor.restrict(prims, dst); });
+        const RestrictedTreePool::Entry e = pool.share(prims, [&](CsgTree& dst) {
+            return restrictor ? restrictor->restrict(prims, dst) : -1;
+        });
         r.list = e.list;
         r.root = e.root;
     };
@@ -28,7 +35,7 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
                out.zoneFirstRegion.capacity() * sizeof(uint32_t) + pool.bytes();
     };
     // What the zones not cut yet cost at least (merged): kept free for them.
-    size_t reserve = bsp.zoneCount() * kMergedZoneBytes + bsp.zonePrims.size() * kMergedRefBytes;
+    size_t reserve = bsp.zoneCount() * kMergedZoneBytes + bsp.zonePrims.size() * refBytes;
     // Slabs still to make at least: one per zone not cut yet.
     size_t regionsLeft = bsp.zoneCount();
     std::vector<double> cuts, allCuts;
@@ -61,7 +68,7 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
             }
             const size_t slabs = first == last ? 1 : cuts.size() - 1;
             allSlabs += slabs;
-            allBytes += slabs * kMergedZoneBytes + refs * kMergedRefBytes;
+            allBytes += slabs * kMergedZoneBytes + refs * refBytes;
         }
         // The charge counts every reference's list entry and tree, which lists shared between
         // slabs make about half (balls:3, lattice:12): the per-zone check below holds each zone
@@ -76,7 +83,7 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
         const size_t now = guard || maxBytes ? bytes() : 0;
         const size_t k = size_t(last - first);
         const size_t refsLeft = bsp.zonePrims.size() - bsp.zoneFirst[z];
-        reserve -= kMergedZoneBytes + k * kMergedRefBytes;
+        reserve -= kMergedZoneBytes + k * refBytes;
         --regionsLeft;
         if (guard) guard->poll("depth slabs", now, out.regions.size());
         IrregularRegion r;
@@ -124,11 +131,11 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
             }
             const size_t slabs = cuts.size() - 1;
             const size_t refs = spans();
-            const size_t cost = slabs * kMergedZoneBytes + refs * kMergedRefBytes;
+            const size_t cost = slabs * kMergedZoneBytes + refs * refBytes;
             // Within the limits, and within twice the zone's share of what is left beyond every
             // zone's least (its references over theirs), so the first zones do not take it all.
             const double share = ample ? 1e300 : 2.0 * double(k) / double(refsLeft);
-            const size_t least = kMergedZoneBytes + k * kMergedRefBytes;
+            const size_t least = kMergedZoneBytes + k * refBytes;
             const bool fits =
                 (!maxBytes ||
                  (now + cost + reserve <= maxBytes &&

@@ -88,7 +88,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     sp.maxZones = kMaxZones;
     sp.maxBytes = share / 9;
     sp.zoneBytes = kMergedZoneBytes;
-    sp.refBytes = kMergedRefBytes;
+    sp.refBytes = mergedRefBytes(scene.tree.unionOnly());
     sp.guard = &guard;
     s.bsp_ = ScreenBsp::build(box, live, {s.bounds_.lo.x, s.bounds_.lo.y},
                               {s.bounds_.hi.x, s.bounds_.hi.y}, sp);
@@ -116,6 +116,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     s.pool_ = std::move(slabs.pool);
     s.listFirst_ = std::move(slabs.listFirst);
     s.listPrims_ = std::move(slabs.listPrims);
+    s.flat_ = slabs.flat;
     s.budget_ = 16 * s.regions_.size() + 1024;
 
     double eyeMs = 0.0;
@@ -148,7 +149,10 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["bsp_stopped"] = s.bsp_.stopped;
     extra["merged_zones"] = slabs.mergedZones;
     extra["coarse_zones"] = slabs.coarseZones;
-    extra["distinct_trees"] = s.listFirst_.size() - 1;
+    // Union-only scenes: regions hold their primitive lists alone (no tree, distinct_trees 0).
+    extra["flat_regions"] = s.flat_;
+    extra["distinct_lists"] = s.listFirst_.size() - 1;
+    extra["distinct_trees"] = s.flat_ ? 0 : s.listFirst_.size() - 1;
     extra["pool_nodes"] = s.pool_.nodes.size();
     extra["prims_per_region"] = double(refs) / double(s.regions_.size());
     extra["max_prims_per_region"] = most;

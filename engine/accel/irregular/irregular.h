@@ -70,8 +70,11 @@ class IrregularSubdivision {
     const ProjectiveZones& projective() const { return eye_; }
     /// Zone z's regions are [zoneFirstRegion()[z], zoneFirstRegion()[z + 1]), by depth.
     const std::vector<uint32_t>& zoneFirstRegion() const { return zoneFirstRegion_; }
-    /// The pool of the regions' restricted trees.
+    /// The pool of the regions' restricted trees (empty when flat()).
     const CsgTree& treePool() const { return pool_; }
+    /// The scene is union-only: regions keep their primitive lists and no tree (root -1); the
+    /// walk merges the listed primitives' spans (hitInLeaf, flatUnion).
+    bool flat() const { return flat_; }
     /// Primitives of a region.
     std::span<const uint32_t> primitives(uint32_t region) const {
         uint32_t l = regions_[region].list;
@@ -124,6 +127,7 @@ class IrregularSubdivision {
     CsgTree pool_;
     std::vector<uint32_t> listFirst_, listPrims_;
     size_t budget_ = 0;  ///< steps allowed to one walk
+    bool flat_ = false;
 };
 
 template <class Obs>
@@ -186,6 +190,13 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         obs.locate(frame_.toWorld(glm::clamp(rc.at(t), bounds_.lo, bounds_.hi)), r);
     size_t budget = budget_;
     int lastRoot = -1;
+    // hitInLeaf keeps the boundaries of the primitives this walk has tested, from its first
+    // region: a fresh mailbox id, so that a primitive an earlier walk of the same ray id tested
+    // (its boundaries not kept) is tested again.
+    if (flat_) {
+        ctx.newStamp();
+        ctx.pending.clear();
+    }
     for (;;) {
         const IrregularRegion& R = regions_[r];
         int axis, ties;
@@ -194,7 +205,12 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         double t1 = std::min(te, tend);
         ++ctx.counters.regionVisits;
         obs.region(r, t, t1);
-        if (R.root >= 0) {
+        if (flat_) {
+            const std::span<const uint32_t> prims = primitives(r);
+            if (hitInLeaf(*scene_, nullptr, -1, prims.data(), uint32_t(prims.size()), ray, tmin, t,
+                          t1, ctx, obs, hit))
+                return true;
+        } else if (R.root >= 0) {
             if (R.root != lastRoot) {
                 if (hitInRegion(*scene_, pool_, R.root, ray, tmin, t, t1, ctx, obs, hit))
                     return true;

@@ -84,8 +84,10 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     s.pool_ = std::move(slabs.pool);
     s.listFirst_ = std::move(slabs.listFirst);
     s.listPrims_ = std::move(slabs.listPrims);
+    s.flat_ = slabs.flat;
     std::sort(nearPrims.begin(), nearPrims.end());
-    if (!nearPrims.empty()) s.nearRoot_ = TreeRestrictor(scene.tree).restrict(nearPrims, s.pool_);
+    if (!nearPrims.empty() && !s.flat_)
+        s.nearRoot_ = TreeRestrictor(scene.tree).restrict(nearPrims, s.pool_);
     s.nearPrims_ = nearPrims;
 
     extra["projective_zones"] = s.zones_;
@@ -102,7 +104,10 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
 size_t ProjectiveZones::memoryBytes() const {
     return bsp_.memoryBytes() + zoneFirst_.size() * sizeof(uint32_t) +
            slabLo_.size() * sizeof(double) + slabRoot_.size() * sizeof(int32_t) +
-           pool_.nodes.size() * sizeof(CsgNode);
+           pool_.nodes.size() * sizeof(CsgNode) +
+           (flat_ ? (slabList_.size() + listFirst_.size() + listPrims_.size() + nearPrims_.size()) *
+                        sizeof(uint32_t)
+                  : 0);
 }
 
 }  // namespace lancer

@@ -58,7 +58,9 @@ class ProjectiveZones {
     /// The zones, in (u, v).
     const ScreenBsp& screen() const { return bsp_; }
     /// Primitives listed in the near region [0, zNear].
-    bool hasNearRegion() const { return nearRoot_ >= 0; }
+    bool hasNearRegion() const { return flat_ ? !nearPrims_.empty() : nearRoot_ >= 0; }
+    /// The scene is union-only: slabs keep their primitive lists and no tree (roots -1).
+    bool flat() const { return flat_; }
 
     // Inspection (structure_view.h).
     /// The screen rectangle in (u, v) that the zones tile.
@@ -93,11 +95,12 @@ class ProjectiveZones {
     std::vector<double> slabLo_;       ///< depth where each slab starts; the last one ends at zFar_
     std::vector<int32_t> slabRoot_;    ///< restricted tree of each slab (-1: empty)
     CsgTree pool_;
-    // The slabs' primitive lists, kept for inspection only: the walk reads the trees, so
-    // memoryBytes() leaves them out.
+    // The slabs' primitive lists: the walk reads them when flat_, the trees otherwise (then
+    // they are kept for inspection only and memoryBytes() leaves them out).
     std::vector<uint32_t> slabList_;  ///< list of each slab
     std::vector<uint32_t> listFirst_, listPrims_;
     std::vector<uint32_t> nearPrims_;
+    bool flat_ = false;
 };
 
 template <class Obs>
@@ -124,14 +127,24 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         }
     };
     double t = tmin;
-    if (nearRoot_ >= 0) {
+    // hitInLeaf keeps the boundaries of the primitives this walk has tested, from its first
+    // region: a fresh mailbox id, so that a primitive an earlier walk of the same ray id tested
+    // (its boundaries not kept) is tested again.
+    if (flat_) {
+        ctx.newStamp();
+        ctx.pending.clear();
+    }
+    if (hasNearRegion()) {
         double t1 = std::min(zNear_ / dz, tmax);
         if (t <= t1) {
             const uint32_t id = firstId + uint32_t(slabRoot_.size());
             enter(id, t);
             ++ctx.counters.regionVisits;
             obs.region(id, t, t1);
-            if (hitInRegion(scene, pool_, nearRoot_, ray, tmin, t, t1, ctx, obs, hit)) return true;
+            if (flat_ ? hitInLeaf(scene, nullptr, -1, nearPrims_.data(),
+                                  uint32_t(nearPrims_.size()), ray, tmin, t, t1, ctx, obs, hit)
+                      : hitInRegion(scene, pool_, nearRoot_, ray, tmin, t, t1, ctx, obs, hit))
+                return true;
             leave(zNear_);
         }
     }
@@ -149,7 +162,12 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         enter(firstId + i, t0);
         ++ctx.counters.regionVisits;
         obs.region(firstId + i, t0, t1);
-        if (root >= 0) {
+        if (flat_) {
+            const std::span<const uint32_t> prims = slabPrimitives(i);
+            if (hitInLeaf(scene, nullptr, -1, prims.data(), uint32_t(prims.size()), ray, tmin, t0,
+                          t1, ctx, obs, hit))
+                return true;
+        } else if (root >= 0) {
             if (root != lastRoot) {
                 if (hitInRegion(scene, pool_, root, ray, tmin, t0, t1, ctx, obs, hit)) return true;
                 lastRoot = root;

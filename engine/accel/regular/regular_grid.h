@@ -279,10 +279,10 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
             found = unionOnly_
                         ? hitInUnionLeaf(L.primitives(primList), L.prims,
                                          ScenePrimTest{scene_, &ray}, tmin, t0, t1, ctx, obs, hit)
-                        : hitInLeaf(*scene_, pool_, L.root, L.primitives(primList), L.prims, ray,
+                        : hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList), L.prims, ray,
                                     tmin, t0, t1, ctx, obs, hit);
         } else {
-            found = hitInLeaf(*scene_, pool_, L.root, L.primitives(primList), L.prims, ray, tmin,
+            found = hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList), L.prims, ray, tmin,
                               t0, t1, ctx, obs, hit, unionOnly_);
         }
         if (found) return true;
