@@ -146,6 +146,18 @@ inline void flatUnion(SpanList& spans, SpanList& out) {
     }
 }
 
+/// The union of the spans held in the mailboxes of `keys` (all filled by this walk) into
+/// ctx.result: a union-only region's spans without its tree.
+inline void mergeHeldSpans(const uint32_t* keys, uint32_t count, TraceContext& ctx) {
+    SpanList& spans = ctx.leafSpans;
+    spans.clear();
+    for (uint32_t i = 0; i < count; ++i) {
+        const Mailbox* m = ctx.heldMailbox(keys[i]);
+        spans.insert(spans.end(), m->spans, m->spans + m->count);
+    }
+    flatUnion(spans, ctx.result);
+}
+
 /// hitInUnionLeaf's `test` for regions that list the scene's primitives: Scene::primSpans.
 struct ScenePrimTest {
     const Scene* scene;
@@ -215,13 +227,7 @@ template <class Obs, class Test>
         hit = {first.t, first.prim, first.part, first.flip};
         return true;
     }
-    SpanList& spans = ctx.leafSpans;
-    spans.clear();
-    for (uint32_t i = 0; i < count; ++i) {
-        const Mailbox* m = ctx.heldMailbox(keys[i]);
-        spans.insert(spans.end(), m->spans, m->spans + m->count);
-    }
-    flatUnion(spans, ctx.result);
+    mergeHeldSpans(keys, count, ctx);
     const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
     if (b) hit = {b->t, b->prim, b->part, b->flip};
     return b != nullptr;
@@ -271,13 +277,7 @@ template <class Obs>
     if (!(pend.next <= t1) && !Obs::kActive)
         return false;  // the observer is shown the spans anyway
     if (!tree || (unionOnly && !Obs::kActive)) {
-        SpanList& spans = ctx.leafSpans;
-        spans.clear();
-        for (uint32_t i = 0; i < count; ++i) {
-            const Mailbox* m = ctx.heldMailbox(prims[i]);
-            spans.insert(spans.end(), m->spans, m->spans + m->count);
-        }
-        flatUnion(spans, ctx.result);
+        mergeHeldSpans(prims, count, ctx);
     } else {
         evalTree<Obs, Fetch::Fresh>(scene, *tree, root, ray, ctx, obs, 0, ctx.result);
     }
