@@ -80,7 +80,7 @@ struct TraceContext {
     };
     std::vector<Tag> tags;          ///< per primitive
     std::vector<Mailbox> held;      ///< [0] empty; then the current ray id's mailboxes, as filled
-    PendingBoundaries pending;      ///< of the ray the regular walk is on
+    PendingBoundaries pending;      ///< of the ray a leaf walk (hitInLeaf) is on
     std::vector<SpanList> scratch;  ///< two buffers per tree level, reused without allocation
     SpanList result;                ///< spans of the tree evaluated last
     SpanList leafSpans;             ///< the spans of a region's primitives (hitInLeaf's union)
@@ -100,6 +100,13 @@ struct TraceContext {
     void newStamp() {
         held.resize(1);  // held[0], the empty mailbox, stays
         if (++rayId == 0) wrap();
+    }
+    /// hitInLeaf's state for a walk from its first region: a fresh mailbox id (a primitive an
+    /// earlier walk of the same ray id tested, its boundaries not kept, is tested again) and no
+    /// pending boundaries.
+    void beginLeafWalk() {
+        newStamp();
+        pending.clear();
     }
     /// The mailbox primitive `p` holds for the current ray id, or null when none was filled.
     Mailbox* heldMailbox(uint32_t p) {

@@ -190,13 +190,7 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         obs.locate(frame_.toWorld(glm::clamp(rc.at(t), bounds_.lo, bounds_.hi)), r);
     size_t budget = budget_;
     int lastRoot = -1;
-    // hitInLeaf keeps the boundaries of the primitives this walk has tested, from its first
-    // region: a fresh mailbox id, so that a primitive an earlier walk of the same ray id tested
-    // (its boundaries not kept) is tested again.
-    if (flat_) {
-        ctx.newStamp();
-        ctx.pending.clear();
-    }
+    if (flat_) ctx.beginLeafWalk();
     for (;;) {
         const IrregularRegion& R = regions_[r];
         int axis, ties;

@@ -127,13 +127,7 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         }
     };
     double t = tmin;
-    // hitInLeaf keeps the boundaries of the primitives this walk has tested, from its first
-    // region: a fresh mailbox id, so that a primitive an earlier walk of the same ray id tested
-    // (its boundaries not kept) is tested again.
-    if (flat_) {
-        ctx.newStamp();
-        ctx.pending.clear();
-    }
+    if (flat_) ctx.beginLeafWalk();
     if (hasNearRegion()) {
         double t1 = std::min(zNear_ / dz, tmax);
         if (t <= t1) {
