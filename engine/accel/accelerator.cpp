@@ -5,6 +5,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include "engine/util/format.h"
+
 namespace lancer {
 
 namespace {
@@ -15,11 +17,11 @@ namespace {
 /// of the 40-50 ms the two took one after the other.
 template <class Structure, class Build, class Clock>
 std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildParams& params,
-                                             const BuildGuard& guard, Build&& build,
+                                             bool buffered, const BuildGuard& guard, Build&& build,
                                              Clock&& elapsedMs) {
     // The buffer stops with the build: a cancelled build waits for it below.
     std::future<LightBuffer> lightBuffer;
-    if (params.lightBuffer)
+    if (buffered)
         lightBuffer = std::async(std::launch::async, [&scene, stop = guard.control().stop] {
             return LightBuffer(scene, LightBuffer::kBins, stop);
         });
@@ -35,10 +37,15 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
     info.memoryBytes = s->memoryBytes();
     LightBuffer lb = lightBuffer.valid() ? lightBuffer.get() : LightBuffer();
     guard.poll();  // the buffer may have stopped early
-    if (params.lightBuffer) {
+    if (buffered) {
         info.memoryBytes += lb.memoryBytes();
         info.extra["light_buffer_bytes"] = lb.memoryBytes();
         info.extra["light_buffer_lights"] = lb.mappedLights();
+    } else if (params.lightBuffer) {
+        info.extra["light_buffer_left_out"] =
+            formatBytes(LightBuffer::bytesAtMost(scene.lights.size())) +
+            " is over a quarter of the memory budget (--memory-budget " +
+            formatBytes(guard.given()) + ")";
     }
     info.buildMs = elapsedMs();
     return std::make_unique<Accelerator>(std::move(*s), params, std::move(info), std::move(lb));
@@ -49,7 +56,15 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
 std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params,
                                               const BuildControl& control) {
     if (!scene.prepared) throw std::logic_error("buildAccelerator: scene not prepared");
-    BuildGuard guard(params.memoryBudget, control);
+    // The light buffer is held with the structure, so its bytes (known before it is built) come
+    // out of the budget. It only shortens shadow rays' walks (the same hits without it): when it
+    // would take more than a quarter of the budget, it is left out and the structure gets all.
+    const size_t budget = params.memoryBudget ? params.memoryBudget : defaultMemoryBudget();
+    const size_t lightBytes = params.scheme != SchemeKind::Brute && params.lightBuffer
+                                  ? LightBuffer::bytesAtMost(scene.lights.size())
+                                  : 0;
+    const bool buffered = params.lightBuffer && lightBytes <= budget / 4;
+    BuildGuard guard(budget, control, buffered ? lightBytes : 0);
     auto start = std::chrono::steady_clock::now();
     auto elapsedMs = [&] {
         return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -66,14 +81,14 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
         }
         case SchemeKind::Regular:
             return withLightBuffer<RegularGrid>(
-                scene, params, guard,
+                scene, params, buffered, guard,
                 [&](AccelInfo& info) {
                     return RegularGrid::build(scene, params.regular, info.extra, &guard);
                 },
                 elapsedMs);
         case SchemeKind::Irregular:
             return withLightBuffer<IrregularSubdivision>(
-                scene, params, guard,
+                scene, params, buffered, guard,
                 [&](AccelInfo& info) {
                     return IrregularSubdivision::build(scene, params.irregular, info.extra, &guard);
                 },

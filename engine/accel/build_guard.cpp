@@ -6,6 +6,8 @@
 #include <cctype>
 #include <cmath>
 
+#include "engine/util/format.h"
+
 namespace lancer {
 
 size_t physicalMemoryBytes() {
@@ -51,11 +53,18 @@ size_t parseMemoryBudget(const std::string& text) {
     return size_t(v);
 }
 
-BuildGuard::BuildGuard(size_t budget, BuildControl control)
-    : budget_(budget ? budget : defaultMemoryBudget()),
+BuildGuard::BuildGuard(size_t budget, BuildControl control, size_t held)
+    : given_(budget ? budget : defaultMemoryBudget()),
+      budget_(given_ - std::min(held, given_)),
       control_(std::move(control)),
       start_(std::chrono::steady_clock::now()),
       last_(start_) {}
+
+std::string BuildGuard::describe() const {
+    if (budget_ == given_) return formatBytes(given_);
+    return formatBytes(given_) + " (" + formatBytes(given_ - budget_) +
+           " of it held by the light buffer)";
+}
 
 void BuildGuard::report(const char* stage, size_t bytes, size_t items) {
     const std::unique_lock lock(reporting_, std::try_to_lock);

@@ -51,10 +51,16 @@ struct BuildControl {
 /// the next growth stays within the whole (fits()).
 class BuildGuard {
   public:
-    /// `budget` 0: defaultMemoryBudget().
-    explicit BuildGuard(size_t budget = 0, BuildControl control = {});
+    /// `budget` 0: defaultMemoryBudget(). `held`: bytes of it that something built beside the
+    /// structure holds (the light buffer); the structure may take the rest.
+    explicit BuildGuard(size_t budget = 0, BuildControl control = {}, size_t held = 0);
 
+    /// The bytes the structure may take: the whole budget but what is held beside it.
     size_t budget() const { return budget_; }
+    /// The whole budget (--memory-budget, or the default), as messages name it.
+    size_t given() const { return given_; }
+    /// The budget as messages name it: "4.0 MiB", and what is held beside the structure.
+    std::string describe() const;
     /// Arrays of `bytes` (by capacity) can still grow once within `limit` (default: the budget).
     static bool fits(size_t bytes, size_t limit) { return bytes <= limit / 3; }
     bool fits(size_t bytes) const { return fits(bytes, budget_); }
@@ -74,7 +80,7 @@ class BuildGuard {
   private:
     void report(const char* stage, size_t bytes, size_t items);
 
-    size_t budget_;
+    size_t given_, budget_;
     BuildControl control_;
     std::chrono::steady_clock::time_point start_, last_;  ///< last_: under reporting_
     std::atomic<unsigned> calls_{0};

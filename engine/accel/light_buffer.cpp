@@ -277,6 +277,15 @@ size_t LightBuffer::memoryBytes() const {
     return bytes;
 }
 
+size_t LightBuffer::bytesAtMost(size_t points, int bins, int slots) {
+    // As buildMap() makes them: n x n fine bins, and max(1, n / 4)^2 coarse ones; a task's
+    // scratch is a column of n bins' depths (two doubles each), the points a Vec3 each.
+    const size_t n = size_t(std::max(1, bins)), coarse = std::max<size_t>(1, n / 4);
+    const size_t k = size_t(std::clamp(slots, 1, kSlots));
+    return points * (sizeof(Map) + (n * n + coarse * coarse) * k * sizeof(Slot) +
+                     2 * n * sizeof(double) + sizeof(Vec3));
+}
+
 size_t LightBuffer::mappedLights() const {
     return size_t(std::count_if(maps_.begin(), maps_.end(),
                                 [](const Map& m) { return !m.fine.slots.empty(); }));

@@ -93,6 +93,10 @@ class LightBuffer {
 
     bool empty() const { return maps_.empty(); }
     size_t memoryBytes() const;
+    /// The most a buffer for `points` lights (or eyes) holds, known before it is built: each
+    /// map's fine and coarse bins at their largest (memoryBytes() at most), and while it is
+    /// built, the scratch of each map's task.
+    static size_t bytesAtMost(size_t points, int bins = kBins, int slots = kSlots);
     /// Lights with a depth map.
     size_t mappedLights() const;
 

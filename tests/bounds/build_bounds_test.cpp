@@ -167,6 +167,50 @@ TEST(BoundedBuild, RegularOverItsBudgetIsRefusedWithinIt) {
     EXPECT_LE(peak, p.memoryBudget);
 }
 
+TEST(BoundedBuild, TheLightBufferIsHeldWithinTheBudget) {
+    // At the defaults the light buffer is built beside the structure and held with it: its
+    // bytes come out of the budget, and when they would pass a quarter of it the buffer is left
+    // out. Either way the whole build (structure and buffer, both threads) stays within the
+    // budget, or is refused within it, with brute force's hits.
+    Scene scene = sponge();
+    ASSERT_GT(scene.lights.size(), 0u);
+    const size_t light = LightBuffer::bytesAtMost(scene.lights.size());
+    for (SchemeKind scheme : {SchemeKind::Regular, SchemeKind::Irregular}) {
+        for (size_t budget : {5 * light, light}) {  // the buffer held; left out
+            SCOPED_TRACE(std::string(schemeName(scheme)) + " under " + std::to_string(budget));
+            BuildParams p;
+            p.scheme = scheme;
+            p.memoryBudget = budget;
+            std::unique_ptr<Accelerator> a;
+            const size_t peak = peakOf([&] {
+                try {
+                    a = buildAccelerator(scene, p);
+                } catch (const std::invalid_argument& e) {
+                    EXPECT_NE(std::string(e.what()).find("--memory-budget"), std::string::npos)
+                        << e.what();
+                }
+            });
+            std::printf("%s, budget %zu (light buffer at most %zu): peak heap %zu%s\n",
+                        schemeName(scheme), budget, light, peak, a ? "" : " (refused)");
+            EXPECT_LE(peak, budget);
+            if (!a) continue;
+            const nlohmann::json& x = a->info().extra;
+            EXPECT_LE(a->info().memoryBytes, budget) << x.dump();
+            if (light <= budget / 4) {
+                EXPECT_GT(x.value("light_buffer_bytes", size_t(0)), 0u) << x.dump();
+                EXPECT_LE(x.value("light_buffer_bytes", size_t(0)), light);
+            } else {
+                EXPECT_FALSE(x.contains("light_buffer_bytes")) << x.dump();
+                EXPECT_NE(x.value("light_buffer_left_out", std::string()).find("over a quarter"),
+                          std::string::npos)
+                    << x.dump();
+            }
+            auto bad = test::compareWithBrute(scene, *a, test::pixelRays(scene, 32, 32));
+            EXPECT_TRUE(bad.empty()) << bad.size() << " rays differ from brute force";
+        }
+    }
+}
+
 TEST(BoundedBuild, BudgetOptionValues) {
     EXPECT_EQ(parseMemoryBudget("512M"), size_t(512) << 20);
     EXPECT_EQ(parseMemoryBudget("2GiB"), size_t(2) << 30);

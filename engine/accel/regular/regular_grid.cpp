@@ -397,7 +397,7 @@ struct RegularBuilder {
         guard.poll("regular BSP", b, made);
         if (!guard.fits(b))
             throw std::invalid_argument(
-                "--memory-budget " + formatBytes(guard.budget()) + ": the regular subdivision at " +
+                "--memory-budget " + guard.describe() + ": the regular subdivision at " +
                 options() + " passes its memory budget (" + formatBytes(b) + " after " +
                 std::to_string(made) +
                 " BSP nodes, with room to grow); lower --max-level, raise --max-objects or raise "
@@ -906,7 +906,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
             what + ": the regular directory at level " + std::to_string(finest) + " would take " +
             (dirBytes == SIZE_MAX ? std::string("2^") + std::to_string(finest + 2) + " bytes"
                                   : formatBytes(dirBytes)) +
-            ", over the memory budget of " + formatBytes(budget) + " (--memory-budget)" +
+            ", over the memory budget of " + guard.describe() + " (--memory-budget)" +
             (full ? "; use sub-tables (drop --full-table)" : "; lower --max-level"));
     }
     guard.poll();
