@@ -182,7 +182,8 @@ int main(int argc, char** argv) {
                        "Each scheme at its defaults, and the peer: the comparison table");
     benchCmd
         ->add_option("--schemes", bopt.schemes,
-                     "Schemes measured; without brute (--schemes-only only) no speedup or error")
+                     "Schemes measured; without brute (--schemes-only or --scale only) no speedup "
+                     "or error")
         ->check(CLI::IsMember({"brute", "regular", "irregular"}))
         ->capture_default_str();
     bool scale = false;
@@ -222,7 +223,9 @@ int main(int argc, char** argv) {
                      "--scale: the builds' --memory-budget (0: an eighth of physical memory)")
         ->capture_default_str()
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
-    benchCmd->add_flag("--no-peer{false}", scaleOpt.peer, "--scale: without Embree");
+    benchCmd->add_flag("--no-peer{false}", scaleOpt.peer,
+                       "--scale: without Embree (measured only at --bounces 0, on scenes that are "
+                       "a union of primitives)");
 
     // Hidden: the README's option section, generated from the parameter table.
     CLI::App* helpOptions = app.add_subcommand("help-options", "")->group("");

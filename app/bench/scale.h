@@ -13,6 +13,8 @@
 namespace lancer::bench {
 
 struct ScaleOptions {
+    // scenes to outDir: `lancer bench --scale` sets them from bench's own options (256x256, all
+    // cores, 3 bounces, bench-out unless given); the defaults here are the scale table's.
     std::vector<std::string> scenes;
     int width = 512, height = 512;
     bool sceneSize = false;  ///< each scene's own image size instead of width x height
