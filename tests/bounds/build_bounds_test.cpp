@@ -145,6 +145,50 @@ TEST(BoundedBuild, IrregularRuleFitsTheMeasuredPeak) {
     }
 }
 
+TEST(BoundedBuild, IrregularUnderItsLeastStructureIsRefusedWithinIt) {
+    // Budgets from a byte up: each one either refuses, naming --memory-budget, or builds within
+    // it (peak heap and structure), with brute force's hits. A budget limit of 0 bytes once
+    // meant "no limit" (a 1-byte budget built the unbounded 2.3 MB structure), and budgets
+    // under the least structure built it anyway, over them.
+    Scene scene = sponge();
+    BuildParams p;
+    p.scheme = SchemeKind::Irregular;
+    p.lightBuffer = false;
+    for (IrregularFrame frame : {IrregularFrame::Camera, IrregularFrame::Projective}) {
+        p.irregular.frame = frame;
+        SCOPED_TRACE(irregularFrameName(frame));
+        int refused = 0, built = 0;
+        for (size_t budget :
+             {size_t(1), size_t(17), size_t(1) << 10, size_t(16) << 10, size_t(32) << 10,
+              size_t(48) << 10, size_t(64) << 10, size_t(256) << 10}) {
+            SCOPED_TRACE(budget);
+            p.memoryBudget = budget;
+            std::unique_ptr<Accelerator> a;
+            const size_t peak = peakOf([&] {
+                try {
+                    a = buildAccelerator(scene, p);
+                } catch (const std::invalid_argument& e) {
+                    const std::string what = e.what();
+                    EXPECT_EQ(what.rfind("--memory-budget ", 0), 0u) << what;
+                    EXPECT_NE(what.find("raise --memory-budget"), std::string::npos) << what;
+                }
+            });
+            if (!a) {
+                EXPECT_LE(peak, 4096u);  // the primitives' list and the message, nothing built
+                ++refused;
+                continue;
+            }
+            EXPECT_LE(peak, budget);
+            ++built;
+            EXPECT_LE(a->info().memoryBytes, budget);
+            auto bad = test::compareWithBrute(scene, *a, test::pixelRays(scene, 24, 24));
+            EXPECT_TRUE(bad.empty()) << bad.size() << " rays differ from brute force";
+        }
+        EXPECT_GE(refused, 3);  // 1 B, 17 B and 1 KiB hold no structure of 221 primitives
+        EXPECT_GE(built, 1);    // 256 KiB holds a coarse one
+    }
+}
+
 TEST(BoundedBuild, RegularOverItsBudgetIsRefusedWithinIt) {
     Scene scene = sponge();
     BuildParams p;

@@ -48,16 +48,16 @@ PY2
 # A build over --memory-budget is a refusal row naming the budget, a failure (exit status 1);
 # the stopped irregular build under the same budget passes.
 "$LANCER" bench --scale --scenes "$SRC/assets/openscad/sponge.csg" --schemes brute regular irregular \
-  --width 24 --height 24 --no-peer --memory-budget 64K --out "$tmp/budget" >"$tmp/out" 2>&1
+  --width 24 --height 24 --no-peer --memory-budget 256K --out "$tmp/budget" >"$tmp/out" 2>&1
 [ $? -eq 1 ] || fail "a refused build did not exit 1: $(cat "$tmp/out")"
-grep -q "^- .*/sponge.csg regular: refused: --memory-budget 64.0 KiB: " "$tmp/budget/scale.md" \
+grep -q "^- .*/sponge.csg regular: refused: --memory-budget 256.0 KiB: " "$tmp/budget/scale.md" \
   || fail "refusal not listed with its budget: $(cat "$tmp/out")"
 grep -q "^- .*/sponge.csg irregular" "$tmp/budget/scale.md" \
   && fail "the stopped irregular build failed: $(cat "$tmp/out")"
 python3 - "$tmp/budget/scale.json" <<'PY3' || fail "scale.json of the refusal"
 import json, sys
 rows = {r["scheme"]: r for r in json.load(open(sys.argv[1]))["rows"]}
-assert rows["regular"]["refused"].startswith("--memory-budget 64.0 KiB"), rows["regular"]
+assert rows["regular"]["refused"].startswith("--memory-budget 256.0 KiB"), rows["regular"]
 i = rows["irregular"]
 assert "failure" not in i and i["hits_differing"] == 0 and i["pixels_compared"] == 24 * 24, i
 PY3

@@ -8,6 +8,7 @@
 #include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/corner_pointers.h"
 #include "engine/accel/irregular/depth_slabs.h"
+#include "engine/util/format.h"
 
 namespace lancer {
 
@@ -26,6 +27,11 @@ constexpr size_t kMaxZones = 4'000'000;
 /// 16 times their sum, within 2^20..2^23 (docs/irregular.md, "Budget and stopping rule").
 size_t regionBudget(size_t prims, size_t pixels) {
     return std::clamp<size_t>(16 * (prims + pixels), size_t(1) << 20, size_t(1) << 23);
+}
+/// Refuses a build past `guard`'s budget: `what` says what would take how much.
+[[noreturn]] void refuseOverBudget(const BuildGuard& guard, const std::string& what) {
+    throw std::invalid_argument("--memory-budget " + guard.describe() +
+                                ": the irregular subdivision " + what + "; raise --memory-budget");
 }
 /// Regions beyond this many are refused: pointers are 32-bit and memory would run out first.
 constexpr size_t kMaxRegions = 50'000'000;
@@ -56,6 +62,17 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
         return s;
     }
 
+    const size_t frames = params.frame == IrregularFrame::Projective ? 2 : 1;
+    const size_t share = guard.budget() / frames;
+    // The least a frame's build holds: the primitives' boxes, the screen BSP's root cell, and
+    // one zone whose one region lists every primitive. A budget too small for it is refused
+    // before anything is built; the limits below are at least a byte, since 0 would mean none.
+    const size_t least = scene.prims.size() * sizeof(Box3) + ScreenBsp::rootBytes(live.size()) +
+                         kMergedZoneBytes + live.size() * mergedRefBytes(scene.tree.unionOnly());
+    if (least > share)
+        refuseOverBudget(guard, "needs at least " + formatBytes(least) + " a frame (" +
+                                    std::to_string(frames) + " frame" + (frames > 1 ? "s" : "") +
+                                    ")");
     // Camera-frame boxes, padded by a few thousand rounding errors of the largest coordinate
     // involved, so that a hit point and the ray's own camera-frame point never fall outside the
     // box of the primitive they belong to; the structure's box is padded twice as much so every
@@ -80,13 +97,12 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     // zones (when built). Of each share, the screen BSP may take a ninth (then it stops) and the
     // slabs two ninths (then each further zone's slabs merge into one): a third in all, so the
     // arrays can still double (BuildGuard::fits).
-    const size_t share = guard.budget() / (params.frame == IrregularFrame::Projective ? 2 : 1);
     ScreenBspParams sp;
     sp.heuristic = params.heuristic;
     sp.stopObjects = params.maxObjects;
     sp.stepCost = params.costStop ? params.stepCost : 0.0;
     sp.maxZones = kMaxZones;
-    sp.maxBytes = share / 9;
+    sp.maxBytes = std::max<size_t>(share / 9, 1);
     sp.zoneBytes = kMergedZoneBytes;
     sp.refBytes = mergedRefBytes(scene.tree.unionOnly());
     sp.guard = &guard;
@@ -97,8 +113,9 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     // 3D step.
     guard.poll();
     auto t1 = Clock::now();
+    const size_t slabBytes = std::max<size_t>(2 * share / 9, 1);
     DepthSlabs slabs = buildDepthSlabs(scene, s.bsp_, box, s.bounds_.lo.z, s.bounds_.hi.z, &guard,
-                                       2 * share / 9, maxRegions);
+                                       slabBytes, maxRegions);
     if (slabs.regions.size() > kMaxRegions)
         throw std::invalid_argument("--scheme irregular: " + std::to_string(slabs.regions.size()) +
                                     " regions is over the limit of " + std::to_string(kMaxRegions) +
@@ -123,8 +140,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["frame"] = irregularFrameName(params.frame);
     if (params.frame == IrregularFrame::Projective) {
         auto t3 = Clock::now();
-        s.eye_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, extra, 2 * share / 9,
-                                        maxRegions);
+        s.eye_ =
+            ProjectiveZones::build(scene, s.frame_, box, live, sp, extra, slabBytes, maxRegions);
         eyeMs = ms(t3);
     }
 
@@ -160,6 +177,10 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["slabs_ms"] = slabMs;
     extra["pointers_ms"] = linkMs;
     extra["projective_ms"] = eyeMs;
+    // The 2D step and the slabs keep within a third of the budget; what they cannot stop (the
+    // regions' fixed part, the trees) is checked here, so no structure over it is returned.
+    if (s.memoryBytes() > guard.budget())
+        refuseOverBudget(guard, "takes " + formatBytes(s.memoryBytes()) + " at its coarsest");
     return s;
 }
 

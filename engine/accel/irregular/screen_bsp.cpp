@@ -217,11 +217,21 @@ void renumber(ScreenBsp& bsp, const std::vector<uint8_t>& firstSide) {
 
 }  // namespace
 
+size_t ScreenBsp::rootBytes(size_t prims) {
+    // Four edges a rectangle. Scoring the root's line puts each segment's line or both its ends
+    // in arrays of doubles that may double, and sorts the lines with two 64-bit keys each.
+    const size_t segs = 4 * prims;
+    return segs * sizeof(Segment) + prims * sizeof(uint32_t) + 2 * 2 * segs * sizeof(double) +
+           2 * segs * sizeof(uint64_t);
+}
+
 ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint32_t>& prims,
                            glm::dvec2 lo, glm::dvec2 hi, const ScreenBspParams& params) {
     ScreenBsp bsp;
     bsp.zoneFirst.push_back(0);
     Cell top{lo, hi, {}, {}, -1, 0, 0};
+    top.segs.reserve(4 * prims.size());
+    top.prims.reserve(prims.size());
     // The four edges of each rectangle, in primitive order; an edge on the cell's border splits
     // nothing and is left out.
     for (uint32_t p : prims) {

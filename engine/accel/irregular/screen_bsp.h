@@ -59,6 +59,9 @@ struct ScreenBsp {
     /// Build over the rectangles rect[p].xy of the primitives `prims`, inside [lo, hi].
     static ScreenBsp build(const std::vector<Box3>& rect, const std::vector<uint32_t>& prims,
                            glm::dvec2 lo, glm::dvec2 hi, const ScreenBspParams& params);
+    /// The most a build over `prims` rectangles holds before its first split (the root cell's
+    /// lists and the scratch scoring its line): the least any budget must leave it.
+    static size_t rootBytes(size_t prims);
 };
 
 }  // namespace lancer
