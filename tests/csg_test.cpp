@@ -2,6 +2,7 @@
 // agreement with the full tree inside a region.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "engine/accel/eval.h"
@@ -126,9 +127,65 @@ TEST(Restriction, InPlaceWritesTheAppendedNodesAndUnionSizeCountsThem) {
         }
         EXPECT_EQ(out[size].prim, 12345u);
         EXPECT_EQ(marks, std::vector<char>(marks.size(), 0));
+        // The same nodes from the kept leaves alone.
+        ASSERT_TRUE(restrictor.unionsOnly());
+        std::vector<CsgNode> direct(size + 1);
+        direct[size].prim = 12345u;
+        std::vector<int> scratch;
+        EXPECT_EQ(restrictor.restrictUnions(prims, direct.data(), 3, scratch), appended.root);
+        for (size_t i = 0; i < size; ++i)
+            EXPECT_TRUE(direct[i].op == out[i].op && direct[i].left == out[i].left &&
+                        direct[i].right == out[i].right && direct[i].prim == out[i].prim)
+                << "node " << i << " of the restriction to " << prims.size() << " primitives";
+        EXPECT_EQ(direct[size].prim, 12345u);
     }
     EXPECT_EQ(restrictor.unionSize(std::vector<uint32_t>{7}), 3u);
     EXPECT_EQ(restrictor.unionSize(std::vector<uint32_t>{}), 0u);
+}
+
+TEST(Restriction, UnionsFromTheKeptLeavesAsTheWalkOnRandomShapes) {
+    // Unions of random shapes (chains, lopsided and balanced parts), primitives in a shuffled
+    // order, some in two leaves, a leaf the root does not reach: restrictUnions() writes the
+    // walk's nodes, numbered alike.
+    std::mt19937 rng(11);
+    for (int trial = 0; trial < 300; ++trial) {
+        CsgTree t;
+        const uint32_t prims = 1 + rng() % 60;
+        std::vector<int> parts;
+        for (uint32_t p = 0; p < prims; ++p)
+            parts.push_back(t.leaf((p * 7 + uint32_t(trial)) % prims));
+        for (int d = 0; d < int(rng() % 4); ++d) parts.push_back(t.leaf(rng() % prims));
+        std::shuffle(parts.begin(), parts.end(), rng);
+        t.leaf(rng() % prims);  // unreached
+        while (parts.size() > 1) {
+            const size_t i = rng() % (parts.size() - 1);
+            parts[i] = t.combine(Op::Union, parts[i], parts[i + 1]);
+            parts.erase(parts.begin() + std::ptrdiff_t(i) + 1);
+        }
+        t.root = parts[0];
+        const TreeRestrictor restrictor(t);
+        ASSERT_TRUE(restrictor.unionsOnly());
+        std::vector<char> marks(restrictor.nodeCount(), 0);
+        std::vector<int> scratch;
+        for (int set = 0; set < 20; ++set) {
+            std::vector<uint32_t> keep;
+            const uint32_t share = 1 + rng() % 4;
+            for (uint32_t p = 0; p < prims; ++p)
+                if (rng() % share == 0) keep.push_back(p);
+            CsgTree walked;
+            walked.nodes.resize(5);
+            walked.root = restrictor.restrict(keep, walked, marks);
+            const size_t size = walked.nodes.size() - 5;
+            std::vector<CsgNode> direct(size);
+            ASSERT_EQ(restrictor.restrictUnions(keep, direct.data(), 5, scratch), walked.root);
+            for (size_t i = 0; i < size; ++i) {
+                const CsgNode &a = walked.nodes[5 + i], &b = direct[i];
+                ASSERT_TRUE(a.op == b.op && a.left == b.left && a.right == b.right &&
+                            a.prim == b.prim)
+                    << "trial " << trial << " node " << i << " of " << size << ": " << t.toString();
+            }
+        }
+    }
 }
 
 TEST(CsgTree, DepthOfALongChainAndABalancedUnion) {

@@ -8,7 +8,9 @@
 #include <random>
 #include <set>
 
+#include "engine/accel/build_guard.h"
 #include "engine/accel/eval.h"
+#include "engine/accel/regular/directory.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
 #include "tests/support/differential.h"
@@ -502,6 +504,22 @@ TEST(RegularSubTables, SameLeafAsFullTableInLessMemory) {
                         L.lo[2] <= k && k < L.hi[2]);
         }
     }
+}
+
+// The directory's fill polls the build's guard: a cancelled build stops there too (a full table
+// of 2^18 entries for one leaf is written by that leaf alone).
+TEST(RegularDirectory, FillStopsWhenTheBuildIsCancelled) {
+    BspNodes bsp;
+    bsp.nodes.resize(1);
+    std::stop_source stop;
+    stop.request_stop();
+    const BuildGuard cancelled(0, {stop.get_token(), {}});
+    Directory d;
+    EXPECT_THROW(d.build(bsp, AxisSchedule(), 18, true, &cancelled), BuildCancelled);
+    const BuildGuard running;
+    d.build(bsp, AxisSchedule(), 18, true, &running);
+    EXPECT_EQ(d.entryCount(), size_t(1) << 18);
+    EXPECT_EQ(d.lookup(5, 17, 63), 0u);
 }
 
 // A rope is a cached directory lookup: for every face of every leaf, each finest cell just

@@ -13,15 +13,22 @@ namespace lancer {
 
 void LightBuffer::Map::project(const Box3& x, double& dNear, double& uLo, double& uHi, double& vLo,
                                double& vHi) const {
-    dNear = s > 0.0 ? L[a] - x.hi[a] : x.lo[a] - L[a];
-    const double dFar = s > 0.0 ? L[a] - x.lo[a] : x.hi[a] - L[a];
+    // Coordinates by coord(): the axes are known at run time only.
+    const double la = coord(L, a), lb = coord(L, b), lc = coord(L, c);
+    dNear = s > 0.0 ? la - coord(x.hi, a) : coord(x.lo, a) - la;
+    const double dFar = s > 0.0 ? la - coord(x.lo, a) : coord(x.hi, a) - la;
+    const double b0 = coord(x.lo, b) - lb, b1 = coord(x.hi, b) - lb;
+    const double c0 = coord(x.lo, c) - lc, c1 = coord(x.hi, c) - lc;
+    quotients(dNear, dFar, b0, b1, c0, c1, uLo, uHi, vLo, vHi);
+}
+
+void LightBuffer::Map::quotients(double dNear, double dFar, double b0, double b1, double c0,
+                                 double c1, double& uLo, double& uHi, double& vLo, double& vHi) {
     // n / d is monotone in n and in d (d > 0): the extremes are at the box's corners, and which
     // corner is known from the numerator's sign (a correctly rounded division is monotone too):
     // n >= 0 is least over the farthest depth, n < 0 over the nearest. Four divisions instead of
     // eight, the same quotients (a box of 600,000 is projected twice per light).
     if (dNear > 0.0 && dFar >= dNear) {
-        const double b0 = x.lo[b] - L[b], b1 = x.hi[b] - L[b];
-        const double c0 = x.lo[c] - L[c], c1 = x.hi[c] - L[c];
         uLo = b0 / (b0 >= 0.0 ? dFar : dNear);
         uHi = b1 / (b1 >= 0.0 ? dNear : dFar);
         vLo = c0 / (c0 >= 0.0 ? dFar : dNear);
@@ -32,8 +39,8 @@ void LightBuffer::Map::project(const Box3& x, double& dNear, double& uLo, double
     uHi = vHi = -kInf;
     for (double d : {dNear, dFar})
         for (int k = 0; k < 2; ++k) {
-            const double u = ((k ? x.hi[b] : x.lo[b]) - L[b]) / d;
-            const double v = ((k ? x.hi[c] : x.lo[c]) - L[c]) / d;
+            const double u = (k ? b1 : b0) / d;
+            const double v = (k ? c1 : c0) / d;
             uLo = std::min(uLo, u), uHi = std::max(uHi, u);
             vLo = std::min(vLo, v), vHi = std::max(vHi, v);
         }
@@ -183,13 +190,15 @@ bool LightBuffer::buildMap(Map& m, const Vec3& point, const std::vector<Box3>& b
 }
 
 bool LightBuffer::image(const Map& m, const Box3& mb, double side, double largeArea, BoxImage& im) {
-    if (mb.isEmpty()) return false;                  // a dropped primitive
-    Box3 x{mb.lo - Vec3(side), mb.hi + Vec3(side)};  // widened across the view axis only
-    x.lo[m.a] = mb.lo[m.a], x.hi[m.a] = mb.hi[m.a];
-    m.project(x, im.dn, im.u0, im.u1, im.v0, im.v1);
-    im.df = m.s > 0.0 ? m.L[m.a] - x.lo[m.a] : x.hi[m.a] - m.L[m.a];
-    im.b0 = x.lo[m.b] - m.L[m.b], im.b1 = x.hi[m.b] - m.L[m.b];
-    im.c0 = x.lo[m.c] - m.L[m.c], im.c1 = x.hi[m.c] - m.L[m.c];
+    if (mb.isEmpty()) return false;  // a dropped primitive
+    // The box widened across the view axis only, by `side`, seen from the point: what
+    // m.project() of the widened box computes, with the differences kept for Grid::add.
+    const double la = coord(m.L, m.a), lb = coord(m.L, m.b), lc = coord(m.L, m.c);
+    im.dn = m.s > 0.0 ? la - coord(mb.hi, m.a) : coord(mb.lo, m.a) - la;
+    im.df = m.s > 0.0 ? la - coord(mb.lo, m.a) : coord(mb.hi, m.a) - la;
+    im.b0 = (coord(mb.lo, m.b) - side) - lb, im.b1 = (coord(mb.hi, m.b) + side) - lb;
+    im.c0 = (coord(mb.lo, m.c) - side) - lc, im.c1 = (coord(mb.hi, m.c) + side) - lc;
+    Map::quotients(im.dn, im.df, im.b0, im.b1, im.c0, im.c1, im.u0, im.u1, im.v0, im.v1);
     im.large = (im.u1 - im.u0) * (im.v1 - im.v0) > largeArea;
     return true;
 }

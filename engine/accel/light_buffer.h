@@ -163,6 +163,10 @@ class LightBuffer {
         }
         void project(const Box3& x, double& dNear, double& u0, double& u1, double& v0,
                      double& v1) const;
+        /// The rectangle of project() from the box's depths and its extents relative to the
+        /// point on the two image axes.
+        static void quotients(double dNear, double dFar, double b0, double b1, double c0, double c1,
+                              double& u0, double& u1, double& v0, double& v1);
     };
     /// The bin of the shadow ray from `o` along `dir` toward light `light`, with o's depth `d`
     /// and the fall of the depth per unit of t; null when the buffer does not know.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/glm.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <limits>
 #include <string>
 
@@ -14,6 +15,10 @@ using Mat4 = glm::dmat4;
 using Mat3 = glm::dmat3;
 
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// Coordinate `a` (0, 1 or 2) of `v`. glm's operator[] is a switch on the index, a branch or two
+/// per access where the axis is known only at run time (the builders' loops over primitives).
+inline double coord(const Vec3& v, int a) { return glm::value_ptr(v)[a]; }
 
 std::string toString(const Vec3& v);
 

@@ -1,5 +1,7 @@
 #include "engine/model/restriction.h"
 
+#include <algorithm>
+
 #include "engine/util/hash.h"
 
 namespace lancer {
@@ -84,6 +86,69 @@ TreeRestrictor::TreeRestrictor(const CsgTree& tree) : tree_(&tree), parent_(tree
             leafNodes_[leafFirst_[tree.nodes[n].prim]++] = int(n);
     for (size_t p = leafFirst_.size(); p-- > 1;) leafFirst_[p] = leafFirst_[p - 1];
     if (!leafFirst_.empty()) leafFirst_[0] = 0;
+    // A union-only tree's depth-first places, for restrictUnions(), from a stack rather than a
+    // recursion (a chain of unions may be deep): a node is placed when first met, and its
+    // subtree's end set when ~node, pushed under its children, comes back up.
+    unionsOnly_ = tree.unionOnly();
+    if (!unionsOnly_ || tree.root < 0) return;
+    places_.assign(tree.nodes.size(), Place{});
+    std::vector<int> stack{tree.root};
+    int placed = 0;
+    while (!stack.empty()) {
+        const int n = stack.back();
+        stack.pop_back();
+        if (n < 0) {
+            places_[size_t(~n)].last = placed;
+            continue;
+        }
+        places_[size_t(n)].pre = placed++;
+        stack.push_back(~n);
+        const CsgNode& x = tree.nodes[size_t(n)];
+        if (x.op != Op::Primitive) stack.push_back(x.right), stack.push_back(x.left);
+    }
+}
+
+int TreeRestrictor::restrictUnions(std::span<const uint32_t> prims, CsgNode* out, int base,
+                                   std::vector<int>& scratch) const {
+    // The kept leaves the root reaches, in depth-first order (a balanced union of primitives
+    // listed in order already has them so).
+    scratch.clear();
+    for (uint32_t p : prims) {
+        if (size_t(p) + 1 >= leafFirst_.size()) continue;
+        for (uint32_t l = leafFirst_[p]; l < leafFirst_[size_t(p) + 1]; ++l)
+            if (places_[size_t(leafNodes_[l])].pre >= 0) scratch.push_back(leafNodes_[l]);
+    }
+    const auto before = [&](int a, int b) {
+        return places_[size_t(a)].pre < places_[size_t(b)].pre;
+    };
+    if (!std::is_sorted(scratch.begin(), scratch.end(), before))
+        std::sort(scratch.begin(), scratch.end(), before);
+    const size_t leaves = scratch.size();
+    if (leaves == 0) return -1;
+    // restrictWalk writes a union once its right side is done, that is before the first kept
+    // leaf past it: the unions met between two leaves wait on a stack (behind the leaves in
+    // `scratch`), each with its left side's root, and those below the next meeting point are
+    // written, deepest first, before the next leaf.
+    ArrayDst dst{out, base};
+    const std::vector<CsgNode>& nodes = tree_->nodes;
+    int cur = dst.leaf(nodes[size_t(scratch[0])].prim);
+    for (size_t i = 1; i < leaves; ++i) {
+        const int next = places_[size_t(scratch[i])].pre;
+        int meet = parent_[size_t(scratch[i - 1])];
+        while (!(places_[size_t(meet)].pre <= next && next < places_[size_t(meet)].last))
+            meet = parent_[size_t(meet)];
+        while (scratch.size() > leaves &&
+               places_[size_t(scratch[scratch.size() - 2])].pre > places_[size_t(meet)].pre) {
+            cur = dst.combine(Op::Union, scratch.back(), cur);
+            scratch.resize(scratch.size() - 2);
+        }
+        scratch.push_back(meet);
+        scratch.push_back(cur);
+        cur = dst.leaf(nodes[size_t(scratch[i])].prim);
+    }
+    for (; scratch.size() > leaves; scratch.resize(scratch.size() - 2))
+        cur = dst.combine(Op::Union, scratch.back(), cur);
+    return cur;
 }
 
 void TreeRestrictor::mark(std::span<const uint32_t> prims, char value,

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "engine/accel/build_guard.h"
+
 namespace lancer {
 
 AxisSchedule::AxisSchedule() : AxisSchedule(std::vector<int>{}) {}
@@ -56,14 +58,28 @@ size_t Directory::estimateBytes(const BspNodes& bsp, int finestLevel, bool full)
     return entries * sizeof(uint32_t) + tables * sizeof(Table);
 }
 
-void Directory::build(const BspNodes& bsp, const AxisSchedule& schedule, int finestLevel,
-                      bool full) {
+void Directory::build(const BspNodes& bsp, const AxisSchedule& schedule, int finestLevel, bool full,
+                      const BuildGuard* guard) {
     schedule_ = schedule;
     entries_.clear();
     tables_.clear();
+    guard_ = guard;
+    unpolled_ = 0;
+    struct Unset {
+        const BuildGuard*& g;
+        ~Unset() { g = nullptr; }
+    } unset{guard_};
     addTable(bsp, 0, 0, finestLevel, full);
     entries_.shrink_to_fit();
     tables_.shrink_to_fit();
+}
+
+void Directory::written(size_t entries) {
+    // Polled by the entries written, not by the leaves: a full table's leaf may own millions.
+    unpolled_ += entries;
+    if (unpolled_ < kPollEntries) return;
+    unpolled_ = 0;
+    if (guard_) guard_->poll();
 }
 
 uint32_t Directory::addTable(const BspNodes& bsp, int node, int level, int finestLevel, bool full) {
@@ -101,10 +117,12 @@ void Directory::fill(const BspNodes& bsp, uint32_t table, int tableLevel, int le
             lo[a] = pos[a] << size;
             hi[a] = (pos[a] + 1) << size;
         }
-        for (uint32_t x = lo[0]; x < hi[0]; ++x)
+        for (uint32_t x = lo[0]; x < hi[0]; ++x) {
             for (uint32_t y = lo[1]; y < hi[1]; ++y)
                 for (uint32_t z = lo[2]; z < hi[2]; ++z)
                     entries_[t.offset + (x << t.lowBits) + (y << t.bits[2]) + z] = value;
+            written(size_t(hi[1] - lo[1]) * (hi[2] - lo[2]));
+        }
         return;
     }
     const int axis = schedule_.axis(level);  // the cut at level + 1

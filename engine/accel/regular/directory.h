@@ -10,6 +10,8 @@
 
 namespace lancer {
 
+class BuildGuard;
+
 /// The axis the regular BSP cuts at each level. Every node of a level is cut on the same axis,
 /// at its middle, so the cells of a level are all alike, and a cell's level fixes how many times
 /// each axis was cut: the directory's resolution per axis follows from the finest level. The
@@ -60,8 +62,10 @@ class Directory {
 
     /// Bytes the table built by `build` would take, computed without allocating it.
     static size_t estimateBytes(const BspNodes& bsp, int finestLevel, bool full);
-    /// Fill the directory of a BSP cut by `schedule` whose deepest leaf is at `finestLevel`.
-    void build(const BspNodes& bsp, const AxisSchedule& schedule, int finestLevel, bool full);
+    /// Fill the directory of a BSP cut by `schedule` whose deepest leaf is at `finestLevel`,
+    /// polling `guard` (when given) for a cancellation as it goes.
+    void build(const BspNodes& bsp, const AxisSchedule& schedule, int finestLevel, bool full,
+               const BuildGuard* guard = nullptr);
 
     /// Leaf number of the finest cell (i, j, k), each index in [0, 2^n) of its axis.
     uint32_t lookup(uint32_t i, uint32_t j, uint32_t k) const {
@@ -145,9 +149,15 @@ class Directory {
     void fill(const BspNodes& bsp, uint32_t table, int tableLevel, int levels, int node, int level,
               const uint32_t pos[3], int finestLevel, bool full);
 
+    /// Polls guard_ once in kPollEntries entries written (a leaf's block counts its entries).
+    void written(size_t entries);
+    static constexpr size_t kPollEntries = size_t(1) << 16;
+
     std::vector<uint32_t> entries_;
     std::vector<Table> tables_;
-    AxisSchedule schedule_;  ///< of the BSP being filled
+    AxisSchedule schedule_;              ///< of the BSP being filled
+    const BuildGuard* guard_ = nullptr;  ///< while build() runs
+    size_t unpolled_ = 0;                ///< entries written since guard_ was last polled
 };
 
 }  // namespace lancer

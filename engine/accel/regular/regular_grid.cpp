@@ -240,8 +240,8 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
             for (size_t i = ch.begin; i < ch.end; ++i) {
                 const uint32_t r = refs[i];
                 const Box3& b = boxes[r];
-                if (b.lo[axis] <= mid) *lo++ = r;
-                if (b.hi[axis] >= mid) *hi++ = r;
+                if (coord(b.lo, axis) <= mid) *lo++ = r;
+                if (coord(b.hi, axis) >= mid) *hi++ = r;
             }
         }));
         fence.acquire();
@@ -340,9 +340,10 @@ struct RegularBuilder {
     /// primitives' ancestors, and cells keep no tree (restricting each cell's tree for its
     /// children took half of the build on balls:5). Null: each cell restricts its tree.
     std::unique_ptr<TreeRestrictor> restrictor;
-    /// Per thread: membership marks of restrictTreeTo (one per primitive) and the restrictor's
-    /// (one per node of the scene's tree), all 0 between uses; a use never waits for a task.
-    tbb::enumerable_thread_specific<std::vector<char>> keep, restrictorMarks;
+    /// Per thread: membership marks of restrictTreeTo (one per primitive), all 0 between uses,
+    /// and the restrictor's scratch; a use never waits for a task.
+    tbb::enumerable_thread_specific<std::vector<char>> keep;
+    tbb::enumerable_thread_specific<std::vector<int>> restrictorScratch;
     std::atomic<size_t> nodes{1};  ///< BSP nodes made by every fragment
     std::atomic<size_t> bytes{0};  ///< the fragments' bytes(), as last reported
 
@@ -362,8 +363,6 @@ struct RegularBuilder {
         // log2 N.
         if (unionOnly && s.tree.depth() <= kRestrictorDepth) {
             restrictor = std::make_unique<TreeRestrictor>(s.tree);
-            restrictorMarks = tbb::enumerable_thread_specific<std::vector<char>>(
-                [n = restrictor->nodeCount()] { return std::vector<char>(n, 0); });
         }
     }
 
@@ -429,8 +428,8 @@ struct RegularBuilder {
         size_t count[2] = {0, 0};
         for (uint32_t p : prims) {
             const Box3& b = scene.minBox[p];
-            if (b.lo[axis] <= mid) tests[0] += weight[p], ++count[0];
-            if (b.hi[axis] >= mid) tests[1] += weight[p], ++count[1];
+            if (coord(b.lo, axis) <= mid) tests[0] += weight[p], ++count[0];
+            if (coord(b.hi, axis) >= mid) tests[1] += weight[p], ++count[1];
         }
         const double parentArea = area(box);
         double cost = 0.0;
@@ -440,7 +439,8 @@ struct RegularBuilder {
                 PrimList& in = f.look[depth];
                 in.clear();
                 for (uint32_t p : prims)
-                    if (side ? scene.minBox[p].hi[axis] >= mid : scene.minBox[p].lo[axis] <= mid)
+                    if (side ? coord(scene.minBox[p].hi, axis) >= mid
+                             : coord(scene.minBox[p].lo, axis) <= mid)
                         in.push_back(p);
                 if (!coveredByAll(scene, in, child[side]))
                     c = std::min(c, splitCost(f, child[side], in, level + 1, depth - 1));
@@ -508,14 +508,15 @@ struct RegularBuilder {
         for (size_t s = 0; s < sets; ++s) at[s + 1] = at[s] + restrictor->unionSize(setOf(s));
         TaskFence fence;
         try {
-            tbb::parallel_for(
-                tbb::blocked_range<size_t>(0, sets, 1024), fence.task([&](const auto& r) {
-                    guard.poll();
-                    std::vector<char>& marks = restrictorMarks.local();
-                    for (size_t s = r.begin(); s != r.end(); ++s)
-                        if (at[s + 1] > at[s])
-                            restrictor->restrict(setOf(s), nodes.data() + at[s], int(at[s]), marks);
-                }));
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, sets, 1024),
+                              fence.task([&](const auto& r) {
+                                  guard.poll();
+                                  std::vector<int>& scratch = restrictorScratch.local();
+                                  for (size_t s = r.begin(); s != r.end(); ++s)
+                                      if (at[s + 1] > at[s])
+                                          restrictor->restrictUnions(setOf(s), nodes.data() + at[s],
+                                                                     int(at[s]), scratch);
+                              }));
         } catch (...) {
             fence.acquire();
             throw;
@@ -553,10 +554,10 @@ struct RegularBuilder {
                 if (scene.minBox[p].overlaps(child)) out.push_back(p);
         } else if (side == 0) {
             for (uint32_t p : prims)
-                if (scene.minBox[p].lo[axis] <= mid) out.push_back(p);
+                if (coord(scene.minBox[p].lo, axis) <= mid) out.push_back(p);
         } else {
             for (uint32_t p : prims)
-                if (scene.minBox[p].hi[axis] >= mid) out.push_back(p);
+                if (coord(scene.minBox[p].hi, axis) >= mid) out.push_back(p);
         }
     }
 
@@ -635,8 +636,8 @@ struct RegularBuilder {
             if (unitWeights) {
                 for (uint32_t p : prims) {
                     const Box3& b = boxes[p];
-                    *lo = p, lo += b.lo[axis] <= mid;
-                    *hi = p, hi += b.hi[axis] >= mid;
+                    *lo = p, lo += coord(b.lo, axis) <= mid;
+                    *hi = p, hi += coord(b.hi, axis) >= mid;
                 }
                 all = double(prims.size());
                 tests[0] = double(lo - in0.data());
@@ -645,7 +646,7 @@ struct RegularBuilder {
                 for (uint32_t p : prims) {
                     const Box3& b = boxes[p];
                     const double w = weight[p];
-                    const bool l = b.lo[axis] <= mid, h = b.hi[axis] >= mid;
+                    const bool l = coord(b.lo, axis) <= mid, h = coord(b.hi, axis) >= mid;
                     all += w;
                     *lo = p, lo += l;
                     *hi = p, hi += h;
@@ -910,7 +911,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
             (full ? "; use sub-tables (drop --full-table)" : "; lower --max-level"));
     }
     guard.poll();
-    dir_.build(bsp, schedule_, finest, full);
+    dir_.build(bsp, schedule_, finest, full, &guard);
 
     // Ropes: across each face, the cell at the face's low corner names the neighbour leaf; it is
     // the only one when it covers the face on the other two axes.
