@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <set>
 
@@ -751,7 +752,7 @@ TEST(RegularCost, ManySmallSeparatedPrimitivesAreSplitDeeply) {
     p.regular.maxObjects = 1;
     auto a = buildAccelerator(s, p);
     const auto& x = a->info().extra;
-    EXPECT_EQ(int(x["effective_max_level"]), automaticMaxLevel(200));
+    EXPECT_EQ(int(x["effective_max_level"]), automaticMaxLevel(200) + kGainDepth);
     EXPECT_GE(int(x["finest_level"]), 15);
     EXPECT_LE(int(x["max_prims_per_leaf"]), 2);
     EXPECT_LT(double(x["prims_per_leaf"]), 1.0);  // empty space cut away: more leaves than spheres
@@ -773,10 +774,53 @@ TEST(RegularCost, AutomaticMaxLevelGrowsWithThePrimitiveCount) {
     EXPECT_EQ(automaticMaxLevel(7382), 24);    // balls4
     EXPECT_EQ(automaticMaxLevel(597871), 28);  // balls:6
     EXPECT_EQ(automaticMaxLevel(size_t(1) << 62), 48);
+    // The automatic depth goes kGainDepth levels below the base level where the gain floor
+    // lets a split through.
     RegularConfig c;
+    EXPECT_EQ(effectiveMaxLevel(c, 7382), 24 + kGainDepth);
+    EXPECT_EQ(gainLevel(c, 7382), 24);
+    // Without the cost stop nothing bounds the depth but the cap: the base level.
+    c.costStop = false;
     EXPECT_EQ(effectiveMaxLevel(c, 7382), 24);
+    EXPECT_EQ(gainLevel(c, 7382), std::numeric_limits<int>::max());
+    // An explicit max-level is a cap kept as it is, with no gain floor.
+    c.costStop = true;
     c.maxLevel = 7;
     EXPECT_EQ(effectiveMaxLevel(c, 7382), 7);
+    EXPECT_EQ(gainLevel(c, 7382), std::numeric_limits<int>::max());
+}
+
+TEST(RegularCost, GainFloorSplitsTheDenseCellsOfASphereflakeDeeper) {
+    // balls:4: the sphereflake's smallest spheres, 1/81 of the largest, cluster around their
+    // parents. With a uniform depth (the base level as an explicit cap) the cells holding the
+    // clusters stop at the cap, many spheres each; the gain floor takes those deeper, and only
+    // those: a few more leaves, fewer tests, and every hit is brute force's.
+    Scene s = loadScene("builtin:balls:4");
+    s.prepare();
+    const size_t n = s.tree.primitives().size();
+    BuildParams p = regular();
+    // A lower floor than the default's 8, which lets balls:6's clusters (of 9^6 spheres) go
+    // deeper but not balls:4's.
+    p.regular.minGain = 2.0;
+    auto floor = buildAccelerator(s, p);
+    p.regular.maxLevel = automaticMaxLevel(n);
+    auto uniform = buildAccelerator(s, p);
+    const auto &xf = floor->info().extra, &xu = uniform->info().extra;
+    EXPECT_GT(size_t(xf["gain_leaves"]), 0u);
+    EXPECT_EQ(xu["gain_level"], nullptr);
+    EXPECT_EQ(int(xf["gain_level"]), automaticMaxLevel(n));
+    EXPECT_GT(int(xf["finest_level"]), automaticMaxLevel(n));
+    std::vector<Ray> rays = test::pixelRays(s, 64, 64);
+    const auto more = test::randomRays(s, 7, 3000);
+    rays.insert(rays.end(), more.begin(), more.end());
+    auto bad = test::compareWithBrute(s, *floor, rays);
+    EXPECT_TRUE(bad.empty()) << describe(s, bad);
+    EXPECT_EQ(walkErrors(s, *floor, rays), 0u);
+    const RayCounters f = test::traceCounters(s, *floor, rays),
+                      u = test::traceCounters(s, *uniform, rays);
+    EXPECT_LT(f.primTests, u.primTests);
+    EXPECT_LT(double(floor->info().regions), 1.05 * double(uniform->info().regions));
+    EXPECT_GT(floor->info().regions, uniform->info().regions);
 }
 
 TEST(RegularBuild, LeavesHoldTheirOverlappingPrimitivesAndShareTrees) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <ostream>
 #include <sstream>
 
@@ -45,7 +46,14 @@ int automaticMaxLevel(size_t primitives) {
 }
 
 int effectiveMaxLevel(const RegularConfig& config, size_t primitives) {
-    return config.maxLevel > 0 ? config.maxLevel : automaticMaxLevel(primitives);
+    if (config.maxLevel > 0) return config.maxLevel;
+    const int base = automaticMaxLevel(primitives);
+    return config.costStop ? std::min(base + kGainDepth, 48) : base;
+}
+
+int gainLevel(const RegularConfig& config, size_t primitives) {
+    if (config.maxLevel > 0 || !config.costStop) return std::numeric_limits<int>::max();
+    return automaticMaxLevel(primitives);
 }
 
 std::string toString(const BuildParams& p) {
