@@ -328,6 +328,137 @@ TEST(RegularUnion, SphereflakeRenderEqualsBruteForce) {
     EXPECT_GT(fast.primTests, rays.size());
 }
 
+/// A union of spheres of sizes 1 to 1/1000 of the scene, far from the origin, with exact
+/// duplicates (ties between spheres sharing their boundary) and spheres touching, over a floor
+/// polygon (a primitive the sphere quads cannot reject); and rays that graze spheres (at the
+/// radius, a hair inside and outside it), start inside them, or are aimed at their centres.
+struct QuadScene {
+    Scene scene;
+    std::vector<Ray> rays;
+};
+
+QuadScene quadScene(uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    QuadScene q;
+    Scene& s = q.scene;
+    const Vec3 offset(1e4, -3e3, 2e3);
+    std::vector<int> leaves;
+    std::vector<Sphere> spheres;
+    for (int i = 0; i < 400; ++i) {
+        Sphere sp;
+        sp.r = 10.0 * std::pow(1e-3, u(rng));
+        sp.c = offset + Vec3(u(rng), u(rng), u(rng)) * 100.0;
+        if (i % 10 == 1) sp = spheres.back();  // a duplicate: the same spans
+        if (i % 10 == 2) {                     // touching the previous one
+            const Sphere& o = spheres.back();
+            const Vec3 dir = glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5));
+            sp.c = o.c + dir * (o.r + sp.r);
+        }
+        spheres.push_back(sp);
+        s.prims.push_back(makePrimitive(sp, Transform{}));
+        leaves.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
+    }
+    Polygon floor;
+    makePolygon({offset + Vec3(-10, -10, -1), offset + Vec3(110, -10, -1),
+                 offset + Vec3(110, 110, -1), offset + Vec3(-10, 110, -1)},
+                floor);
+    s.prims.push_back(makePrimitive(floor, Transform{}));
+    leaves.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
+    s.tree.root = s.tree.balanced(Op::Union, leaves);
+    s.prepare();
+    const auto unit = [&] {
+        return glm::normalize(Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) + 1e-9);
+    };
+    for (size_t i = 0; i < spheres.size(); ++i) {
+        const Sphere& sp = spheres[i];
+        const Vec3 d = unit();
+        // Perpendicular to d: the line passes at distance `at` from the centre.
+        const Vec3 side = glm::normalize(glm::cross(d, unit()));
+        for (double at : {0.0, 1.0, 1.0 - 1e-12, 1.0 + 1e-12, 1.0 - 1e-7, 1.0 + 1e-7}) {
+            const Vec3 p = sp.c + side * (at * sp.r);
+            q.rays.push_back({p - d * 300.0, d});                      // from outside the scene
+            q.rays.push_back({p - d * (0.5 * sp.r), d * 1e-3});        // near it, a short d
+            q.rays.push_back({sp.c + unit() * (0.5 * sp.r), unit()});  // from inside it
+        }
+    }
+    std::vector<Ray> random = test::randomRays(s, seed, 3000);
+    q.rays.insert(q.rays.end(), random.begin(), random.end());
+    return q;
+}
+
+// The quads' first look at a leaf's spheres (RegularGrid::quadMisses) rejects only spheres
+// whose exact test finds no span, at every point of the ray the walk may take it from (near
+// each leaf), and rejects most of a leaf's spheres that the ray misses.
+TEST(RegularUnion, SphereQuadsRejectOnlyMisses) {
+    size_t rejected = 0, missed = 0, grazing = 0;
+    for (uint64_t seed : {3u, 4u}) {
+        QuadScene q = quadScene(seed);
+        const Scene& s = q.scene;
+        auto accel = buildAccelerator(s, regular());
+        const RegularGrid& g = gridOf(*accel);
+        ASSERT_FALSE(g.sphereQuads().empty());
+        const std::vector<uint32_t>& list = g.primList();
+        for (const Ray& ray : q.rays) {
+            RegularGrid::QuadRay qr = g.quadRay(ray);
+            double tA, tB;
+            if (!clipLine(ray, g.box(), tA, tB)) continue;
+            for (double f : {0.0, 0.3, 1.0}) {
+                qr.at(ray.at(tA + f * (tB - tA)));
+                for (size_t k = 0; k < g.sphereQuads().size(); ++k) {
+                    const uint32_t misses = RegularGrid::quadMisses(g.sphereQuads()[k], qr);
+                    for (size_t j = 0; j < 4 && 4 * k + j < list.size(); ++j) {
+                        Span spans[2];
+                        const uint32_t p = list[4 * k + j];
+                        const int n = s.primSpans(p, ray, spans);
+                        if (misses >> j & 1) {
+                            ASSERT_EQ(n, 0) << "sphere " << p << " rejected, but the ray "
+                                            << ray.toString() << " meets it";
+                            ++rejected;
+                        } else if (n > 0 && (spans[0].out.t - spans[0].in.t) * glm::length(ray.d) <
+                                                2e-3 * s.packedSpheres[p].r) {
+                            ++grazing;  // kept, as it must be: the ray barely meets it
+                        }
+                        missed += n == 0;
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_GT(rejected, missed * 9 / 10) << "the quads should reject most missed spheres";
+    EXPECT_GT(grazing, 100u);
+}
+
+// The walk with the sphere quads (no active observer) against the walk an observer sees (each
+// leaf's tree evaluated) and against brute force: the same hits, and the same tests, mailbox
+// hits and leaf visits, on rays that graze spheres, start inside them, start at tmin > 0, and on
+// the floor the quads cannot reject. Without the mailboxes too.
+TEST(RegularUnion, SphereQuadWalkEqualsObservedWalkAndBruteForce) {
+    for (uint64_t seed : {5u, 6u}) {
+        QuadScene q = quadScene(seed);
+        const Scene& s = q.scene;
+        for (bool mailboxes : {true, false}) {
+            BuildParams p = regular();
+            p.mailboxes = mailboxes;
+            auto accel = buildAccelerator(s, p);
+            ASSERT_FALSE(gridOf(*accel).sphereQuads().empty());
+            auto bad = test::compareWithBrute(s, *accel, q.rays);
+            ASSERT_TRUE(bad.empty()) << bad.size() << " rays differ\n" << describe(s, bad);
+            auto later = test::compareWithBrute(s, *accel, q.rays, 1e-4 * s.scale());
+            ASSERT_TRUE(later.empty()) << "tmin > 0\n" << describe(s, later);
+            const RayCounters fast = test::traceCounters(s, *accel, q.rays);
+            TraceContext ctx(s.prims.size(), s.tree.depth());
+            ctx.useMailboxes = accel->usesMailboxes();
+            for (const Ray& r : q.rays) test::recordWalk(*accel, r, ctx);
+            EXPECT_EQ(fast.primTests, ctx.counters.primTests);
+            EXPECT_EQ(fast.mailboxHits, ctx.counters.mailboxHits);
+            EXPECT_EQ(fast.regionVisits, ctx.counters.regionVisits);
+            EXPECT_GT(fast.primTests, 2 * q.rays.size());
+            if (mailboxes) EXPECT_GT(fast.mailboxHits, 0u);
+        }
+    }
+}
+
 TEST(RegularUnion, UnionOnlyScenesRayForRay) {
     size_t total = 0;
     for (uint64_t seed = 1; seed <= 6; ++seed) {

@@ -26,6 +26,7 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
             return LightBuffer(scene, LightBuffer::kBins, stop);
         });
     AccelInfo info;
+    info.treeDepth = scene.tree.depth();
     std::optional<Structure> s;
     try {
         s.emplace(build(info));
@@ -73,6 +74,7 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
     switch (params.scheme) {
         case SchemeKind::Brute: {
             AccelInfo info;
+            info.treeDepth = scene.tree.depth();
             BruteForce b = BruteForce::build(scene, BruteConfig{}, info.extra);
             info.regions = b.regionCount();
             info.memoryBytes = b.memoryBytes();

@@ -109,8 +109,10 @@ void LightBuffer::insert(Slot* bin, int k, Slot x) {
 }
 
 LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
-                         const std::vector<Vec3>& points, int bins, int slots,
-                         std::stop_token stop) {
+                         const std::vector<Vec3>& points, int bins, int slots, std::stop_token stop,
+                         Use use)
+    : nearOnly_(use == Use::NearOnly) {
+    if (nearOnly_) slots = 1;
     if (bounds.isEmpty() || !bounds.isBounded() || points.empty()) return;
     const Vec3 e = bounds.extent();
     const double largest = std::max({e.x, e.y, e.z});
@@ -183,8 +185,8 @@ bool LightBuffer::buildMap(Map& m, const Vec3& point, const std::vector<Box3>& b
         if ((i & 255) == 0 && stop.stop_requested()) return false;
         BoxImage im;
         if (!image(m, boxes[i], side, largeArea, im)) continue;
-        m.fine.add(im, colLo, colHi);
-        if (window && im.large) m.coarse.add(im, colLo, colHi);
+        m.fine.add(im, colLo, colHi, nearOnly_);
+        if (window && im.large) m.coarse.add(im, colLo, colHi, nearOnly_);
     }
     return true;
 }
@@ -240,9 +242,20 @@ bool coneDepths(double ua, double ub, double w0, double w1, double& lo, double& 
 }  // namespace
 
 void LightBuffer::Grid::add(const BoxImage& im, std::vector<double>& colLo,
-                            std::vector<double>& colHi) {
+                            std::vector<double>& colHi, bool nearOnly) {
     const int i0 = index(im.u0 - pad, u0, su), i1 = index(im.u1 + pad, u0, su);
     const int j0 = index(im.v0 - pad, v0, sv), j1 = index(im.v1 + pad, v0, sv);
+    // Every depth the box gives a bin is at least its nearest, im.dn: where each of its bins
+    // already holds one as near, it changes no bin's least depth (on balls:6 seen from the
+    // camera, 586,117 of 597,872 boxes; the eye's buffer then takes 20-26 ms instead of 28-33).
+    if (nearOnly && k == 1) {
+        bool lowers = false;
+        for (int j = j0; j <= j1 && !lowers; ++j) {
+            const Slot* row = at(0, j);
+            for (int i = i0; i <= i1 && !lowers; ++i) lowers = row[i].near > im.dn;
+        }
+        if (!lowers) return;
+    }
     // A bin's cone: its image rectangle widened by pad (far above the rounding of the bin a
     // point falls in), the cone's depths widened by 1e-12 of themselves (far above that of the
     // divisions). A bin at the grid's edge also holds the points clamped into it: its cone is

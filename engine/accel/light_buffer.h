@@ -44,6 +44,11 @@ class LightBuffer {
     /// bins cover the others' images only.
     static constexpr double kLargeShare = 1.0 / 16.0;
 
+    /// What a buffer answers: shadow rays' stretches (shadowSegments) and nearFrom, or nearFrom
+    /// alone (an eye's buffer: its bins keep the least depth only, and boxes that lower none of
+    /// their bins' are skipped; shadowSegments says it does not know).
+    enum class Use : uint8_t { Shadows, NearOnly };
+
     LightBuffer() = default;
     /// One depth map per light of the (prepared) scene that lies outside its bounds, kSlots
     /// intervals per bin.
@@ -54,7 +59,8 @@ class LightBuffer {
     /// ones are skipped), `slots` intervals per bin (1 to kSlots): the scene's lights, or the
     /// eye of a perspective camera (which needs only the least depth: 1).
     LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes, const std::vector<Vec3>& points,
-                int bins = kBins, int slots = kSlots, std::stop_token stop = {});
+                int bins = kBins, int slots = kSlots, std::stop_token stop = {},
+                Use use = Use::Shadows);
 
     /// A stretch [t0, t1] of a shadow ray that boxes may occupy.
     struct Segment {
@@ -144,8 +150,11 @@ class LightBuffer {
             return at(int(fu), int(fv));
         }
         /// Add a box to the bins its image meets (clamped into the grid), each with the depths
-        /// at which the bin's cone of sight meets the box. colLo, colHi: scratch.
-        void add(const struct BoxImage& im, std::vector<double>& colLo, std::vector<double>& colHi);
+        /// at which the bin's cone of sight meets the box. colLo, colHi: scratch. `nearOnly`
+        /// (one interval a bin): a box whose nearest depth lowers no bin's is skipped, so the
+        /// bins' far ends are left unspecified.
+        void add(const struct BoxImage& im, std::vector<double>& colLo, std::vector<double>& colHi,
+                 bool nearOnly = false);
     };
     struct Map {
         Vec3 L{0.0};
@@ -172,7 +181,7 @@ class LightBuffer {
     /// and the fall of the depth per unit of t; null when the buffer does not know.
     const Slot* shadowBin(const Vec3& o, const Vec3& dir, uint32_t light, double& d,
                           double& rate) const {
-        if (light >= maps_.size()) return nullptr;
+        if (light >= maps_.size() || nearOnly_) return nullptr;
         const Map& m = maps_[light];
         if (m.fine.slots.empty() || !box_.contains(o)) return nullptr;
         d = m.s * (m.L[m.a] - o[m.a]);  // > 0: o is in the box, the light beyond
@@ -190,6 +199,7 @@ class LightBuffer {
     Box3 box_;               ///< the scene bounds, widened by hair_
     double hair_ = 0.0;      ///< rounding allowance, in scene units
     std::vector<Map> maps_;  ///< per scene light
+    bool nearOnly_ = false;  ///< built for Use::NearOnly
 };
 
 }  // namespace lancer

@@ -49,7 +49,7 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     // Where each primary ray can first meet a box (empty unless the scheme uses one).
     const LightBuffer eyeBuilt = eyeGiven ? LightBuffer() : accel.eyeBuffer(scene, cam);
     const LightBuffer& eye = eyeGiven ? *eyeGiven : eyeBuilt;
-    const int depth = scene.tree.depth();
+    const int depth = accel.info().treeDepth >= 0 ? accel.info().treeDepth : scene.tree.depth();
     const bool mailboxes = accel.usesMailboxes();
     tbb::enumerable_thread_specific<TraceContext> contexts([&] {
         TraceContext c(scene.prims.size(), depth);

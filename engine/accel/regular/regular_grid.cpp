@@ -6,6 +6,8 @@
 #include <tbb/task_group.h>
 
 #include <atomic>
+#include <cmath>
+#include <limits>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -991,6 +993,8 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     }
     fence.acquire();
 
+    if (unionOnly_) makeSphereQuads();
+
     extra_ = {
         {"directory", full ? "full" : "sub-tables"},
         {"directory_bytes", dir_.memoryBytes()},
@@ -1015,6 +1019,36 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         {"prims_per_leaf", leaves_.empty() ? 0.0 : double(root.primRefs) / double(leaves_.size())},
         {"max_prims_per_leaf", root.maxPrims},
     };
+}
+
+void RegularGrid::makeSphereQuads() {
+    const Scene& scene = *scene_;
+    quadScale_ = 0.0;
+    for (int a = 0; a < 3; ++a)
+        quadScale_ = std::max({quadScale_, std::abs(clipBox_.lo[a]), std::abs(clipBox_.hi[a])});
+    // A centre and the walk's point in floats are each off by 2^-24 of the largest coordinate:
+    // the radius is grown by ten times their sum, and by ten times the floats' relative
+    // rounding of the comparison.
+    const double grow = 1e-6 * quadScale_;
+    bool spheres = false;
+    quads_.assign((primList_.size() + 3) / 4, SphereQuad{});
+    for (size_t i = 0; i < primList_.size(); ++i) {
+        const uint32_t p = primList_[i];
+        SphereQuad& q = quads_[i / 4];
+        const size_t j = i % 4;
+        const bool packed = p < scene.packedSpheres.size() && scene.packedSpheres[p].r >= 0.0;
+        if (!packed) {
+            q.x[j] = q.y[j] = q.z[j] = 0.0f;
+            q.r[j] = std::numeric_limits<float>::infinity();
+            continue;
+        }
+        const PackedSphere& s = scene.packedSpheres[p];
+        spheres = true;
+        q.x[j] = float(s.c.x), q.y[j] = float(s.c.y), q.z[j] = float(s.c.z);
+        const double r = s.r * (1.0 + 4e-6) + grow;
+        q.r[j] = std::nextafter(float(r), std::numeric_limits<float>::infinity());
+    }
+    if (!spheres) quads_.clear();
 }
 
 std::string RegularGrid::describeLeaf(uint32_t id) const {

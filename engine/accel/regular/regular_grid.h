@@ -12,6 +12,9 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
 
 #include "engine/accel/build_params.h"
 #include "engine/accel/eval.h"
@@ -43,6 +46,15 @@ struct alignas(128) RegularLeaf {
     }
 };
 static_assert(sizeof(RegularLeaf) == 128);
+
+/// Four consecutive entries of RegularGrid::primList() (4q .. 4q + 3, whatever leaves list them)
+/// as floats, for the walk's first look at a union-only leaf's spheres: the centre, and the radius
+/// grown by an allowance for the floats' rounding (RegularGrid::sphereQuads). An entry that is no
+/// packed sphere has an infinite radius: it is never rejected.
+struct alignas(64) SphereQuad {
+    float x[4], y[4], z[4], r[4];
+};
+static_assert(sizeof(SphereQuad) == 64);
 
 inline constexpr uint32_t kSplitFace = 0xffffffffu;
 inline constexpr uint32_t kBorder = 0xfffffffeu;
@@ -80,7 +92,7 @@ class RegularGrid {
     size_t regionCount() const { return leaves_.size(); }
     size_t memoryBytes() const {
         return leaves_.size() * sizeof(RegularLeaf) + pool_.nodes.size() * sizeof(CsgNode) +
-               primList_.size() * sizeof(uint32_t) +
+               primList_.size() * sizeof(uint32_t) + quads_.size() * sizeof(SphereQuad) +
                (planes_[0].size() + planes_[1].size() + planes_[2].size()) * sizeof(double) +
                dir_.memoryBytes();
     }
@@ -116,11 +128,50 @@ class RegularGrid {
         return dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
     }
 
+    /// primList() as SphereQuads, four entries each: empty unless the scene is union-only and
+    /// holds packed spheres.
+    const std::vector<SphereQuad>& sphereQuads() const { return quads_; }
+    /// The ray as the quads' test takes it: a point of it in floats (the walk's point in the
+    /// leaf), its direction as a unit vector in floats, and an allowance for the rounding of the
+    /// exact test far from the ray's origin.
+    struct QuadRay {
+        using F4 = float __attribute__((vector_size(16)));
+        F4 p[3], d[3];  ///< each coordinate in the four lanes
+        F4 allowance;
+        /// Set the point to `at`.
+        void at(const Vec3& at) {
+            for (int a = 0; a < 3; ++a) p[a] = F4{} + float(at[a]);
+        }
+    };
+    /// The ray for the quads' test, its point at the ray's origin (QuadRay::p is set to a point
+    /// near each leaf the walk tests).
+    QuadRay quadRay(const Ray& ray) const;
+    /// Bit j set: entry 4q + j of primList() is a sphere whose exact test (Scene::primSpans)
+    /// finds no span along the ray, as the floats of quad q tell. A clear bit says nothing.
+    static uint32_t quadMisses(const SphereQuad& q, const QuadRay& r);
+    /// Bit i set: entry `from` + i of primList() is such a sphere, for i < `count` <= 60.
+    uint64_t entryMisses(uint32_t from, uint32_t count, const QuadRay& r) const {
+        const SphereQuad* const q = quads_.data();
+        uint64_t bits = 0;
+        for (uint32_t k = 0, n = (from % 4 + count + 3) / 4; k < n; ++k)
+            bits |= uint64_t(quadMisses(q[from / 4 + k], r)) << (4 * k);
+        return (bits >> (from % 4)) & ((uint64_t(1) << count) - 1);
+    }
+
   private:
     /// intersect() for one step method.
     template <bool kExact, class Obs>
     bool walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
               Hit& hit) const;
+    /// hitInUnionLeaf for leaf `L` of a union-only scene with sphere quads, the same hit, tests
+    /// and mailbox hits: each sphere not yet tested for the ray id is first looked at in floats
+    /// four at a time (quadMisses), and only those it cannot reject take the exact test. A
+    /// rejected sphere is a test (counted, its mailbox the empty one) as a missed one is.
+    template <class Obs>
+    bool hitInSphereLeaf(const RegularLeaf& L, QuadRay& qr, const Ray& ray, double tmin, double tIn,
+                         double t0, double t1, TraceContext& ctx, Obs& obs, Hit& hit) const;
+    /// Fill quads_ from primList_ (union-only scenes with packed spheres).
+    void makeSphereQuads();
 
     const Scene* scene_;
     bool exact_ = true;       ///< --step exact (else push)
@@ -137,6 +188,8 @@ class RegularGrid {
     std::vector<RegularLeaf> leaves_;
     CsgTree pool_;  ///< restricted trees of all leaves, shared between equal primitive sets
     std::vector<uint32_t> primList_;  ///< each distinct primitive set once, as leaves list it
+    std::vector<SphereQuad> quads_;   ///< primList_ in floats, four entries a quad
+    double quadScale_ = 0.0;          ///< the grid's largest coordinate, for a ray's allowance
     Directory dir_;
     nlohmann::json extra_;
 
@@ -183,6 +236,10 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     }
     const RegularLeaf* const leaves = leaves_.data();
     const uint32_t* const primList = primList_.data();
+    [[maybe_unused]] const bool quads = !quads_.empty();
+    [[maybe_unused]] QuadRay qr;
+    if constexpr (!Obs::kActive)
+        if (quads) qr = quadRay(ray);
     // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
     // inside the grid, so this only admits hits that rounding puts a hair outside the box.
     double t0 = tmin, tIn = tStart;
@@ -265,6 +322,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         }
         const double t1 = last ? tmax : std::max(tExit, tIn);
         ++ctx.counters.regionVisits;
+        if (!last) __builtin_prefetch(leaves_.data() + nextLeaf);
         // The stretch told ends where the ray leaves the leaf: at the clip of the grown box only
         // when that comes first. A ray leaving the grid through an edge or a corner may cross
         // the tied interior face as it leaves, so past the leaf's exit it is outside the leaf.
@@ -276,11 +334,16 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         // primitives' spans (hitInUnionLeaf); the observer is shown the tree's evaluation.
         bool found;
         if constexpr (!Obs::kActive) {
-            found = unionOnly_
-                        ? hitInUnionLeaf(L.primitives(primList), L.prims,
-                                         ScenePrimTest{scene_, &ray}, tmin, t0, t1, ctx, obs, hit)
-                        : hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList), L.prims, ray,
-                                    tmin, t0, t1, ctx, obs, hit);
+            if (quads) {
+                found =
+                    L.prims != 0 && hitInSphereLeaf(L, qr, ray, tmin, tIn, t0, t1, ctx, obs, hit);
+            } else {
+                found = unionOnly_ ? hitInUnionLeaf(L.primitives(primList), L.prims,
+                                                    ScenePrimTest{scene_, &ray}, tmin, t0, t1, ctx,
+                                                    obs, hit)
+                                   : hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList),
+                                               L.prims, ray, tmin, t0, t1, ctx, obs, hit);
+            }
         } else {
             found = hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList), L.prims, ray, tmin,
                               t0, t1, ctx, obs, hit, unionOnly_);
@@ -304,6 +367,124 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         t0 = tIn = t1;
         leaf = nextLeaf;
     }
+}
+
+inline RegularGrid::QuadRay RegularGrid::quadRay(const Ray& ray) const {
+    QuadRay r;
+    const Vec3 u = ray.d / glm::length(ray.d);
+    r.at(ray.o);
+    for (int a = 0; a < 3; ++a) r.d[a] = QuadRay::F4{} + float(u[a]);
+    // The exact test computes the line's distance to the centre from the ray's origin: its
+    // rounding grows with that distance, some 1e-15 of it (the allowance is a thousand times
+    // that).
+    const double far = std::max({std::abs(ray.o.x), std::abs(ray.o.y), std::abs(ray.o.z)});
+    r.allowance = QuadRay::F4{} + float(1e-12 * (far + quadScale_));
+    return r;
+}
+
+inline uint32_t RegularGrid::quadMisses(const SphereQuad& q, const QuadRay& r) {
+    using F4 = QuadRay::F4;
+    using I4 = int32_t __attribute__((vector_size(16)));
+    // The vector from the ray's point to each centre, and the line's distance to the centre
+    // as |f x d| (d a unit vector): no cancellation but that of the cross product's terms.
+    const F4 fx = *reinterpret_cast<const F4*>(q.x) - r.p[0];
+    const F4 fy = *reinterpret_cast<const F4*>(q.y) - r.p[1];
+    const F4 fz = *reinterpret_cast<const F4*>(q.z) - r.p[2];
+    const F4 gx = fy * r.d[2] - fz * r.d[1];
+    const F4 gy = fz * r.d[0] - fx * r.d[2];
+    const F4 gz = fx * r.d[1] - fy * r.d[0];
+    const F4 dist2 = gx * gx + gy * gy + gz * gz;
+    // The floats' rounding: a few 1e-7 of |f| (bounded by its 1-norm) from f, d and the cross
+    // product, besides the centre's and the point's own (in the stored radius, see
+    // makeSphereQuads); allowed for ten times over.
+    const I4 absMask = {0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff};
+    const F4 norm1 = reinterpret_cast<F4>(reinterpret_cast<I4>(fx) & absMask) +
+                     reinterpret_cast<F4>(reinterpret_cast<I4>(fy) & absMask) +
+                     reinterpret_cast<F4>(reinterpret_cast<I4>(fz) & absMask);
+    const F4 reach = *reinterpret_cast<const F4*>(q.r) + r.allowance + 4e-6f * norm1;
+    // NaN and infinities compare false: such a sphere is not rejected.
+    const I4 miss = dist2 > reach * reach;
+#if defined(__SSE2__)
+    return uint32_t(_mm_movemask_ps(reinterpret_cast<__m128>(miss)));
+#else
+    return uint32_t(miss[0] & 1) | uint32_t(miss[1] & 2) | uint32_t(miss[2] & 4) |
+           uint32_t(miss[3] & 8);
+#endif
+}
+
+template <class Obs>
+[[gnu::always_inline]] inline bool RegularGrid::hitInSphereLeaf(const RegularLeaf& L, QuadRay& qr,
+                                                                const Ray& ray, double tmin,
+                                                                double tIn, double t0, double t1,
+                                                                TraceContext& ctx, Obs& obs,
+                                                                Hit& hit) const {
+    if (!ctx.useMailboxes) ctx.newStamp();
+    const uint32_t* const keys = L.primitives(primList_.data());
+    const uint32_t count = L.prims;
+    TraceContext::Tag* const tags = ctx.tags.data();
+    // The tags the loop reads, fetched together rather than one miss at a time.
+    for (uint32_t i = 0; i < count; ++i) __builtin_prefetch(tags + keys[i]);
+    // The quads' floats are near the leaf: the walk's point in it (the ray's origin for a first
+    // leaf entered from an infinite tmin).
+    if (std::isfinite(tIn)) qr.at(ray.at(tIn));
+    const uint32_t rayId = ctx.rayId;
+    Boundary first;
+    first.t = kInf;
+    bool found = false;
+    for (uint32_t from = 0; from < count; from += 60) {
+        const uint32_t n = std::min(count - from, 60u);
+        uint64_t misses = entryMisses(L.first + from, n, qr);
+        // The spheres the quads could not reject take the exact test: fetched now, while the
+        // tags are read.
+        for (uint64_t take = ~misses & ((uint64_t(1) << n) - 1); take; take &= take - 1)
+            __builtin_prefetch(scene_->packedSpheres.data() + keys[from + __builtin_ctzll(take)]);
+        for (uint32_t i = from; i < from + n; ++i, misses >>= 1) {
+            const uint32_t key = keys[i];
+            TraceContext::Tag& tag = tags[key];
+            const Mailbox* m;
+            if (tag.stamp == rayId) {
+                ++ctx.counters.mailboxHits;
+                obs.mailboxHit(key);
+                if (tag.slot == 0) continue;  // tested and missed
+                m = &ctx.held[tag.slot];
+            } else {
+                ++ctx.counters.primTests;
+                if (misses & 1) {
+                    obs.primTest(key, nullptr, 0);
+                    tag = {rayId, 0};  // the empty mailbox, as ctx.heldEmpty
+                    continue;
+                }
+                // Storage for the spans the test writes, not cleared first (Span's members
+                // have defaults: a declared array costs its clearing in each test).
+                alignas(Span) std::byte room[2 * sizeof(Span)];
+                Span* const spans = reinterpret_cast<Span*>(room);
+                const int k = scene_->primSpans(key, ray, spans);
+                obs.primTest(key, spans, k);
+                if (k == 0) {
+                    tag = {rayId, 0};
+                    continue;
+                }
+                Mailbox& fill = ctx.takeMailbox(key);
+                fill.count = uint8_t(k);
+                std::copy_n(spans, k, fill.spans);
+                m = &fill;
+            }
+            for (int k = 0; k < m->count; ++k) {
+                const Span& s = m->spans[k];
+                if (s.out.t < t0 || !(s.out.t > tmin) || s.in.t > t1) continue;
+                if (s.in.t < first.t) first = s.in, found = true;
+            }
+        }
+    }
+    if (!found) return false;
+    if (first.t >= t0 && first.t > tmin) {
+        hit = {first.t, first.prim, first.part, first.flip};
+        return true;
+    }
+    mergeHeldSpans(keys, count, ctx);
+    const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
+    if (b) hit = {b->t, b->prim, b->part, b->flip};
+    return b != nullptr;
 }
 
 }  // namespace lancer
