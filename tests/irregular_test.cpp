@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <random>
 
 #include "engine/model/restriction.h"
@@ -511,6 +512,130 @@ TEST(Irregular, UnionOnlyRegionsKeepListsNotTrees) {
     EXPECT_TRUE(std::any_of(t.regions().begin(), t.regions().end(),
                             [](const IrregularRegion& r) { return r.root >= 0; }));
     EXPECT_GT(withTrees->info().extra["distinct_trees"].get<size_t>(), 0u);
+}
+
+/// A union-only cloud of overlapping spheres around an eye inside one of them, written as an NFF
+/// file: every primary ray starts inside the union, and so do rays from the spheres' centres.
+Scene overlappingSpheres(uint64_t seed, int count) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> c(-2.0, 2.0), r(0.2, 0.7);
+    const std::string path = ::testing::TempDir() + "/overlapping" + std::to_string(seed) + ".nff";
+    {
+        std::ofstream f(path);
+        f << "v\nfrom 0.1 0.2 0.3\nat 3 2.5 2\nup 0 0 1\nangle 50\nhither 0.01\n"
+          << "resolution 64 64\nl 5 4 6\nf 1 0.8 0.6 0.5 0.5 3 0 1\n";
+        f << "s 0.1 0.2 0.3 0.6\n";  // holds the eye
+        for (int i = 1; i < count; ++i)
+            f << "s " << c(rng) << ' ' << c(rng) << ' ' << c(rng) << ' ' << r(rng) << '\n';
+    }
+    Scene scene = loadScene(path);
+    std::filesystem::remove(path);
+    return scene;
+}
+
+// A union-only scene's walks without an observer (hitInIrregularRegion with NullObserver, whose
+// regions skip the merge when no boundary of theirs lies in the window) against the walks an
+// observer sees (shown every region's merged spans) and brute force, ray for ray, in both frames
+// and with and without mailboxes: primary rays from an eye inside a sphere (the near region,
+// then depth slabs), rays from the spheres' centres (the camera-frame walk, starting inside the
+// union, where a region's hit is the end of a merged stretch), secondary rays off the hits, and
+// an orthographic view. The two give the same hit (t, primitive, part, side) and the same tests,
+// mailbox hits, region visits and pointer steps, and the observer is told every visit, test and
+// mailbox hit the counters count.
+TEST(Irregular, UnionOnlyWalkEqualsObservedWalkAndBruteForce) {
+    Scene scene = overlappingSpheres(41, 240);
+    ASSERT_TRUE(scene.tree.unionOnly());
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> n;
+    std::vector<Ray> fromInside;
+    for (uint32_t p = 0; p < scene.prims.size(); p += 3) {
+        const Vec3 o = scene.minBox[p].center();
+        for (int k = 0; k < 3; ++k)
+            fromInside.push_back({o, glm::normalize(Vec3(n(rng), n(rng), n(rng)))});
+    }
+    const std::vector<Ray> primary = test::pixelRays(scene, 32, 32);
+    const std::vector<Ray> secondary = secondaryRays(scene, primary, 9);
+    const double offset = 1e-9 * scene.scale();
+    Scene ortho = scene;
+    test::makeOrthographic(ortho);
+    ortho.prepare();
+    const std::vector<Ray> orthoRays = test::pixelRays(ortho, 24, 24);
+
+    size_t merged = 0, compared = 0;
+    auto check = [&](const Scene& sc, const Accelerator& accel, const std::vector<Ray>& rays,
+                     double tmin, bool mailboxes, const std::string& what) {
+        expectSame(sc, accel, rays, what, tmin);
+        TraceContext fast(sc.prims.size(), sc.tree.depth()), seen(sc.prims.size(), sc.tree.depth());
+        fast.useMailboxes = seen.useMailboxes = mailboxes;
+        NullObserver none;
+        for (const Ray& ray : rays) {
+            const RayCounters a = fast.counters, b = seen.counters;
+            Hit hf, ho;
+            fast.beginRay();
+            seen.beginRay();
+            RecordingObserver obs;
+            const bool ff = accel.intersect(ray, tmin, kInf, fast, none, hf);
+            const bool fo = accel.intersect(ray, tmin, kInf, seen, obs, ho);
+            ASSERT_EQ(ff, fo) << what;
+            if (ff) {
+                ASSERT_EQ(hf.t, ho.t) << what;
+                ASSERT_EQ(hf.prim, ho.prim) << what;
+                ASSERT_EQ(hf.part, ho.part) << what;
+                ASSERT_EQ(hf.flip, ho.flip) << what;
+            }
+            ASSERT_EQ(fast.counters.primTests - a.primTests, seen.counters.primTests - b.primTests)
+                << what;
+            ASSERT_EQ(fast.counters.mailboxHits - a.mailboxHits,
+                      seen.counters.mailboxHits - b.mailboxHits)
+                << what;
+            ASSERT_EQ(fast.counters.regionVisits - a.regionVisits,
+                      seen.counters.regionVisits - b.regionVisits)
+                << what;
+            ASSERT_EQ(fast.counters.pointerSteps - a.pointerSteps,
+                      seen.counters.pointerSteps - b.pointerSteps)
+                << what;
+            uint64_t regions = 0, tests = 0, mailboxHits = 0;
+            for (const WalkEvent& e : obs.events) {
+                regions += e.kind == WalkEvent::Region;
+                tests += e.kind == WalkEvent::PrimTest;
+                mailboxHits += e.kind == WalkEvent::MailboxHit;
+            }
+            ASSERT_EQ(regions, seen.counters.regionVisits - b.regionVisits) << what;
+            ASSERT_EQ(tests, seen.counters.primTests - b.primTests) << what;
+            ASSERT_EQ(mailboxHits, seen.counters.mailboxHits - b.mailboxHits) << what;
+            // A ray starting inside the union: its hit ends the merged stretch it starts in.
+            if (ff) {
+                bool inside = false;
+                for (uint32_t p = 0; p < sc.prims.size() && !inside; ++p) {
+                    Span sp[2];
+                    const int k = sc.primSpans(p, ray, sp);
+                    for (int j = 0; j < k; ++j) inside |= sp[j].in.t < tmin && sp[j].out.t > tmin;
+                }
+                merged += inside;
+            }
+            ++compared;
+        }
+    };
+    for (IrregularFrame frame : {IrregularFrame::Projective, IrregularFrame::Camera}) {
+        auto accel = buildIrregular(scene, BspHeuristic::Balanced, 4, frame);
+        const IrregularSubdivision& s = irregularOf(*accel);
+        ASSERT_TRUE(s.flat());
+        if (frame == IrregularFrame::Projective) {
+            ASSERT_TRUE(s.projective().flat());
+            EXPECT_TRUE(s.projective().hasNearRegion());  // the eye's sphere
+        }
+        const std::string name = irregularFrameName(frame);
+        for (bool mailboxes : {true, false}) {
+            const std::string m = mailboxes ? "" : " no mailbox";
+            check(scene, *accel, primary, 0.0, mailboxes, name + " primary" + m);
+            check(scene, *accel, fromInside, 0.0, mailboxes, name + " from inside" + m);
+            check(scene, *accel, secondary, offset, mailboxes, name + " secondary" + m);
+        }
+    }
+    auto orthoAccel = buildIrregular(ortho);
+    check(ortho, *orthoAccel, orthoRays, 0.0, true, "orthographic");
+    EXPECT_GT(merged, 500u);
+    EXPECT_GT(compared, 10000u);
 }
 
 // Primary rays on the projective zones: regions in depth order with contiguous intervals, no

@@ -6,9 +6,13 @@
 
 namespace lancer {
 
+class BuildGuard;  // build_guard.h
+
 /// Fill lo[] and hi[] of every region. Built with the screen BSP (a point location per zone
 /// corner) and a binary search over the neighbour zone's slabs; the walk never uses either.
-void linkCorners(const ScreenBsp& bsp, const Box3& bounds, DepthSlabs& slabs);
+/// `guard` (may be null) is polled for cancellation.
+void linkCorners(const ScreenBsp& bsp, const Box3& bounds, DepthSlabs& slabs,
+                 const BuildGuard* guard = nullptr);
 
 /// The slab of zone `zone` holding depth z, on the side `s` of a cut (+1 above, -1 below).
 uint32_t slabAt(const std::vector<IrregularRegion>& regions,

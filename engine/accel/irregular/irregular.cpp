@@ -1,5 +1,7 @@
 #include "engine/accel/irregular/irregular.h"
 
+#include <tbb/task_group.h>
+
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
@@ -9,6 +11,7 @@
 #include "engine/accel/irregular/corner_pointers.h"
 #include "engine/accel/irregular/depth_slabs.h"
 #include "engine/util/format.h"
+#include "engine/util/task_fence.h"
 
 namespace lancer {
 
@@ -106,27 +109,60 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     sp.zoneBytes = kMergedZoneBytes;
     sp.refBytes = mergedRefBytes(scene.tree.unionOnly());
     sp.guard = &guard;
-    s.bsp_ = ScreenBsp::build(box, live, {s.bounds_.lo.x, s.bounds_.lo.y},
-                              {s.bounds_.hi.x, s.bounds_.hi.y}, sp);
-    double bspMs = ms(t0);
 
-    // 3D step.
-    guard.poll();
-    auto t1 = Clock::now();
+    // The two frames' structures are independent (each within its half of the budget): the
+    // projective zones are built as a task beside the camera frame's, which halves the build's
+    // wall time on two cores (balls:6: the camera frame 14.7 s, the projective zones 14.0 s).
     const size_t slabBytes = std::max<size_t>(2 * share / 9, 1);
-    DepthSlabs slabs = buildDepthSlabs(scene, s.bsp_, box, s.bounds_.lo.z, s.bounds_.hi.z, &guard,
-                                       slabBytes, maxRegions);
-    if (slabs.regions.size() > kMaxRegions)
-        throw std::invalid_argument("--scheme irregular: " + std::to_string(slabs.regions.size()) +
-                                    " regions is over the limit of " + std::to_string(kMaxRegions) +
-                                    "; stop the 2D step earlier with --max-objects");
-    double slabMs = ms(t1);
+    tbb::task_group tasks;
+    TaskFence fence;
+    nlohmann::json eyeExtra;
+    double eyeMs = 0.0;
+    if (params.frame == IrregularFrame::Projective) {
+        tasks.run(fence.task([&] {
+            auto t3 = Clock::now();
+            s.eye_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, eyeExtra, slabBytes,
+                                            maxRegions);
+            eyeMs = ms(t3);
+        }));
+    }
+    double bspMs = 0.0, slabMs = 0.0, linkMs = 0.0;
+    DepthSlabs slabs;
+    try {
+        s.bsp_ = ScreenBsp::build(box, live, {s.bounds_.lo.x, s.bounds_.lo.y},
+                                  {s.bounds_.hi.x, s.bounds_.hi.y}, sp);
+        bspMs = ms(t0);
 
-    auto t2 = Clock::now();
-    guard.poll();
-    linkCorners(s.bsp_, s.bounds_, slabs);
-    guard.poll();
-    double linkMs = ms(t2);
+        // 3D step.
+        guard.poll();
+        auto t1 = Clock::now();
+        slabs = buildDepthSlabs(scene, s.bsp_, box, s.bounds_.lo.z, s.bounds_.hi.z, &guard,
+                                slabBytes, maxRegions);
+        if (slabs.regions.size() > kMaxRegions)
+            throw std::invalid_argument(
+                "--scheme irregular: " + std::to_string(slabs.regions.size()) +
+                " regions is over the limit of " + std::to_string(kMaxRegions) +
+                "; stop the 2D step earlier with --max-objects");
+        slabMs = ms(t1);
+
+        auto t2 = Clock::now();
+        guard.poll();
+        linkCorners(s.bsp_, s.bounds_, slabs, &guard);
+        guard.poll();
+        linkMs = ms(t2);
+    } catch (...) {
+        // The projective task polls the same guard: a cancellation ends it as soon; any other
+        // error waits for it to finish (its own error, if any, is dropped for this one).
+        try {
+            tasks.wait();
+        } catch (...) {
+        }
+        fence.acquire();
+        throw;
+    }
+    tasks.wait();
+    fence.acquire();
+    if (eyeExtra.is_object()) extra.update(eyeExtra);
 
     s.regions_ = std::move(slabs.regions);
     s.zoneFirstRegion_ = std::move(slabs.zoneFirstRegion);
@@ -135,15 +171,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     s.listPrims_ = std::move(slabs.listPrims);
     s.flat_ = slabs.flat;
     s.budget_ = 16 * s.regions_.size() + 1024;
-
-    double eyeMs = 0.0;
     extra["frame"] = irregularFrameName(params.frame);
-    if (params.frame == IrregularFrame::Projective) {
-        auto t3 = Clock::now();
-        s.eye_ =
-            ProjectiveZones::build(scene, s.frame_, box, live, sp, extra, slabBytes, maxRegions);
-        eyeMs = ms(t3);
-    }
 
     size_t refs = 0, most = 0;
     for (uint32_t r = 0; r < s.regions_.size(); ++r) {

@@ -36,6 +36,7 @@
 #include "engine/accel/irregular/camera_frame.h"
 #include "engine/accel/irregular/projective_zones.h"
 #include "engine/accel/irregular/region.h"
+#include "engine/accel/irregular/region_hit.h"
 #include "engine/accel/irregular/screen_bsp.h"
 
 namespace lancer {
@@ -199,26 +200,9 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         double t1 = std::min(te, tend);
         ++ctx.counters.regionVisits;
         obs.region(r, t, t1);
-        if (flat_) {
-            const std::span<const uint32_t> prims = primitives(r);
-            if (hitInLeaf(*scene_, nullptr, -1, prims.data(), uint32_t(prims.size()), ray, tmin, t,
-                          t1, ctx, obs, hit))
-                return true;
-        } else if (R.root >= 0) {
-            if (R.root != lastRoot) {
-                if (hitInRegion(*scene_, pool_, R.root, ray, tmin, t, t1, ctx, obs, hit))
-                    return true;
-                lastRoot = R.root;
-            } else {
-                // The same tree as the region before (a shared restriction): its spans along
-                // the whole line are still in ctx.result; only the interval changed.
-                if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
-                if (const Boundary* b = firstBoundary(ctx.result, tmin, t, t1)) {
-                    hit = {b->t, b->prim, b->part, b->flip};
-                    return true;
-                }
-            }
-        }
+        if (hitInIrregularRegion(*scene_, flat_, primitives(r), pool_, R.root, lastRoot, ray, tmin,
+                                 t, t1, ctx, obs, hit))
+            return true;
         if (te >= tend) return false;
         if constexpr (Obs::kActive) obs.regionExit(te, frame_.toWorld(p), axis, ties);
         // Out through the structure's border (a face, or an edge or corner touching it).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/depth_slabs.h"
 #include "engine/model/restriction.h"
 
@@ -42,6 +43,7 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     std::vector<uint32_t> inside, nearPrims;
     glm::dvec2 lo(kInf), hi(-kInf);
     for (uint32_t p : live) {
+        if (sp.guard && (p & 8191) == 0) sp.guard->poll();
         const Box3& b = box[p];
         if (b.lo.z < zNear) nearPrims.push_back(p);
         if (!(b.hi.z > zNear)) continue;
@@ -76,6 +78,7 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     s.slabLo_.reserve(slabs.regions.size());
     s.slabRoot_.reserve(slabs.regions.size());
     s.slabList_.reserve(slabs.regions.size());
+    if (sp.guard) sp.guard->poll();
     for (const IrregularRegion& r : slabs.regions) {
         s.slabLo_.push_back(r.box.lo.z);
         s.slabRoot_.push_back(r.root);

@@ -23,6 +23,7 @@
 
 #include "engine/accel/eval.h"
 #include "engine/accel/irregular/camera_frame.h"
+#include "engine/accel/irregular/region_hit.h"
 #include "engine/accel/irregular/screen_bsp.h"
 
 namespace lancer {
@@ -127,6 +128,7 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         }
     };
     double t = tmin;
+    int lastRoot = -1;  // the tree whose spans ctx.result holds (hitInIrregularRegion)
     if (flat_) ctx.beginLeafWalk();
     if (hasNearRegion()) {
         double t1 = std::min(zNear_ / dz, tmax);
@@ -135,9 +137,8 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
             enter(id, t);
             ++ctx.counters.regionVisits;
             obs.region(id, t, t1);
-            if (flat_ ? hitInLeaf(scene, nullptr, -1, nearPrims_.data(),
-                                  uint32_t(nearPrims_.size()), ray, tmin, t, t1, ctx, obs, hit)
-                      : hitInRegion(scene, pool_, nearRoot_, ray, tmin, t, t1, ctx, obs, hit))
+            if (hitInIrregularRegion(scene, flat_, nearPrims_, pool_, nearRoot_, lastRoot, ray,
+                                     tmin, t, t1, ctx, obs, hit))
                 return true;
             leave(zNear_);
         }
@@ -146,33 +147,17 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
     uint32_t i = zoneFirst_[zone], last = zoneFirst_[zone + 1];
     // Skip the slabs wholly before tmin (a primary ray has tmin = 0: none).
     while (i + 1 < last && slabLo_[i + 1] / dz < t) ++i;
-    int lastRoot = -1;
     for (; i < last; ++i) {
         double t0 = std::max(slabLo_[i] / dz, t);
         double z1 = i + 1 < last ? slabLo_[i + 1] : zFar_;
         double t1 = std::min(z1 / dz, tmax);
         if (t0 > tmax) return false;
-        int root = slabRoot_[i];
         enter(firstId + i, t0);
         ++ctx.counters.regionVisits;
         obs.region(firstId + i, t0, t1);
-        if (flat_) {
-            const std::span<const uint32_t> prims = slabPrimitives(i);
-            if (hitInLeaf(scene, nullptr, -1, prims.data(), uint32_t(prims.size()), ray, tmin, t0,
-                          t1, ctx, obs, hit))
-                return true;
-        } else if (root >= 0) {
-            if (root != lastRoot) {
-                if (hitInRegion(scene, pool_, root, ray, tmin, t0, t1, ctx, obs, hit)) return true;
-                lastRoot = root;
-            } else {
-                if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
-                if (const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1)) {
-                    hit = {b->t, b->prim, b->part, b->flip};
-                    return true;
-                }
-            }
-        }
+        if (hitInIrregularRegion(scene, flat_, slabPrimitives(i), pool_, slabRoot_[i], lastRoot,
+                                 ray, tmin, t0, t1, ctx, obs, hit))
+            return true;
         leave(z1);
     }
     return false;

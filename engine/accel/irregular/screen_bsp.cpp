@@ -170,7 +170,7 @@ bool overlapsOpen(const Box3& r, glm::dvec2 lo, glm::dvec2 hi) {
 /// Number the nodes and zones of a BSP built best first as a depth-first build numbers them
 /// (preorder, the child `firstSide[node]` first): a build that no limit stops is then the same
 /// structure, ids included, whatever the order its cells were split in.
-void renumber(ScreenBsp& bsp, const std::vector<uint8_t>& firstSide) {
+void renumber(ScreenBsp& bsp, const std::vector<uint8_t>& firstSide, const BuildGuard* guard) {
     if (bsp.root < 0) return;  // a single zone
     std::vector<ScreenBsp::Node> nodes;
     std::vector<glm::dvec2> zoneLo, zoneHi;
@@ -186,7 +186,9 @@ void renumber(ScreenBsp& bsp, const std::vector<uint8_t>& firstSide) {
         int side;
     };
     std::vector<Item> stack{{bsp.root, -1, 0}};
-    while (!stack.empty()) {
+    // Every zone's list is copied (millions of references on balls:6): polled as the build is.
+    for (size_t polled = 0; !stack.empty();) {
+        if (guard && (++polled & 8191) == 0) guard->poll();
         const Item it = stack.back();
         stack.pop_back();
         int32_t ref;
@@ -414,7 +416,7 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         add(std::move(below));
         add(std::move(above));
     }
-    renumber(bsp, firstSide);
+    renumber(bsp, firstSide, params.guard);
     return bsp;
 }
 
