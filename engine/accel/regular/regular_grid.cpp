@@ -993,7 +993,11 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     }
     fence.acquire();
 
-    if (unionOnly_) makeSphereQuads();
+    // The quads are a copy the walk reads instead of the spheres: made only within the budget
+    // (the walk tests the spheres themselves without them), and said so in --stats.
+    const size_t quadBytes = (primList_.size() + 3) / 4 * sizeof(SphereQuad);
+    const bool quadsFit = memoryBytes() + quadBytes <= guard.budget();
+    if (unionOnly_ && quadsFit) makeSphereQuads();
 
     extra_ = {
         {"directory", full ? "full" : "sub-tables"},
@@ -1018,7 +1022,10 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         {"tree_pool_nodes", pool_.nodes.size()},
         {"prims_per_leaf", leaves_.empty() ? 0.0 : double(root.primRefs) / double(leaves_.size())},
         {"max_prims_per_leaf", root.maxPrims},
+        {"sphere_quad_bytes", quads_.size() * sizeof(SphereQuad)},
     };
+    if (unionOnly_ && !quadsFit)
+        extra_["sphere_quads_left_out"] = formatBytes(quadBytes) + " would pass the memory budget";
 }
 
 void RegularGrid::makeSphereQuads() {
