@@ -197,8 +197,8 @@ std::vector<ParamDesc> makeTable() {
          "memory budget",
          "Bytes a structure and its light buffer may take while they are built (512M, 2G, "
          "1.5GiB; 0: an eighth of physical memory); over it the irregular scheme stops "
-         "subdividing, the regular one is refused; a light buffer over a quarter of it is left "
-         "out",
+         "subdividing (refused when even its coarsest structure does not fit), the regular one "
+         "is refused; a light buffer over a quarter of it is left out",
          ParamKind::Size};
     d.schemes = kAccelerated;
     d.effect = ChangeEffect::Rebuild;
