@@ -158,6 +158,44 @@ inline void mergeHeldSpans(const uint32_t* keys, uint32_t count, TraceContext& c
     flatUnion(spans, ctx.result);
 }
 
+/// The spans a primitive's test gave (`n` > 0), held in a mailbox of its own for the ray.
+inline const Mailbox* holdSpans(uint32_t key, const Span* spans, int n, TraceContext& ctx) {
+    Mailbox& fill = ctx.takeMailbox(key);
+    fill.count = uint8_t(n);
+    std::copy_n(spans, n, fill.spans);
+    return &fill;
+}
+
+/// A union-only region's hit from its primitives' spans as they come (hitInUnionLeaf, the
+/// regular walk's sphere quads): the first start among the spans reaching into the window
+/// [t0, t1] after tmin, then the hit it gives.
+struct UnionFirstStart {
+    double tmin, t0, t1;
+    Boundary first{kInf};
+    bool found = false;
+    /// Takes one primitive's spans.
+    void add(const Mailbox& m) {
+        for (int k = 0; k < m.count; ++k) {
+            const Span& s = m.spans[k];
+            if (s.out.t < t0 || !(s.out.t > tmin) || s.in.t > t1) continue;
+            if (s.in.t < first.t) first = s.in, found = true;
+        }
+    }
+    /// The region's hit, once every primitive of `keys` was added: the first start when it is
+    /// inside the window, else the end of the stretch the ray starts in, from the merged spans.
+    bool hit(const uint32_t* keys, uint32_t count, TraceContext& ctx, Hit& out) const {
+        if (!found) return false;
+        if (first.t >= t0 && first.t > tmin) {
+            out = {first.t, first.prim, first.part, first.flip};
+            return true;
+        }
+        mergeHeldSpans(keys, count, ctx);
+        const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
+        if (b) out = {b->t, b->prim, b->part, b->flip};
+        return b != nullptr;
+    }
+};
+
 /// hitInUnionLeaf's `test` for regions that list the scene's primitives: Scene::primSpans.
 struct ScenePrimTest {
     const Scene* scene;
@@ -193,9 +231,7 @@ template <class Obs, class Test>
         __builtin_prefetch(ctx.tags.data() + keys[i]);
         test.prefetch(keys[i]);
     }
-    Boundary first;
-    first.t = kInf;
-    bool found = false;
+    UnionFirstStart start{tmin, t0, t1};
     for (uint32_t i = 0; i < count; ++i) {
         const uint32_t key = keys[i];
         const Mailbox* m = ctx.heldMailbox(key);
@@ -211,26 +247,11 @@ template <class Obs, class Test>
                 ctx.heldEmpty(key);
                 continue;
             }
-            Mailbox& fill = ctx.takeMailbox(key);
-            fill.count = uint8_t(n);
-            std::copy_n(spans, n, fill.spans);
-            m = &fill;
+            m = holdSpans(key, spans, n, ctx);
         }
-        for (int k = 0; k < m->count; ++k) {
-            const Span& s = m->spans[k];
-            if (s.out.t < t0 || !(s.out.t > tmin) || s.in.t > t1) continue;
-            if (s.in.t < first.t) first = s.in, found = true;
-        }
+        start.add(*m);
     }
-    if (!found) return false;
-    if (first.t >= t0 && first.t > tmin) {
-        hit = {first.t, first.prim, first.part, first.flip};
-        return true;
-    }
-    mergeHeldSpans(keys, count, ctx);
-    const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
-    if (b) hit = {b->t, b->prim, b->part, b->flip};
-    return b != nullptr;
+    return start.hit(keys, count, ctx, hit);
 }
 
 /// hitInRegion for a region that lists its tree's primitives (`prims`, `count`), walked in ray

@@ -428,9 +428,7 @@ template <class Obs>
     // leaf entered from an infinite tmin).
     if (std::isfinite(tIn)) qr.at(ray.at(tIn));
     const uint32_t rayId = ctx.rayId;
-    Boundary first;
-    first.t = kInf;
-    bool found = false;
+    UnionFirstStart start{tmin, t0, t1};
     for (uint32_t from = 0; from < count; from += 60) {
         const uint32_t n = std::min(count - from, 60u);
         uint64_t misses = entryMisses(L.first + from, n, qr);
@@ -464,27 +462,12 @@ template <class Obs>
                     tag = {rayId, 0};
                     continue;
                 }
-                Mailbox& fill = ctx.takeMailbox(key);
-                fill.count = uint8_t(k);
-                std::copy_n(spans, k, fill.spans);
-                m = &fill;
+                m = holdSpans(key, spans, k, ctx);
             }
-            for (int k = 0; k < m->count; ++k) {
-                const Span& s = m->spans[k];
-                if (s.out.t < t0 || !(s.out.t > tmin) || s.in.t > t1) continue;
-                if (s.in.t < first.t) first = s.in, found = true;
-            }
+            start.add(*m);
         }
     }
-    if (!found) return false;
-    if (first.t >= t0 && first.t > tmin) {
-        hit = {first.t, first.prim, first.part, first.flip};
-        return true;
-    }
-    mergeHeldSpans(keys, count, ctx);
-    const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
-    if (b) hit = {b->t, b->prim, b->part, b->flip};
-    return b != nullptr;
+    return start.hit(keys, count, ctx, hit);
 }
 
 }  // namespace lancer
