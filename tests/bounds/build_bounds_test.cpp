@@ -68,6 +68,26 @@ size_t peakOf(F&& f) {
     return gPeak.load() - before;
 }
 
+/// A build under its budget: the accelerator (null when refused), the refusal's message and
+/// the heap the build took at its peak.
+struct BoundedResult {
+    std::unique_ptr<Accelerator> accel;
+    std::string refusal;
+    size_t peak = 0;
+};
+
+BoundedResult buildBounded(const Scene& scene, const BuildParams& p) {
+    BoundedResult r;
+    r.peak = peakOf([&] {
+        try {
+            r.accel = buildAccelerator(scene, p);
+        } catch (const std::invalid_argument& e) {
+            r.refusal = e.what();
+        }
+    });
+    return r;
+}
+
 Scene sponge() { return loadScene(std::string(LANCER_SOURCE_DIR) + "/assets/openscad/sponge.csg"); }
 
 TEST(BoundedBuild, IrregularOverItsBudgetStopsWithinIt) {
@@ -163,17 +183,10 @@ TEST(BoundedBuild, IrregularUnderItsLeastStructureIsRefusedWithinIt) {
               size_t(48) << 10, size_t(64) << 10, size_t(256) << 10}) {
             SCOPED_TRACE(budget);
             p.memoryBudget = budget;
-            std::unique_ptr<Accelerator> a;
-            const size_t peak = peakOf([&] {
-                try {
-                    a = buildAccelerator(scene, p);
-                } catch (const std::invalid_argument& e) {
-                    const std::string what = e.what();
-                    EXPECT_EQ(what.rfind("--memory-budget ", 0), 0u) << what;
-                    EXPECT_NE(what.find("raise --memory-budget"), std::string::npos) << what;
-                }
-            });
+            const auto [a, what, peak] = buildBounded(scene, p);
             if (!a) {
+                EXPECT_EQ(what.rfind("--memory-budget ", 0), 0u) << what;
+                EXPECT_NE(what.find("raise --memory-budget"), std::string::npos) << what;
                 EXPECT_LE(peak, 4096u);  // the primitives' list and the message, nothing built
                 ++refused;
                 continue;
@@ -225,15 +238,10 @@ TEST(BoundedBuild, TheLightBufferIsHeldWithinTheBudget) {
             BuildParams p;
             p.scheme = scheme;
             p.memoryBudget = budget;
-            std::unique_ptr<Accelerator> a;
-            const size_t peak = peakOf([&] {
-                try {
-                    a = buildAccelerator(scene, p);
-                } catch (const std::invalid_argument& e) {
-                    EXPECT_NE(std::string(e.what()).find("--memory-budget"), std::string::npos)
-                        << e.what();
-                }
-            });
+            const auto [a, what, peak] = buildBounded(scene, p);
+            if (!a) {
+                EXPECT_NE(what.find("--memory-budget"), std::string::npos) << what;
+            }
             std::printf("%s, budget %zu (light buffer at most %zu): peak heap %zu%s\n",
                         schemeName(scheme), budget, light, peak, a ? "" : " (refused)");
             EXPECT_LE(peak, budget);
