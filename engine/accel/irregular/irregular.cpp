@@ -160,7 +160,12 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
         fence.acquire();
         throw;
     }
-    tasks.wait();
+    try {
+        tasks.wait();  // rethrows the projective task's error (its cancellation)
+    } catch (...) {
+        fence.acquire();
+        throw;
+    }
     fence.acquire();
     if (eyeExtra.is_object()) extra.update(eyeExtra);
 
