@@ -1,4 +1,4 @@
-// The engine's small helpers: byte counts written for people, and the hash.
+// The engine's small helpers: byte counts written for people, the hash, and huge-page advice.
 #include <gtest/gtest.h>
 
 #include <string_view>
@@ -6,6 +6,7 @@
 
 #include "engine/util/format.h"
 #include "engine/util/hash.h"
+#include "engine/util/huge_pages.h"
 
 namespace lancer {
 namespace {
@@ -47,6 +48,25 @@ TEST(Hash, WordsTakeOneStepPerValue) {
     EXPECT_EQ(hashWords(a), h);
     EXPECT_NE(hashWords(a), hashWords(b));  // order matters
     EXPECT_EQ(hashWords({}), kHashStart);
+}
+
+// The advice is only advice: a large buffer reserved with it keeps what is written to it, and
+// ranges too small or not aligned to a huge page are left as they are.
+TEST(HugePages, ReservedBufferHoldsWhatIsWrittenAndGrowsAsUsual) {
+    std::vector<uint64_t> v;
+    const size_t n = kHugePageAdviceBytes / sizeof(uint64_t) + 12345;
+    reserveHuge(v, n);
+    ASSERT_GE(v.capacity(), n);
+    const uint64_t* data = v.data();
+    for (size_t i = 0; i < n; ++i) v.push_back(i * 2654435761u);
+    EXPECT_EQ(v.data(), data);  // no reallocation within the reserved room
+    size_t wrong = 0;
+    for (size_t i = 0; i < n; ++i) wrong += v[i] != i * 2654435761u;
+    EXPECT_EQ(wrong, 0u);
+    std::vector<char> small(100, 'x');
+    adviseHugePages(small.data() + 1, 50);
+    reserveHuge(small, 10);  // under the capacity: nothing changes
+    EXPECT_EQ(small, std::vector<char>(100, 'x'));
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "engine/util/hash.h"
+#include "engine/util/huge_pages.h"
 
 namespace lancer {
 
@@ -61,7 +62,9 @@ int restrictTreeTo(const CsgTree& src, const std::vector<uint32_t>& prims, std::
     return root;
 }
 
-TreeRestrictor::TreeRestrictor(const CsgTree& tree) : tree_(&tree), parent_(tree.nodes.size(), -1) {
+TreeRestrictor::TreeRestrictor(const CsgTree& tree) : tree_(&tree) {
+    reserveHuge(parent_, tree.nodes.size());
+    parent_.assign(tree.nodes.size(), -1);
     // Count each primitive's leaves, then place them: leaves in node order per primitive. The
     // arrays are sized once and placing moves each start to the next one's, shifted back after
     // (on a million nodes, growing them and a copy for the cursors were thousands of fresh
@@ -69,7 +72,10 @@ TreeRestrictor::TreeRestrictor(const CsgTree& tree) : tree_(&tree), parent_(tree
     uint32_t prims = 0;
     for (const CsgNode& x : tree.nodes)
         if (x.op == Op::Primitive) prims = std::max(prims, x.prim + 1);
-    if (prims) leafFirst_.assign(size_t(prims) + 1, 0);
+    if (prims) {
+        reserveHuge(leafFirst_, size_t(prims) + 1);
+        leafFirst_.assign(size_t(prims) + 1, 0);
+    }
     for (size_t n = 0; n < tree.nodes.size(); ++n) {
         const CsgNode& x = tree.nodes[n];
         if (x.op == Op::Primitive) {
@@ -80,6 +86,7 @@ TreeRestrictor::TreeRestrictor(const CsgTree& tree) : tree_(&tree), parent_(tree
         }
     }
     for (size_t p = 1; p < leafFirst_.size(); ++p) leafFirst_[p] += leafFirst_[p - 1];
+    reserveHuge(leafNodes_, leafFirst_.empty() ? 0 : leafFirst_.back());
     leafNodes_.resize(leafFirst_.empty() ? 0 : leafFirst_.back());
     for (size_t n = 0; n < tree.nodes.size(); ++n)
         if (tree.nodes[n].op == Op::Primitive)
@@ -91,7 +98,9 @@ TreeRestrictor::TreeRestrictor(const CsgTree& tree) : tree_(&tree), parent_(tree
     // subtree's end set when ~node, pushed under its children, comes back up.
     unionsOnly_ = tree.unionOnly();
     if (!unionsOnly_ || tree.root < 0) return;
+    reserveHuge(places_, tree.nodes.size());
     places_.assign(tree.nodes.size(), Place{});
+    for (size_t n = 0; n < tree.nodes.size(); ++n) places_[n].parent = parent_[n];
     std::vector<int> stack{tree.root};
     int placed = 0;
     while (!stack.empty()) {
@@ -134,9 +143,9 @@ int TreeRestrictor::restrictUnions(std::span<const uint32_t> prims, CsgNode* out
     int cur = dst.leaf(nodes[size_t(scratch[0])].prim);
     for (size_t i = 1; i < leaves; ++i) {
         const int next = places_[size_t(scratch[i])].pre;
-        int meet = parent_[size_t(scratch[i - 1])];
+        int meet = places_[size_t(scratch[i - 1])].parent;
         while (!(places_[size_t(meet)].pre <= next && next < places_[size_t(meet)].last))
-            meet = parent_[size_t(meet)];
+            meet = places_[size_t(meet)].parent;
         while (scratch.size() > leaves &&
                places_[size_t(scratch[scratch.size() - 2])].pre > places_[size_t(meet)].pre) {
             cur = dst.combine(Op::Union, scratch.back(), cur);

@@ -69,9 +69,10 @@ class TreeRestrictor {
     std::vector<int> parent_;
     bool unionsOnly_ = false;
     /// A node's place in a depth-first walk from the root (left side first), -1 where the
-    /// root does not reach it; its subtree takes places pre .. last - 1.
+    /// root does not reach it; its subtree takes places pre .. last - 1. With its parent:
+    /// restrictUnions() climbs from node to parent reading both.
     struct Place {
-        int pre = -1, last = -1;
+        int pre = -1, last = -1, parent = -1;
     };
     std::vector<Place> places_;  ///< per node, with unionsOnly_ (together: one cache line)
     /// Leaves of primitive p: leafNodes_[leafFirst_[p] .. leafFirst_[p + 1]) (one array rather
