@@ -88,6 +88,16 @@ std::vector<float> testWeights(const Scene& scene) {
     return w;
 }
 
+/// testWeights() in quarters of a test, as integers: every weight is a multiple of a quarter
+/// (4 + vertices quarters, or a float of 2^21 or more, a whole number), so their sums are
+/// exact in a double, and an integer sum divided by 4 is the double sum bit for bit. The loops
+/// over references sum integers, whose additions do not wait on a double's latency.
+std::vector<uint32_t> testQuarters(const std::vector<float>& weights) {
+    std::vector<uint32_t> q(weights.size());
+    for (size_t i = 0; i < q.size(); ++i) q[i] = uint32_t(double(weights[i]) * 4.0);
+    return q;
+}
+
 /// Surface area of a box.
 double area(const Box3& b) {
     const Vec3 e = b.extent();
@@ -109,13 +119,14 @@ constexpr int kRestrictorDepth = 64;
 /// alone (no CSG restriction, so a little pessimistic). Every cell of a level has the same
 /// surface area A(axis) once cut on `axis`, so with the surface area heuristic the next level
 /// costs A(axis) x (2 visits + the tests of the primitive references) per cut cell; the cheapest
-/// axis is cut, ties going to x, then y; a test weighs as testWeights() says. Cells stop as in
+/// axis is cut, ties going to x, then y; a test weighs as testWeights() says (`quarters`:
+/// testQuarters()). Cells stop as in
 /// the build: at most max-objects primitives, or covered by all their boxes. On a cube of
 /// evenly spread primitives this is the report's x, y, z; on a flat scene (balls4: 24 x 24 x 1.5)
 /// it cuts x and y until the cells are about cubes, where the report's order makes them 16 times
 /// flatter than wide.
 AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector<uint32_t>& live,
-                          const std::vector<float>& cost, int maxLevel, int maxObjects,
+                          const std::vector<uint32_t>& quarters, int maxLevel, int maxObjects,
                           const BuildGuard& guard) {
     // The cells of a level, their primitives in one array: cell c holds refs[begin, end).
     struct Cell {
@@ -178,23 +189,23 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
             const double mid[3] = {0.5 * (cb.lo.x + cb.hi.x), 0.5 * (cb.lo.y + cb.hi.y),
                                    0.5 * (cb.lo.z + cb.hi.z)};
             // Sums held locally: stored to the chunk each time, they would be reloaded after
-            // every store (a double in the chunk may alias the boxes' doubles).
-            double tests[3] = {0.0, 0.0, 0.0};
+            // every store. Tests in quarters (testQuarters()).
+            uint64_t tests[3] = {0, 0, 0};
             size_t count[3][2] = {};
             const Box3* const boxes = scene.minBox.data();
-            const float* const weights = cost.data();
+            const uint32_t* const weights = quarters.data();
             for (size_t i = ch.begin; i < ch.end; ++i) {
                 const Box3& b = boxes[refs[i]];
-                const double w = weights[refs[i]];
+                const uint64_t w = weights[refs[i]];
                 for (int a = 0; a < 3; ++a) {
                     const int lo = b.lo[a] <= mid[a], hi = b.hi[a] >= mid[a];
                     count[a][0] += size_t(lo);
                     count[a][1] += size_t(hi);
-                    tests[a] += w * double(lo + hi);
+                    tests[a] += w * uint64_t(lo + hi);
                 }
             }
             for (int a = 0; a < 3; ++a) {
-                ch.tests[a] = tests[a];
+                ch.tests[a] = double(tests[a]) * 0.25;
                 ch.count[a][0] = count[a][0];
                 ch.count[a][1] = count[a][1];
             }
@@ -347,8 +358,9 @@ struct RegularBuilder {
     /// Surface area of a cell of gainLevel (every cell of a level is alike); set once the axes
     /// are planned (setGainArea).
     double gainArea = 0.0;
-    std::vector<float> weight;  ///< each primitive's test, in sphere tests (testWeights)
-    bool unitWeights = false;   ///< every weight is 1: their sums are counts
+    std::vector<float> weight;       ///< each primitive's test, in sphere tests (testWeights)
+    std::vector<uint32_t> quarters;  ///< the same in quarters (testQuarters)
+    bool unitWeights = false;        ///< every weight is 1: their sums are counts
     /// The scene's tree has only unions: a restriction then keeps every primitive it is given.
     bool unionOnly = false;
     /// A union-only scene's tree of small depth: the leaves restrict it, visiting only their
@@ -371,6 +383,7 @@ struct RegularBuilder {
           maxLevel(effectiveMaxLevel(p, livePrims)),
           gainLevel(lancer::gainLevel(p, livePrims)),
           weight(testWeights(s)),
+          quarters(testQuarters(weight)),
           unitWeights(std::all_of(weight.begin(), weight.end(), [](float w) { return w == 1.0f; })),
           unionOnly(s.tree.unionOnly()),
           keep([n = s.prims.size()] { return std::vector<char>(n, 0); }) {
@@ -693,16 +706,22 @@ struct RegularBuilder {
                 tests[0] = double(lo - in0.data());
                 tests[1] = double(hi - in1.data());
             } else {
+                // In quarters (testQuarters()): the double sums exactly.
+                uint64_t q[2] = {0, 0}, qAll = 0;
+                const uint32_t* const weights = quarters.data();
                 for (uint32_t p : prims) {
                     const Box3& b = boxes[p];
-                    const double w = weight[p];
+                    const uint64_t w = weights[p];
                     const bool l = coord(b.lo, axis) <= mid, h = coord(b.hi, axis) >= mid;
-                    all += w;
+                    qAll += w;
                     *lo = p, lo += l;
                     *hi = p, hi += h;
-                    tests[0] += l ? w : 0.0;
-                    tests[1] += h ? w : 0.0;
+                    q[0] += w & (uint64_t(0) - uint64_t(l));
+                    q[1] += w & (uint64_t(0) - uint64_t(h));
                 }
+                all = double(qAll) * 0.25;
+                tests[0] = double(q[0]) * 0.25;
+                tests[1] = double(q[1]) * 0.25;
             }
             in0.resize(size_t(lo - in0.data()));
             in1.resize(size_t(hi - in1.data()));
@@ -899,7 +918,8 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     sortedUnique(live);
     RegularBuilder b(scene, params, *this, guard, live.size());
     if (params.splitAxes == SplitAxes::Cost)
-        schedule_ = planSchedule(scene, box_, live, b.weight, b.maxLevel, params.maxObjects, guard);
+        schedule_ =
+            planSchedule(scene, box_, live, b.quarters, b.maxLevel, params.maxObjects, guard);
     b.setGainArea();
     const uint32_t origin[3] = {0, 0, 0};
     RegularBuilder::Fragment root(b.maxLevel);
