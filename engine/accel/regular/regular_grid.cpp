@@ -17,6 +17,7 @@
 #include "engine/accel/build_guard.h"
 #include "engine/model/restriction.h"
 #include "engine/util/format.h"
+#include "engine/util/hash.h"
 #include "engine/util/huge_pages.h"
 #include "engine/util/task_fence.h"
 
@@ -50,9 +51,87 @@ struct NoInit : std::allocator<T> {
 /// The builder's lists of primitives.
 using PrimList = std::vector<uint32_t, NoInit<uint32_t>>;
 
+/// The leaves' distinct primitive sets, each with its restricted tree: RestrictedTreePool's
+/// sets and numbering (list 0 the empty set, the others in the order they first arrive), looked
+/// up by an open-addressing index of list numbers into `lists` itself. The pool's index keeps
+/// each set again in a node of its own (two allocations a set, freed one by one): on balls:6,
+/// 65,000 sets in the fragments and again in the layout.
+class SetPool {
+  public:
+    SetPool() : listFirst{0, 0}, roots{-1}, hashes{hashOf({})} { grow(); }
+
+    /// The entry of `prims` (sorted, distinct), whose hash is hashOf(prims). A set not seen
+    /// before gets the tree restrict(trees), which appends the restriction to `prims` to trees
+    /// and returns its root.
+    template <class Restrict>
+    RestrictedTreePool::Entry share(std::span<const uint32_t> prims, uint32_t hash,
+                                    Restrict&& restrict) {
+        const uint32_t mask = uint32_t(slots_.size() - 1);
+        for (uint32_t i = hash & mask;; i = (i + 1) & mask) {
+            const uint32_t l = slots_[i];
+            if (l == kEmpty) {
+                const uint32_t list = uint32_t(roots.size());
+                roots.push_back(restrict(trees));  // before the list: restrict may read prims
+                lists.insert(lists.end(), prims.begin(), prims.end());
+                listFirst.push_back(uint32_t(lists.size()));
+                hashes.push_back(hash);
+                slots_[i] = list;
+                if (2 * roots.size() > slots_.size()) grow();
+                return {roots[list], list};
+            }
+            if (hashes[l] == hash && listFirst[l + 1] - listFirst[l] == prims.size() &&
+                std::equal(prims.begin(), prims.end(), lists.begin() + listFirst[l]))
+                return {roots[l], l};
+        }
+    }
+    /// The hash share() takes.
+    static uint32_t hashOf(std::span<const uint32_t> prims) {
+        const uint64_t h = hashWords(prims);
+        return uint32_t(h ^ (h >> 32));
+    }
+    /// Set `list`'s primitives.
+    std::span<const uint32_t> set(uint32_t list) const {
+        return {lists.data() + listFirst[list], listFirst[list + 1] - listFirst[list]};
+    }
+    /// Distinct sets, the empty one included.
+    size_t size() const { return roots.size(); }
+    /// Heap bytes held, vectors by capacity, with each set charged as RestrictedTreePool
+    /// charges it (its index's node and key, RestrictedTreePool::kEntryBytes, and the key's
+    /// elements again): more than this pool holds, but the budget's refusals stay where they
+    /// were (--memory-budget's tests refuse the sponge at 256 KiB).
+    size_t bytes() const {
+        return trees.nodes.capacity() * sizeof(CsgNode) +
+               (listFirst.capacity() + 2 * lists.capacity() + roots.capacity() + hashes.capacity() +
+                slots_.capacity()) *
+                   sizeof(uint32_t) +
+               roots.size() * RestrictedTreePool::kEntryBytes;
+    }
+
+    CsgTree trees;                    ///< every set's restricted tree
+    std::vector<uint32_t> listFirst;  ///< list l: lists[listFirst[l] .. [l + 1])
+    std::vector<uint32_t> lists;      ///< every set's primitives, set after set
+    std::vector<int> roots;           ///< set l's tree's root in trees; -1: empty
+    std::vector<uint32_t> hashes;     ///< set l's hashOf()
+
+  private:
+    static constexpr uint32_t kEmpty = 0xffffffffu;
+    /// Twice the slots, the sets placed again by their hashes: at most half the slots are used.
+    void grow() {
+        slots_.assign(std::max<size_t>(16, 2 * slots_.size()), kEmpty);
+        const uint32_t mask = uint32_t(slots_.size() - 1);
+        for (uint32_t l = 0; l < roots.size(); ++l) {
+            uint32_t i = hashes[l] & mask;
+            while (slots_[i] != kEmpty) i = (i + 1) & mask;
+            slots_[i] = l;
+        }
+    }
+    std::vector<uint32_t> slots_;  ///< a list number or kEmpty
+};
+
 }  // namespace regular_build
 
 using regular_build::PrimList;
+using regular_build::SetPool;
 
 namespace {
 
@@ -305,8 +384,7 @@ struct RegularBuilder {
         /// than here and copied (on balls:6, 12 MB grown by doubling in fresh pages).
         std::vector<LeafPlace> places;
         std::vector<uint32_t> leafList;
-        RestrictedTreePool pool;              ///< the leaves' trees and lists
-        std::vector<int> setRoot = {-1};      ///< set l's tree's root in pool.trees
+        SetPool pool;                         ///< the leaves' trees and lists
         std::vector<size_t> treeStart = {0};  ///< set l's tree: pool.trees.nodes[treeStart[l]..)
         /// With a restrictor, the nodes the sets' trees will take: the trees are made once the
         /// sets have their final order (RegularBuilder::makeTrees), not in the fragments.
@@ -318,7 +396,7 @@ struct RegularBuilder {
         PrimList look[kLookahead + 1] = {};  ///< the cost estimate's lists, per depth
         // A task's own inputs: its cell's primitives and tree, when not its parent's.
         PrimList in, live;
-        std::vector<uint32_t> key;  ///< a leaf's set, as the pool's index keeps it
+        std::vector<uint32_t> key;  ///< a set's primitives, for restrictTreeTo()
         CsgTree sub;
         size_t reported = 0;  ///< bytes() last added to RegularBuilder::bytes
         uint64_t primRefs = 0;
@@ -539,18 +617,16 @@ struct RegularBuilder {
     /// where they belong, rather than made in each fragment and copied (on balls:6 1.8 million
     /// nodes, made and copied in fresh pages).
     RestrictedTreePool::Entry treeFor(Fragment& f, const CsgTree& tree, const PrimList& prims) {
-        f.key.assign(prims.begin(), prims.end());
-        const RestrictedTreePool::Entry entry = f.pool.share(f.key, [&](CsgTree& dst) {
-            if (restrictor) return reserveTree(f.key, f.treeNodes);
+        return f.pool.share(prims, SetPool::hashOf(prims), [&](CsgTree& dst) {
+            if (restrictor) return reserveTree(prims, f.treeNodes);
             f.treeStart.push_back(dst.nodes.size());
+            f.key.assign(prims.begin(), prims.end());
             return restrictTreeTo(tree, f.key, keep.local(), dst);
         });
-        if (entry.list == f.setRoot.size()) f.setRoot.push_back(entry.root);  // a new set
-        return entry;
     }
 
     /// The leaf over set `list` of `pool`, whose tree's root is `root`.
-    static RegularLeaf leafOf(const RestrictedTreePool& pool, uint32_t list, int root) {
+    static RegularLeaf leafOf(const SetPool& pool, uint32_t list, int root) {
         RegularLeaf leaf;
         leaf.root = root;
         leaf.first = pool.listFirst[list];
@@ -563,7 +639,7 @@ struct RegularBuilder {
     /// The trees of `pool`'s sets, `count` nodes reserved by reserveTree() in the sets' order,
     /// made in parallel: each set's restriction is written at its place, so the nodes are
     /// those that restricting the sets one after the other would append.
-    void makeTrees(RestrictedTreePool& pool, size_t count) {
+    void makeTrees(SetPool& pool, size_t count) {
         std::vector<CsgNode>& nodes = pool.trees.nodes;
         reserveHuge(nodes, count);
         nodes.resize(count);
@@ -801,9 +877,8 @@ struct RegularBuilder {
         BspNodes bsp;
         std::vector<RegularLeaf> leaves;
         std::vector<LeafPlace> places;
-        RestrictedTreePool pool;
-        size_t treeNodes = 0;       ///< with a restrictor, the trees' nodes (see makeTrees)
-        std::vector<uint32_t> key;  ///< scratch: a set's primitives
+        SetPool pool;
+        size_t treeNodes = 0;  ///< with a restrictor, the trees' nodes (see makeTrees)
     };
 
     /// Node `i` of fragment `f` as node `g` of the layout, and its subtree.
@@ -824,10 +899,9 @@ struct RegularBuilder {
         if (f.placed.empty()) f.placed.assign(f.pool.listFirst.size() - 1, {-1, kUnplaced});
         const uint32_t set = f.leafList[n.leaf];
         if (f.placed[set].list == kUnplaced) {
-            const uint32_t* p = f.pool.lists.data();
-            out.key.assign(p + f.pool.listFirst[set], p + f.pool.listFirst[set + 1]);
-            f.placed[set] = out.pool.share(out.key, [&](CsgTree& dst) {
-                if (restrictor) return reserveTree(out.key, out.treeNodes);
+            const std::span<const uint32_t> prims = f.pool.set(set);
+            f.placed[set] = out.pool.share(prims, f.pool.hashes[set], [&](CsgTree& dst) {
+                if (restrictor) return reserveTree(prims, out.treeNodes);
                 const size_t begin = f.treeStart[set];
                 const size_t end =
                     set + 1 < f.treeStart.size() ? f.treeStart[set + 1] : f.pool.trees.nodes.size();
@@ -837,7 +911,7 @@ struct RegularBuilder {
                     if (c.op != Op::Primitive) c.left += shift, c.right += shift;
                     dst.nodes.push_back(c);
                 }
-                return f.setRoot[set] < 0 ? -1 : f.setRoot[set] + shift;
+                return f.pool.roots[set] < 0 ? -1 : f.pool.roots[set] + shift;
             });
         }
         out.bsp.nodes[g] = {-1, uint32_t(out.leaves.size()), 0};
@@ -866,6 +940,8 @@ struct RegularBuilder {
         reserveHuge(out.pool.trees.nodes, trees);
         reserveHuge(out.pool.lists, lists);
         reserveHuge(out.pool.listFirst, sets);
+        reserveHuge(out.pool.roots, sets);
+        reserveHuge(out.pool.hashes, sets);
     }
 
     /// Every fragment's counters added into `f`'s.
@@ -931,7 +1007,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         out.bsp = std::move(root.bsp);
         reserveHuge(out.leaves, root.leafList.size());
         for (const uint32_t set : root.leafList)
-            out.leaves.push_back(RegularBuilder::leafOf(root.pool, set, root.setRoot[set]));
+            out.leaves.push_back(RegularBuilder::leafOf(root.pool, set, root.pool.roots[set]));
         out.places = std::move(root.places);
         out.pool = std::move(root.pool);
         out.treeNodes = root.treeNodes;
