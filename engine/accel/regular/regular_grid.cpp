@@ -686,18 +686,21 @@ struct RegularBuilder {
     void half(const PrimList& prims, int level, const Box3& child, int axis, double mid, int side,
               PrimList& out) const {
         // Below the root every primitive overlaps the cell, which differs from the child on the
-        // cut axis alone: the test there is the whole test.
+        // cut axis alone: the test there is the whole test. Without branches, as the one-pass
+        // split writes its lists: each primitive written, the end moved past it when it
+        // belongs (a coin toss for the branch predictor).
         out.clear();
+        out.resize(prims.size());
+        uint32_t* o = out.data();
+        const Box3* const boxes = scene.minBox.data();
         if (level == 0) {
-            for (uint32_t p : prims)
-                if (scene.minBox[p].overlaps(child)) out.push_back(p);
+            for (uint32_t p : prims) *o = p, o += boxes[p].overlaps(child);
         } else if (side == 0) {
-            for (uint32_t p : prims)
-                if (coord(scene.minBox[p].lo, axis) <= mid) out.push_back(p);
+            for (uint32_t p : prims) *o = p, o += coord(boxes[p].lo, axis) <= mid;
         } else {
-            for (uint32_t p : prims)
-                if (coord(scene.minBox[p].hi, axis) >= mid) out.push_back(p);
+            for (uint32_t p : prims) *o = p, o += coord(boxes[p].hi, axis) >= mid;
         }
+        out.resize(size_t(o - out.data()));
     }
 
     /// Build child `id` at `level` over the primitives `in` of its cell, restricting `tree` (its
