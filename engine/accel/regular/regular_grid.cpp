@@ -199,8 +199,8 @@ constexpr int kRestrictorDepth = 64;
 /// surface area A(axis) once cut on `axis`, so with the surface area heuristic the next level
 /// costs A(axis) x (2 visits + the tests of the primitive references) per cut cell; the cheapest
 /// axis is cut, ties going to x, then y; a test weighs as testWeights() says (`quarters`:
-/// testQuarters()). Cells stop as in
-/// the build: at most max-objects primitives, or covered by all their boxes. On a cube of
+/// testQuarters()). Cells stop as in the build: at most max-objects primitives, or covered by
+/// all their boxes. On a cube of
 /// evenly spread primitives this is the report's x, y, z; on a flat scene (balls4: 24 x 24 x 1.5)
 /// it cuts x and y until the cells are about cubes, where the report's order makes them 16 times
 /// flatter than wide.
