@@ -329,5 +329,40 @@ TEST(LightBuffer, SameImageFewerRegionVisits) {
     EXPECT_FALSE(b->info().extra.contains("light_buffer_bytes"));
 }
 
+// The eye buffer built with the structure for the scene's camera is the one every render from
+// that eye reads (not rebuilt per frame), and answers as one built on demand; a camera moved
+// elsewhere gets its own. Renders from both cameras equal brute force's.
+TEST(EyeBuffer, TheSceneCameraOneIsBuiltWithTheStructure) {
+    Scene s = loadScene(std::string(LANCER_SPD_DIR) + "/balls1.nff");
+    BuildParams reg;
+    reg.scheme = SchemeKind::Regular;
+    auto a = buildAccelerator(s, reg), brute = buildAccelerator(s, BuildParams{});
+    ASSERT_TRUE(a->info().extra.contains("eye_buffer_bytes"));
+    const auto kept = a->eyeBuffer(s, s.camera);
+    EXPECT_EQ(kept.get(), a->eyeBuffer(s, s.camera).get());
+    EXPECT_EQ(kept->mappedLights(), 1u);
+    const LightBuffer fresh = Accelerator::makeEyeBuffer(s, s.camera, reg);
+    for (const Ray& r : test::pixelRays(s, 32, 32))
+        EXPECT_EQ(kept->nearFrom(r.d, 0), fresh.nearFrom(r.d, 0));
+    Camera moved = s.camera;
+    moved.from += 0.25 * s.bounds.extent();
+    const auto other = a->eyeBuffer(s, moved);
+    EXPECT_NE(other.get(), kept.get());
+    EXPECT_EQ(other->mappedLights(), 1u);
+    // Brute force and --no-light-buffer have none.
+    EXPECT_EQ(brute->eyeBuffer(s, s.camera)->mappedLights(), 0u);
+    EXPECT_FALSE(brute->info().extra.contains("eye_buffer_bytes"));
+    for (const Camera& cam : {s.camera, moved}) {
+        RenderOptions opt;
+        opt.width = opt.height = 40;
+        opt.camera = cam;
+        Image ia(40, 40), ib(40, 40);
+        render(s, *a, opt, ia);
+        render(s, *brute, opt, ib);
+        EXPECT_EQ(ia.color, ib.color);
+        EXPECT_EQ(ia.hitPrim, ib.hitPrim);
+    }
+}
+
 }  // namespace
 }  // namespace lancer

@@ -429,10 +429,11 @@ TEST(RegularUnion, SphereQuadsRejectOnlyMisses) {
     EXPECT_GT(grazing, 100u);
 }
 
-// The walk with the sphere quads (no active observer) against the walk an observer sees (each
-// leaf's tree evaluated) and against brute force: the same hits, and the same tests, mailbox
-// hits and leaf visits, on rays that graze spheres, start inside them, start at tmin > 0, and on
-// the floor the quads cannot reject. Without the mailboxes too.
+// The walk with the sphere quads (no active observer) against the walk an observer sees (the
+// same walk, told to the observer) and against brute force: the same hits, and the same tests (a
+// sphere the quads reject is a test each time a leaf lists it), mailbox hits and leaf visits, on
+// rays that graze spheres, start inside them, start at tmin > 0, and on the floor the quads
+// cannot reject. Without the mailboxes too.
 TEST(RegularUnion, SphereQuadWalkEqualsObservedWalkAndBruteForce) {
     for (uint64_t seed : {5u, 6u}) {
         QuadScene q = quadScene(seed);

@@ -11,20 +11,28 @@ namespace lancer {
 
 namespace {
 
-/// An accelerated scheme's structure, from `build`, and its light buffer, counted in its memory
-/// and reported in `extra`. The light buffer needs only the scene, so it is built on another
-/// thread meanwhile: the structure's build is single-threaded, and on balls4 the buffer took 5-7
-/// of the 40-50 ms the two took one after the other.
+/// An accelerated scheme's structure, from `build`, and its light buffers (the lights', and the
+/// scene camera's eye buffer when the scheme has one), counted in its memory and reported in
+/// `extra`. The light buffers need only the scene, so they are built on another thread
+/// meanwhile: on balls4 the lights' buffer took 5-7 of the 40-50 ms the two took one after the
+/// other. The eye buffer is built here rather than by each render: on balls:6 it is some 25 ms
+/// of one thread, every frame of an unmoved camera the same.
 template <class Structure, class Build, class Clock>
 std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildParams& params,
                                              bool buffered, const BuildGuard& guard, Build&& build,
                                              Clock&& elapsedMs) {
-    // The buffer stops with the build: a cancelled build waits for it below.
-    std::future<LightBuffer> lightBuffer;
+    // The buffers stop with the build: a cancelled build waits for them below.
+    struct Buffers {
+        LightBuffer lights, eye;
+    };
+    std::future<Buffers> lightBuffer;
     if (buffered)
-        lightBuffer = std::async(std::launch::async, [&scene, stop = guard.control().stop] {
-            return LightBuffer(scene, LightBuffer::kBins, stop);
-        });
+        lightBuffer =
+            std::async(std::launch::async, [&scene, &params, stop = guard.control().stop] {
+                Buffers b{LightBuffer(scene, LightBuffer::kBins, stop), {}};
+                b.eye = Accelerator::makeEyeBuffer(scene, scene.camera, params, stop);
+                return b;
+            });
     AccelInfo info;
     info.treeDepth = scene.tree.depth();
     std::optional<Structure> s;
@@ -36,12 +44,17 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
     }
     info.regions = s->regionCount();
     info.memoryBytes = s->memoryBytes();
-    LightBuffer lb = lightBuffer.valid() ? lightBuffer.get() : LightBuffer();
-    guard.poll();  // the buffer may have stopped early
+    Buffers lb = lightBuffer.valid() ? lightBuffer.get() : Buffers();
+    guard.poll();  // the buffers may have stopped early
+    std::shared_ptr<const LightBuffer> eye;
     if (buffered) {
-        info.memoryBytes += lb.memoryBytes();
-        info.extra["light_buffer_bytes"] = lb.memoryBytes();
-        info.extra["light_buffer_lights"] = lb.mappedLights();
+        info.memoryBytes += lb.lights.memoryBytes() + lb.eye.memoryBytes();
+        info.extra["light_buffer_bytes"] = lb.lights.memoryBytes();
+        info.extra["light_buffer_lights"] = lb.lights.mappedLights();
+        if (Accelerator::hasEyeBuffer(params, scene.camera)) {
+            info.extra["eye_buffer_bytes"] = lb.eye.memoryBytes();
+            eye = std::make_shared<const LightBuffer>(std::move(lb.eye));
+        }
     } else if (params.lightBuffer) {
         info.extra["light_buffer_left_out"] =
             formatBytes(LightBuffer::bytesAtMost(scene.lights.size())) +
@@ -49,7 +62,8 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
             formatBytes(guard.given()) + ")";
     }
     info.buildMs = elapsedMs();
-    return std::make_unique<Accelerator>(std::move(*s), params, std::move(info), std::move(lb));
+    return std::make_unique<Accelerator>(std::move(*s), params, std::move(info),
+                                         std::move(lb.lights), std::move(eye), scene.camera.from);
 }
 
 }  // namespace
@@ -62,7 +76,10 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
     // would take more than a quarter of the budget, it is left out and the structure gets all.
     const size_t budget = params.memoryBudget ? params.memoryBudget : defaultMemoryBudget();
     const size_t lightBytes = params.scheme != SchemeKind::Brute && params.lightBuffer
-                                  ? LightBuffer::bytesAtMost(scene.lights.size())
+                                  ? LightBuffer::bytesAtMost(scene.lights.size()) +
+                                        (Accelerator::hasEyeBuffer(params, scene.camera)
+                                             ? LightBuffer::bytesAtMost(1, LightBuffer::kBins, 1)
+                                             : 0)
                                   : 0;
     const bool buffered = params.lightBuffer && lightBytes <= budget / 4;
     BuildGuard guard(budget, control, buffered ? lightBytes : 0);

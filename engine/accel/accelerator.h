@@ -31,11 +31,16 @@ class Accelerator {
   public:
     using Impl = std::variant<BruteForce, RegularGrid, IrregularSubdivision>;
 
-    Accelerator(Impl impl, BuildParams params, AccelInfo info, LightBuffer lightBuffer = {})
+    /// `eye`: the eye buffer of the camera at `eyeFrom` (eyeBuffer() returns it for a camera
+    /// there), null when none was built with the structure.
+    Accelerator(Impl impl, BuildParams params, AccelInfo info, LightBuffer lightBuffer = {},
+                std::shared_ptr<const LightBuffer> eye = {}, Vec3 eyeFrom = Vec3(0.0))
         : impl_(std::move(impl)),
           params_(params),
           info_(std::move(info)),
-          lightBuffer_(std::move(lightBuffer)) {}
+          lightBuffer_(std::move(lightBuffer)),
+          eye_(std::move(eye)),
+          eyeFrom_(eyeFrom) {}
 
     /// Nearest visible hit with t in (tmin, tmax]; reports the walk to `obs`.
     template <class Obs>
@@ -79,13 +84,24 @@ class Accelerator {
     /// The light buffer built from a perspective camera's eye (light_buffer.h), for primary
     /// rays: the regular scheme's, when it uses a light buffer; empty otherwise (brute force is
     /// the reference, and the irregular scheme's projective zones already start primary rays
-    /// where they meet their first region).
-    LightBuffer eyeBuffer(const Scene& scene, const Camera& cam) const {
-        if (!params_.lightBuffer || params_.scheme != SchemeKind::Regular ||
-            cam.projection != Projection::Perspective)
-            return {};
-        return LightBuffer(scene.bounds, scene.minBox, {cam.from}, LightBuffer::kBins, 1, {},
-                           LightBuffer::Use::NearOnly);
+    /// where they meet their first region). The one built with the structure for the scene's
+    /// camera when `cam` has its eye; else built now. Never null.
+    std::shared_ptr<const LightBuffer> eyeBuffer(const Scene& scene, const Camera& cam) const {
+        if (eye_ && cam.projection == Projection::Perspective && cam.from == eyeFrom_) return eye_;
+        return std::make_shared<const LightBuffer>(makeEyeBuffer(scene, cam, params_));
+    }
+    /// Whether a scheme built with `params` gives `cam` an eye buffer.
+    static bool hasEyeBuffer(const BuildParams& params, const Camera& cam) {
+        return params.lightBuffer && params.scheme == SchemeKind::Regular &&
+               cam.projection == Projection::Perspective;
+    }
+    /// The eye buffer of `cam` for a scheme built with `params` (empty when it has none); a
+    /// requested `stop` ends it early, empty.
+    static LightBuffer makeEyeBuffer(const Scene& scene, const Camera& cam,
+                                     const BuildParams& params, std::stop_token stop = {}) {
+        if (!hasEyeBuffer(params, cam)) return {};
+        return LightBuffer(scene.bounds, scene.minBox, {cam.from}, LightBuffer::kBins, 1,
+                           std::move(stop), LightBuffer::Use::NearOnly);
     }
     bool usesMailboxes() const {
         return params_.mailboxes &&
@@ -99,7 +115,9 @@ class Accelerator {
     Impl impl_;
     BuildParams params_;
     AccelInfo info_;
-    LightBuffer lightBuffer_;  ///< empty for brute force and with --no-light-buffer
+    LightBuffer lightBuffer_;                 ///< empty for brute force and with --no-light-buffer
+    std::shared_ptr<const LightBuffer> eye_;  ///< the scene camera's eye buffer, or null
+    Vec3 eyeFrom_;                            ///< where eye_ was built from
 };
 
 /// Build the scheme named in `params` over a prepared scene. Throws std::invalid_argument for

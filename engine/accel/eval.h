@@ -146,14 +146,14 @@ inline void flatUnion(SpanList& spans, SpanList& out) {
     }
 }
 
-/// The union of the spans held in the mailboxes of `keys` (all filled by this walk) into
-/// ctx.result: a union-only region's spans without its tree.
+/// The union of the spans held in the mailboxes of `keys` (filled by this walk; none for a
+/// sphere the quads rejected) into ctx.result: a union-only region's spans without its tree.
 inline void mergeHeldSpans(const uint32_t* keys, uint32_t count, TraceContext& ctx) {
     SpanList& spans = ctx.leafSpans;
     spans.clear();
     for (uint32_t i = 0; i < count; ++i) {
-        const Mailbox* m = ctx.heldMailbox(keys[i]);
-        spans.insert(spans.end(), m->spans, m->spans + m->count);
+        if (const Mailbox* m = ctx.heldMailbox(keys[i]))
+            spans.insert(spans.end(), m->spans, m->spans + m->count);
     }
     flatUnion(spans, ctx.result);
 }

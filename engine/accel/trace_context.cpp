@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <ostream>
 
+#include "engine/util/huge_pages.h"
+
 namespace lancer {
 
 RayCounters& RayCounters::operator+=(const RayCounters& o) {
@@ -44,6 +46,11 @@ std::string RayCounters::toString() const {
 std::ostream& operator<<(std::ostream& os, const RayCounters& c) { return os << c.toString(); }
 
 void TraceContext::reset(size_t primitives, int treeDepth) {
+    // Read at random by every walk: huge pages spare most TLB misses.
+    if (tags.capacity() < primitives) {
+        tags.clear();
+        reserveHuge(tags, primitives);
+    }
     tags.assign(primitives, Tag{});
     held.reserve(64);
     held.assign(1, Mailbox{});

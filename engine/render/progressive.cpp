@@ -154,7 +154,7 @@ void ProgressiveRenderer::run() {
         Image& work = work_;
         if (work.width != w || work.height != h) work = Image(w, h);
         // Where primary rays can first meet a box: once for all the passes of the view.
-        const LightBuffer eye = job.accel->eyeBuffer(
+        const std::shared_ptr<const LightBuffer> eye = job.accel->eyeBuffer(
             *job.scene, job.options.camera ? *job.options.camera : job.scene->camera);
         int previous = 0;
         bool complete = true;
@@ -179,7 +179,7 @@ void ProgressiveRenderer::run() {
                 lattice.rowBegin = y0;
                 lattice.rowEnd = std::min(h, y0 + bandRows);
                 RenderStats rs = render(*job.scene, *job.accel, job.options, work, lattice,
-                                        &cancel_, &progressDone_, &eye);
+                                        &cancel_, &progressDone_, eye.get());
                 if (rs.cancelled) {
                     complete = false;
                     break;

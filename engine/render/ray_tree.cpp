@@ -426,7 +426,7 @@ RayTree tracePixel(const Scene& scene, const Accelerator& accel, const ShadingOp
                    const Camera& cam, int x, int y, int w, int h) {
     const Tracer tracer(scene, accel, shading);
     const PrimaryRays primary(cam, w, h);
-    const LightBuffer eye = accel.eyeBuffer(scene, cam);
+    const std::shared_ptr<const LightBuffer> eye = accel.eyeBuffer(scene, cam);
     TraceContext ctx(scene.prims.size(), scene.tree.depth());
     ctx.useMailboxes = accel.usesMailboxes();
     RayTreeRecorder rec;
@@ -436,7 +436,7 @@ RayTree tracePixel(const Scene& scene, const Accelerator& accel, const ShadingOp
     tree.y = y;
     tree.width = w;
     tree.height = h;
-    tree.color = tracer.pixel(primary, eye, x, y, ctx, rec, hit);
+    tree.color = tracer.pixel(primary, *eye, x, y, ctx, rec, hit);
     tree.counters = ctx.counters;
     tree.rays = std::move(rec.rays);
     // A shadow ray's blocker is told as a Hit alone: its point and normal, as for any hit.

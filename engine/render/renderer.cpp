@@ -47,8 +47,9 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     const Tracer tracer(scene, accel, opt.shading);
     const PrimaryRays primary(cam, w, h);
     // Where each primary ray can first meet a box (empty unless the scheme uses one).
-    const LightBuffer eyeBuilt = eyeGiven ? LightBuffer() : accel.eyeBuffer(scene, cam);
-    const LightBuffer& eye = eyeGiven ? *eyeGiven : eyeBuilt;
+    const std::shared_ptr<const LightBuffer> eyeBuilt =
+        eyeGiven ? nullptr : accel.eyeBuffer(scene, cam);
+    const LightBuffer& eye = eyeGiven ? *eyeGiven : *eyeBuilt;
     const int depth = accel.info().treeDepth >= 0 ? accel.info().treeDepth : scene.tree.depth();
     const bool mailboxes = accel.usesMailboxes();
     tbb::enumerable_thread_specific<TraceContext> contexts([&] {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "engine/model/restriction.h"
+#include "engine/util/huge_pages.h"
 
 namespace lancer {
 
@@ -22,6 +23,9 @@ void Scene::prepare() {
     }
     bounds = Box3::empty();
     for (uint32_t p : tree.primitives()) bounds.expand(minBox[p]);
+    // Read at random by every walk over a union of spheres: huge pages spare most TLB misses.
+    packedSpheres.clear();
+    reserveHuge(packedSpheres, prims.size());
     packedSpheres.assign(prims.size(), PackedSphere{});
     for (size_t i = 0; i < prims.size(); ++i)
         if (const Sphere* sp = std::get_if<Sphere>(&prims[i].shape); sp && !prims[i].hasXf)
