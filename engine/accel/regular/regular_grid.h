@@ -243,8 +243,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     const RegularLeaf* const leaves = leaves_.data();
     const uint32_t* const primList = primList_.data();
     const bool quads = !quads_.empty();
-    QuadRay qr;
-    if (quads) qr = quadRay(ray);
+    QuadRay qr = quads ? quadRay(ray) : QuadRay{};
     // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
     // inside the grid, so this only admits hits that rounding puts a hair outside the box.
     double t0 = tmin, tIn = tStart;
