@@ -433,11 +433,10 @@ template <class Obs>
     for (uint32_t from = 0; from < count; from += 60) {
         const uint32_t n = std::min(count - from, 60u);
         const uint64_t misses = entryMisses(L.first + from, n, qr);
-        // A sphere the quads reject is a test, every time a leaf lists it: its mailbox is neither
-        // read nor written, which spares the walk most of the tags' cache misses (a rejected
-        // sphere has no span, so no hit depends on it).
-        // Counted as tests here, the spheres the mailboxes hold below taken back: without
-        // -mpopcnt a popcount is a call.
+        // A rejected sphere has no span: its mailbox is neither read nor written (most of the
+        // tags' cache misses spared), and it is a test each time a leaf lists it. All n are
+        // counted as tests here and the mailbox hits below taken back: without -mpopcnt a
+        // popcount is a call.
         ctx.counters.primTests += n;
         const uint64_t take = ~misses & ((uint64_t(1) << n) - 1);
         // The others' tags and spheres, fetched together rather than one miss at a time.
