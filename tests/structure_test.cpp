@@ -301,6 +301,8 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
                 switch (r.kind) {
                     case RegionKind::SceneBox:
                     case RegionKind::Leaf:
+                    case RegionKind::BvhLeaf:
+                    case RegionKind::BvhInner:
                         crossing = crosses(box, r.frameBox, margin);
                         break;
                     case RegionKind::Slab:

@@ -14,7 +14,8 @@ namespace {
 
 constexpr uint8_t kRegular = schemeBit(SchemeKind::Regular);
 constexpr uint8_t kIrregular = schemeBit(SchemeKind::Irregular);
-constexpr uint8_t kAccelerated = kRegular | kIrregular;
+constexpr uint8_t kBvh = schemeBit(SchemeKind::Bvh);
+constexpr uint8_t kAccelerated = kRegular | kIrregular | kBvh;
 
 std::vector<ParamDesc> makeTable() {
     using K = Knobs;
@@ -36,7 +37,7 @@ std::vector<ParamDesc> makeTable() {
     add(d);
 
     d = {"--scheme", "S", "scheme", "scheme", "Acceleration scheme", ParamKind::Enum};
-    d.names = {"brute", "regular", "irregular"};
+    d.names = {"brute", "regular", "irregular", "bvh"};
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.scheme); };
     d.set = [](K& k, double v) { k.build.scheme = SchemeKind(int(v)); };
@@ -45,15 +46,19 @@ std::vector<ParamDesc> makeTable() {
          "N",
          "max_level",
          "max-level",
-         "Deepest subdivision level (one axis cut per level); 0: automatic, 16 + 0.65 log2 of the "
-         "primitive count, 4 deeper where a split saves enough",
+         "Deepest subdivision level (regular: one axis cut per level, 0 automatic: 16 + 0.65 "
+         "log2 of the primitive count, 4 deeper where a split saves enough; bvh: tree depth, 0 "
+         "automatic: 64)",
          ParamKind::Int,
          0,
          48};
-    d.schemes = kRegular;
+    d.schemes = kRegular | kBvh;
     d.effect = ChangeEffect::Rebuild;
-    d.get = [](const K& k) { return double(k.build.regular.maxLevel); };
-    d.set = [](K& k, double v) { k.build.regular.maxLevel = int(v); };
+    d.get = [](const K& k) {
+        return double(k.build.scheme == SchemeKind::Bvh ? k.build.bvh.maxLevel
+                                                        : k.build.regular.maxLevel);
+    };
+    d.set = [](K& k, double v) { k.build.regular.maxLevel = k.build.bvh.maxLevel = int(v); };
     add(d);
     // One knob for both schemes, as the report has one: the regular scheme refuses 0 when it
     // builds (a cell must stop on a count), the irregular one splits until no segment is left.
@@ -62,7 +67,7 @@ std::vector<ParamDesc> makeTable() {
          "max_objects",
          "max-objects",
          "Stop subdividing a cell holding at most N primitives (irregular: 0 never stops; "
-         "regular: at least 1)",
+         "regular and bvh: at least 1; bvh default 2)",
          ParamKind::Int,
          0,
          1000000};
@@ -70,10 +75,11 @@ std::vector<ParamDesc> makeTable() {
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) {
         return double(k.build.scheme == SchemeKind::Irregular ? k.build.irregular.maxObjects
+                      : k.build.scheme == SchemeKind::Bvh     ? k.build.bvh.maxObjects
                                                               : k.build.regular.maxObjects);
     };
     d.set = [](K& k, double v) {
-        k.build.regular.maxObjects = k.build.irregular.maxObjects = int(v);
+        k.build.regular.maxObjects = k.build.irregular.maxObjects = k.build.bvh.maxObjects = int(v);
     };
     add(d);
     d = {"--step",       "M", "step", "step", "Next-cell method: exact, or the report's push",
@@ -134,10 +140,11 @@ std::vector<ParamDesc> makeTable() {
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) {
         return double(k.build.scheme == SchemeKind::Irregular ? k.build.irregular.costStop
+                      : k.build.scheme == SchemeKind::Bvh     ? k.build.bvh.costStop
                                                               : k.build.regular.costStop);
     };
     d.set = [](K& k, double v) {
-        k.build.regular.costStop = k.build.irregular.costStop = v != 0.0;
+        k.build.regular.costStop = k.build.irregular.costStop = k.build.bvh.costStop = v != 0.0;
     };
     add(d);
     d = {"--bsp-heuristic",

@@ -112,6 +112,11 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
                     return IrregularSubdivision::build(scene, params.irregular, info.extra, &guard);
                 },
                 elapsedMs);
+        case SchemeKind::Bvh:
+            return withLightBuffer<Bvh>(
+                scene, params, buffered, guard,
+                [&](AccelInfo& info) { return Bvh::build(scene, params.bvh, info.extra, &guard); },
+                elapsedMs);
     }
     throw std::logic_error("buildAccelerator: unknown scheme");
 }

@@ -10,6 +10,7 @@
 #include "engine/accel/brute_force.h"
 #include "engine/accel/build_guard.h"
 #include "engine/accel/build_params.h"
+#include "engine/accel/bvh/bvh.h"
 #include "engine/accel/irregular/irregular.h"
 #include "engine/accel/light_buffer.h"
 #include "engine/accel/regular/regular_grid.h"
@@ -29,7 +30,7 @@ struct AccelInfo {
 
 class Accelerator {
   public:
-    using Impl = std::variant<BruteForce, RegularGrid, IrregularSubdivision>;
+    using Impl = std::variant<BruteForce, RegularGrid, IrregularSubdivision, Bvh>;
 
     /// `eye`: the eye buffer of the camera at `eyeFrom` (eyeBuffer() returns it for a camera
     /// there), null when none was built with the structure.

@@ -16,6 +16,8 @@ const char* schemeName(SchemeKind k) {
             return "regular";
         case SchemeKind::Irregular:
             return "irregular";
+        case SchemeKind::Bvh:
+            return "bvh";
     }
     return "?";
 }
@@ -73,6 +75,10 @@ std::string toString(const BuildParams& p) {
         os << " --max-objects " << i.maxObjects << " --bsp-heuristic " << heuristicName(i.heuristic)
            << " --irregular-frame " << irregularFrameName(i.frame);
         if (!i.costStop) os << " --no-cost-stop";
+    } else if (p.scheme == SchemeKind::Bvh) {
+        const BvhConfig& b = p.bvh;
+        os << " --max-level " << b.maxLevel << " --max-objects " << b.maxObjects;
+        if (!b.costStop) os << " --no-cost-stop";
     }
     if (p.scheme != SchemeKind::Brute) {
         if (!p.mailboxes) os << " --no-mailbox";

@@ -9,10 +9,12 @@
 #include <iosfwd>
 #include <string>
 
+#include "engine/accel/bvh/bvh_config.h"
+
 namespace lancer {
 
-enum class SchemeKind : uint8_t { Brute, Regular, Irregular };
-inline constexpr int kSchemeCount = 3;
+enum class SchemeKind : uint8_t { Brute, Regular, Irregular, Bvh };
+inline constexpr int kSchemeCount = 4;
 enum class StepMethod : uint8_t { Exact, Push };
 enum class BspHeuristic : uint8_t { First, Balanced, FewestCuts };
 /// Regular scheme: the axis each level of the BSP cuts. Cycle: x, y, z in turn (the report's);
@@ -104,6 +106,7 @@ struct BuildParams {
     size_t memoryBudget = 0;
     RegularConfig regular;      ///< read by the regular scheme only
     IrregularConfig irregular;  ///< read by the irregular scheme only
+    BvhConfig bvh;              ///< read by the BVH only
 };
 
 /// The knobs the scheme in use reads, as command-line options: "regular --max-level 0

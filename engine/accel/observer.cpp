@@ -33,6 +33,9 @@ std::string axes(int mask) {
     return s.empty() ? "-" : s;
 }
 
+/// BVH events' "no node" (kNoNode, engine/accel/bvh/bvh.h).
+constexpr uint32_t kNoNodeId = 0xffffffffu;
+
 std::string prim(uint32_t p, const Scene* scene) {
     std::string s = "p" + std::to_string(p);
     if (scene && p < scene->prims.size()) s += " " + scene->prims[p].toString();
@@ -94,6 +97,18 @@ std::string WalkEvent::toString(const Scene* scene) const {
         case Rope:
             return "rope " + std::to_string(a) + " -> " + std::to_string(b) + " across face " +
                    (axis % 2 ? "+" : "-") + axes(1 << (axis / 2));
+        case Children: {
+            const std::string node = "node " + std::to_string(corner);
+            if (a == kNoNodeId) return node + ": the ray meets neither child's box";
+            std::string s = node + ": child " + std::to_string(a) + " at t = " + num(t0);
+            if (b != kNoNodeId) s += ", then child " + std::to_string(b) + " at t = " + num(t1);
+            return s;
+        }
+        case Restart:
+            return "walk restarts: " + what;
+        case Culled:
+            return "node " + std::to_string(a) + " skipped: its box begins at t = " + num(t0) +
+                   ", beyond the hit at t = " + num(t1);
         case Stretch:
             return "light buffer stretch " + std::to_string(a) + "  " + interval(t0, t1);
         case LightBufferClear:

@@ -63,6 +63,13 @@ struct NullObserver {
     void push(const Vec3& point, int axes) {}
     void indexStep(int axis, const uint32_t cell[3]) {}
     void rope(uint32_t from, int face, uint32_t to) {}
+    // BVH: an inner node's children the ray's interval meets, in the order they are visited
+    // (`second` kNoNode when one or none is met), with the t each box is entered at; a node
+    // left unvisited because its box begins beyond the hit found.
+    void nodeChildren(uint32_t node, uint32_t first, double t0First, uint32_t second,
+                      double t0Second) {}
+    void nodeCulled(uint32_t node, double t0, double best) {}
+    void walkRestart(const char* why) {}
     // Shadow rays and the light buffer: each stretch walked, none to walk, what blocked it.
     void stretch(int index, double t0, double t1) {}
     void lightBufferClear() {}
@@ -76,19 +83,22 @@ struct NullObserver {
 /// One event of a walk, in order. Which fields are set depends on the kind (see each kind).
 struct WalkEvent {
     enum Kind : uint8_t {
-        Region,            ///< a: region id; t0, t1: the ray's interval in it
-        Pointer,           ///< a -> b by the corner pointer at `corner` (bit 0 x, 1 y, 2 z high)
-        PrimTest,          ///< a: primitive; spans: its spans along the whole line
-        MailboxHit,        ///< a: primitive whose spans the mailbox held
-        Spans,             ///< spans: the region's tree along the whole line
-        Error,             ///< what: why the walk ended
-        Locate,            ///< point: where the walk starts (world); b: its region
-        Exit,              ///< t0: where the region is left; point (world); axis; ties: axes mask
-        Lookup,            ///< point: the point located (world); cell: directory cell; b: leaf
-        Push,              ///< point: the exit point pushed across the axes in `ties` (world)
-        IndexStep,         ///< axis: the exit axis; cell: the next cell's indices
-        Rope,              ///< a -> b by the rope of face `axis` (2 * axis + 1 for the high face)
-        Stretch,           ///< a: index; t0, t1: a stretch the light buffer leaves to walk
+        Region,      ///< a: region id; t0, t1: the ray's interval in it
+        Pointer,     ///< a -> b by the corner pointer at `corner` (bit 0 x, 1 y, 2 z high)
+        PrimTest,    ///< a: primitive; spans: its spans along the whole line
+        MailboxHit,  ///< a: primitive whose spans the mailbox held
+        Spans,       ///< spans: the region's tree along the whole line
+        Error,       ///< what: why the walk ended
+        Locate,      ///< point: where the walk starts (world); b: its region
+        Exit,        ///< t0: where the region is left; point (world); axis; ties: axes mask
+        Lookup,      ///< point: the point located (world); cell: directory cell; b: leaf
+        Push,        ///< point: the exit point pushed across the axes in `ties` (world)
+        IndexStep,   ///< axis: the exit axis; cell: the next cell's indices
+        Rope,        ///< a -> b by the rope of face `axis` (2 * axis + 1 for the high face)
+        Children,    ///< BVH: node `corner`'s children met, a (entered at t0) then b (at t1)
+        Culled,      ///< BVH: node a not entered: its box begins at t0, beyond the hit at t1
+        Restart,     ///< what: why the walk starts again another way (BVH: in box-entry order)
+        Stretch,     ///< a: index; t0, t1: a stretch the light buffer leaves to walk
         LightBufferClear,  ///< the light buffer shows nothing can block: no walk
         Blocker,           ///< a: the primitive that blocks a shadow ray; t0: where
         RayBegin,  ///< point: origin; t0, t1: [tmin, tmax]; axis: RayKind; b: depth; corner: light
@@ -173,6 +183,22 @@ struct RecordingObserver {
         e.b = to;
         e.axis = face;
     }
+    void nodeChildren(uint32_t node, uint32_t first, double t0First, uint32_t second,
+                      double t0Second) {
+        WalkEvent& e = add(WalkEvent::Children);
+        e.corner = int(node);
+        e.a = first;
+        e.t0 = t0First;
+        e.b = second;
+        e.t1 = t0Second;
+    }
+    void nodeCulled(uint32_t node, double t0, double best) {
+        WalkEvent& e = add(WalkEvent::Culled);
+        e.a = node;
+        e.t0 = t0;
+        e.t1 = best;
+    }
+    void walkRestart(const char* why) { add(WalkEvent::Restart).what = why; }
     void stretch(int index, double t0, double t1) {
         WalkEvent& e = add(WalkEvent::Stretch);
         e.a = uint32_t(index);

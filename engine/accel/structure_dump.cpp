@@ -88,6 +88,43 @@ class Writer {
     std::string buf_;
 };
 
+/// docs/design.md section 6: "bvh": {"bounds", "nodes": [{"id", "depth", "box", "children"} or
+/// {"id", "depth", "box", "prims"}]}.
+void writeBvh(Writer& w, const Bvh& b, bool summary) {
+    w.raw(",\"bvh\":{\"bounds\":");
+    w.box(b.box());
+    w.raw(",\"node_count\":");
+    w.num(uint64_t(b.nodes().size()));
+    w.raw(",\"depth\":");
+    w.num(uint64_t(b.depth()));
+    if (!summary) {
+        w.raw(",\"nodes\":[");
+        for (uint32_t id = 0; id < b.nodes().size(); ++id) {
+            const BvhNode& n = b.nodes()[id];
+            if (id) w.raw(",");
+            w.raw("{\"id\":");
+            w.num(id);
+            w.raw(",\"depth\":");
+            w.num(uint64_t(n.depth));
+            w.raw(",\"box\":");
+            w.box(n.box());
+            if (n.leaf) {
+                w.raw(",\"prims\":");
+                w.ids({b.primList().data() + n.first, n.count});
+            } else {
+                w.raw(",\"children\":[");
+                w.num(n.first);
+                w.raw(",");
+                w.num(n.first + 1);
+                w.raw("]");
+            }
+            w.raw("}");
+        }
+        w.raw("]");
+    }
+    w.raw("}");
+}
+
 void writeRegular(Writer& w, const StructureView& v, bool summary) {
     const RegularGrid& g = *v.regular();
     w.raw(",\"regular\":{\"bounds\":");
@@ -240,6 +277,7 @@ void writeStructureJson(const StructureView& view, const StructureDumpOptions& o
     w.raw("]");
 
     if (view.regular()) writeRegular(w, view, summary);
+    if (const Bvh* b = view.bvh()) writeBvh(w, *b, summary);
     for (const ZoneFrameView& f : view.frames()) writeFrame(w, f, o, summary);
     w.raw("}\n");
 }

@@ -36,6 +36,10 @@ const char* regionKindName(RegionKind k) {
             return "projective slab";
         case RegionKind::NearRegion:
             return "near region";
+        case RegionKind::BvhInner:
+            return "node";
+        case RegionKind::BvhLeaf:
+            return "bvh leaf";
     }
     return "?";
 }
@@ -186,7 +190,7 @@ StructureView::StructureView(const Scene& scene, const Accelerator& accel)
         if (!s->regions().empty()) frames_.emplace_back(scene, *s, ZoneFrameKind::Camera);
         if (s->projective().zoneCount() > 0)
             frames_.emplace_back(scene, *s, ZoneFrameKind::Projective);
-    } else if (!regular()) {
+    } else if (!regular() && !bvh()) {
         live_ = scene.livePrimitives();
         std::sort(live_.begin(), live_.end());
     }
@@ -199,6 +203,8 @@ const RegularGrid* StructureView::regular() const {
 const IrregularSubdivision* StructureView::irregular() const {
     return std::get_if<IrregularSubdivision>(&accel_->impl());
 }
+
+const Bvh* StructureView::bvh() const { return std::get_if<Bvh>(&accel_->impl()); }
 
 const ZoneFrameView* StructureView::frame(ZoneFrameKind kind) const {
     for (const ZoneFrameView& f : frames_)
@@ -216,6 +222,7 @@ std::array<Vec3, 8> StructureView::regionCorners(uint32_t id) const {
         return boxCorners(
             {{L.plane[0], L.plane[1], L.plane[2]}, {L.plane[3], L.plane[4], L.plane[5]}});
     }
+    if (const Bvh* b = bvh()) return boxCorners(b->nodes().at(id).box());
     const IrregularSubdivision* s = irregular();
     if (!s) return boxCorners(scene_->bounds);
     const CameraFrame& f = s->frame();
@@ -248,6 +255,19 @@ RegionInfo StructureView::region(uint32_t id) const {
         r.prims = {L.primitives(g->primList().data()), L.prims};
         r.pool = &g->treePool();
         r.root = L.root;
+        return r;
+    }
+    if (const Bvh* b = bvh()) {
+        const BvhNode& n = b->nodes().at(id);
+        r.kind = n.leaf ? RegionKind::BvhLeaf : RegionKind::BvhInner;
+        r.frameBox = n.box();
+        r.level = n.depth;
+        for (int a = 0; a < 3; ++a) r.lo[a] = r.hi[a] = kNotLinked;
+        if (n.leaf) {
+            r.prims = {b->primList().data() + n.first, n.count};
+            r.pool = &b->treePool();
+            r.root = n.root;
+        }
         return r;
     }
     const IrregularSubdivision* s = irregular();
@@ -312,6 +332,7 @@ std::string StructureView::toString(uint32_t id) const {
     const RegionInfo r = region(id);
     if (const RegularGrid* g = regular())
         return g->describeLeaf(id) + " level " + std::to_string(r.level);
+    if (const Bvh* b = bvh()) return b->describe(id);
     std::string out = std::string(regionKindName(r.kind)) + " " + std::to_string(id);
     if (r.kind == RegionKind::Slab || r.kind == RegionKind::ProjectiveSlab)
         out += " zone " + std::to_string(r.zone) + " slab " + std::to_string(r.slab);
@@ -332,6 +353,7 @@ std::string StructureView::toString(uint32_t id) const {
 
 uint32_t StructureView::regionAt(const Vec3& world) const {
     if (const RegularGrid* g = regular()) return g->leafAt(world);
+    if (const Bvh* b = bvh()) return b->regionCount() ? b->leafAt(world) : 0;
     const IrregularSubdivision* s = irregular();
     if (!s || s->regions().empty()) return 0;
     const Vec3 p = glm::clamp(s->frame().point(world), s->bounds().lo, s->bounds().hi);
@@ -340,6 +362,7 @@ uint32_t StructureView::regionAt(const Vec3& world) const {
 
 std::array<Vec3, 8> StructureView::structureCorners() const {
     if (const RegularGrid* g = regular()) return boxCorners(g->box());
+    if (const Bvh* b = bvh()) return boxCorners(b->regionCount() ? b->box() : scene_->bounds);
     const IrregularSubdivision* s = irregular();
     if (!s) return boxCorners(scene_->bounds);
     std::array<Vec3, 8> c = boxCorners(s->bounds());

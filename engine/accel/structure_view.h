@@ -6,9 +6,10 @@
 // irregular scheme on balls4 has millions of regions, so nothing is stored per region.
 //
 // Region ids are the ids the walk reports to the observer (observer.h): brute force has one
-// region (the scene box); the regular scheme's are its leaves; the irregular scheme's are its
-// camera-frame regions, then from IrregularSubdivision::regions().size() on the projective
-// slabs in zone order, the near region last (projective_zones.h).
+// region (the scene box); the regular scheme's are its leaves; the BVH's are its nodes, inner
+// and leaf; the irregular scheme's are its camera-frame regions, then from
+// IrregularSubdivision::regions().size() on the projective slabs in zone order, the near region
+// last (projective_zones.h).
 #pragma once
 
 #include <array>
@@ -28,6 +29,8 @@ enum class RegionKind : uint8_t {
     Slab,            ///< irregular: a depth slab of a camera-frame zone, a box of the camera frame
     ProjectiveSlab,  ///< irregular: a depth slab of a projective zone (a piece of a pyramid)
     NearRegion,      ///< irregular: the projective near region, depth [0, zNear] of every pixel
+    BvhInner,        ///< BVH: an inner node, a box of the world holding its two children's
+    BvhLeaf,         ///< BVH: a leaf, a box of the world listing the primitives meeting it
 };
 const char* regionKindName(RegionKind k);
 
@@ -54,7 +57,7 @@ struct RegionInfo {
     /// The region's box in its own frame: world (brute force, regular), camera frame (x, y,
     /// depth; slabs), projective (u, v, depth; projective slabs and the near region).
     Box3 frameBox;
-    int level = -1;                           ///< regular: BSP level of the leaf; -1 otherwise
+    int level = -1;  ///< regular: BSP level of the leaf; BVH: the node's depth; -1 otherwise
     uint32_t cellLo[3] = {}, cellHi[3] = {};  ///< regular: directory cells [lo, hi) per axis
     int64_t zone = -1;  ///< irregular: zone in its frame's BSP; -1 for the near region
     uint32_t slab = 0;  ///< irregular: index of the slab in its zone, by increasing depth
@@ -224,6 +227,8 @@ class StructureView {
 
     // Irregular scheme (nullptr / empty otherwise).
     const IrregularSubdivision* irregular() const;
+    // BVH (nullptr otherwise).
+    const Bvh* bvh() const;
     /// The screen frames present: the camera frame always, the projective one when primary rays
     /// walk it.
     const std::vector<ZoneFrameView>& frames() const { return frames_; }

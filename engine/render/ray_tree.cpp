@@ -241,12 +241,73 @@ std::string regionName(const StructureView& view, uint32_t region) {
                    std::to_string(r.zone) + id;
         case RegionKind::NearRegion:
             return "the near region" + id;
+        case RegionKind::BvhInner:
+            return "node " + std::to_string(region) + " (depth " + std::to_string(r.level) + ")";
+        case RegionKind::BvhLeaf:
+            return "leaf node " + std::to_string(region) + " (depth " + std::to_string(r.level) +
+                   ", " + std::to_string(r.prims.size()) + " prims)";
     }
     return "region " + std::to_string(region);
 }
 
+namespace {
+
+/// The BVH's steps: each node visited, what it did (its children's boxes met, in the order
+/// walked; a leaf's hit or none), and the nodes skipped for lying beyond the hit.
+std::vector<StepReason> explainBvhSteps(const TracedRay& r, const StructureView& view,
+                                        const Scene* scene) {
+    const std::vector<WalkEvent>& ev = r.events;
+    const std::vector<size_t> steps = r.regionSteps();
+    std::vector<StepReason> out(steps.size());
+    for (size_t k = 0; k < steps.size(); ++k) {
+        const WalkEvent& reg = ev[steps[k]];
+        const size_t end = k + 1 < steps.size() ? steps[k + 1] : ev.size();
+        const RegionInfo info = view.region(reg.a);
+        std::string s = (k == 0 ? "the walk starts at the root, " : "") + regionName(view, reg.a) +
+                        ", its box met on t = [" + num6(reg.t0) + ", " + num6(reg.t1) + "]: ";
+        std::vector<std::string> culled;
+        bool told = false;
+        for (size_t i = steps[k] + 1; i < end; ++i) {
+            const WalkEvent& e = ev[i];
+            if (e.kind == WalkEvent::Children) {
+                told = true;
+                if (e.a == kNoNode)
+                    s += "the ray meets neither child's box";
+                else if (e.b == kNoNode)
+                    s += "only child " + std::to_string(e.a) +
+                         "'s box is met (at t = " + num6(e.t0) + ")";
+                else
+                    s += "both children's boxes are met; the nearer, " + std::to_string(e.a) +
+                         " (at t = " + num6(e.t0) + "), first, then " + std::to_string(e.b) +
+                         " (at t = " + num6(e.t1) + ") unless a hit comes before it";
+            } else if (e.kind == WalkEvent::Culled) {
+                culled.push_back(std::to_string(e.a) + " (its box begins at t = " + num6(e.t0) +
+                                 ")");
+            }
+        }
+        if (!told && info.kind == RegionKind::BvhLeaf) {
+            const bool hitHere = r.kind != RayKind::Shadow && r.hit.valid() && r.hit.t >= reg.t0 &&
+                                 r.hit.t <= reg.t1;
+            s += info.prims.empty() ? "an empty leaf"
+                 : hitHere ? "its primitives give the hit on " + primText(r.hit.prim, scene) +
+                                 " at t = " + num6(r.hit.t) + " inside its box"
+                           : "no boundary of its tree lies inside its box";
+        }
+        if (!culled.empty()) {
+            s += "; then skipped, beyond the hit found:";
+            for (size_t i = 0; i < culled.size(); ++i) s += (i ? ", node " : " node ") + culled[i];
+        }
+        out[k].text = std::move(s);
+        out[k].next = k + 1 < steps.size() ? int64_t(ev[steps[k + 1]].a) : -1;
+    }
+    return out;
+}
+
+}  // namespace
+
 std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& view,
                                      const Scene* scene) {
+    if (view.bvh()) return explainBvhSteps(r, view, scene);
     const std::vector<WalkEvent>& ev = r.events;
     const std::vector<size_t> steps = r.regionSteps();
     std::vector<StepReason> out(steps.size());
@@ -531,6 +592,19 @@ nlohmann::json toJson(const WalkEvent& e, const RegionCornersFn& corners) {
                  {"to", e.b},
                  {"axis", e.axis / 2},
                  {"side", e.axis % 2 ? "high" : "low"}};
+            break;
+        case WalkEvent::Children:
+            j = {{"event", "children"}, {"node", e.corner}};
+            j["first"] = e.a == kNoNode ? nlohmann::json(nullptr) : nlohmann::json(e.a);
+            j["first_t"] = tJson(e.t0);
+            j["second"] = e.b == kNoNode ? nlohmann::json(nullptr) : nlohmann::json(e.b);
+            j["second_t"] = tJson(e.t1);
+            break;
+        case WalkEvent::Restart:
+            j = {{"event", "restart"}, {"what", e.what}};
+            break;
+        case WalkEvent::Culled:
+            j = {{"event", "culled"}, {"node", e.a}, {"t0", tJson(e.t0)}, {"hit_t", tJson(e.t1)}};
             break;
         case WalkEvent::Stretch:
             j = {{"event", "stretch"}, {"index", e.a}, {"t0", tJson(e.t0)}, {"t1", tJson(e.t1)}};

@@ -76,6 +76,24 @@ void regularRegions(InspectorModel& m, const StructureView& view, const Inspecto
     }
 }
 
+/// The BVH's nodes in the level range (by depth), leaves and inner nodes alike.
+void bvhRegions(InspectorModel& m, const StructureView& view, const InspectorOptions& opt,
+                const InspectorView& insp) {
+    const Bvh& b = *view.bvh();
+    m.total = b.nodes().size();
+    m.maxLevel = b.depth();
+    for (uint32_t id = 0; id < b.nodes().size(); ++id) {
+        const BvhNode& n = b.nodes()[id];
+        if (!inLevelRange(n.depth, opt.levelLo, opt.levelHi)) continue;
+        RegionView r;
+        r.id = id;
+        r.level = n.depth;
+        r.prims = n.leaf ? n.count : 0;
+        r.corners = view.regionCorners(id);
+        if (!offer(m, opt, insp, r)) break;
+    }
+}
+
 /// The frame primary rays walk: the projective zones when present, else the camera frame.
 const ZoneFrameView* primaryFrame(const StructureView& view) {
     const ZoneFrameView* f = view.frame(ZoneFrameKind::Projective);
@@ -176,6 +194,8 @@ InspectorModel buildModel(const StructureView& view, const InspectorOptions& opt
         if (opt.grid) directoryBlocks(m, view, opt, insp);
     } else if (view.scheme() == SchemeKind::Irregular) {
         irregularRegions(m, view, opt, insp, selected);
+    } else if (view.scheme() == SchemeKind::Bvh) {
+        if (opt.regions) bvhRegions(m, view, opt, insp);
     } else if (opt.regions) {
         RegionView r;
         r.corners = view.regionCorners(0);

@@ -247,6 +247,41 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
     g.wires = gl::mergeCollinearLines(g.wires);
 }
 
+/// The BVH's node boxes ("leaves" layer): every node whose depth lies in the level range, the
+/// visible ones first under the cap, coloured by depth or by the primitives a leaf lists.
+void bvhLayer(const StructureView& sv, const gl::ImageProjector& proj, int w, int h,
+              const OverlayOptions& o, OverlayGeometry& g) {
+    const Bvh& bvh = *sv.bvh();
+    const std::vector<BvhNode>& nodes = bvh.nodes();
+    size_t mostPrims = 1;
+    std::vector<uint32_t> picked;
+    for (uint32_t i = 0; i < nodes.size(); ++i) {
+        const int depth = nodes[i].depth;
+        if (depth < o.levelMin || depth > o.levelMax) continue;
+        ++g.regionsTotal;
+        if (picked.size() >= o.cap) {
+            g.cameraDependent = true;
+            continue;
+        }
+        if (nodes.size() > o.cap && !mayBeVisible(proj, sv.regionCorners(i), w, h)) {
+            g.cameraDependent = true;
+            continue;
+        }
+        picked.push_back(i);
+        mostPrims = std::max(mostPrims, size_t(nodes[i].count));
+    }
+    for (uint32_t i : picked) {
+        const BvhNode& n = nodes[i];
+        const glm::vec3 col =
+            o.leafColor == LeafColor::Level
+                ? depthColor(n.depth, bvh.depth() + 1)
+                : colormap(0.3f + 0.7f * float(n.leaf ? n.count : 0) / float(mostPrims));
+        g.wires.box(toF(Vec3(n.lo[0], n.lo[1], n.lo[2])), toF(Vec3(n.hi[0], n.hi[1], n.hi[2])),
+                    gl::rgba8(col));
+    }
+    g.regionsDrawn += picked.size();
+}
+
 }  // namespace
 
 glm::vec3 depthColor(int depth, int count) {
@@ -309,6 +344,7 @@ OverlayGeometry buildOverlayGeometry(const StructureView& sv, const Camera& view
         irregularLayers(sv, proj, width, height, options, g);
     if (sv.regular() && (options.leaves || options.grid))
         regularLayers(sv, proj, width, height, options, g);
+    if (sv.bvh() && options.leaves) bvhLayer(sv, proj, width, height, options, g);
     // The longest lines show the structure's coarse shape: drawn first while the camera moves.
     std::vector<size_t> order(g.wires.lineCount());
     for (size_t k = 0; k < order.size(); ++k) order[k] = k;

@@ -1,0 +1,440 @@
+// A bounding volume hierarchy (BVH) over the minimized boxes, split by the surface-area
+// heuristic (MacDonald and Booth, 1990; binned as in Wald, 2007): the modern baseline beside
+// the report's two subdivisions, in the same tool and ray for ray.
+//
+// A CSG scene needs one thing more than a BVH of triangles: a leaf's tree must give the full
+// tree's spans inside the leaf's box. Each leaf is built from the primitives assigned to it by
+// the splits, and lists every primitive whose minimized box meets its box (the assigned ones
+// and those of other leaves reaching into it), with their restricted tree (report, section 2)
+// as every region of the other schemes has. Inside that box the restricted tree agrees with the
+// full one, so the first boundary a leaf finds within its box is a boundary of the scene; the
+// nearest of the leaves' is the visible hit. Leaves overlap, so the walk is not in ray order:
+// front to back by box entry, a node whose box starts beyond the hit found is not entered, and
+// the mailboxes spare a primitive listed by several leaves a second test.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "engine/accel/bvh/bvh_config.h"
+#include "engine/accel/eval.h"
+
+namespace lancer {
+
+class BuildGuard;  // engine/accel/build_guard.h
+
+/// One node, in one cache line: its box (grown by a hair, BvhBuilder), and either its two
+/// children (next to each other) or its leaf's primitives and restricted tree.
+struct alignas(64) BvhNode {
+    double lo[3] = {}, hi[3] = {};
+    uint32_t first = 0;    ///< inner: the left child (the right one is first + 1); leaf: primList
+    uint32_t count = 0;    ///< leaf: primitives listed (primList[first, first + count))
+    int32_t root = -1;     ///< leaf: restricted tree in the pool; -1: none (union-only, or empty)
+    uint16_t depth = 0;    ///< the root is depth 0
+    uint8_t leaf = 0;      ///< 1: a leaf
+    uint8_t assigned = 0;  ///< leaf: primitives the splits gave it (at most 255 shown; see count)
+    Box3 box() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
+};
+static_assert(sizeof(BvhNode) == 64);
+
+/// A node id meaning "no node" in the walk's events.
+inline constexpr uint32_t kNoNode = 0xffffffffu;
+
+class Bvh {
+  public:
+    /// Build over a prepared scene; the scheme's figures go to `extra`. Throws
+    /// std::invalid_argument naming the option for refused parameters or a structure over the
+    /// guard's memory budget, BuildCancelled when its stop is requested. `guard` null: the
+    /// default budget, no cancellation.
+    static Bvh build(const Scene& scene, const BvhConfig& config, nlohmann::json& extra,
+                     BuildGuard* guard = nullptr);
+
+    /// Nearest visible hit with t in (tmin, tmax], the nodes visited front to back.
+    template <class Obs>
+    bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                   Hit& hit) const {
+        if (nodes_.empty()) return false;
+        // An axis the ray runs parallel to is tested by the origin's place, not by a product
+        // with an infinite inverse (0 times infinity is NaN on a box face).
+        const bool parallel = ray.d.x == 0.0 || ray.d.y == 0.0 || ray.d.z == 0.0;
+        if (unionOnly_) {
+            const int r = parallel ? walkFirstStart<true>(ray, tmin, tmax, ctx, obs, hit)
+                                   : walkFirstStart<false>(ray, tmin, tmax, ctx, obs, hit);
+            if (r >= 0) return r == 1;
+            if constexpr (Obs::kActive)
+                obs.walkRestart(
+                    "bvh: the ray begins inside a primitive "
+                    "or two starts tie; walked in order");
+            return parallel ? walkUnion<true>(ray, tmin, tmax, ctx, obs, hit)
+                            : walkUnion<false>(ray, tmin, tmax, ctx, obs, hit);
+        }
+        return parallel ? walk<true>(ray, tmin, tmax, ctx, obs, hit)
+                        : walk<false>(ray, tmin, tmax, ctx, obs, hit);
+    }
+
+    /// Regions are the nodes, inner and leaf: the ids the walk reports.
+    size_t regionCount() const { return nodes_.size(); }
+    size_t memoryBytes() const {
+        return nodes_.size() * sizeof(BvhNode) + primList_.size() * sizeof(uint32_t) +
+               parent_.size() * sizeof(uint32_t) + pool_.nodes.size() * sizeof(CsgNode);
+    }
+    /// A union-only scene's leaves list only their own primitives, each primitive in one leaf.
+    bool usesMailboxes() const { return !unionOnly_; }
+
+    const std::vector<BvhNode>& nodes() const { return nodes_; }
+    /// Node `id`'s parent; kNoNode for the root.
+    uint32_t parent(uint32_t id) const { return parent_[id]; }
+    /// Primitives listed by the leaves: leaf n's are primList()[n.first, n.first + n.count).
+    const std::vector<uint32_t>& primList() const { return primList_; }
+    /// The leaves' restricted trees (empty for a union-only scene: its leaves merge their
+    /// primitives' spans).
+    const CsgTree& treePool() const { return pool_; }
+    /// The structure's box: the root's.
+    Box3 box() const { return nodes_.empty() ? Box3() : nodes_[0].box(); }
+    /// Deepest level reached.
+    int depth() const { return depth_; }
+    /// The leaf holding a point, for picking: the deepest leaf whose box contains it (the
+    /// nearest leaf's box when none does); kNoNode for an empty structure.
+    uint32_t leafAt(const Vec3& p) const;
+    /// "leaf 12 depth 5 Box3{..} 3 prims (2 assigned)" or "node 3 depth 1 Box3{..} children 4, 5".
+    std::string describe(uint32_t id) const;
+
+  private:
+    /// The walk of a scene with intersections or differences: leaves list every primitive
+    /// meeting their box, with its restricted tree; front to back by a stack, each leaf's hit
+    /// inside its box, the nearest kept.
+    template <bool kParallel, class Obs>
+    bool walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+              Hit& hit) const;
+    /// A union-only scene's walk for a ray that begins outside every primitive, most rays: the
+    /// union's first boundary is then the first start of a span after tmin, and the walk is a
+    /// closest-hit walk (a stack, nodes beyond the nearest start culled). Returns 1 (hit), 0
+    /// (none), or -1 when a span holds tmin or two starts tie for the first: walkUnion decides.
+    template <bool kParallel, class Obs>
+    int walkFirstStart(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                       Hit& hit) const;
+    /// The walk of a union-only scene: each primitive in one leaf only, leaves in order of the
+    /// t their box is entered at (a heap), their primitives' spans merged as they come. When a
+    /// node is entered at t, every span that starts before t is known (its primitive's box lies
+    /// in a leaf entered before it). The union's first boundary after tmin is the first start
+    /// when the ray begins outside every primitive, else the end of the stretch it begins in;
+    /// either is final once the next node is entered beyond it. (A stretch grows as spans join
+    /// it, so a node is culled when taken from the heap, never when pushed.)
+    template <bool kParallel, class Obs>
+    bool walkUnion(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                   Hit& hit) const;
+    /// The ray's interval in node `n`'s box, within [tmin, tmax]: false when empty.
+    template <bool kParallel>
+    static bool clip(const BvhNode& n, const double o[3], const double inv[3], double tmin,
+                     double tmax, double& t0, double& t1);
+    /// The leaf's visible hit inside [t0, t1] (t > tmin).
+    template <class Obs>
+    bool hitInLeafBox(const BvhNode& n, const Ray& ray, double tmin, double t0, double t1,
+                      TraceContext& ctx, Obs& obs, Hit& hit) const;
+
+    const Scene* scene_ = nullptr;
+    bool unionOnly_ = false;  ///< the scene's tree has only unions: leaves keep no tree
+    int depth_ = 0;
+    std::vector<BvhNode> nodes_;
+    std::vector<uint32_t> parent_;
+    std::vector<uint32_t> primList_;
+    CsgTree pool_;
+
+    friend struct BvhBuilder;
+};
+
+template <bool kParallel>
+[[gnu::always_inline]] inline bool Bvh::clip(const BvhNode& n, const double o[3],
+                                             const double inv[3], double tmin, double tmax,
+                                             double& t0, double& t1) {
+    t0 = tmin;
+    t1 = tmax;
+    for (int a = 0; a < 3; ++a) {
+        if constexpr (kParallel) {
+            if (inv[a] == 0.0) {  // parallel: inside the slab or not at all
+                if (o[a] < n.lo[a] || o[a] > n.hi[a]) return false;
+                continue;
+            }
+        }
+        const double ta = (n.lo[a] - o[a]) * inv[a], tb = (n.hi[a] - o[a]) * inv[a];
+        const double near = ta < tb ? ta : tb, far = ta < tb ? tb : ta;
+        t0 = near > t0 ? near : t0;
+        t1 = far < t1 ? far : t1;
+    }
+    return t0 <= t1;
+}
+
+template <class Obs>
+[[gnu::always_inline]] inline bool Bvh::hitInLeafBox(const BvhNode& n, const Ray& ray, double tmin,
+                                                     double t0, double t1, TraceContext& ctx,
+                                                     Obs& obs, Hit& hit) const {
+    const uint32_t* const prims = primList_.data() + n.first;
+    if (unionOnly_) {
+        const bool found = hitInUnionLeaf(prims, n.count, ScenePrimTest{scene_, &ray}, tmin, t0, t1,
+                                          ctx, obs, hit);
+        if constexpr (Obs::kActive) {
+            mergeHeldSpans(prims, n.count, ctx);  // the leaf's spans, as the other schemes show
+            obs.regionSpans(ctx.result);
+        }
+        return found;
+    }
+    if (n.root < 0) return false;
+    if (!ctx.useMailboxes) ctx.newStamp();
+    // Every boundary of a CSG result is a boundary of one of its primitives: when none of the
+    // leaf's primitives has one in the window, the tree is not evaluated. Unlike the regular
+    // walk's pending boundaries, this holds whatever order the leaves come in.
+    const double from = std::max(t0, tmin);
+    bool any = false;
+    for (uint32_t i = 0; i < n.count; ++i) {
+        const Mailbox& m = mailboxSpans(*scene_, prims[i], ray, ctx, obs);
+        for (int k = 0; k < m.count; ++k) {
+            const Span& s = m.spans[k];
+            any |= (s.in.t >= from && s.in.t > tmin && s.in.t <= t1) ||
+                   (s.out.t >= from && s.out.t > tmin && s.out.t <= t1);
+        }
+    }
+    if (!any && !Obs::kActive) return false;  // the observer is shown the spans anyway
+    evalTree<Obs, Fetch::Fresh>(*scene_, pool_, n.root, ray, ctx, obs, 0, ctx.result);
+    if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
+    const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
+    if (b) hit = {b->t, b->prim, b->part, b->flip};
+    return b != nullptr;
+}
+
+template <bool kParallel, class Obs>
+int Bvh::walkFirstStart(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                        Hit& hit) const {
+    const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
+    double inv[3];
+    for (int a = 0; a < 3; ++a) inv[a] = ray.d[a] == 0.0 ? 0.0 : 1.0 / ray.d[a];
+    const BvhNode* const nodes = nodes_.data();
+    struct Entry {
+        uint32_t node;
+        double t0, t1;
+    };
+    Entry stack[kAutomaticBvhDepth + 2];
+    int sp = 0;
+    {
+        double t0, t1;
+        if (!clip<kParallel>(nodes[0], o, inv, tmin, tmax, t0, t1)) return 0;
+        stack[sp++] = {0, t0, t1};
+    }
+    // The first start after tmin so far. The ray begins outside every primitive as long as no
+    // span holds tmin; a primitive whose box holds the ray's start is in a leaf entered at
+    // tmin, never culled, so a span holding tmin is always met.
+    Boundary first{tmax};
+    bool found = false, tie = false;
+    while (sp > 0) {
+        const Entry e = stack[--sp];
+        if (e.t0 > first.t) {
+            if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, first.t);
+            continue;
+        }
+        const BvhNode& n = nodes[e.node];
+        ++ctx.counters.regionVisits;
+        obs.region(e.node, e.t0, std::min(e.t1, first.t));
+        if (n.leaf) {
+            const uint32_t* const prims = primList_.data() + n.first;
+            for (uint32_t i = 0; i < n.count; ++i) {
+                Span local[2];
+                const int k = scene_->primSpans(prims[i], ray, local);
+                ++ctx.counters.primTests;
+                obs.primTest(prims[i], local, k);
+                for (int j = 0; j < k; ++j) {
+                    const Span& sp2 = local[j];
+                    if (!(sp2.out.t > tmin)) continue;
+                    if (!(sp2.in.t > tmin)) return -1;  // the ray begins inside it
+                    if (sp2.in.t < first.t) {
+                        first = sp2.in;
+                        found = true;
+                        tie = false;
+                    } else if (found && sp2.in.t == first.t) {
+                        tie = true;
+                    }
+                }
+            }
+            if constexpr (Obs::kActive) {
+                ctx.result.clear();
+                if (found) ctx.result.push_back({first, first});
+                obs.regionSpans(ctx.result);
+            }
+            continue;
+        }
+        const uint32_t l = n.first, r = n.first + 1;
+        double l0, l1, r0, r1;
+        const bool hl = clip<kParallel>(nodes[l], o, inv, tmin, first.t, l0, l1);
+        const bool hr = clip<kParallel>(nodes[r], o, inv, tmin, first.t, r0, r1);
+        if (hl && hr) {
+            const bool leftFirst = l0 <= r0;
+            const Entry nearE = leftFirst ? Entry{l, l0, l1} : Entry{r, r0, r1};
+            const Entry farE = leftFirst ? Entry{r, r0, r1} : Entry{l, l0, l1};
+            if constexpr (Obs::kActive)
+                obs.nodeChildren(e.node, nearE.node, nearE.t0, farE.node, farE.t0);
+            stack[sp++] = farE;
+            stack[sp++] = nearE;
+        } else if (hl || hr) {
+            const Entry only = hl ? Entry{l, l0, l1} : Entry{r, r0, r1};
+            if constexpr (Obs::kActive) obs.nodeChildren(e.node, only.node, only.t0, kNoNode, kInf);
+            stack[sp++] = only;
+        } else if constexpr (Obs::kActive) {
+            obs.nodeChildren(e.node, kNoNode, kInf, kNoNode, kInf);
+        }
+    }
+    if (tie) return -1;
+    if (found) hit = {first.t, first.prim, first.part, first.flip};
+    return found ? 1 : 0;
+}
+
+template <bool kParallel, class Obs>
+bool Bvh::walkUnion(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                    Hit& hit) const {
+    const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
+    double inv[3];
+    for (int a = 0; a < 3; ++a) inv[a] = ray.d[a] == 0.0 ? 0.0 : 1.0 / ray.d[a];
+    const BvhNode* const nodes = nodes_.data();
+    struct Entry {
+        double t0, t1;
+        uint32_t node;
+    };
+    // A min-heap by entry t, one per thread, reused from ray to ray.
+    auto later = [](const Entry& a, const Entry& b) { return a.t0 > b.t0; };
+    thread_local std::vector<Entry> heap;
+    heap.clear();
+    {
+        double t0, t1;
+        if (!clip<kParallel>(nodes[0], o, inv, tmin, tmax, t0, t1)) return false;
+        heap.push_back({t0, t1, 0});
+    }
+    SpanList& spans = ctx.leafSpans;  // the spans met so far that end after tmin
+    spans.clear();
+    double best = tmax;  // the union's first boundary after tmin among the spans known
+    bool found = false;
+    while (!heap.empty()) {
+        std::pop_heap(heap.begin(), heap.end(), later);
+        const Entry e = heap.back();
+        heap.pop_back();
+        if (e.t0 > best) {  // every node left begins beyond it: the boundary is final
+            if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, best);
+            break;
+        }
+        const BvhNode& n = nodes[e.node];
+        ++ctx.counters.regionVisits;
+        obs.region(e.node, e.t0, std::min(e.t1, best));
+        if (!n.leaf) {
+            const uint32_t l = n.first, r = n.first + 1;
+            double l0, l1, r0, r1;
+            const bool hl = clip<kParallel>(nodes[l], o, inv, tmin, tmax, l0, l1);
+            const bool hr = clip<kParallel>(nodes[r], o, inv, tmin, tmax, r0, r1);
+            if (hl) {
+                heap.push_back({l0, l1, l});
+                std::push_heap(heap.begin(), heap.end(), later);
+            }
+            if (hr) {
+                heap.push_back({r0, r1, r});
+                std::push_heap(heap.begin(), heap.end(), later);
+            }
+            if constexpr (Obs::kActive) {
+                const bool leftFirst = hl && (!hr || l0 <= r0);
+                if (hl && hr)
+                    obs.nodeChildren(e.node, leftFirst ? l : r, leftFirst ? l0 : r0,
+                                     leftFirst ? r : l, leftFirst ? r0 : l0);
+                else
+                    obs.nodeChildren(e.node, hl ? l : (hr ? r : kNoNode),
+                                     hl ? l0 : (hr ? r0 : kInf), kNoNode, kInf);
+            }
+            continue;
+        }
+        const uint32_t* const prims = primList_.data() + n.first;
+        bool added = false;
+        for (uint32_t i = 0; i < n.count; ++i) {
+            Span local[2];
+            const int k = scene_->primSpans(prims[i], ray, local);
+            ++ctx.counters.primTests;
+            obs.primTest(prims[i], local, k);
+            for (int j = 0; j < k; ++j)
+                if (local[j].out.t > tmin && local[j].in.t <= tmax) {
+                    spans.push_back(local[j]);
+                    added = true;
+                }
+        }
+        if (added) {
+            flatUnion(spans, ctx.result);  // sorts `spans` in place
+            const Boundary* b = firstBoundary(ctx.result, tmin, tmin, tmax);
+            found = b != nullptr;
+            if (b) hit = {b->t, b->prim, b->part, b->flip};
+            best = b ? b->t : tmax;
+        }
+        if constexpr (Obs::kActive) {
+            flatUnion(spans, ctx.result);
+            obs.regionSpans(ctx.result);
+        }
+    }
+    return found;
+}
+
+template <bool kParallel, class Obs>
+bool Bvh::walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+               Hit& hit) const {
+    const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
+    double inv[3];
+    for (int a = 0; a < 3; ++a) inv[a] = ray.d[a] == 0.0 ? 0.0 : 1.0 / ray.d[a];
+    const BvhNode* const nodes = nodes_.data();
+    struct Entry {
+        uint32_t node;
+        double t0, t1;
+    };
+    // Push the far child, go on with the near one: at most one entry a level waits.
+    Entry stack[kAutomaticBvhDepth + 2];
+    int sp = 0;
+    double best = tmax;  // the leaves' windows end at the nearest hit found so far
+    bool found = false;
+    {
+        double t0, t1;
+        if (!clip<kParallel>(nodes[0], o, inv, tmin, tmax, t0, t1)) return false;
+        stack[sp++] = {0, t0, t1};
+    }
+    while (sp > 0) {
+        const Entry e = stack[--sp];
+        if (e.t0 > best) {  // its box begins beyond the hit: nothing nearer in it
+            if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, best);
+            continue;
+        }
+        const BvhNode& n = nodes[e.node];
+        const double t1 = std::min(e.t1, best);
+        ++ctx.counters.regionVisits;
+        obs.region(e.node, e.t0, t1);
+        if (n.leaf) {
+            Hit h;
+            if (hitInLeafBox(n, ray, tmin, e.t0, t1, ctx, obs, h) && (!found || h.t < best)) {
+                hit = h;
+                best = h.t;
+                found = true;
+            }
+            continue;
+        }
+        const uint32_t l = n.first, r = n.first + 1;
+        double l0, l1, r0, r1;
+        const bool hl = clip<kParallel>(nodes[l], o, inv, tmin, best, l0, l1);
+        const bool hr = clip<kParallel>(nodes[r], o, inv, tmin, best, r0, r1);
+        if (hl && hr) {
+            const bool leftFirst = l0 <= r0;
+            const Entry nearE = leftFirst ? Entry{l, l0, l1} : Entry{r, r0, r1};
+            const Entry farE = leftFirst ? Entry{r, r0, r1} : Entry{l, l0, l1};
+            if constexpr (Obs::kActive)
+                obs.nodeChildren(e.node, nearE.node, nearE.t0, farE.node, farE.t0);
+            stack[sp++] = farE;
+            stack[sp++] = nearE;
+        } else if (hl || hr) {
+            const Entry only = hl ? Entry{l, l0, l1} : Entry{r, r0, r1};
+            if constexpr (Obs::kActive) obs.nodeChildren(e.node, only.node, only.t0, kNoNode, kInf);
+            stack[sp++] = only;
+        } else if constexpr (Obs::kActive) {
+            obs.nodeChildren(e.node, kNoNode, kInf, kNoNode, kInf);
+        }
+    }
+    return found;
+}
+
+}  // namespace lancer

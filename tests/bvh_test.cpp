@@ -1,0 +1,316 @@
+// The BVH against brute force, ray for ray: SPD and built-in scenes pixel by pixel (perspective
+// and orthographic, secondary rays from the surfaces), random CSG scenes with rays aimed at the
+// nodes' corners, edges and faces, both stop rules; its structure (every leaf lists each
+// primitive meeting its box, children inside their parent); the observed walk; refusals.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <random>
+
+#include "engine/accel/build_guard.h"
+#include "engine/accel/structure_view.h"
+#include "engine/scene/loader.h"
+#include "tests/support/differential.h"
+
+namespace lancer {
+namespace {
+
+BuildParams bvhParams(int maxObjects = 2, bool costStop = true, int maxLevel = 0) {
+    BuildParams p;
+    p.scheme = SchemeKind::Bvh;
+    p.bvh.maxObjects = maxObjects;
+    p.bvh.costStop = costStop;
+    p.bvh.maxLevel = maxLevel;
+    return p;
+}
+
+const Bvh& bvhOf(const Accelerator& a) { return std::get<Bvh>(a.impl()); }
+
+void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
+                const std::string& what, double tmin = 0.0) {
+    auto bad = test::compareWithBrute(scene, accel, rays, tmin);
+    EXPECT_TRUE(bad.empty()) << what << ": " << bad.size() << " mismatches of " << rays.size()
+                             << ", first:\n"
+                             << (bad.empty() ? "" : bad[0].toString(scene));
+}
+
+/// From each brute-force hit of `primary`: a random ray and one toward the first light.
+std::vector<Ray> secondaryRays(const Scene& scene, const std::vector<Ray>& primary, uint64_t seed) {
+    auto brute = buildAccelerator(scene, BuildParams{});
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    NullObserver obs;
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> n;
+    std::vector<Ray> rays;
+    for (const Ray& r : primary) {
+        Hit h;
+        ctx.beginRay();
+        if (!brute->intersect(r, 0.0, kInf, ctx, obs, h)) continue;
+        const Vec3 p = r.at(h.t);
+        rays.push_back({p, glm::normalize(Vec3(n(rng), n(rng), n(rng)))});
+        if (!scene.lights.empty())
+            rays.push_back({p, glm::normalize(scene.lights[0].position - p)});
+    }
+    return rays;
+}
+
+/// Corners, edge midpoints and face centres of some nodes' boxes: where a box test rounds.
+std::vector<Vec3> nodePoints(const Bvh& b, size_t count, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::vector<Vec3> pts;
+    for (size_t k = 0; k < count && !b.nodes().empty(); ++k) {
+        const Box3 box = b.nodes()[rng() % b.nodes().size()].box();
+        for (int i = 0; i < 27; i += 2) {
+            Vec3 c;
+            for (int a = 0, j = i; a < 3; ++a, j /= 3)
+                c[a] = j % 3 == 0 ? box.lo[a] : (j % 3 == 1 ? box.center()[a] : box.hi[a]);
+            pts.push_back(c);
+        }
+    }
+    return pts;
+}
+
+TEST(Bvh, SpdScenesPixelForPixel) {
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(LANCER_SPD_DIR))
+        if (e.path().extension() == ".nff") files.push_back(e.path());
+    ASSERT_GE(files.size(), 10u);
+    std::sort(files.begin(), files.end());
+    for (const auto& path : files) {
+        Scene scene = loadScene(path.string());
+        const int n = path.filename() == "balls4.nff" ? 24 : 40;
+        for (int ortho = 0; ortho < 2; ++ortho) {
+            if (ortho) test::makeOrthographic(scene);
+            auto accel = buildAccelerator(scene, bvhParams());
+            const std::string what =
+                path.filename().string() + (ortho ? " orthographic" : " perspective");
+            const std::vector<Ray> rays = test::pixelRays(scene, n, n);
+            expectSame(scene, *accel, rays, what);
+            expectSame(scene, *accel, secondaryRays(scene, rays, 7), what + " secondary",
+                       1e-9 * scene.scale());
+        }
+    }
+}
+
+TEST(Bvh, BuiltinCsgScenesPixelForPixel) {
+    for (const char* spec : {"builtin:default", "builtin:drilled:4", "builtin:lattice:4"}) {
+        Scene scene = loadScene(spec);
+        for (int ortho = 0; ortho < 2; ++ortho) {
+            if (ortho) test::makeOrthographic(scene);
+            for (const BuildParams& p : {bvhParams(), bvhParams(1, false), bvhParams(4, true, 6)}) {
+                auto accel = buildAccelerator(scene, p);
+                const std::string what = std::string(spec) + (ortho ? " orthographic " : " ") +
+                                         toString(accel->params());
+                const std::vector<Ray> rays = test::pixelRays(scene, 48, 48);
+                expectSame(scene, *accel, rays, what);
+                expectSame(scene, *accel, secondaryRays(scene, rays, 3), what + " secondary",
+                           1e-9 * scene.scale());
+            }
+        }
+    }
+}
+
+// 24 random scenes x (3000 random + node-corner + pixel rays), both stop rules: over 10^5 rays.
+TEST(Bvh, RandomScenesAndHardRays) {
+    size_t total = 0;
+    for (uint64_t seed = 1; seed <= 24; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.transforms = seed % 2 == 0;
+        opt.surfaces = seed % 3 == 0;
+        opt.primitives = 8 + int(seed % 4) * 6;
+        opt.groups = seed % 4 == 1 ? 3 : 1;
+        if (seed % 5 == 0) opt.offset = Vec3(1e6, -1e6, 5e5);
+        Scene scene = test::randomCsgScene(seed, opt);
+        if (scene.bounds.isEmpty()) continue;
+        const BuildParams p = bvhParams(1 + int(seed % 3), seed % 2 == 1);
+        auto accel = buildAccelerator(scene, p);
+        const std::string what = "seed " + std::to_string(seed) + " " + toString(p);
+        std::vector<Ray> rays = test::randomRays(scene, seed, 3000);
+        const std::vector<Ray> corner =
+            test::raysThroughPoints(nodePoints(bvhOf(*accel), 60, seed), scene.bounds, seed);
+        rays.insert(rays.end(), corner.begin(), corner.end());
+        const std::vector<Ray> pix = test::pixelRays(scene, 16, 16);
+        rays.insert(rays.end(), pix.begin(), pix.end());
+        expectSame(scene, *accel, rays, what);
+        // Rays starting on node boundaries, with a tmin as the tracer's secondary rays have.
+        std::vector<Ray> onBoundary;
+        for (size_t i = 0; i < corner.size(); i += 4) onBoundary.push_back(corner[i + 1]);
+        expectSame(scene, *accel, onBoundary, what + " tmin", 1e-9 * scene.scale());
+        total += rays.size() + onBoundary.size();
+    }
+    EXPECT_GE(total, 100000u);
+}
+
+// Without mailboxes every leaf tests its primitives again: the same hits, more tests.
+TEST(Bvh, MailboxesSpareRepeatedTestsOnly) {
+    Scene scene = loadScene("builtin:lattice:4");
+    BuildParams with = bvhParams(), without = bvhParams();
+    without.mailboxes = false;
+    auto a = buildAccelerator(scene, with), b = buildAccelerator(scene, without);
+    const std::vector<Ray> rays = test::pixelRays(scene, 32, 32);
+    expectSame(scene, *a, rays, "mailboxes");
+    expectSame(scene, *b, rays, "no mailboxes");
+    const RayCounters ca = test::traceCounters(scene, *a, rays);
+    const RayCounters cb = test::traceCounters(scene, *b, rays);
+    EXPECT_GT(ca.mailboxHits, 0u);
+    EXPECT_EQ(cb.mailboxHits, 0u);
+    EXPECT_EQ(ca.primTests + ca.mailboxHits, cb.primTests);
+    EXPECT_EQ(ca.regionVisits, cb.regionVisits);
+}
+
+// Each leaf lists exactly the live primitives whose minimized box meets its box, sorted (its
+// restricted tree then holds there); every live primitive is listed by some leaf; a child's box
+// lies inside its parent's; the depth limit holds.
+TEST(Bvh, LeavesListEveryPrimitiveMeetingTheirBox) {
+    for (uint64_t seed = 40; seed <= 45; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.transforms = true;
+        opt.primitives = 30;
+        opt.groups = 3;
+        Scene scene = test::randomCsgScene(seed, opt);
+        auto accel = buildAccelerator(scene, bvhParams(1, seed % 2 == 0, seed == 45 ? 3 : 0));
+        const Bvh& b = bvhOf(*accel);
+        std::vector<char> listed(scene.prims.size(), 0);
+        const std::vector<uint32_t> live = scene.livePrimitives();
+        for (uint32_t id = 0; id < b.nodes().size(); ++id) {
+            const BvhNode& n = b.nodes()[id];
+            if (seed == 45) {
+                EXPECT_LE(n.depth, 3);
+            }
+            if (!n.leaf) {
+                for (uint32_t c : {n.first, n.first + 1}) {
+                    EXPECT_EQ(b.parent(c), id);
+                    const Box3 cb = b.nodes()[c].box(), pb = n.box();
+                    EXPECT_TRUE(glm::all(glm::greaterThanEqual(cb.lo, pb.lo)) &&
+                                glm::all(glm::lessThanEqual(cb.hi, pb.hi)))
+                        << "seed " << seed << " node " << c;
+                }
+                continue;
+            }
+            const std::vector<uint32_t> got(b.primList().begin() + n.first,
+                                            b.primList().begin() + n.first + n.count);
+            EXPECT_TRUE(std::is_sorted(got.begin(), got.end()));
+            std::vector<uint32_t> want;
+            for (uint32_t p : live) {
+                if (scene.minBox[p].isEmpty()) continue;
+                Box3 grown = scene.minBox[p];
+                grown.lo -= Vec3(1e-9 * scene.scale());
+                grown.hi += Vec3(1e-9 * scene.scale());
+                if (grown.overlaps(n.box())) want.push_back(p);
+            }
+            std::sort(want.begin(), want.end());
+            EXPECT_EQ(got, want) << "seed " << seed << " leaf " << id;
+            for (uint32_t p : got) listed[p] = 1;
+        }
+        for (uint32_t p : live) {
+            if (!scene.minBox[p].isEmpty()) {
+                EXPECT_TRUE(listed[p]) << "seed " << seed << " p" << p;
+            }
+        }
+    }
+}
+
+// The knobs change the structure as a user expects: more leaves at max-objects 1 than at 8
+// without the cost stop, a shallower tree under a lower max-level.
+TEST(Bvh, KnobsChangeTheStructure) {
+    Scene scene = loadScene("builtin:lattice:4");
+    auto fine = buildAccelerator(scene, bvhParams(1, false));
+    auto coarse = buildAccelerator(scene, bvhParams(8, false));
+    auto shallow = buildAccelerator(scene, bvhParams(1, false, 3));
+    EXPECT_GT(fine->info().regions, coarse->info().regions);
+    EXPECT_LE(bvhOf(*shallow).depth(), 3);
+    EXPECT_GT(bvhOf(*fine).depth(), 3);
+    EXPECT_EQ(fine->info().regions, bvhOf(*fine).nodes().size());
+    const nlohmann::json& x = fine->info().extra;
+    EXPECT_EQ(x.at("leaves").get<size_t>(),
+              x.at("stop_reasons").at("max_objects").get<size_t>() +
+                  x.at("stop_reasons").at("max_level").get<size_t>() +
+                  x.at("stop_reasons").at("cost").get<size_t>() +
+                  x.at("stop_reasons").at("unsplittable").get<size_t>());
+}
+
+// The observer sees the walk the render makes: the same hit and counts; every region event
+// names a node whose box holds the event's stretch; children events name the visited nodes.
+TEST(Bvh, ObservedWalkEqualsTheRender) {
+    Scene scene = loadScene("builtin:drilled:4");
+    auto accel = buildAccelerator(scene, bvhParams());
+    const Bvh& b = bvhOf(*accel);
+    const std::vector<Ray> rays = test::pixelRays(scene, 24, 24);
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    RayCounters observed;
+    for (const Ray& r : rays) {
+        const RayCounters before = ctx.counters;
+        const RecordingObserver rec = test::recordWalk(*accel, r, ctx);
+        observed += ctx.counters - before;
+        for (const WalkEvent& e : rec.events) {
+            if (e.kind != WalkEvent::Region) continue;
+            ASSERT_LT(e.a, b.nodes().size());
+            if (std::isfinite(e.t0) && e.t0 <= e.t1) {
+                Box3 box = b.nodes()[e.a].box();
+                const Vec3 pad(1e-6 * scene.scale());
+                box.lo -= pad;
+                box.hi += pad;
+                EXPECT_TRUE(box.contains(r.at(0.5 * (e.t0 + e.t1)))) << "node " << e.a;
+            }
+        }
+    }
+    const RayCounters rendered = test::traceCounters(scene, *accel, rays);
+    EXPECT_EQ(observed.primTests, rendered.primTests);
+    EXPECT_EQ(observed.mailboxHits, rendered.mailboxHits);
+    EXPECT_EQ(observed.regionVisits, rendered.regionVisits);
+    EXPECT_GT(rendered.regionVisits, rays.size());
+}
+
+// The structure view describes nodes as regions: leaves with their list and tree, inner nodes
+// without; a point inside a leaf's box picks a leaf containing it.
+TEST(Bvh, StructureViewDescribesNodes) {
+    Scene scene = loadScene("builtin:default");
+    auto accel = buildAccelerator(scene, bvhParams(1, false));
+    const StructureView view(scene, *accel);
+    ASSERT_EQ(view.regionCount(), bvhOf(*accel).nodes().size());
+    size_t leaves = 0;
+    for (uint32_t id = 0; id < view.regionCount(); ++id) {
+        const RegionInfo r = view.region(id);
+        const BvhNode& n = bvhOf(*accel).nodes()[id];
+        EXPECT_EQ(r.level, n.depth);
+        EXPECT_EQ(r.frameBox, n.box());
+        if (r.kind == RegionKind::BvhLeaf) {
+            ++leaves;
+            EXPECT_EQ(r.prims.size(), n.count);
+            EXPECT_GE(r.root, 0);
+            const Vec3 c = n.box().center();
+            EXPECT_TRUE(view.region(view.regionAt(c)).frameBox.contains(c));
+        } else {
+            EXPECT_EQ(r.kind, RegionKind::BvhInner);
+            EXPECT_TRUE(r.prims.empty());
+        }
+    }
+    EXPECT_GT(leaves, 1u);
+    EXPECT_EQ(view.structureCorners()[0], bvhOf(*accel).box().lo);
+}
+
+TEST(Bvh, RefusesBadParametersAndBudgets) {
+    Scene scene = loadScene("builtin:default");
+    for (int bad : {0, -3}) {
+        try {
+            buildAccelerator(scene, bvhParams(bad));
+            ADD_FAILURE() << "--max-objects " << bad << " accepted";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find("--max-objects"), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_THROW(buildAccelerator(scene, bvhParams(2, true, 65)), std::invalid_argument);
+    Scene big = loadScene("builtin:lattice:8");
+    BuildParams p = bvhParams(1, false);
+    p.memoryBudget = 16 * 1024;
+    try {
+        buildAccelerator(big, p);
+        ADD_FAILURE() << "a 16 KiB budget accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("--memory-budget"), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+}  // namespace lancer
