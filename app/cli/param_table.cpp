@@ -81,7 +81,12 @@ std::vector<ParamDesc> makeTable() {
         k.build.regular.maxObjects = k.build.irregular.maxObjects = int(v);
     };
     add(d);
-    d = {"--step",       "M", "step", "step", "Next-cell method: exact, or the report's push",
+    d = {"--step",
+         "M",
+         "step",
+         "step",
+         "Next-cell method: exact, or the report's push (lancer view with --pick: the playback "
+         "step to stop at instead, first, last or N from 0)",
          ParamKind::Enum};
     d.names = {"exact", "push"};
     d.schemes = kRegular;
