@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # `lancer view` under Xvfb with a structure the options make impossible: refused at start, the
 # run ends with status 2 naming the options, and no brute-force image stands in for it (no
-# screenshot, no success line). A live change in the viewer keeps falling back: not this test.
+# screenshot, no success line). A live change to a refused structure keeps what is shown.
 # Usage: viewer_refusal_cli.sh LANCER SOURCE_DIR
 set -euo pipefail
 lancer=$1
@@ -26,6 +26,12 @@ grep -q "BSP nodes" "$tmp/err.txt" || { cat "$tmp/err.txt" >&2; exit 1; }
 fails "the structure was refused: --memory-budget 256" \
   run "$src/assets/openscad/sponge.csg" --scheme regular --memory-budget 256K
 [ ! -e "$tmp/shot.png" ] || { echo "a refused start wrote a screenshot" >&2; exit 1; }
+# A live change to a structure that is refused keeps the one on screen: the run goes on.
+rm -f "$tmp/shot.png"
+run builtin:default --change max-level=48,max-objects=1 >"$tmp/live.txt" 2>"$tmp/live_err.txt"
+grep -q "Structure not built: --max-level 48 --max-objects 1" "$tmp/live_err.txt" \
+  || { cat "$tmp/live_err.txt" >&2; exit 1; }
+test -s "$tmp/shot.png"
 # The same options on a structure that fits: the run succeeds.
 run builtin:default --max-level 8 --max-objects 1 >"$tmp/ok.txt"
 test -s "$tmp/shot.png"
