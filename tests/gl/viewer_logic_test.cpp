@@ -153,6 +153,8 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     EXPECT_EQ(settingsLines(bad), lines);
 }
 
+void readLines(ViewerSettings& r, const std::string& lines);
+
 // The ini writes max-objects' automatic value as "auto" and reads it back; an explicit value
 // replaces it (the report's rule), and "auto" restores the default.
 TEST(ViewerSettingsIni, MaxObjectsAutoRoundTrips) {
@@ -164,6 +166,16 @@ TEST(ViewerSettingsIni, MaxObjectsAutoRoundTrips) {
     readSettingsLine(s, "max_objects=auto");
     EXPECT_EQ(s.build.irregular.maxObjects, kAutoObjects);
     EXPECT_TRUE(s.build.regular.usesCostStop());
+    // An ini written before "auto" (no knob_format line) held its default as max_objects=4:
+    // read as auto, the build it stood for; since, 4 is an explicit 4.
+    ViewerSettings old;
+    readSettingsLine(old, "max_objects=4");
+    EXPECT_EQ(old.build.regular.maxObjects, kAutoObjects);
+    ViewerSettings now;
+    now.build.regular.maxObjects = now.build.irregular.maxObjects = 4;
+    ViewerSettings back;
+    readLines(back, settingsLines(now));
+    EXPECT_EQ(back.build.regular.maxObjects, 4);
 }
 
 // The Parameters panel's line of stop reasons, from a build's --stats figures.
