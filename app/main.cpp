@@ -8,6 +8,7 @@
 #include "app/cli/commands.h"
 #include "engine/accel/build_guard.h"
 #include "engine/scene/builtin_scenes.h"
+#include "engine/scene/loader.h"
 #ifdef LANCER_WITH_VIEWER
 #include "app/viewer/compare/rebuild_diff.h"
 #include "app/viewer/overlay/overlays.h"
@@ -120,8 +121,9 @@ int main(int argc, char** argv) {
     view->remove_option(view->get_option("--step"));
     std::string stepArg;
     view->add_option("--step", stepArg,
-                     "Regular scheme's next-cell method (exact or push); with --pick, a number: "
-                     "the playback step to stop at (0: the ray's first region)");
+                     "Two meanings. Without --pick: the regular scheme's next-cell method, exact "
+                     "or push. With --pick: the playback step to stop at, first, last or N (from "
+                     "0, the ray's first region)");
 #endif
 
     std::string out;
@@ -227,8 +229,9 @@ int main(int argc, char** argv) {
                        "--scale: without Embree (measured only at --bounces 0, on scenes that are "
                        "a union of primitives)");
 
-    // Hidden: the README's option section, generated from the parameter table.
-    CLI::App* helpOptions = app.add_subcommand("help-options", "")->group("");
+    // The README's option section, generated from the parameter table.
+    CLI::App* helpOptions = app.add_subcommand(
+        "help-options", "Print the common options as a Markdown table (README's options section)");
 
     try {
         app.parse(argc, argv);
@@ -283,27 +286,54 @@ int main(int argc, char** argv) {
     }
     // view (explicit or default): the window when there is a display, else a headless render.
     std::string why = "the interactive viewer is not available in this build";
+    // A missing file or a directory is refused before any window opens.
+    if (view->count("scene")) {
+        try {
+            checkSceneFile(viewOpt.scene);
+        } catch (const SceneError& e) {
+            std::cerr << "error: " << e.what() << "\n";
+            return 2;
+        }
+    }
 #ifdef LANCER_WITH_VIEWER
     bool stepIsMethod = false;
     if (!stepArg.empty()) {
         std::string lower;
         for (char c : stepArg) lower += char(std::tolower(static_cast<unsigned char>(c)));
+        const bool number =
+            stepArg.find_first_not_of("0123456789") == std::string::npos && stepArg.size() < 10;
         if (lower == "exact" || lower == "push") {
             viewOpt.knobs.build.regular.step =
                 lower == "exact" ? StepMethod::Exact : StepMethod::Push;
             stepIsMethod = true;
-        } else if (stepArg.find_first_not_of("0123456789") == std::string::npos &&
-                   stepArg.size() < 10) {
+        } else if (number || lower == "first" || lower == "last") {
             if (pickXY.empty()) {
                 std::cerr << "error: --step " << stepArg
-                          << ": a playback step needs --pick X Y (the step method is exact or "
-                             "push)\n";
+                          << ": a playback step (first, last or N) needs --pick X Y; without "
+                             "it --step is the next-cell method, exact or push\n";
                 return 2;
             }
-            vopt.pickStep = std::stoi(stepArg);
+            vopt.pickStep = lower == "last" ? viewer::kLastStep : number ? std::stoi(stepArg) : 0;
         } else {
             std::cerr << "error: --step " << stepArg
-                      << ": expected exact, push, or with --pick a step number\n";
+                      << ": expected exact or push (the next-cell method), or with --pick a "
+                         "playback step: first, last or N\n";
+            return 2;
+        }
+    }
+    if (view->count("--ab") && !view->count("--change")) {
+        std::cerr << "error: --ab " << vopt.ab
+                  << ": the A/B compares the images before and after a rebuild; it needs "
+                     "--change NAME=VALUE\n";
+        return 2;
+    }
+    // A layer of another scheme is refused here when --scheme is given (else the viewer checks
+    // it against the saved scheme).
+    if (view->count("--show") && view->count("--scheme")) {
+        if (std::string why =
+                viewer::overlay::showListMismatch(vopt.show, viewOpt.knobs.build.scheme);
+            !why.empty()) {
+            std::cerr << "error: " << why << "\n";
             return 2;
         }
     }

@@ -16,7 +16,8 @@
 namespace lancer {
 namespace {
 
-BuildParams bvhParams(int maxObjects = 2, bool costStop = true, int maxLevel = 0) {
+/// maxObjects -1: automatic (the cost stop with kAutoBvhObjects).
+BuildParams bvhParams(int maxObjects = -1, bool costStop = true, int maxLevel = 0) {
     BuildParams p;
     p.scheme = SchemeKind::Bvh;
     p.bvh.maxObjects = maxObjects;
@@ -98,7 +99,7 @@ TEST(Bvh, BuiltinCsgScenesPixelForPixel) {
         Scene scene = loadScene(spec);
         for (int ortho = 0; ortho < 2; ++ortho) {
             if (ortho) test::makeOrthographic(scene);
-            for (const BuildParams& p : {bvhParams(), bvhParams(1, false), bvhParams(4, true, 6)}) {
+            for (const BuildParams& p : {bvhParams(), bvhParams(1), bvhParams(4, true, 6)}) {
                 auto accel = buildAccelerator(scene, p);
                 const std::string what = std::string(spec) + (ortho ? " orthographic " : " ") +
                                          toString(accel->params());
@@ -123,7 +124,7 @@ TEST(Bvh, RandomScenesAndHardRays) {
         if (seed % 5 == 0) opt.offset = Vec3(1e6, -1e6, 5e5);
         Scene scene = test::randomCsgScene(seed, opt);
         if (scene.bounds.isEmpty()) continue;
-        const BuildParams p = bvhParams(1 + int(seed % 3), seed % 2 == 1);
+        const BuildParams p = bvhParams(seed % 2 == 1 ? -1 : 1 + int(seed % 3));
         auto accel = buildAccelerator(scene, p);
         const std::string what = "seed " + std::to_string(seed) + " " + toString(p);
         std::vector<Ray> rays = test::randomRays(scene, seed, 3000);
@@ -300,7 +301,7 @@ TEST(Bvh, RefusesBadParametersAndBudgets) {
             EXPECT_NE(std::string(e.what()).find("--max-objects"), std::string::npos) << e.what();
         }
     }
-    EXPECT_THROW(buildAccelerator(scene, bvhParams(2, true, 65)), std::invalid_argument);
+    EXPECT_THROW(buildAccelerator(scene, bvhParams(-1, true, 65)), std::invalid_argument);
     Scene big = loadScene("builtin:lattice:8");
     BuildParams p = bvhParams(1, false);
     p.memoryBudget = 16 * 1024;

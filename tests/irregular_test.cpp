@@ -698,7 +698,7 @@ TEST(Irregular, RefusesBadParameters) {
     Scene scene = loadScene("builtin:default");
     BuildParams p;
     p.scheme = SchemeKind::Irregular;
-    p.irregular.maxObjects = -1;
+    p.irregular.maxObjects = -2;  // -1 is kAutoObjects
     try {
         buildAccelerator(scene, p);
         ADD_FAILURE() << "negative --max-objects accepted";
@@ -708,6 +708,36 @@ TEST(Irregular, RefusesBadParameters) {
     p.irregular.maxObjects = 0;
     scene.camera.at = scene.camera.from;  // no viewing direction
     EXPECT_THROW(buildAccelerator(scene, p), std::invalid_argument);
+}
+
+TEST(IrregularKnobs, ExplicitMaxObjectsBuildsByTheReportsRule) {
+    // balls:2 with the cost stop leaves the same zones at max-objects 1, 2 and 4; an explicit
+    // max-objects turns it off (docs/irregular.md, "Explicit max-objects"), and each zone is
+    // counted by the reason its cell was not split.
+    Scene scene = loadScene("builtin:balls:2");
+    scene.width = 64;
+    scene.height = 64;
+    BuildParams p;
+    p.scheme = SchemeKind::Irregular;
+    auto zonesOf = [&](int maxObjects) {
+        p.irregular.maxObjects = maxObjects;
+        auto a = buildAccelerator(scene, p);
+        const nlohmann::json& x = a->info().extra;
+        const nlohmann::json& r = x["stop_reasons"];
+        size_t sum = 0;
+        for (const char* k : {"max_objects", "max_level", "cost", "memory"}) sum += size_t(r[k]);
+        EXPECT_EQ(sum, size_t(x["zones"])) << maxObjects;
+        EXPECT_EQ(size_t(r["max_level"]), 0u);
+        EXPECT_LE(size_t(x["covered_zones"]), size_t(r["cost"]));
+        EXPECT_EQ(x["cost_stop"], maxObjects == kAutoObjects);
+        return size_t(x["zones"]);
+    };
+    const size_t automatic = zonesOf(kAutoObjects), one = zonesOf(1), two = zonesOf(2),
+                 sixteen = zonesOf(16);
+    EXPECT_GT(one, automatic);
+    EXPECT_GE(one, two);
+    EXPECT_GT(two, sixteen);
+    EXPECT_NE(one, two);
 }
 
 }  // namespace

@@ -182,6 +182,36 @@ TEST(ParamTable, RangesAreTheSameOnTheCommandLineAndInTheIni) {
     EXPECT_EQ(p.o.knobs.build.irregular.maxObjects, 0);
 }
 
+// max-objects' automatic value is written "auto" and read back from the command line, the ini
+// and --change; an explicit number replaces it for both schemes.
+TEST(ParamTable, MaxObjectsTakesAutoOrANumber) {
+    const ParamDesc& d = *findParam("--max-objects");
+    const Knobs defaults;
+    EXPECT_EQ(defaults.build.regular.maxObjects, kAutoObjects);
+    EXPECT_EQ(defaults.build.irregular.maxObjects, kAutoObjects);
+    EXPECT_EQ(formatValue(d, defaults), "auto");
+    Parsed one({"render", "x", "--max-objects", "1"});
+    ASSERT_EQ(one.error, "");
+    EXPECT_EQ(one.o.knobs.build.regular.maxObjects, 1);
+    EXPECT_EQ(one.o.knobs.build.irregular.maxObjects, 1);
+    Parsed back({"render", "x", "--max-objects", "auto"});
+    ASSERT_EQ(back.error, "");
+    EXPECT_EQ(back.o.knobs.build.regular.maxObjects, kAutoObjects);
+    Knobs k = one.o.knobs;
+    EXPECT_TRUE(parseValue(d, "auto", k));
+    EXPECT_EQ(k.build.irregular.maxObjects, kAutoObjects);
+    applyAssignments("max-objects=7", k);
+    EXPECT_EQ(k.build.regular.maxObjects, 7);
+    applyAssignments("max_objects=auto", k);
+    EXPECT_EQ(k.build.regular.maxObjects, kAutoObjects);
+    for (const char* bad : {"-1", "Auto", "4x", ""}) {
+        EXPECT_FALSE(parseValue(d, bad, k)) << bad;
+        Parsed p({"render", "x", "--max-objects", bad});
+        EXPECT_NE(p.error.find("--max-objects"), std::string::npos) << bad << ": " << p.error;
+    }
+    EXPECT_NE(optionsMarkdown().find("| 0 to 1000000, auto | auto |"), std::string::npos);
+}
+
 TEST(ParamTable, EveryValueRoundTripsThroughItsText) {
     Knobs k;
     for (const ParamDesc& d : paramTable()) changeValue(d, k);

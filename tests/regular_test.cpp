@@ -846,10 +846,11 @@ Scene randomSpheres(int n, double r, uint64_t seed) {
     return s;
 }
 
-TEST(RegularCost, CellOfOverlappingPrimitivesIsNotSplitAtAnyMaxLevel) {
+TEST(RegularCost, CellOfOverlappingPrimitivesIsNotSplitAtTheDefaults) {
     // Eight unit spheres whose centres are 0.2 apart: every half, quarter and eighth of the
     // scene box overlaps all eight boxes, though no cell lies inside all of them, so no split
-    // lowers the cost. The report's rule alone (max-objects 1) splits down to max-level.
+    // lowers the cost. The report's rule alone (max-objects 1, or 4 with --no-cost-stop)
+    // splits down to max-level.
     Scene s;
     int root = -1;
     for (int i = 0; i < 8; ++i) {
@@ -861,41 +862,53 @@ TEST(RegularCost, CellOfOverlappingPrimitivesIsNotSplitAtAnyMaxLevel) {
     s.tree.root = root;
     s.prepare();
     BuildParams p = regular();
-    p.regular.maxObjects = 1;
-    for (int level : {12, 30, 48}) {
-        p.regular.maxLevel = level;
-        auto a = buildAccelerator(s, p);
-        EXPECT_EQ(a->info().regions, 1u) << "max-level " << level;
-        EXPECT_EQ(int(a->info().extra["cost_leaves"]), 1);
-        auto bad = test::compareWithBrute(s, *a, test::randomRays(s, 3, 2000));
-        EXPECT_TRUE(bad.empty()) << describe(s, bad);
-    }
+    auto a = buildAccelerator(s, p);
+    EXPECT_EQ(a->info().regions, 1u);
+    EXPECT_EQ(int(a->info().extra["cost_leaves"]), 1);
+    EXPECT_EQ(int(a->info().extra["stop_reasons"]["cost"]), 1);
+    auto bad = test::compareWithBrute(s, *a, test::randomRays(s, 3, 2000));
+    EXPECT_TRUE(bad.empty()) << describe(s, bad);
+    // An explicit knob asks for the report's rule.
     p.regular.maxLevel = 12;
+    p.regular.maxObjects = 1;
+    EXPECT_GT(buildAccelerator(s, p)->info().regions, 1000u);
+    p.regular.maxLevel = 30;
+    EXPECT_THROW(buildAccelerator(s, p), std::invalid_argument);  // more than 4M BSP nodes
+    p = regular();
     p.regular.costStop = false;
     EXPECT_GT(buildAccelerator(s, p)->info().regions, 1000u);
 }
 
 TEST(RegularCost, ManySmallSeparatedPrimitivesAreSplitDeeply) {
     // 200 spheres of radius 0.002 in a unit cube, about 0.17 apart: 3 cuts per axis (level 9)
-    // separate most of them, and splits keep paying around the closest ones, whose cells are
-    // cut 5 times per axis and more.
+    // separate most of them. At the defaults the cost rule splits while a cell holds more than
+    // 4; the report's rule at max-objects 1 keeps splitting around the closest ones, whose cells
+    // are cut 5 times per axis and more.
     Scene s = randomSpheres(200, 0.002, 11);
     BuildParams p = regular();
+    auto automatic = buildAccelerator(s, p);
+    const auto& xa = automatic->info().extra;
+    EXPECT_EQ(int(xa["effective_max_level"]), automaticMaxLevel(200) + kGainDepth);
+    EXPECT_LE(int(xa["max_prims_per_leaf"]), kAutoObjectsCount);
     p.regular.maxObjects = 1;
     auto a = buildAccelerator(s, p);
     const auto& x = a->info().extra;
-    EXPECT_EQ(int(x["effective_max_level"]), automaticMaxLevel(200) + kGainDepth);
+    EXPECT_EQ(int(x["effective_max_level"]), automaticMaxLevel(200));
     EXPECT_GE(int(x["finest_level"]), 15);
     EXPECT_LE(int(x["max_prims_per_leaf"]), 2);
     EXPECT_LT(double(x["prims_per_leaf"]), 1.0);  // empty space cut away: more leaves than spheres
-    std::vector<Ray> rays = test::randomRays(s, 4, 3000);
-    const auto more = test::raysThroughPoints(gridPoints(gridOf(*a), 4), s.bounds, 5);
-    rays.insert(rays.end(), more.begin(), more.end());
-    auto bad = test::compareWithBrute(s, *a, rays);
-    EXPECT_TRUE(bad.empty()) << describe(s, bad);
-    EXPECT_EQ(walkErrors(s, *a, rays), 0u);
+    for (const Accelerator* g : {automatic.get(), a.get()}) {
+        std::vector<Ray> rays = test::randomRays(s, 4, 3000);
+        const auto more = test::raysThroughPoints(gridPoints(gridOf(*g), 4), s.bounds, 5);
+        rays.insert(rays.end(), more.begin(), more.end());
+        auto bad = test::compareWithBrute(s, *g, rays);
+        EXPECT_TRUE(bad.empty()) << describe(s, bad);
+        EXPECT_EQ(walkErrors(s, *g, rays), 0u);
+    }
     // An explicit max-level is a cap the build keeps.
     p.regular.maxLevel = 9;
+    EXPECT_EQ(int(buildAccelerator(s, p)->info().extra["finest_level"]), 9);
+    p.regular.maxObjects = kAutoObjects;
     EXPECT_EQ(int(buildAccelerator(s, p)->info().extra["finest_level"]), 9);
 }
 
@@ -924,7 +937,7 @@ TEST(RegularCost, AutomaticMaxLevelGrowsWithThePrimitiveCount) {
 
 TEST(RegularCost, GainFloorSplitsTheDenseCellsOfASphereflakeDeeper) {
     // balls:4: the sphereflake's smallest spheres, 1/81 of the largest, cluster around their
-    // parents. With a uniform depth (the base level as an explicit cap) the cells holding the
+    // parents. With a uniform depth (every cell stopped at the base level) the cells holding the
     // clusters stop at the cap, many spheres each; the gain floor takes those deeper, and only
     // those: a few more leaves, fewer tests, and every hit is brute force's.
     Scene s = loadScene("builtin:balls:4");
@@ -935,11 +948,13 @@ TEST(RegularCost, GainFloorSplitsTheDenseCellsOfASphereflakeDeeper) {
     // deeper but not balls:4's.
     p.regular.minGain = 2.0;
     auto floor = buildAccelerator(s, p);
-    p.regular.maxLevel = automaticMaxLevel(n);
+    // An infinite floor stops every cell at the base level: the cost stop capped there (an
+    // explicit --max-level would build by the report's rule instead).
+    p.regular.minGain = std::numeric_limits<double>::infinity();
     auto uniform = buildAccelerator(s, p);
     const auto &xf = floor->info().extra, &xu = uniform->info().extra;
     EXPECT_GT(size_t(xf["gain_leaves"]), 0u);
-    EXPECT_EQ(xu["gain_level"], nullptr);
+    EXPECT_EQ(int(xu["finest_level"]), automaticMaxLevel(n));
     EXPECT_EQ(int(xf["gain_level"]), automaticMaxLevel(n));
     EXPECT_GT(int(xf["finest_level"]), automaticMaxLevel(n));
     std::vector<Ray> rays = test::pixelRays(s, 64, 64);
@@ -981,6 +996,87 @@ TEST(RegularBuild, LeavesHoldTheirOverlappingPrimitivesAndShareTrees) {
             std::vector<uint32_t> ps = L.root < 0 ? std::vector<uint32_t>{} : t.primitives();
             EXPECT_EQ(ps.size(), L.prims);
             for (uint32_t p : ps) ASSERT_TRUE(s.minBox[p].overlaps(cell));
+        }
+    }
+}
+
+/// The stop reasons of a regular build, checked to add up to its leaves.
+size_t stopSum(const Accelerator& a) {
+    const nlohmann::json& r = a.info().extra["stop_reasons"];
+    EXPECT_EQ(r.size(), 4u);
+    size_t sum = 0;
+    for (const char* k : {"max_objects", "max_level", "cost", "memory"}) {
+        EXPECT_TRUE(r.contains(k)) << k;
+        sum += r.value(k, size_t(0));
+    }
+    EXPECT_EQ(sum, a.info().regions);
+    EXPECT_EQ(size_t(a.info().extra["leaves"]), a.info().regions);
+    return sum;
+}
+
+TEST(RegularKnobs, ExplicitMaxLevelAndMaxObjectsChangeTheStructure) {
+    // builtin:default at the defaults: the cost stop leaves 2 leaves, whatever a cap would say.
+    // An explicit knob builds by the report's rule (docs/regular.md, "Explicit knobs").
+    Scene s = loadScene("builtin:default");
+    BuildParams p = regular();
+    auto automatic = buildAccelerator(s, p);
+    EXPECT_EQ(automatic->info().regions, 2u);
+    EXPECT_EQ(automatic->info().extra["cost_stop"], true);
+    EXPECT_EQ(size_t(automatic->info().extra["stop_reasons"]["cost"]), 2u);
+    stopSum(*automatic);
+    p.regular.maxObjects = 1;
+    size_t last = 0;
+    for (int level : {4, 8, 12}) {
+        SCOPED_TRACE("max-level " + std::to_string(level));
+        p.regular.maxLevel = level;
+        auto a = buildAccelerator(s, p);
+        EXPECT_EQ(a->info().extra["cost_stop"], false);
+        EXPECT_EQ(int(a->info().extra["finest_level"]), level);
+        EXPECT_GT(a->info().regions, last);
+        EXPECT_GT(size_t(a->info().extra["stop_reasons"]["max_level"]), 0u);
+        last = a->info().regions;
+        stopSum(*a);
+        auto bad = test::compareWithBrute(s, *a, test::pixelRays(s, 24, 16));
+        EXPECT_TRUE(bad.empty()) << describe(s, bad);
+    }
+    // Either knob alone: max-objects at the automatic depth's base level, max-level at
+    // max-objects 4.
+    p = regular();
+    p.regular.maxObjects = 1;
+    auto objects = buildAccelerator(s, p);
+    EXPECT_GT(objects->info().regions, 2u);
+    EXPECT_EQ(int(objects->info().extra["effective_max_level"]), automaticMaxLevel(s.prims.size()));
+    stopSum(*objects);
+    p = regular();
+    p.regular.maxLevel = 8;
+    auto level = buildAccelerator(s, p);
+    EXPECT_GT(level->info().regions, 2u);
+    EXPECT_GT(size_t(level->info().extra["stop_reasons"]["max_objects"]), 0u);
+    stopSum(*level);
+    // auto is the default; kAutoObjectsCount is what the cells stop at.
+    RegularConfig c;
+    EXPECT_TRUE(c.automatic());
+    EXPECT_TRUE(c.usesCostStop());
+    EXPECT_EQ(c.objects(), kAutoObjectsCount);
+    c.maxObjects = 4;
+    EXPECT_FALSE(c.usesCostStop());
+}
+
+TEST(RegularKnobs, StopReasonsAddUpToTheLeaves) {
+    // Covered cells (inside all their primitives' boxes) and the cost estimate's stops count
+    // as cost; cells of at most max-objects primitives as max_objects; the cap as max_level.
+    for (const char* spec : {"builtin:lattice:4", "builtin:balls:2", "builtin:drilled"}) {
+        SCOPED_TRACE(spec);
+        Scene s = loadScene(spec);
+        for (bool costStop : {true, false}) {
+            BuildParams p = regular();
+            p.regular.costStop = costStop;
+            auto a = buildAccelerator(s, p);
+            stopSum(*a);
+            const auto& x = a->info().extra;
+            EXPECT_EQ(size_t(x["stop_reasons"]["cost"]),
+                      size_t(x["cost_leaves"]) + size_t(x["covered_leaves"]));
+            EXPECT_EQ(size_t(x["stop_reasons"]["memory"]), 0u);
         }
     }
 }

@@ -26,6 +26,22 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
         CLI::Option* opt = nullptr;
         switch (d.kind) {
             case ParamKind::Int:
+                if (d.autoWord) {  // a number or the automatic value's word
+                    const std::string expected =
+                        "expected an integer in " + std::to_string((long long)d.lo) + ".." +
+                        std::to_string((long long)d.hi) + " or " + d.autoWord;
+                    opt = app.add_option_function<std::string>(
+                                 d.flag, [p, k](const std::string& v) { parseValue(*p, v, *k); },
+                                 help)
+                              ->check(CLI::Validator(
+                                  [p, expected](std::string& v) {
+                                      Knobs scratch;
+                                      return parseValue(*p, v, scratch) ? std::string()
+                                                                        : v + ": " + expected;
+                                  },
+                                  "N"));
+                    break;
+                }
                 opt = app.add_option_function<long long>(
                              d.flag, [p, k](const long long& v) { p->set(*k, double(v)); }, help)
                           ->check(CLI::Range((long long)d.lo, (long long)d.hi));

@@ -47,8 +47,8 @@ std::vector<ParamDesc> makeTable() {
          "max_level",
          "max-level",
          "Deepest subdivision level (regular: one axis cut per level, 0 automatic: 16 + 0.65 "
-         "log2 of the primitive count, 4 deeper where a split saves enough; bvh: tree depth, 0 "
-         "automatic: 64)",
+         "log2 of the primitive count, 4 deeper where a split saves enough, an explicit N builds "
+         "by the report's rule alone, no cost stop; bvh: tree depth, 0 automatic: 64)",
          ParamKind::Int,
          0,
          48};
@@ -62,15 +62,19 @@ std::vector<ParamDesc> makeTable() {
     add(d);
     // One knob for both schemes, as the report has one: the regular scheme refuses 0 when it
     // builds (a cell must stop on a count), the irregular one splits until no segment is left.
+    // auto: 4, the cost stop deciding (an explicit value turns it off).
     d = {"--max-objects",
          "N",
          "max_objects",
          "max-objects",
          "Stop subdividing a cell holding at most N primitives (irregular: 0 never stops; "
-         "regular and bvh: at least 1; bvh default 2)",
+         "regular and bvh: at least 1); auto: 4 (bvh: 2), and a cost estimate stops cells where "
+         "a split does not pay; an explicit N builds by the report's rule alone (no cost stop)",
          ParamKind::Int,
          0,
          1000000};
+    d.autoWord = "auto";
+    d.autoValue = kAutoObjects;
     d.schemes = kAccelerated;
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) {
@@ -82,7 +86,12 @@ std::vector<ParamDesc> makeTable() {
         k.build.regular.maxObjects = k.build.irregular.maxObjects = k.build.bvh.maxObjects = int(v);
     };
     add(d);
-    d = {"--step",       "M", "step", "step", "Next-cell method: exact, or the report's push",
+    d = {"--step",
+         "M",
+         "step",
+         "step",
+         "Next-cell method: exact, or the report's push (lancer view with --pick: the playback "
+         "step to stop at instead, first, last or N from 0)",
          ParamKind::Enum};
     d.names = {"exact", "push"};
     d.schemes = kRegular;
@@ -132,8 +141,9 @@ std::vector<ParamDesc> makeTable() {
          "",
          "cost_stop",
          "cost stop",
-         "Split cells (irregular: screen cells) down to max-objects or max-level even where the "
-         "cost estimate says a split does not pay (the report's rule)",
+         "With max-level 0 and max-objects auto, split cells (irregular: screen cells) down to 4 "
+         "primitives or the automatic max-level even where the cost estimate says a split does "
+         "not pay (the report's rule, which an explicit max-level or max-objects also gives)",
          ParamKind::Switch};
     d.flagValue = false;
     d.schemes = kAccelerated;
@@ -343,6 +353,7 @@ ChangeEffect changeEffect(const Knobs& before, const Knobs& after) {
 std::string formatValue(const ParamDesc& d, const Knobs& k) {
     switch (d.kind) {
         case ParamKind::Int:
+            if (d.autoWord && d.get(k) == d.autoValue) return d.autoWord;
             return std::to_string(int(d.get(k)));
         case ParamKind::Real:
             return number(d.get(k));
@@ -361,6 +372,10 @@ std::string formatValue(const ParamDesc& d, const Knobs& k) {
 bool parseValue(const ParamDesc& d, const std::string& text, Knobs& k) {
     switch (d.kind) {
         case ParamKind::Int: {
+            if (d.autoWord && text == d.autoWord) {
+                d.set(k, d.autoValue);
+                return true;
+            }
             long long v = 0;
             auto r = std::from_chars(text.data(), text.data() + text.size(), v);
             if (r.ec != std::errc() || r.ptr != text.data() + text.size()) return false;
@@ -450,6 +465,7 @@ std::string optionsMarkdown() {
                 values = d.kind == ParamKind::Int ? std::to_string((long long)d.lo) + " to " +
                                                         std::to_string((long long)d.hi)
                                                   : number(d.lo) + " to " + number(d.hi);
+                if (d.autoWord) values += std::string(", ") + d.autoWord;
                 def = formatValue(d, defaults);
                 if (d.kind == ParamKind::Int &&
                     (d.flag == std::string("--width") || d.flag == std::string("--height")))

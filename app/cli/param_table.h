@@ -77,6 +77,10 @@ struct ParamDesc {
     std::string Knobs::*path = nullptr;  ///< Path: the member it fills
     /// Besides the scheme, when it is read (delta: with --step push only); nullptr: always.
     bool (*when)(const Knobs& k) = nullptr;
+    /// Int: a word for the automatic value `autoValue` (lo - 1), taken and written in its
+    /// place ("auto"); nullptr: none.
+    const char* autoWord = nullptr;
+    double autoValue = 0.0;
 };
 
 /// The table, in the order of the help.
@@ -91,7 +95,8 @@ bool applies(const ParamDesc& d, const Knobs& k);
 /// re-render when a rendering knob changed, else nothing.
 ChangeEffect changeEffect(const Knobs& before, const Knobs& after);
 
-/// The value as the ini and the help write it: "24", "1e-06", "exact", "1" / "0", a path.
+/// The value as the ini and the help write it: "24", "auto", "1e-06", "exact", "1" / "0", a
+/// path.
 std::string formatValue(const ParamDesc& d, const Knobs& k);
 /// Parse `text` (the ini's form, or an enum name) into `k`. False, and `k` unchanged, when it
 /// is not a value of `d` or lies outside its range.

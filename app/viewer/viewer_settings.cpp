@@ -79,6 +79,7 @@ std::string settingsLines(const ViewerSettings& s) {
     std::ostringstream o;
     o.precision(17);
     o << "scene=" << s.scene << "\n";
+    o << "knob_format=2\n";
     const cli::Knobs k = knobsOf(s);
     for (const cli::ParamDesc& d : cli::paramTable())
         if (d.iniKey) o << d.iniKey << "=" << cli::formatValue(d, k) << "\n";
@@ -126,6 +127,13 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
     size_t eq = line.find('=');
     if (eq == std::string::npos) return;
     std::string key = line.substr(0, eq), value = line.substr(eq + 1);
+    if (key == "knob_format") {
+        s.knobFormat = value == "2" ? 2 : 1;
+        return;
+    }
+    // An ini of format 1 wrote the default max-objects as 4, and any max-objects then built as
+    // the default does (the cost stop deciding): auto keeps that build.
+    if (key == "max_objects" && value == "4" && s.knobFormat < 2) value = "auto";
     for (const cli::ParamDesc& d : cli::paramTable())
         if (d.iniKey && key == d.iniKey) {
             cli::Knobs k = knobsOf(s);

@@ -42,6 +42,10 @@ struct ViewerSettings {
     /// opens that scene first restores it instead of framing the structure afresh.
     std::optional<Camera> inspectorCamera;
     std::string inspectorScene;
+    /// The knobs' format of the ini read: 1 (no `knob_format` line) before max-objects took
+    /// "auto", when every ini wrote its default as max_objects=4 (read as auto, the same build);
+    /// 2 since, written first.
+    int knobFormat = 1;
 };
 
 /// Register the [Lancer][Settings] ini handler of the current ImGui context, reading into and

@@ -231,6 +231,8 @@ bool ViewerState::takeUpload(RowRange& rows) {
 void ViewerState::pollBuilder() {
     std::optional<BuildResult> r = builder_.poll();
     if (!r) return;
+    const bool first = !started_;
+    started_ = true;
     if (r->sceneBuild) {
         const bool newScene = !sceneBuild_ || sceneBuild_->spec != r->sceneBuild->spec;
         logTiming(buildWhy_ + ": structure ready " + std::to_string(msSince(buildChangeAt_)) +
@@ -274,6 +276,10 @@ void ViewerState::pollBuilder() {
             s_.scene = sceneBuild_->spec;
         else
             s_.build = sceneBuild_->accel->params();
+    } else if (!r->sceneFailed && first) {
+        // The structure the run starts with is refused: the options are wrong, and a
+        // brute-force image in its place would hide it (the run ends, window.cpp).
+        startRefusal_ = r->error;
     } else if (!r->sceneFailed && s_.build.scheme != SchemeKind::Brute) {
         // Nothing on screen yet: show the scene with the reference scheme meanwhile.
         s_.build.scheme = SchemeKind::Brute;

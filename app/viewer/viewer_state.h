@@ -85,6 +85,9 @@ class ViewerState {
     bool rendering() const { return renderer_.job() != 0 && !renderer_.finished(); }
     const ProgressiveRenderer& renderer() const { return renderer_; }
     const std::string& error() const { return error_; }
+    /// Why the run's first structure was refused (its options, its memory budget); "" while it
+    /// was not. A refusal at start ends the run (window.cpp); later ones keep what is shown.
+    const std::string& startRefusal() const { return startRefusal_; }
     const Camera& camera() const { return camera_; }
     const Camera& home() const { return home_; }
     /// The image on screen (the last snapshot taken).
@@ -179,6 +182,8 @@ class ViewerState {
     std::shared_ptr<const SceneBuild> sceneBuild_;
     Camera camera_, home_;
     std::string error_;
+    std::string startRefusal_;
+    bool started_ = false;  ///< a first build result (a structure or a failure) came
     PanelNotes notes_;
     bool panelsHidden_ = false;
 

@@ -89,6 +89,14 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
         ImGui::LoadIniSettingsFromDisk(ini.c_str());
     }
     applyCommandLine(o, given, settings);
+    // A layer the scheme (from the command line or the ini) does not have: refused by name.
+    if (std::string bad = overlay::showListMismatch(v.show, settings.build.scheme); !bad.empty()) {
+        std::cerr << "error: " << bad << "\n";
+        io.IniFilename = nullptr;  // nothing changed: the settings file stays as it is
+        ImGui::DestroyContext();
+        glfwTerminate();
+        return 2;
+    }
     if (std::optional<ViewMode> m = viewModeOf(v.view)) settings.mode = *m;
     if (v.select >= 0) settings.showSelection = true;
 
@@ -211,6 +219,12 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             ImGui_ImplGlfw_NewFrame();
             app.frame(fbw, fbh);
             ++frames;
+            if (const std::string& refused = app.state().startRefusal(); !refused.empty()) {
+                // No fallback image: the options the run was started with are wrong.
+                std::cerr << "error: lancer view: the structure was refused: " << refused << "\n";
+                status = 2;
+                break;
+            }
             if (v.replayChange && !replayed && app.settled() && app.sceneBuild()) {
                 app.rebuild("replayed parameter change");
                 replayed = true;
@@ -243,15 +257,22 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                               << (sv ? sv->regionCount() : 0) << " regions)\n";
                     status = 2;
                 }
+                std::string played;  // "ray 0 at step 3 of 5": where the playback stopped
                 if (v.pick.size() == 2 && app.rayPlayer().playback().empty()) {
                     std::cerr << "error: --pick: " << app.rayPlayer().note() << "\n";
                     status = 2;
+                } else if (v.pick.size() == 2) {
+                    const playback::RayPlayback& pb = app.rayPlayer().playback();
+                    played = ", ray " + std::to_string(v.pickRay) + " at step " +
+                             std::to_string(pb.state().step) + " of " +
+                             std::to_string(pb.stepCount());
                 }
-                if (!v.screenshot.empty()) {
+                // A failed run writes no screenshot: a file there would pass for its result.
+                if (!v.screenshot.empty() && status == 0) {
                     try {
                         app.saveScreenshot(v.screenshot, fbw, fbh);
                         std::cout << "lancer view: " << frames << " frames, screenshot "
-                                  << v.screenshot << "\n";
+                                  << v.screenshot << played << "\n";
                     } catch (const std::exception& e) {
                         std::cerr << "error: --screenshot: " << e.what() << "\n";
                         status = 2;

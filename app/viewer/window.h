@@ -29,8 +29,9 @@ struct ViewOptions {
     int64_t select = -1;  ///< a region id to select once the structure is built; -1: none
     /// `--pick X Y`: the pixel whose ray tree is played (empty: none).
     std::vector<int> pick;
-    int pickRay = 0;   ///< `--ray K`: the ray of the tree played
-    int pickStep = 0;  ///< `--step N` with --pick: the step the playback stops at
+    int pickRay = 0;  ///< `--ray K`: the ray of the tree played
+    /// `--step first|last|N` with --pick: the step the playback stops at (kLastStep: last).
+    int pickStep = 0;
     /// `--show LIST` (docs/design.md section 6: a comma list, "none" for none); empty: the
     /// saved ones.
     std::string show;
@@ -38,6 +39,9 @@ struct ViewOptions {
     std::string ab;    ///< `--ab new|old|diff`: the rebuild A/B the heat map shows
     std::string change;  ///< `--change LIST`: NAME=VALUE changes applied after the first image
 };
+
+/// ViewOptions::pickStep of `--step last`: the ray's final step.
+inline constexpr int kLastStep = -1;
 
 /// What runViewer returns when no window can be opened (no display, no OpenGL 3.3).
 inline constexpr int kNoDisplay = -1;

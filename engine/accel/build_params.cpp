@@ -50,12 +50,16 @@ int automaticMaxLevel(size_t primitives) {
 int effectiveMaxLevel(const RegularConfig& config, size_t primitives) {
     if (config.maxLevel > 0) return config.maxLevel;
     const int base = automaticMaxLevel(primitives);
-    return config.costStop ? std::min(base + kGainDepth, 48) : base;
+    return config.usesCostStop() ? std::min(base + kGainDepth, 48) : base;
 }
 
 int gainLevel(const RegularConfig& config, size_t primitives) {
-    if (config.maxLevel > 0 || !config.costStop) return std::numeric_limits<int>::max();
+    if (!config.usesCostStop()) return std::numeric_limits<int>::max();
     return automaticMaxLevel(primitives);
+}
+
+std::string maxObjectsText(int maxObjects) {
+    return maxObjects == kAutoObjects ? "auto" : std::to_string(maxObjects);
 }
 
 std::string toString(const BuildParams& p) {
@@ -64,20 +68,20 @@ std::string toString(const BuildParams& p) {
     os << schemeName(p.scheme);
     if (p.scheme == SchemeKind::Regular) {
         const RegularConfig& r = p.regular;
-        os << " --max-level " << r.maxLevel << " --max-objects " << r.maxObjects << " --step "
-           << stepName(r.step);
+        os << " --max-level " << r.maxLevel << " --max-objects " << maxObjectsText(r.maxObjects)
+           << " --step " << stepName(r.step);
         if (r.step == StepMethod::Push) os << " --delta " << r.delta;
         os << " --split-axes " << splitAxesName(r.splitAxes);
         if (r.fullTable) os << " --full-table";
         if (!r.costStop) os << " --no-cost-stop";
     } else if (p.scheme == SchemeKind::Irregular) {
         const IrregularConfig& i = p.irregular;
-        os << " --max-objects " << i.maxObjects << " --bsp-heuristic " << heuristicName(i.heuristic)
-           << " --irregular-frame " << irregularFrameName(i.frame);
+        os << " --max-objects " << maxObjectsText(i.maxObjects) << " --bsp-heuristic "
+           << heuristicName(i.heuristic) << " --irregular-frame " << irregularFrameName(i.frame);
         if (!i.costStop) os << " --no-cost-stop";
     } else if (p.scheme == SchemeKind::Bvh) {
         const BvhConfig& b = p.bvh;
-        os << " --max-level " << b.maxLevel << " --max-objects " << b.maxObjects;
+        os << " --max-level " << b.maxLevel << " --max-objects " << maxObjectsText(b.maxObjects);
         if (!b.costStop) os << " --no-cost-stop";
     }
     if (p.scheme != SchemeKind::Brute) {

@@ -29,22 +29,33 @@ const char* heuristicName(BspHeuristic h);
 const char* splitAxesName(SplitAxes s);
 const char* irregularFrameName(IrregularFrame f);
 
+/// max-objects' automatic value (RegularConfig, IrregularConfig; `--max-objects auto`): cells of
+/// at most kAutoObjectsCount primitives stop, and the cost stop decides above that.
+inline constexpr int kAutoObjects = -1;
+inline constexpr int kAutoObjectsCount = 4;
+
 /// The regular scheme's knobs (report, section 3). Defaults measured in docs/regular.md
 /// ("Cost-driven splits", "Axis order", "Where push goes wrong"): a cell is split while the
 /// split lowers the estimated cost of the rays crossing it, down to a depth that grows with the
 /// scene; split axes `cost` takes 25% fewer render instructions than `cycle` on balls4, at most
 /// 4% more on the SPD scenes; push matches brute force on every test ray at delta 1e-6, 0.05
 /// skips thin cells, 1e-19 stalls.
+///
+/// The cost stop belongs to the automatic mode (max-level 0 and max-objects kAutoObjects): an
+/// explicit max-level or max-objects builds by the report's rule, a cell split while it holds
+/// more than max-objects primitives and is above max-level (docs/regular.md, "Explicit knobs").
 struct RegularConfig {
     /// Deepest BSP level (one axis cut per level); 0: automatic (effectiveMaxLevel()).
     int maxLevel = 0;
-    int maxObjects = 4;                     ///< a cell with at most this many primitives stops
+    /// A cell with at most this many primitives stops; kAutoObjects: automatic (objects()).
+    int maxObjects = kAutoObjects;
     StepMethod step = StepMethod::Exact;    ///< next-leaf method: exact, or the report's push
     double delta = 1e-6;                    ///< push distance, relative to the box's extent
     SplitAxes splitAxes = SplitAxes::Cost;  ///< the axis each BSP level cuts
     bool fullTable = false;                 ///< one full directory instead of sub-tables
-    /// Stop a cell where no split lowers the estimated cost (false: the report's rule alone,
-    /// max-objects and max-level, with cells inside all their primitives' boxes kept whole).
+    /// In the automatic mode, stop a cell where no split lowers the estimated cost (false: the
+    /// report's rule alone, max-objects and max-level, with cells inside all their primitives'
+    /// boxes kept whole). An explicit max-level or max-objects turns it off (usesCostStop()).
     bool costStop = true;
     /// Cost of a leaf the walk crosses, in primitive tests: callgrind instructions per region
     /// visit over those per sphere test, fitted on balls4 (docs/regular.md, "Cost-driven splits").
@@ -59,6 +70,13 @@ struct RegularConfig {
     /// the others (balls:6: 17% fewer tests per ray for 16% more leaves; docs/regular.md,
     /// "Cost-driven splits").
     double minGain = 8.0;
+
+    /// Neither max-level nor max-objects is set: the depth and the stops are the build's choice.
+    bool automatic() const { return maxLevel == 0 && maxObjects == kAutoObjects; }
+    /// The max-objects the build stops cells at.
+    int objects() const { return maxObjects == kAutoObjects ? kAutoObjectsCount : maxObjects; }
+    /// Whether the cost stop (and the gain floor) decide: in the automatic mode, unless turned off.
+    bool usesCostStop() const { return costStop && automatic(); }
 };
 
 /// The automatic depth's base level for a scene of `primitives` live primitives:
@@ -69,11 +87,11 @@ int automaticMaxLevel(size_t primitives);
 inline constexpr int kGainDepth = 4;
 /// The max-level a build over `primitives` uses: the configured one; automatically
 /// automaticMaxLevel() + kGainDepth with the cost stop (the gain floor bounds it), the base
-/// level without (the report's rule alone would split every cell down to the cap).
+/// level without (the report's rule alone would split every cell down to the cap; so with an
+/// explicit max-objects).
 int effectiveMaxLevel(const RegularConfig& config, size_t primitives);
-/// The level from which the gain floor holds: automaticMaxLevel() with the automatic depth and
-/// the cost stop; otherwise none (INT_MAX), an explicit --max-level being a cap the build keeps
-/// as it is.
+/// The level from which the gain floor holds: automaticMaxLevel() with the cost stop
+/// (RegularConfig::usesCostStop()); otherwise none (INT_MAX).
 int gainLevel(const RegularConfig& config, size_t primitives);
 
 /// The irregular scheme's knobs (report, section 2). Defaults measured in docs/irregular.md
@@ -82,16 +100,25 @@ int gainLevel(const RegularConfig& config, size_t primitives);
 /// `fewest-cuts`; the projective zones save 2-26% of the instructions per ray. max-objects 4 is
 /// the regular scheme's value; the cost stop (stepCost 4, "Budget and stopping rule") leaves
 /// balls4 a tenth of the zones and halves its region visits per ray.
+/// As the regular scheme's, the cost stop belongs to the automatic mode: an explicit
+/// max-objects builds by the report's rule alone (docs/irregular.md, "Explicit max-objects").
 struct IrregularConfig {
-    int maxObjects = 4;  ///< a screen cell over at most this many rectangles is a zone (0: never)
+    /// A screen cell over at most this many rectangles is a zone (0: never; kAutoObjects:
+    /// automatic, objects()).
+    int maxObjects = kAutoObjects;
     BspHeuristic heuristic = BspHeuristic::Balanced;    ///< choice of the splitting segment
     IrregularFrame frame = IrregularFrame::Projective;  ///< what primary rays walk
-    /// Leave a screen cell whole where no split lowers the estimated tests per ray (false: the
-    /// report's rule alone, max-objects).
+    /// With the automatic max-objects, leave a screen cell whole where no split lowers the
+    /// estimated tests per ray (false: the report's rule alone, max-objects).
     bool costStop = true;
     /// Cost of the zone a screen split adds, in primitive tests (2, 4 and 8 measured: 4 renders
     /// balls4 and lattice:12 fastest for their build).
     double stepCost = 4.0;
+
+    /// The max-objects the screen BSP stops cells at.
+    int objects() const { return maxObjects == kAutoObjects ? kAutoObjectsCount : maxObjects; }
+    /// Whether the cost stop decides: with the automatic max-objects, unless turned off.
+    bool usesCostStop() const { return costStop && maxObjects == kAutoObjects; }
 };
 
 /// Builder parameters: the scheme, the knobs every scheme reads, and each scheme's Config.
@@ -109,9 +136,12 @@ struct BuildParams {
     BvhConfig bvh;              ///< read by the BVH only
 };
 
+/// A max-objects as the command line writes it: "auto" for kAutoObjects, else the number.
+std::string maxObjectsText(int maxObjects);
 /// The knobs the scheme in use reads, as command-line options: "regular --max-level 0
-/// --max-objects 4 --step exact --split-axes cost" (and --delta, --full-table, --no-cost-stop,
-/// --no-mailbox, --no-light-buffer where they apply and differ from the defaults).
+/// --max-objects auto --step exact --split-axes cost" (and --delta, --full-table,
+/// --no-cost-stop, --no-mailbox, --no-light-buffer where they apply and differ from the
+/// defaults).
 std::string toString(const BuildParams& p);
 std::ostream& operator<<(std::ostream& os, const BuildParams& p);
 

@@ -26,12 +26,13 @@ nlohmann::json statsJson(const Scene& scene, const Accelerator& accel, const Ren
     j["light_buffer_skips"] = c.lightBufferSkips;
     j["regions"] = info.regions;
     j["memory_bytes"] = info.memoryBytes;
-    // The scheme's own max-objects; the regular scheme's other knobs are written for every
-    // scheme, as they always were (DESIGN.md section 6 lists max_level and step).
+    // The scheme's own max-objects (the automatic one's count); the regular scheme's other
+    // knobs are written for every scheme, as they always were (DESIGN.md section 6 lists
+    // max_level and step).
     j["max_level"] = p.scheme == SchemeKind::Bvh ? p.bvh.maxLevel : p.regular.maxLevel;
-    j["max_objects"] = p.scheme == SchemeKind::Irregular ? p.irregular.maxObjects
-                       : p.scheme == SchemeKind::Bvh     ? p.bvh.maxObjects
-                                                         : p.regular.maxObjects;
+    j["max_objects"] = p.scheme == SchemeKind::Irregular ? p.irregular.objects()
+                       : p.scheme == SchemeKind::Bvh     ? p.bvh.objects()
+                                                         : p.regular.objects();
     j["step"] = stepName(p.regular.step);
     j["delta"] = p.regular.delta;
     j["bsp_heuristic"] = heuristicName(p.irregular.heuristic);

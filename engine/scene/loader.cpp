@@ -4,6 +4,7 @@
 #include "engine/scene/json_reader.h"
 #include "engine/scene/nff_reader.h"
 #include "engine/scene/openscad_reader.h"
+#include "engine/scene/source_text.h"
 
 namespace lancer {
 
@@ -18,8 +19,14 @@ std::string extension(const std::string& path) {
 }
 }  // namespace
 
+void checkSceneFile(const std::string& spec) {
+    if (parseBuiltinSpec(spec)) return;
+    if (std::string why = fileProblem(spec); !why.empty()) throw SceneError(spec + ": " + why);
+}
+
 Scene loadScene(const std::string& spec) {
     if (std::optional<BuiltinSpec> builtin = parseBuiltinSpec(spec)) return makeBuiltin(*builtin);
+    checkSceneFile(spec);
     std::string ext = extension(spec);
     if (ext == ".json") return readJsonScene(SourceText::fromFile(spec));
     if (ext == ".nff") return readNff(SourceText::fromFile(spec));

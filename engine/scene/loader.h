@@ -9,6 +9,9 @@ namespace lancer {
 
 /// Throws SceneError with the file, line and column of any problem.
 Scene loadScene(const std::string& spec);
+/// Throws SceneError naming `spec` when it is a path that is missing ("no such file") or a
+/// directory; a built-in name passes (its own errors come when it is made).
+void checkSceneFile(const std::string& spec);
 /// Replace the camera of a loaded scene with the one in `path`, a JSON object with the
 /// .camera.json sidecar's keys (docs/design.md section 6; what the viewer's Copy JSON writes): keys
 /// not given keep the scene's values, except a missing "projection", which means perspective;

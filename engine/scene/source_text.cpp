@@ -1,12 +1,21 @@
 #include "engine/scene/source_text.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "engine/scene/scene.h"
 
 namespace lancer {
+
+std::string fileProblem(const std::string& path) {
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::status(path, ec);
+    if (st.type() == std::filesystem::file_type::not_found) return "no such file";
+    if (st.type() == std::filesystem::file_type::directory) return "is a directory, not a file";
+    return "";
+}
 
 SourceText::SourceText(std::string path, std::string text)
     : path_(std::move(path)), text_(std::move(text)) {
@@ -16,6 +25,8 @@ SourceText::SourceText(std::string path, std::string text)
 }
 
 SourceText SourceText::fromFile(const std::string& path) {
+    // A directory opens as an empty stream on Linux: refused by name, as a missing file is.
+    if (std::string why = fileProblem(path); !why.empty()) throw SceneError(path + ": " + why);
     std::ifstream f(path, std::ios::binary);
     if (!f) throw SceneError(path + ": cannot open the file");
     std::ostringstream ss;

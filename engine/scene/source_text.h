@@ -6,6 +6,10 @@
 
 namespace lancer {
 
+/// Why `path` cannot be read as a file: "no such file", "is a directory, not a file", or ""
+/// (other problems show when it is opened).
+std::string fileProblem(const std::string& path);
+
 class SourceText {
   public:
     SourceText(std::string path, std::string text);

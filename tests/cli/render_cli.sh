@@ -70,7 +70,7 @@ out=$("$LANCER" render "$tmp/bad.json" -o "$tmp/d.png" 2>&1); status=$?
 echo "$out" | grep -q "bad.json:2:24: expected a positive number" || fail "bad scene message: $out"
 [ ! -e "$tmp/d.png" ] || fail "an image was written for a bad scene"
 out=$("$LANCER" render "$tmp/missing.json" -o "$tmp/d.png" 2>&1) && fail "missing scene accepted"
-echo "$out" | grep -q "missing.json: cannot open" || fail "missing file message: $out"
+echo "$out" | grep -q "missing.json: no such file" || fail "missing file message: $out"
 out=$("$LANCER" render builtin:nosuch -o "$tmp/d.png" 2>&1) && fail "unknown builtin accepted"
 echo "$out" | grep -q "unknown built-in scene" || fail "unknown builtin message: $out"
 

@@ -6,7 +6,9 @@
 
 #include "app/viewer/camera_control.h"
 #include "app/viewer/image_view.h"
+#include "app/viewer/panels/panels.h"
 #include "app/viewer/viewer_settings.h"
+#include "engine/scene/loader.h"
 #include "engine/scene/scene.h"
 
 namespace lancer::viewer {
@@ -149,6 +151,55 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
           "window=5 5", "delta=-1", "threads=x", "garbage"})
         readSettingsLine(bad, line);
     EXPECT_EQ(settingsLines(bad), lines);
+}
+
+void readLines(ViewerSettings& r, const std::string& lines);
+
+// The ini writes max-objects' automatic value as "auto" and reads it back; an explicit value
+// replaces it (the report's rule), and "auto" restores the default.
+TEST(ViewerSettingsIni, MaxObjectsAutoRoundTrips) {
+    ViewerSettings s;
+    EXPECT_NE(settingsLines(s).find("\nmax_objects=auto\n"), std::string::npos);
+    readSettingsLine(s, "max_objects=2");
+    EXPECT_EQ(s.build.regular.maxObjects, 2);
+    EXPECT_FALSE(s.build.regular.usesCostStop());
+    readSettingsLine(s, "max_objects=auto");
+    EXPECT_EQ(s.build.irregular.maxObjects, kAutoObjects);
+    EXPECT_TRUE(s.build.regular.usesCostStop());
+    // An ini written before "auto" (no knob_format line) held its default as max_objects=4:
+    // read as auto, the build it stood for; since, 4 is an explicit 4.
+    ViewerSettings old;
+    readSettingsLine(old, "max_objects=4");
+    EXPECT_EQ(old.build.regular.maxObjects, kAutoObjects);
+    ViewerSettings now;
+    now.build.regular.maxObjects = now.build.irregular.maxObjects = 4;
+    ViewerSettings back;
+    readLines(back, settingsLines(now));
+    EXPECT_EQ(back.build.regular.maxObjects, 4);
+}
+
+// The Parameters panel's line of stop reasons, from a build's --stats figures.
+TEST(ParametersPanel, StopReasonsLineCountsEachReason) {
+    Scene scene = loadScene("builtin:default");
+    BuildParams p;
+    p.scheme = SchemeKind::Regular;
+    p.regular.maxLevel = 6;
+    p.regular.maxObjects = 1;
+    const auto a = buildAccelerator(scene, p);
+    const nlohmann::json& r = a->info().extra["stop_reasons"];
+    const size_t covered = a->info().extra["covered_leaves"];
+    EXPECT_EQ(stopReasonsLine(a->info().extra, SchemeKind::Regular),
+              "leaves stopped by max-objects " + std::to_string(size_t(r["max_objects"])) +
+                  ", max-level " + std::to_string(size_t(r["max_level"])) + ", cost " +
+                  std::to_string(size_t(r["cost"])) +
+                  (covered ? " (" + std::to_string(covered) + " covered)" : "") + ", memory 0");
+    EXPECT_GT(size_t(r["max_level"]), 0u);
+    p.scheme = SchemeKind::Irregular;
+    const auto b = buildAccelerator(scene, p);
+    EXPECT_EQ(stopReasonsLine(b->info().extra, SchemeKind::Irregular).rfind("zones stopped by ", 0),
+              0u);
+    p.scheme = SchemeKind::Brute;
+    EXPECT_EQ(stopReasonsLine(buildAccelerator(scene, p)->info().extra, SchemeKind::Brute), "");
 }
 
 /// Every line of `lines` read into `r`.

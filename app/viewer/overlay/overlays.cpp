@@ -471,4 +471,20 @@ std::vector<std::string> applyShowList(const std::string& list, OverlayOptions& 
     return notDrawn;
 }
 
+std::string showListMismatch(const std::string& list, SchemeKind scheme) {
+    std::stringstream in(list);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        const bool irregular = item == "bsp" || item == "zones" || item == "slabs";
+        const bool regular = item == "leaves" || item == "grid";
+        if (!irregular && !regular) continue;
+        const SchemeKind owner = irregular ? SchemeKind::Irregular : SchemeKind::Regular;
+        if (owner == scheme) continue;
+        return "--show " + item + ": the " + schemeName(scheme) + " scheme has no " + item +
+               " (a layer of the " + schemeName(owner) + " scheme; --scheme " + schemeName(owner) +
+               " draws it)";
+    }
+    return "";
+}
+
 }  // namespace lancer::viewer::overlay

@@ -151,5 +151,9 @@ class Overlays {
 /// Parse a --show list into `options`; returns the items the overlays do not draw (an empty
 /// list when all were taken) and throws std::invalid_argument naming an unknown item.
 std::vector<std::string> applyShowList(const std::string& list, OverlayOptions& options);
+/// Why a --show list does not fit `scheme`: "--show leaves: the irregular scheme has no leaves
+/// (the regular scheme's layer)" for the first item that names another scheme's layer (bsp,
+/// zones, slabs: irregular; leaves, grid: regular); "" when every item fits.
+std::string showListMismatch(const std::string& list, SchemeKind scheme);
 
 }  // namespace lancer::viewer::overlay

@@ -34,6 +34,10 @@ void drawPanels(ViewerState& st, const PanelLayout& layout, PanelHeights& height
 void menuBar(ViewerState& st);
 /// Scene, subdivision and rendering parameters.
 void parametersPanel(ViewerState& st);
+/// The Parameters panel's line of a structure's stop reasons (`--stats` "stop_reasons" in its
+/// `extra`): "leaves stopped by max-objects 3, max-level 0, cost 12, memory 0" ("zones" for
+/// the irregular scheme); "" when it has none (brute force).
+std::string stopReasonsLine(const nlohmann::json& extra, SchemeKind scheme);
 /// Projection, eye and target, reset, copy and paste as JSON.
 void cameraPanel(ViewerState& st);
 /// Passes, rays and work per ray, and the speedup over brute force.

@@ -15,7 +15,12 @@ bool paramControl(const cli::ParamDesc& d, cli::Knobs& k, int maxThreads) {
     switch (d.kind) {
         case cli::ParamKind::Int: {
             int v = int(d.get(k));
-            if (d.hi - d.lo <= 64 || d.flag == std::string("--threads")) {
+            const int lo = d.autoWord ? int(d.autoValue) : int(d.lo);
+            if (d.autoWord) {
+                // Dragged below lo, the automatic value, written as its word (ctrl+click types).
+                changed = ImGui::DragInt(d.label, &v, 0.2f, lo, int(d.hi),
+                                         v == lo ? d.autoWord : "%d", ImGuiSliderFlags_AlwaysClamp);
+            } else if (d.hi - d.lo <= 64 || d.flag == std::string("--threads")) {
                 const int hi =
                     d.flag == std::string("--threads") ? std::max(maxThreads, 1) : int(d.hi);
                 changed =
@@ -24,7 +29,7 @@ bool paramControl(const cli::ParamDesc& d, cli::Knobs& k, int maxThreads) {
             } else {
                 changed = ImGui::InputInt(d.label, &v);
             }
-            v = std::clamp(v, int(d.lo), int(d.hi));
+            v = std::clamp(v, lo, int(d.hi));
             changed = changed && double(v) != d.get(k);
             if (changed) d.set(k, double(v));
             break;

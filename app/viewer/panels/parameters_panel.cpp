@@ -27,6 +27,27 @@ std::optional<BuiltinSpec> builtinOf(const std::string& spec) {
 
 }  // namespace
 
+std::string stopReasonsLine(const nlohmann::json& extra, SchemeKind scheme) {
+    const auto it = extra.find("stop_reasons");
+    if (it == extra.end() || !it->is_object()) return "";
+    std::string out = scheme == SchemeKind::Irregular ? "zones" : "leaves";
+    out += " stopped by";
+    const char* keys[][2] = {{"max_objects", "max-objects"},
+                             {"max_level", "max-level"},
+                             {"cost", "cost"},
+                             {"memory", "memory"}};
+    // Of the cost stops, the cells inside all their primitives' boxes (kept whole by any rule).
+    const size_t covered = extra.value(
+        scheme == SchemeKind::Irregular ? "covered_zones" : "covered_leaves", size_t(0));
+    for (size_t i = 0; i < std::size(keys); ++i) {
+        out += std::string(i ? ", " : " ") + keys[i][1] + " " +
+               std::to_string(it->value(keys[i][0], size_t(0)));
+        if (keys[i][0] == std::string("cost") && covered)
+            out += " (" + std::to_string(covered) + " covered)";
+    }
+    return out;
+}
+
 void parametersPanel(ViewerState& st) {
     ViewerSettings& s = st.settings();
     PanelNotes& notes = st.notes();
@@ -71,6 +92,15 @@ void parametersPanel(ViewerState& st) {
         ImGui::Text("on screen: %s, built in %.1f ms", schemeName(b->accel->params().scheme),
                     ai.buildMs);
         ImGui::Text("regions %zu, memory %s", ai.regions, formatBytes(ai.memoryBytes).c_str());
+        if (const std::string why = stopReasonsLine(ai.extra, b->accel->params().scheme);
+            !why.empty()) {
+            ImGui::TextUnformatted(why.c_str());
+            if (ImGui::IsItemHovered())
+                ImGui::SetTooltip(
+                    "Why each cell was not split: it held at most max-objects primitives, it "
+                    "reached max-level, no split would pay (the cost estimate, or a cell inside "
+                    "all its primitives' boxes), or the memory budget");
+        }
         ImGui::Text("%zu primitives (%d dropped by minimization)", b->scene->prims.size(),
                     b->scene->droppedPrims);
     }

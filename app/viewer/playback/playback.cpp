@@ -300,15 +300,18 @@ std::string traceCommand(const std::string& scene, const std::string& cameraFile
        << " --scheme " << schemeName(b.scheme);
     // --max-objects is read by the scheme in use (each has its own).
     if (b.scheme == SchemeKind::Irregular)
-        os << " --max-objects " << b.irregular.maxObjects << " --bsp-heuristic "
+        os << " --max-objects " << maxObjectsText(b.irregular.maxObjects) << " --bsp-heuristic "
            << heuristicName(b.irregular.heuristic) << " --irregular-frame "
            << irregularFrameName(b.irregular.frame);
     else
-        os << " --max-level " << b.regular.maxLevel << " --max-objects " << b.regular.maxObjects
-           << " --step " << stepName(b.regular.step) << " --delta " << b.regular.delta
-           << " --split-axes " << splitAxesName(b.regular.splitAxes);
+        os << " --max-level " << b.regular.maxLevel << " --max-objects "
+           << maxObjectsText(b.regular.maxObjects) << " --step " << stepName(b.regular.step)
+           << " --delta " << b.regular.delta << " --split-axes "
+           << splitAxesName(b.regular.splitAxes);
     os << " --bounces " << sh.bounces << " --offset " << sh.offsetScale;
     if (b.regular.fullTable && b.scheme == SchemeKind::Regular) os << " --full-table";
+    if (b.scheme == SchemeKind::Irregular ? !b.irregular.costStop : !b.regular.costStop)
+        os << " --no-cost-stop";
     if (!b.mailboxes) os << " --no-mailbox";
     if (!b.lightBuffer) os << " --no-light-buffer";
     if (!sh.shadows) os << " --no-shadows";

@@ -35,7 +35,9 @@ bool RayPlayer::update(const ViewerState& st, double seconds) {
                     play_.clear();
                 } else {
                     play_.selectRay(p.ray);
-                    if (p.step > 0 && p.step >= play_.stepCount()) {
+                    if (p.step < 0) {
+                        play_.last();
+                    } else if (p.step > 0 && p.step >= play_.stepCount()) {
                         note_ = "--step " + std::to_string(p.step) + ": ray " +
                                 std::to_string(p.ray) + " has " +
                                 std::to_string(play_.stepCount()) + " steps";

@@ -17,7 +17,7 @@ namespace lancer::viewer::playback {
 struct ScriptedPick {
     int x = 0, y = 0;
     int ray = 0;
-    int step = 0;
+    int step = 0;  ///< from 0; negative: the last step
 };
 
 class RayPlayer {

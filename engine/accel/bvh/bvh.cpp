@@ -109,7 +109,7 @@ struct BvhBuilder {
         }
         if (bestAxis < 0) return b;  // every centre in one place
         const double cost = config.stepCost + (area > 0.0 ? bestCost / area : double(count));
-        if (config.costStop && count <= uint32_t(kCostLeafPrims) && cost >= double(count)) {
+        if (config.usesCostStop() && count <= uint32_t(kCostLeafPrims) && cost >= double(count)) {
             ++stops.cost;
             return e;
         }
@@ -131,7 +131,7 @@ struct BvhBuilder {
         guard.poll("BVH", bytes, out.nodes_.size());
         const uint32_t b = begin[node], e = end[node], count = e - b;
         uint32_t m = b;
-        if (count <= uint32_t(std::max(config.maxObjects, 1))) {
+        if (count <= uint32_t(config.objects())) {
             ++stops.maxObjects;
         } else if (depth >= maxDepth) {
             ++stops.maxLevel;
@@ -246,8 +246,8 @@ struct BvhBuilder {
 
 Bvh Bvh::build(const Scene& scene, const BvhConfig& config, nlohmann::json& extra,
                BuildGuard* guard) {
-    if (config.maxObjects < 1)
-        throw std::invalid_argument("--max-objects: the BVH needs at least 1 (got " +
+    if (config.maxObjects < 1 && config.maxObjects != -1)
+        throw std::invalid_argument("--max-objects: the BVH needs at least 1 or auto (got " +
                                     std::to_string(config.maxObjects) + ")");
     if (config.maxLevel < 0 || config.maxLevel > kAutomaticBvhDepth)
         throw std::invalid_argument("--max-level: the BVH takes 0 (automatic) to " +

@@ -4,16 +4,25 @@
 
 namespace lancer {
 
+/// The automatic max-objects.
+inline constexpr int kAutoBvhObjects = 2;
+
 /// A bounding volume hierarchy over the minimized boxes, split by the surface-area heuristic
 /// (engine/accel/bvh/bvh.h): the modern baseline beside the report's two subdivisions.
 struct BvhConfig {
     /// Deepest level (the root is level 0); 0: automatic (kAutomaticBvhDepth).
     int maxLevel = 0;
-    /// A node of at most this many primitives is a leaf (--max-objects).
-    int maxObjects = 2;
-    /// Make a node a leaf where no split lowers the surface-area estimate of its cost, for nodes
-    /// of at most kCostLeafPrims primitives (false: split down to max-objects).
+    /// A node of at most this many primitives is a leaf (--max-objects); -1 (kAutoObjects,
+    /// build_params.h): automatic, kAutoBvhObjects and the cost stop, as the other schemes.
+    int maxObjects = -1;
+    /// With the automatic max-objects: make a node a leaf where no split lowers the
+    /// surface-area estimate of its cost, for nodes of at most kCostLeafPrims primitives
+    /// (false: split down to max-objects). An explicit max-objects splits down to it.
     bool costStop = true;
+    /// The max-objects the build uses.
+    int objects() const { return maxObjects < 0 ? kAutoBvhObjects : maxObjects; }
+    /// Whether the surface-area estimate stops nodes.
+    bool usesCostStop() const { return costStop && maxObjects < 0; }
     /// Cost of visiting a node's two children (their box tests), in primitive tests.
     double stepCost = 1.0;
 };

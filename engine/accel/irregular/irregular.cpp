@@ -51,10 +51,10 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     };
     if (std::string err = scene.camera.validate(); !err.empty())
         throw std::invalid_argument("--scheme irregular: the camera is invalid: " + err);
-    if (params.maxObjects < 0)
+    if (params.maxObjects < 0 && params.maxObjects != kAutoObjects)
         throw std::invalid_argument(
             "--max-objects " + std::to_string(params.maxObjects) +
-            ": must be >= 0 (0: split the screen until no segment is left)");
+            ": must be >= 0 (0: split the screen until no segment is left) or auto");
 
     IrregularSubdivision s;
     s.scene_ = &scene;
@@ -62,6 +62,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     std::vector<uint32_t> live = scene.livePrimitives();
     if (live.empty() || scene.bounds.isEmpty()) {
         extra["zones"] = 0;
+        extra["stop_reasons"] = {{"max_objects", 0}, {"max_level", 0}, {"cost", 0}, {"memory", 0}};
         return s;
     }
 
@@ -102,8 +103,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     // arrays can still double (BuildGuard::fits).
     ScreenBspParams sp;
     sp.heuristic = params.heuristic;
-    sp.stopObjects = params.maxObjects;
-    sp.stepCost = params.costStop ? params.stepCost : 0.0;
+    sp.stopObjects = params.objects();
+    sp.stepCost = params.usesCostStop() ? params.stepCost : 0.0;
     sp.maxZones = kMaxZones;
     sp.maxBytes = std::max<size_t>(share / 9, 1);
     sp.zoneBytes = kMergedZoneBytes;
@@ -188,6 +189,14 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["segments"] = s.bsp_.segments;
     extra["cut_segments"] = s.bsp_.cuts;
     extra["cost_stops"] = s.bsp_.costStops;
+    // Why each zone of the camera frame's BSP was not split (docs/irregular.md, "Stop
+    // reasons"): zones inside all their rectangles count as cost (no split separates them).
+    extra["stop_reasons"] = {{"max_objects", s.bsp_.objectStops},
+                             {"max_level", 0},
+                             {"cost", s.bsp_.costStops + s.bsp_.coveredStops},
+                             {"memory", s.bsp_.limitStops}};
+    extra["covered_zones"] = s.bsp_.coveredStops;
+    extra["cost_stop"] = params.usesCostStop();
     extra["bsp_nodes"] = s.bsp_.nodes.size();
     extra["bsp_depth"] = s.bsp_.depth;
     extra["slabs"] = slabs.slabs;

@@ -296,6 +296,10 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         bsp.depth = std::max(bsp.depth, cell.depth);
         if (cell.segs.empty() ||
             (params.stopObjects > 0 && cell.prims.size() <= size_t(params.stopObjects))) {
+            // At most max-objects rectangles (an empty cell holds at most any), else no edge
+            // crosses the cell: it lies inside all its rectangles.
+            ++(cell.prims.size() <= size_t(std::max(params.stopObjects, 0)) ? bsp.objectStops
+                                                                            : bsp.coveredStops);
             makeZone(cell);
             return;
         }
@@ -359,6 +363,7 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         if ((params.maxZones && bsp.zoneLo.size() + queue.size() + 1 >= params.maxZones) ||
             (params.maxBytes && bytes + waiting >= params.maxBytes)) {
             bsp.stopped = true;
+            ++bsp.limitStops;
             makeZone(cell);
             continue;
         }

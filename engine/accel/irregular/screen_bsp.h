@@ -46,7 +46,11 @@ struct ScreenBsp {
     size_t segments = 0;   ///< rectangle edges fed to the BSP
     size_t cuts = 0;       ///< segments cut in two by a splitting line
     size_t costStops = 0;  ///< cells left whole because no split paid (stepCost)
-    int depth = 0;         ///< deepest node
+    /// Zones by why their cell was not split, besides costStops: at most stopObjects
+    /// rectangles; no segment left (the cell inside all its rectangles); the zone or byte limit.
+    /// The four add up to the zones.
+    size_t objectStops = 0, coveredStops = 0, limitStops = 0;
+    int depth = 0;  ///< deepest node
     bool stopped =
         false;  ///< the zone or byte limit stopped the splitting before the segments ran out
 

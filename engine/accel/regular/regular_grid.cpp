@@ -402,8 +402,10 @@ struct RegularBuilder {
         uint64_t primRefs = 0;
         uint32_t maxPrims = 0;
         /// Leaves: without primitives, inside all their boxes, stopped by the cost estimate,
-        /// and (of the last) by the gain floor.
+        /// and (of the last) by the gain floor; at most max-objects primitives, at max-level
+        /// with more. Every leaf is one of objects, level, covered or cost leaves.
         size_t emptyLeaves = 0, coveredLeaves = 0, costLeaves = 0, gainLeaves = 0;
+        size_t objectsLeaves = 0, levelLeaves = 0;
 
         explicit Fragment(int maxLevel) : scratch(size_t(maxLevel) + 2) { bsp.nodes.resize(1); }
         /// Free the working lists once the fragment is built, for the tasks still running to
@@ -483,7 +485,7 @@ struct RegularBuilder {
 
     std::string options() const {
         return "--max-level " + std::to_string(maxLevel) + " --max-objects " +
-               std::to_string(params.maxObjects);
+               std::to_string(params.objects());
     }
 
     std::string refusal() const {
@@ -546,7 +548,7 @@ struct RegularBuilder {
             // floor's saving on its own (beyond it, it found splits at the level above that the
             // floor then stopped: 9% more leaves on tetra:7 for the same tests).
             if (depth > 1 && level + 1 < std::min(maxLevel, gainLevel) &&
-                count[side] > size_t(params.maxObjects)) {
+                count[side] > size_t(params.objects())) {
                 PrimList& in = f.look[depth];
                 in.clear();
                 for (uint32_t p : prims)
@@ -737,7 +739,9 @@ struct RegularBuilder {
     /// tree restricted to them (unused with a restrictor).
     void build(Fragment& f, int id, int level, const uint32_t pos[3], const Box3& box,
                const CsgTree& tree, const PrimList& prims) {
-        if (prims.size() <= size_t(params.maxObjects) || level >= maxLevel) {
+        const bool few = prims.size() <= size_t(params.objects());
+        if (few || level >= maxLevel) {
+            ++(few ? f.objectsLeaves : f.levelLeaves);
             makeLeaf(f, id, level, pos, tree, prims);
             return;
         }
@@ -808,7 +812,7 @@ struct RegularBuilder {
             // made (splitPays(), its first estimate from these sums).
             const double leaf = params.stepCost + params.testCost * all;
             const double split = splitCostOf(box, axis, mid, tests);
-            if (params.costStop) {
+            if (params.usesCostStop()) {
                 const bool gainStop = belowGainFloor(level, box, leaf - split);
                 if (gainStop ||
                     !(split < leaf || splitCost(f, box, prims, level, kLookahead) < leaf)) {
@@ -819,7 +823,7 @@ struct RegularBuilder {
                 }
             }
         } else if (bool gainStop = false;
-                   params.costStop && !splitPays(f, box, prims, level, gainStop)) {
+                   params.usesCostStop() && !splitPays(f, box, prims, level, gainStop)) {
             ++f.costLeaves;
             f.gainLeaves += gainStop;
             makeLeaf(f, id, level, pos, tree, prims);
@@ -957,6 +961,8 @@ struct RegularBuilder {
             f.coveredLeaves += k->coveredLeaves;
             f.costLeaves += k->costLeaves;
             f.gainLeaves += k->gainLeaves;
+            f.objectsLeaves += k->objectsLeaves;
+            f.levelLeaves += k->levelLeaves;
         }
     }
 };
@@ -970,9 +976,9 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     if (params.maxLevel < 0 || params.maxLevel > 48)
         throw std::invalid_argument("--max-level " + std::to_string(params.maxLevel) +
                                     ": must be in 0..48 for the regular scheme (0: automatic)");
-    if (params.maxObjects < 1)
+    if (params.maxObjects < 1 && params.maxObjects != kAutoObjects)
         throw std::invalid_argument("--max-objects " + std::to_string(params.maxObjects) +
-                                    ": must be at least 1");
+                                    ": must be at least 1 for the regular scheme (or auto)");
     if (!exact_ && !(params.delta > 0.0 && params.delta < 1.0))
         throw std::invalid_argument("--delta " + std::to_string(params.delta) +
                                     ": must be in (0, 1) (relative to the scene size)");
@@ -998,7 +1004,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     RegularBuilder b(scene, params, *this, guard, live.size());
     if (params.splitAxes == SplitAxes::Cost)
         schedule_ =
-            planSchedule(scene, box_, live, b.quarters, b.maxLevel, params.maxObjects, guard);
+            planSchedule(scene, box_, live, b.quarters, b.maxLevel, params.objects(), guard);
     b.setGainArea();
     const uint32_t origin[3] = {0, 0, 0};
     RegularBuilder::Fragment root(b.maxLevel);
@@ -1121,6 +1127,15 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         {"covered_leaves", root.coveredLeaves},
         {"cost_leaves", root.costLeaves},
         {"gain_leaves", root.gainLeaves},
+        // Why each leaf's cell was not split (docs/regular.md, "Stop reasons"): covered cells,
+        // whose parts would all hold the same primitives, count as cost; a build over its memory
+        // budget is refused, never stopped.
+        {"stop_reasons",
+         {{"max_objects", root.objectsLeaves},
+          {"max_level", root.levelLeaves},
+          {"cost", root.coveredLeaves + root.costLeaves},
+          {"memory", 0}}},
+        {"cost_stop", params.usesCostStop()},
         {"effective_max_level", b.maxLevel},
         {"gain_level",
          b.gainLevel < b.maxLevel ? nlohmann::json(b.gainLevel) : nlohmann::json(nullptr)},
