@@ -176,6 +176,17 @@ int main(int argc, char** argv) {
     benchCmd->add_option("--out", bopt.outDir, "Output directory")
         ->capture_default_str()
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    std::string reportDir;
+    benchCmd->add_option("--report", reportDir,
+                         "Write DIR/index.html, one self-contained page (plots inline as SVG), "
+                         "beside the CSV in DIR (instead of --out)");
+    benchCmd
+        ->add_option("--repeats", bopt.repeats,
+                     "Runs of each configuration, in turn (round-robin); figures are medians "
+                     "with their range")
+        ->check(CLI::Range(1, 1000))
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     benchCmd->add_flag("--quick", bopt.quick, "Fewer knob values (a smoke run)");
     benchCmd->add_flag("--no-plots{false}", bopt.plots, "Write the CSV only");
     benchCmd->add_flag("--schemes-only", bopt.schemesOnly,
@@ -272,7 +283,14 @@ int main(int argc, char** argv) {
         }
         return bench::runScale(scaleOpt);
     }
-    if (*benchCmd) return bench::runBench(bopt);
+    if (*benchCmd) {
+        if (!reportDir.empty()) {
+            bopt.outDir = reportDir;
+            bopt.html = true;
+        }
+        bopt.commandLine.assign(argv, argv + argc);
+        return bench::runBench(bopt);
+    }
 
     if (*render) return cli::runRender(renderOpt, out, quiet);
     if (*structure) return cli::runStructure(structureOpt, sopt);
