@@ -153,6 +153,22 @@ int main(int argc, char** argv) {
     structure->add_flag("-q,--quiet", sopt.quiet, "Print nothing on success");
     cli::addCommonOptions(*structure, structureOpt);
 
+    cli::CommonOptions exportOpt;
+    cli::ExportOptions eopt;
+    CLI::App* exportCmd =
+        app.add_subcommand("export", "Write the scene for another renderer (POV-Ray 3.7)");
+    exportCmd->add_option("scene", exportOpt.scene, kSceneHelp)->required();
+    exportCmd
+        ->add_option("--pov", eopt.pov,
+                     "POV-Ray 3.7 scene: the same camera (each pixel's ray through its centre), "
+                     "primitives, CSG and, roughly, materials and lights")
+        ->required();
+    exportCmd->add_flag("--pov-depth", eopt.depth,
+                        "Surfaces emit their primary hit distance as grey, 1 - distance / range "
+                        "(render with +FN16 File_Gamma=1.0): POV-Ray's depth image");
+    exportCmd->add_flag("-q,--quiet", eopt.quiet, "Print nothing on success");
+    cli::addCommonOptions(*exportCmd, exportOpt);
+
     // A value given twice takes the last, so scripts' defaults can be overridden after them.
     bench::BenchOptions bopt;
     CLI::App* benchCmd =
@@ -293,6 +309,7 @@ int main(int argc, char** argv) {
     }
 
     if (*render) return cli::runRender(renderOpt, out, quiet);
+    if (*exportCmd) return cli::runExport(exportOpt, eopt);
     if (*structure) return cli::runStructure(structureOpt, sopt);
     if (*trace) {
         topt.x = pixel[0];

@@ -38,6 +38,16 @@ std::string BenchRow::tableName() const {
     return scheme;
 }
 
+std::string BenchRow::csvNote() const {
+    if (!measured()) return note;
+    std::string out = errorNote;
+    if (!wallMs.empty()) {
+        if (!out.empty()) out += "; ";
+        out += "process wall time " + fixed(spreadOf(wallMs).median, 0) + " ms (median)";
+    }
+    return out;
+}
+
 std::string BenchRow::label() const {
     if (knob == "scheme") return scheme + " (defaults)";
     if (knob.compare(0, 5, "peer ") == 0) return tableName();

@@ -25,9 +25,11 @@ struct BenchRow {
     RayCounters counters;  ///< of the first repeat (the counters are the same each time)
     std::vector<double> buildMs, renderMs;  ///< one a repeat, in the order run
     std::vector<double> speedup;            ///< a repeat's brute-force time over its own
-    bool compared = false;  ///< `error` measured against the brute-force image of the run
+    std::vector<double> wallMs;  ///< a peer run as a process: its wall time, start to end
+    bool compared = false;       ///< `error` measured against the brute-force image of the run
     ImageError error;
-    double rmse = -1.0;  ///< progressive passes: colour RMSE against the final image (0..1)
+    bool colorCompared = true;  ///< `error`'s colour figures hold (not for POV-Ray's shading)
+    double rmse = -1.0;         ///< progressive passes: colour RMSE against the final image (0..1)
     /// Why the row has no figures ("not installed", "not a union of primitives"); empty when
     /// it was measured.
     std::string note;
@@ -41,6 +43,9 @@ struct BenchRow {
     std::string tableName() const;
     /// "regular max-level 6", "irregular (defaults)", "push delta 1e-12": the configuration.
     std::string label() const;
+    /// The CSV's note: why there are no figures, or what the error columns hold and a peer
+    /// process's wall time.
+    std::string csvNote() const;
 };
 
 /// `v` with up to 6 significant digits; "inf" for infinity.

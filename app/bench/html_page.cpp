@@ -223,12 +223,14 @@ bool writeHtmlPage(const std::string& path, const RunInfo& run, const PageSettin
                           r.peer ? "" : fixed(double(r.counters.primTests) / rays, 2),
                           r.peer ? "" : fixed(double(r.counters.regionVisits) / rays, 2)});
             if (r.compared)
-                cells.insert(cells.end(),
-                             {std::to_string(r.error.hitDiff), std::to_string(r.error.colorDiff),
-                              num(r.error.maxDepthDiff), num(r.error.colorRmse)});
+                cells.insert(
+                    cells.end(),
+                    {std::to_string(r.error.hitDiff),
+                     r.colorCompared ? std::to_string(r.error.colorDiff) : "-",
+                     num(r.error.maxDepthDiff), r.colorCompared ? num(r.error.colorRmse) : "-"});
             else
                 cells.insert(cells.end(), {"-", "-", "-", "-"});
-            cells.push_back(r.errorNote);
+            cells.push_back(r.csvNote());
         } else {
             cells.resize(head.size() - 1);
             cells.push_back(r.note);

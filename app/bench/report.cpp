@@ -16,6 +16,7 @@
 #include "app/bench/image_error.h"
 #include "app/bench/machine.h"
 #include "app/bench/plots.h"
+#include "app/bench/pov_peer.h"
 #include "app/cli/param_table.h"
 #include "engine/render/progressive.h"
 #include "engine/render/renderer.h"
@@ -145,18 +146,26 @@ void writeCsvRow(std::ostream& csv, const BenchRow& r) {
     const RayCounters& c = r.counters;
     const double rays = c.rays ? double(c.rays) : 1.0;
     auto opt = [](bool have, double v) { return have ? num(v) : std::string(); };
-    csv << num(b.median) << "," << r.info.memoryBytes << "," << r.info.regions << ","
-        << num(t.median) << "," << opt(s.count > 0, s.median) << "," << c.rays << ","
-        << num(double(c.primTests) / rays) << "," << num(double(c.regionVisits) / rays) << ","
-        << c.mailboxHits << "," << c.walkErrors << ",";
+    const std::string none;
+    // A peer has no structure of ours and no counters but its rays; POV-Ray's colours are not
+    // compared (its shading is only near ours).
+    csv << num(b.median) << "," << (r.peer ? none : std::to_string(r.info.memoryBytes)) << ","
+        << (r.peer ? none : std::to_string(r.info.regions)) << "," << num(t.median) << ","
+        << opt(s.count > 0, s.median) << "," << c.rays << ","
+        << (r.peer ? none : num(double(c.primTests) / rays)) << ","
+        << (r.peer ? none : num(double(c.regionVisits) / rays)) << ","
+        << (r.peer ? none : std::to_string(c.mailboxHits)) << ","
+        << (r.peer ? none : std::to_string(c.walkErrors)) << ",";
     if (r.compared)
-        csv << r.error.hitDiff << "," << r.error.colorDiff << "," << num(r.error.maxDepthDiff);
+        csv << r.error.hitDiff << ","
+            << (r.colorCompared ? std::to_string(r.error.colorDiff) : none) << ","
+            << num(r.error.maxDepthDiff);
     else
         csv << ",,";
     csv << "," << t.count << "," << num(b.min) << "," << num(b.max) << "," << num(t.min) << ","
         << num(t.max) << "," << opt(s.count > 0, s.min) << "," << opt(s.count > 0, s.max) << ","
-        << (r.compared ? num(r.error.colorRmse) : std::string()) << "," << csvField(r.errorNote)
-        << "\n";
+        << (r.compared && r.colorCompared ? num(r.error.colorRmse) : none) << ","
+        << csvField(r.csvNote()) << "\n";
 }
 
 using Clock = std::chrono::steady_clock;
@@ -190,10 +199,13 @@ int runBench(const BenchOptions& opt) {
     // Before anything runs: the load average is the machine's, not ours.
     const RunInfo run = collectRunInfo(opt.commandLine);
     const auto runStart = Clock::now();
+    const bool povray = PovPeer::available();
+    int sceneIndex = 0;
 
     std::deque<BenchRow> rows;  // every row of every scene, in the order made (stable addresses)
     std::vector<std::string> done;
     for (const std::string& spec : opt.scenes) {
+        ++sceneIndex;
         Scene scene;
         try {
             scene = loadScene(spec);
@@ -333,6 +345,50 @@ int runBench(const BenchOptions& opt) {
             });
         }
 
+        // POV-Ray on the same scene, camera and bounces: its own trace time against our renders.
+        const std::string peerN = "peer (bounces " + std::to_string(opt.bounces) + ")";
+        {
+            BenchRow& row = newRow("povray", peerN, "povray");
+            row.inTable = true;
+            row.peer = true;
+            if (!povray) {
+                row.note = "not installed (no povray on the PATH)";
+            } else {
+                if (bruteRow) against.push_back({&row, bruteRow});
+                std::shared_ptr<PovPeer> pov;
+                try {
+                    pov = std::make_shared<PovPeer>(
+                        scene, ro, opt.outDir, std::to_string(sceneIndex) + "-" + sceneSlug(spec));
+                } catch (const std::exception& e) {
+                    row.note = std::string("failed: ") + e.what();
+                }
+                if (pov)
+                    jobs.push_back(
+                        [pov, &row, &ref, compare = bruteRow != nullptr, record](int round) {
+                            if (!row.note.empty()) return;
+                            PovRun p = pov->render(round == 0 && compare ? &ref : nullptr);
+                            if (!p.failure.empty()) {
+                                row.note = "failed: " + p.failure;
+                                return;
+                            }
+                            AccelInfo info;
+                            info.buildMs = p.parseMs;
+                            info.regions = 0;
+                            RenderStats s;
+                            s.renderMs = p.traceMs;
+                            s.counters.rays = p.rays;
+                            record(row, info, s, round);
+                            row.wallMs.push_back(p.wallMs);
+                            if (round == 0 && p.compared) {
+                                row.error = p.error;
+                                row.compared = true;
+                                row.errorNote = p.errorNote;
+                                row.colorCompared = false;
+                            }
+                        });
+            }
+        }
+
         // Progressive passes of the command line's default scheme: error of each pass against
         // the brute-force image, and the time since the first pass started.
         if (!opt.schemesOnly && bruteRow) {
@@ -440,6 +496,11 @@ int runBench(const BenchOptions& opt) {
                                      ? "Embree 3 (in this build), on scenes that are a union of "
                                        "primitives, at --bounces 0"
                                      : "Embree: not installed (this build has no Embree)");
+        settings.peers.push_back(povray ? PovPeer::version() + " (" + PovPeer::executable() +
+                                              "), on every scene, at --bounces " +
+                                              std::to_string(opt.bounces) +
+                                              ": its parse and trace times"
+                                        : "POV-Ray: not installed (no povray on the PATH)");
         const std::string page = opt.outDir + "/index.html";
         if (!writeHtmlPage(page, run, settings, rows, figures)) {
             std::cerr << "error: could not write " << page << "\n";
