@@ -111,7 +111,7 @@ std::vector<std::string> comparisonCells(const BenchRow& r) {
     const Spread s = spreadOf(r.speedup);
     c[9] = s.count ? withRange(s, [](double v) { return fixed(v, 1) + "x"; }) : "-";
     c[10] = r.compared ? std::to_string(r.error.hitDiff) : "-";
-    if (r.compared && !r.errorNote.empty()) c[10] += " (" + r.errorNote + ")";
+    if (r.compared && !r.errorNote.empty()) c[10] += " (depth image)";
     return c;
 }
 

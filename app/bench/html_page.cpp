@@ -27,6 +27,7 @@ th, td { border: 1px solid #d8d8d8; padding: 3px 7px; vertical-align: top; }
 th { background: #f3f3f3; text-align: left; }
 td.n { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
 td.note { color: #8a5a00; font-style: italic; }
+table.schemes td:nth-child(-n+2) { white-space: nowrap; }
 tr.scene-start td { border-top: 2px solid #999; }
 table.run th { width: 11em; }
 table.run td { max-width: 60em; }
@@ -134,7 +135,11 @@ bool writeHtmlPage(const std::string& path, const RunInfo& run, const PageSettin
                          : "")
       << ". Speedup: brute force's render time over the row's, in the same round, at the same "
          "bounces. Hits differing: pixels whose primary hit (primitive or distance) differs from "
-         "brute force's.</p>\n<table class=\"schemes\" id=\"schemes-table\">\n<tr>";
+         "brute force's; for POV-Ray (depth image), pixels where it hits and brute force misses "
+         "or the reverse, or where their distances differ by more than a step of its 16-bit "
+         "depth image (the depth range over 65535). Embree and the schemes marked (bounces 0) "
+         "trace primary and shadow rays only, against brute force at --bounces 0.</p>\n"
+         "<table class=\"schemes\" id=\"schemes-table\">\n<tr>";
     for (const std::string& c : comparisonHeader()) h << "<th>" << htmlEscape(c) << "</th>";
     h << "</tr>\n";
     std::string last;
