@@ -143,8 +143,9 @@ std::vector<size_t> paretoFront(const std::vector<double>& speed, const std::vec
 }
 
 /// Labels hanging from the floor, spread along a log x axis so that neighbours do not overlap:
-/// each at least `gap` (in decades) from the next, as near its point as that allows.
-std::vector<double> spreadLabels(const std::vector<double>& x, double gap) {
+/// each at least `gap` (in decades) from the next, as near its point as that allows, and all
+/// within [lo, hi] where they fit.
+std::vector<double> spreadLabels(const std::vector<double>& x, double gap, double lo, double hi) {
     const size_t n = x.size();
     std::vector<size_t> order(n);
     for (size_t i = 0; i < n; ++i) order[i] = i;
@@ -167,6 +168,14 @@ std::vector<double> spreadLabels(const std::vector<double>& x, double gap) {
                 moved = true;
             }
         if (!moved) break;
+    }
+    // Inside the axis: pushed in from the right end, then from the left one.
+    const double l = std::log10(lo), h = std::log10(hi);
+    if (n > 0) {
+        pos[n - 1] = std::min(pos[n - 1], h);
+        for (size_t k = n - 1; k-- > 0;) pos[k] = std::min(pos[k], pos[k + 1] - gap);
+        pos[0] = std::max(pos[0], l);
+        for (size_t k = 1; k < n; ++k) pos[k] = std::max(pos[k], pos[k - 1] + gap);
     }
     std::vector<double> out(n);
     for (size_t k = 0; k < n; ++k) out[order[k]] = std::pow(10.0, pos[k]);
@@ -260,7 +269,7 @@ std::string speedErrorPanel(Writer& wr, const std::string& name, const std::stri
     std::vector<double> y(errs.size());
     for (size_t i = 0; i < errs.size(); ++i) y[i] = ax.map(errs[i]);
 
-    std::vector<std::vector<std::string>> points, above, hanging, leaders, front;
+    std::vector<std::vector<std::string>> points, above, aboveLeft, hanging, leaders, front;
     std::vector<size_t> floorIdx;
     std::vector<double> floorX;
     for (size_t i = 0; i < pts.size(); ++i) {
@@ -270,13 +279,16 @@ std::string speedErrorPanel(Writer& wr, const std::string& name, const std::stri
         if (ax.atFloor(errs[i])) {
             floorIdx.push_back(i);
             floorX.push_back(s.median);
-        } else {
+        } else if (std::log10(s.median / xlo) < 0.7 * std::log10(xhi / xlo)) {
             above.push_back({num(s.median), num(y[i]), pts[i]->label()});
+        } else {  // near the right edge: written to the left of the point
+            aboveLeft.push_back({num(s.median), num(y[i]), pts[i]->label()});
         }
     }
     // About 13 px between hanging labels on a plot area of about 860 px.
     const double gap = std::log10(xhi / xlo) * 13.0 / 860.0;
-    const std::vector<double> lx = spreadLabels(floorX, gap);
+    const double margin = std::pow(10.0, gap);
+    const std::vector<double> lx = spreadLabels(floorX, gap, xlo * margin, xhi / margin);
     const double labelY = ax.floor / std::pow(ax.floor / ax.lo, 0.06);
     for (size_t k = 0; k < floorIdx.size(); ++k) {
         const size_t i = floorIdx[k];
@@ -312,6 +324,10 @@ std::string speedErrorPanel(Writer& wr, const std::string& name, const std::stri
     if (!above.empty())
         clauses.push_back(wr.data(base, "above", above) +
                           " using 1:2:3 with labels left offset char 0.7,0.35 font ',9' notitle");
+    if (!aboveLeft.empty())
+        clauses.push_back(wr.data(base, "above-left", aboveLeft) +
+                          " using 1:2:3 with labels right offset char -0.7,0.35 font ',9' "
+                          "notitle");
     os << "plot ";
     for (size_t i = 0; i < clauses.size(); ++i) os << (i ? ", \\\n     " : "") << clauses[i];
     os << "\n";
@@ -435,10 +451,11 @@ std::vector<Figure> drawPlots(const std::string& dir, const std::deque<BenchRow>
                 const std::string c = std::string("lc rgb '") + color(int(si) + 1) + "'";
                 clauses.push_back(f + " using 1:2:3:4 with xerrorlines pt 7 " + c + " title " +
                                   q(scenes[si] + " (" + passes.front()->scheme + ")"));
-                // Scenes' labels alternately above and below their points.
+                // Each scene's labels at a height of their own beside the points.
+                const char* const dy[] = {"0.8", "-0.9", "-1.9", "1.8"};
                 clauses.push_back(f + " using 1:2:5 with labels left offset char 0.8," +
-                                  (clauses.size() % 4 ? "-0.9" : "0.7") + " font ',9' tc rgb '" +
-                                  color(int(si) + 1) + "' notitle");
+                                  dy[si % 4] + " font ',9' tc rgb '" + color(int(si) + 1) +
+                                  "' notitle");
             }
             body << "plot ";
             for (size_t i = 0; i < clauses.size(); ++i)
