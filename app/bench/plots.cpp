@@ -47,6 +47,7 @@ std::string cell(std::string s) {
 struct LogAxis {
     double floor = 0.5, ceiling = 0.0, lo = 0.1, hi = 10.0;
     bool hasInf = false;
+    bool hasFinite = false;  ///< some value is positive and finite (else no decade tics)
     std::string infLabel = "inf";
 
     /// For values `v` (>= 0, maybe inf); `unit`: the smallest positive value that can occur
@@ -61,6 +62,7 @@ struct LogAxis {
             } else if (x > 0.0) {
                 minPos = std::min(minPos, x);
                 maxFin = std::max(maxFin, x);
+                a.hasFinite = true;
             }
         }
         if (unit > 0.0) {
@@ -92,7 +94,8 @@ struct LogAxis {
         const double first = std::ceil(std::log10(floor) + 1e-9);
         const double last = std::floor(std::log10(hasInf ? ceiling / 10.0 : hi) + 1e-9);
         const int step = std::max(1, int(std::ceil((last - first + 1) / 8.0)));
-        for (double e = first; e <= last; e += step) os << ", \"1e" << int(e) << "\" 1e" << int(e);
+        for (double e = first; e <= last && hasFinite; e += step)
+            os << ", \"1e" << int(e) << "\" 1e" << int(e);
         if (hasInf) os << ", " << q(infLabel) << " " << num(ceiling);
         os << ")\nset arrow from graph 0, first " << num(floor) << " to graph 1, first "
            << num(floor) << " nohead dt 3 lc rgb '#999999' back\n";
@@ -272,6 +275,23 @@ std::string speedErrorPanel(Writer& wr, const std::string& name, const std::stri
     std::vector<std::vector<std::string>> points, above, aboveLeft, hanging, leaders, front;
     std::vector<size_t> floorIdx;
     std::vector<double> floorX;
+    // Labels beside their points: one a line below the other where points crowd (within 0.08
+    // of the x axis's width and a line of the y axis's height).
+    const double xDecades = std::log10(xhi / xlo), yLine = std::log10(ax.hi / ax.lo) * 14.0 / 420.0;
+    std::vector<std::pair<double, double>> placed;  // log x, log y of the labels written
+    auto labelY = [&](double x, double yv) {
+        double ly = std::log10(yv);
+        for (bool moved = true; moved;) {
+            moved = false;
+            for (const auto& [px, py] : placed)
+                if (std::abs(px - std::log10(x)) < 0.08 * xDecades && std::abs(py - ly) < yLine) {
+                    ly = py - yLine;
+                    moved = true;
+                }
+        }
+        placed.push_back({std::log10(x), ly});
+        return num(std::pow(10.0, ly));
+    };
     for (size_t i = 0; i < pts.size(); ++i) {
         const Spread s = spreadOf(pts[i]->speedup);
         points.push_back({num(s.median), num(y[i]), num(s.min), num(s.max),
@@ -280,21 +300,21 @@ std::string speedErrorPanel(Writer& wr, const std::string& name, const std::stri
             floorIdx.push_back(i);
             floorX.push_back(s.median);
         } else if (std::log10(s.median / xlo) < 0.7 * std::log10(xhi / xlo)) {
-            above.push_back({num(s.median), num(y[i]), pts[i]->label()});
+            above.push_back({num(s.median), labelY(s.median, y[i]), pts[i]->label()});
         } else {  // near the right edge: written to the left of the point
-            aboveLeft.push_back({num(s.median), num(y[i]), pts[i]->label()});
+            aboveLeft.push_back({num(s.median), labelY(s.median, y[i]), pts[i]->label()});
         }
     }
     // About 13 px between hanging labels on a plot area of about 860 px.
     const double gap = std::log10(xhi / xlo) * 13.0 / 860.0;
     const double margin = std::pow(10.0, gap);
     const std::vector<double> lx = spreadLabels(floorX, gap, xlo * margin, xhi / margin);
-    const double labelY = ax.floor / std::pow(ax.floor / ax.lo, 0.06);
+    const double hangY = ax.floor / std::pow(ax.floor / ax.lo, 0.06);
     for (size_t k = 0; k < floorIdx.size(); ++k) {
         const size_t i = floorIdx[k];
-        hanging.push_back({num(lx[k]), num(labelY), pts[i]->label()});
+        hanging.push_back({num(lx[k]), num(hangY), pts[i]->label()});
         leaders.push_back(
-            {num(floorX[k]), num(ax.floor), num(lx[k] - floorX[k]), num(labelY - ax.floor)});
+            {num(floorX[k]), num(ax.floor), num(lx[k] - floorX[k]), num(hangY - ax.floor)});
     }
     for (size_t i : paretoFront(speed, y)) front.push_back({num(speed[i]), num(y[i])});
 
