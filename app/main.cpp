@@ -155,6 +155,22 @@ int main(int argc, char** argv) {
     structure->add_flag("-q,--quiet", sopt.quiet, "Print nothing on success");
     cli::addCommonOptions(*structure, structureOpt);
 
+    cli::CommonOptions exportOpt;
+    cli::ExportOptions eopt;
+    CLI::App* exportCmd =
+        app.add_subcommand("export", "Write the scene for another renderer (POV-Ray 3.7)");
+    exportCmd->add_option("scene", exportOpt.scene, kSceneHelp)->required();
+    exportCmd
+        ->add_option("--pov", eopt.pov,
+                     "POV-Ray 3.7 scene: the same camera (each pixel's ray through its centre), "
+                     "primitives, CSG and, roughly, materials and lights")
+        ->required();
+    exportCmd->add_flag("--pov-depth", eopt.depth,
+                        "Surfaces emit their primary hit distance as grey, 1 - distance / range "
+                        "(render with +FN16 File_Gamma=1.0): POV-Ray's depth image");
+    exportCmd->add_flag("-q,--quiet", eopt.quiet, "Print nothing on success");
+    cli::addCommonOptions(*exportCmd, exportOpt);
+
     // A value given twice takes the last, so scripts' defaults can be overridden after them.
     bench::BenchOptions bopt;
     CLI::App* benchCmd =
@@ -176,6 +192,17 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     benchCmd->add_option("--out", bopt.outDir, "Output directory")
+        ->capture_default_str()
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    std::string reportDir;
+    benchCmd->add_option("--report", reportDir,
+                         "Write DIR/index.html, one self-contained page (plots inline as SVG), "
+                         "beside the CSV in DIR (instead of --out)");
+    benchCmd
+        ->add_option("--repeats", bopt.repeats,
+                     "Runs of each configuration, in turn (round-robin); figures are medians "
+                     "with their range")
+        ->check(CLI::Range(1, 1000))
         ->capture_default_str()
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     benchCmd->add_flag("--quick", bopt.quick, "Fewer knob values (a smoke run)");
@@ -275,9 +302,17 @@ int main(int argc, char** argv) {
         }
         return bench::runScale(scaleOpt);
     }
-    if (*benchCmd) return bench::runBench(bopt);
+    if (*benchCmd) {
+        if (!reportDir.empty()) {
+            bopt.outDir = reportDir;
+            bopt.html = true;
+        }
+        bopt.commandLine.assign(argv, argv + argc);
+        return bench::runBench(bopt);
+    }
 
     if (*render) return cli::runRender(renderOpt, out, quiet);
+    if (*exportCmd) return cli::runExport(exportOpt, eopt);
     if (*structure) return cli::runStructure(structureOpt, sopt);
     if (*trace) {
         topt.x = pixel[0];

@@ -8,7 +8,7 @@ LANCER_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libglfw3-dev libimgui-dev libglm-dev libosmesa6-dev libgl-dev xvfb xauth
   libtbb-dev nlohmann-json3-dev libcli11-dev libstb-dev
-  libgtest-dev libbenchmark-dev libembree-dev gnuplot-nox
+  libgtest-dev libbenchmark-dev libembree-dev gnuplot-nox povray
   clang clang-format libclang-rt-14-dev
 )
 

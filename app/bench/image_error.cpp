@@ -9,6 +9,7 @@ namespace lancer::bench {
 ImageError compareImages(const Image& ref, const Image& img, const PassLattice& on) {
     ImageError e;
     std::vector<uint8_t> a = ref.rgba8(), b = img.rgba8();
+    double squares = 0.0;
     for (int y = 0; y < ref.height; ++y)
         for (int x = 0; x < ref.width; ++x) {
             if (!on.contains(x, y)) continue;
@@ -25,12 +26,15 @@ ImageError compareImages(const Image& ref, const Image& img, const PassLattice& 
                 e.maxDepthDiff = std::max(e.maxDepthDiff, dd);
             else
                 e.maxDepthDiff = kInf;
-            for (int c = 0; c < 3; ++c)
-                if (std::abs(int(a[4 * i + size_t(c)]) - int(b[4 * i + size_t(c)])) > 2) {
-                    ++e.colorDiff;
-                    break;
-                }
+            bool differs = false;
+            for (int c = 0; c < 3; ++c) {
+                const int d = int(a[4 * i + size_t(c)]) - int(b[4 * i + size_t(c)]);
+                squares += double(d) * double(d);
+                differs = differs || std::abs(d) > 2;
+            }
+            e.colorDiff += differs;
         }
+    if (e.compared) e.colorRmse = std::sqrt(squares / (3.0 * double(e.compared))) / 255.0;
     return e;
 }
 

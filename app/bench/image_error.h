@@ -13,6 +13,9 @@ struct ImageError {
     size_t hitDiff = 0;    ///< pixels whose primary hit (primitive or distance) differs
     size_t colorDiff = 0;  ///< pixels whose colour differs by more than 2/255
     double maxDepthDiff = 0.0;
+    /// Root mean square of the colour difference, over the three channels of the pixels compared,
+    /// on the 8-bit values scaled to 0..1 (what the viewer shows).
+    double colorRmse = 0.0;
     size_t compared = 0;  ///< pixels compared
 };
 

@@ -1,21 +1,26 @@
 #include "app/bench/report.h"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
-#include <optional>
 #include <sstream>
 
+#include "app/bench/bench_rows.h"
 #include "app/bench/embree_peer.h"
+#include "app/bench/html_page.h"
 #include "app/bench/image_error.h"
-#include "app/bench/speedup.h"
+#include "app/bench/machine.h"
+#include "app/bench/plots.h"
+#include "app/bench/pov_peer.h"
+#include "app/cli/param_table.h"
 #include "engine/render/progressive.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
-#include "engine/util/format.h"
 
 namespace lancer::bench {
 
@@ -28,140 +33,142 @@ struct Config {
     ShadingOptions shading;
 };
 
-std::string num(double v) {
-    if (std::isinf(v)) return "inf";
-    std::ostringstream os;
-    os.precision(6);
-    os << v;
-    return os.str();
+/// The schemes other than brute force that `wanted` keeps, in the table's order (every
+/// SchemeKind, so that a scheme added to the table is measured without a change here).
+std::vector<SchemeKind> accelerated(const std::function<bool(SchemeKind)>& wanted) {
+    std::vector<SchemeKind> out;
+    for (int k = 0; k < kSchemeCount; ++k)
+        if (SchemeKind(k) != SchemeKind::Brute && wanted(SchemeKind(k)))
+            out.push_back(SchemeKind(k));
+    return out;
 }
 
-std::vector<Config> sweep(bool quick, bool schemesOnly, bool regularOn, bool irregularOn) {
+std::vector<Config> sweep(bool quick, bool schemesOnly,
+                          const std::function<bool(SchemeKind)>& wanted) {
     std::vector<Config> out;
     auto add = [&](const std::string& knob, const std::string& value, BuildParams b,
                    ShadingOptions s = {}) {
         out.push_back({knob, value, b, s});
     };
+    for (SchemeKind k : accelerated(wanted)) {
+        BuildParams b;
+        b.scheme = k;
+        add("scheme", schemeName(k), b);
+    }
+    if (schemesOnly) return out;
     BuildParams regular;
     regular.scheme = SchemeKind::Regular;
     BuildParams irregular;
     irregular.scheme = SchemeKind::Irregular;
-    if (regularOn) add("scheme", "regular", regular);
-    if (irregularOn) add("scheme", "irregular", irregular);
-    if (schemesOnly) return out;
+    const bool regularOn = wanted(SchemeKind::Regular), irregularOn = wanted(SchemeKind::Irregular);
     std::vector<int> levels =
         quick ? std::vector<int>{6, 12} : std::vector<int>{3, 6, 9, 12, 15, 18, 21, 24};
-    for (int l : levels) {
-        BuildParams b = regular;
-        b.regular.maxLevel = l;
-        add("regular max-level", std::to_string(l), b);
-    }
+    if (regularOn)
+        for (int l : levels) {
+            BuildParams b = regular;
+            b.regular.maxLevel = l;
+            add("regular max-level", std::to_string(l), b);
+        }
     std::vector<int> objects =
         quick ? std::vector<int>{1, 8} : std::vector<int>{1, 2, 4, 8, 16, 32};
     for (int m : objects) {
         BuildParams b = regular;
         b.regular.maxObjects = m;
-        add("regular max-objects", std::to_string(m), b);
+        if (regularOn) add("regular max-objects", std::to_string(m), b);
         BuildParams c = irregular;
         c.irregular.maxObjects = m;
-        add("irregular max-objects", std::to_string(m), c);
+        if (irregularOn) add("irregular max-objects", std::to_string(m), c);
     }
     std::vector<double> deltas =
         quick ? std::vector<double>{1e-12, 1e-2}
               : std::vector<double>{1e-15, 1e-12, 1e-9, 1e-6, 1e-4, 1e-3, 1e-2, 5e-2};
-    for (double d : deltas) {
-        BuildParams b = regular;
-        b.regular.step = StepMethod::Push;
-        b.regular.delta = d;
-        add("push delta", num(d), b);
-    }
-    for (BspHeuristic h : {BspHeuristic::First, BspHeuristic::Balanced, BspHeuristic::FewestCuts}) {
-        BuildParams b = irregular;
-        b.irregular.heuristic = h;
-        add("bsp-heuristic", heuristicName(h), b);
-    }
-    for (SplitAxes a : {SplitAxes::Cycle, SplitAxes::Cost}) {
-        BuildParams b = regular;
-        b.regular.splitAxes = a;
-        add("split-axes", splitAxesName(a), b);
-    }
-    for (bool mail : {true, false}) {
-        BuildParams b = regular;
-        b.mailboxes = mail;
-        add("regular mailboxes", mail ? "on" : "off", b);
-    }
-    std::vector<double> offsets =
-        quick ? std::vector<double>{0.0, 1e-9}
-              : std::vector<double>{0.0, 1e-14, 1e-12, 1e-9, 1e-6, 1e-4, 1e-2};
-    for (double o : offsets) {
-        ShadingOptions s;
-        s.offsetScale = o;
-        add("offset", num(o), regular, s);
+    if (regularOn)
+        for (double d : deltas) {
+            BuildParams b = regular;
+            b.regular.step = StepMethod::Push;
+            b.regular.delta = d;
+            add("push delta", num(d), b);
+        }
+    if (irregularOn)
+        for (BspHeuristic h :
+             {BspHeuristic::First, BspHeuristic::Balanced, BspHeuristic::FewestCuts}) {
+            BuildParams b = irregular;
+            b.irregular.heuristic = h;
+            add("bsp-heuristic", heuristicName(h), b);
+        }
+    if (regularOn) {
+        for (SplitAxes a : {SplitAxes::Cycle, SplitAxes::Cost}) {
+            BuildParams b = regular;
+            b.regular.splitAxes = a;
+            add("split-axes", splitAxesName(a), b);
+        }
+        for (bool mail : {true, false}) {
+            BuildParams b = regular;
+            b.mailboxes = mail;
+            add("regular mailboxes", mail ? "on" : "off", b);
+        }
+        std::vector<double> offsets =
+            quick ? std::vector<double>{0.0, 1e-9}
+                  : std::vector<double>{0.0, 1e-14, 1e-12, 1e-9, 1e-6, 1e-4, 1e-2};
+        for (double o : offsets) {
+            ShadingOptions s;
+            s.offsetScale = o;
+            add("offset", num(o), regular, s);
+        }
     }
     return out;
 }
 
 const char* kHeader =
     "scene,scheme,knob,value,build_ms,memory_bytes,regions,render_ms,speedup,rays,prim_tests_per_"
-    "ray,"
-    "region_visits_per_ray,mailbox_hits,walk_errors,hit_diff_pixels,color_diff_pixels,max_depth_"
-    "diff\n";
+    "ray,region_visits_per_ray,mailbox_hits,walk_errors,hit_diff_pixels,color_diff_pixels,max_"
+    "depth_diff,repeats,build_ms_min,build_ms_max,render_ms_min,render_ms_max,speedup_min,speedup_"
+    "max,color_rmse,note\n";
 
-void writePlots(const std::string& dir, const std::vector<std::string>& scenes) {
-    // One gnuplot script per figure; each reads report.csv with awk-filtered rows.
-    auto script = [&](const std::string& name, const std::string& body) {
-        std::ofstream f(dir + "/" + name + ".gp");
-        f << "set datafile separator ','\nset terminal pngcairo size 1000,620 font 'sans,10'\n"
-          << "set output '" << name << ".png'\nset key outside right\nset grid\n"
-          << body;
-    };
-    auto rows = [](const std::string& scene, const std::string& knob) {
-        return "'< awk -F, \"\\$1==\\\"" + scene + "\\\" && \\$3==\\\"" + knob +
-               "\\\"\" report.csv'";
-    };
-    std::string speedErr =
-        "set title 'Speed against error (every configuration)'\nset xlabel 'speedup over brute "
-        "force'\n"
-        "set ylabel 'pixels whose primary hit differs from brute force'\nset logscale x\nset "
-        "yrange [-1:*]\nplot ";
-    std::string level =
-        "set title 'Regular scheme: max-level'\nset xlabel 'max-level'\nset ylabel 'speedup'\nset "
-        "y2label 'memory (KiB)'\nset y2tics\nplot ";
-    std::string delta =
-        "set title 'Push step: delta against error'\nset xlabel 'delta (relative to the scene "
-        "size)'\nset logscale x\n"
-        "set ylabel 'pixels whose hit differs'\nset yrange [-1:*]\nplot ";
-    std::string offset =
-        "set title 'Secondary-ray offset against error'\nset xlabel 'offset (relative to the scene "
-        "scale; 0 plotted at 1e-16)'\nset logscale x\n"
-        "set ylabel 'pixels whose colour differs'\nset yrange [-1:*]\nplot ";
-    std::string prog =
-        "set title 'Progressive passes: error and time'\nset xlabel 'pass stride'\nset logscale x "
-        "2\nset xrange [*:*] reverse\n"
-        "set ylabel 'pixels differing from the final image'\nset y2label 'time since the start "
-        "(ms)'\nset y2tics\nplot ";
-    for (size_t i = 0; i < scenes.size(); ++i) {
-        const std::string& s = scenes[i];
-        std::string sep = i + 1 < scenes.size() ? ", \\\n  " : "\n";
-        speedErr += "'< awk -F, \"\\$1==\\\"" + s +
-                    "\\\"\" report.csv' using 9:15 with points pt 7 title '" + s + "'" + sep;
-        level += rows(s, "regular max-level") + " using 4:9 with linespoints title '" + s +
-                 " speedup', " + rows(s, "regular max-level") +
-                 " using 4:($6/1024) axes x1y2 with linespoints dt 2 title '" + s + " memory'" +
-                 sep;
-        delta += rows(s, "push delta") + " using 4:15 with linespoints title '" + s + "'" + sep;
-        offset += rows(s, "offset") + " using ($4==0?1e-16:$4):16 with linespoints title '" + s +
-                  "'" + sep;
-        prog += rows(s, "progressive pass") + " using 4:16 with linespoints title '" + s +
-                " error', " + rows(s, "progressive pass") +
-                " using 4:8 axes x1y2 with linespoints dt 2 title '" + s + " time'" + sep;
-    }
-    script("speed_vs_error", speedErr);
-    script("regular_max_level", level);
-    script("push_delta", delta);
-    script("offset", offset);
-    script("progressive", prog);
+/// A CSV field: quoted when it holds a comma or a quote.
+std::string csvField(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string out = "\"";
+    for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
 }
+
+void writeCsvRow(std::ostream& csv, const BenchRow& r) {
+    csv << csvField(r.scene) << "," << r.scheme << "," << csvField(r.knob) << ","
+        << csvField(r.value) << ",";
+    if (!r.measured()) {
+        // Every figure empty, the reason last.
+        for (int i = 0; i < 21; ++i) csv << ",";
+        csv << csvField(r.note) << "\n";
+        return;
+    }
+    const Spread b = spreadOf(r.buildMs), t = spreadOf(r.renderMs), s = spreadOf(r.speedup);
+    const RayCounters& c = r.counters;
+    const double rays = c.rays ? double(c.rays) : 1.0;
+    auto opt = [](bool have, double v) { return have ? num(v) : std::string(); };
+    const std::string none;
+    // A peer has no structure of ours and no counters but its rays; POV-Ray's colours are not
+    // compared (its shading is only near ours).
+    csv << num(b.median) << "," << (r.peer ? none : std::to_string(r.info.memoryBytes)) << ","
+        << (r.peer ? none : std::to_string(r.info.regions)) << "," << num(t.median) << ","
+        << opt(s.count > 0, s.median) << "," << c.rays << ","
+        << (r.peer ? none : num(double(c.primTests) / rays)) << ","
+        << (r.peer ? none : num(double(c.regionVisits) / rays)) << ","
+        << (r.peer ? none : std::to_string(c.mailboxHits)) << ","
+        << (r.peer ? none : std::to_string(c.walkErrors)) << ",";
+    if (r.compared)
+        csv << r.error.hitDiff << ","
+            << (r.colorCompared ? std::to_string(r.error.colorDiff) : none) << ","
+            << num(r.error.maxDepthDiff);
+    else
+        csv << ",,";
+    csv << "," << t.count << "," << num(b.min) << "," << num(b.max) << "," << num(t.min) << ","
+        << num(t.max) << "," << opt(s.count > 0, s.min) << "," << opt(s.count > 0, s.max) << ","
+        << (r.compared && r.colorCompared ? num(r.error.colorRmse) : none) << ","
+        << csvField(r.csvNote()) << "\n";
+}
+
+using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
@@ -174,7 +181,10 @@ bool createOutDir(const std::string& dir) {
 
 int runBench(const BenchOptions& opt) {
     namespace fs = std::filesystem;
-    if (!createOutDir(opt.outDir)) return 2;
+    if (opt.repeats < 1) {
+        std::cerr << "error: --repeats " << opt.repeats << ": at least 1\n";
+        return 2;
+    }
     auto wanted = [&](SchemeKind k) {
         return std::find(opt.schemes.begin(), opt.schemes.end(), schemeName(k)) !=
                opt.schemes.end();
@@ -185,13 +195,17 @@ int runBench(const BenchOptions& opt) {
                      "force; add --schemes-only\n";
         return 2;
     }
-    std::ostringstream csv, table;
-    csv << kHeader;
-    table << "| scene | scheme | build ms | regions | memory | render ms | us/ray | prim tests/ray "
-             "| region visits/ray | speedup | hits differing |\n"
-          << "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    if (!createOutDir(opt.outDir)) return 2;
+    // Before anything runs: the load average is the machine's, not ours.
+    const RunInfo run = collectRunInfo(opt.commandLine);
+    const auto runStart = Clock::now();
+    const bool povray = PovPeer::available();
+    int sceneIndex = 0;
+
+    std::deque<BenchRow> rows;  // every row of every scene, in the order made (stable addresses)
     std::vector<std::string> done;
     for (const std::string& spec : opt.scenes) {
+        ++sceneIndex;
         Scene scene;
         try {
             scene = loadScene(spec);
@@ -204,180 +218,295 @@ int runBench(const BenchOptions& opt) {
         ro.height = opt.height;
         ro.threads = opt.threads;
         ro.shading.bounces = opt.bounces;
+        const int w = ro.width, h = ro.height;
 
-        // The reference of this run (after a small warm-up render that starts the thread pool).
-        // Without brute force, renders are timed alone, with no speedup and no error.
-        BuildParams bruteParams;
-        auto brute = buildAccelerator(scene, bruteParams);
-        Image ref(ro.width, ro.height);
-        std::optional<SpeedupBaseline> baseline;
-        if (withBrute) {
-            render(scene, *brute, ro, ref, PassLattice{16, 0});
-            baseline.emplace(scene, *brute, ro, PassLattice{}, ref);
-        }
-        auto alone = [&](const RenderStats& s) {
-            Speedup sp;
-            sp.scheme = s;
-            sp.pixels = size_t(ro.width) * size_t(ro.height);
-            return sp;
+        // The jobs of this scene, each run once a round, every job in turn each round.
+        std::vector<std::function<void(int)>> jobs;
+        // Rows whose speedup is over a brute-force row's render of the same round.
+        std::vector<std::pair<BenchRow*, const BenchRow*>> against;
+        auto newRow = [&](const std::string& scheme, const std::string& knob,
+                          const std::string& value) -> BenchRow& {
+            rows.emplace_back();
+            BenchRow& r = rows.back();
+            r.scene = spec;
+            r.scheme = scheme;
+            r.knob = knob;
+            r.value = value;
+            return r;
         };
-        auto row = [&](const char* scheme, const std::string& knob, const std::string& value,
-                       const AccelInfo& info, const Speedup& sp, const ImageError& e) {
-            const RenderStats& s = sp.scheme;
-            const RayCounters& c = s.counters;
-            double rays = c.rays ? double(c.rays) : 1.0;
-            if (knob == "scheme" || knob == "peer (bounces 0)") {
-                char speedup[32] = "-", differing[32] = "-";
-                if (withBrute) {
-                    std::snprintf(speedup, sizeof speedup, "%.1fx", sp.ratio());
-                    std::snprintf(differing, sizeof differing, "%zu", e.hitDiff);
+        auto record = [](BenchRow& row, const AccelInfo& info, const RenderStats& s, int round) {
+            row.buildMs.push_back(info.buildMs);
+            row.renderMs.push_back(s.renderMs);
+            if (round == 0) {
+                row.info = info;
+                row.counters = s.counters;
+            }
+        };
+        // Build `params` and render with `r`; the first round's image is compared with `ref`.
+        auto schemeJob = [&](BenchRow& row, BuildParams params, RenderOptions r, const Image* ref) {
+            jobs.push_back([&scene, &row, params, r, ref, w, h, record](int round) {
+                if (!row.note.empty()) return;
+                std::unique_ptr<Accelerator> accel;
+                try {
+                    accel = buildAccelerator(scene, params);
+                } catch (const std::invalid_argument& e) {
+                    row.note = std::string("skipped: ") + e.what();
+                    return;
                 }
-                char line[512];
-                std::snprintf(line, sizeof line,
-                              "| %s | %s%s | %.0f | %zu | %s | %.0f | %.2f | %.1f | %.1f | "
-                              "%s | %s |\n",
-                              spec.c_str(), scheme, knob == "scheme" ? "" : " (bounces 0)",
-                              info.buildMs, info.regions,
-                              formatBytes(info.memoryBytes, ByteUnit::MiB).c_str(), s.renderMs,
-                              1000.0 * s.renderMs / rays, double(c.primTests) / rays,
-                              double(c.regionVisits) / rays, speedup, differing);
-                table << line;
-            }
-            csv << spec << "," << scheme << "," << knob << "," << value << "," << num(info.buildMs)
-                << "," << info.memoryBytes << "," << info.regions << "," << num(s.renderMs) << ","
-                << num(sp.ratio()) << "," << c.rays << "," << num(double(c.primTests) / rays) << ","
-                << num(double(c.regionVisits) / rays) << "," << c.mailboxHits << "," << c.walkErrors
-                << "," << e.hitDiff << "," << e.colorDiff << "," << num(e.maxDepthDiff) << "\n";
+                Image img(w, h);
+                const RenderStats s = render(scene, *accel, r, img);
+                record(row, accel->info(), s, round);
+                if (round == 0 && ref) {
+                    row.error = compareImages(*ref, img);
+                    row.compared = true;
+                }
+            });
         };
-        if (baseline) {
-            row("brute", "scheme", "brute", brute->info(), baseline->against(baseline->brute()),
-                {});
-            std::cerr << spec << ": brute force " << int(baseline->brute().renderMs) << " ms\n";
-        }
 
-        for (const Config& c : sweep(opt.quick, opt.schemesOnly, wanted(SchemeKind::Regular),
-                                     wanted(SchemeKind::Irregular))) {
-            std::unique_ptr<Accelerator> accel;
-            try {
-                accel = buildAccelerator(scene, c.build);
-            } catch (const std::invalid_argument& e) {
-                std::cerr << spec << ": " << c.knob << " = " << c.value << ": skipped: " << e.what()
-                          << "\n";
-                continue;
-            }
+        // The reference of this run. Without brute force, renders are timed alone, with no
+        // speedup and no error.
+        Image ref(w, h);
+        BenchRow* bruteRow = nullptr;
+        if (withBrute) {
+            BenchRow& row = newRow("brute", "scheme", "brute");
+            row.inTable = true;
+            row.compared = true;  // it is the reference: nothing differs
+            bruteRow = &row;
+            against.push_back({&row, &row});
+            jobs.push_back([&scene, &row, &ref, ro, w, h, record](int round) {
+                auto brute = buildAccelerator(scene, BuildParams{});
+                Image scratch(round ? w : 0, round ? h : 0);
+                const RenderStats s = render(scene, *brute, ro, round ? scratch : ref);
+                record(row, brute->info(), s, round);
+            });
+        }
+        for (const Config& c : sweep(opt.quick, opt.schemesOnly, wanted)) {
+            BenchRow& row = newRow(schemeName(c.build.scheme), c.knob, c.value);
+            row.inTable = c.knob == "scheme";
+            if (bruteRow) against.push_back({&row, bruteRow});
             RenderOptions r = ro;
             r.shading.offsetScale = c.shading.offsetScale;
-            Image img(ro.width, ro.height);
-            // The offset sweep changes the options: timed against the same brute-force render.
-            const Speedup s = !baseline ? alone(render(scene, *accel, r, img))
-                              : r.shading.offsetScale == ro.shading.offsetScale
-                                  ? baseline->measure(*accel, img)
-                                  : baseline->against(render(scene, *accel, r, img));
-            row(schemeName(c.build.scheme), c.knob, c.value, accel->info(), s,
-                baseline ? compareImages(ref, img) : ImageError{});
-            std::cerr << spec << ": " << c.knob << " = " << c.value << ": "
-                      << int(s.scheme.renderMs) << " ms\n";
+            schemeJob(row, c.build, r, bruteRow ? &ref : nullptr);
         }
 
-        // Against a peer: Embree on union-only scenes, on primary and shadow rays
-        // (--bounces 0), with every scheme of ours on the same workload.
-        if (EmbreePeer::available() && EmbreePeer::supports(scene)) {
-            RenderOptions r0 = ro;
-            r0.shading.bounces = 0;
-            Image ref0(ro.width, ro.height);
-            // Speedups of these rows are over brute force at --bounces 0.
-            std::optional<SpeedupBaseline> base0;
+        // Against Embree, on union-only scenes, on primary and shadow rays (--bounces 0), with
+        // every scheme of ours on the same workload.
+        RenderOptions r0 = ro;
+        r0.shading.bounces = 0;
+        Image ref0(w, h);
+        const std::string peer0 = "peer (bounces 0)";
+        if (!EmbreePeer::available() || !EmbreePeer::supports(scene)) {
+            BenchRow& row = newRow("embree", peer0, "embree");
+            row.inTable = true;
+            row.note = !EmbreePeer::available()
+                           ? "not installed (this build has no Embree)"
+                           : "not run: the scene has intersections or differences (Embree "
+                             "traces unions of primitives)";
+        } else {
+            BenchRow* brute0 = nullptr;
             if (withBrute) {
-                base0.emplace(scene, *brute, r0, PassLattice{}, ref0);
-                row("brute", "peer (bounces 0)", "brute", brute->info(),
-                    base0->against(base0->brute()), {});
+                BenchRow& row = newRow("brute", peer0, "brute");
+                row.inTable = true;
+                row.compared = true;
+                brute0 = &row;
+                against.push_back({&row, &row});
+                jobs.push_back([&scene, &row, &ref0, r0, w, h, record](int round) {
+                    auto brute = buildAccelerator(scene, BuildParams{});
+                    Image scratch(round ? w : 0, round ? h : 0);
+                    const RenderStats s = render(scene, *brute, r0, round ? scratch : ref0);
+                    record(row, brute->info(), s, round);
+                });
             }
-            auto against0 = [&](const RenderStats& s) {
-                return base0 ? base0->against(s) : alone(s);
-            };
-            for (SchemeKind k : {SchemeKind::Regular, SchemeKind::Irregular}) {
-                if (!wanted(k)) continue;
+            for (SchemeKind k : accelerated(wanted)) {
+                BenchRow& row = newRow(schemeName(k), peer0, schemeName(k));
+                row.inTable = true;
+                if (brute0) against.push_back({&row, brute0});
                 BuildParams b;
                 b.scheme = k;
-                try {
-                    auto a = buildAccelerator(scene, b);
-                    Image img(ro.width, ro.height);
-                    // Rendered before it is compared: a function's arguments have no order.
-                    const Speedup sp = against0(render(scene, *a, r0, img));
-                    row(schemeName(k), "peer (bounces 0)", schemeName(k), a->info(), sp,
-                        base0 ? compareImages(ref0, img) : ImageError{});
-                } catch (const std::invalid_argument&) {
-                }
+                schemeJob(row, b, r0, brute0 ? &ref0 : nullptr);
             }
-            EmbreePeer peer(scene);
-            Image img(ro.width, ro.height);
-            const Speedup s = against0(peer.render(r0, img));
-            AccelInfo info;
-            info.buildMs = peer.buildMs();
-            info.regions = 0;
-            row("embree", "peer (bounces 0)", "embree", info, s,
-                base0 ? compareImages(ref0, img) : ImageError{});
-            std::cerr << spec << ": embree " << int(s.scheme.renderMs) << " ms";
-            if (base0)
-                std::cerr << " (brute force at --bounces 0: " << int(base0->brute().renderMs)
-                          << " ms)";
-            std::cerr << "\n";
+            BenchRow& row = newRow("embree", peer0, "embree");
+            row.inTable = true;
+            row.peer = true;
+            if (brute0) against.push_back({&row, brute0});
+            const bool compare = brute0 != nullptr;
+            jobs.push_back([&scene, &row, &ref0, r0, w, h, compare, record](int round) {
+                EmbreePeer peer(scene);
+                Image img(w, h);
+                const RenderStats s = peer.render(r0, img);
+                AccelInfo info;
+                info.buildMs = peer.buildMs();
+                info.regions = 0;
+                record(row, info, s, round);
+                if (round == 0 && compare) {
+                    row.error = compareImages(ref0, img);
+                    row.compared = true;
+                }
+            });
         }
 
-        if (opt.schemesOnly) {
-            done.push_back(spec);
-            continue;
-        }
-        // Progressive passes of the fastest default scheme available: error of each pass
-        // against the final image, and the time since the first pass started.
-        std::unique_ptr<Accelerator> best;
-        for (SchemeKind k : {SchemeKind::Irregular, SchemeKind::Regular, SchemeKind::Brute}) {
-            BuildParams b;
-            b.scheme = k;
-            try {
-                best = buildAccelerator(scene, b);
-                break;
-            } catch (const std::invalid_argument&) {
+        // POV-Ray on the same scene, camera and bounces: its own trace time against our renders.
+        const std::string peerN = "peer (bounces " + std::to_string(opt.bounces) + ")";
+        {
+            BenchRow& row = newRow("povray", peerN, "povray");
+            row.inTable = true;
+            row.peer = true;
+            if (!povray) {
+                row.note = "not installed (no povray on the PATH)";
+            } else {
+                if (bruteRow) against.push_back({&row, bruteRow});
+                std::shared_ptr<PovPeer> pov;
+                try {
+                    pov = std::make_shared<PovPeer>(
+                        scene, ro, opt.outDir, std::to_string(sceneIndex) + "-" + sceneSlug(spec));
+                } catch (const std::exception& e) {
+                    row.note = std::string("failed: ") + e.what();
+                }
+                if (pov)
+                    jobs.push_back(
+                        [pov, &row, &ref, compare = bruteRow != nullptr, record](int round) {
+                            if (!row.note.empty()) return;
+                            PovRun p = pov->render(round == 0 && compare ? &ref : nullptr);
+                            if (!p.failure.empty()) {
+                                row.note = "failed: " + p.failure;
+                                return;
+                            }
+                            AccelInfo info;
+                            info.buildMs = p.parseMs;
+                            info.regions = 0;
+                            RenderStats s;
+                            s.renderMs = p.traceMs;
+                            s.counters.rays = p.rays;
+                            record(row, info, s, round);
+                            row.wallMs.push_back(p.wallMs);
+                            if (round == 0 && p.compared) {
+                                row.error = p.error;
+                                row.compared = true;
+                                row.errorNote = p.errorNote;
+                                row.colorCompared = false;
+                            }
+                        });
             }
         }
-        Image prog(ro.width, ro.height);
-        double elapsed = 0.0;
-        int prev = 0;
-        for (int stride : ProgressiveRenderer::kDefaultStrides) {  // the viewer's passes
-            RenderStats s = render(scene, *best, ro, prog, PassLattice{stride, prev});
-            elapsed += s.renderMs;
-            s.renderMs = elapsed;
-            Image shown;  // what the viewer shows after this pass
-            fillBlocks(prog, stride, shown);
-            ImageError e = compareImages(ref, shown);
-            // Speedup of the time to this pass, over brute force on the whole image.
-            row(schemeName(best->params().scheme), "progressive pass", std::to_string(stride),
-                best->info(), baseline->against(s), e);
-            prev = stride;
+
+        // Progressive passes of the command line's default scheme: error of each pass against
+        // the brute-force image, and the time since the first pass started.
+        if (!opt.schemesOnly && bruteRow) {
+            std::vector<BenchRow*> passes;
+            BuildParams b;
+            b.scheme = cli::Knobs{}.build.scheme;
+            for (int stride : ProgressiveRenderer::kDefaultStrides) {  // the viewer's passes
+                BenchRow& row =
+                    newRow(schemeName(b.scheme), "progressive pass", std::to_string(stride));
+                against.push_back({&row, bruteRow});
+                passes.push_back(&row);
+            }
+            jobs.push_back([&scene, passes, b, ro, &ref, w, h, record](int round) {
+                auto accel = buildAccelerator(scene, b);
+                Image prog(w, h);
+                double elapsed = 0.0;
+                int prev = 0, i = 0;
+                for (int stride : ProgressiveRenderer::kDefaultStrides) {
+                    RenderStats s = render(scene, *accel, ro, prog, PassLattice{stride, prev});
+                    elapsed += s.renderMs;
+                    s.renderMs = elapsed;
+                    record(*passes[size_t(i)], accel->info(), s, round);
+                    if (round == 0) {
+                        Image shown;  // what the viewer shows after this pass
+                        fillBlocks(prog, stride, shown);
+                        passes[size_t(i)]->error = compareImages(ref, shown);
+                        passes[size_t(i)]->compared = true;
+                    }
+                    prev = stride;
+                    ++i;
+                }
+            });
+        }
+
+        // A small warm-up render starts the thread pool; then the rounds.
+        {
+            auto brute = buildAccelerator(scene, BuildParams{});
+            Image warm(w, h);
+            render(scene, *brute, ro, warm, PassLattice{16, 0});
+        }
+        const auto sceneStart = Clock::now();
+        for (int round = 0; round < opt.repeats; ++round) {
+            for (auto& job : jobs) {
+                try {
+                    job(round);
+                } catch (const std::exception& e) {
+                    std::cerr << spec << ": error: " << e.what() << "\n";
+                    return 1;
+                }
+            }
+            std::cerr << spec << ": round " << round + 1 << " of " << opt.repeats << " done ("
+                      << num(std::round(
+                                 std::chrono::duration<double>(Clock::now() - sceneStart).count() *
+                                 10.0) /
+                             10.0)
+                      << " s)\n";
+        }
+        for (auto& [row, base] : against) {
+            if (!row->measured() || !base->measured()) continue;
+            const size_t n = std::min(row->renderMs.size(), base->renderMs.size());
+            for (size_t i = 0; i < n; ++i)
+                if (row->renderMs[i] > 0.0)
+                    row->speedup.push_back(base->renderMs[i] / row->renderMs[i]);
+        }
+        for (const BenchRow& r : rows) {
+            if (r.scene != spec) continue;
+            const Spread t = spreadOf(r.renderMs);
+            std::cerr << spec << ": " << r.label() << ": "
+                      << (r.measured()
+                              ? num(std::round(t.median)) + " ms (" + num(std::round(t.min)) + "-" +
+                                    num(std::round(t.max)) + ")"
+                              : r.note)
+                      << "\n";
         }
         done.push_back(spec);
     }
+
+    std::ostringstream csv;
+    csv << kHeader;
+    for (const BenchRow& r : rows) writeCsvRow(csv, r);
+    const std::string table = comparisonMarkdown(rows);
     std::ofstream(opt.outDir + "/report.csv") << csv.str();
-    std::ofstream(opt.outDir + "/schemes.md") << table.str();
-    std::cout << table.str() << "wrote " << opt.outDir << "/report.csv and schemes.md\n";
+    std::ofstream(opt.outDir + "/schemes.md") << table;
+    std::cout << table << "wrote " << opt.outDir << "/report.csv and schemes.md\n";
+    std::vector<Figure> figures;
     if (opt.plots) {
-        writePlots(opt.outDir, done);
-        // A plot is drawn when the CSV has rows for its knob.
-        const std::pair<const char*, const char*> plots[] = {
-            {"speed_vs_error", ",scheme,"},
-            {"regular_max_level", ",regular max-level,"},
-            {"push_delta", ",push delta,"},
-            {"offset", ",offset,"},
-            {"progressive", ",progressive pass,"}};
-        for (const auto& [name, knob] : plots) {
-            if (csv.str().find(knob) == std::string::npos) continue;
-            std::string cmd = "cd '" + opt.outDir + "' && gnuplot " + name + ".gp 2>/dev/null";
-            if (std::system(cmd.c_str()) != 0)
-                std::cerr << "warning: gnuplot failed on " << name
-                          << ".gp (is gnuplot installed?)\n";
+        figures = drawPlots(opt.outDir, rows, done, opt.html ? PlotFormat::Svg : PlotFormat::Png);
+        for (const Figure& f : figures)
+            if (f.drawn)
+                std::cout << "wrote " << opt.outDir << "/" << f.file << "\n";
             else
-                std::cout << "wrote " << opt.outDir << "/" << name << ".png\n";
+                std::cerr << "warning: " << f.name << ": " << f.why << "\n";
+    }
+    if (opt.html) {
+        PageSettings settings;
+        settings.width = opt.width;
+        settings.height = opt.height;
+        settings.threads = effectiveThreads(opt.threads);
+        settings.bounces = opt.bounces;
+        settings.repeats = opt.repeats;
+        settings.quick = opt.quick;
+        settings.schemesOnly = opt.schemesOnly;
+        settings.seconds = std::chrono::duration<double>(Clock::now() - runStart).count();
+        settings.peers.push_back(EmbreePeer::available()
+                                     ? "Embree 3 (in this build), on scenes that are a union of "
+                                       "primitives, at --bounces 0"
+                                     : "Embree: not installed (this build has no Embree)");
+        settings.peers.push_back(povray ? PovPeer::version() + " (" + PovPeer::executable() +
+                                              "), on every scene, at --bounces " +
+                                              std::to_string(opt.bounces) +
+                                              ": its parse and trace times"
+                                        : "POV-Ray: not installed (no povray on the PATH)");
+        const std::string page = opt.outDir + "/index.html";
+        if (!writeHtmlPage(page, run, settings, rows, figures)) {
+            std::cerr << "error: could not write " << page << "\n";
+            return 1;
         }
+        std::cout << "wrote " << page << "\n";
     }
     return 0;
 }

@@ -20,13 +20,24 @@ struct BenchOptions {
     /// The schemes measured. Without brute force (scenes too large for it; --schemes-only only)
     /// no reference is rendered and the rows have no speedup and no error.
     std::vector<std::string> schemes{"brute", "regular", "irregular"};
+    /// Each configuration is built and rendered this many times, the configurations of a scene
+    /// in turn (round-robin), so that a change in the machine's load falls on all of them; the
+    /// figures are the medians, with their range.
+    int repeats = 3;
+    /// Write OUT/index.html, one self-contained page (plots inline as SVG) with the machine, the
+    /// commit, the date and the command line.
+    bool html = false;
+    /// The command line that started the run (for the page), argv[0] first.
+    std::vector<std::string> commandLine;
 };
 
 /// Create the output directory `dir` (and its parents); false, with an error naming --out on
 /// stderr, when it cannot be made.
 bool createOutDir(const std::string& dir);
 
-/// Run the sweeps, write OUT/report.csv, OUT/*.gp and OUT/*.png. Returns the exit status.
+/// Run the sweeps, write OUT/report.csv, OUT/schemes.md (the comparison table, markdown),
+/// OUT/*.gp and the plots (OUT/*.png, or with `html` OUT/*.svg and OUT/index.html). Returns the
+/// exit status.
 int runBench(const BenchOptions& opt);
 
 }  // namespace lancer::bench

@@ -25,4 +25,13 @@ struct StructureOptions {
 /// Build the structure and write its dump (docs/design.md section 6, "Structure dump").
 int runStructure(const CommonOptions& o, const StructureOptions& s);
 
+struct ExportOptions {
+    std::string pov;     ///< --pov FILE.pov
+    bool depth = false;  ///< --pov-depth: surfaces emit their distance (a depth image)
+    bool quiet = false;
+};
+/// Write the scene for POV-Ray 3.7 with the same camera (docs/design.md section 6, "Export and
+/// report").
+int runExport(const CommonOptions& o, const ExportOptions& e);
+
 }  // namespace lancer::cli

@@ -15,7 +15,7 @@ grep -q "^builtin:default,brute,scheme,brute," "$csv" || fail "no brute-force re
 grep ',progressive pass,1,' "$csv" | awk -F, '{ if ($15 != 0 || $16 != 0) exit 1 }' || fail "final pass differs from brute force"
 # Every scheme row that was measured agrees with brute force at default settings.
 awk -F, '$3=="scheme" && $15 != 0 { exit 1 }' "$csv" || fail "a scheme differs from brute force at defaults"
-[ -s "$tmp/b/speed_vs_error.png" ] || fail "no speed_vs_error plot"
+[ -s "$tmp/b/speed_vs_error-default.png" ] || fail "no speed_vs_error plot"
 # The comparison table on a union-only scene: with the peer (Embree, when built in) come the
 # schemes at --bounces 0, each compared with brute force at --bounces 0 after it was rendered.
 "$LANCER" bench --schemes-only --no-plots --scenes builtin:balls:1 --width 48 --height 32 \
