@@ -16,6 +16,9 @@
 namespace lancer {
 namespace {
 
+using test::expectSame;
+using test::secondaryRays;
+
 /// maxObjects -1: automatic (the cost stop with kAutoBvhObjects).
 BuildParams bvhParams(int maxObjects = -1, bool costStop = true, int maxLevel = 0) {
     BuildParams p;
@@ -28,33 +31,7 @@ BuildParams bvhParams(int maxObjects = -1, bool costStop = true, int maxLevel = 
 
 const Bvh& bvhOf(const Accelerator& a) { return std::get<Bvh>(a.impl()); }
 
-void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
-                const std::string& what, double tmin = 0.0) {
-    auto bad = test::compareWithBrute(scene, accel, rays, tmin);
-    EXPECT_TRUE(bad.empty()) << what << ": " << bad.size() << " mismatches of " << rays.size()
-                             << ", first:\n"
-                             << (bad.empty() ? "" : bad[0].toString(scene));
-}
 
-/// From each brute-force hit of `primary`: a random ray and one toward the first light.
-std::vector<Ray> secondaryRays(const Scene& scene, const std::vector<Ray>& primary, uint64_t seed) {
-    auto brute = buildAccelerator(scene, BuildParams{});
-    TraceContext ctx(scene.prims.size(), scene.tree.depth());
-    NullObserver obs;
-    std::mt19937_64 rng(seed);
-    std::normal_distribution<double> n;
-    std::vector<Ray> rays;
-    for (const Ray& r : primary) {
-        Hit h;
-        ctx.beginRay();
-        if (!brute->intersect(r, 0.0, kInf, ctx, obs, h)) continue;
-        const Vec3 p = r.at(h.t);
-        rays.push_back({p, glm::normalize(Vec3(n(rng), n(rng), n(rng)))});
-        if (!scene.lights.empty())
-            rays.push_back({p, glm::normalize(scene.lights[0].position - p)});
-    }
-    return rays;
-}
 
 /// Corners, edge midpoints and face centres of some nodes' boxes: where a box test rounds.
 std::vector<Vec3> nodePoints(const Bvh& b, size_t count, uint64_t seed) {

@@ -16,6 +16,9 @@
 namespace lancer {
 namespace {
 
+using test::expectSame;
+using test::secondaryRays;
+
 const IrregularSubdivision& irregularOf(const Accelerator& a) {
     return std::get<IrregularSubdivision>(a.impl());
 }
@@ -32,12 +35,6 @@ std::unique_ptr<Accelerator> buildIrregular(const Scene& scene,
     return buildAccelerator(scene, p);
 }
 
-void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
-                const std::string& what, double tmin = 0.0) {
-    auto bad = test::compareWithBrute(scene, accel, rays, tmin);
-    EXPECT_TRUE(bad.empty()) << what << ": " << bad.size() << " mismatches, first:\n"
-                             << (bad.empty() ? "" : bad[0].toString(scene));
-}
 
 /// World points at the corners, edge midpoints and face centres of some regions.
 std::vector<Vec3> regionPoints(const IrregularSubdivision& s, size_t maxRegions, uint64_t seed) {
@@ -70,26 +67,6 @@ std::vector<Ray> cameraAxisRays(const IrregularSubdivision& s, const std::vector
     return rays;
 }
 
-/// Secondary rays from the brute-force hits of `primary`: mirror and random directions.
-std::vector<Ray> secondaryRays(const Scene& scene, const std::vector<Ray>& primary, uint64_t seed) {
-    BuildParams bp;
-    auto brute = buildAccelerator(scene, bp);
-    TraceContext ctx(scene.prims.size(), scene.tree.depth());
-    NullObserver obs;
-    std::mt19937_64 rng(seed);
-    std::normal_distribution<double> n;
-    std::vector<Ray> rays;
-    for (const Ray& r : primary) {
-        Hit h;
-        ctx.beginRay();
-        if (!brute->intersect(r, 0.0, kInf, ctx, obs, h)) continue;
-        Vec3 p = r.at(h.t);
-        rays.push_back({p, glm::normalize(Vec3(n(rng), n(rng), n(rng)))});
-        if (!scene.lights.empty())
-            rays.push_back({p, glm::normalize(scene.lights[0].position - p)});
-    }
-    return rays;
-}
 
 /// Rays from the eye through the corners, edge midpoints and centres of projective zones, and
 /// random ones: they run along zone borders, where (u, v) ties.

@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include <gtest/gtest.h>
+
 #include "engine/accel/irregular/camera_frame.h"
 
 namespace lancer::test {
@@ -242,6 +244,33 @@ std::vector<Ray> pixelRays(const Scene& scene, int w, int h) {
     rays.reserve(size_t(w) * size_t(h));
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) rays.push_back(scene.camera.primaryRay(x, y, w, h));
+    return rays;
+}
+
+void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
+                const std::string& what, double tmin) {
+    auto bad = compareWithBrute(scene, accel, rays, tmin);
+    EXPECT_TRUE(bad.empty()) << what << ": " << bad.size() << " mismatches of " << rays.size()
+                             << ", first:\n"
+                             << (bad.empty() ? "" : bad[0].toString(scene));
+}
+
+std::vector<Ray> secondaryRays(const Scene& scene, const std::vector<Ray>& primary, uint64_t seed) {
+    auto brute = buildAccelerator(scene, BuildParams{});
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    NullObserver obs;
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> n;
+    std::vector<Ray> rays;
+    for (const Ray& r : primary) {
+        Hit h;
+        ctx.beginRay();
+        if (!brute->intersect(r, 0.0, kInf, ctx, obs, h)) continue;
+        const Vec3 p = r.at(h.t);
+        rays.push_back({p, glm::normalize(Vec3(n(rng), n(rng), n(rng)))});
+        if (!scene.lights.empty())
+            rays.push_back({p, glm::normalize(scene.lights[0].position - p)});
+    }
     return rays;
 }
 

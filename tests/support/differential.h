@@ -68,4 +68,11 @@ RecordingObserver recordWalk(const Accelerator& accel, const Ray& ray, TraceCont
 /// Primary rays of every pixel of a w x h image of the scene's camera.
 std::vector<Ray> pixelRays(const Scene& scene, int w, int h);
 
+/// Fails the current test, naming `what`, when `accel` and brute force disagree on any ray.
+void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
+                const std::string& what, double tmin = 0.0);
+
+/// From each brute-force hit of `primary`: a random ray and one toward the first light.
+std::vector<Ray> secondaryRays(const Scene& scene, const std::vector<Ray>& primary, uint64_t seed);
+
 }  // namespace lancer::test
