@@ -34,7 +34,9 @@ lancer_install_packages() {
     || { echo "lancer: apt-get failed; run: sudo apt-get install -y ${missing[*]}" >&2; return 1; }
 }
 
+# Warnings are errors: the build is kept at zero (docs/testing.md, "Warnings").
 lancer_build() {
-  cmake -S "$LANCER_ROOT" -B "$LANCER_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null \
+  cmake -S "$LANCER_ROOT" -B "$LANCER_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    -DLANCER_WERROR=ON "$@" >/dev/null \
     && cmake --build "$LANCER_BUILD" --parallel "$(nproc)"
 }

@@ -325,8 +325,8 @@ TEST(CameraOption, CopyJsonRoundTripGivesTheSameImage) {
         return img;
     };
     const std::string src = LANCER_SOURCE_DIR;
-    for (const std::string spec : {std::string("builtin:default"), src + "/assets/spd/balls1.nff",
-                                   src + "/assets/openscad/bracket.csg"}) {
+    for (const std::string& spec : {std::string("builtin:default"), src + "/assets/spd/balls1.nff",
+                                    src + "/assets/openscad/bracket.csg"}) {
         for (int moved = 0; moved < 3; ++moved) {
             SCOPED_TRACE(spec + " camera " + std::to_string(moved));
             CommonOptions o;

@@ -455,7 +455,9 @@ TEST(RegularUnion, SphereQuadWalkEqualsObservedWalkAndBruteForce) {
             EXPECT_EQ(fast.mailboxHits, ctx.counters.mailboxHits);
             EXPECT_EQ(fast.regionVisits, ctx.counters.regionVisits);
             EXPECT_GT(fast.primTests, 2 * q.rays.size());
-            if (mailboxes) EXPECT_GT(fast.mailboxHits, 0u);
+            if (mailboxes) {
+                EXPECT_GT(fast.mailboxHits, 0u);
+            }
         }
     }
 }

@@ -23,35 +23,53 @@ std::vector<ParamDesc> makeTable() {
     auto add = [&](ParamDesc d) { t.push_back(std::move(d)); };
     ParamDesc d{};
 
-    d = {"--width",      "W", "width", "width", "Image width in pixels (default: the scene's)",
-         ParamKind::Int, 1,   16384};
+    d = {.flag = "--width",
+         .metavar = "W",
+         .iniKey = "width",
+         .label = "width",
+         .help = "Image width in pixels (default: the scene's)",
+         .kind = ParamKind::Int,
+         .lo = 1,
+         .hi = 16384};
     d.reach = ViewerReach::Window;
     d.get = [](const K& k) { return double(k.width); };
     d.set = [](K& k, double v) { k.width = int(v); };
     add(d);
-    d = {"--height",     "H", "height", "height", "Image height in pixels (default: the scene's)",
-         ParamKind::Int, 1,   16384};
+    d = {.flag = "--height",
+         .metavar = "H",
+         .iniKey = "height",
+         .label = "height",
+         .help = "Image height in pixels (default: the scene's)",
+         .kind = ParamKind::Int,
+         .lo = 1,
+         .hi = 16384};
     d.reach = ViewerReach::Window;
     d.get = [](const K& k) { return double(k.height); };
     d.set = [](K& k, double v) { k.height = int(v); };
     add(d);
 
-    d = {"--scheme", "S", "scheme", "scheme", "Acceleration scheme", ParamKind::Enum};
+    d = {.flag = "--scheme",
+         .metavar = "S",
+         .iniKey = "scheme",
+         .label = "scheme",
+         .help = "Acceleration scheme",
+         .kind = ParamKind::Enum};
     d.names = {"brute", "regular", "irregular", "bvh"};
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.scheme); };
     d.set = [](K& k, double v) { k.build.scheme = SchemeKind(int(v)); };
     add(d);
-    d = {"--max-level",
-         "N",
-         "max_level",
-         "max-level",
-         "Deepest subdivision level (regular: one axis cut per level, 0 automatic: 16 + 0.65 "
-         "log2 of the primitive count, 4 deeper where a split saves enough, an explicit N builds "
-         "by the report's rule alone, no cost stop; bvh: tree depth, 0 automatic: 64)",
-         ParamKind::Int,
-         0,
-         48};
+    d = {.flag = "--max-level",
+         .metavar = "N",
+         .iniKey = "max_level",
+         .label = "max-level",
+         .help =
+             "Deepest subdivision level (regular: one axis cut per level, 0 automatic: 16 + 0.65 "
+             "log2 of the primitive count, 4 deeper where a split saves enough, an explicit N "
+             "builds by the report's rule alone, no cost stop; bvh: tree depth, 0 automatic: 64)",
+         .kind = ParamKind::Int,
+         .lo = 0,
+         .hi = 48};
     d.schemes = kRegular | kBvh;
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) {
@@ -63,16 +81,18 @@ std::vector<ParamDesc> makeTable() {
     // One knob for both schemes, as the report has one: the regular scheme refuses 0 when it
     // builds (a cell must stop on a count), the irregular one splits until no segment is left.
     // auto: 4, the cost stop deciding (an explicit value turns it off).
-    d = {"--max-objects",
-         "N",
-         "max_objects",
-         "max-objects",
-         "Stop subdividing a cell holding at most N primitives (irregular: 0 never stops; "
-         "regular and bvh: at least 1); auto: 4 (bvh: 2), and a cost estimate stops cells where "
-         "a split does not pay; an explicit N builds by the report's rule alone (no cost stop)",
-         ParamKind::Int,
-         0,
-         1000000};
+    d = {.flag = "--max-objects",
+         .metavar = "N",
+         .iniKey = "max_objects",
+         .label = "max-objects",
+         .help =
+             "Stop subdividing a cell holding at most N primitives (irregular: 0 never stops; "
+             "regular and bvh: at least 1); auto: 4 (bvh: 2), and a cost estimate stops cells "
+             "where a split does not pay; an explicit N builds by the report's rule alone (no "
+             "cost stop)",
+         .kind = ParamKind::Int,
+         .lo = 0,
+         .hi = 1000000};
     d.autoWord = "auto";
     d.autoValue = kAutoObjects;
     d.schemes = kAccelerated;
@@ -86,65 +106,68 @@ std::vector<ParamDesc> makeTable() {
         k.build.regular.maxObjects = k.build.irregular.maxObjects = k.build.bvh.maxObjects = int(v);
     };
     add(d);
-    d = {"--step",
-         "M",
-         "step",
-         "step",
-         "Next-cell method: exact, or the report's push (lancer view with --pick: the playback "
-         "step to stop at instead, first, last or N from 0)",
-         ParamKind::Enum};
+    d = {.flag = "--step",
+         .metavar = "M",
+         .iniKey = "step",
+         .label = "step",
+         .help = "Next-cell method: exact, or the report's push (lancer view with --pick: the "
+                 "playback step to stop at instead, first, last or N from 0)",
+         .kind = ParamKind::Enum};
     d.names = {"exact", "push"};
     d.schemes = kRegular;
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.regular.step); };
     d.set = [](K& k, double v) { k.build.regular.step = StepMethod(int(v)); };
     add(d);
-    d = {"--delta",
-         "D",
-         "delta",
-         "delta",
-         "Push distance of --step push, relative to the scene size",
-         ParamKind::Real,
-         1e-15,
-         0.5};
+    d = {.flag = "--delta",
+         .metavar = "D",
+         .iniKey = "delta",
+         .label = "delta",
+         .help = "Push distance of --step push, relative to the scene size",
+         .kind = ParamKind::Real,
+         .lo = 1e-15,
+         .hi = 0.5};
     d.schemes = kRegular;
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return k.build.regular.delta; };
     d.set = [](K& k, double v) { k.build.regular.delta = v; };
     d.when = [](const K& k) { return k.build.regular.step == StepMethod::Push; };
     add(d);
-    d = {"--split-axes",
-         "A",
-         "split_axes",
-         "split axes",
-         "Axis per BSP level: cycle (x, y, z in turn, the report's) or cost (the cheapest by an "
-         "area estimate)",
-         ParamKind::Enum};
+    d = {.flag = "--split-axes",
+         .metavar = "A",
+         .iniKey = "split_axes",
+         .label = "split axes",
+         .help =
+             "Axis per BSP level: cycle (x, y, z in turn, the report's) or cost (the cheapest by "
+             "an area estimate)",
+         .kind = ParamKind::Enum};
     d.names = {"cycle", "cost"};
     d.schemes = kRegular;
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.regular.splitAxes); };
     d.set = [](K& k, double v) { k.build.regular.splitAxes = SplitAxes(int(v)); };
     add(d);
-    d = {"--full-table",
-         "",
-         "full_table",
-         "full table",
-         "One full directory table instead of sub-tables",
-         ParamKind::Switch};
+    d = {.flag = "--full-table",
+         .metavar = "",
+         .iniKey = "full_table",
+         .label = "full table",
+         .help = "One full directory table instead of sub-tables",
+         .kind = ParamKind::Switch};
     d.schemes = kRegular;
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.regular.fullTable); };
     d.set = [](K& k, double v) { k.build.regular.fullTable = v != 0.0; };
     add(d);
-    d = {"--no-cost-stop",
-         "",
-         "cost_stop",
-         "cost stop",
-         "With max-level 0 and max-objects auto, split cells (irregular: screen cells) down to 4 "
-         "primitives or the automatic max-level even where the cost estimate says a split does "
-         "not pay (the report's rule, which an explicit max-level or max-objects also gives)",
-         ParamKind::Switch};
+    d = {.flag = "--no-cost-stop",
+         .metavar = "",
+         .iniKey = "cost_stop",
+         .label = "cost stop",
+         .help =
+             "With max-level 0 and max-objects auto, split cells (irregular: screen cells) down "
+             "to 4 primitives or the automatic max-level even where the cost estimate says a "
+             "split does not pay (the report's rule, which an explicit max-level or max-objects "
+             "also gives)",
+         .kind = ParamKind::Switch};
     d.flagValue = false;
     d.schemes = kAccelerated;
     d.effect = ChangeEffect::Rebuild;
@@ -157,49 +180,50 @@ std::vector<ParamDesc> makeTable() {
         k.build.regular.costStop = k.build.irregular.costStop = k.build.bvh.costStop = v != 0.0;
     };
     add(d);
-    d = {"--bsp-heuristic",
-         "H",
-         "bsp_heuristic",
-         "BSP heuristic",
-         "Choice of the screen BSP's splitting segment",
-         ParamKind::Enum};
+    d = {.flag = "--bsp-heuristic",
+         .metavar = "H",
+         .iniKey = "bsp_heuristic",
+         .label = "BSP heuristic",
+         .help = "Choice of the screen BSP's splitting segment",
+         .kind = ParamKind::Enum};
     d.names = {"first", "balanced", "fewest-cuts"};
     d.schemes = kIrregular;
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.irregular.heuristic); };
     d.set = [](K& k, double v) { k.build.irregular.heuristic = BspHeuristic(int(v)); };
     add(d);
-    d = {"--irregular-frame",
-         "F",
-         "irregular_frame",
-         "primary rays",
-         "What primary rays walk: camera (the camera-frame structure) or projective (zones in "
-         "screen x/z, y/z)",
-         ParamKind::Enum};
+    d = {.flag = "--irregular-frame",
+         .metavar = "F",
+         .iniKey = "irregular_frame",
+         .label = "primary rays",
+         .help =
+             "What primary rays walk: camera (the camera-frame structure) or projective (zones in "
+             "screen x/z, y/z)",
+         .kind = ParamKind::Enum};
     d.names = {"camera", "projective"};
     d.schemes = kIrregular;
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.irregular.frame); };
     d.set = [](K& k, double v) { k.build.irregular.frame = IrregularFrame(int(v)); };
     add(d);
-    d = {"--no-mailbox",
-         "",
-         "mailboxes",
-         "mailboxes",
-         "Turn the mailboxes off (to measure their effect)",
-         ParamKind::Switch};
+    d = {.flag = "--no-mailbox",
+         .metavar = "",
+         .iniKey = "mailboxes",
+         .label = "mailboxes",
+         .help = "Turn the mailboxes off (to measure their effect)",
+         .kind = ParamKind::Switch};
     d.flagValue = false;
     d.schemes = kAccelerated;
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.mailboxes); };
     d.set = [](K& k, double v) { k.build.mailboxes = v != 0.0; };
     add(d);
-    d = {"--no-light-buffer",
-         "",
-         "light_buffer",
-         "light buffer",
-         "Trace shadow rays without the light buffer (to measure its effect)",
-         ParamKind::Switch};
+    d = {.flag = "--no-light-buffer",
+         .metavar = "",
+         .iniKey = "light_buffer",
+         .label = "light buffer",
+         .help = "Trace shadow rays without the light buffer (to measure its effect)",
+         .kind = ParamKind::Switch};
     d.flagValue = false;
     d.schemes = kAccelerated;
     d.effect = ChangeEffect::Rebuild;
@@ -208,93 +232,118 @@ std::vector<ParamDesc> makeTable() {
     add(d);
     // Every scheme's builder reads it; brute force builds nothing worth bounding, so the regular
     // and irregular schemes only. A change rebuilds under the new budget.
-    d = {"--memory-budget",
-         "SIZE",
-         "memory_budget",
-         "memory budget",
-         "Bytes a structure and its light buffer may take while they are built (512M, 2G, "
-         "1.5GiB; 0: an eighth of physical memory); over it the irregular scheme stops "
-         "subdividing (refused when even its coarsest structure does not fit), the regular one "
-         "is refused; a light buffer over a quarter of it is left out",
-         ParamKind::Size};
+    d = {.flag = "--memory-budget",
+         .metavar = "SIZE",
+         .iniKey = "memory_budget",
+         .label = "memory budget",
+         .help =
+             "Bytes a structure and its light buffer may take while they are built (512M, 2G, "
+             "1.5GiB; 0: an eighth of physical memory); over it the irregular scheme stops "
+             "subdividing (refused when even its coarsest structure does not fit), the regular one "
+             "is refused; a light buffer over a quarter of it is left out",
+         .kind = ParamKind::Size};
     d.schemes = kAccelerated;
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.memoryBudget); };
     d.set = [](K& k, double v) { k.build.memoryBudget = size_t(v); };
     add(d);
 
-    d = {"--threads",    "N", "threads", "threads", "Worker threads (0: all cores)",
-         ParamKind::Int, 0,   1024};
+    d = {.flag = "--threads",
+         .metavar = "N",
+         .iniKey = "threads",
+         .label = "threads",
+         .help = "Worker threads (0: all cores)",
+         .kind = ParamKind::Int,
+         .lo = 0,
+         .hi = 1024};
     d.effect = ChangeEffect::Rerender;
     d.get = [](const K& k) { return double(k.threads); };
     d.set = [](K& k, double v) { k.threads = int(v); };
     add(d);
-    d = {"--bounces",
-         "N",
-         "bounces",
-         "bounces",
-         "Reflection/refraction depth; 0 = primary and shadow rays only",
-         ParamKind::Int,
-         0,
-         64};
+    d = {.flag = "--bounces",
+         .metavar = "N",
+         .iniKey = "bounces",
+         .label = "bounces",
+         .help = "Reflection/refraction depth; 0 = primary and shadow rays only",
+         .kind = ParamKind::Int,
+         .lo = 0,
+         .hi = 64};
     d.effect = ChangeEffect::Rerender;
     d.get = [](const K& k) { return double(k.shading.bounces); };
     d.set = [](K& k, double v) { k.shading.bounces = int(v); };
     add(d);
-    d = {"--offset",
-         "E",
-         "offset",
-         "offset",
-         "Secondary-ray origin offset, relative to the scene scale",
-         ParamKind::Real,
-         0.0,
-         1e-2};
+    d = {.flag = "--offset",
+         .metavar = "E",
+         .iniKey = "offset",
+         .label = "offset",
+         .help = "Secondary-ray origin offset, relative to the scene scale",
+         .kind = ParamKind::Real,
+         .lo = 0.0,
+         .hi = 1e-2};
     d.effect = ChangeEffect::Rerender;
     d.get = [](const K& k) { return k.shading.offsetScale; };
     d.set = [](K& k, double v) { k.shading.offsetScale = v; };
     add(d);
-    d = {"--no-shadows", "", "shadows", "shadows", "Trace no shadow rays", ParamKind::Switch};
+    d = {.flag = "--no-shadows",
+         .metavar = "",
+         .iniKey = "shadows",
+         .label = "shadows",
+         .help = "Trace no shadow rays",
+         .kind = ParamKind::Switch};
     d.flagValue = false;
     d.effect = ChangeEffect::Rerender;
     d.get = [](const K& k) { return double(k.shading.shadows); };
     d.set = [](K& k, double v) { k.shading.shadows = v != 0.0; };
     add(d);
-    d = {"--no-reflections", "", "reflections", "reflection", "Trace no reflected rays",
-         ParamKind::Switch};
+    d = {.flag = "--no-reflections",
+         .metavar = "",
+         .iniKey = "reflections",
+         .label = "reflection",
+         .help = "Trace no reflected rays",
+         .kind = ParamKind::Switch};
     d.flagValue = false;
     d.effect = ChangeEffect::Rerender;
     d.get = [](const K& k) { return double(k.shading.reflections); };
     d.set = [](K& k, double v) { k.shading.reflections = v != 0.0; };
     add(d);
-    d = {"--no-refractions", "", "refractions", "refraction", "Trace no refracted rays",
-         ParamKind::Switch};
+    d = {.flag = "--no-refractions",
+         .metavar = "",
+         .iniKey = "refractions",
+         .label = "refraction",
+         .help = "Trace no refracted rays",
+         .kind = ParamKind::Switch};
     d.flagValue = false;
     d.effect = ChangeEffect::Rerender;
     d.get = [](const K& k) { return double(k.shading.refractions); };
     d.set = [](K& k, double v) { k.shading.refractions = v != 0.0; };
     add(d);
 
-    d = {"--camera",
-         "FILE",
-         nullptr,
-         "camera",
-         "A camera in the .camera.json sidecar's keys (the viewer's Copy JSON), replacing the "
-         "scene's",
-         ParamKind::Path};
+    d = {.flag = "--camera",
+         .metavar = "FILE",
+         .iniKey = nullptr,
+         .label = "camera",
+         .help =
+             "A camera in the .camera.json sidecar's keys (the viewer's Copy JSON), replacing the "
+             "scene's",
+         .kind = ParamKind::Path};
     d.reach = ViewerReach::Startup;
     d.path = &Knobs::cameraPath;
     add(d);
-    d = {"--stats",      "FILE", nullptr, "stats", "Write statistics as JSON to this file",
-         ParamKind::Path};
+    d = {.flag = "--stats",
+         .metavar = "FILE",
+         .iniKey = nullptr,
+         .label = "stats",
+         .help = "Write statistics as JSON to this file",
+         .kind = ParamKind::Path};
     d.reach = ViewerReach::BatchOnly;
     d.path = &Knobs::statsPath;
     add(d);
-    d = {"--depth",
-         "FILE",
-         nullptr,
-         "depth",
-         "Write the primary hit distances as a PFM to this file",
-         ParamKind::Path};
+    d = {.flag = "--depth",
+         .metavar = "FILE",
+         .iniKey = nullptr,
+         .label = "depth",
+         .help = "Write the primary hit distances as a PFM to this file",
+         .kind = ParamKind::Path};
     d.reach = ViewerReach::BatchOnly;
     d.path = &Knobs::depthPath;
     add(d);

@@ -65,10 +65,10 @@ struct ParamDesc {
     const char* label;    ///< the panel control's label
     const char* help;     ///< one line: what it does
     ParamKind kind;
-    double lo = 0.0, hi = 0.0;       ///< Int and Real: the accepted range, everywhere
-    std::vector<const char*> names;  ///< Enum: the names, index = the enum's value
-    bool flagValue = true;           ///< Switch: the value the flag sets (false: --no-...)
-    uint8_t schemes = kAllSchemes;   ///< the schemes that read it
+    double lo = 0.0, hi = 0.0;         ///< Int and Real: the accepted range, everywhere
+    std::vector<const char*> names{};  ///< Enum: the names, index = the enum's value
+    bool flagValue = true;             ///< Switch: the value the flag sets (false: --no-...)
+    uint8_t schemes = kAllSchemes;     ///< the schemes that read it
     ViewerReach reach = ViewerReach::Panel;
     ChangeEffect effect = ChangeEffect::None;  ///< when it changes and applies
     /// Int, Real, Enum (index), Switch (0 or 1): the value in `k`, and setting it.

@@ -16,13 +16,18 @@ std::string num(double x) {
     return buf;
 }
 
-std::string pt(const Vec3& p) { return "(" + num(p.x) + ", " + num(p.y) + ", " + num(p.z) + ")"; }
+std::string pt(const Vec3& p) {
+    std::string s = "(";
+    s.append(num(p.x)).append(", ").append(num(p.y)).append(", ").append(num(p.z));
+    return s.append(")");
+}
 
 std::string interval(double t0, double t1) { return "t = [" + num(t0) + ", " + num(t1) + "]"; }
 
 std::string cells(const uint32_t c[3]) {
-    return "[" + std::to_string(c[0]) + ", " + std::to_string(c[1]) + ", " + std::to_string(c[2]) +
-           "]";
+    std::string s = "[";
+    s.append(std::to_string(c[0])).append(", ").append(std::to_string(c[1])).append(", ");
+    return s.append(std::to_string(c[2])).append("]");
 }
 
 /// "x", "xy", "xyz": the axes set in `mask`.
@@ -37,8 +42,9 @@ std::string axes(int mask) {
 constexpr uint32_t kNoNodeId = 0xffffffffu;
 
 std::string prim(uint32_t p, const Scene* scene) {
-    std::string s = "p" + std::to_string(p);
-    if (scene && p < scene->prims.size()) s += " " + scene->prims[p].toString();
+    std::string s = "p";
+    s += std::to_string(p);
+    if (scene && p < scene->prims.size()) s.append(" ").append(scene->prims[p].toString());
     return s;
 }
 

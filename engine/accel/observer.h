@@ -44,40 +44,41 @@ struct RayEnd {
 struct NullObserver {
     static constexpr bool kActive = false;
     // The walk inside a region.
-    void region(uint32_t id, double t0, double t1) {}
-    void primTest(uint32_t prim, const Span* spans, int n) {}
-    void mailboxHit(uint32_t prim) {}
-    void regionSpans(const SpanList& spans) {}
+    void region(uint32_t /*id*/, double /*t0*/, double /*t1*/) {}
+    void primTest(uint32_t /*prim*/, const Span* /*spans*/, int /*n*/) {}
+    void mailboxHit(uint32_t /*prim*/) {}
+    void regionSpans(const SpanList& /*spans*/) {}
     // A node of the tree evaluated (evalTree): its spans along the whole line. Not reached from
     // the render path (wrapped in `if constexpr (Obs::kActive)`).
-    void csgNode(int node, const SpanList& spans) {}
-    void walkError(const char* what) {}
+    void csgNode(int /*node*/, const SpanList& /*spans*/) {}
+    void walkError(const char* /*what*/) {}
     // From region to region. Irregular: the region a walk starts in, the exit (with the tied
     // axes: face, edge or corner) and each corner pointer followed.
-    void locate(const Vec3& point, uint32_t region) {}
-    void regionExit(double t, const Vec3& point, int axis, int ties) {}
-    void pointer(uint32_t from, uint32_t to, int corner) {}
+    void locate(const Vec3& /*point*/, uint32_t /*region*/) {}
+    void regionExit(double /*t*/, const Vec3& /*point*/, int /*axis*/, int /*ties*/) {}
+    void pointer(uint32_t /*from*/, uint32_t /*to*/, int /*corner*/) {}
     // Regular: the directory cell looked up (start and step), the pushed point (push), the
     // index step (exact) or the rope followed (exact, a face one leaf covers).
-    void lookup(const Vec3& point, const uint32_t cell[3], uint32_t leaf) {}
-    void push(const Vec3& point, int axes) {}
-    void indexStep(int axis, const uint32_t cell[3]) {}
-    void rope(uint32_t from, int face, uint32_t to) {}
+    void lookup(const Vec3& /*point*/, const uint32_t /*cell*/[3], uint32_t /*leaf*/) {}
+    void push(const Vec3& /*point*/, int /*axes*/) {}
+    void indexStep(int /*axis*/, const uint32_t /*cell*/[3]) {}
+    void rope(uint32_t /*from*/, int /*face*/, uint32_t /*to*/) {}
     // BVH: an inner node's children the ray's interval meets, in the order they are visited
     // (`second` kNoNode when one or none is met), with the t each box is entered at; a node
     // left unvisited because its box begins beyond the hit found.
-    void nodeChildren(uint32_t node, uint32_t first, double t0First, uint32_t second,
-                      double t0Second) {}
-    void nodeCulled(uint32_t node, double t0, double best) {}
-    void walkRestart(const char* why) {}
+    void nodeChildren(uint32_t /*node*/, uint32_t /*first*/, double /*t0First*/,
+                      uint32_t /*second*/, double /*t0Second*/) {}
+    void nodeCulled(uint32_t /*node*/, double /*t0*/, double /*best*/) {}
+    void walkRestart(const char* /*why*/) {}
     // Shadow rays and the light buffer: each stretch walked, none to walk, what blocked it.
-    void stretch(int index, double t0, double t1) {}
+    void stretch(int /*index*/, double /*t0*/, double /*t1*/) {}
     void lightBufferClear() {}
-    void blocker(const Hit& hit) {}
+    void blocker(const Hit& /*hit*/) {}
     // The tracer: a ray of the pixel's tree begins (depth: bounces before it; light: the
     // shadow ray's light, else -1) and ends.
-    void rayBegin(RayKind kind, int depth, int light, const Ray& ray, double tmin, double tmax) {}
-    void rayEnd(const RayEnd& end) {}
+    void rayBegin(RayKind /*kind*/, int /*depth*/, int /*light*/, const Ray& /*ray*/,
+                  double /*tmin*/, double /*tmax*/) {}
+    void rayEnd(const RayEnd& /*end*/) {}
 };
 
 /// One event of a walk, in order. Which fields are set depends on the kind (see each kind).
@@ -141,7 +142,7 @@ struct RecordingObserver {
     void regionSpans(const SpanList& s) { add(WalkEvent::Spans).spans = s; }
     /// Not recorded: a walk's events keep the primitives' spans and the tree's, from which
     /// evalNodes (engine/render/ray_csg.h) gets every node's again with evalTree.
-    void csgNode(int node, const SpanList& spans) {}
+    void csgNode(int /*node*/, const SpanList& /*spans*/) {}
     void walkError(const char* what) { add(WalkEvent::Error).what = what; }
     void locate(const Vec3& point, uint32_t region) {
         WalkEvent& e = add(WalkEvent::Locate);

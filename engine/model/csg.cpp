@@ -108,9 +108,13 @@ std::string CsgTree::toString() const {
     if (root < 0) return "∅";
     std::function<std::string(int)> s = [&](int n) -> std::string {
         const CsgNode& x = nodes[n];
-        if (x.op == Op::Primitive) return "p" + std::to_string(x.prim);
+        if (x.op == Op::Primitive) {
+            std::string out = "p";
+            return out.append(std::to_string(x.prim));
+        }
         const char* sym = x.op == Op::Union ? " ∪ " : x.op == Op::Intersection ? " ∩ " : " − ";
-        return "(" + s(x.left) + sym + s(x.right) + ")";
+        std::string out = "(";
+        return out.append(s(x.left)).append(sym).append(s(x.right)).append(")");
     };
     return s(root);
 }

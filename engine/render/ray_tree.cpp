@@ -125,7 +125,9 @@ std::string num6(double x) {
 }
 
 std::string pt6(const Vec3& p) {
-    return "(" + num6(p.x) + ", " + num6(p.y) + ", " + num6(p.z) + ")";
+    std::string s = "(";
+    s.append(num6(p.x)).append(", ").append(num6(p.y)).append(", ").append(num6(p.z));
+    return s.append(")");
 }
 
 /// Ten significant digits: a pushed point differs from the exit point by a small delta.
@@ -136,13 +138,15 @@ std::string pt10(const Vec3& p) {
 }
 
 std::string cellText(const uint32_t c[3]) {
-    return "(" + std::to_string(c[0]) + ", " + std::to_string(c[1]) + ", " + std::to_string(c[2]) +
-           ")";
+    std::string s = "(";
+    s.append(std::to_string(c[0])).append(", ").append(std::to_string(c[1])).append(", ");
+    return s.append(std::to_string(c[2])).append(")");
 }
 
 std::string primText(uint32_t p, const Scene* scene) {
-    std::string s = "p" + std::to_string(p);
-    if (scene && p < scene->prims.size()) s += " " + scene->prims[p].toString();
+    std::string s = "p";
+    s += std::to_string(p);
+    if (scene && p < scene->prims.size()) s.append(" ").append(scene->prims[p].toString());
     return s;
 }
 

@@ -929,18 +929,18 @@ struct RegularBuilder {
     /// Room in the layout for what the fragments under `f` hold (an upper bound for the pool,
     /// whose sets the fragments may share): a vector grown by doubling touches twice its final
     /// memory, and on the machines measured a first touch of a page costs more than the copy.
-    static void reserve(Layout& out, const Fragment& f, size_t& leaves, size_t& nodes,
-                        size_t& trees, size_t& lists, size_t& sets) {
+    static void reserve(const Fragment& f, size_t& leaves, size_t& nodes, size_t& trees,
+                        size_t& lists, size_t& sets) {
         leaves += f.leafList.size();
         nodes += f.bsp.nodes.size();
         trees += f.pool.trees.nodes.size();
         lists += f.pool.lists.size();
         sets += f.pool.listFirst.size();
-        for (const auto& k : f.children) reserve(out, *k, leaves, nodes, trees, lists, sets);
+        for (const auto& k : f.children) reserve(*k, leaves, nodes, trees, lists, sets);
     }
     static void reserve(Layout& out, const Fragment& root) {
         size_t leaves = 0, nodes = 0, trees = 0, lists = 0, sets = 0;
-        reserve(out, root, leaves, nodes, trees, lists, sets);
+        reserve(root, leaves, nodes, trees, lists, sets);
         reserveHuge(out.leaves, leaves);
         reserveHuge(out.places, leaves);
         reserveHuge(out.bsp.nodes, nodes);
