@@ -213,7 +213,7 @@ int main(int argc, char** argv) {
         ->add_option("--schemes", bopt.schemes,
                      "Schemes measured; without brute (--schemes-only or --scale only) no speedup "
                      "or error")
-        ->check(CLI::IsMember({"brute", "regular", "irregular"}))
+        ->check(CLI::IsMember(schemeNames()))
         ->capture_default_str();
     bool scale = false;
     std::string memoryLimit = "4G", memoryBudget = "0";

@@ -182,6 +182,17 @@ TEST(ParamTable, RangesAreTheSameOnTheCommandLineAndInTheIni) {
     EXPECT_EQ(p.o.knobs.build.irregular.maxObjects, 0);
 }
 
+// --scheme takes every name of the scheme table, and only those.
+TEST(ParamTable, SchemeTakesTheTablesNames) {
+    for (const SchemeInfo& info : kSchemeTable) {
+        Parsed p({"render", "x", "--scheme", info.name});
+        EXPECT_EQ(p.error, "") << info.name;
+        EXPECT_EQ(p.o.knobs.build.scheme, info.kind) << info.name;
+    }
+    Parsed bad({"render", "x", "--scheme", "kd-tree"});
+    EXPECT_NE(bad.error.find("--scheme"), std::string::npos) << bad.error;
+}
+
 // max-objects' automatic value is written "auto" and read back from the command line, the ini
 // and --change; an explicit number replaces it for both schemes.
 TEST(ParamTable, MaxObjectsTakesAutoOrANumber) {

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/accel/build_params.h"
+
 namespace lancer::bench {
 
 struct BenchOptions {
@@ -19,7 +21,7 @@ struct BenchOptions {
     bool schemesOnly = false;  ///< default settings of each scheme (and the peer) only: the table
     /// The schemes measured. Without brute force (scenes too large for it; --schemes-only only)
     /// no reference is rendered and the rows have no speedup and no error.
-    std::vector<std::string> schemes{"brute", "regular", "irregular"};
+    std::vector<std::string> schemes = schemeNames();  ///< every scheme of kSchemeTable
     /// Each configuration is built and rendered this many times, the configurations of a scene
     /// in turn (round-robin), so that a change in the machine's load falls on all of them; the
     /// figures are the medians, with their range.

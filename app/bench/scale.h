@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/accel/build_params.h"
+
 namespace lancer::bench {
 
 struct ScaleOptions {
@@ -29,7 +31,7 @@ struct ScaleOptions {
     double killAfterS = 0.0;
     bool peer = true;  ///< Embree on union-only scenes (at --bounces 0 only)
     /// The schemes measured (--schemes); without brute force no hits are compared.
-    std::vector<std::string> schemes{"brute", "regular", "irregular"};
+    std::vector<std::string> schemes = schemeNames();  ///< every scheme of kSchemeTable
 };
 
 /// Measure every scene, write OUT/scale.md and OUT/scale.json, print the table and the list of

@@ -54,7 +54,7 @@ std::vector<ParamDesc> makeTable() {
          .label = "scheme",
          .help = "Acceleration scheme",
          .kind = ParamKind::Enum};
-    d.names = {"brute", "regular", "irregular", "bvh"};
+    for (const SchemeInfo& s : kSchemeTable) d.names.push_back(s.name);
     d.effect = ChangeEffect::Rebuild;
     d.get = [](const K& k) { return double(k.build.scheme); };
     d.set = [](K& k, double v) { k.build.scheme = SchemeKind(int(v)); };

@@ -66,6 +66,42 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
                                          std::move(lb.lights), std::move(eye), scene.camera.from);
 }
 
+/// Scheme `S`'s structure: brute force alone (nothing to walk around, so no light buffer), an
+/// accelerated scheme with its light buffers.
+template <class S, class Clock>
+std::unique_ptr<Accelerator> buildOne(const Scene& scene, const BuildParams& params, bool buffered,
+                                      BuildGuard& guard, Clock&& elapsedMs) {
+    if constexpr (S::kKind == SchemeKind::Brute) {
+        AccelInfo info;
+        info.treeDepth = scene.tree.depth();
+        S b = S::build(scene, S::config(params), info.extra, &guard);
+        info.regions = b.regionCount();
+        info.memoryBytes = b.memoryBytes();
+        info.buildMs = elapsedMs();
+        return std::make_unique<Accelerator>(std::move(b), params, std::move(info));
+    } else {
+        return withLightBuffer<S>(
+            scene, params, buffered, guard,
+            [&](AccelInfo& info) { return S::build(scene, S::config(params), info.extra, &guard); },
+            elapsedMs);
+    }
+}
+
+/// The build of the alternative of Accelerator::Impl whose kind `params` names.
+template <class Clock, size_t... I>
+std::unique_ptr<Accelerator> buildScheme(const Scene& scene, const BuildParams& params,
+                                         bool buffered, BuildGuard& guard, Clock&& elapsedMs,
+                                         std::index_sequence<I...>) {
+    std::unique_ptr<Accelerator> out;
+    ((params.scheme == SchemeKind(I)
+          ? (void)(out = buildOne<std::variant_alternative_t<I, Accelerator::Impl>>(
+                       scene, params, buffered, guard, elapsedMs))
+          : (void)0),
+     ...);
+    if (!out) throw std::logic_error("buildAccelerator: unknown scheme");
+    return out;
+}
+
 }  // namespace
 
 std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildParams& params,
@@ -88,37 +124,8 @@ std::unique_ptr<Accelerator> buildAccelerator(const Scene& scene, const BuildPar
         return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
             .count();
     };
-    switch (params.scheme) {
-        case SchemeKind::Brute: {
-            AccelInfo info;
-            info.treeDepth = scene.tree.depth();
-            BruteForce b = BruteForce::build(scene, BruteConfig{}, info.extra);
-            info.regions = b.regionCount();
-            info.memoryBytes = b.memoryBytes();
-            info.buildMs = elapsedMs();
-            return std::make_unique<Accelerator>(std::move(b), params, std::move(info));
-        }
-        case SchemeKind::Regular:
-            return withLightBuffer<RegularGrid>(
-                scene, params, buffered, guard,
-                [&](AccelInfo& info) {
-                    return RegularGrid::build(scene, params.regular, info.extra, &guard);
-                },
-                elapsedMs);
-        case SchemeKind::Irregular:
-            return withLightBuffer<IrregularSubdivision>(
-                scene, params, buffered, guard,
-                [&](AccelInfo& info) {
-                    return IrregularSubdivision::build(scene, params.irregular, info.extra, &guard);
-                },
-                elapsedMs);
-        case SchemeKind::Bvh:
-            return withLightBuffer<Bvh>(
-                scene, params, buffered, guard,
-                [&](AccelInfo& info) { return Bvh::build(scene, params.bvh, info.extra, &guard); },
-                elapsedMs);
-    }
-    throw std::logic_error("buildAccelerator: unknown scheme");
+    return buildScheme(scene, params, buffered, guard, elapsedMs,
+                       std::make_index_sequence<kSchemeCount>());
 }
 
 }  // namespace lancer

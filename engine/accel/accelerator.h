@@ -1,10 +1,14 @@
 // The acceleration schemes as one closed set: brute force (the reference), the regular
-// subdivision and the irregular subdivision of Arnaldi, Priol and Bouatouch (1986).
+// subdivision and the irregular subdivision of Arnaldi, Priol and Bouatouch (1986), and a BVH
+// (the modern baseline). Each is a class meeting AccelerationScheme, an alternative of
+// Accelerator::Impl at its SchemeKind's index, and a row of kSchemeTable (build_params.h).
 #pragma once
 
+#include <concepts>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <variant>
 
 #include "engine/accel/brute_force.h"
@@ -16,6 +20,24 @@
 #include "engine/accel/regular/regular_grid.h"
 
 namespace lancer {
+
+/// What every scheme is: built from the scene and its own knobs (`S::config` picks them out of
+/// BuildParams; the scheme's figures go to `extra`, the guard bounds and cancels the build),
+/// it walks a ray with any observer (the render's null one, the trace's recording one) and
+/// reports its regions and bytes. Its regions' description lives in structure_view.h.
+template <class S>
+concept AccelerationScheme = requires(const S& s, const Scene& scene, const BuildParams& p,
+                                      nlohmann::json& extra, BuildGuard* guard, const Ray& ray,
+                                      TraceContext& ctx, NullObserver& null, RecordingObserver& rec,
+                                      Hit& hit) {
+    { S::kKind } -> std::convertible_to<SchemeKind>;
+    { S::build(scene, S::config(p), extra, guard) } -> std::same_as<S>;
+    { s.intersect(ray, 0.0, 1.0, ctx, null, hit) } -> std::same_as<bool>;
+    { s.intersect(ray, 0.0, 1.0, ctx, rec, hit) } -> std::same_as<bool>;
+    { s.regionCount() } -> std::convertible_to<size_t>;
+    { s.memoryBytes() } -> std::convertible_to<size_t>;
+    { s.usesMailboxes() } -> std::convertible_to<bool>;
+};
 
 /// What a built structure reports: `--stats` and the viewer show it.
 struct AccelInfo {
@@ -30,6 +52,7 @@ struct AccelInfo {
 
 class Accelerator {
   public:
+    /// The schemes, alternative i being scheme SchemeKind(i) (checked below).
     using Impl = std::variant<BruteForce, RegularGrid, IrregularSubdivision, Bvh>;
 
     /// `eye`: the eye buffer of the camera at `eyeFrom` (eyeBuffer() returns it for a camera
@@ -120,6 +143,19 @@ class Accelerator {
     std::shared_ptr<const LightBuffer> eye_;  ///< the scene camera's eye buffer, or null
     Vec3 eyeFrom_;                            ///< where eye_ was built from
 };
+
+// Each alternative of Accelerator::Impl is a scheme, at its SchemeKind's index: a scheme added
+// to the table but not to Impl (or the other way round, or out of order) does not compile.
+static_assert(std::variant_size_v<Accelerator::Impl> == size_t(kSchemeCount),
+              "Accelerator::Impl holds one alternative per row of kSchemeTable");
+static_assert(
+    []<size_t... I>(std::index_sequence<I...>) {
+        return ((AccelerationScheme<std::variant_alternative_t<I, Accelerator::Impl>> &&
+                 std::variant_alternative_t<I, Accelerator::Impl>::kKind == SchemeKind(I)) &&
+                ...);
+    }(std::make_index_sequence<kSchemeCount>()),
+    "alternative i of Accelerator::Impl meets AccelerationScheme with kKind "
+    "SchemeKind(i)");
 
 /// Build the scheme named in `params` over a prepared scene. Throws std::invalid_argument for
 /// parameters that are refused (for example a max level whose structure would not fit), and

@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "engine/accel/build_params.h"
 #include "engine/accel/eval.h"
 
 namespace lancer {
@@ -10,11 +11,18 @@ namespace lancer {
 /// Brute force has no knobs; its empty config gives every scheme the same build shape.
 struct BruteConfig {};
 
+class BuildGuard;  // engine/accel/build_guard.h
+
 class BruteForce {
   public:
+    static constexpr SchemeKind kKind = SchemeKind::Brute;  ///< its row of kSchemeTable
+    /// Its knobs in `p`: none.
+    static BruteConfig config(const BuildParams& /*p*/) { return {}; }
+
     explicit BruteForce(const Scene& scene) : scene_(&scene) {}
     /// The scheme's build, in the shape every scheme has: nothing to build, nothing to report.
-    static BruteForce build(const Scene& scene, const BruteConfig&, nlohmann::json& /*extra*/) {
+    static BruteForce build(const Scene& scene, const BruteConfig&, nlohmann::json& /*extra*/,
+                            BuildGuard* /*guard*/ = nullptr) {
         return BruteForce(scene);
     }
 

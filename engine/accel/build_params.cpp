@@ -9,17 +9,19 @@
 namespace lancer {
 
 const char* schemeName(SchemeKind k) {
-    switch (k) {
-        case SchemeKind::Brute:
-            return "brute";
-        case SchemeKind::Regular:
-            return "regular";
-        case SchemeKind::Irregular:
-            return "irregular";
-        case SchemeKind::Bvh:
-            return "bvh";
-    }
-    return "?";
+    return size_t(k) < kSchemeTable.size() ? schemeInfo(k).name : "?";
+}
+
+std::optional<SchemeKind> schemeFromName(std::string_view name) {
+    for (const SchemeInfo& s : kSchemeTable)
+        if (name == s.name) return s.kind;
+    return std::nullopt;
+}
+
+std::vector<std::string> schemeNames() {
+    std::vector<std::string> out;
+    for (const SchemeInfo& s : kSchemeTable) out.push_back(s.name);
+    return out;
 }
 
 const char* stepName(StepMethod s) { return s == StepMethod::Exact ? "exact" : "push"; }

@@ -4,17 +4,61 @@
 // panel and its ini file.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <iosfwd>
+#include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "engine/accel/bvh/bvh_config.h"
 
 namespace lancer {
 
+/// The schemes, in kSchemeTable's order (and Accelerator::Impl's alternatives').
 enum class SchemeKind : uint8_t { Brute, Regular, Irregular, Bvh };
-inline constexpr int kSchemeCount = 4;
+
+/// One scheme as the command line, the viewer, the dumps and the bench name and describe it.
+struct SchemeInfo {
+    SchemeKind kind;
+    const char* name;     ///< --scheme, the ini, --stats, trace JSON, bench rows
+    const char* title;    ///< a heading: what the scheme is
+    const char* regions;  ///< what one of its regions is called, plural ("leaves", "zones")
+    const char* help;     ///< one line for --help and the Parameters panel
+};
+
+/// Every scheme, one row each: a scheme added here (with its SchemeKind, its class in
+/// Accelerator::Impl meeting AccelerationScheme, and its Config in BuildParams) is offered by
+/// --scheme, the viewer's panel, `lancer bench` and the report without another change.
+inline constexpr std::array kSchemeTable = {
+    SchemeInfo{SchemeKind::Brute, "brute", "Brute force", "regions",
+               "every primitive and the whole tree for every ray (the reference)"},
+    SchemeInfo{SchemeKind::Regular, "regular", "Regular subdivision", "leaves",
+               "3-axis BSP over the scene, a directory of its leaves, restricted trees "
+               "(the report's section 3)"},
+    SchemeInfo{SchemeKind::Irregular, "irregular", "Irregular subdivision", "zones",
+               "2D screen BSP, depth slabs, corner pointers (the report's section 2)"},
+    SchemeInfo{SchemeKind::Bvh, "bvh", "Bounding volume hierarchy", "nodes",
+               "binned surface-area BVH over the minimized boxes, restricted trees in its "
+               "leaves (the modern baseline)"},
+};
+inline constexpr int kSchemeCount = int(kSchemeTable.size());
+static_assert(
+    [] {
+        for (int k = 0; k < kSchemeCount; ++k)
+            if (kSchemeTable[k].kind != SchemeKind(k)) return false;
+        return true;
+    }(),
+    "kSchemeTable lists the schemes in SchemeKind's order");
+
+/// The table's row of scheme `k`.
+constexpr const SchemeInfo& schemeInfo(SchemeKind k) { return kSchemeTable[size_t(k)]; }
+/// The scheme named `name` (kSchemeTable's names), if any.
+std::optional<SchemeKind> schemeFromName(std::string_view name);
+/// Every scheme's name, in the table's order.
+std::vector<std::string> schemeNames();
 enum class StepMethod : uint8_t { Exact, Push };
 enum class BspHeuristic : uint8_t { First, Balanced, FewestCuts };
 /// Regular scheme: the axis each level of the BSP cuts. Cycle: x, y, z in turn (the report's);

@@ -16,10 +16,10 @@ python3 - "$tmp/ok/scale.json" <<'PY' || fail "scale.json contents"
 import json, sys
 j = json.load(open(sys.argv[1]))
 rows = {r["scheme"]: r for r in j["rows"]}
-assert set(rows) == {"brute", "regular", "irregular"}, rows.keys()  # --no-peer: no Embree
+assert set(rows) == {"brute", "regular", "irregular", "bvh"}, rows.keys()  # --no-peer: no Embree
 b = rows["brute"]
 assert b["stride"] == 1 and b["primitives"] == 11
-for s in ("regular", "irregular"):
+for s in ("regular", "irregular", "bvh"):
     r = rows[s]
     # Every pixel compared with brute force, none differing; the figures of a measured run.
     assert r["pixels_compared"] == b["width"] * b["height"] and r["hits_differing"] == 0, r
@@ -32,6 +32,7 @@ PY
 [ $? -eq 1 ] || fail "a broken limit did not exit 1"
 grep -q "^- builtin:balls:1 regular: peak resident memory" "$tmp/out" || fail "regular not listed: $(cat "$tmp/out")"
 grep -q "^- builtin:balls:1 irregular: peak resident memory" "$tmp/out" || fail "irregular not listed"
+grep -q "^- builtin:balls:1 bvh: peak resident memory" "$tmp/out" || fail "bvh not listed"
 # A child past --kill-after is killed and listed with the step it was in (balls:5 takes longer
 # than 0.1 s to load anywhere), its CPU time and peak; the JSON row names the step.
 "$LANCER" bench --scale --scenes builtin:balls:5 --schemes regular --no-peer --kill-after 0.1 \

@@ -297,23 +297,8 @@ std::string traceCommand(const std::string& scene, const std::string& cameraFile
     os.precision(17);
     os << "lancer trace " << shellWord(scene) << " --camera " << shellWord(cameraFile)
        << " --width " << px.width << " --height " << px.height << " --pixel " << px.x << " " << px.y
-       << " --scheme " << schemeName(b.scheme);
-    // --max-objects is read by the scheme in use (each has its own).
-    if (b.scheme == SchemeKind::Irregular)
-        os << " --max-objects " << maxObjectsText(b.irregular.maxObjects) << " --bsp-heuristic "
-           << heuristicName(b.irregular.heuristic) << " --irregular-frame "
-           << irregularFrameName(b.irregular.frame);
-    else
-        os << " --max-level " << b.regular.maxLevel << " --max-objects "
-           << maxObjectsText(b.regular.maxObjects) << " --step " << stepName(b.regular.step)
-           << " --delta " << b.regular.delta << " --split-axes "
-           << splitAxesName(b.regular.splitAxes);
+       << " --scheme " << toString(b);  // the scheme, its own knobs, mailboxes, light buffer
     os << " --bounces " << sh.bounces << " --offset " << sh.offsetScale;
-    if (b.regular.fullTable && b.scheme == SchemeKind::Regular) os << " --full-table";
-    if (b.scheme == SchemeKind::Irregular ? !b.irregular.costStop : !b.regular.costStop)
-        os << " --no-cost-stop";
-    if (!b.mailboxes) os << " --no-mailbox";
-    if (!b.lightBuffer) os << " --no-light-buffer";
     if (!sh.shadows) os << " --no-shadows";
     if (!sh.reflections) os << " --no-reflections";
     if (!sh.refractions) os << " --no-refractions";

@@ -378,6 +378,14 @@ TEST(Playback, TraceCommandNamesEveryParameter) {
         << cmd;
     EXPECT_NE(cmd.find(" --bounces 1"), std::string::npos);
     EXPECT_NE(cmd.find(" --no-mailbox"), std::string::npos);
+    // Each scheme's own knobs: the BVH's, not the regular scheme's.
+    b.scheme = SchemeKind::Bvh;
+    b.bvh.maxLevel = 10;
+    b.bvh.maxObjects = 3;
+    b.regular.maxLevel = 20;
+    const std::string bvh = traceCommand("s.nff", "/tmp/cam.json", {3, 4, 640, 480}, b, sh);
+    EXPECT_NE(bvh.find(" --scheme bvh --max-level 10 --max-objects 3"), std::string::npos) << bvh;
+    EXPECT_EQ(bvh.find(" --max-level 20"), std::string::npos) << bvh;
 }
 
 }  // namespace

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/accel/bvh/bvh_config.h"
+#include "engine/accel/build_params.h"
 #include "engine/accel/eval.h"
 
 namespace lancer {
@@ -44,6 +44,10 @@ inline constexpr uint32_t kNoNode = 0xffffffffu;
 
 class Bvh {
   public:
+    static constexpr SchemeKind kKind = SchemeKind::Bvh;  ///< its row of kSchemeTable
+    /// Its knobs in `p`.
+    static const BvhConfig& config(const BuildParams& p) { return p.bvh; }
+
     /// Build over a prepared scene; the scheme's figures go to `extra`. Throws
     /// std::invalid_argument naming the option for refused parameters or a structure over the
     /// guard's memory budget, BuildCancelled when its stop is requested. `guard` null: the

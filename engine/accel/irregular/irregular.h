@@ -45,6 +45,10 @@ class BuildGuard;  // build_guard.h
 
 class IrregularSubdivision {
   public:
+    static constexpr SchemeKind kKind = SchemeKind::Irregular;  ///< its row of kSchemeTable
+    /// Its knobs in `p`.
+    static const IrregularConfig& config(const BuildParams& p) { return p.irregular; }
+
     /// Build over a prepared scene from scene.camera; scheme figures go to `extra`. Throws
     /// std::invalid_argument for refused parameters or a structure over its limits,
     /// BuildCancelled when `guard`'s stop is requested. Within the guard's memory budget the 2D

@@ -61,6 +61,10 @@ inline constexpr uint32_t kBorder = 0xfffffffeu;
 
 class RegularGrid {
   public:
+    static constexpr SchemeKind kKind = SchemeKind::Regular;  ///< its row of kSchemeTable
+    /// Its knobs in `p`.
+    static const RegularConfig& config(const BuildParams& p) { return p.regular; }
+
     /// BSP nodes allowed while building (4M: about 200 MiB of nodes, leaves and tables). An
     /// absurd max-level / max-objects pair is refused after bounded work (a few seconds at
     /// most) even under a large memory budget; the largest useful builds measured (lattice at
