@@ -290,6 +290,7 @@ TEST(MinimizedBoxes, IteratesToAFixedPoint) {
 
 TEST(MinimizedBoxes, EveryVisibleHitLiesInItsPrimitivesBox) {
     NullObserver obs;
+    size_t hits = 0;  // the rays must hit: a test of no hit would check nothing
     for (uint64_t seed = 1; seed <= 40; ++seed) {
         Scene s = test::randomCsgScene(seed);
         BuildParams bp;
@@ -300,6 +301,7 @@ TEST(MinimizedBoxes, EveryVisibleHitLiesInItsPrimitivesBox) {
             Hit h;
             ctx.beginRay();
             if (!brute->intersect(r, 0.0, kInf, ctx, obs, h)) continue;
+            ++hits;
             Vec3 p = r.at(h.t);
             Box3 b = s.minBox[h.prim];
             Vec3 slack = Vec3(1e-9 * std::max(1.0, glm::length(p)));
@@ -309,6 +311,7 @@ TEST(MinimizedBoxes, EveryVisibleHitLiesInItsPrimitivesBox) {
                 << toString(p) << " outside " << b.toString();
         }
     }
+    EXPECT_GT(hits, 40u * 500u / 10u);
 }
 
 // Within any box region, the tree restricted to the primitives whose minimized boxes overlap

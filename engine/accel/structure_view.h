@@ -133,8 +133,6 @@ class ZoneFrameView {
     size_t zoneCount() const { return bsp_->zoneCount(); }
     /// Regions of this frame's slabs (the near region not counted).
     size_t slabCount() const;
-    /// Region id of the first slab of zone 0.
-    uint32_t firstRegion() const { return first_; }
 
     /// Every node with its depth and its cut clipped to the node's cell, in cut order.
     std::vector<BspCut> cuts() const;
@@ -174,8 +172,8 @@ class ZoneFrameView {
     ZoneFrameKind kind_;
     const ScreenBsp* bsp_;
     glm::dvec2 lo_{0.0}, hi_{0.0};
-    uint32_t first_ = 0;
-    double half_ = 1.0;  ///< half the image height in frame units (ortho height / 2, tan(fov/2))
+    uint32_t first_ = 0;  ///< region id of the first slab of zone 0
+    double half_ = 1.0;   ///< half the image height in frame units (ortho height / 2, tan(fov/2))
 };
 
 /// The description of a built structure; holds references to the scene and the accelerator,
