@@ -271,6 +271,13 @@ template <class Obs, class Test>
 /// observer is still shown the tree's evaluation). `tree` null: the region keeps no tree, only
 /// its primitives, of a union-only scene (the irregular scheme's regions there); they are
 /// merged by flatUnion for every observer, and the region is empty when `count` is 0.
+/// A leaf with a tree over more primitives than this is evaluated as brute force evaluates the
+/// scene: lazily, a difference or intersection whose left side is empty along the ray leaving
+/// its right side untested, instead of testing every primitive first for the pending check. On
+/// OpenSCAD's example024 (a turned sponge whose one leaf holds 221 primitives) the up-front
+/// tests made 120 tests per ray against brute force's 61 (docs/model.md, "Large leaves").
+inline constexpr uint32_t kLazyLeafPrims = 16;
+
 template <class Obs>
 [[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree* tree, int root,
                                              const uint32_t* prims, uint32_t count, const Ray& ray,
@@ -284,6 +291,14 @@ template <class Obs>
     } else if (pend.next < t0) {
         pend.advance(t0);
     }
+    if (tree && !unionOnly && count > kLazyLeafPrims) {
+        pend.incomplete = true;
+        evalTree<Obs, Fetch::Counted>(scene, *tree, root, ray, ctx, obs, 0, ctx.result);
+        if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
+        const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
+        if (b) hit = {b->t, b->prim, b->part, b->flip};
+        return b != nullptr;
+    }
     const double from = std::max(t0, tmin);  // boundaries must be >= t0 and > tmin
     for (uint32_t i = 0; i < count; ++i) {
         bool fresh;
@@ -295,7 +310,7 @@ template <class Obs>
             if (s.out.t >= from && s.out.t > tmin) pend.add(s.out.t);
         }
     }
-    if (!(pend.next <= t1) && !Obs::kActive)
+    if (!(pend.next <= t1) && !pend.incomplete && !Obs::kActive)
         return false;  // the observer is shown the spans anyway
     if (!tree || (unionOnly && !Obs::kActive)) {
         mergeHeldSpans(prims, count, ctx);

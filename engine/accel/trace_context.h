@@ -43,10 +43,14 @@ struct Mailbox {
 struct PendingBoundaries {
     std::vector<double> t;  ///< unordered; those behind the walk are dropped lazily
     double next = kInf;     ///< the least of t
+    /// A leaf of this ray evaluated its tree lazily (hitInLeaf, kLazyLeafPrims): the primitives
+    /// it tested added nothing here, so `next` no longer bounds the boundaries to come.
+    bool incomplete = false;
 
     void clear() {
         t.clear();
         next = kInf;
+        incomplete = false;
     }
     void add(double x) {
         t.push_back(x);

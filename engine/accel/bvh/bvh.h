@@ -186,6 +186,17 @@ template <class Obs>
     }
     if (n.root < 0) return false;
     if (!ctx.useMailboxes) ctx.newStamp();
+    // A leaf over more than kLazyLeafPrims primitives evaluates its tree lazily, as hitInLeaf
+    // does (eval.h): on builtin:lattice:6 its up-front tests made 253 tests per ray, brute
+    // force 149, the lazy tree 89. Smaller ones test their primitives first and evaluate the
+    // tree only when one has a boundary inside the leaf's box.
+    if (n.count > kLazyLeafPrims) {
+        evalTree<Obs, Fetch::Counted>(*scene_, pool_, n.root, ray, ctx, obs, 0, ctx.result);
+        if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
+        const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
+        if (b) hit = {b->t, b->prim, b->part, b->flip};
+        return b != nullptr;
+    }
     // Every boundary of a CSG result is a boundary of one of its primitives: when none of the
     // leaf's primitives has one in the window, the tree is not evaluated. Unlike the regular
     // walk's pending boundaries, this holds whatever order the leaves come in.
