@@ -133,10 +133,12 @@ class ViewerApp {
     /// Upload rows [rowBegin, rowEnd) (-1: to the last) of the image on screen, with the heat
     /// values the state gives (a counter, or an A/B's).
     void uploadImage(int rowBegin, int rowEnd);
-    /// The hover tooltip and Ctrl+click picking over the image (mouse not taken by ImGui).
-    void overlayInput(int fbWidth, int fbHeight);
-    /// Steps 5 of frame(): the overlays' layer handed to the image view, and its timing.
-    void prepareOverlays(int fbWidth, int fbHeight);
+    /// The hover tooltip and Ctrl+click picking over the image viewport (mouse not taken by
+    /// ImGui).
+    void overlayInput();
+    /// Steps 5 of frame(): the overlays' layer (imageW x imageH, the image's size) handed to
+    /// the image view, and its timing.
+    void prepareOverlays(int imageW, int imageH);
     /// The overlays' and the inspector's options and camera into the settings the ini is
     /// written from (marked to be saved when they changed).
     void keepSettings();

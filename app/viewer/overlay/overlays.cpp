@@ -124,12 +124,12 @@ void Overlays::drawLayers(const Camera& view, int width, int height, size_t line
     renderer_->draw(*cuts_, toClip, cuts);
 }
 
-void Overlays::drawSelection(const Camera& view, int width, int height) {
+void Overlays::drawSelection(const Camera& view, int width, int height, int x0, int y0) {
     if (!view_ || width <= 0 || height <= 0) return;
     if (!selection_ || selection_->region >= view_->regionCount()) return;
     const auto [nearDepth, farDepth] = clipDepths(*view_, view);
     const glm::mat4 toClip = gl::worldToClip(view, width, height, nearDepth, farDepth);
-    glViewport(0, 0, width, height);
+    glViewport(x0, y0, width, height);
     // The selected region: its faces tinted, its edges bright.
     const std::array<Vec3, 8> wc = view_->regionCorners(selection_->region);
     std::array<glm::vec3, 8> c;
