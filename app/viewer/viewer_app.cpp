@@ -177,6 +177,18 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     more.inspector = [this](bool* open) { inspector_->panel(open); };
     more.ray = [this](bool* open) { rayPanel(state_, player_, open); };
     drawPanels(state_, layout_, panelHeights_, more);
+    // The keys of the overlays and the heat map, in the image viewport's corner.
+    KeyInput keys;
+    keys.image = layout_.image;
+    if (overlays_->view()) {
+        keys.overlays = &overlays_->options;
+        keys.geometry = &overlays_->geometry();
+    }
+    keys.mode = s.mode;
+    keys.heatScale = state_.heatScale();
+    keys.logScale = s.logScale;
+    keys.diverging = state_.heatDiverging();
+    keys_ = drawKeys(keys);
     state_.startWork(imageW, imageH);
     ImGui::Render();
 

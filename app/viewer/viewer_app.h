@@ -16,6 +16,7 @@
 #include "app/viewer/inspector/inspector.h"
 #include "app/viewer/overlay/overlays.h"
 #include "app/viewer/panel_cache.h"
+#include "app/viewer/panels/keys.h"
 #include "app/viewer/panels/panels.h"
 #include "app/viewer/playback/ray_player.h"
 #include "app/viewer/viewer_state.h"
@@ -128,6 +129,8 @@ class ViewerApp {
     PanelCache& panelLayer() { return panels_; }
     /// Where the last frame put the panels, the image and the inspector (display units).
     const PanelLayout& layout() const { return layout_; }
+    /// The colour keys the last frame drew over the image viewport's corner, and where.
+    const KeyReport& keys() const { return keys_; }
 
   private:
     /// Upload rows [rowBegin, rowEnd) (-1: to the last) of the image on screen, with the heat
@@ -165,6 +168,7 @@ class ViewerApp {
     PanelCache panels_;          ///< ImGui's panels, each redrawn only when it changed
     PanelHeights panelHeights_;  ///< what each panel asked for last frame
     PanelLayout layout_;         ///< where this frame's panels, image and inspector go
+    KeyReport keys_;             ///< the colour keys drawn this frame
     bool settled_ = false;
 };
 

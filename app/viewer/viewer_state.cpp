@@ -59,8 +59,8 @@ void ViewerState::updateAutoScale() {
     if (s_.mode == ViewMode::Color) return;
     const compare::CounterImage* old = diff_.old();
     if (abStatus_.comparable && ab_ == compare::AbView::Diff) {
-        autoScale_ = compare::diffAutoScale(
-            compare::diffChannel(*old, shown_, s_.mode, 0, abStatus_.rows, abStatus_.rows));
+        autoScale_ = decadeScale(compare::diffAutoScale(
+            compare::diffChannel(*old, shown_, s_.mode, 0, abStatus_.rows, abStatus_.rows)));
         return;
     }
     autoScale_ = autoScale(heatChannel(shown_, s_.mode));
@@ -73,6 +73,9 @@ void ViewerState::updateAutoScale() {
         }
         autoScale_ = std::max(autoScale_, oldScale_[int(s_.mode)]);
     }
+    // Whole decades: the key reads 1, 10, 100, ..., and a rebuild that keeps the 99th
+    // percentile within its decade keeps the colours.
+    autoScale_ = decadeScale(autoScale_);
 }
 
 void ViewerState::setAbView(compare::AbView v) {

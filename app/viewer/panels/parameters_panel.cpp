@@ -94,7 +94,7 @@ void parametersPanel(ViewerState& st) {
         ImGui::Text("regions %zu, memory %s", ai.regions, formatBytes(ai.memoryBytes).c_str());
         if (const std::string why = stopReasonsLine(ai.extra, b->accel->params().scheme);
             !why.empty()) {
-            ImGui::TextUnformatted(why.c_str());
+            ImGui::TextWrapped("%s", why.c_str());
             if (ImGui::IsItemHovered())
                 ImGui::SetTooltip(
                     "Why each cell was not split: it held at most max-objects primitives, it "
