@@ -4,11 +4,10 @@
 
 #include <gtest/gtest.h>
 
-#include "app/viewer/colormap.h"
-
 #include <glm/vec4.hpp>
 #include <random>
 
+#include "app/viewer/colormap.h"
 #include "app/viewer/gl/transforms.h"
 
 namespace lancer::viewer::inspector {

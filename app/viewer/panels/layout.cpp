@@ -82,10 +82,28 @@ void stack(const std::vector<PanelId>& ids, const Rect& col, const LayoutInput& 
         for (size_t i : which) w.push_back(want(i));
         return w;
     };
+    // Each keeps a title bar and two lines; a column too short for that and a usable Ray
+    // panel keeps the others to a title bar and one line, so the step list stays readable.
     float extra = room;
     for (size_t i : expanded) {
         h[i] = std::min(want(i), keep);
         extra -= h[i];
+    }
+    const bool ray = std::any_of(expanded.begin(), expanded.end(),
+                                 [&](size_t i) { return ids[i] == PanelId::Ray; });
+    if (ray && extra < kUsablePanelHeight - keep) {
+        const float tight = std::ceil(2.0f * title);
+        for (size_t i : others) {
+            const float t = std::min(want(i), tight);
+            extra += h[i] - t;
+            h[i] = t;
+        }
+        for (size_t i : expanded)  // the Selection panel too, if still short
+            if (ids[i] == PanelId::Selection && extra < kUsablePanelHeight - keep) {
+                const float t = std::min(want(i), tight);
+                extra += h[i] - t;
+                h[i] = t;
+            }
     }
     std::vector<float> shared;
     if (extra < 0.0f) {

@@ -81,7 +81,7 @@ struct PanelLayout {
 
 /// The height the Ray panel, then the Selection panel, get before the others when a column's
 /// panels do not fit (the Ray panel's pixel, counts, rays and transport), room permitting.
-inline constexpr float kUsablePanelHeight = 260.0f;
+inline constexpr float kUsablePanelHeight = 380.0f;
 
 /// The menu bar's height the panels stay under.
 inline constexpr float kMenuBarHeight = 28.0f;
