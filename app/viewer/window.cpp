@@ -290,8 +290,11 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 if (!v.screenshot.empty() && status == 0) {
                     try {
                         app.saveScreenshot(v.screenshot, fbw, fbh);
+                        // Where the image viewport is, so a script finds the render in it.
+                        const PixelRect& ia = app.state().imageArea();
                         std::cout << "lancer view: " << frames << " frames, screenshot "
-                                  << v.screenshot << played << "\n";
+                                  << v.screenshot << played << ", image " << ia.x1 - ia.x0 << "x"
+                                  << ia.y1 - ia.y0 << " at " << ia.x0 << "," << ia.y0 << "\n";
                     } catch (const std::exception& e) {
                         std::cerr << "error: --screenshot: " << e.what() << "\n";
                         status = 2;
