@@ -333,7 +333,7 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
     const float line = ImGui::GetTextLineHeightWithSpacing();
     const float least = kStepLines * line + 2.0f * ImGui::GetStyle().WindowPadding.y;
     const float listH = std::max(least, ImGui::GetContentRegionAvail().y - restHeight);
-    if (ImGui::BeginChild("steps", ImVec2(0, listH), true)) {
+    if (ImGui::BeginChild("steps", ImVec2(0, listH), true, ImGuiWindowFlags_HorizontalScrollbar)) {
         size_t step = 0, regionNo = 0;
         for (size_t i = 0; i < ray.events.size(); ++i) {
             const bool current = i >= s.eventBegin && i < s.eventEnd;
@@ -365,7 +365,7 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
     if (s.step >= 0 && size_t(s.step) < why.size())
         ImGui::TextWrapped("why: %s", why[size_t(s.step)].text.c_str());
     // The tree: one line per ray, as `lancer trace` prints it; a click plays that ray.
-    if (ImGui::BeginChild("rays", ImVec2(0, 90), true)) {
+    if (ImGui::BeginChild("rays", ImVec2(0, 90), true, ImGuiWindowFlags_HorizontalScrollbar)) {
         for (size_t k = 0; k < tree.rays.size(); ++k) {
             const TracedRay& r = tree.rays[k];
             std::string line(size_t(2 * r.depth + (r.kind == RayKind::Shadow ? 2 : 0)), ' ');
