@@ -83,7 +83,8 @@ void stack(const std::vector<PanelId>& ids, const Rect& col, const LayoutInput& 
         return w;
     };
     // Each keeps a title bar and two lines; a column too short for that and a usable Ray
-    // panel keeps the others to a title bar and one line, so the step list stays readable.
+    // panel keeps the others to their title bar (a line cut in half reads worse than none), so
+    // the step list stays readable; folding the Ray panel gives them their room back.
     float extra = room;
     for (size_t i : expanded) {
         h[i] = std::min(want(i), keep);
@@ -92,7 +93,7 @@ void stack(const std::vector<PanelId>& ids, const Rect& col, const LayoutInput& 
     const bool ray = std::any_of(expanded.begin(), expanded.end(),
                                  [&](size_t i) { return ids[i] == PanelId::Ray; });
     if (ray && extra < kUsablePanelHeight - keep) {
-        const float tight = std::ceil(2.0f * title);
+        const float tight = title;
         for (size_t i : others) {
             const float t = std::min(want(i), tight);
             extra += h[i] - t;

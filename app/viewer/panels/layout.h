@@ -80,7 +80,8 @@ struct PanelLayout {
 };
 
 /// The height the Ray panel, then the Selection panel, get before the others when a column's
-/// panels do not fit (the Ray panel's pixel, counts, rays and transport), room permitting.
+/// panels do not fit: the Ray panel's pixel, counts, transport and 8 lines of its step list at
+/// 1280x720, room permitting.
 inline constexpr float kUsablePanelHeight = 380.0f;
 
 /// The menu bar's height the panels stay under.
@@ -93,18 +94,19 @@ inline constexpr float kHandleWidth = 8.0f;
 /// The least width or height the image (and the inspector) keep when a handle is dragged.
 inline constexpr float kMinViewportSide = 160.0f;
 
-/// Polyscope's arrangement: the panels stack in a column on the left and, when the window is
-/// wide enough, a second on the right (the parameters on the left, the view and statistics on
-/// the right, the others in the column with more room), so the image keeps the middle. With the
-/// inspector shown, the inspector takes the right half of what the panels leave, and a second
+/// Polyscope's arrangement, docked: the panels stack in a column on the left and, when the
+/// window is wide enough, a second on the right (the parameters on the left, the view and
+/// statistics on the right, the others in the column with more room); the image viewport is
+/// what they leave, each column's inner edge a drag handle. With the inspector shown, the
+/// inspector takes the viewport's right part (imageShare, with a handle between), and a second
 /// column (the Inspector, Selection and Ray panels) stands right of it only when one column
 /// cannot hold the open panels and the image and the inspector keep 400 units each. A column's
 /// panels share its height: each gets what its content asks for while they all fit; else each
-/// keeps a title bar and two lines, the Ray panel then the Selection panel grow to
+/// keeps a title bar and two lines (only its title bar when that would leave the Ray panel less
+/// than kUsablePanelHeight), the Ray panel then the Selection panel grow to
 /// kUsablePanelHeight, the others are cut down to a common height and scroll, and what they
-/// leave goes to the Selection panel, then the Ray panel (whose step list fills what it is
-/// given). A folded panel takes its title bar. Nothing overlaps, and everything stays inside the
-/// window at any size.
+/// leave goes to the Selection panel, then the Ray panel. A folded panel takes its title bar.
+/// Nothing overlaps, and everything stays inside the window at any size.
 PanelLayout layoutPanels(const LayoutInput& in);
 
 /// The window size whose layout (`in`, its width and height ignored) gives an image viewport
