@@ -99,6 +99,7 @@ class ViewerState {
     /// Where the image viewport lies in the framebuffer this frame (pixels, row 0 at the top):
     /// every mapping between the mouse and an image pixel goes through it.
     const PixelRect& imageArea() const { return imageArea_; }
+    /// Set by the frame from the layout, before the panels and the input read it.
     void setImageArea(const PixelRect& r) { imageArea_ = r; }
     /// The image pixel under the mouse, if the mouse is over the image viewport.
     std::optional<std::pair<int, int>> pixelUnderMouse() const;
@@ -165,7 +166,7 @@ class ViewerState {
     void presented();
 
   private:
-    PixelRect imageArea_;
+    PixelRect imageArea_;  ///< the image viewport this frame (framebuffer pixels)
     struct SpeedupJob {
         std::atomic<bool> cancel{false}, done{false};
         SpeedupResult result;
