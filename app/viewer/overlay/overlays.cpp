@@ -424,8 +424,11 @@ void Overlays::selectionPanel(bool* open) {
     }
     if (ImGui::CollapsingHeader("neighbours", ImGuiTreeNodeFlags_DefaultOpen)) {
         const bool regular = r.kind == RegionKind::Leaf;
-        ImGui::TextDisabled(regular ? "ropes across each face"
-                                    : "corner pointers (the region beyond each face's corner)");
+        ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+        ImGui::TextWrapped("%s", regular
+                                     ? "ropes across each face"
+                                     : "corner pointers (the region beyond each face's corner)");
+        ImGui::PopStyleColor();
         static const char* axes[3] = {"x", "y", "z"};
         std::optional<uint32_t> go;
         for (int a = 0; a < 3; ++a)
