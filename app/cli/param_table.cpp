@@ -110,8 +110,9 @@ std::vector<ParamDesc> makeTable() {
          .metavar = "M",
          .iniKey = "step",
          .label = "step",
-         .help = "Next-cell method: exact, or the report's push (lancer view with --pick: the "
-                 "playback step to stop at instead, first, last or N from 0)",
+         .help =
+             "Next-cell method: exact, or the report's push (lancer view with --pick: the "
+             "playback step to stop at instead, first, last or N from 0)",
          .kind = ParamKind::Enum};
     d.names = {"exact", "push"};
     d.schemes = kRegular;
@@ -500,7 +501,7 @@ void applyAssignments(const std::string& list, Knobs& k) {
 }
 
 std::string optionsMarkdown() {
-    static const char* reach[] = {"panel", "window size", "at start", "batch only"};
+    static const char* reach[] = {"panel", "image size", "at start", "batch only"};
     const Knobs defaults;
     std::ostringstream o;
     o << "| option | values | default | schemes | viewer | what it does |\n"

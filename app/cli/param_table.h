@@ -26,7 +26,8 @@ struct Knobs {
     }();
     ShadingOptions shading;  ///< bounces, shadows, reflections, refractions, offset
     int threads = 0;         ///< render threads (0: all cores)
-    /// Image size; 0: the scene's own (the other follows its aspect). The viewer's window size.
+    /// Image size; 0: the scene's own (the other follows its aspect). The viewer's image viewport
+    /// (the window opens around it with the panels).
     int width = 0, height = 0;
     std::string cameraPath;  ///< --camera: a .camera.json replacing the scene's camera
     std::string statsPath;   ///< --stats: statistics as JSON

@@ -47,6 +47,48 @@ glm::vec3 colormap(float v) {
     return s[size_t(i)] * (1.0f - f) + s[size_t(i) + 1] * f;
 }
 
+glm::vec3 levelColor(int level) {
+    if (level < 0) level = 0;
+    if (level >= kLevelRamp) return glm::vec3(1.0f);
+    const float hue = 0.8f * float(level) / float(kLevelRamp - 1) * 6.0f;  // red .. violet
+    const float x = 1.0f - std::abs(std::fmod(hue, 2.0f) - 1.0f);
+    glm::vec3 c;
+    switch (int(hue) % 6) {
+        case 0:
+            c = {1, x, 0};
+            break;
+        case 1:
+            c = {x, 1, 0};
+            break;
+        case 2:
+            c = {0, 1, x};
+            break;
+        case 3:
+            c = {0, x, 1};
+            break;
+        case 4:
+            c = {x, 0, 1};
+            break;
+        default:
+            c = {1, 0, x};
+            break;
+    }
+    return 0.25f + 0.75f * c;  // never black: a line on a dark image
+}
+
+float countPosition(double count) {
+    if (!(count > 1.0)) return 0.0f;
+    return std::clamp(float(std::log10(count)) / float(kCountDecades), 0.0f, 1.0f);
+}
+
+glm::vec3 countColor(double count) { return colormap(0.3f + 0.7f * countPosition(count)); }
+
+float decadeScale(float p99) {
+    if (!(p99 > 1.0f)) return 1.0f;
+    const float d = std::pow(10.0f, std::ceil(std::log10(p99) - 1e-6f));
+    return d < p99 ? d * 10.0f : d;
+}
+
 std::vector<float> heatChannel(const Image& img, ViewMode mode, int rowBegin, int rowEnd) {
     size_t first, last;
     img.pixelRange(rowBegin, rowEnd, first, last);

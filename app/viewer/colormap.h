@@ -37,6 +37,26 @@ float autoScale(const std::vector<float>& heat);
 /// scale log(1 + count) / log(1 + scale) (the shader computes the same).
 float heatValue(float count, float scale, bool logScale);
 
+/// Levels coloured the same in every build: BSP levels, screen-BSP cut depths, slab order in
+/// depth, sub-table depth. Level k < kLevelRamp has hue from red (0) to violet
+/// (kLevelRamp - 1) in even steps; deeper levels are all white. Never relative to the deepest
+/// level a build has, so a colour names one level across rebuilds.
+inline constexpr int kLevelRamp = 24;
+glm::vec3 levelColor(int level);
+/// Counts (primitives per leaf or zone, slabs per zone) on a fixed log scale: 1 to
+/// 10^kCountDecades spread evenly by decade over the colour map from its purple to its pale
+/// yellow; 0 and 1 share the bottom, more than 10^kCountDecades the top.
+inline constexpr int kCountDecades = 3;
+/// Where `count` falls on that scale, in [0, 1].
+float countPosition(double count);
+/// Its colour: colormap(0.3 + 0.7 * countPosition(count)) (the map's dark third does not read
+/// as a line on a dark image).
+glm::vec3 countColor(double count);
+/// The heat maps' automatic scale: the power of ten at or above `p99` (at least 1), so the
+/// key's ends are whole decades and a rebuild whose 99th percentile stays within the decade
+/// keeps the scale.
+float decadeScale(float p99);
+
 /// A difference channel's value for a pixel with nothing to compare (the new image has not
 /// reached it): drawn as grey stripes, unlike any value of the map. Counters differ by far less.
 inline constexpr float kNoDiff = 1e30f;

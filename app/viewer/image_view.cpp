@@ -177,17 +177,28 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
-    if (covered.empty() || width_ != fbWidth || height_ != fbHeight) {
-        glBlitFramebuffer(0, 0, width_, height_, 0, 0, fbWidth, fbHeight, GL_COLOR_BUFFER_BIT,
-                          GL_NEAREST);
+    const PixelRect d = viewport(fbWidth, fbHeight);
+    const int dw = d.x1 - d.x0, dh = d.y1 - d.y0;
+    if (covered.empty() || width_ != dw || height_ != dh) {
+        glBlitFramebuffer(0, 0, width_, height_, d.x0, fbHeight - d.y1, d.x1, fbHeight - d.y0,
+                          GL_COLOR_BUFFER_BIT, GL_NEAREST);
     } else {
         // One texel per pixel: each uncovered rectangle is copied as is (GL's rows go up).
-        for (const PixelRect& r : uncovered(fbWidth, fbHeight, covered))
-            glBlitFramebuffer(r.x0, fbHeight - r.y1, r.x1, fbHeight - r.y0, r.x0, fbHeight - r.y1,
-                              r.x1, fbHeight - r.y0, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+        std::vector<PixelRect> inImage;
+        for (const PixelRect& c : covered)
+            inImage.push_back({c.x0 - d.x0, c.y0 - d.y0, c.x1 - d.x0, c.y1 - d.y0});
+        for (const PixelRect& r : uncovered(dw, dh, inImage))
+            glBlitFramebuffer(r.x0, dh - r.y1, r.x1, dh - r.y0, d.x0 + r.x0, fbHeight - d.y0 - r.y1,
+                              d.x0 + r.x1, fbHeight - d.y0 - r.y0, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
+}
+
+PixelRect ImageView::viewport(int fbWidth, int fbHeight) const {
+    if (viewport_.x1 <= viewport_.x0 || viewport_.y1 <= viewport_.y0)
+        return {0, 0, fbWidth, fbHeight};
+    return viewport_;
 }
 
 void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging, int rowBegin,

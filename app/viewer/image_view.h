@@ -38,18 +38,23 @@ class ImageView {
     /// its size differs), e.g. an A/B's difference; it must hold one value per pixel of them.
     void upload(const Image& img, ViewMode mode, int rowBegin = 0, int rowEnd = -1,
                 const std::vector<float>* heat = nullptr);
-    /// Draw the uploaded image over the whole viewport of a fbWidth x fbHeight framebuffer
-    /// (framebuffer 0); heat maps divide the counter by `scale`. Nothing is drawn before the
-    /// first upload. The shader runs once per upload, mode or scale, into a texture; each frame
-    /// then only copies that texture (a blit), which software GL does far faster than shading.
-    /// Pixels inside `covered` (opaque panels drawn over the image next) are left as they are:
-    /// under software GL the copy costs 7 ns a pixel. `logScale`: heat maps show
-    /// heatValue(count, scale, true). `diverging`: the heat values are signed differences,
-    /// drawn on the diverging map (divergingColor(diffValue(d, scale, logScale)); kNoDiff as
-    /// grey stripes).
+    /// Draw the uploaded image into viewport() of a fbWidth x fbHeight framebuffer
+    /// (framebuffer 0), scaled if its size differs; heat maps divide the counter by `scale`.
+    /// Nothing is drawn before the first upload. The shader runs once per upload, mode or scale,
+    /// into a texture; each frame then only copies that texture (a blit), which software GL does
+    /// far faster than shading. Pixels inside `covered` (framebuffer pixels: opaque menus or popups
+    /// drawn over the image next) are left as they are: under software GL the copy costs 7 ns a
+    /// pixel. `logScale`: heat maps show heatValue(count, scale, true). `diverging`: the heat
+    /// values are signed differences, drawn on the diverging map (divergingColor(diffValue(d,
+    /// scale, logScale)); kNoDiff as grey stripes).
     void draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
               const std::vector<PixelRect>& covered = {}, bool logScale = false,
               bool diverging = false) const;
+    /// Where draw() puts the image: a rectangle of the framebuffer (row 0 at the top), the
+    /// image viewport the panels leave; empty (the default): the whole framebuffer.
+    void setViewport(const PixelRect& r) { viewport_ = r; }
+    /// The rectangle draw() fills in a fbWidth x fbHeight framebuffer.
+    PixelRect viewport(int fbWidth, int fbHeight) const;
     /// Composite a layer over the image when it is shaded: `texture` an RGBA8 texture of
     /// premultiplied colour drawn like the framebuffer (row 0 at the bottom), any size; 0: none.
     /// A new `version` shades the whole image again; otherwise only uploaded rows are, so a
@@ -76,6 +81,7 @@ class ImageView {
     /// pass each time).
     mutable RowRange dirty_;
     int width_ = 0, height_ = 0;
+    PixelRect viewport_;
     unsigned overlayTex_ = 0;
     uint64_t overlayVersion_ = 0;
     int locOverlay_ = -1, locHasOverlay_ = -1;

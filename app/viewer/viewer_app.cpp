@@ -91,20 +91,22 @@ void ViewerApp::pickPixel(int x, int y, int ray, int step) {
 
 namespace {
 
-/// A Shift+click on the image (outside the inspector and the panels) picks the pixel for the
-/// ray playback; a Ctrl+click is the overlays' pick of a region.
-std::optional<glm::ivec2> shiftClick(int fbWidth, int fbHeight, const PixelRect* inspector) {
+/// A Shift+click on the image viewport picks the pixel for the ray playback; a Ctrl+click is
+/// the overlays' pick of a region.
+std::optional<glm::ivec2> shiftClick(const ViewerState& st) {
     ImGuiIO& io = ImGui::GetIO();
     if (io.WantCaptureMouse || !io.KeyShift || io.KeyCtrl ||
-        !ImGui::IsMouseClicked(ImGuiMouseButton_Left) || !ImGui::IsMousePosValid())
+        !ImGui::IsMouseClicked(ImGuiMouseButton_Left))
         return std::nullopt;
-    const int x = int(io.MousePos.x * io.DisplayFramebufferScale.x);
-    const int y = int(io.MousePos.y * io.DisplayFramebufferScale.y);
-    if (x < 0 || y < 0 || x >= fbWidth || y >= fbHeight) return std::nullopt;
-    if (inspector && x >= inspector->x0 && x < inspector->x1 && y >= inspector->y0 &&
-        y < inspector->y1)
-        return std::nullopt;
-    return glm::ivec2(x, y);
+    const auto px = st.pixelUnderMouse();
+    if (!px) return std::nullopt;
+    return glm::ivec2(px->first, px->second);
+}
+
+/// `r` (display units) in framebuffer pixels.
+PixelRect toPixels(const Rect& r, glm::vec2 scale) {
+    return {int(std::lround(r.x0 * scale.x)), int(std::lround(r.y0 * scale.y)),
+            int(std::lround(r.x1 * scale.x)), int(std::lround(r.y1 * scale.y))};
 }
 
 }  // namespace
@@ -121,9 +123,15 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     const ImGuiIO& io = ImGui::GetIO();
     layout_ = planPanels(state_, panelHeights_, io.DisplaySize.x, io.DisplaySize.y);
     const glm::vec2 scale(io.DisplayFramebufferScale.x, io.DisplayFramebufferScale.y);
-    const Rect& ir = layout_.inspector;
-    inspector_->setArea({int(std::lround(ir.x0 * scale.x)), int(std::lround(ir.y0 * scale.y)),
-                         int(std::lround(ir.x1 * scale.x)), int(std::lround(ir.y1 * scale.y))});
+    inspector_->setArea(toPixels(layout_.inspector, scale));
+    // The image viewport: the render's size, and where mouse and pixels meet.
+    PixelRect area = toPixels(layout_.image, scale);
+    area.x0 = std::clamp(area.x0, 0, fbWidth);
+    area.x1 = std::clamp(area.x1, area.x0, fbWidth);
+    area.y0 = std::clamp(area.y0, 0, fbHeight);
+    area.y1 = std::clamp(area.y1, area.y0, fbHeight);
+    state_.setImageArea(area);
+    const int imageW = area.x1 - area.x0, imageH = area.y1 - area.y0;
     inspector_->setShown(s.showInspector);
     inspector_->update(state_.sceneBuild(),
                        {state_.camera(), std::max(state_.width(), 1), std::max(state_.height(), 1)},
@@ -133,17 +141,15 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     if (inspector_->handleMouse(fbWidth, fbHeight, picked)) {
         if (picked) selectRegion(*picked);
     } else {
-        handleMouse(state_, fbHeight);
-        overlayInput(fbWidth, fbHeight);
+        handleMouse(state_, imageH);
+        overlayInput();
     }
     handleKeys(state_);
 
     // 2b. Ray playback: a Shift+click picks a pixel; the pick is traced, traced again after a
     // rebuild, and played on the frame's clock. The current region is the selection, so the
     // inspector highlights it.
-    const PixelRect inspectorArea = inspector_->area(fbWidth, fbHeight);
-    if (std::optional<glm::ivec2> px =
-            shiftClick(fbWidth, fbHeight, inspector_->shown() ? &inspectorArea : nullptr)) {
+    if (std::optional<glm::ivec2> px = shiftClick(state_)) {
         player_.pick(px->x, px->y);
         s.showRay = true;
     }
@@ -171,21 +177,43 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     more.inspector = [this](bool* open) { inspector_->panel(open); };
     more.ray = [this](bool* open) { rayPanel(state_, player_, open); };
     drawPanels(state_, layout_, panelHeights_, more);
-    state_.startWork(fbWidth, fbHeight);
+    // The keys of the overlays and the heat map, in the image viewport's corner.
+    KeyInput keys;
+    keys.image = layout_.image;
+    if (overlays_->view()) {
+        keys.overlays = &overlays_->options;
+        keys.geometry = &overlays_->geometry();
+    }
+    keys.mode = s.mode;
+    keys.heatScale = state_.heatScale();
+    keys.logScale = s.logScale;
+    keys.diverging = state_.heatDiverging();
+    keys_ = drawKeys(keys);
+    state_.startWork(imageW, imageH);
     ImGui::Render();
 
-    // 4. Image: the traced image or a heat map, copied only around the opaque panels drawn over
-    // it in step 6. The image covers the whole framebuffer: clear only while there is none (one
-    // full-screen fill less per frame, which software GL feels).
+    // 4. Image: the traced image or a heat map, the size of its viewport, copied there only
+    // around the opaque popups or menus drawn over it in step 6. What no view fills (the gaps
+    // between panels, under the menu bar) is cleared, the image viewport only while there is
+    // no image: one full-window fill less per frame, which software GL feels.
     if (RowRange rows; state_.takeUpload(rows)) uploadImage(rows.begin, rows.end);
-    prepareOverlays(fbWidth, fbHeight);
+    prepareOverlays(imageW, imageH);
     glViewport(0, 0, fbWidth, fbHeight);
-    if (view_->width() == 0) {
-        glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
+    glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
+    std::vector<PixelRect> views;
+    if (view_->width() > 0) views.push_back(area);
+    if (inspector_->shown()) views.push_back(inspector_->area(fbWidth, fbHeight));
+    glEnable(GL_SCISSOR_TEST);
+    for (const PixelRect& r : uncovered(fbWidth, fbHeight, views)) {
+        glScissor(r.x0, fbHeight - r.y1, r.x1 - r.x0, r.y1 - r.y0);
         glClear(GL_COLOR_BUFFER_BIT);
     }
-    std::vector<PixelRect> covered = panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight);
-    if (inspector_->shown()) covered.push_back(inspector_->area(fbWidth, fbHeight));
+    glDisable(GL_SCISSOR_TEST);
+    std::vector<PixelRect> covered;  // a menu or a tooltip over the image
+    for (const PixelRect& r : panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight))
+        if (r.x0 < area.x1 && area.x0 < r.x1 && r.y0 < area.y1 && area.y0 < r.y1)
+            covered.push_back(r);
+    view_->setViewport(area);
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale,
                 state_.heatDiverging());
 
@@ -210,30 +238,27 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // (prepareOverlays); the selection's highlight is drawn over the image, under the panels
     // (the panel layer replaces the pixels of every panel's rectangle next).
     const Clock::time_point selectionStart = Clock::now();
-    if (inspector_->shown()) {  // the main view's highlight stays off the inspector's view
-        const PixelRect v = inspector_->area(fbWidth, fbHeight);
-        glEnable(GL_SCISSOR_TEST);
-        glScissor(0, 0, v.x0, fbHeight);
-    }
-    overlays_->drawSelection(state_.camera(), fbWidth, fbHeight);
+    // In the image viewport, and nowhere else (GL's rows go up).
+    const int glY0 = fbHeight - area.y1;
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(area.x0, glY0, imageW, imageH);
+    overlays_->drawSelection(state_.camera(), imageW, imageH, area.x0, glY0);
     glDisable(GL_SCISSOR_TEST);
     overlayStat_.ms +=
         std::chrono::duration<double, std::milli>(Clock::now() - selectionStart).count();
 
-    // 5b. The ray played, with the viewer's camera, as the
-    // tracer's rays go through the pixels (gl::worldToClip), left of the inspector.
+    // 5b. The ray played, with the viewer's camera, as the tracer's rays go through the
+    // pixels (gl::worldToClip), in the image viewport.
     if (!rayLines.empty() && state_.width() > 0 && state_.height() > 0) {
         if (!rayRenderer_) rayRenderer_ = std::make_unique<gl::BatchRenderer>();
         const glm::mat4 toClip = playback::imageClipMatrix(
             state_.camera(), state_.width(), state_.height(), player_.playback(), *player_.view());
-        glViewport(0, 0, fbWidth, fbHeight);
-        if (inspector_->shown()) {
-            const PixelRect r = inspector_->area(fbWidth, fbHeight);
-            glEnable(GL_SCISSOR_TEST);
-            glScissor(0, 0, r.x0, fbHeight);
-        }
+        glViewport(area.x0, glY0, imageW, imageH);
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(area.x0, glY0, imageW, imageH);
         rayRenderer_->drawNow(rayLines, toClip);
         glDisable(GL_SCISSOR_TEST);
+        glViewport(0, 0, fbWidth, fbHeight);
     }
 
     // 6. Panel layer: ImGui's panels, each rasterized again only when it changed.
@@ -325,12 +350,15 @@ void ViewerApp::logOverlayTiming(double ms, bool layerDrawn) {
     overlayStat_ = {};
 }
 
-void ViewerApp::overlayInput(int fbWidth, int fbHeight) {
+void ViewerApp::overlayInput() {
     ImGuiIO& io = ImGui::GetIO();
     // Clicks ImGui wants never pick; a plain left drag orbits, so picking takes Ctrl+click.
     if (io.WantCaptureMouse || !state_.sceneBuild() || !ImGui::IsMousePosValid()) return;
-    const double x = double(io.MousePos.x * io.DisplayFramebufferScale.x);
-    const double y = double(io.MousePos.y * io.DisplayFramebufferScale.y);
+    // Continuous image coordinates: the viewport's corner is the image's (0, 0).
+    const PixelRect& area = state_.imageArea();
+    const int fbWidth = area.x1 - area.x0, fbHeight = area.y1 - area.y0;
+    const double x = double(io.MousePos.x * io.DisplayFramebufferScale.x) - area.x0;
+    const double y = double(io.MousePos.y * io.DisplayFramebufferScale.y) - area.y0;
     if (x < 0.0 || y < 0.0 || x >= fbWidth || y >= fbHeight) return;
     // The primary hit's depth under the mouse, from the image on screen when it is this size.
     const Image& shown = state_.shown();

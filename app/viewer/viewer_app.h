@@ -16,6 +16,7 @@
 #include "app/viewer/inspector/inspector.h"
 #include "app/viewer/overlay/overlays.h"
 #include "app/viewer/panel_cache.h"
+#include "app/viewer/panels/keys.h"
 #include "app/viewer/panels/panels.h"
 #include "app/viewer/playback/ray_player.h"
 #include "app/viewer/viewer_state.h"
@@ -128,15 +129,19 @@ class ViewerApp {
     PanelCache& panelLayer() { return panels_; }
     /// Where the last frame put the panels, the image and the inspector (display units).
     const PanelLayout& layout() const { return layout_; }
+    /// The colour keys the last frame drew over the image viewport's corner, and where.
+    const KeyReport& keys() const { return keys_; }
 
   private:
     /// Upload rows [rowBegin, rowEnd) (-1: to the last) of the image on screen, with the heat
     /// values the state gives (a counter, or an A/B's).
     void uploadImage(int rowBegin, int rowEnd);
-    /// The hover tooltip and Ctrl+click picking over the image (mouse not taken by ImGui).
-    void overlayInput(int fbWidth, int fbHeight);
-    /// Steps 5 of frame(): the overlays' layer handed to the image view, and its timing.
-    void prepareOverlays(int fbWidth, int fbHeight);
+    /// The hover tooltip and Ctrl+click picking over the image viewport (mouse not taken by
+    /// ImGui).
+    void overlayInput();
+    /// Steps 5 of frame(): the overlays' layer (imageW x imageH, the image's size) handed to
+    /// the image view, and its timing.
+    void prepareOverlays(int imageW, int imageH);
     /// The overlays' and the inspector's options and camera into the settings the ini is
     /// written from (marked to be saved when they changed).
     void keepSettings();
@@ -163,6 +168,7 @@ class ViewerApp {
     PanelCache panels_;          ///< ImGui's panels, each redrawn only when it changed
     PanelHeights panelHeights_;  ///< what each panel asked for last frame
     PanelLayout layout_;         ///< where this frame's panels, image and inspector go
+    KeyReport keys_;             ///< the colour keys drawn this frame
     bool settled_ = false;
 };
 

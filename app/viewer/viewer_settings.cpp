@@ -86,6 +86,7 @@ std::string settingsLines(const ViewerSettings& s) {
     o << "panels=" << s.showParameters << " " << s.showStatistics << " " << s.showCamera << " "
       << s.showView << "\n"
       << "inspector=" << s.showInspector << "\n"
+      << "layout=" << s.leftColumn << " " << s.rightColumn << " " << s.imageShare << "\n"
       << "view=" << viewModeKey(s.mode) << "\n"
       << "auto_scale=" << s.autoScale << "\n"
       << "heat_scale=" << s.heatScale << "\n"
@@ -158,6 +159,14 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
     } else if (key == "inspector") {
         int on;
         if (in >> on) s.showInspector = on;
+    } else if (key == "layout") {
+        float l = 0.0f, r = 0.0f, share = 0.5f;
+        if (readIn(in, l, 0.0f, 1e5f) && readIn(in, r, 0.0f, 1e5f) &&
+            readIn(in, share, 0.0f, 1.0f)) {
+            s.leftColumn = l;
+            s.rightColumn = r;
+            s.imageShare = share;
+        }
     } else if (key == "view") {
         for (int i = 0; i < kViewModeCount; ++i)
             if (value == viewModeKey(ViewMode(i))) s.mode = ViewMode(i);

@@ -21,6 +21,9 @@ struct ViewerSettings {
     std::string cameraPath;
     int threads = 0;  ///< render threads (0: all cores)
     int windowWidth = 1280, windowHeight = 720;
+    /// The panel columns' widths as last dragged (0: automatic) and, with the inspector
+    /// shown, the image's share of the width they leave (panels/layout.h).
+    float leftColumn = 0.0f, rightColumn = 0.0f, imageShare = 0.5f;
     bool showParameters = true, showStatistics = true, showCamera = true, showView = true;
     bool showOverlays = true;
     bool showSelection = false;  ///< opened by a pick or --select

@@ -3,6 +3,7 @@
 #include <imgui.h>
 #include <imgui_internal.h>  // MarkIniSettingsDirty
 
+#include <cmath>
 #include <iostream>
 
 #include "app/viewer/camera_control.h"
@@ -58,8 +59,8 @@ void ViewerState::updateAutoScale() {
     if (s_.mode == ViewMode::Color) return;
     const compare::CounterImage* old = diff_.old();
     if (abStatus_.comparable && ab_ == compare::AbView::Diff) {
-        autoScale_ = compare::diffAutoScale(
-            compare::diffChannel(*old, shown_, s_.mode, 0, abStatus_.rows, abStatus_.rows));
+        autoScale_ = decadeScale(compare::diffAutoScale(
+            compare::diffChannel(*old, shown_, s_.mode, 0, abStatus_.rows, abStatus_.rows)));
         return;
     }
     autoScale_ = autoScale(heatChannel(shown_, s_.mode));
@@ -72,6 +73,9 @@ void ViewerState::updateAutoScale() {
         }
         autoScale_ = std::max(autoScale_, oldScale_[int(s_.mode)]);
     }
+    // Whole decades: the key reads 1, 10, 100, ..., and a rebuild that keeps the 99th
+    // percentile within its decade keeps the colours.
+    autoScale_ = decadeScale(autoScale_);
 }
 
 void ViewerState::setAbView(compare::AbView v) {
@@ -314,6 +318,17 @@ bool ViewerState::takeSnapshot() {
                 {changeWhy_ + ": full image ", " ms after the change", changeAt_});
     }
     return true;
+}
+
+std::optional<std::pair<int, int>> ViewerState::pixelUnderMouse() const {
+    const ImGuiIO& io = ImGui::GetIO();
+    if (!ImGui::IsMousePosValid()) return std::nullopt;
+    // Framebuffer pixels, then the image's: the viewport's corner is the image's pixel (0, 0).
+    const int x = int(std::floor(io.MousePos.x * io.DisplayFramebufferScale.x)) - imageArea_.x0;
+    const int y = int(std::floor(io.MousePos.y * io.DisplayFramebufferScale.y)) - imageArea_.y0;
+    if (x < 0 || y < 0 || x >= imageArea_.x1 - imageArea_.x0 || y >= imageArea_.y1 - imageArea_.y0)
+        return std::nullopt;
+    return std::pair{x, y};
 }
 
 void ViewerState::startWork(int fbWidth, int fbHeight) {

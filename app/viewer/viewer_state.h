@@ -16,6 +16,7 @@
 #include "app/bench/speedup.h"
 #include "app/viewer/colormap.h"
 #include "app/viewer/compare/rebuild_diff.h"
+#include "app/viewer/image_view.h"
 #include "app/viewer/structure_builder.h"
 #include "app/viewer/viewer_settings.h"
 #include "engine/render/progressive.h"
@@ -92,9 +93,16 @@ class ViewerState {
     const Camera& home() const { return home_; }
     /// The image on screen (the last snapshot taken).
     const Image& shown() const { return shown_; }
-    /// Size of the render: the framebuffer's.
+    /// Size of the render: the image viewport's (panels/layout.h), in pixels.
     int width() const { return jobWidth_; }
     int height() const { return jobHeight_; }
+    /// Where the image viewport lies in the framebuffer this frame (pixels, row 0 at the top):
+    /// every mapping between the mouse and an image pixel goes through it.
+    const PixelRect& imageArea() const { return imageArea_; }
+    /// Set by the frame from the layout, before the panels and the input read it.
+    void setImageArea(const PixelRect& r) { imageArea_ = r; }
+    /// The image pixel under the mouse, if the mouse is over the image viewport.
+    std::optional<std::pair<int, int>> pixelUnderMouse() const;
     /// The heat scale in use this frame, and the automatic one (the shown counter's largest).
     float heatScale() const { return scale_; }
     float autoHeatScale() const { return autoScale_; }
@@ -158,6 +166,7 @@ class ViewerState {
     void presented();
 
   private:
+    PixelRect imageArea_;  ///< the image viewport this frame (framebuffer pixels)
     struct SpeedupJob {
         std::atomic<bool> cancel{false}, done{false};
         SpeedupResult result;

@@ -6,6 +6,7 @@
 #include <imgui_impl_opengl3.h>
 #include <imgui_internal.h>  // MarkIniSettingsDirty
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/viewer/panels/panels.h"
 #include "app/viewer/viewer_app.h"
 
 namespace lancer::viewer {
@@ -99,6 +101,23 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
     }
     if (std::optional<ViewMode> m = viewModeOf(v.view)) settings.mode = *m;
     if (v.select >= 0) settings.showSelection = true;
+    if (given("--width") || given("--height")) {
+        // --width and --height are the image's size: the window opens at that size plus the
+        // panels that open with it (the inspector and the Ray panel as --show and --pick
+        // open them), so the image viewport is exactly W x H.
+        ViewerSettings opening = settings;
+        for (size_t b = 0; b <= v.show.size();) {
+            const size_t e = std::min(v.show.find(',', b), v.show.size());
+            if (v.show.compare(b, e - b, "inspector") == 0) opening.showInspector = true;
+            b = e + 1;
+        }
+        if (v.pick.size() == 2) opening.showRay = true;
+        const auto [w, h] =
+            windowForImage(layoutInputOf(opening, v.hidePanels, PanelHeights{}, 0.0f, 0.0f),
+                           float(settings.windowWidth), float(settings.windowHeight));
+        settings.windowWidth = int(w);
+        settings.windowHeight = int(h);
+    }
 
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
@@ -271,8 +290,11 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 if (!v.screenshot.empty() && status == 0) {
                     try {
                         app.saveScreenshot(v.screenshot, fbw, fbh);
+                        // Where the image viewport is, so a script finds the render in it.
+                        const PixelRect& ia = app.state().imageArea();
                         std::cout << "lancer view: " << frames << " frames, screenshot "
-                                  << v.screenshot << played << "\n";
+                                  << v.screenshot << played << ", image " << ia.x1 - ia.x0 << "x"
+                                  << ia.y1 - ia.y0 << " at " << ia.x0 << "," << ia.y0 << "\n";
                     } catch (const std::exception& e) {
                         std::cerr << "error: --screenshot: " << e.what() << "\n";
                         status = 2;

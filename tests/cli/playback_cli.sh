@@ -19,7 +19,8 @@ if ! command -v xvfb-run >/dev/null; then
   echo "xvfb-run is not installed (apt-get install xvfb)" >&2
   exit 1
 fi
-run() { timeout 240 xvfb-run -a -s "-screen 0 800x600x24" "$lancer" view builtin:default \
+# --width and --height are the image viewport's: the window (panels beside it) fits the screen.
+run() { timeout 240 xvfb-run -a -s "-screen 0 1920x1080x24" "$lancer" view builtin:default \
   --width 640 --height 400 --frames 3 --ini none "$@"; }
 fails "--show" run --show rays
 fails "--pick" run --pick 5000 10

@@ -33,12 +33,13 @@ PY
 grep -q "^- builtin:balls:1 regular: peak resident memory" "$tmp/out" || fail "regular not listed: $(cat "$tmp/out")"
 grep -q "^- builtin:balls:1 irregular: peak resident memory" "$tmp/out" || fail "irregular not listed"
 grep -q "^- builtin:balls:1 bvh: peak resident memory" "$tmp/out" || fail "bvh not listed"
-# A child past --kill-after is killed and listed with the step it was in (balls:5 takes longer
-# than 0.1 s to load anywhere), its CPU time and peak; the JSON row names the step.
-"$LANCER" bench --scale --scenes builtin:balls:5 --schemes regular --no-peer --kill-after 0.1 \
+# A child past --kill-after is killed and listed with the step it was in (balls:6, 597,871
+# spheres, takes longer than 0.1 s to load anywhere; balls:5 came to load in 0.1 s), its CPU
+# time and peak; the JSON row names the step.
+"$LANCER" bench --scale --scenes builtin:balls:6 --schemes regular --no-peer --kill-after 0.1 \
   --out "$tmp/kill" >"$tmp/out" 2>&1
 [ $? -eq 1 ] || fail "a killed child did not exit 1: $(cat "$tmp/out")"
-grep -q "^- builtin:balls:5 regular: killed after 0.1 s while loading (CPU time .* s, peak RSS " \
+grep -q "^- builtin:balls:6 regular: killed after 0.1 s while loading (CPU time .* s, peak RSS " \
   "$tmp/out" || fail "kill not listed with its step: $(cat "$tmp/out")"
 python3 - "$tmp/kill/scale.json" <<'PY2' || fail "scale.json of the kill"
 import json, sys

@@ -16,7 +16,7 @@ if ! command -v xvfb-run >/dev/null; then
 fi
 # -noreset: Xvfb signals xvfb-run again when its last client leaves, which can fail
 # xvfb-run's clean-up (status 5) when the viewer exits at once.
-run() { timeout 240 xvfb-run -a -s "-screen 0 800x600x24 -noreset" "$lancer" view "$@" --width 320 \
+run() { timeout 240 xvfb-run -a -s "-screen 0 1920x1080x24 -noreset" "$lancer" view "$@" --width 320 \
   --height 200 --frames 3 --ini none --screenshot "$tmp/shot.png"; }
 fails "the structure was refused: --max-level 48 --max-objects 1" \
   run "$src/assets/spd/balls4.nff" --max-level 48 --max-objects 1 --no-cost-stop

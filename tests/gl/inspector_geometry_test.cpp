@@ -7,6 +7,7 @@
 #include <glm/vec4.hpp>
 #include <random>
 
+#include "app/viewer/colormap.h"
 #include "app/viewer/gl/transforms.h"
 
 namespace lancer::viewer::inspector {
@@ -155,14 +156,21 @@ TEST(InspectorGeometry, LevelRangeAndSlabKeepWhatTheySay) {
     EXPECT_TRUE(s.keeps(cell(5.0, 6.0)));
 }
 
-TEST(InspectorGeometry, RegionColoursFollowTheValue) {
-    // Brighter with the value, clamped at the top, never black.
-    glm::vec3 a = regionColor(0.0, 10.0), b = regionColor(5.0, 10.0), c = regionColor(10.0, 10.0);
+TEST(InspectorGeometry, RegionColoursFollowTheValueOnTheFixedScales) {
+    // By primitives: brighter with the count on the fixed log scale, clamped at its top, never
+    // black; the same count gives the same colour whatever else the structure holds.
+    glm::vec3 a = regionColor(1.0, ColorBy::Prims), b = regionColor(30.0, ColorBy::Prims),
+              c = regionColor(1000.0, ColorBy::Prims);
     auto lum = [](glm::vec3 v) { return v.x + v.y + v.z; };
     EXPECT_GT(lum(a), 0.1f);
     EXPECT_LT(lum(a), lum(b));
     EXPECT_LT(lum(b), lum(c));
-    EXPECT_EQ(regionColor(50.0, 10.0), c);
+    EXPECT_EQ(regionColor(5000.0, ColorBy::Prims), c);
+    EXPECT_EQ(regionColor(30.0, ColorBy::Prims), countColor(30.0));
+    // By level: the overlays' palette, indexed by the absolute level.
+    for (int level : {0, 3, 7, 23, 30})
+        EXPECT_EQ(regionColor(double(level), ColorBy::Level), levelColor(level)) << level;
+    EXPECT_NE(regionColor(3.0, ColorBy::Level), regionColor(4.0, ColorBy::Level));
 }
 
 TEST(InspectorGeometry, RayEntersBoxesAndFrusta) {

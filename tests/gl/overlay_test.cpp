@@ -60,17 +60,15 @@ std::shared_ptr<SceneBuild> twoBoxes(SchemeKind scheme, int maxLevel = 24) {
     return s;
 }
 
-/// The twelve edges of every leaf of levels [lo, hi], coloured by level as the overlay colours
-/// them: what the merged wireframe must cover, point for point.
+/// The twelve edges of every leaf of levels [lo, hi], coloured by their absolute level (the
+/// fixed palette the key shows): what the merged wireframe must cover, point for point.
 gl::Batch leafEdges(const StructureView& sv, int lo = 0, int hi = 64) {
-    int maxLevel = 0;
-    for (uint32_t i = 0; i < sv.regionCount(); ++i) maxLevel = std::max(maxLevel, sv.leafLevel(i));
     gl::Batch b;
     for (uint32_t i = 0; i < sv.regionCount(); ++i) {
         const int level = sv.leafLevel(i);
         if (level < lo || level > hi) continue;
         const std::array<Vec3, 8> c = sv.regionCorners(i);
-        b.box(glm::vec3(c[0]), glm::vec3(c[7]), gl::rgba8(depthColor(level, maxLevel + 1)));
+        b.box(glm::vec3(c[0]), glm::vec3(c[7]), gl::rgba8(levelColor(level)));
     }
     return b;
 }

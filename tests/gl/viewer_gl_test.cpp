@@ -278,9 +278,19 @@ class ViewerFrames : public ::testing::Test {
                  std::chrono::steady_clock::now() - start < std::chrono::seconds(120));
         return frames;
     }
-    // The middle of the window, between the default panels (left 8..338, right kW-348..).
-    static bool inCentre(int x, int y) {
-        return x >= 350 && x < kW - 360 && y >= 40 && y < kH - 10;
+    /// The image viewport (framebuffer pixels) of the last frame.
+    PixelRect area() const { return app_->state().imageArea(); }
+    int imageW() const { return area().x1 - area().x0; }
+    int imageH() const { return area().y1 - area().y0; }
+    /// Image pixel (x, y) inside the colour keys' box (display units = pixels here).
+    bool inKeys(int x, int y) const {
+        const Rect& k = app_->keys().box;
+        const float wx = float(x + area().x0) + 0.5f, wy = float(y + area().y0) + 0.5f;
+        return !k.empty() && wx >= k.x0 && wx < k.x1 && wy >= k.y0 && wy < k.y1;
+    }
+    /// The framebuffer's pixel `i` of image pixel (x, y).
+    size_t windowIndex(int x, int y) const {
+        return size_t(y + area().y0) * kW + size_t(x + area().x0);
     }
 
     std::unique_ptr<OffscreenGl> gl_;
@@ -303,55 +313,69 @@ TEST_F(ViewerFrames, ShowListShowsTheInspectorOverTheRightHalf) {
     // right part of what the panels leave) the inspector, not the traced image.
     std::vector<uint8_t> shown = gl_->read();
     Camera cam = app_->camera();
-    Traced t = traceCpu("builtin:default", &cam, kW, kH);
+    Traced t = traceCpu("builtin:default", &cam, imageW(), imageH());
     std::vector<uint8_t> cpu = t.img.rgba8();
     const Rect image = app_->layout().image, insp = app_->layout().inspector;
     ASSERT_FALSE(insp.empty());
-    ASSERT_GE(image.x1, insp.x0 - 1.0f);
-    size_t left0 = 0, leftSame = 0, right0 = 0, rightSame = 0;
-    for (int y = 60; y < kH - 20; ++y)
-        for (int x = int(image.x0) + 4; x < int(insp.x1) - 10; ++x) {
-            const size_t i = 4 * (size_t(y) * kW + size_t(x));
-            bool same = true;
-            for (int c = 0; c < 3; ++c) same &= std::abs(int(shown[i + c]) - int(cpu[i + c])) <= 1;
-            if (x < int(insp.x0)) {
-                ++left0;
-                leftSame += same;
-            } else {
-                ++right0;
-                rightSame += same;
+    ASSERT_LE(image.x1, insp.x0) << "the inspector lies beside the image, not over it";
+    // The image viewport is the CPU render at its size; the inspector's view, at the same
+    // offsets from its corner, is not.
+    size_t image0 = 0, imageSame = 0, insp0 = 0, inspSame = 0;
+    for (int y = 0; y < imageH(); ++y)
+        for (int x = 0; x < imageW(); ++x) {
+            const size_t c = 4 * (size_t(y) * size_t(imageW()) + size_t(x));
+            auto same = [&](size_t w) {
+                bool eq = true;
+                for (int k = 0; k < 3; ++k)
+                    eq &= std::abs(int(shown[4 * w + size_t(k)]) - int(cpu[c + size_t(k)])) <= 1;
+                return eq;
+            };
+            ++image0;
+            imageSame += same(windowIndex(x, y));
+            const int ix = int(insp.x0) + x, iy = int(insp.y0) + y;
+            if (ix < int(insp.x1) && iy < int(insp.y1)) {
+                ++insp0;
+                inspSame += same(size_t(iy) * kW + size_t(ix));
             }
         }
-    EXPECT_GT(leftSame, left0 * 99 / 100);
-    EXPECT_LT(rightSame, right0 / 2);
+    EXPECT_EQ(imageSame, image0);
+    EXPECT_LT(inspSame, insp0 / 2);
 }
 
 TEST_F(ViewerFrames, ShowsTheRenderedSceneAndThePanels) {
     runUntilSettled();
     ASSERT_TRUE(app_->settled());
     ASSERT_TRUE(app_->error().empty()) << app_->error();
-    ASSERT_EQ(app_->displayed().width, kW);
+    // The render is the image viewport's size, which the status line shows.
+    ASSERT_EQ(app_->displayed().width, imageW());
+    ASSERT_EQ(app_->displayed().height, imageH());
+    ASSERT_LT(imageW(), kW);
     std::vector<uint8_t> shown = gl_->read();
     Camera cam = app_->camera();
-    Traced t = traceCpu("builtin:default", &cam, kW, kH);
+    Traced t = traceCpu("builtin:default", &cam, imageW(), imageH());
     std::vector<uint8_t> cpu = t.img.rgba8();
-    size_t centre = 0, centreDiff = 0, outside = 0, outsideDiff = 0;
-    for (int y = 0; y < kH; ++y)
-        for (int x = 0; x < kW; ++x) {
-            size_t i = 4 * (size_t(y) * kW + size_t(x));
-            bool differs = false;
-            for (int c = 0; c < 3; ++c)
-                differs |= std::abs(int(shown[i + c]) - int(cpu[i + c])) > 1;
-            if (inCentre(x, y)) {
-                ++centre;
-                centreDiff += differs;
-            } else if (x < 330 && y > 40 && y < 400) {  // the Parameters panel
-                ++outside;
-                outsideDiff += differs;
-            }
+    size_t differs = 0;
+    for (int y = 0; y < imageH(); ++y)
+        for (int x = 0; x < imageW(); ++x) {
+            const size_t w = 4 * windowIndex(x, y),
+                         c = 4 * (size_t(y) * size_t(imageW()) + size_t(x));
+            for (int k = 0; k < 3; ++k)
+                differs += std::abs(int(shown[w + size_t(k)]) - int(cpu[c + size_t(k)])) > 1;
         }
-    EXPECT_EQ(centreDiff, 0u) << "between the panels the window shows the CPU render exactly";
-    EXPECT_GT(outsideDiff, outside / 2) << "the Parameters panel is drawn over the image";
+    EXPECT_EQ(differs, 0u) << "the image viewport shows the CPU render at its size exactly";
+    // The Parameters panel is drawn beside it: its pixels are not the render's.
+    const Rect p = app_->layout()[PanelId::Parameters];
+    ASSERT_FALSE(p.empty());
+    EXPECT_LE(p.x1, float(area().x0));
+    size_t panel = 0, panelDiff = 0;
+    for (int y = int(p.y0) + 20; y < int(p.y1) - 4; y += 3)
+        for (int x = int(p.x0) + 4; x < int(p.x1) - 4; x += 3) {
+            const size_t i = 4 * (size_t(y) * kW + size_t(x));
+            ++panel;
+            panelDiff += shown[i] != 0 || shown[i + 1] != 0 || shown[i + 2] != 0;
+        }
+    EXPECT_GT(panelDiff, 0u);
+    EXPECT_GT(panel, 100u);
 }
 
 TEST_F(ViewerFrames, EagerUntilAChangeIsOnScreenThenRefinesAtTheWindowsPace) {
@@ -433,18 +457,21 @@ TEST_F(ViewerFrames, HeatMapModeShowsPrimitiveTests) {
     std::vector<uint8_t> hot = gl_->read();
     const Image& img = app_->displayed();
     const float scale = app_->heatScale();
-    EXPECT_EQ(scale, autoScale(heatChannel(img, ViewMode::PrimTests)));
+    // The 99th percentile, up to a whole decade (the key's scale).
+    EXPECT_EQ(scale, decadeScale(autoScale(heatChannel(img, ViewMode::PrimTests))));
+    ASSERT_EQ(img.width, imageW());
     int worst = 0;
     size_t changed = 0, n = 0;
-    for (int y = 0; y < kH; ++y)
-        for (int x = 0; x < kW; ++x) {
-            if (!inCentre(x, y)) continue;
-            size_t i = size_t(y) * kW + size_t(x);
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            if (inKeys(x, y)) continue;
+            const size_t i = img.index(x, y), w = windowIndex(x, y);
             worst =
-                std::max(worst, maxDiff(&hot[4 * i], colormap(float(img.primTests[i]) / scale)));
-            changed += std::abs(int(hot[4 * i]) - int(colour[4 * i])) > 8;
+                std::max(worst, maxDiff(&hot[4 * w], colormap(float(img.primTests[i]) / scale)));
+            changed += std::abs(int(hot[4 * w]) - int(colour[4 * w])) > 8;
             ++n;
         }
+    ASSERT_FALSE(app_->keys().keys.empty()) << "the heat map draws its key";
     EXPECT_LE(worst, 2);
     EXPECT_GT(changed, n / 2);
 }
@@ -492,7 +519,7 @@ TEST_F(ViewerFrames, DragsMoveTheCameraExceptWhenImGuiWantsTheMouse) {
     // The new view is rendered: once settled, the screen shows the orthographic CPU render.
     runUntilSettled();
     Camera cam = app_->camera();
-    Traced t = traceCpu("builtin:default", &cam, kW, kH);
+    Traced t = traceCpu("builtin:default", &cam, imageW(), imageH());
     EXPECT_EQ(app_->displayed().color, t.img.color);
 }
 
@@ -535,7 +562,7 @@ TEST_F(ViewerFrames, SpeedupTracesTheSamePixelsAndRaysWithBothSchemes) {
     ASSERT_TRUE(r->error.empty()) << r->error;
     EXPECT_EQ(r->scheme, "regular");
     const bench::Speedup& m = r->speedup;
-    EXPECT_EQ(m.pixels, size_t((kW + 3) / 4) * size_t((kH + 3) / 4));
+    EXPECT_EQ(m.pixels, size_t((imageW() + 3) / 4) * size_t((imageH() + 3) / 4));
     EXPECT_GE(m.scheme.counters.rays, m.pixels);
     EXPECT_EQ(m.scheme.counters.rays, m.brute.counters.rays);
     const Scene& scene = *app_->sceneBuild()->scene;
@@ -571,7 +598,7 @@ TEST_F(ViewerFrames, CameraCopiedAsJsonPastesBackAndABadPasteKeepsTheCamera) {
     // The pasted view is the one rendered.
     runUntilSettled();
     Camera cam = app_->camera();
-    Traced t = traceCpu("builtin:default", &cam, kW, kH);
+    Traced t = traceCpu("builtin:default", &cam, imageW(), imageH());
     EXPECT_EQ(app_->displayed().color, t.img.color);
 }
 
@@ -702,7 +729,7 @@ void expectPanelsOnScreen(float width, float height, bool apart) {
 // scrollbar or another panel while the window has room) and stay on screen when it shrinks.
 TEST_F(ViewerFrames, PanelsFitTheirContentAndStayOnScreen) {
     ImGuiIO& io = ImGui::GetIO();
-    io.DisplaySize = ImVec2(float(kW), 720.0f);  // a 900 x 720 window (the buffer is shorter)
+    io.DisplaySize = ImVec2(1280.0f, 720.0f);  // a 1280 x 720 window (the buffer is smaller)
     runUntilSettled();
     app_->measureSpeedup(4);
     auto start = std::chrono::steady_clock::now();
@@ -714,9 +741,11 @@ TEST_F(ViewerFrames, PanelsFitTheirContentAndStayOnScreen) {
     ASSERT_TRUE(app_->speedupResult());
     // The layout follows the content a frame late, and ImGui's scrollbar the size a frame later.
     for (int i = 0; i < 4; ++i) app_->frame(kW, kH);
-    expectPanelsOnScreen(float(kW), 720.0f, true);
+    expectPanelsOnScreen(1280.0f, 720.0f, true);
     for (const char* name : {"Parameters", "Camera", "Statistics", "View"})
-        EXPECT_FALSE(panelWindow(name)->ScrollbarY) << name << " needs a scrollbar at 900 x 720";
+        EXPECT_FALSE(panelWindow(name)->ScrollbarY)
+            << name << " needs a scrollbar at 1280 x 720: " << panelWindow(name)->Size.y << " for "
+            << panelWindow(name)->ContentSize.y;
 
     // A smaller window: the right column follows its edge, every panel stays inside (the
     // panels no longer all fit: the last one scrolls, over another if it must).

@@ -124,6 +124,9 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     s.mode = ViewMode::TimeUs;
     s.autoScale = false;
     s.heatScale = 42.0f;
+    s.leftColumn = 300.0f;  // the columns and the split as dragged
+    s.rightColumn = 412.0f;
+    s.imageShare = 0.625f;
     ViewerSettings r;
     std::string lines = settingsLines(s);
     size_t start = 0;
@@ -145,10 +148,13 @@ TEST(ViewerSettingsIni, LinesRoundTripAndBadValuesAreIgnored) {
     EXPECT_TRUE(r.build.regular.fullTable);
     EXPECT_EQ(r.build.irregular.frame, IrregularFrame::Camera);
     EXPECT_EQ(r.shading.offsetScale, 2.5e-8);
+    EXPECT_EQ(r.leftColumn, 300.0f);
+    EXPECT_EQ(r.rightColumn, 412.0f);
+    EXPECT_EQ(r.imageShare, 0.625f);
     ViewerSettings bad = r;
     for (const char* line :
          {"max_level=999", "max_objects=-1", "full_table=2", "scheme=octree", "split_axes=diagonal",
-          "window=5 5", "delta=-1", "threads=x", "garbage"})
+          "window=5 5", "delta=-1", "threads=x", "layout=1 2 3", "layout=-5 0 0.5", "garbage"})
         readSettingsLine(bad, line);
     EXPECT_EQ(settingsLines(bad), lines);
 }

@@ -133,13 +133,8 @@ bool Slab::keeps(const Corners& c) const {
 
 const char* colorByName(ColorBy c) { return c == ColorBy::Prims ? "primitives" : "level"; }
 
-glm::vec3 regionColor(double v, double top) {
-    top = std::max(top, 1.0);
-    // The lowest third of the map is too dark to read as a line on the dark background; the
-    // square root spreads the many small values (most leaves hold a few primitives, a few hold
-    // many) over more of the map.
-    const double t = 0.35 + 0.65 * std::sqrt(std::clamp(v / top, 0.0, 1.0));
-    return colormap(float(t));
+glm::vec3 regionColor(double v, ColorBy by) {
+    return by == ColorBy::Level ? levelColor(int(v)) : countColor(v);
 }
 
 std::optional<double> rayEnters(const Ray& ray, const Corners& c) {

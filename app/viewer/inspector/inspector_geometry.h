@@ -79,10 +79,10 @@ struct Slab {
 /// What colours a region.
 enum class ColorBy : uint8_t { Prims, Level };
 const char* colorByName(ColorBy c);
-/// The colour of a region whose value (primitive count or level) is `v`, on a scale whose top
-/// is `top` (the colour map's upper stop; at least 1): the viewer's heat map, starting above
-/// black so that an empty region still shows on a dark background.
-glm::vec3 regionColor(double v, double top);
+/// The colour of a region whose value is `v`: by level, the overlays' fixed level palette
+/// (levelColor); by primitives, their fixed log scale of counts (countColor). The same colour
+/// means the same value in every build, and the image's key reads for the inspector too.
+glm::vec3 regionColor(double v, ColorBy by);
 
 /// Distance along the ray (o, d) to where it enters the convex volume of `c` (0 when o is
 /// inside); nullopt when it misses. The faces of `c` must be planar (boxes, boxes of the camera

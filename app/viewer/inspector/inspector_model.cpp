@@ -206,7 +206,7 @@ InspectorModel buildModel(const StructureView& view, const InspectorOptions& opt
     m.top = 1.0;
     for (const RegionView& r : m.regions) m.top = std::max(m.top, valueOf(r, opt.colorBy));
     for (const RegionView& r : m.regions)
-        addVolume(m.lines, r.corners, regionColor(valueOf(r, opt.colorBy), m.top));
+        addVolume(m.lines, r.corners, regionColor(valueOf(r, opt.colorBy), opt.colorBy));
     if (opt.boxes) {
         size_t drawn = 0;
         for (const Box3& b : scene.minBox) {

@@ -100,7 +100,8 @@ void irregularLayers(const StructureView& sv, const gl::ImageProjector& proj, in
         }
         for (const BspCut& c : cuts) {
             if (c.depth > deepest) continue;
-            const glm::vec3 col = depthColor(c.depth, g.maxCutDepth + 1);
+            const glm::vec3 col = levelColor(c.depth);
+            g.noteLevel(c.depth);
             g.cuts.line(world(c.a, d.near), world(c.b, d.near), gl::rgba8(col));
             if (d.two) g.cuts.line(world(c.a, d.far), world(c.b, d.far), gl::rgba8(col * 0.6f));
         }
@@ -146,11 +147,9 @@ void irregularLayers(const StructureView& sv, const gl::ImageProjector& proj, in
     g.zonesDrawn = shown.size();
     if (o.zones) {
         std::vector<size_t> count(shown.size());
-        size_t most = 1;
         for (size_t i = 0; i < shown.size(); ++i) {
             count[i] = o.zoneFill == ZoneFill::Prims ? fr->zonePrims(shown[i]).size()
                                                      : fr->slabs(shown[i]).size();
-            most = std::max(most, count[i]);
         }
         for (size_t i = 0; i < shown.size(); ++i) {
             const auto [lo, hi] = rects[i];
@@ -158,7 +157,8 @@ void irregularLayers(const StructureView& sv, const gl::ImageProjector& proj, in
                                        world(hi, d.near), world({lo.x, hi.y}, d.near)};
             // Empty zones stay clear; the others from the colour map's purple to its yellow.
             if (count[i] == 0) continue;
-            g.fills.fill(quad, gl::rgba8(colormap(0.3f + 0.7f * float(count[i]) / float(most))));
+            g.fills.fill(quad, gl::rgba8(countColor(double(count[i]))));
+            g.countMax = std::max(g.countMax, count[i]);
         }
     }
     if (o.slabs) {
@@ -170,7 +170,8 @@ void irregularLayers(const StructureView& sv, const gl::ImageProjector& proj, in
                 std::array<glm::vec3, 8> c;
                 const std::array<Vec3, 8> wc = sv.regionCorners(slabs[k].region);
                 for (size_t i = 0; i < 8; ++i) c[i] = toF(wc[i]);
-                g.wires.box(c, gl::rgba8(depthColor(int(k), int(slabs.size()))));
+                g.wires.box(c, gl::rgba8(levelColor(int(k))));
+                g.slabMax = std::max(g.slabMax, int(k));
                 ++g.regionsDrawn;
             }
         }
@@ -182,12 +183,9 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
     const RegularGrid& grid = *sv.regular();
     if (o.leaves) {
         const size_t n = grid.leaves().size();
-        int maxLevel = 0;
-        size_t mostPrims = 1;
         std::vector<uint32_t> picked;
         for (uint32_t i = 0; i < n; ++i) {
             const int level = sv.leafLevel(i);
-            maxLevel = std::max(maxLevel, level);
             if (level < o.levelMin || level > o.levelMax) continue;
             ++g.regionsTotal;
             if (picked.size() >= o.cap) {
@@ -199,14 +197,16 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
                 continue;
             }
             picked.push_back(i);
-            mostPrims = std::max(mostPrims, size_t(grid.leaves()[i].prims));
         }
         for (uint32_t i : picked) {
             const std::array<Vec3, 8> wc = sv.regionCorners(i);
-            const glm::vec3 col =
-                o.leafColor == LeafColor::Level
-                    ? depthColor(sv.leafLevel(i), maxLevel + 1)
-                    : colormap(0.3f + 0.7f * float(grid.leaves()[i].prims) / float(mostPrims));
+            const glm::vec3 col = o.leafColor == LeafColor::Level
+                                      ? levelColor(sv.leafLevel(i))
+                                      : countColor(double(grid.leaves()[i].prims));
+            if (o.leafColor == LeafColor::Level)
+                g.noteLevel(sv.leafLevel(i));
+            else
+                g.countMax = std::max(g.countMax, size_t(grid.leaves()[i].prims));
             g.wires.box(toF(wc[0]), toF(wc[7]), gl::rgba8(col));
         }
         g.regionsDrawn += picked.size();
@@ -217,11 +217,6 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
         for (int a = 0; a < 3; ++a)
             cell[a] = (b.hi[a] - b.lo[a]) / double(1u << sv.directoryLog2(a));
         const std::vector<DirectoryBlock> blocks = sv.directoryBlocks();
-        int maxLevel = 0, maxDepth = 0;
-        for (const DirectoryBlock& blk : blocks) {
-            maxLevel = std::max(maxLevel, blk.level);
-            maxDepth = std::max(maxDepth, blk.depth);
-        }
         for (const DirectoryBlock& blk : blocks) {
             if (blk.level < o.levelMin || blk.level > o.levelMax) continue;
             ++g.regionsTotal;
@@ -232,11 +227,12 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
                 hi[a] = b.lo[a] + cell[a] * blk.hi[a];
             }
             // By kind: sub-table blocks in orange, single entries in grey-blue.
-            const glm::vec3 col =
-                o.gridColor == GridColor::Level        ? depthColor(blk.level, maxLevel + 1)
-                : o.gridColor == GridColor::TableDepth ? depthColor(blk.depth, maxDepth + 1)
-                : blk.subTable                         ? glm::vec3(1.0f, 0.55f, 0.1f)
-                                                       : glm::vec3(0.55f, 0.65f, 0.8f);
+            const glm::vec3 col = o.gridColor == GridColor::Level        ? levelColor(blk.level)
+                                  : o.gridColor == GridColor::TableDepth ? levelColor(blk.depth)
+                                  : blk.subTable ? glm::vec3(1.0f, 0.55f, 0.1f)
+                                                 : glm::vec3(0.55f, 0.65f, 0.8f);
+            if (o.gridColor == GridColor::Level) g.noteLevel(blk.level);
+            if (o.gridColor == GridColor::TableDepth) g.noteLevel(blk.depth);
             g.wires.box(toF(lo), toF(hi), gl::rgba8(col));
             ++g.regionsDrawn;
         }
@@ -253,7 +249,6 @@ void bvhLayer(const StructureView& sv, const gl::ImageProjector& proj, int w, in
               const OverlayOptions& o, OverlayGeometry& g) {
     const Bvh& bvh = *sv.bvh();
     const std::vector<BvhNode>& nodes = bvh.nodes();
-    size_t mostPrims = 1;
     std::vector<uint32_t> picked;
     for (uint32_t i = 0; i < nodes.size(); ++i) {
         const int depth = nodes[i].depth;
@@ -268,14 +263,16 @@ void bvhLayer(const StructureView& sv, const gl::ImageProjector& proj, int w, in
             continue;
         }
         picked.push_back(i);
-        mostPrims = std::max(mostPrims, size_t(nodes[i].count));
     }
     for (uint32_t i : picked) {
         const BvhNode& n = nodes[i];
-        const glm::vec3 col =
-            o.leafColor == LeafColor::Level
-                ? depthColor(n.depth, bvh.depth() + 1)
-                : colormap(0.3f + 0.7f * float(n.leaf ? n.count : 0) / float(mostPrims));
+        const glm::vec3 col = o.leafColor == LeafColor::Level
+                                  ? levelColor(n.depth)
+                                  : countColor(double(n.leaf ? n.count : 0));
+        if (o.leafColor == LeafColor::Level)
+            g.noteLevel(n.depth);
+        else
+            g.countMax = std::max(g.countMax, size_t(n.leaf ? n.count : 0));
         g.wires.box(toF(Vec3(n.lo[0], n.lo[1], n.lo[2])), toF(Vec3(n.hi[0], n.hi[1], n.hi[2])),
                     gl::rgba8(col));
     }
@@ -283,34 +280,6 @@ void bvhLayer(const StructureView& sv, const gl::ImageProjector& proj, int w, in
 }
 
 }  // namespace
-
-glm::vec3 depthColor(int depth, int count) {
-    const float t = count > 1 ? float(depth) / float(count - 1) : 0.0f;
-    const float hue = 0.8f * std::clamp(t, 0.0f, 1.0f) * 6.0f;  // red .. violet
-    const float x = 1.0f - std::abs(std::fmod(hue, 2.0f) - 1.0f);
-    glm::vec3 c;
-    switch (int(hue) % 6) {
-        case 0:
-            c = {1, x, 0};
-            break;
-        case 1:
-            c = {x, 1, 0};
-            break;
-        case 2:
-            c = {0, 1, x};
-            break;
-        case 3:
-            c = {0, x, 1};
-            break;
-        case 4:
-            c = {x, 0, 1};
-            break;
-        default:
-            c = {1, 0, x};
-            break;
-    }
-    return 0.25f + 0.75f * c;  // never black
-}
 
 const ZoneFrameView* overlayFrame(const StructureView& sv, bool projective) {
     if (projective)

@@ -5,6 +5,7 @@
 // camera frame's BSP is drawn in perspective). Also picking: the region under a pixel.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -61,6 +62,17 @@ struct OverlayGeometry {
     size_t regionsDrawn = 0;  ///< of them, drawn (visible, under the cap)
     size_t zonesTotal = 0, zonesDrawn = 0;
     bool cameraDependent = false;  ///< culled or capped by visibility: rebuild when it moves
+    /// What the keys list: the levels (or cut depths, sub-table depths) drawn in level colours
+    /// (levelLo > levelHi: none), the largest count drawn in count colours, the deepest slab
+    /// index drawn (-1: no slab).
+    int levelLo = 1 << 30, levelHi = -1;
+    size_t countMax = 0;
+    int slabMax = -1;
+    /// Record that level `l` was drawn in its level colour.
+    void noteLevel(int l) {
+        levelLo = std::min(levelLo, l);
+        levelHi = std::max(levelHi, l);
+    }
 };
 
 /// Build the layers `options` asks for, for a width x height image seen by `view`.
@@ -85,9 +97,5 @@ std::optional<PickResult> pick(const StructureView& sv, const Camera& view, int 
 
 /// The frame the irregular overlays draw: the projective one when asked and present.
 const ZoneFrameView* overlayFrame(const StructureView& sv, bool projective);
-
-/// A colour for a BSP depth or a level out of `count` (hues from red to violet, all bright on a
-/// dark or a light image).
-glm::vec3 depthColor(int depth, int count);
 
 }  // namespace lancer::viewer::overlay

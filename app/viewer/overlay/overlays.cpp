@@ -124,12 +124,12 @@ void Overlays::drawLayers(const Camera& view, int width, int height, size_t line
     renderer_->draw(*cuts_, toClip, cuts);
 }
 
-void Overlays::drawSelection(const Camera& view, int width, int height) {
+void Overlays::drawSelection(const Camera& view, int width, int height, int x0, int y0) {
     if (!view_ || width <= 0 || height <= 0) return;
     if (!selection_ || selection_->region >= view_->regionCount()) return;
     const auto [nearDepth, farDepth] = clipDepths(*view_, view);
     const glm::mat4 toClip = gl::worldToClip(view, width, height, nearDepth, farDepth);
-    glViewport(0, 0, width, height);
+    glViewport(x0, y0, width, height);
     // The selected region: its faces tinted, its edges bright.
     const std::array<Vec3, 8> wc = view_->regionCorners(selection_->region);
     std::array<glm::vec3, 8> c;
@@ -293,22 +293,26 @@ void Overlays::panel(bool* open) {
     }
     ImGui::SliderFloat("line opacity", &look.lineOpacity, 0.0f, 1.0f);
     int moving = int(std::min<size_t>(look.movingLines, 10000000));
-    if (ImGui::InputInt("lines while moving", &moving, 500, 5000))
+    // Short labels: the columns are 250 units wide at least, the hover says the rest.
+    if (ImGui::InputInt("moving lines", &moving, 500, 5000))
         look.movingLines = size_t(std::max(0, moving));
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Lines drawn while the camera moves");
     const size_t lines = geometry_.wires.lineCount();
     if (lines > 0)
         ImGui::TextDisabled("%zu lines; %zu drawn while the camera moves", lines,
                             std::min(lines, look.movingLines));
     int cap = int(std::min<size_t>(o.cap, 10000000));
-    if (ImGui::InputInt("cap (regions drawn)", &cap, 1000, 100000))
-        o.cap = size_t(std::max(0, cap));
+    if (ImGui::InputInt("cap", &cap, 1000, 100000)) o.cap = size_t(std::max(0, cap));
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Most regions and cuts drawn, visible first");
     if (geometry_.regionsTotal > 0)
         ImGui::Text(
             "regions drawn: %zu of %zu%s", geometry_.regionsDrawn, geometry_.regionsTotal,
             geometry_.regionsDrawn < geometry_.regionsTotal ? " (visible first, capped)" : "");
     ImGui::Checkbox("hover tooltip", &look.tooltip);
-    ImGui::TextDisabled("batches built in %.1f ms (%llu builds), drawn in %.1f ms", lastBuildMs_,
-                        static_cast<unsigned long long>(rebuilds_), lastLayerMs_);
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+    ImGui::TextWrapped("batches built in %.1f ms (%llu builds), drawn in %.1f ms", lastBuildMs_,
+                       static_cast<unsigned long long>(rebuilds_), lastLayerMs_);
+    ImGui::PopStyleColor();
     ImGui::End();
 }
 
@@ -384,9 +388,10 @@ void Overlays::selectionPanel(bool* open) {
         const size_t shown = std::min<size_t>(r.prims.size(), 200);
         if (ImGui::BeginTable("prims", 3, ImGuiTableFlags_Borders | ImGuiTableFlags_ScrollY,
                               ImVec2(0, 140))) {
-            ImGui::TableSetupColumn("id");
-            ImGui::TableSetupColumn("kind");
-            ImGui::TableSetupColumn("minimized box");
+            // The box wraps in the column the id and kind leave.
+            ImGui::TableSetupColumn("id", ImGuiTableColumnFlags_WidthFixed);
+            ImGui::TableSetupColumn("kind", ImGuiTableColumnFlags_WidthFixed);
+            ImGui::TableSetupColumn("minimized box", ImGuiTableColumnFlags_WidthStretch);
             ImGui::TableHeadersRow();
             for (size_t i = 0; i < shown; ++i) {
                 const uint32_t p = r.prims[i];
@@ -396,8 +401,8 @@ void Overlays::selectionPanel(bool* open) {
                 ImGui::TextUnformatted(p < scene.prims.size() ? shapeName(scene.prims[p].shape)
                                                               : "?");
                 ImGui::TableNextColumn();
-                ImGui::TextUnformatted(p < scene.minBox.size() ? boxText(scene.minBox[p]).c_str()
-                                                               : "");
+                ImGui::TextWrapped("%s",
+                                   p < scene.minBox.size() ? boxText(scene.minBox[p]).c_str() : "");
             }
             ImGui::EndTable();
         }
@@ -410,14 +415,20 @@ void Overlays::selectionPanel(bool* open) {
             const bool played =
                 evalRegion_ == int64_t(r.id) && evalPool_ == r.pool && !evalNodes_.empty();
             if (played)
-                ImGui::TextDisabled("the played ray's evaluation: nodes reached lit, with spans");
+                ImGui::PushStyleColor(ImGuiCol_Text,
+                                      ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+            ImGui::TextWrapped("the played ray's evaluation: nodes reached lit, with spans");
+            ImGui::PopStyleColor();
             csgTreeNode(*r.pool, r.root, scene, played ? &evalNodes_ : nullptr);
         }
     }
     if (ImGui::CollapsingHeader("neighbours", ImGuiTreeNodeFlags_DefaultOpen)) {
         const bool regular = r.kind == RegionKind::Leaf;
-        ImGui::TextDisabled(regular ? "ropes across each face"
-                                    : "corner pointers (the region beyond each face's corner)");
+        ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+        ImGui::TextWrapped("%s", regular
+                                     ? "ropes across each face"
+                                     : "corner pointers (the region beyond each face's corner)");
+        ImGui::PopStyleColor();
         static const char* axes[3] = {"x", "y", "z"};
         std::optional<uint32_t> go;
         for (int a = 0; a < 3; ++a)

@@ -63,8 +63,10 @@ class Overlays {
     }
     /// The layers with at most `lines` wireframe lines (the longest), cut lines and fills.
     void drawLayers(const Camera& view, int width, int height, size_t lines);
-    /// The selection's highlight alone (a few lines and faces: cheap to draw every frame).
-    void drawSelection(const Camera& view, int width, int height);
+    /// The selection's highlight alone (a few lines and faces: cheap to draw every frame), in
+    /// a width x height viewport whose lower-left corner is framebuffer pixel (x0, y0) (GL's
+    /// rows: the image viewport).
+    void drawSelection(const Camera& view, int width, int height, int x0 = 0, int y0 = 0);
     /// The layers drawn into a texture of their own (premultiplied RGBA, framebuffer rows),
     /// again only when the batches, the camera, the size or the look changed: the image view
     /// composites it when it shades the image (ImageView::setOverlay), so layers of a million

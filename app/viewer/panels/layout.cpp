@@ -82,10 +82,29 @@ void stack(const std::vector<PanelId>& ids, const Rect& col, const LayoutInput& 
         for (size_t i : which) w.push_back(want(i));
         return w;
     };
+    // Each keeps a title bar and two lines; a column too short for that and a usable Ray
+    // panel keeps the others to their title bar (a line cut in half reads worse than none), so
+    // the step list stays readable; folding the Ray panel gives them their room back.
     float extra = room;
     for (size_t i : expanded) {
         h[i] = std::min(want(i), keep);
         extra -= h[i];
+    }
+    const bool ray = std::any_of(expanded.begin(), expanded.end(),
+                                 [&](size_t i) { return ids[i] == PanelId::Ray; });
+    if (ray && extra < kUsablePanelHeight - keep) {
+        const float tight = title;
+        for (size_t i : others) {
+            const float t = std::min(want(i), tight);
+            extra += h[i] - t;
+            h[i] = t;
+        }
+        for (size_t i : expanded)  // the Selection panel too, if still short
+            if (ids[i] == PanelId::Selection && extra < kUsablePanelHeight - keep) {
+                const float t = std::min(want(i), tight);
+                extra += h[i] - t;
+                h[i] = t;
+            }
     }
     std::vector<float> shared;
     if (extra < 0.0f) {
@@ -151,10 +170,19 @@ PanelLayout layoutPanels(const LayoutInput& in) {
     float imageTop = 0.0f, imageLeft = 0.0f, imageRight = w;
     if (!in.panelsHidden) {
         imageTop = std::min(kMenuBarHeight, h);
-        const float colW = std::max(
-            0.0f, std::min(std::clamp(0.27f * w, kColumnMin, kColumnMax), w - 2 * kMargin));
+        // A column is as wide as the user dragged it, else about a quarter of the window; never
+        // so wide that two columns leave the image less than kMinViewportSide. Whole units, so
+        // the image's pixels are whole too.
+        const float autoWidth = std::clamp(0.27f * w, kColumnMin, kColumnMax);
+        const float widest =
+            std::max(kColumnMinWidth, 0.5f * (w - kMinViewportSide) - kMargin - kHandleWidth);
+        auto columnWidth = [&](float asked) {
+            const float c = std::clamp(asked > 0.0f ? asked : autoWidth, kColumnMinWidth, widest);
+            return std::floor(std::max(0.0f, std::min(c, w - kMargin - kHandleWidth)));
+        };
+        const float leftW = columnWidth(in.leftWidth), rightW = columnWidth(in.rightWidth);
         const float top = imageTop, bottom = std::max(top, h - kMargin);
-        const float between = w - 2.0f * (colW + 2.0f * kMargin);
+        const float between = w - (leftW + rightW + 2.0f * (kMargin + kHandleWidth));
         if (!in.inspector) {
             out.twoColumns = between >= kMinImageWidth;
         } else if (between >= 2.0f * kMinViewWidth) {
@@ -179,21 +207,50 @@ PanelLayout layoutPanels(const LayoutInput& in) {
             (toRight ? right : left).push_back(PanelId(i));
             (toRight ? rightUsed : leftUsed) += (p.collapsed ? in.titleHeight : kTypical[i]) + kGap;
         }
-        stack(left, {kMargin, top, kMargin + colW, bottom}, in, out);
-        stack(right, {w - kMargin - colW, top, w - kMargin, bottom}, in, out);
-        if (!left.empty()) imageLeft = std::min(w, 2.0f * kMargin + colW);
-        if (!right.empty()) imageRight = std::max(imageLeft, w - 2.0f * kMargin - colW);
+        stack(left, {kMargin, top, kMargin + leftW, bottom}, in, out);
+        stack(right, {w - kMargin - rightW, top, w - kMargin, bottom}, in, out);
+        // Each column's inner edge is its drag handle, the gap between it and the image.
+        if (!left.empty()) {
+            imageLeft = std::min(w, kMargin + leftW + kHandleWidth);
+            out.leftHandle = {kMargin + leftW, top, imageLeft, h};
+            out.leftWidth = leftW;
+        }
+        if (!right.empty()) {
+            imageRight = std::max(imageLeft, w - kMargin - rightW - kHandleWidth);
+            out.rightHandle = {imageRight, top, w - kMargin - rightW, h};
+            out.rightWidth = rightW;
+        }
     }
     out.image = {imageLeft, imageTop, imageRight, h};
     if (in.inspector) {
-        // The inspector's view takes the right half of what the panels leave, to the window's
-        // edge or to the second column.
-        const float end = imageRight < w ? imageRight : w;
-        const float mid = std::floor(imageLeft + 0.5f * (end - imageLeft));
-        out.image.x1 = mid;
-        out.inspector = {mid, imageTop, end, h};
+        // The inspector's view takes the image's right part, as the split says, with the
+        // split's handle between them.
+        const float total = std::max(0.0f, imageRight - imageLeft - kHandleWidth);
+        float imageW = std::round(std::clamp(in.imageShare, 0.0f, 1.0f) * total);
+        if (total >= 2.0f * kMinViewportSide)
+            imageW = std::clamp(imageW, kMinViewportSide, total - kMinViewportSide);
+        out.image.x1 = imageLeft + imageW;
+        out.splitHandle = {out.image.x1, imageTop, out.image.x1 + kHandleWidth, h};
+        out.inspector = {out.splitHandle.x1, imageTop, imageRight, h};
     }
     return out;
+}
+
+std::pair<float, float> windowForImage(LayoutInput in, float imageWidth, float imageHeight) {
+    float w = imageWidth + 2.0f * (kColumnMax + kMargin + kHandleWidth);
+    float h = imageHeight + kMenuBarHeight;
+    for (int step = 0; step < 16; ++step) {
+        in.width = w;
+        in.height = h;
+        const PanelLayout l = layoutPanels(in);
+        const float dw = imageWidth - l.image.width(), dh = imageHeight - l.image.height();
+        if (dw == 0.0f && dh == 0.0f) break;
+        // With the inspector, the image gets its share of each unit the window grows by.
+        const float share = in.inspector ? std::clamp(in.imageShare, 0.1f, 1.0f) : 1.0f;
+        w = std::max(1.0f, w + std::round(dw / share));
+        h = std::max(1.0f, h + dh);
+    }
+    return {w, h};
 }
 
 }  // namespace lancer::viewer

@@ -77,11 +77,14 @@ TEST(PanelLayout, PanelsThatFitGetTheirHeightAndTheRayPanelTakesWhatIsLeft) {
         in[id].open = false;
     const PanelLayout l = layoutPanels(in);
     expectApart(in, l);
-    for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics})
+    // Parameters has the left column, View fits beside the Ray panel; the Ray panel gets its
+    // usable height first, Statistics what it leaves.
+    for (PanelId id : {PanelId::Parameters, PanelId::View})
         EXPECT_EQ(l[id].height(), in[id].want) << panelTitle(id);
+    EXPECT_GE(l[PanelId::Statistics].height(), 3.0f * in.titleHeight);
     // The Ray panel goes down to the bottom margin of its column.
     EXPECT_FLOAT_EQ(l[PanelId::Ray].y1, 720.0f - 8.0f);
-    EXPECT_GT(l[PanelId::Ray].height(), 200.0f);
+    EXPECT_GE(l[PanelId::Ray].height(), kUsablePanelHeight);
 
     // Folding the panels gives the Ray panel their room.
     LayoutInput folded = in;
@@ -102,11 +105,16 @@ TEST(PanelLayout, HiddenPanelsLeaveTheWindowToTheImageAndTheInspectorItsRightHal
     for (const Rect& r : l.panels) EXPECT_TRUE(r.empty());
     in.inspector = true;
     l = layoutPanels(in);
-    // Where the inspector has always drawn with the panels hidden.
-    const PixelRect v = inspector::Inspector::viewport(1280, 720);
-    EXPECT_EQ(l.inspector.toString(),
-              Rect({float(v.x0), float(v.y0), float(v.x1), float(v.y1)}).toString());
-    EXPECT_EQ(l.image.toString(), Rect({0, 0, 640, 720}).toString());
+    // The image, the split's handle and the inspector tile the window, split in half.
+    EXPECT_EQ(l.image.toString(), Rect({0, 0, 636, 720}).toString());
+    EXPECT_EQ(l.splitHandle.toString(), Rect({636, 0, 644, 720}).toString());
+    EXPECT_EQ(l.inspector.toString(), Rect({644, 0, 1280, 720}).toString());
+    // The split dragged: the image's share of the width, the inspector the rest.
+    in.imageShare = 0.25f;
+    l = layoutPanels(in);
+    EXPECT_EQ(l.image.width(), 318.0f);
+    EXPECT_EQ(l.inspector.x1, 1280.0f);
+    EXPECT_FALSE(l.image.overlaps(l.inspector));
 }
 
 /// The panels a first run shows (Overlays folded), with the inspector and a ray picked.
@@ -132,7 +140,7 @@ float tallestOther(const LayoutInput& in, const PanelLayout& l,
 
 TEST(PanelLayout, WithTheInspectorTheRayPanelKeepsAUsableHeight) {
     // One column holds every panel beside the image and the inspector: the Ray panel gets a
-    // usable height before the others, which keep a title bar and two lines each.
+    // usable height before the others, which keep at least their title bar.
     for (const auto& [w, h, least] :
          {std::tuple{1280.0f, 720.0f, kUsablePanelHeight}, std::tuple{900.0f, 600.0f, 200.0f}}) {
         SCOPED_TRACE(testing::Message() << w << " x " << h);
@@ -144,7 +152,7 @@ TEST(PanelLayout, WithTheInspectorTheRayPanelKeepsAUsableHeight) {
         EXPECT_FLOAT_EQ(l[PanelId::Ray].y1, h - 8.0f) << "down to the bottom margin";
         for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics, PanelId::Camera,
                            PanelId::Inspector})
-            EXPECT_GE(l[id].height(), 3.0f * in.titleHeight) << panelTitle(id);
+            EXPECT_GE(l[id].height(), in.titleHeight) << panelTitle(id);
         EXPECT_EQ(l[PanelId::Overlays].height(), in.titleHeight) << "folded: its title bar";
     }
     // A ray played selects its region, which opens the Selection panel: the Ray panel still
@@ -154,14 +162,15 @@ TEST(PanelLayout, WithTheInspectorTheRayPanelKeepsAUsableHeight) {
     PanelLayout l = layoutPanels(playing);
     expectApart(playing, l);
     EXPECT_GE(l[PanelId::Ray].height(), kUsablePanelHeight);
-    EXPECT_GE(l[PanelId::Selection].height(), 3.0f * playing.titleHeight);
-    // Every panel open and expanded at 1280 x 720: the Ray panel is cut last, and more than
-    // three times as tall as any other.
+    EXPECT_GE(l[PanelId::Selection].height(), playing.titleHeight);
+    // Every panel open and expanded at 1280 x 720: the Ray panel is cut last, gets its usable
+    // height, and more than twice the height of any other.
     LayoutInput all = everyPanel(1280.0f, 720.0f, true);
     l = layoutPanels(all);
     expectApart(all, l);
-    EXPECT_GT(l[PanelId::Ray].height(), 3.0f * tallestOther(all, l, {PanelId::Ray}));
-    EXPECT_GE(l[PanelId::Selection].height(), 3.0f * all.titleHeight);
+    EXPECT_GE(l[PanelId::Ray].height(), kUsablePanelHeight);
+    EXPECT_GT(l[PanelId::Ray].height(), 2.0f * tallestOther(all, l, {PanelId::Ray}));
+    EXPECT_GE(l[PanelId::Selection].height(), all.titleHeight);
     // Folding the other panels gives the Ray panel the column.
     for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics, PanelId::Camera,
                        PanelId::Overlays, PanelId::Inspector, PanelId::Selection})
@@ -260,6 +269,54 @@ TEST(PanelLayout, ASmallWindowKeepsEveryPanelInside) {
             EXPECT_LE(r.y1, h);
         }
     }
+}
+
+TEST(PanelLayout, DraggedColumnsKeepTheirWidthAndTheirHandlesSeparateThemFromTheImage) {
+    for (const auto& [w, h] : {std::pair{1280.0f, 720.0f}, std::pair{1920.0f, 1080.0f}}) {
+        SCOPED_TRACE(testing::Message() << w << " x " << h);
+        LayoutInput in = everyPanel(w, h, false);
+        in.leftWidth = 300.0f;
+        in.rightWidth = 420.0f;
+        const PanelLayout l = layoutPanels(in);
+        expectApart(in, l);
+        ASSERT_TRUE(l.twoColumns);
+        EXPECT_EQ(l.leftWidth, 300.0f);
+        EXPECT_EQ(l.rightWidth, 420.0f);
+        EXPECT_EQ(l[PanelId::Parameters].width(), 300.0f);
+        // Each handle lies between its column and the image, and the image fills the rest.
+        EXPECT_EQ(l.leftHandle.x0, l[PanelId::Parameters].x1);
+        EXPECT_EQ(l.leftHandle.x1, l.image.x0);
+        EXPECT_EQ(l.rightHandle.x0, l.image.x1);
+        EXPECT_EQ(l.rightHandle.x1, l[PanelId::View].x0);
+        EXPECT_FALSE(l.leftHandle.overlaps(l.image));
+    }
+}
+
+TEST(PanelLayout, AColumnDraggedTooWideOrTooNarrowIsClampedAndTheImageKeepsItsMinimum) {
+    LayoutInput in = everyPanel(1280.0f, 720.0f, false);
+    in.leftWidth = 5000.0f;
+    in.rightWidth = 10.0f;
+    const PanelLayout l = layoutPanels(in);
+    expectApart(in, l);
+    EXPECT_EQ(l.rightWidth, kColumnMinWidth);
+    EXPECT_GE(l.image.width(), kMinViewportSide - 1.0f);
+}
+
+TEST(PanelLayout, TheWindowForAnImageSizeGivesExactlyThatImageViewport) {
+    for (bool inspector : {false, true})
+        for (const auto& [iw, ih] :
+             {std::pair{640.0f, 480.0f}, std::pair{1280.0f, 720.0f}, std::pair{640.0f, 360.0f}}) {
+            SCOPED_TRACE(testing::Message()
+                         << iw << " x " << ih << (inspector ? ", inspector" : ""));
+            LayoutInput in = everyPanel(0.0f, 0.0f, inspector);
+            const auto [w, h] = windowForImage(in, iw, ih);
+            in.width = w;
+            in.height = h;
+            const PanelLayout l = layoutPanels(in);
+            EXPECT_EQ(l.image.width(), iw) << "window " << w << " x " << h;
+            EXPECT_EQ(l.image.height(), ih);
+            expectApart(in, l);
+        }
 }
 
 }  // namespace

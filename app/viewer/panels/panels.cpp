@@ -58,6 +58,58 @@ void measure(PanelId id, PanelRequest& req) {
                                               2.0f * style.WindowPadding.y + w->TitleBarHeight());
 }
 
+/// A drag handle at `r` (a column's inner edge, the image and inspector's split): a window of
+/// its own, so ImGui takes the mouse over it, drawn as a bar that brightens while hovered or
+/// dragged. Returns the horizontal drag of this frame, in display units.
+float dragHandle(const char* name, const Rect& r) {
+    if (r.empty()) return 0.0f;
+    placeNext(r);
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0.0f, 0.0f));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowBorderSize, 0.0f);
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowRounding, 0.0f);
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowMinSize, ImVec2(1.0f, 1.0f));
+    float dx = 0.0f;
+    if (ImGui::Begin(name, nullptr,
+                     ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove |
+                         ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoFocusOnAppearing |
+                         ImGuiWindowFlags_NoBringToFrontOnFocus | ImGuiWindowFlags_NoNav |
+                         ImGuiWindowFlags_NoScrollWithMouse)) {
+        ImGui::InvisibleButton("##drag",
+                               ImVec2(std::max(r.width(), 1.0f), std::max(r.height(), 1.0f)));
+        const bool active = ImGui::IsItemActive(), hovered = ImGui::IsItemHovered();
+        if (active || hovered) ImGui::SetMouseCursor(ImGuiMouseCursor_ResizeEW);
+        const float cx = std::floor(0.5f * (r.x0 + r.x1));
+        ImGui::GetWindowDrawList()->AddRectFilled(
+            ImVec2(cx - 1.0f, r.y0), ImVec2(cx + 1.0f, r.y1),
+            ImGui::GetColorU32(active    ? ImGuiCol_SeparatorActive
+                               : hovered ? ImGuiCol_SeparatorHovered
+                                         : ImGuiCol_Separator));
+        if (active) dx = ImGui::GetIO().MouseDelta.x;
+    }
+    ImGui::End();
+    ImGui::PopStyleVar(4);
+    return dx;
+}
+
+/// The handles of `layout`, and their drags into the settings (saved in the ini).
+void dragHandles(ViewerSettings& s, const PanelLayout& layout) {
+    bool changed = false;
+    if (const float dx = dragHandle("##left column edge", layout.leftHandle); dx != 0.0f) {
+        s.leftColumn = std::max(kColumnMinWidth, layout.leftWidth + dx);
+        changed = true;
+    }
+    if (const float dx = dragHandle("##right column edge", layout.rightHandle); dx != 0.0f) {
+        s.rightColumn = std::max(kColumnMinWidth, layout.rightWidth - dx);
+        changed = true;
+    }
+    if (const float dx = dragHandle("##image inspector split", layout.splitHandle); dx != 0.0f) {
+        const float both = layout.image.width() + layout.inspector.width();
+        if (both > 0.0f) s.imageShare = std::clamp((layout.image.width() + dx) / both, 0.0f, 1.0f);
+        changed = true;
+    }
+    if (changed) ImGui::MarkIniSettingsDirty();
+}
+
 /// One of panels.h's own panels, in a window of its own.
 void ownPanel(PanelId id, bool& open, ViewerState& st, void (*content)(ViewerState&)) {
     if (ImGui::Begin(panelTitle(id), &open, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize))
@@ -85,24 +137,35 @@ void menuBar(ViewerState& st) {
         ImGui::EndMenu();
     }
     ImGui::TextDisabled("%s", s.scene.c_str());
+    // The image viewport's size is the traced image's: what `lancer render` needs to trace the
+    // same rays.
+    if (st.width() > 0) ImGui::TextDisabled("image %d x %d", st.width(), st.height());
     if (st.building()) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "building...");
     if (!st.error().empty())
         ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "error (see Parameters)");
     ImGui::EndMainMenuBar();
 }
 
-PanelLayout planPanels(const ViewerState& st, const PanelHeights& heights, float width,
-                       float height) {
+LayoutInput layoutInputOf(const ViewerSettings& s, bool panelsHidden, const PanelHeights& heights,
+                          float width, float height) {
     LayoutInput in;
     in.width = width;
     in.height = height;
-    in.panelsHidden = st.panelsHidden();
-    in.inspector = st.settings().showInspector;
-    in.titleHeight = ImGui::GetFrameHeight();
+    in.panelsHidden = panelsHidden;
+    in.inspector = s.showInspector;
+    if (ImGui::GetCurrentContext() && ImGui::GetFontSize() > 0.0f)
+        in.titleHeight = ImGui::GetFrameHeight();
+    in.leftWidth = s.leftColumn;
+    in.rightWidth = s.rightColumn;
+    in.imageShare = s.imageShare;
     in.panels = heights;
-    for (int i = 0; i < kPanelCount; ++i)
-        in.panels[size_t(i)].open = openFlag(st.settings(), PanelId(i));
-    return layoutPanels(in);
+    for (int i = 0; i < kPanelCount; ++i) in.panels[size_t(i)].open = openFlag(s, PanelId(i));
+    return in;
+}
+
+PanelLayout planPanels(const ViewerState& st, const PanelHeights& heights, float width,
+                       float height) {
+    return layoutPanels(layoutInputOf(st.settings(), st.panelsHidden(), heights, width, height));
 }
 
 void drawPanels(ViewerState& st, const PanelLayout& layout, PanelHeights& heights,
@@ -110,6 +173,7 @@ void drawPanels(ViewerState& st, const PanelLayout& layout, PanelHeights& height
     if (st.panelsHidden()) return;
     ViewerSettings& s = st.settings();
     menuBar(st);
+    dragHandles(s, layout);
     for (int i = 0; i < kPanelCount; ++i) {
         const PanelId id = PanelId(i);
         bool& open = openFlag(s, id);

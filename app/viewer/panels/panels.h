@@ -20,6 +20,9 @@ struct PanelContents {
     std::function<void(bool*)> overlays, selection, inspector, ray;
 };
 
+/// What the layout is given for a width x height window: the panels `s` shows, at `heights`.
+LayoutInput layoutInputOf(const ViewerSettings& s, bool panelsHidden, const PanelHeights& heights,
+                          float width, float height);
 /// This frame's layout (layout.h) of a width x height window (display units): the panels the
 /// settings show, at the heights they asked for last frame.
 PanelLayout planPanels(const ViewerState& st, const PanelHeights& heights, float width,

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <string>
+#include <utility>
 
 #include "app/viewer/panels/panels.h"
 #include "app/viewer/panels/param_controls.h"
@@ -94,12 +96,22 @@ void parametersPanel(ViewerState& st) {
         ImGui::Text("regions %zu, memory %s", ai.regions, formatBytes(ai.memoryBytes).c_str());
         if (const std::string why = stopReasonsLine(ai.extra, b->accel->params().scheme);
             !why.empty()) {
-            ImGui::TextUnformatted(why.c_str());
+            // Short enough for a column at 1280 x 720: "stops: objects 3, level 0, ...".
+            std::string shortWhy = why;
+            for (const auto& [from, to] :
+                 {std::pair<std::string, std::string>{"leaves stopped by", "stops:"},
+                  {"zones stopped by", "stops:"},
+                  {"max-objects", "objects"},
+                  {"max-level", "level"}})
+                if (const size_t at = shortWhy.find(from); at != std::string::npos)
+                    shortWhy.replace(at, from.size(), to);
+            ImGui::TextWrapped("%s", shortWhy.c_str());
             if (ImGui::IsItemHovered())
                 ImGui::SetTooltip(
-                    "Why each cell was not split: it held at most max-objects primitives, it "
-                    "reached max-level, no split would pay (the cost estimate, or a cell inside "
-                    "all its primitives' boxes), or the memory budget");
+                    "%s.\nWhy each cell was not split: it held at most max-objects primitives, "
+                    "it reached max-level, no split would pay (the cost estimate, or a cell "
+                    "inside all its primitives' boxes), or the memory budget",
+                    why.c_str());
         }
         ImGui::Text("%zu primitives (%d dropped by minimization)", b->scene->prims.size(),
                     b->scene->droppedPrims);

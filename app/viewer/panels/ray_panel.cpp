@@ -236,6 +236,9 @@ void rayCsgStrip(playback::RayPlayer& player) {
 
 }  // namespace
 
+/// The step list's least height, in lines: a user reads the steps around the current one.
+constexpr float kStepLines = 8.5f;
+
 void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
     if (!ImGui::Begin("Ray", open)) {
         ImGui::End();
@@ -265,21 +268,6 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
     const RayTree& tree = play.tree();
     ImGui::TextWrapped("%s", tree.counters.toString().c_str());
 
-    // The tree: one line per ray, as `lancer trace` prints it; a click plays that ray.
-    if (ImGui::BeginChild("rays", ImVec2(0, 90), true)) {
-        for (size_t k = 0; k < tree.rays.size(); ++k) {
-            const TracedRay& r = tree.rays[k];
-            std::string line(size_t(2 * r.depth + (r.kind == RayKind::Shadow ? 2 : 0)), ' ');
-            line += r.toString();
-            if (std::optional<playback::WalkCounts> was = play.previousCounts(int(k)))
-                line += "   [rebuilt: " + compareCounts(*was, playback::countsOf(r)) + "]";
-            ImGui::PushID(int(k));
-            if (ImGui::Selectable(line.c_str(), int(k) == play.state().ray)) play.selectRay(int(k));
-            ImGui::PopID();
-        }
-    }
-    ImGui::EndChild();
-
     // Transport: first, back, play / pause, forward, last, speed.
     if (ImGui::Button("|<")) play.first();
     ImGui::SameLine();
@@ -297,18 +285,14 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
     if (ImGui::Button(">|")) play.last();
     ImGui::SameLine();
     float speed = float(play.speed());
-    ImGui::SetNextItemWidth(120);
+    ImGui::SetNextItemWidth(80);
     if (ImGui::SliderFloat("steps/s", &speed, 0.1f, 20.0f, "%.1f", ImGuiSliderFlags_Logarithmic))
         play.setSpeed(speed);
-    ImGui::SameLine();
     if (play.stepCount() > 0)
         ImGui::Text("step %d / %d", play.state().step + 1, play.stepCount());
     else
         ImGui::TextUnformatted("walks no region");
-    const TracedRay& ray = play.ray();
-    if (std::optional<playback::WalkCounts> was = play.previousCounts(play.state().ray))
-        ImGui::TextWrapped("after the rebuild: %s",
-                           compareCounts(*was, playback::countsOf(ray)).c_str());
+    ImGui::SameLine();
 
     if (ImGui::Button("Copy as trace command")) {
         const std::string file =
@@ -316,15 +300,12 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
         const std::string cmd = player.copyTraceCommand(st, file);
         if (!cmd.empty()) ImGui::SetClipboardText(cmd.c_str());
     }
-    if (player.note().rfind("pixel", 0) != 0 && !player.note().empty()) {
-        ImGui::SameLine();
+    if (player.note().rfind("pixel", 0) != 0 && !player.note().empty())
         hintText(player.note().c_str());
-    }
-
-    if (ImGui::CollapsingHeader("CSG in this region", ImGuiTreeNodeFlags_DefaultOpen))
-        regionCsgStrip(player);
-    if (ImGui::CollapsingHeader("CSG along the whole ray", ImGuiTreeNodeFlags_DefaultOpen))
-        rayCsgStrip(player);
+    const TracedRay& ray = play.ray();
+    if (std::optional<playback::WalkCounts> was = play.previousCounts(play.state().ray))
+        ImGui::TextWrapped("after the rebuild: %s",
+                           compareCounts(*was, playback::countsOf(ray)).c_str());
 
     // The wasted work (docs/viewer.md): the ray's, this step's, and each wasted test's class in
     // the step list.
@@ -345,9 +326,14 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
     const std::vector<StepReason> why =
         player.view() ? explainSteps(ray, *player.view(), &player.view()->scene())
                       : std::vector<StepReason>();
-    const float whyLines = 3.0f;
-    if (ImGui::BeginChild("steps", ImVec2(0, -ImGui::GetTextLineHeightWithSpacing() * whyLines),
-                          true)) {
+    // The list keeps kStepLines lines, and grows into what the panel has beyond what the
+    // rest of it (the reason, the rays, the CSG strips) took last frame; the panel scrolls to
+    // the rest when it is short.
+    static float restHeight = 0.0f;
+    const float line = ImGui::GetTextLineHeightWithSpacing();
+    const float least = kStepLines * line + 2.0f * ImGui::GetStyle().WindowPadding.y;
+    const float listH = std::max(least, ImGui::GetContentRegionAvail().y - restHeight);
+    if (ImGui::BeginChild("steps", ImVec2(0, listH), true, ImGuiWindowFlags_HorizontalScrollbar)) {
         size_t step = 0, regionNo = 0;
         for (size_t i = 0; i < ray.events.size(); ++i) {
             const bool current = i >= s.eventBegin && i < s.eventEnd;
@@ -375,8 +361,30 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
         }
     }
     ImGui::EndChild();
+    const float restTop = ImGui::GetCursorPosY();
     if (s.step >= 0 && size_t(s.step) < why.size())
         ImGui::TextWrapped("why: %s", why[size_t(s.step)].text.c_str());
+    // The tree: one line per ray, as `lancer trace` prints it; a click plays that ray.
+    if (ImGui::BeginChild("rays", ImVec2(0, 90), true, ImGuiWindowFlags_HorizontalScrollbar)) {
+        for (size_t k = 0; k < tree.rays.size(); ++k) {
+            const TracedRay& r = tree.rays[k];
+            std::string line(size_t(2 * r.depth + (r.kind == RayKind::Shadow ? 2 : 0)), ' ');
+            line += r.toString();
+            if (std::optional<playback::WalkCounts> was = play.previousCounts(int(k)))
+                line += "   [rebuilt: " + compareCounts(*was, playback::countsOf(r)) + "]";
+            ImGui::PushID(int(k));
+            if (ImGui::Selectable(line.c_str(), int(k) == play.state().ray)) play.selectRay(int(k));
+            ImGui::PopID();
+        }
+    }
+    ImGui::EndChild();
+
+    if (ImGui::CollapsingHeader("CSG in this region", ImGuiTreeNodeFlags_DefaultOpen))
+        regionCsgStrip(player);
+    if (ImGui::CollapsingHeader("CSG along the whole ray", ImGuiTreeNodeFlags_DefaultOpen))
+        rayCsgStrip(player);
+
+    restHeight = ImGui::GetCursorPosY() - restTop;
     ImGui::End();
 }
 

@@ -61,9 +61,13 @@ void statisticsPanel(ViewerState& st) {
         const double asked = double(total.primTests + total.mailboxHits);
         ImGui::Text("mailbox hit rate    %.1f %%",
                     asked > 0 ? 100.0 * double(total.mailboxHits) / asked : 0.0);
-        if (total.shadowRays)
-            ImGui::Text("shadow rays with no walk %.1f %% (light buffer)",
+        if (total.shadowRays) {
+            // Short enough for the narrowest column; the hover says what it counts.
+            ImGui::Text("unwalked shadow rays %.1f %%",
                         100.0 * double(total.lightBufferSkips) / double(total.shadowRays));
+            if (ImGui::IsItemHovered())
+                ImGui::SetTooltip("Shadow rays the light buffer cleared without a walk");
+        }
         if (total.walkErrors)
             ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "walk errors %llu",
                                (unsigned long long)total.walkErrors);

@@ -214,8 +214,8 @@ void viewPanel(ViewerState& st) {
     // The pixel under the cursor, from the same per-pixel counters as --stats.
     const Image& shown = st.shown();
     if (!io.WantCaptureMouse && shown.width > 0) {
-        int x = int(io.MousePos.x * io.DisplayFramebufferScale.x),
-            y = int(io.MousePos.y * io.DisplayFramebufferScale.y);
+        const auto px = st.pixelUnderMouse();
+        const int x = px ? px->first : -1, y = px ? px->second : -1;
         if (x >= 0 && y >= 0 && x < shown.width && y < shown.height) {
             size_t i = shown.index(x, y);
             ImGui::Text("pixel %d %d: %u prim tests, %u regions, %.1f us", x, y, shown.primTests[i],
