@@ -124,9 +124,6 @@ class ViewerApp {
     /// What is built, rendered and shown (what the panels read).
     ViewerState& state() { return state_; }
     const ViewerState& state() const { return state_; }
-    /// The layer the panels are drawn from (PanelCache::invalidate for a panel showing a live
-    /// texture).
-    PanelCache& panelLayer() { return panels_; }
     /// Where the last frame put the panels, the image and the inspector (display units).
     const PanelLayout& layout() const { return layout_; }
     /// The colour keys the last frame drew over the image viewport's corner, and where.

@@ -103,9 +103,8 @@ class ViewerState {
     void setImageArea(const PixelRect& r) { imageArea_ = r; }
     /// The image pixel under the mouse, if the mouse is over the image viewport.
     std::optional<std::pair<int, int>> pixelUnderMouse() const;
-    /// The heat scale in use this frame, and the automatic one (the shown counter's largest).
+    /// The heat scale in use this frame.
     float heatScale() const { return scale_; }
-    float autoHeatScale() const { return autoScale_; }
     PanelNotes& notes() { return notes_; }
     const PanelNotes& notes() const { return notes_; }
     /// Every panel and the menu bar hidden (Tab, --hide-panels): the image alone.
