@@ -17,7 +17,6 @@ namespace lancer {
 namespace {
 
 using test::expectSame;
-using test::secondaryRays;
 
 /// maxObjects -1: automatic (the cost stop with kAutoBvhObjects).
 BuildParams bvhParams(int maxObjects = -1, bool costStop = true, int maxLevel = 0) {
@@ -30,8 +29,6 @@ BuildParams bvhParams(int maxObjects = -1, bool costStop = true, int maxLevel = 
 }
 
 const Bvh& bvhOf(const Accelerator& a) { return std::get<Bvh>(a.impl()); }
-
-
 
 /// Corners, edge midpoints and face centres of some nodes' boxes: where a box test rounds.
 std::vector<Vec3> nodePoints(const Bvh& b, size_t count, uint64_t seed) {
@@ -63,10 +60,7 @@ TEST(Bvh, SpdScenesPixelForPixel) {
             auto accel = buildAccelerator(scene, bvhParams());
             const std::string what =
                 path.filename().string() + (ortho ? " orthographic" : " perspective");
-            const std::vector<Ray> rays = test::pixelRays(scene, n, n);
-            expectSame(scene, *accel, rays, what);
-            expectSame(scene, *accel, secondaryRays(scene, rays, 7), what + " secondary",
-                       1e-9 * scene.scale());
+            test::expectSamePixelsAndSecondaries(scene, *accel, n, 7, what);
         }
     }
 }
@@ -80,10 +74,7 @@ TEST(Bvh, BuiltinCsgScenesPixelForPixel) {
                 auto accel = buildAccelerator(scene, p);
                 const std::string what = std::string(spec) + (ortho ? " orthographic " : " ") +
                                          toString(accel->params());
-                const std::vector<Ray> rays = test::pixelRays(scene, 48, 48);
-                expectSame(scene, *accel, rays, what);
-                expectSame(scene, *accel, secondaryRays(scene, rays, 3), what + " secondary",
-                           1e-9 * scene.scale());
+                test::expectSamePixelsAndSecondaries(scene, *accel, 48, 3, what);
             }
         }
     }

@@ -35,7 +35,6 @@ std::unique_ptr<Accelerator> buildIrregular(const Scene& scene,
     return buildAccelerator(scene, p);
 }
 
-
 /// World points at the corners, edge midpoints and face centres of some regions.
 std::vector<Vec3> regionPoints(const IrregularSubdivision& s, size_t maxRegions, uint64_t seed) {
     std::mt19937_64 rng(seed);
@@ -66,7 +65,6 @@ std::vector<Ray> cameraAxisRays(const IrregularSubdivision& s, const std::vector
     }
     return rays;
 }
-
 
 /// Rays from the eye through the corners, edge midpoints and centres of projective zones, and
 /// random ones: they run along zone borders, where (u, v) ties.
@@ -150,10 +148,7 @@ TEST(Irregular, BuiltinCsgScenesPixelForPixel) {
                 std::string what = std::string(spec) +
                                    (ortho ? " orthographic " : " perspective ") + heuristicName(h) +
                                    " " + irregularFrameName(f);
-                std::vector<Ray> rays = test::pixelRays(scene, 48, 48);
-                expectSame(scene, *accel, rays, what);
-                expectSame(scene, *accel, secondaryRays(scene, rays, 3), what + " secondary",
-                           1e-9 * scene.scale());
+                test::expectSamePixelsAndSecondaries(scene, *accel, 48, 3, what);
             }
         }
     }

@@ -1,8 +1,8 @@
 #include "tests/support/differential.h"
 
-#include <sstream>
-
 #include <gtest/gtest.h>
+
+#include <sstream>
 
 #include "engine/accel/irregular/camera_frame.h"
 
@@ -253,6 +253,14 @@ void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<
     EXPECT_TRUE(bad.empty()) << what << ": " << bad.size() << " mismatches of " << rays.size()
                              << ", first:\n"
                              << (bad.empty() ? "" : bad[0].toString(scene));
+}
+
+void expectSamePixelsAndSecondaries(const Scene& scene, const Accelerator& accel, int n,
+                                    uint64_t seed, const std::string& what) {
+    const std::vector<Ray> rays = pixelRays(scene, n, n);
+    expectSame(scene, accel, rays, what);
+    expectSame(scene, accel, secondaryRays(scene, rays, seed), what + " secondary",
+               1e-9 * scene.scale());
 }
 
 std::vector<Ray> secondaryRays(const Scene& scene, const std::vector<Ray>& primary, uint64_t seed) {

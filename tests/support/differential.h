@@ -72,6 +72,11 @@ std::vector<Ray> pixelRays(const Scene& scene, int w, int h);
 void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
                 const std::string& what, double tmin = 0.0);
 
+/// expectSame on the scene camera's n x n pixel rays, and on secondaryRays(seed) from their hits
+/// (t > a hair of the scene's size).
+void expectSamePixelsAndSecondaries(const Scene& scene, const Accelerator& accel, int n,
+                                    uint64_t seed, const std::string& what);
+
 /// From each brute-force hit of `primary`: a random ray and one toward the first light.
 std::vector<Ray> secondaryRays(const Scene& scene, const std::vector<Ray>& primary, uint64_t seed);
 

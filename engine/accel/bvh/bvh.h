@@ -129,6 +129,27 @@ class Bvh {
     template <bool kParallel, class Obs>
     bool walkUnion(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                    Hit& hit) const;
+    /// The ray as the box tests read it: its origin, and its inverse direction (0 along an
+    /// axis it is parallel to).
+    struct SlabRay {
+        double o[3], inv[3];
+        explicit SlabRay(const Ray& r) {
+            for (int a = 0; a < 3; ++a) {
+                o[a] = r.o[a];
+                inv[a] = r.d[a] == 0.0 ? 0.0 : 1.0 / r.d[a];
+            }
+        }
+    };
+    /// A node waiting on a stack walk's stack, with the ray's interval in its box.
+    struct StackEntry {
+        uint32_t node;
+        double t0, t1;
+    };
+    /// Inner node `e`'s children the ray meets within [tmin, tmax], pushed far one first so
+    /// that the near one is walked next; told to the observer.
+    template <bool kParallel, class Obs>
+    void pushChildren(const StackEntry& e, const double o[3], const double inv[3], double tmin,
+                      double tmax, StackEntry* stack, int& sp, Obs& obs) const;
     /// The ray's interval in node `n`'s box, within [tmin, tmax]: false when empty.
     template <bool kParallel>
     static bool clip(const BvhNode& n, const double o[3], const double inv[3], double tmin,
@@ -219,16 +240,38 @@ template <class Obs>
 }
 
 template <bool kParallel, class Obs>
+[[gnu::always_inline]] inline void Bvh::pushChildren(const StackEntry& e, const double o[3],
+                                                     const double inv[3], double tmin, double tmax,
+                                                     StackEntry* stack, int& sp, Obs& obs) const {
+    const BvhNode* const nodes = nodes_.data();
+    const uint32_t l = nodes[e.node].first, r = l + 1;
+    double l0, l1, r0, r1;
+    const bool hl = clip<kParallel>(nodes[l], o, inv, tmin, tmax, l0, l1);
+    const bool hr = clip<kParallel>(nodes[r], o, inv, tmin, tmax, r0, r1);
+    if (hl && hr) {
+        const bool leftFirst = l0 <= r0;
+        const StackEntry nearE = leftFirst ? StackEntry{l, l0, l1} : StackEntry{r, r0, r1};
+        const StackEntry farE = leftFirst ? StackEntry{r, r0, r1} : StackEntry{l, l0, l1};
+        if constexpr (Obs::kActive)
+            obs.nodeChildren(e.node, nearE.node, nearE.t0, farE.node, farE.t0);
+        stack[sp++] = farE;
+        stack[sp++] = nearE;
+    } else if (hl || hr) {
+        const StackEntry only = hl ? StackEntry{l, l0, l1} : StackEntry{r, r0, r1};
+        if constexpr (Obs::kActive) obs.nodeChildren(e.node, only.node, only.t0, kNoNode, kInf);
+        stack[sp++] = only;
+    } else if constexpr (Obs::kActive) {
+        obs.nodeChildren(e.node, kNoNode, kInf, kNoNode, kInf);
+    }
+}
+
+template <bool kParallel, class Obs>
 int Bvh::walkFirstStart(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                         Hit& hit) const {
-    const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
-    double inv[3];
-    for (int a = 0; a < 3; ++a) inv[a] = ray.d[a] == 0.0 ? 0.0 : 1.0 / ray.d[a];
+    const SlabRay slab(ray);
+    const double *const o = slab.o, *const inv = slab.inv;
     const BvhNode* const nodes = nodes_.data();
-    struct Entry {
-        uint32_t node;
-        double t0, t1;
-    };
+    using Entry = StackEntry;
     Entry stack[kAutomaticBvhDepth + 2];
     int sp = 0;
     {
@@ -277,25 +320,7 @@ int Bvh::walkFirstStart(const Ray& ray, double tmin, double tmax, TraceContext& 
             }
             continue;
         }
-        const uint32_t l = n.first, r = n.first + 1;
-        double l0, l1, r0, r1;
-        const bool hl = clip<kParallel>(nodes[l], o, inv, tmin, first.t, l0, l1);
-        const bool hr = clip<kParallel>(nodes[r], o, inv, tmin, first.t, r0, r1);
-        if (hl && hr) {
-            const bool leftFirst = l0 <= r0;
-            const Entry nearE = leftFirst ? Entry{l, l0, l1} : Entry{r, r0, r1};
-            const Entry farE = leftFirst ? Entry{r, r0, r1} : Entry{l, l0, l1};
-            if constexpr (Obs::kActive)
-                obs.nodeChildren(e.node, nearE.node, nearE.t0, farE.node, farE.t0);
-            stack[sp++] = farE;
-            stack[sp++] = nearE;
-        } else if (hl || hr) {
-            const Entry only = hl ? Entry{l, l0, l1} : Entry{r, r0, r1};
-            if constexpr (Obs::kActive) obs.nodeChildren(e.node, only.node, only.t0, kNoNode, kInf);
-            stack[sp++] = only;
-        } else if constexpr (Obs::kActive) {
-            obs.nodeChildren(e.node, kNoNode, kInf, kNoNode, kInf);
-        }
+        pushChildren<kParallel>(e, o, inv, tmin, first.t, stack, sp, obs);
     }
     if (tie) return -1;
     if (found) hit = {first.t, first.prim, first.part, first.flip};
@@ -305,9 +330,8 @@ int Bvh::walkFirstStart(const Ray& ray, double tmin, double tmax, TraceContext& 
 template <bool kParallel, class Obs>
 bool Bvh::walkUnion(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                     Hit& hit) const {
-    const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
-    double inv[3];
-    for (int a = 0; a < 3; ++a) inv[a] = ray.d[a] == 0.0 ? 0.0 : 1.0 / ray.d[a];
+    const SlabRay slab(ray);
+    const double *const o = slab.o, *const inv = slab.inv;
     const BvhNode* const nodes = nodes_.data();
     struct Entry {
         double t0, t1;
@@ -392,14 +416,10 @@ bool Bvh::walkUnion(const Ray& ray, double tmin, double tmax, TraceContext& ctx,
 template <bool kParallel, class Obs>
 bool Bvh::walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                Hit& hit) const {
-    const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
-    double inv[3];
-    for (int a = 0; a < 3; ++a) inv[a] = ray.d[a] == 0.0 ? 0.0 : 1.0 / ray.d[a];
+    const SlabRay slab(ray);
+    const double *const o = slab.o, *const inv = slab.inv;
     const BvhNode* const nodes = nodes_.data();
-    struct Entry {
-        uint32_t node;
-        double t0, t1;
-    };
+    using Entry = StackEntry;
     // Push the far child, go on with the near one: at most one entry a level waits.
     Entry stack[kAutomaticBvhDepth + 2];
     int sp = 0;
@@ -429,25 +449,7 @@ bool Bvh::walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs&
             }
             continue;
         }
-        const uint32_t l = n.first, r = n.first + 1;
-        double l0, l1, r0, r1;
-        const bool hl = clip<kParallel>(nodes[l], o, inv, tmin, best, l0, l1);
-        const bool hr = clip<kParallel>(nodes[r], o, inv, tmin, best, r0, r1);
-        if (hl && hr) {
-            const bool leftFirst = l0 <= r0;
-            const Entry nearE = leftFirst ? Entry{l, l0, l1} : Entry{r, r0, r1};
-            const Entry farE = leftFirst ? Entry{r, r0, r1} : Entry{l, l0, l1};
-            if constexpr (Obs::kActive)
-                obs.nodeChildren(e.node, nearE.node, nearE.t0, farE.node, farE.t0);
-            stack[sp++] = farE;
-            stack[sp++] = nearE;
-        } else if (hl || hr) {
-            const Entry only = hl ? Entry{l, l0, l1} : Entry{r, r0, r1};
-            if constexpr (Obs::kActive) obs.nodeChildren(e.node, only.node, only.t0, kNoNode, kInf);
-            stack[sp++] = only;
-        } else if constexpr (Obs::kActive) {
-            obs.nodeChildren(e.node, kNoNode, kInf, kNoNode, kInf);
-        }
+        pushChildren<kParallel>(e, o, inv, tmin, best, stack, sp, obs);
     }
     return found;
 }
