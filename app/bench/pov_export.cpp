@@ -87,6 +87,11 @@ struct Writer {
                     else
                         head =
                             "triangle { " + vec(s.p[0]) + ", " + vec(s.p[1]) + ", " + vec(s.p[2]);
+                } else if constexpr (std::is_same_v<T, Polytope>) {
+                    // POV-Ray's plane {n, d} holds the points where dot(n, x) < d, as ours.
+                    head = "intersection {";
+                    for (const glm::dvec4& pl : s.planes)
+                        head += " plane { " + vec(Vec3(pl)) + ", " + n(pl.w) + " }";
                 } else {
                     // Closed explicitly: the first point again (an even-odd polygon, as ours).
                     head = "polygon { " + std::to_string(s.p.size() + 1);

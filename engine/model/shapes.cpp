@@ -170,6 +170,33 @@ int polygonSpans(const Polygon& pg, const Ray& r, uint32_t prim, Span* out) {
     return 1;
 }
 
+int polytopeSpans(const Polytope& k, const Ray& r, uint32_t prim, Span* out) {
+    // Kay and Kajiya's slab clipping, one plane at a time: the ray enters where it crosses a
+    // plane whose normal faces it and leaves where it crosses one facing away.
+    double t0 = -kInf, t1 = kInf;
+    uint8_t p0 = 0, p1 = 0;
+    for (size_t i = 0; i < k.planes.size(); ++i) {
+        const glm::dvec4& pl = k.planes[i];
+        const Vec3 n(pl);
+        double dn = glm::dot(n, r.d);
+        double dist = pl.w - glm::dot(n, r.o);
+        if (dn == 0.0) {
+            if (dist < 0.0) return 0;
+            continue;
+        }
+        double t = dist / dn;
+        if (dn < 0.0) {
+            if (t > t0) t0 = t, p0 = uint8_t(i);
+        } else if (t < t1) {
+            t1 = t, p1 = uint8_t(i);
+        }
+        if (!(t0 < t1)) return 0;
+    }
+    if (!std::isfinite(t0) || !std::isfinite(t1)) return 0;
+    out[0] = {{t0, prim, p0, false}, {t1, prim, p1, false}};
+    return 1;
+}
+
 }  // namespace
 
 int shapeSpans(const Shape& s, const Ray& r, uint32_t prim, Span* out) {
@@ -178,7 +205,8 @@ int shapeSpans(const Shape& s, const Ray& r, uint32_t prim, Span* out) {
                    [&](const Block& x) { return blockSpans(x, r, prim, out); },
                    [&](const Cone& x) { return coneSpans(x, r, prim, out); },
                    [&](const Triangle& x) { return triangleSpans(x, r, prim, out); },
-                   [&](const Polygon& x) { return polygonSpans(x, r, prim, out); }},
+                   [&](const Polygon& x) { return polygonSpans(x, r, prim, out); },
+                   [&](const Polytope& x) { return polytopeSpans(x, r, prim, out); }},
         s);
 }
 
@@ -212,7 +240,8 @@ Vec3 shapeNormal(const Shape& s, const Vec3& p, uint8_t part) {
                        n = glm::normalize(n);
                        return glm::dot(n, g) < 0.0 ? -n : n;
                    },
-                   [&](const Polygon& x) { return x.n; }},
+                   [&](const Polygon& x) { return x.n; },
+                   [&](const Polytope& x) { return Vec3(x.planes[part]); }},
         s);
 }
 
@@ -236,7 +265,8 @@ Box3 shapeBounds(const Shape& s) {
                                      Box3 b;
                                      for (const Vec3& p : x.p) b.expand(p);
                                      return b;
-                                 }},
+                                 },
+                                 [](const Polytope& x) { return x.bounds; }},
                       s);
 }
 
@@ -246,7 +276,7 @@ bool shapeIsSurface(const Shape& s) {
 }
 
 const char* shapeName(const Shape& s) {
-    static const char* names[] = {"sphere", "box", "cone", "triangle", "polygon"};
+    static const char* names[] = {"sphere", "box", "cone", "triangle", "polygon", "polytope"};
     if (const Cone* c = std::get_if<Cone>(&s)) {
         if (c->open) return "open cone";
         if (c->r1 == c->r2) return "cylinder";

@@ -71,7 +71,15 @@ struct Polygon {
     int drop = 2;    ///< axis dropped for the 2D inside test
 };
 
-using Shape = std::variant<Sphere, Block, Cone, Triangle, Polygon>;
+/// Convex polyhedron: the points where dot(plane.xyz, x) <= plane.w for every plane (at most
+/// 255 planes; part k is plane k). `bounds` holds it (the caller computes it from its vertices,
+/// which a plane list alone does not give cheaply). OpenSCAD's linear extrusions are built of it.
+struct Polytope {
+    std::vector<glm::dvec4> planes;  ///< unit normal and offset of each face's plane
+    Box3 bounds;                     ///< a box holding the solid
+};
+
+using Shape = std::variant<Sphere, Block, Cone, Triangle, Polygon, Polytope>;
 
 /// Spans of the line `r` (in the shape's frame) through the shape, written to `out` (capacity 2).
 int shapeSpans(const Shape& s, const Ray& r, uint32_t prim, Span* out);

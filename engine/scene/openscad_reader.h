@@ -18,6 +18,10 @@ struct OpenScadCounts {
     int colors = 0;
     int leftOut = 0;  ///< subtrees dropped by the `*` or `%` modifier (or outside a `!` root)
     int empty = 0;    ///< zero-size primitives (OpenSCAD makes nothing of them)
+    int squares = 0, circles = 0, polygons = 0;  ///< 2D nodes read inside extrusions
+    int linearExtrudes = 0, rotateExtrudes = 0;  ///< extrusions modelled
+    int polytopes = 0;  ///< convex polytopes made (extruded pieces, partial-sweep wedges)
+    int leftOut2D = 0;  ///< 2D nodes beside solids, not part of the solid model (as OpenSCAD)
 };
 
 /// Nodes the reader models exactly; every other node is refused naming the node and position.

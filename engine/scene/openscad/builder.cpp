@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "engine/scene/openscad/colors.h"
+#include "engine/scene/openscad/region2d.h"
 
 namespace lancer::openscad {
 
@@ -114,6 +115,11 @@ class Builder {
         } else {
             b = unionOf(top, Transform(), 0);
         }
+        if (b.kind != Built::Kind::Node && first2D_)
+            src_.fail(first2D_->pos,
+                      "the model is 2D (its first 2D node is '" + first2D_->name +
+                          "') and has no solid: Lancer traces solids; extrude the drawing with "
+                          "linear_extrude or rotate_extrude to render it");
         return b.kind == Built::Kind::Node ? b.node : -1;
     }
 
@@ -182,16 +188,510 @@ class Builder {
             if (!n.children.empty()) src_.fail(n.children.front().pos, k + "() takes no children");
             return primitive(n, xf, mat);
         }
+        if (k == "linear_extrude") return linearExtrude(n, xf, mat);
+        if (k == "rotate_extrude") return rotateExtrude(n, xf, mat);
+        if (is2DNode(k)) {
+            // As OpenSCAD's render: a 2D object beside solids is not part of the solid model.
+            if (!first2D_) first2D_ = &n;
+            ++counts_.leftOut2D;
+            return Built::absent();
+        }
         refuse(n);
     }
 
+    static bool is2DNode(const std::string& k) {
+        static const char* names[] = {"circle", "square",     "polygon",   "text",
+                                      "offset", "projection", "import_dxf"};
+        for (const char* t : names)
+            if (k == t) return true;
+        return false;
+    }
+
+    // ---- 2D regions: a tree of convex pieces and ellipses, in the plane z = 0 ----
+
+    /// A 2D region node: a convex piece, an ellipse (the unit disk under `disk`), or a boolean.
+    struct Region {
+        enum class Kind : uint8_t { Piece, Disk, Union, Intersection, Difference } kind;
+        ConvexPiece piece;
+        glm::dmat3 disk{1.0};  ///< 2D affine (homogeneous) of the unit disk
+        int a = -1, b = -1;
+        size_t pos = 0;  ///< the node that made it
+    };
+
+    int region(Region r) {
+        regions_.push_back(std::move(r));
+        return int(regions_.size()) - 1;
+    }
+    int regionOp(Region::Kind k, const std::vector<int>& items, size_t pos) {
+        int acc = items[0];
+        for (size_t i = 1; i < items.size(); ++i) {
+            Region r{k, {}, glm::dmat3(1.0), acc, items[i], pos};
+            acc = region(std::move(r));
+        }
+        return acc;
+    }
+
+    /// The plane part of a transform: x and y of the image of (x, y, 0), as OpenSCAD applies a
+    /// 3D matrix to 2D geometry.
+    static glm::dmat3 planeAffine(const Transform& t) {
+        glm::dmat3 a(1.0);
+        a[0] = {t.m[0][0], t.m[0][1], 0.0};
+        a[1] = {t.m[1][0], t.m[1][1], 0.0};
+        a[2] = {t.m[3][0], t.m[3][1], 1.0};
+        return a;
+    }
+
+    Built region2(const Node& n, const glm::dmat3& af, const Node& extrude) {
+        if (n.disable || n.background) {
+            ++counts_.leftOut;
+            return Built::absent();
+        }
+        const std::string& k = n.name;
+        if (k == "group" || k == "union" || k == "render" || k == "color") {
+            if (k == "render")
+                Args(src_, n, {"convexity"}, {});
+            else if (k == "color")
+                color(n, 0);  // checked; the extrusion takes the colour of its own context
+            else
+                Args(src_, n, {}, {});
+            return regionUnion(n.children, af, extrude);
+        }
+        if (k == "intersection" || k == "difference") {
+            Args(src_, n, {}, {});
+            std::vector<Built> kids;
+            for (const Node& c : n.children) {
+                Built b = region2(c, af, extrude);
+                if (b.kind != Built::Kind::Absent) kids.push_back(b);
+            }
+            if (kids.empty()) return Built::empty();
+            if (k == "intersection") {
+                std::vector<int> items;
+                for (const Built& b : kids) {
+                    if (b.kind == Built::Kind::Empty) return Built::empty();
+                    items.push_back(b.node);
+                }
+                return Built::of(regionOp(Region::Kind::Intersection, items, n.pos));
+            }
+            if (kids[0].kind == Built::Kind::Empty) return Built::empty();
+            std::vector<int> items{kids[0].node};
+            for (size_t i = 1; i < kids.size(); ++i)
+                if (kids[i].kind == Built::Kind::Node) items.push_back(kids[i].node);
+            return Built::of(regionOp(Region::Kind::Difference, items, n.pos));
+        }
+        if (k == "multmatrix" || k == "translate" || k == "rotate" || k == "scale" ||
+            k == "mirror") {
+            ++counts_.transforms;
+            glm::dmat3 t = af * planeAffine(transform(n));
+            double det = t[0][0] * t[1][1] - t[1][0] * t[0][1];
+            if (!(det != 0.0) || !std::isfinite(det))
+                src_.fail(n.pos, k + "() flattens its 2D children to nothing");
+            return regionUnion(n.children, t, extrude);
+        }
+        if (k == "square" || k == "circle" || k == "polygon") {
+            if (!n.children.empty()) src_.fail(n.children.front().pos, k + "() takes no children");
+            return shape2(n, af);
+        }
+        if (is2DNode(k))
+            src_.fail(n.pos, "the 2D node '" + k + "' is not supported (supported in 2D: square, "
+                                                   "circle, polygon, their booleans and transforms)");
+        if (k == "linear_extrude" || k == "rotate_extrude" || k == "cube" || k == "sphere" ||
+            k == "cylinder")
+            src_.fail(n.pos, "the 3D node '" + k + "' is inside " + extrude.name + "() at " +
+                                 src_.where(extrude.pos) + ", which extrudes 2D children only");
+        refuse(n);
+    }
+
+    Built regionUnion(const std::vector<Node>& kids, const glm::dmat3& af, const Node& extrude) {
+        std::vector<int> items;
+        for (const Node& c : kids) {
+            Built b = region2(c, af, extrude);
+            if (b.kind == Built::Kind::Node) items.push_back(b.node);
+        }
+        if (items.empty()) return Built::empty();
+        return Built::of(regionOp(Region::Kind::Union, items, kids.front().pos));
+    }
+
+    Built pieces(const std::vector<std::vector<Vec2>>& paths, size_t pos) {
+        std::vector<ConvexPiece> ps = convexPieces(paths);
+        if (ps.empty()) return emptyPrimitive();
+        std::vector<int> items;
+        for (ConvexPiece& p : ps) items.push_back(region({Region::Kind::Piece, std::move(p),
+                                                          glm::dmat3(1.0), -1, -1, pos}));
+        return Built::of(regionOp(Region::Kind::Union, items, pos));
+    }
+
+    Vec2 vec2(const Args& a, const Value& v, const std::string& what) {
+        if (v.kind != Value::Kind::Vector || (v.items.size() != 2 && v.items.size() != 3))
+            src_.fail(v.pos, "expected [x, y] for " + what);
+        return {a.number(v.items[0], what), a.number(v.items[1], what)};
+    }
+
+    Built shape2(const Node& n, const glm::dmat3& af) {
+        const std::string& k = n.name;
+        auto apply = [&](Vec2 p) { return Vec2(af * glm::dvec3(p, 1.0)); };
+        if (k == "square") {
+            Args a(src_, n, {"size", "center"}, {});
+            Vec2 size(1.0);
+            if (const Value* s = a.get("size")) {
+                size = s->kind == Value::Kind::Number ? Vec2(s->number)
+                                                      : vec2(a, *s, "'size' of square()");
+                if (size.x < 0.0 || size.y < 0.0)
+                    src_.fail(s->pos, "square sizes must not be negative");
+            }
+            bool center = a.boolean("center", false);
+            if (size.x == 0.0 || size.y == 0.0) return emptyPrimitive();
+            Vec2 lo = center ? -0.5 * size : Vec2(0.0), hi = lo + size;
+            ++counts_.squares;
+            return pieces({{apply(lo), apply({hi.x, lo.y}), apply(hi), apply({lo.x, hi.y})}},
+                          n.pos);
+        }
+        if (k == "circle") {
+            Args a(src_, n, {"r"}, {"d"});
+            double r = 1.0;
+            if (auto d = a.number("d"))
+                r = 0.5 * nonNegative(a, "d", *d);
+            else if (auto rr = a.number("r"))
+                r = nonNegative(a, "r", *rr);
+            if (r == 0.0) return emptyPrimitive();
+            ++counts_.circles;
+            glm::dmat3 s(1.0);
+            s[0][0] = s[1][1] = r;
+            return Built::of(region({Region::Kind::Disk, {}, af * s, -1, -1, n.pos}));
+        }
+        Args a(src_, n, {"points", "paths", "convexity"}, {});
+        const Value* pts = a.get("points");
+        if (!pts) return emptyPrimitive();
+        if (pts->kind != Value::Kind::Vector)
+            src_.fail(pts->pos, "expected a list of [x, y] points for 'points' of polygon()");
+        std::vector<Vec2> p;
+        for (const Value& v : pts->items) p.push_back(apply(vec2(a, v, "a polygon point")));
+        std::vector<std::vector<Vec2>> paths;
+        if (const Value* ps = a.get("paths")) {
+            if (ps->kind != Value::Kind::Vector)
+                src_.fail(ps->pos, "expected a list of index lists for 'paths' of polygon()");
+            for (const Value& path : ps->items) {
+                if (path.kind != Value::Kind::Vector)
+                    src_.fail(path.pos, "expected a list of point indices for a polygon path");
+                std::vector<Vec2> q;
+                for (const Value& iv : path.items) {
+                    double i = a.number(iv, "a point index");
+                    if (i < 0 || i >= double(p.size()) || i != std::floor(i))
+                        src_.fail(iv.pos, "a polygon path index must be a whole number from 0 "
+                                          "to " + std::to_string(p.size() - 1));
+                    q.push_back(p[size_t(i)]);
+                }
+                paths.push_back(std::move(q));
+            }
+        } else {
+            paths.push_back(p);
+        }
+        size_t edges = 0;
+        for (const auto& q : paths) edges += q.size();
+        if (edges > 20000)
+            src_.fail(n.pos, "polygon() has more than 20000 edges, which Lancer does not cut");
+        ++counts_.polygons;
+        return pieces(paths, n.pos);
+    }
+
+    /// xf followed by a shift of `z` along local z, with the inverse composed exactly so that
+    /// shapes shifted by different amounts see the same local x and y of a ray (their walls then
+    /// meet bit for bit).
+    static Transform shiftedZ(const Transform& xf, double z) {
+        Transform t;
+        t.m = xf.m * glm::translate(Mat4(1.0), Vec3(0.0, 0.0, z));
+        t.inv = glm::translate(Mat4(1.0), Vec3(0.0, 0.0, -z)) * xf.inv;
+        t.normal = xf.normal;
+        return t;
+    }
+
+    Built place(Shape shape, const Transform& xf, int mat, size_t pos, const std::string& what) {
+        Primitive p = makePrimitive(std::move(shape), xf, mat);
+        if (!p.worldBox.isBounded())
+            src_.fail(pos, what + " is too large: its bounds overflow a double");
+        p.origin = src_.where(pos);
+        scene_.prims.push_back(std::move(p));
+        return Built::of(scene_.tree.leaf(uint32_t(scene_.prims.size() - 1)));
+    }
+
+    // ---- linear_extrude ----
+
+    Built linearExtrude(const Node& n, const Transform& xf, int mat) {
+        Args a(src_, n, {"height"},
+               {"v", "center", "convexity", "twist", "slices", "scale", "segments", "file",
+                "layer", "origin"});
+        if (a.get("file"))
+            src_.fail(a.get("file")->pos,
+                      "linear_extrude(file = ...) imports a DXF drawing, which Lancer does not read");
+        double h = 100.0;  // OpenSCAD's default
+        if (auto v = a.number("height")) h = *v;
+        if (const Value* v = a.get("v")) {
+            Vec3 d = a.vec3(*v, "'v' of linear_extrude()");
+            if (d.x != 0.0 || d.y != 0.0 || !(d.z > 0.0))
+                src_.fail(v->pos, "linear_extrude along a direction other than +z is not "
+                                  "supported");
+            h = d.z;
+        }
+        if (auto t = a.number("twist"); t && *t != 0.0)
+            src_.fail(n.pos, "linear_extrude with twist = " + std::to_string(*t) +
+                                 " is not supported: a twisted wall is a ruled surface that "
+                                 "Lancer does not trace exactly");
+        a.number("slices");
+        a.number("segments");
+        Vec2 scale(1.0);
+        if (const Value* s = a.get("scale")) {
+            scale = s->kind == Value::Kind::Number ? Vec2(s->number)
+                                                   : vec2(a, *s, "'scale' of linear_extrude()");
+            if (scale.x < 0.0 || scale.y < 0.0)
+                src_.fail(s->pos, "'scale' of linear_extrude() must not be negative");
+        }
+        bool center = a.boolean("center", false);
+        Built r = regionUnion(n.children, glm::dmat3(1.0), n);
+        if (r.kind != Built::Kind::Node) return r;
+        if (!(h > 0.0)) return emptyPrimitive();  // OpenSCAD makes nothing of it
+        ++counts_.linearExtrudes;
+        Transform local = center ? xf * Transform::translate({0.0, 0.0, -0.5 * h}) : xf;
+        return extrudeRegion(r.node, n, local, mat, h, (scale - 1.0) / h);
+    }
+
+    /// The region's node extruded: 2D booleans become 3D booleans of the extruded leaves (the
+    /// extrusion maps each height's section one to one, so it commutes with them). `k`: the
+    /// section at height z is the base scaled by 1 + k z about the origin.
+    Built extrudeRegion(int id, const Node& n, const Transform& xf, int mat, double h,
+                        const Vec2& k) {
+        const Region& r = regions_[size_t(id)];
+        if (r.kind == Region::Kind::Union || r.kind == Region::Kind::Intersection ||
+            r.kind == Region::Kind::Difference) {
+            Built a = extrudeRegion(r.a, n, xf, mat, h, k);
+            Built b = extrudeRegion(r.b, n, xf, mat, h, k);
+            Op op = r.kind == Region::Kind::Union          ? Op::Union
+                    : r.kind == Region::Kind::Intersection ? Op::Intersection
+                                                           : Op::Difference;
+            return Built::of(scene_.tree.combine(op, a.node, b.node));
+        }
+        if (r.kind == Region::Kind::Disk) {
+            if (k.x != k.y)
+                src_.fail(n.pos, "linear_extrude with a non-uniform scale of a circle (at " +
+                                     src_.where(r.pos) +
+                                     ") makes a wall that is not a quadric, which Lancer does "
+                                     "not trace");
+            // The cone of radius 1 to 1 + k h, sheared so that its axis follows the centre's
+            // path c (1 + k z), then mapped by the disk's linear part.
+            const glm::dmat3& d = r.disk;
+            Mat4 m(1.0);
+            m[0] = {d[0][0], d[0][1], 0.0, 0.0};
+            m[1] = {d[1][0], d[1][1], 0.0, 0.0};
+            m[2] = {k.x * d[2][0], k.x * d[2][1], 1.0, 0.0};
+            m[3] = {d[2][0], d[2][1], 0.0, 1.0};
+            ++(k.x == 0.0 ? counts_.cylinders : counts_.cones);
+            return place(Cone{1.0, 1.0 + k.x * h, h, false}, xf * Transform(m), mat, r.pos,
+                         "linear_extrude()");
+        }
+        Polytope pt;
+        for (const HalfPlane& s : r.piece.sides) {
+            // a x / (1 + kx z) + b y / (1 + ky z) <= c is a plane when kx = ky or a or b is 0.
+            double kz;
+            if (s.b == 0.0)
+                kz = k.x;
+            else if (s.a == 0.0 || k.x == k.y)
+                kz = k.y;
+            else
+                src_.fail(n.pos, "linear_extrude with a non-uniform scale of a slanted edge "
+                                 "(of the 2D node at " +
+                                     src_.where(r.pos) +
+                                     ") makes a wall that is not a plane, which Lancer does not "
+                                     "trace");
+            Vec3 nn(s.a, s.b, -s.c * kz);
+            double len = glm::length(nn);
+            if (!(len > 0.0)) continue;
+            pt.planes.push_back(glm::dvec4(nn / len, s.c / len));
+        }
+        pt.planes.push_back({0.0, 0.0, -1.0, 0.0});
+        pt.planes.push_back({0.0, 0.0, 1.0, h});
+        for (const Vec2& v : r.piece.vertices) {
+            pt.bounds.expand(Vec3(v, 0.0));
+            pt.bounds.expand(Vec3(v.x * (1.0 + k.x * h), v.y * (1.0 + k.y * h), h));
+        }
+        // The corners are computed, the planes are exact: a margin keeps the solid inside.
+        Vec3 pad = 1e-9 * (glm::abs(pt.bounds.lo) + glm::abs(pt.bounds.hi)) + Vec3(1e-300);
+        pt.bounds.lo -= pad;
+        pt.bounds.hi += pad;
+        ++counts_.polytopes;
+        return place(std::move(pt), xf, mat, r.pos, "linear_extrude()");
+    }
+
+    // ---- rotate_extrude ----
+
+    /// The box of a region (union: hull, intersection: overlap, difference: the first's).
+    Box3 regionBox(int id) const {
+        const Region& r = regions_[size_t(id)];
+        if (r.kind == Region::Kind::Piece) {
+            Box3 b;
+            for (const Vec2& v : r.piece.vertices) b.expand(Vec3(v, 0.0));
+            return b;
+        }
+        if (r.kind == Region::Kind::Disk) {
+            double ex = std::hypot(r.disk[0][0], r.disk[1][0]);
+            double ey = std::hypot(r.disk[0][1], r.disk[1][1]);
+            Vec3 c(r.disk[2][0], r.disk[2][1], 0.0);
+            return {c - Vec3(ex, ey, 0.0), c + Vec3(ex, ey, 0.0)};
+        }
+        Box3 a = regionBox(r.a), b = regionBox(r.b);
+        if (r.kind == Region::Kind::Union) {
+            a.expand(b);
+            return a;
+        }
+        if (r.kind == Region::Kind::Intersection)
+            return {glm::max(a.lo, b.lo), glm::min(a.hi, b.hi)};
+        return a;
+    }
+
+    void mirrorRegion(int id) {
+        Region& r = regions_[size_t(id)];
+        if (r.kind == Region::Kind::Piece) {
+            for (HalfPlane& s : r.piece.sides) s.a = -s.a;
+            for (Vec2& v : r.piece.vertices) v.x = -v.x;
+            std::reverse(r.piece.vertices.begin(), r.piece.vertices.end());
+        } else if (r.kind == Region::Kind::Disk) {
+            for (int c = 0; c < 3; ++c) r.disk[c][0] = -r.disk[c][0];
+        } else {
+            mirrorRegion(r.a);
+            mirrorRegion(r.b);
+        }
+    }
+
+    Built rotateExtrude(const Node& n, const Transform& xf, int mat) {
+        Args a(src_, n, {}, {"angle", "convexity", "file", "layer", "origin", "scale"});
+        if (a.get("file"))
+            src_.fail(a.get("file")->pos,
+                      "rotate_extrude(file = ...) imports a DXF drawing, which Lancer does not read");
+        double angle = std::clamp(a.number("angle").value_or(360.0), -360.0, 360.0);
+        Built r = regionUnion(n.children, glm::dmat3(1.0), n);
+        if (r.kind != Built::Kind::Node) return r;
+        if (angle == 0.0) return emptyPrimitive();
+        Box3 box = regionBox(r.node);
+        if (box.lo.x < 0.0 && box.hi.x > 0.0)
+            src_.fail(n.pos, "rotate_extrude(): the profile crosses the axis (x from " +
+                                 std::to_string(box.lo.x) + " to " + std::to_string(box.hi.x) +
+                                 "); as in OpenSCAD, all of it must lie on one side of x = 0");
+        if (box.hi.x <= 0.0) {
+            mirrorRegion(r.node);
+            box = regionBox(r.node);
+        }
+        if (!(box.hi.x > 0.0) || !(box.hi.y > box.lo.y)) return emptyPrimitive();
+        ++counts_.rotateExtrudes;
+        Built solid = revolveRegion(r.node, n, xf, mat);
+        if (std::abs(angle) == 360.0) return solid;
+        // A partial sweep from the +x axis: the solid cut by a wedge (a polytope bounded by a box
+        // larger than the solid, so that no face of the wedge's box touches it).
+        double sweep = std::abs(angle), start = angle > 0.0 ? 0.0 : angle;
+        bool keep = sweep <= 180.0;
+        if (!keep) {
+            start = angle > 0.0 ? angle : 0.0;
+            sweep = 360.0 - sweep;
+        }
+        double R = 1.1 * box.hi.x + 1e-9, z0 = box.lo.y, z1 = box.hi.y;
+        double dz = 0.1 * (z1 - z0) + 1e-9;
+        double s0 = glm::radians(start), s1 = glm::radians(start + sweep);
+        Polytope w;
+        w.planes = {{std::sin(s0), -std::cos(s0), 0.0, 0.0}, {-std::sin(s1), std::cos(s1), 0.0, 0.0},
+                    {-1, 0, 0, R}, {1, 0, 0, R}, {0, -1, 0, R}, {0, 1, 0, R},
+                    {0, 0, -1, -(z0 - dz)}, {0, 0, 1, z1 + dz}};
+        w.bounds = {Vec3(-R, -R, z0 - dz), Vec3(R, R, z1 + dz)};
+        ++counts_.polytopes;
+        Built wedge = place(std::move(w), xf, mat, n.pos, "rotate_extrude()");
+        return Built::of(scene_.tree.combine(keep ? Op::Intersection : Op::Difference, solid.node,
+                                             wedge.node));
+    }
+
+    /// The region revolved about the profile's y axis (which becomes z): booleans commute with
+    /// the revolution as with an extrusion.
+    Built revolveRegion(int id, const Node& n, const Transform& xf, int mat) {
+        const Region& r = regions_[size_t(id)];
+        if (r.kind == Region::Kind::Union || r.kind == Region::Kind::Intersection ||
+            r.kind == Region::Kind::Difference) {
+            Built a = revolveRegion(r.a, n, xf, mat);
+            Built b = revolveRegion(r.b, n, xf, mat);
+            if (r.kind == Region::Kind::Union) {
+                if (a.kind != Built::Kind::Node) return b;
+                if (b.kind != Built::Kind::Node) return a;
+                return Built::of(scene_.tree.combine(Op::Union, a.node, b.node));
+            }
+            if (a.kind != Built::Kind::Node) return Built::empty();
+            if (b.kind != Built::Kind::Node)
+                return r.kind == Region::Kind::Difference ? a : Built::empty();
+            return Built::of(scene_.tree.combine(
+                r.kind == Region::Kind::Intersection ? Op::Intersection : Op::Difference, a.node,
+                b.node));
+        }
+        if (r.kind == Region::Kind::Disk) {
+            const glm::dmat3& d = r.disk;
+            // An ellipse centred on the axis with its axes along x and y revolves into an
+            // ellipsoid; any other makes a torus.
+            if (d[2][0] != 0.0 || d[1][0] != 0.0 || d[0][1] != 0.0)
+                src_.fail(n.pos, "rotate_extrude() of the circle at " + src_.where(r.pos) +
+                                     " makes a torus, which Lancer does not model (a circle "
+                                     "centred on the axis, a sphere, is supported)");
+            double rx = std::abs(d[0][0]), ry = std::abs(d[1][1]);
+            ++counts_.spheres;
+            return place(Sphere{Vec3(0.0), 1.0},
+                         xf * Transform::translate({0.0, 0.0, d[2][1]}) *
+                             Transform::scale({rx, rx, ry}),
+                         mat, r.pos, "rotate_extrude()");
+        }
+        return revolvePiece(r.piece, xf, mat, r.pos);
+    }
+
+    /// A convex piece a x + b y <= c (x the radius, y the height) revolved: each side with a > 0
+    /// keeps the inside of a cone (radius (c - b z) / a), each with a < 0 the outside of one,
+    /// each with a = 0 a height already bounded by the piece's extent.
+    Built revolvePiece(const ConvexPiece& pc, const Transform& xf, int mat, size_t pos) {
+        // The part at x >= 0 gives the height range (a piece of a subtracted region may cross
+        // the axis; its sides need no clipping, the radius is never negative).
+        std::vector<Vec2> v;
+        const std::vector<Vec2>& in = pc.vertices;
+        for (size_t i = 0; i < in.size(); ++i) {
+            const Vec2 &p = in[i], &q = in[(i + 1) % in.size()];
+            if (p.x >= 0.0) v.push_back(p);
+            if ((p.x < 0.0) != (q.x < 0.0)) v.push_back({0.0, p.y + (q.y - p.y) * (-p.x / (q.x - p.x))});
+        }
+        if (v.size() < 3) return Built::empty();
+        double z0 = kInf, z1 = -kInf;
+        for (const Vec2& p : v) z0 = std::min(z0, p.y), z1 = std::max(z1, p.y);
+        if (!(z1 > z0)) return Built::empty();
+        double margin = 0.05 * (z1 - z0);
+        std::vector<int> inside, outside;
+        for (const HalfPlane& s : pc.sides) {
+            if (s.a == 0.0) continue;
+            // The radius f(z) = (c - b z) / a over the height range (widened for a subtracted
+            // cone, so that its caps stay clear of the piece's own).
+            double lo = s.a > 0.0 ? z0 : z0 - margin, hi = s.a > 0.0 ? z1 : z1 + margin;
+            auto f = [&](double z) { return (s.c - s.b * z) / s.a; };
+            double fl = f(lo), fh = f(hi);
+            if (fl <= 0.0 && fh <= 0.0) {
+                if (s.a > 0.0) return Built::empty();
+                continue;  // r >= a non-positive radius holds everywhere
+            }
+            double zr = s.c / s.b;  // where the radius is zero (b != 0 when f changes sign)
+            if (fl < 0.0) lo = zr, fl = 0.0;
+            if (fh < 0.0) hi = zr, fh = 0.0;
+            if (!(hi > lo)) {
+                if (s.a > 0.0) return Built::empty();
+                continue;
+            }
+            ++(fl == fh ? counts_.cylinders : counts_.cones);
+            Built c = place(Cone{fl, fh, hi - lo, false}, shiftedZ(xf, lo), mat, pos,
+                            "rotate_extrude()");
+            (s.a > 0.0 ? inside : outside).push_back(c.node);
+        }
+        if (inside.empty()) return Built::empty();
+        int solid = scene_.tree.balanced(Op::Intersection, inside);
+        if (!outside.empty())
+            solid = scene_.tree.combine(Op::Difference, solid,
+                                        scene_.tree.balanced(Op::Union, outside));
+        return Built::of(solid);
+    }
+
     [[noreturn]] void refuse(const Node& n) {
-        static const char* twoD[] = {"circle", "square",     "polygon",   "text",
-                                     "offset", "projection", "import_dxf"};
-        for (const char* t : twoD)
-            if (n.name == t)
-                src_.fail(n.pos,
-                          "the 2D node '" + n.name + "' is not supported: Lancer traces 3D solids");
         std::string list;
         for (const std::string& s : openScadSupportedNodes())
             list += (list.empty() ? "" : ", ") + s;
@@ -413,6 +913,8 @@ class Builder {
     Scene& scene_;
     OpenScadCounts& counts_;
     std::map<std::tuple<double, double, double>, int> materialOf_;
+    std::vector<Region> regions_;
+    const Node* first2D_ = nullptr;  ///< the first 2D node met among solids
 };
 
 }  // namespace
@@ -430,7 +932,8 @@ namespace lancer {
 const std::vector<std::string>& openScadSupportedNodes() {
     static const std::vector<std::string> nodes = {
         "group",  "union", "difference", "intersection", "render", "multmatrix", "translate",
-        "rotate", "scale", "mirror",     "color",        "cube",   "sphere",     "cylinder"};
+        "rotate", "scale", "mirror",     "color",        "cube",   "sphere",     "cylinder",
+        "linear_extrude", "rotate_extrude", "square", "circle", "polygon"};
     return nodes;
 }
 
