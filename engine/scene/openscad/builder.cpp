@@ -1,6 +1,7 @@
 #include "engine/scene/openscad/builder.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -12,6 +13,13 @@
 namespace lancer::openscad {
 
 namespace {
+
+/// A number as the model writes it: the shortest form that reads back ("90", "12.5").
+std::string twistText(double x) {
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, x);
+    return std::string(buf, r.ptr);
+}
 
 /// A subtree's contribution: left out of the model (`*`, `%`), present but empty (an empty
 /// group, a zero-size primitive), or a CSG node.
@@ -292,8 +300,9 @@ class Builder {
             return shape2(n, af);
         }
         if (is2DNode(k))
-            src_.fail(n.pos, "the 2D node '" + k + "' is not supported (supported in 2D: square, "
-                                                   "circle, polygon, their booleans and transforms)");
+            src_.fail(n.pos, "the 2D node '" + k +
+                                 "' is not supported (supported in 2D: square, "
+                                 "circle, polygon, their booleans and transforms)");
         if (k == "linear_extrude" || k == "rotate_extrude" || k == "cube" || k == "sphere" ||
             k == "cylinder")
             src_.fail(n.pos, "the 3D node '" + k + "' is inside " + extrude.name + "() at " +
@@ -315,8 +324,9 @@ class Builder {
         std::vector<ConvexPiece> ps = convexPieces(paths);
         if (ps.empty()) return emptyPrimitive();
         std::vector<int> items;
-        for (ConvexPiece& p : ps) items.push_back(region({Region::Kind::Piece, std::move(p),
-                                                          glm::dmat3(1.0), -1, -1, pos}));
+        for (ConvexPiece& p : ps)
+            items.push_back(
+                region({Region::Kind::Piece, std::move(p), glm::dmat3(1.0), -1, -1, pos}));
         return Built::of(regionOp(Region::Kind::Union, items, pos));
     }
 
@@ -376,8 +386,10 @@ class Builder {
                 for (const Value& iv : path.items) {
                     double i = a.number(iv, "a point index");
                     if (i < 0 || i >= double(p.size()) || i != std::floor(i))
-                        src_.fail(iv.pos, "a polygon path index must be a whole number from 0 "
-                                          "to " + std::to_string(p.size() - 1));
+                        src_.fail(iv.pos,
+                                  "a polygon path index must be a whole number from 0 "
+                                  "to " +
+                                      std::to_string(p.size() - 1));
                     q.push_back(p[size_t(i)]);
                 }
                 paths.push_back(std::move(q));
@@ -417,22 +429,24 @@ class Builder {
 
     Built linearExtrude(const Node& n, const Transform& xf, int mat) {
         Args a(src_, n, {"height"},
-               {"v", "center", "convexity", "twist", "slices", "scale", "segments", "file",
-                "layer", "origin"});
+               {"v", "center", "convexity", "twist", "slices", "scale", "segments", "file", "layer",
+                "origin"});
         if (a.get("file"))
-            src_.fail(a.get("file")->pos,
-                      "linear_extrude(file = ...) imports a DXF drawing, which Lancer does not read");
+            src_.fail(
+                a.get("file")->pos,
+                "linear_extrude(file = ...) imports a DXF drawing, which Lancer does not read");
         double h = 100.0;  // OpenSCAD's default
         if (auto v = a.number("height")) h = *v;
         if (const Value* v = a.get("v")) {
             Vec3 d = a.vec3(*v, "'v' of linear_extrude()");
             if (d.x != 0.0 || d.y != 0.0 || !(d.z > 0.0))
-                src_.fail(v->pos, "linear_extrude along a direction other than +z is not "
-                                  "supported");
+                src_.fail(v->pos,
+                          "linear_extrude along a direction other than +z is not "
+                          "supported");
             h = d.z;
         }
         if (auto t = a.number("twist"); t && *t != 0.0)
-            src_.fail(n.pos, "linear_extrude with twist = " + std::to_string(*t) +
+            src_.fail(n.pos, "linear_extrude with twist = " + twistText(*t) +
                                  " is not supported: a twisted wall is a ruled surface that "
                                  "Lancer does not trace exactly");
         a.number("slices");
@@ -495,11 +509,12 @@ class Builder {
             else if (s.a == 0.0 || k.x == k.y)
                 kz = k.y;
             else
-                src_.fail(n.pos, "linear_extrude with a non-uniform scale of a slanted edge "
-                                 "(of the 2D node at " +
-                                     src_.where(r.pos) +
-                                     ") makes a wall that is not a plane, which Lancer does not "
-                                     "trace");
+                src_.fail(n.pos,
+                          "linear_extrude with a non-uniform scale of a slanted edge "
+                          "(of the 2D node at " +
+                              src_.where(r.pos) +
+                              ") makes a wall that is not a plane, which Lancer does not "
+                              "trace");
             Vec3 nn(s.a, s.b, -s.c * kz);
             double len = glm::length(nn);
             if (!(len > 0.0)) continue;
@@ -562,8 +577,9 @@ class Builder {
     Built rotateExtrude(const Node& n, const Transform& xf, int mat) {
         Args a(src_, n, {}, {"angle", "convexity", "file", "layer", "origin", "scale"});
         if (a.get("file"))
-            src_.fail(a.get("file")->pos,
-                      "rotate_extrude(file = ...) imports a DXF drawing, which Lancer does not read");
+            src_.fail(
+                a.get("file")->pos,
+                "rotate_extrude(file = ...) imports a DXF drawing, which Lancer does not read");
         double angle = std::clamp(a.number("angle").value_or(360.0), -360.0, 360.0);
         Built r = regionUnion(n.children, glm::dmat3(1.0), n);
         if (r.kind != Built::Kind::Node) return r;
@@ -593,14 +609,19 @@ class Builder {
         double dz = 0.1 * (z1 - z0) + 1e-9;
         double s0 = glm::radians(start), s1 = glm::radians(start + sweep);
         Polytope w;
-        w.planes = {{std::sin(s0), -std::cos(s0), 0.0, 0.0}, {-std::sin(s1), std::cos(s1), 0.0, 0.0},
-                    {-1, 0, 0, R}, {1, 0, 0, R}, {0, -1, 0, R}, {0, 1, 0, R},
-                    {0, 0, -1, -(z0 - dz)}, {0, 0, 1, z1 + dz}};
+        w.planes = {{std::sin(s0), -std::cos(s0), 0.0, 0.0},
+                    {-std::sin(s1), std::cos(s1), 0.0, 0.0},
+                    {-1, 0, 0, R},
+                    {1, 0, 0, R},
+                    {0, -1, 0, R},
+                    {0, 1, 0, R},
+                    {0, 0, -1, -(z0 - dz)},
+                    {0, 0, 1, z1 + dz}};
         w.bounds = {Vec3(-R, -R, z0 - dz), Vec3(R, R, z1 + dz)};
         ++counts_.polytopes;
         Built wedge = place(std::move(w), xf, mat, n.pos, "rotate_extrude()");
-        return Built::of(scene_.tree.combine(keep ? Op::Intersection : Op::Difference, solid.node,
-                                             wedge.node));
+        return Built::of(
+            scene_.tree.combine(keep ? Op::Intersection : Op::Difference, solid.node, wedge.node));
     }
 
     /// The region revolved about the profile's y axis (which becomes z): booleans commute with
@@ -633,10 +654,10 @@ class Builder {
                                      "centred on the axis, a sphere, is supported)");
             double rx = std::abs(d[0][0]), ry = std::abs(d[1][1]);
             ++counts_.spheres;
-            return place(Sphere{Vec3(0.0), 1.0},
-                         xf * Transform::translate({0.0, 0.0, d[2][1]}) *
-                             Transform::scale({rx, rx, ry}),
-                         mat, r.pos, "rotate_extrude()");
+            return place(
+                Sphere{Vec3(0.0), 1.0},
+                xf * Transform::translate({0.0, 0.0, d[2][1]}) * Transform::scale({rx, rx, ry}),
+                mat, r.pos, "rotate_extrude()");
         }
         return revolvePiece(r.piece, xf, mat, r.pos);
     }
@@ -652,7 +673,8 @@ class Builder {
         for (size_t i = 0; i < in.size(); ++i) {
             const Vec2 &p = in[i], &q = in[(i + 1) % in.size()];
             if (p.x >= 0.0) v.push_back(p);
-            if ((p.x < 0.0) != (q.x < 0.0)) v.push_back({0.0, p.y + (q.y - p.y) * (-p.x / (q.x - p.x))});
+            if ((p.x < 0.0) != (q.x < 0.0))
+                v.push_back({0.0, p.y + (q.y - p.y) * (-p.x / (q.x - p.x))});
         }
         if (v.size() < 3) return Built::empty();
         double z0 = kInf, z1 = -kInf;
@@ -679,8 +701,8 @@ class Builder {
                 continue;
             }
             ++(fl == fh ? counts_.cylinders : counts_.cones);
-            Built c = place(Cone{fl, fh, hi - lo, false}, shiftedZ(xf, lo), mat, pos,
-                            "rotate_extrude()");
+            Built c =
+                place(Cone{fl, fh, hi - lo, false}, shiftedZ(xf, lo), mat, pos, "rotate_extrude()");
             (s.a > 0.0 ? inside : outside).push_back(c.node);
         }
         if (inside.empty()) return Built::empty();
@@ -931,9 +953,10 @@ namespace lancer {
 
 const std::vector<std::string>& openScadSupportedNodes() {
     static const std::vector<std::string> nodes = {
-        "group",  "union", "difference", "intersection", "render", "multmatrix", "translate",
-        "rotate", "scale", "mirror",     "color",        "cube",   "sphere",     "cylinder",
-        "linear_extrude", "rotate_extrude", "square", "circle", "polygon"};
+        "group",          "union",     "difference", "intersection", "render",
+        "multmatrix",     "translate", "rotate",     "scale",        "mirror",
+        "color",          "cube",      "sphere",     "cylinder",     "linear_extrude",
+        "rotate_extrude", "square",    "circle",     "polygon"};
     return nodes;
 }
 
