@@ -132,10 +132,8 @@ std::vector<ConvexPiece> trapezoids(const std::vector<std::vector<Vec2>>& paths)
         pc.sides.push_back({1.0, 0.0, o.x1});
         pc.sides.push_back(leftOf(hi.q, hi.p));
         pc.sides.push_back({-1.0, 0.0, -o.x0});
-        pc.vertices = {{o.x0, lo.yAt(o.x0)},
-                       {o.x1, lo.yAt(o.x1)},
-                       {o.x1, hi.yAt(o.x1)},
-                       {o.x0, hi.yAt(o.x0)}};
+        pc.vertices = {
+            {o.x0, lo.yAt(o.x0)}, {o.x1, lo.yAt(o.x1)}, {o.x1, hi.yAt(o.x1)}, {o.x0, hi.yAt(o.x0)}};
         pieces.push_back(std::move(pc));
     }
     return pieces;
