@@ -267,19 +267,23 @@ int runBench(const BenchOptions& opt) {
         // speedup and no error.
         Image ref(w, h);
         BenchRow* bruteRow = nullptr;
-        if (withBrute) {
-            BenchRow& row = newRow("brute", "scheme", "brute");
+        // Brute force's row under `knob` at `opts`: the reference, its first round's image into
+        // `image`.
+        auto bruteReference = [&](const std::string& knob, const RenderOptions& opts,
+                                  Image& image) -> BenchRow* {
+            BenchRow& row = newRow("brute", knob, "brute");
             row.inTable = true;
             row.compared = true;  // it is the reference: nothing differs
-            bruteRow = &row;
             against.push_back({&row, &row});
-            jobs.push_back([&scene, &row, &ref, ro, w, h, record](int round) {
+            jobs.push_back([&scene, &row, &image, opts, w, h, record](int round) {
                 auto brute = buildAccelerator(scene, BuildParams{});
                 Image scratch(round ? w : 0, round ? h : 0);
-                const RenderStats s = render(scene, *brute, ro, round ? scratch : ref);
+                const RenderStats s = render(scene, *brute, opts, round ? scratch : image);
                 record(row, brute->info(), s, round);
             });
-        }
+            return &row;
+        };
+        if (withBrute) bruteRow = bruteReference("scheme", ro, ref);
         for (const Config& c : sweep(opt.quick, opt.schemesOnly, wanted)) {
             BenchRow& row = newRow(schemeName(c.build.scheme), c.knob, c.value);
             row.inTable = c.knob == "scheme";
@@ -303,20 +307,7 @@ int runBench(const BenchOptions& opt) {
                            : "not run: the scene has intersections or differences (Embree "
                              "traces unions of primitives)";
         } else {
-            BenchRow* brute0 = nullptr;
-            if (withBrute) {
-                BenchRow& row = newRow("brute", peer0, "brute");
-                row.inTable = true;
-                row.compared = true;
-                brute0 = &row;
-                against.push_back({&row, &row});
-                jobs.push_back([&scene, &row, &ref0, r0, w, h, record](int round) {
-                    auto brute = buildAccelerator(scene, BuildParams{});
-                    Image scratch(round ? w : 0, round ? h : 0);
-                    const RenderStats s = render(scene, *brute, r0, round ? scratch : ref0);
-                    record(row, brute->info(), s, round);
-                });
-            }
+            BenchRow* const brute0 = withBrute ? bruteReference(peer0, r0, ref0) : nullptr;
             for (SchemeKind k : accelerated(wanted)) {
                 BenchRow& row = newRow(schemeName(k), peer0, schemeName(k));
                 row.inTable = true;
