@@ -56,4 +56,58 @@ void handleKeys(ViewerState& st) {
     }
 }
 
+namespace {
+
+/// ImGui key `k` went down this frame (with the repeat while held when `repeat`); false when
+/// the platform backend maps no key to it.
+bool pressed(ImGuiKey k, bool repeat) {
+    const int index = ImGui::GetKeyIndex(k);
+    return index >= 0 && ImGui::IsKeyPressed(index, repeat);
+}
+
+bool keyboardFree() {
+    const ImGuiIO& io = ImGui::GetIO();
+    return !io.WantCaptureKeyboard && !io.WantTextInput;
+}
+
+}  // namespace
+
+bool handlePlaybackKeys(playback::RayPlayback& play) {
+    if (!keyboardFree() || play.empty()) return false;
+    bool acted = true;
+    if (pressed(ImGuiKey_RightArrow, true)) {
+        play.pause();
+        play.forward();
+    } else if (pressed(ImGuiKey_LeftArrow, true)) {
+        play.pause();
+        play.back();
+    } else if (pressed(ImGuiKey_Home, false)) {
+        play.pause();
+        play.first();
+    } else if (pressed(ImGuiKey_End, false)) {
+        play.pause();
+        play.last();
+    } else if (pressed(ImGuiKey_Space, false)) {
+        if (play.playing())
+            play.pause();
+        else
+            play.play();
+    } else if (pressed(ImGuiKey_DownArrow, true)) {
+        if (size_t(play.state().ray) + 1 < play.tree().rays.size())
+            play.selectRay(play.state().ray + 1);
+    } else if (pressed(ImGuiKey_UpArrow, true)) {
+        if (play.state().ray > 0) play.selectRay(play.state().ray - 1);
+    } else {
+        acted = false;
+    }
+    return acted;
+}
+
+bool frameKeyPressed() {
+    if (!keyboardFree()) return false;
+    for (ImWchar ch : ImGui::GetIO().InputQueueCharacters)
+        if (ch == 'f' || ch == 'F') return true;
+    return false;
+}
+
 }  // namespace lancer::viewer

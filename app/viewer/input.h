@@ -3,6 +3,7 @@
 // the mouse, keys act unless ImGui wants the keyboard.
 #pragma once
 
+#include "app/viewer/playback/playback.h"
 #include "app/viewer/viewer_state.h"
 
 namespace lancer::viewer {
@@ -12,5 +13,11 @@ void handleMouse(ViewerState& st, int fbHeight);
 /// R resets the camera, O (or P) toggles perspective and orthographic, Tab hides or shows the
 /// panels, I shows or hides the 3D inspector.
 void handleKeys(ViewerState& st);
+/// The ray playback's keys, once a ray is picked: Left / Right step back / forward (repeating
+/// while held), Home / End go to the first / last step, Space plays or pauses, Up / Down choose
+/// the previous / next ray of the tree. True when one of them acted.
+bool handlePlaybackKeys(playback::RayPlayback& play);
+/// The F key was pressed this frame (frame the selection).
+bool frameKeyPressed();
 
 }  // namespace lancer::viewer

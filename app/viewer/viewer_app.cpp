@@ -63,12 +63,15 @@ void ViewerApp::keepSettings() {
         kept = now;
         changed = true;
     };
-    keep(s.overlays, overlays_->options);
+    overlay::OverlayOptions oo = overlays_->options;
+    oo.only = {};  // the played ray's, not a setting
+    keep(s.overlays, oo);
     overlay::OverlayLook look = overlays_->look;
     look.replayCuts = -1;  // the replay belongs to the structure on screen
     keep(s.overlayLook, look);
     inspector::InspectorOptions io = inspector_->options();
     io.show = false;
+    io.only = {};
     keep(s.inspector, io);
     if (!inspector_->cameraScene().empty()) {
         const Camera& c = inspector_->camera();
@@ -145,6 +148,13 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         overlayInput();
     }
     handleKeys(state_);
+    handlePlaybackKeys(player_.playback());
+    if (frameKeyPressed()) {
+        const ImVec2 m = ImGui::GetIO().MousePos;
+        const Rect& in = layout_.inspector;
+        frameSelection(s.showInspector && m.x >= in.x0 && m.x < in.x1 && m.y >= in.y0 &&
+                       m.y < in.y1);
+    }
 
     // 2b. Ray playback: a Shift+click picks a pixel; the pick is traced, traced again after a
     // rebuild, and played on the frame's clock. The current region is the selection, so the
@@ -163,6 +173,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         if (played >= 0 || selectedRegion() == playedRegion_) selectRegion(played);
         playedRegion_ = played;
     }
+    syncRegionFilter();
     if (const StepCsg* step = player_.currentStep())
         overlays_->setEvaluatedNodes(step->region, step->pool, step->nodes);
     else
@@ -376,11 +387,16 @@ void ViewerApp::overlayInput() {
 std::vector<std::string> ViewerApp::applyShow(const std::string& list) {
     // The overlays take their layers; the inspector and the ray playback take what they leave.
     std::vector<std::string> left;
-    for (std::string& item : applyInspectorShow(overlay::applyShowList(list, overlays_->options)))
-        if (item == "ray")
+    for (std::string& item : applyInspectorShow(overlay::applyShowList(list, overlays_->options))) {
+        if (item == "ray") {
             state_.settings().showRay = true;
-        else
+        } else if (item == "visited") {
+            state_.settings().showRay = true;
+            state_.settings().rayRegionsOnly = true;
+        } else {
             left.push_back(std::move(item));
+        }
+    }
     return left;
 }
 
@@ -389,6 +405,35 @@ void ViewerApp::selectRegion(int64_t id) {
         overlays_->clearSelection();
     } else if (overlays_->select(uint32_t(id))) {
         state_.settings().showSelection = true;
+    }
+}
+
+bool ViewerApp::frameSelection(bool inInspector) {
+    const int64_t id = selectedRegion();
+    const StructureView* view = overlays_->view();
+    if (id < 0 || !view || uint64_t(id) >= view->regionCount()) return false;
+    Box3 box;
+    for (const Vec3& p : view->regionCorners(uint32_t(id))) box.expand(p);
+    // The irregular scheme's regions are cut for the main camera: moving it rebuilds them.
+    if (inInspector || view->scheme() == SchemeKind::Irregular) {
+        state_.settings().showInspector = true;
+        inspector_->setShown(true);
+        inspector_->frame(box);
+    } else {
+        const double aspect = double(std::max(state_.width(), 1)) / std::max(state_.height(), 1);
+        state_.setCamera(inspector::framedOn(state_.camera(), box, aspect));
+    }
+    return true;
+}
+
+void ViewerApp::syncRegionFilter() {
+    RegionFilter f;
+    f.on = state_.settings().rayRegionsOnly && !player_.playback().empty();
+    if (f.on) f.ids = playback::visitedRegions(player_.playback());
+    if (!(overlays_->options.only == f)) overlays_->options.only = f;
+    if (!(inspector_->options().only == f)) {
+        inspector_->options().only = f;
+        inspector_->changed();
     }
 }
 

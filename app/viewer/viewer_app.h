@@ -113,6 +113,10 @@ class ViewerApp {
     }
     /// Select region `id` (-1: clear); the Selection panel opens on it.
     void selectRegion(int64_t id);
+    /// The F key: frame the selected region (the played step's while a ray plays) in the
+    /// inspector when `inInspector` or when the scheme's regions belong to the main camera
+    /// (irregular; the inspector opens), else in the main view. False with no selection.
+    bool frameSelection(bool inInspector);
 
     /// The ray playback: the picked pixel's tree and the ray played (Shift+click, the Ray
     /// panel, `--pick`). The current region is the selected region while a ray is played.
@@ -142,6 +146,9 @@ class ViewerApp {
     /// The overlays' and the inspector's options and camera into the settings the ini is
     /// written from (marked to be saved when they changed).
     void keepSettings();
+    /// The overlays' and the inspector's region filter: the played ray's regions while
+    /// settings().rayRegionsOnly, else all.
+    void syncRegionFilter();
     /// --log-timings: the overlays' work in this frame (`layerDrawn`: it drew the layers).
     void logOverlayTiming(double ms, bool layerDrawn);
 

@@ -31,6 +31,9 @@ struct ViewerSettings {
     bool showInspector = false;
     /// The Ray panel (not saved: it opens with the first pick).
     bool showRay = false;
+    /// The overlays and the inspector draw only the regions the played ray visits (the Ray
+    /// panel, `--show visited`; not saved).
+    bool rayRegionsOnly = false;
     ViewMode mode = ViewMode::Color;
     bool autoScale = true;     ///< heat scale follows the image's largest value
     float heatScale = 100.0f;  ///< counter value at the top of the colour map

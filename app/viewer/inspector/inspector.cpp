@@ -129,6 +129,10 @@ void Inspector::update(const std::shared_ptr<const SceneBuild>& structure, const
         }
         dirtyModel_ = true;
     }
+    if (pendingFrame_ && structure_) {
+        setCamera(framedOn(camera_, *pendingFrame_, double(vw_) / double(vh_)));
+        pendingFrame_.reset();
+    }
     if (!sameCamera(main.camera, main_.camera) || main.width != main_.width ||
         main.height != main_.height) {
         main_ = main;

@@ -50,6 +50,9 @@ class Inspector {
     /// Its camera (framed on the structure when the scene changes), and setting it.
     const Camera& camera() const { return camera_; }
     void setCamera(const Camera& c);
+    /// Move its camera to frame `box` (framedOn(), its viewport's aspect) at the next update(),
+    /// once its viewport and structure are known: the F key.
+    void frame(const Box3& box) { pendingFrame_ = box; }
     /// The scene (its spec) the camera was framed for or moved over; empty before the first.
     const std::string& cameraScene() const { return cameraScene_; }
     /// Use `c` instead of framing the first structure, if it is of scene `sceneSpec` (a camera
@@ -104,6 +107,7 @@ class Inspector {
         std::string scene;
     };
     std::optional<Restore> restore_;
+    std::optional<Box3> pendingFrame_;  ///< frame()
     std::shared_ptr<const SceneBuild> structure_;
     std::unique_ptr<StructureView> view_;
     MainView main_;

@@ -121,6 +121,19 @@ Camera frameBox(const Box3& box, const Vec3& forward, double fov, double aspect)
     return c;
 }
 
+Camera framedOn(const Camera& c, const Box3& box, double aspect) {
+    if (box.isEmpty() || !box.isBounded()) return c;
+    const Camera fit = frameBox(box, c.at - c.from, c.fov, aspect);
+    Camera out = c;
+    out.at = fit.at;
+    out.from = fit.from;
+    if (c.projection == Projection::Orthographic) {
+        const double radius = std::max(0.5 * glm::length(box.extent()), 1e-6);
+        out.orthoHeight = 2.0 * radius / std::min(1.0, aspect);
+    }
+    return out;
+}
+
 bool Slab::keeps(const Corners& c) const {
     if (!on) return true;
     double a = kInf, b = -kInf;

@@ -55,6 +55,10 @@ float windowDepth(const Camera& cam, double near, double far, double depth);
 /// whole bounding sphere in view of a perspective camera with a `fov`-degree vertical field
 /// and a w / h image `aspect` (a narrow image narrows the horizontal field).
 Camera frameBox(const Box3& box, const Vec3& forward, double fov, double aspect = 1.0);
+/// Camera `c` moved to frame `box` (the F key): the same direction, up, field and projection,
+/// aimed at the box's centre from where its bounding sphere just fills the narrower field of
+/// a w / h image `aspect` (orthographic: the image height made the sphere's diameter).
+Camera framedOn(const Camera& c, const Box3& box, double aspect);
 
 /// What the inspector draws a regular leaf (or any region) with, for filtering and colouring.
 struct RegionView {

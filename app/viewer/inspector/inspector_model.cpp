@@ -50,7 +50,7 @@ double valueOf(const RegionView& r, ColorBy by) {
 /// millions of regions costs the cap, not its size.
 bool offer(InspectorModel& m, const InspectorOptions& opt, const InspectorView& insp,
            const RegionView& r) {
-    if (!opt.slab.keeps(r.corners)) return true;
+    if (!opt.only.keeps(r.id) || !opt.slab.keeps(r.corners)) return true;
     if (!maybeVisible(insp.camera, insp.width, insp.height, r.corners)) return true;
     ++m.kept;
     if (m.regions.size() >= size_t(std::max(opt.cap, 0))) return false;

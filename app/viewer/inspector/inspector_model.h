@@ -12,6 +12,7 @@
 
 #include "app/viewer/gl/batch.h"
 #include "app/viewer/inspector/inspector_geometry.h"
+#include "app/viewer/region_filter.h"
 #include "engine/accel/structure_view.h"
 
 namespace lancer::viewer::inspector {
@@ -31,6 +32,8 @@ struct InspectorOptions {
     int levelLo = 0, levelHi = 64;
     Slab slab;        ///< the slice slab (world axis)
     int cap = 20000;  ///< regions (and blocks, and boxes) drawn at most
+    /// Regions drawn: all, or only the played ray's (not saved).
+    RegionFilter only;
     bool operator==(const InspectorOptions&) const = default;
 };
 

@@ -164,8 +164,9 @@ void irregularLayers(const StructureView& sv, const gl::ImageProjector& proj, in
     if (o.slabs) {
         for (uint32_t z : shown) {
             const std::vector<SlabInfo> slabs = fr->slabs(z);
-            g.regionsTotal += slabs.size();
             for (size_t k = 0; k < slabs.size(); ++k) {
+                if (!o.only.keeps(slabs[k].region)) continue;
+                ++g.regionsTotal;
                 if (g.regionsDrawn >= o.cap) break;
                 std::array<glm::vec3, 8> c;
                 const std::array<Vec3, 8> wc = sv.regionCorners(slabs[k].region);
@@ -186,7 +187,7 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
         std::vector<uint32_t> picked;
         for (uint32_t i = 0; i < n; ++i) {
             const int level = sv.leafLevel(i);
-            if (level < o.levelMin || level > o.levelMax) continue;
+            if (level < o.levelMin || level > o.levelMax || !o.only.keeps(i)) continue;
             ++g.regionsTotal;
             if (picked.size() >= o.cap) {
                 g.cameraDependent = true;
@@ -252,7 +253,7 @@ void bvhLayer(const StructureView& sv, const gl::ImageProjector& proj, int w, in
     std::vector<uint32_t> picked;
     for (uint32_t i = 0; i < nodes.size(); ++i) {
         const int depth = nodes[i].depth;
-        if (depth < o.levelMin || depth > o.levelMax) continue;
+        if (depth < o.levelMin || depth > o.levelMax || !o.only.keeps(i)) continue;
         ++g.regionsTotal;
         if (picked.size() >= o.cap) {
             g.cameraDependent = true;

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "app/viewer/gl/batch.h"
+#include "app/viewer/region_filter.h"
 #include "engine/accel/structure_view.h"
 #include "engine/render/image.h"
 
@@ -41,6 +42,8 @@ struct OverlayOptions {
     int levelMin = 0, levelMax = 64;
     /// Most regions (leaves, slabs, blocks) and cuts drawn; the visible ones first.
     size_t cap = 100000;
+    /// Leaves, slabs and BVH nodes drawn: all, or only the played ray's (not saved).
+    RegionFilter only;
     bool operator==(const OverlayOptions&) const = default;
     /// Any layer on.
     bool any() const { return bsp || zones || slabs || leaves || grid; }

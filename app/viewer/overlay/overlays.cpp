@@ -470,13 +470,14 @@ std::vector<std::string> applyShowList(const std::string& list, OverlayOptions& 
             out.grid = true;
         else if (item == "none")
             continue;
-        else if (item == "boxes" || item == "frustum" || item == "inspector" || item == "ray")
+        else if (item == "boxes" || item == "frustum" || item == "inspector" || item == "ray" ||
+                 item == "visited")
             notDrawn.push_back(item);
         else
             throw std::invalid_argument(
                 "unknown item '" + item +
                 "' (expected bsp, zones, slabs, leaves, grid, boxes, frustum, inspector, ray, "
-                "none)");
+                "visited, none)");
     }
     o = out;
     return notDrawn;

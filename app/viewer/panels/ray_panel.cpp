@@ -300,6 +300,16 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
         const std::string cmd = player.copyTraceCommand(st, file);
         if (!cmd.empty()) ImGui::SetClipboardText(cmd.c_str());
     }
+    // The filter of both views, on the same line when the column is wide enough.
+    const char* only = "only its regions";
+    ImGui::SameLine();
+    if (ImGui::GetContentRegionAvail().x < ImGui::CalcTextSize(only).x + 40.0f) ImGui::NewLine();
+    ImGui::Checkbox(only, &st.settings().rayRegionsOnly);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip(
+            "Overlays and inspector draw only the regions this ray visits\n"
+            "(--show visited). Keys: Left / Right step, Home / End first / last,\n"
+            "Space play / pause, Up / Down ray, F frame the step's region.");
     if (player.note().rfind("pixel", 0) != 0 && !player.note().empty())
         hintText(player.note().c_str());
     const TracedRay& ray = play.ray();

@@ -126,6 +126,15 @@ std::optional<WalkCounts> RayPlayback::previousCounts(int k) const {
     return previous_[size_t(k)];
 }
 
+std::vector<uint32_t> visitedRegions(const RayPlayback& play) {
+    std::vector<uint32_t> ids;
+    if (play.empty()) return ids;
+    for (size_t e : play.steps()) ids.push_back(play.ray().events[e].a);
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    return ids;
+}
+
 std::vector<SpanRow> stepSpans(const RayPlayback& play) {
     std::vector<SpanRow> rows;
     if (play.empty() || play.state().step < 0) return rows;

@@ -104,6 +104,10 @@ class RayPlayback {
     uint64_t version_ = 0;
 };
 
+/// The regions the played ray walks (its Region events), sorted and unique; none when nothing
+/// is picked.
+std::vector<uint32_t> visitedRegions(const RayPlayback& play);
+
 /// One row of the CSG strip: a primitive's spans along the ray, or the region tree's combined
 /// spans.
 struct SpanRow {
