@@ -96,4 +96,19 @@ out=$("$LANCER" structure builtin:lattice --scheme regular --max-level 30 --max-
 [ -e "$tmp/x.json" ] || [ -e "$tmp/x.json.tmp" ] && fail "a file was left by a failed dump"
 out=$("$LANCER" structure "$tmp/missing.nff" -o "$tmp/x.json" 2>&1); [ $? -eq 2 ] || fail "missing scene: not exit 2"
 [ -e "$tmp/x.json" ] && fail "a file was written for a missing scene"
+# A nearly singular transform (scale 1e-300, issue 28 item 5) is handled: every scheme builds,
+# and no NaN or infinity reaches the dumped structure (a zero scale is refused by the reader,
+# tests/openscad_reader_test.cpp).
+printf 'multmatrix([[1e-300,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]) cube(size=[1,1,1]);\nscale([1,1e-300,1]) sphere(r=1);\n' \
+  > "$tmp/tiny.csg"
+for s in brute regular irregular bvh; do
+  "$LANCER" structure "$tmp/tiny.csg" --scheme "$s" --width 16 --height 16 -o "$tmp/tiny-$s.json" -q \
+    || fail "tiny-scale dump ($s) exited non-zero"
+  python3 - "$tmp/tiny-$s.json" <<'PY' || fail "tiny-scale dump ($s) holds NaN or infinity"
+import json, sys
+def bad(c):
+    raise ValueError(c)
+json.load(open(sys.argv[1]), parse_constant=bad)
+PY
+done
 echo "ok"
