@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <memory>
 
 #include "app/viewer/gl/transforms.h"
 #include "app/viewer/playback/playback.h"
@@ -38,6 +39,27 @@ Box3 regionBox(ViewerApp& app, int64_t id) {
     Box3 b;
     for (const Vec3& p : app.overlays().view()->regionCorners(uint32_t(id))) b.expand(p);
     return b;
+}
+
+/// A 1280x720 viewer of balls:2 under `scheme`, the image's centre picked and its playback moved
+/// by key `k`; `region` is the played (and selected) region then.
+struct Played {
+    std::unique_ptr<ViewerHarness> h;
+    int64_t region = -1;
+};
+Played playTo(SchemeKind scheme, bool inspector, ImGuiKey k) {
+    Played p;
+    p.h = std::make_unique<ViewerHarness>(kW, kH, focusSettings(scheme, inspector));
+    if (!p.h->ok()) return p;
+    pickCentre(*p.h);
+    p.h->press(k);
+    p.region = p.h->app().selectedRegion();
+    return p;
+}
+
+/// Type `c` with the mouse at the centre of `r`.
+void typeOver(ViewerHarness& h, const Rect& r, char c) {
+    h.type(c, 0.5f * (r.x0 + r.x1), 0.5f * (r.y0 + r.y1));
 }
 
 /// The box's 8 corners all project inside a w x h image of `cam`, and its projection spans at
@@ -93,16 +115,13 @@ TEST(ViewerFocus, PlaybackKeysStepTheRay) {
 }
 
 TEST(ViewerFocus, FOverTheInspectorFramesThePlayedRegionThere) {
-    ViewerHarness h(kW, kH, focusSettings(SchemeKind::Regular, true));
-    ASSERT_TRUE(h.ok());
-    pickCentre(h);
-    h.press(ImGuiKey_RightArrow);
-    const int64_t id = h.app().selectedRegion();
-    ASSERT_GE(id, 0);
+    Played p = playTo(SchemeKind::Regular, true, ImGuiKey_RightArrow);
+    ASSERT_GE(p.region, 0);
+    ViewerHarness& h = *p.h;
+    const int64_t id = p.region;
     const Camera main = h.app().camera();
-    const Rect& in = h.app().layout().inspector;
-    ASSERT_FALSE(in.empty());
-    h.type('f', 0.5f * (in.x0 + in.x1), 0.5f * (in.y0 + in.y1));
+    ASSERT_FALSE(h.app().layout().inspector.empty());
+    typeOver(h, h.app().layout().inspector, 'f');
     h.frame();  // the inspector frames at its next update
     const PixelRect v = h.app().inspector().area(kW, kH);
     expectFramed(h.app().inspector().camera(), v.x1 - v.x0, v.y1 - v.y0, regionBox(h.app(), id));
@@ -110,15 +129,12 @@ TEST(ViewerFocus, FOverTheInspectorFramesThePlayedRegionThere) {
 }
 
 TEST(ViewerFocus, FOverTheImageFramesTheRegionInTheMainView) {
-    ViewerHarness h(kW, kH, focusSettings(SchemeKind::Regular, true));
-    ASSERT_TRUE(h.ok());
-    pickCentre(h);
-    h.press(ImGuiKey_End);
-    const int64_t id = h.app().selectedRegion();
-    ASSERT_GE(id, 0);
+    Played p = playTo(SchemeKind::Regular, true, ImGuiKey_End);
+    ASSERT_GE(p.region, 0);
+    ViewerHarness& h = *p.h;
+    const int64_t id = p.region;
     const Camera inspector = h.app().inspector().camera();
-    const Rect& img = h.app().layout().image;
-    h.type('f', 0.5f * (img.x0 + img.x1), 0.5f * (img.y0 + img.y1));
+    typeOver(h, h.app().layout().image, 'f');
     expectFramed(h.app().camera(), h.app().state().width(), h.app().state().height(),
                  regionBox(h.app(), id));
     EXPECT_EQ(h.app().inspector().camera().toJson(), inspector.toJson());
@@ -127,16 +143,12 @@ TEST(ViewerFocus, FOverTheImageFramesTheRegionInTheMainView) {
 }
 
 TEST(ViewerFocus, FFramesAnIrregularRegionInTheInspector) {
-    ViewerHarness h(kW, kH, focusSettings(SchemeKind::Irregular, false));
-    ASSERT_TRUE(h.ok());
-    pickCentre(h);
-    h.press(ImGuiKey_RightArrow);
-    const int64_t id = h.app().selectedRegion();
-    ASSERT_GE(id, 0);
+    Played p = playTo(SchemeKind::Irregular, false, ImGuiKey_RightArrow);
+    ASSERT_GE(p.region, 0);
+    ViewerHarness& h = *p.h;
     const Camera main = h.app().camera();
-    const Box3 box = regionBox(h.app(), id);
-    const Rect& img = h.app().layout().image;
-    h.type('f', 0.5f * (img.x0 + img.x1), 0.5f * (img.y0 + img.y1));
+    const Box3 box = regionBox(h.app(), p.region);
+    typeOver(h, h.app().layout().image, 'f');
     // Its slabs are cut for the main camera: moving that would rebuild them, so the inspector
     // opens, framed on the slab.
     EXPECT_TRUE(h.app().inspector().shown());
