@@ -722,15 +722,18 @@ class Builder {
     void polyhedronMesh(const Node& n, std::vector<Vec3>& pts, std::vector<std::vector<int>>& faces,
                         size_t& facesPos) {
         Args a(src_, n, {"points", "faces", "convexity"}, {"triangles"});
-        if (!n.children.empty()) src_.fail(n.children.front().pos, "polyhedron() takes no children");
+        if (!n.children.empty())
+            src_.fail(n.children.front().pos, "polyhedron() takes no children");
         const Value* p = a.get("points");
         const Value* f = a.get("faces") ? a.get("faces") : a.get("triangles");
         if (!p || p->kind != Value::Kind::Vector)
-            src_.fail(p ? p->pos : n.pos, "expected a list of [x, y, z] points for 'points' of "
-                                          "polyhedron()");
+            src_.fail(p ? p->pos : n.pos,
+                      "expected a list of [x, y, z] points for 'points' of "
+                      "polyhedron()");
         if (!f || f->kind != Value::Kind::Vector)
-            src_.fail(f ? f->pos : n.pos, "expected a list of index lists for 'faces' of "
-                                          "polyhedron()");
+            src_.fail(f ? f->pos : n.pos,
+                      "expected a list of index lists for 'faces' of "
+                      "polyhedron()");
         if (p->items.size() > 100000 || f->items.size() > 100000)
             src_.fail(n.pos, "polyhedron() has more than 100000 points or faces");
         for (const Value& v : p->items) pts.push_back(a.vec3(v, "a polyhedron point"));
@@ -815,8 +818,9 @@ class Builder {
         }
         if (pt.planes.size() < 4) return emptyPrimitive();
         if (pt.planes.size() > 255)
-            src_.fail(n.pos, "polyhedron() has more than 255 distinct face planes, which Lancer's "
-                             "polytope does not hold");
+            src_.fail(n.pos,
+                      "polyhedron() has more than 255 distinct face planes, which Lancer's "
+                      "polytope does not hold");
         pt.bounds = padded(box);
         ++counts_.polyhedra;
         return place(std::move(pt), xf, mat, n.pos, "polyhedron()");
@@ -884,9 +888,9 @@ class Builder {
             const Transform tl = t * local;
             if (const Block* b = std::get_if<Block>(&*s)) {
                 for (int c = 0; c < 8; ++c)
-                    in.points.push_back(tl.point(
-                        {c & 1 ? b->hi.x : b->lo.x, c & 2 ? b->hi.y : b->lo.y,
-                         c & 4 ? b->hi.z : b->lo.z}));
+                    in.points.push_back(
+                        tl.point({c & 1 ? b->hi.x : b->lo.x, c & 2 ? b->hi.y : b->lo.y,
+                                  c & 4 ? b->hi.z : b->lo.z}));
                 return;
             }
             const Sphere& sp = std::get<Sphere>(*s);
@@ -916,8 +920,9 @@ class Builder {
         HullInput in;
         for (const Node& c : n.children) gatherHull(c, Transform(), n, in);
         if (!in.points.empty() && !in.centres.empty())
-            src_.fail(n.pos, "hull() of spheres together with cubes or polyhedra is not "
-                             "supported (its surface has patches of neither)");
+            src_.fail(n.pos,
+                      "hull() of spheres together with cubes or polyhedra is not "
+                      "supported (its surface has patches of neither)");
         const bool balls = !in.centres.empty();
         std::vector<Vec3>& pts = balls ? in.centres : in.points;
         if (pts.empty()) return Built::empty();
@@ -953,8 +958,9 @@ class Builder {
             items.push_back(place(std::move(pt), xf, mat, n.pos, "hull()").node);
         };
         if (h.dim == 3 && h.planes.size() > 255)
-            src_.fail(n.pos, "hull() has more than 255 faces, which Lancer's polytope does not "
-                             "hold");
+            src_.fail(n.pos,
+                      "hull() has more than 255 faces, which Lancer's polytope does not "
+                      "hold");
         if (h.dim == 3) polytope(h.planes, h.vertices);
         if (!balls) {
             if (items.empty()) return emptyPrimitive();  // a flat hull has no volume
@@ -964,9 +970,8 @@ class Builder {
         for (size_t f = 0; f < h.faces.size(); ++f) {
             const Vec3 nn(h.planes[f]);
             const double w = h.planes[f].w;
-            std::vector<glm::dvec4> planes = {glm::dvec4(nn, w + r),
-                                              h.dim == 2 ? glm::dvec4(-nn, r - w)
-                                                         : glm::dvec4(-nn, -w)};
+            std::vector<glm::dvec4> planes = {
+                glm::dvec4(nn, w + r), h.dim == 2 ? glm::dvec4(-nn, r - w) : glm::dvec4(-nn, -w)};
             std::vector<Vec3> corners;
             const auto& face = h.faces[f];
             for (size_t e = 0; e < face.size(); ++e) {
@@ -1241,12 +1246,13 @@ void buildModel(const SourceText& src, const std::vector<Node>& top, Scene& scen
 namespace lancer {
 
 const std::vector<std::string>& openScadSupportedNodes() {
-    static const std::vector<std::string> nodes = {
-        "group",          "union",     "difference", "intersection", "render",
-        "multmatrix",     "translate", "rotate",     "scale",        "mirror",
-        "color",          "cube",      "sphere",     "cylinder",     "linear_extrude",
-        "rotate_extrude", "square",    "circle",     "polygon",      "polyhedron",
-        "hull"};
+    static const std::vector<std::string> nodes = {"group",          "union",      "difference",
+                                                   "intersection",   "render",     "multmatrix",
+                                                   "translate",      "rotate",     "scale",
+                                                   "mirror",         "color",      "cube",
+                                                   "sphere",         "cylinder",   "linear_extrude",
+                                                   "rotate_extrude", "square",     "circle",
+                                                   "polygon",        "polyhedron", "hull"};
     return nodes;
 }
 

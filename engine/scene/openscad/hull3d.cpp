@@ -129,8 +129,8 @@ ConvexHull3 convexHull3(std::vector<Vec3> pts) {
                 for (size_t k = j + 1; k < n; ++k) {
                     Vec3 nn = glm::cross(pts[j] - pts[i], pts[k] - pts[i]);
                     const double len = glm::length(nn);
-                    if (!(len > 1e-12 * glm::length(pts[j] - pts[i]) *
-                                    glm::length(pts[k] - pts[i])))
+                    if (!(len >
+                          1e-12 * glm::length(pts[j] - pts[i]) * glm::length(pts[k] - pts[i])))
                         continue;
                     nn /= len;
                     const double w = glm::dot(nn, pts[i]);
@@ -145,8 +145,8 @@ ConvexHull3 convexHull3(std::vector<Vec3> pts) {
                     const double ww = glm::dot(nn, pts[i]);
                     bool known = false;
                     for (const glm::dvec4& q : h.planes)
-                        known = known || (glm::dot(Vec3(q), nn) > 1.0 - 1e-12 &&
-                                          std::abs(q.w - ww) <= tol);
+                        known = known ||
+                                (glm::dot(Vec3(q), nn) > 1.0 - 1e-12 && std::abs(q.w - ww) <= tol);
                     if (known) continue;
                     std::vector<int> face;
                     for (size_t m = 0; m < n; ++m)

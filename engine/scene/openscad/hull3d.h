@@ -15,8 +15,8 @@ constexpr size_t kMaxHullPoints = 120;
 
 /// The convex hull of a point set.
 struct ConvexHull3 {
-    int dim = -1;                 ///< -1 no points, 0 a point, 1 a segment, 2 a polygon, 3 a solid
-    std::vector<Vec3> vertices;   ///< the extreme points (dim 0: one, dim 1: both ends)
+    int dim = -1;                ///< -1 no points, 0 a point, 1 a segment, 2 a polygon, 3 a solid
+    std::vector<Vec3> vertices;  ///< the extreme points (dim 0: one, dim 1: both ends)
     std::vector<glm::dvec4> planes;          ///< per face: outward unit normal and offset
     std::vector<std::vector<int>> faces;     ///< per face: vertices, counter-clockwise about it
     std::vector<std::pair<int, int>> edges;  ///< each edge once (dim >= 1)
