@@ -235,10 +235,20 @@ TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
                    "transforms are not supported)");
     // Unsupported nodes, named with their position.
     expectCsgError(
-        "group() {\n\thull() {\n\t\tcube(size = [1, 1, 1], center = false);\n\t}\n}",
-        "mem.csg:2:2: the node 'hull' is not supported (supported: group, union, difference, "
+        "group() {\n\tminkowski() {\n\t\tcube(size = [1, 1, 1], center = false);\n\t}\n}",
+        "mem.csg:2:2: the node 'minkowski' is not supported (supported: group, union, difference, "
         "intersection, render, multmatrix, translate, rotate, scale, mirror, color, cube, sphere, "
-        "cylinder, linear_extrude, rotate_extrude, square, circle, polygon)");
+        "cylinder, linear_extrude, rotate_extrude, square, circle, polygon, polyhedron, hull)");
+    // A non-convex polyhedron and a hull of spheres of two radii are refused by name.
+    expectCsgError(
+        "polyhedron(points = [[0, 0, 0], [4, 0, 0], [0, 4, 0], [1, 1, 3], [1, 1, 1]], "
+        "faces = [[0, 1, 3], [1, 2, 3], [2, 0, 3], [1, 0, 4], [2, 1, 4], [0, 2, 4]]);",
+        "mem.csg:1:1: polyhedron() is not convex (point 3 lies outside the plane of "
+        "face 3): Lancer models convex polyhedra exactly; a non-convex mesh is not "
+        "supported");
+    expectCsgError("hull() { sphere(r = 1); translate([3, 0, 0]) sphere(r = 2); }",
+                   "mem.csg:1:46: hull() of spheres of different radii (1 and 2) is not "
+                   "supported: Lancer takes the exact hull of spheres of one radius");
     // A twisted extrusion and a torus are refused by name, never traced wrongly.
     expectCsgError(
         "group() {\n\tlinear_extrude(height = 10, center = false, convexity = 1, twist = 90, "
@@ -310,6 +320,17 @@ TEST(OpenScadExtrusions, EachEqualsItsSolidTwin) {
                     "difference() { multmatrix([[1, 0, 0, -2], [0, 1, 0, -2], [0, 0, 1, 0], [0, "
                     "0, 0, 1]]) { cube(size = [4, 4, 3]); } multmatrix([[1, 0, 0, 0], [0, 1, 0, "
                     "0], [0, 0, 1, -1], [0, 0, 0, 1]]) { cylinder(h = 5, r1 = 1, r2 = 1); } }");
+    // A mesh cube is a box; the hull of two equal spheres a capsule; of eight, a rounded box.
+    expectSameSolid(
+        "polyhedron(points = [[0, 0, 0], [2, 0, 0], [2, 3, 0], [0, 3, 0], [0, 0, 1], "
+        "[2, 0, 1], [2, 3, 1], [0, 3, 1]], faces = [[0, 1, 2, 3], [4, 7, 6, 5], [0, "
+        "4, 5, 1], [1, 5, 6, 2], [2, 6, 7, 3], [3, 7, 4, 0]]);",
+        "cube(size = [2, 3, 1]);");
+    expectSameSolid("hull() { sphere(r = 1); translate([4, 0, 0]) sphere(r = 1); }",
+                    "union() { sphere(r = 1); translate([4, 0, 0]) sphere(r = 1); rotate([0, "
+                    "90, 0]) cylinder(h = 4, r = 1); }");
+    expectSameSolid("hull() { cube(size = [2, 2, 2]); translate([3, 0, 0]) cube(size = 2); }",
+                    "cube(size = [5, 2, 2]);");
     // rotate_extrude of a square off the axis: a cylinder shell.
     expectSameSolid(
         "rotate_extrude(angle = 360, convexity = 2) { multmatrix([[1, 0, 0, 2], [0, "
@@ -328,7 +349,12 @@ TEST(OpenScadExtrusions, SchemesAgreeWithBruteForce) {
         "{ rotate_extrude(angle = 360) { multmatrix([[1, 0, 0, 0.3], [0, 1, 0, -2], [0, 0, 1, "
         "0], [0, 0, 0, 1]]) { square(size = [0.4, 4]); } } } }\n"
         "multmatrix([[1, 0, 0, 5], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]) { "
-        "rotate_extrude(angle = 360) { polygon(points = [[0, 0], [2, 0], [1, 2]]); } }");
+        "rotate_extrude(angle = 360) { polygon(points = [[0, 0], [2, 0], [1, 2]]); } }\n"
+        "difference() { translate([0, 5, 0]) hull() { sphere(r = 0.5); translate([2, 0, 0]) "
+        "sphere(r = 0.5); translate([0, 2, 1]) sphere(r = 0.5); translate([1, 1, 2]) sphere(r = "
+        "0.5); } translate([1, 6, 0.5]) polyhedron(points = [[1, 0, 0], [0, 1, 0], [-1, 0, 0], "
+        "[0, -1, 0], [0, 0, 1.5]], faces = [[0, 1, 2, 3], [4, 1, 0], [4, 2, 1], [4, 3, 2], [4, "
+        "0, 3]]); }");
     const std::vector<Ray> rays = test::randomRays(s, 5, 3000);
     for (const SchemeInfo& info : kSchemeTable) {
         BuildParams p;

@@ -21,6 +21,8 @@ struct OpenScadCounts {
     int squares = 0, circles = 0, polygons = 0;  ///< 2D nodes read inside extrusions
     int linearExtrudes = 0, rotateExtrudes = 0;  ///< extrusions modelled
     int polytopes = 0;  ///< convex polytopes made (extruded pieces, partial-sweep wedges)
+    int polyhedra = 0;  ///< convex polyhedra modelled
+    int hulls = 0;      ///< hull() nodes modelled
     int leftOut2D = 0;  ///< 2D nodes beside solids, not part of the solid model (as OpenSCAD)
 };
 

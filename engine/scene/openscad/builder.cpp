@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "engine/scene/openscad/colors.h"
+#include "engine/scene/openscad/hull3d.h"
 #include "engine/scene/openscad/region2d.h"
 
 namespace lancer::openscad {
@@ -196,6 +197,8 @@ class Builder {
             if (!n.children.empty()) src_.fail(n.children.front().pos, k + "() takes no children");
             return primitive(n, xf, mat);
         }
+        if (k == "polyhedron") return polyhedron(n, xf, mat);
+        if (k == "hull") return hullNode(n, xf, mat);
         if (k == "linear_extrude") return linearExtrude(n, xf, mat);
         if (k == "rotate_extrude") return rotateExtrude(n, xf, mat);
         if (is2DNode(k)) {
@@ -713,6 +716,289 @@ class Builder {
         return Built::of(solid);
     }
 
+    // ---- polyhedron and hull ----
+
+    /// polyhedron()'s points (in the node's frame) and faces (index lists), checked.
+    void polyhedronMesh(const Node& n, std::vector<Vec3>& pts, std::vector<std::vector<int>>& faces,
+                        size_t& facesPos) {
+        Args a(src_, n, {"points", "faces", "convexity"}, {"triangles"});
+        if (!n.children.empty())
+            src_.fail(n.children.front().pos, "polyhedron() takes no children");
+        const Value* p = a.get("points");
+        const Value* f = a.get("faces") ? a.get("faces") : a.get("triangles");
+        if (!p || p->kind != Value::Kind::Vector)
+            src_.fail(p ? p->pos : n.pos,
+                      "expected a list of [x, y, z] points for 'points' of "
+                      "polyhedron()");
+        if (!f || f->kind != Value::Kind::Vector)
+            src_.fail(f ? f->pos : n.pos,
+                      "expected a list of index lists for 'faces' of "
+                      "polyhedron()");
+        if (p->items.size() > 100000 || f->items.size() > 100000)
+            src_.fail(n.pos, "polyhedron() has more than 100000 points or faces");
+        for (const Value& v : p->items) pts.push_back(a.vec3(v, "a polyhedron point"));
+        facesPos = f->pos;
+        for (const Value& face : f->items) {
+            if (face.kind != Value::Kind::Vector)
+                src_.fail(face.pos, "expected a list of point indices for a polyhedron face");
+            std::vector<int> q;
+            for (const Value& iv : face.items) {
+                double i = a.number(iv, "a point index");
+                if (i < 0 || i >= double(pts.size()) || i != std::floor(i))
+                    src_.fail(iv.pos, "a polyhedron face index must be a whole number from 0 to " +
+                                          std::to_string(pts.size() - 1));
+                if (q.empty() || q.back() != int(i)) q.push_back(int(i));
+            }
+            while (q.size() > 1 && q.front() == q.back()) q.pop_back();
+            if (q.size() < 3)
+                src_.fail(face.pos, "a polyhedron face needs at least three distinct points");
+            faces.push_back(std::move(q));
+        }
+    }
+
+    /// polyhedron() as the convex polytope of its face planes. A mesh that is not closed (an
+    /// edge not shared by exactly two faces), has a face that is not flat, or is not convex is
+    /// refused: parity spans of a general mesh do not fit a primitive's two spans.
+    Built polyhedron(const Node& n, const Transform& xf, int mat) {
+        std::vector<Vec3> pts;
+        std::vector<std::vector<int>> faces;
+        size_t facesPos = n.pos;
+        polyhedronMesh(n, pts, faces, facesPos);
+        if (faces.empty()) return emptyPrimitive();
+        std::map<std::pair<int, int>, int> uses;
+        for (const auto& f : faces)
+            for (size_t e = 0; e < f.size(); ++e) ++uses[std::minmax(f[e], f[(e + 1) % f.size()])];
+        for (const auto& [e, c] : uses)
+            if (c != 2)
+                src_.fail(facesPos, "polyhedron() is not a closed mesh: the edge from point " +
+                                        std::to_string(e.first) + " to point " +
+                                        std::to_string(e.second) + " belongs to " +
+                                        std::to_string(c) + " face" + (c == 1 ? "" : "s") +
+                                        " (two in a closed mesh); open meshes are not supported");
+        Vec3 centre(0.0);
+        Box3 box;
+        double mag = 0.0;
+        for (const Vec3& p : pts) {
+            centre += p;
+            box.expand(p);
+            mag = std::max({mag, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+        }
+        centre /= double(pts.size());
+        const double tol = 1e-9 * std::max(mag, 1e-300);
+        Polytope pt;
+        for (size_t fi = 0; fi < faces.size(); ++fi) {
+            const auto& f = faces[fi];
+            Vec3 nn(0.0), c(0.0);
+            for (size_t i = 0; i < f.size(); ++i) {
+                const Vec3 &a = pts[size_t(f[i])], &b = pts[size_t(f[(i + 1) % f.size()])];
+                nn += Vec3((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x),
+                           (a.x - b.x) * (a.y + b.y));
+                c += a;
+            }
+            const double len = glm::length(nn);
+            if (!(len > 0.0)) continue;  // a face of no area bounds nothing
+            nn /= len;
+            double w = glm::dot(nn, c / double(f.size()));
+            if (glm::dot(nn, centre) > w) nn = -nn, w = -w;
+            for (int i : f)
+                if (std::abs(glm::dot(nn, pts[size_t(i)]) - w) > tol)
+                    src_.fail(facesPos, "face " + std::to_string(fi) +
+                                            " of polyhedron() is not flat (its points are not "
+                                            "in one plane)");
+            for (size_t i = 0; i < pts.size(); ++i)
+                if (glm::dot(nn, pts[i]) - w > tol)
+                    src_.fail(n.pos, "polyhedron() is not convex (point " + std::to_string(i) +
+                                         " lies outside the plane of face " + std::to_string(fi) +
+                                         "): Lancer models convex polyhedra exactly; a non-convex "
+                                         "mesh is not supported");
+            bool known = false;
+            for (const glm::dvec4& q : pt.planes)
+                known = known || (glm::dot(Vec3(q), nn) > 1.0 - 1e-12 && std::abs(q.w - w) <= tol);
+            if (!known) pt.planes.push_back(glm::dvec4(nn, w));
+        }
+        if (pt.planes.size() < 4) return emptyPrimitive();
+        if (pt.planes.size() > 255)
+            src_.fail(n.pos,
+                      "polyhedron() has more than 255 distinct face planes, which Lancer's "
+                      "polytope does not hold");
+        pt.bounds = padded(box);
+        ++counts_.polyhedra;
+        return place(std::move(pt), xf, mat, n.pos, "polyhedron()");
+    }
+
+    /// A computed box grown by a hair, so that a solid bounded by exact planes stays inside.
+    static Box3 padded(Box3 b) {
+        Vec3 pad = 1e-9 * (glm::abs(b.lo) + glm::abs(b.hi)) + Vec3(1e-300);
+        b.lo -= pad;
+        b.hi += pad;
+        return b;
+    }
+
+    /// What hull() wraps: corner points (cubes, polyhedra) and balls (spheres), in the hull's
+    /// frame.
+    struct HullInput {
+        std::vector<Vec3> points;
+        std::vector<Vec3> centres;
+        std::vector<double> radii;
+        std::vector<size_t> ballPos;
+    };
+
+    [[noreturn]] void refuseInHull(const Node& n, const Node& hull) {
+        src_.fail(n.pos, "'" + n.name + "' inside hull() at " + src_.where(hull.pos) +
+                             " is not supported: Lancer takes the exact hull of cubes, polyhedra "
+                             "and spheres of one radius (and their groups and transforms)");
+    }
+
+    void gatherHull(const Node& n, const Transform& t, const Node& hull, HullInput& in) {
+        if (n.disable || n.background) {
+            ++counts_.leftOut;
+            return;
+        }
+        const std::string& k = n.name;
+        if (k == "group" || k == "union" || k == "render" || k == "color") {
+            if (k == "render")
+                Args(src_, n, {"convexity"}, {});
+            else if (k == "color")
+                color(n, 0);  // checked; the hull takes the colour of its own context
+            else
+                Args(src_, n, {}, {});
+            for (const Node& c : n.children) gatherHull(c, t, hull, in);
+            return;
+        }
+        if (k == "multmatrix" || k == "translate" || k == "rotate" || k == "scale" ||
+            k == "mirror") {
+            ++counts_.transforms;
+            Transform u = t * transform(n);
+            for (const Node& c : n.children) gatherHull(c, u, hull, in);
+            return;
+        }
+        if (k == "polyhedron") {
+            std::vector<Vec3> pts;
+            std::vector<std::vector<int>> faces;
+            size_t fp = 0;
+            polyhedronMesh(n, pts, faces, fp);
+            for (const Vec3& p : pts) in.points.push_back(t.point(p));
+            return;
+        }
+        if (k == "cube" || k == "sphere") {
+            if (!n.children.empty()) src_.fail(n.children.front().pos, k + "() takes no children");
+            Transform local;
+            std::optional<Shape> s = primitiveShape(n, local);
+            if (!s) return;
+            const Transform tl = t * local;
+            if (const Block* b = std::get_if<Block>(&*s)) {
+                for (int c = 0; c < 8; ++c)
+                    in.points.push_back(
+                        tl.point({c & 1 ? b->hi.x : b->lo.x, c & 2 ? b->hi.y : b->lo.y,
+                                  c & 4 ? b->hi.z : b->lo.z}));
+                return;
+            }
+            const Sphere& sp = std::get<Sphere>(*s);
+            // A ball stays a ball only under a similarity: orthogonal axes of one length.
+            const Vec3 c0 = tl.vector({1, 0, 0}), c1 = tl.vector({0, 1, 0}),
+                       c2 = tl.vector({0, 0, 1});
+            const double l = glm::length(c0), e = 1e-12 * l * l;
+            if (std::abs(glm::dot(c0, c1)) > e || std::abs(glm::dot(c0, c2)) > e ||
+                std::abs(glm::dot(c1, c2)) > e || std::abs(glm::dot(c1, c1) - l * l) > e ||
+                std::abs(glm::dot(c2, c2) - l * l) > e)
+                src_.fail(n.pos, "a sphere scaled unevenly (an ellipsoid) inside hull() at " +
+                                     src_.where(hull.pos) + " is not supported");
+            in.centres.push_back(tl.point(sp.c));
+            in.radii.push_back(sp.r * l);
+            in.ballPos.push_back(n.pos);
+            return;
+        }
+        refuseInHull(n, hull);
+    }
+
+    /// hull(): of corner points, the convex polytope of their hull; of balls of one radius r,
+    /// the hull of their centres grown by r, exactly the union of that hull, a slab over each
+    /// face, a cylinder along each edge and a ball at each vertex.
+    Built hullNode(const Node& n, const Transform& xf, int mat) {
+        Args(src_, n, {}, {});
+        ++counts_.operators;
+        HullInput in;
+        for (const Node& c : n.children) gatherHull(c, Transform(), n, in);
+        if (!in.points.empty() && !in.centres.empty())
+            src_.fail(n.pos,
+                      "hull() of spheres together with cubes or polyhedra is not "
+                      "supported (its surface has patches of neither)");
+        const bool balls = !in.centres.empty();
+        std::vector<Vec3>& pts = balls ? in.centres : in.points;
+        if (pts.empty()) return Built::empty();
+        double r = 0.0;
+        if (balls) {
+            r = in.radii[0];
+            for (size_t i = 1; i < in.radii.size(); ++i)
+                if (std::abs(in.radii[i] - r) > 1e-12 * r)
+                    src_.fail(in.ballPos[i], "hull() of spheres of different radii (" +
+                                                 twistText(r) + " and " + twistText(in.radii[i]) +
+                                                 ") is not supported: Lancer takes the exact hull "
+                                                 "of spheres of one radius");
+        }
+        {
+            std::sort(pts.begin(), pts.end(), [](const Vec3& a, const Vec3& b) {
+                return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+            });
+            pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+        }
+        if (pts.size() > kMaxHullPoints)
+            src_.fail(n.pos, "hull() of more than " + std::to_string(kMaxHullPoints) +
+                                 " points is not supported");
+        ConvexHull3 h = convexHull3(pts);
+        ++counts_.hulls;
+        std::vector<int> items;
+        auto polytope = [&](std::vector<glm::dvec4> planes, const std::vector<Vec3>& corners) {
+            Polytope pt;
+            pt.planes = std::move(planes);
+            Box3 b;
+            for (const Vec3& p : corners) b.expand(p);
+            pt.bounds = padded(b);
+            ++counts_.polytopes;
+            items.push_back(place(std::move(pt), xf, mat, n.pos, "hull()").node);
+        };
+        if (h.dim == 3 && h.planes.size() > 255)
+            src_.fail(n.pos,
+                      "hull() has more than 255 faces, which Lancer's polytope does not "
+                      "hold");
+        if (h.dim == 3) polytope(h.planes, h.vertices);
+        if (!balls) {
+            if (items.empty()) return emptyPrimitive();  // a flat hull has no volume
+            return Built::of(items[0]);
+        }
+        // Slabs over the faces (both sides of a flat hull's one face).
+        for (size_t f = 0; f < h.faces.size(); ++f) {
+            const Vec3 nn(h.planes[f]);
+            const double w = h.planes[f].w;
+            std::vector<glm::dvec4> planes = {
+                glm::dvec4(nn, w + r), h.dim == 2 ? glm::dvec4(-nn, r - w) : glm::dvec4(-nn, -w)};
+            std::vector<Vec3> corners;
+            const auto& face = h.faces[f];
+            for (size_t e = 0; e < face.size(); ++e) {
+                const Vec3 &a = h.vertices[size_t(face[e])],
+                           &b = h.vertices[size_t(face[(e + 1) % face.size()])];
+                const Vec3 m = glm::normalize(glm::cross(b - a, nn));
+                planes.push_back(glm::dvec4(m, glm::dot(m, a)));
+                corners.push_back(a + r * nn);
+                corners.push_back(a - (h.dim == 2 ? r : 0.0) * nn);
+            }
+            polytope(std::move(planes), corners);
+        }
+        for (const auto& [i, j] : h.edges) {
+            const Vec3 &a = h.vertices[size_t(i)], &b = h.vertices[size_t(j)];
+            ++counts_.cylinders;
+            items.push_back(place(Cone{r, r, glm::length(b - a), false},
+                                  xf * Transform::alongAxis(a, glm::normalize(b - a)), mat, n.pos,
+                                  "hull()")
+                                .node);
+        }
+        for (const Vec3& v : h.vertices) {
+            ++counts_.spheres;
+            items.push_back(place(Sphere{v, r}, xf, mat, n.pos, "hull()").node);
+        }
+        return Built::of(scene_.tree.balanced(Op::Union, items));
+    }
+
     [[noreturn]] void refuse(const Node& n) {
         std::string list;
         for (const std::string& s : openScadSupportedNodes())
@@ -862,9 +1148,22 @@ class Builder {
     }
 
     Built primitive(const Node& n, const Transform& xf, int mat) {
+        Transform local;
+        std::optional<Shape> shape = primitiveShape(n, local);
+        if (!shape) return emptyPrimitive();
+        Primitive p = makePrimitive(std::move(*shape), xf * local, mat);
+        if (!p.worldBox.isBounded())
+            src_.fail(n.pos, n.name + "() is too large: its bounds overflow a double");
+        p.origin = src_.where(n.pos);
+        scene_.prims.push_back(std::move(p));
+        return Built::of(scene_.tree.leaf(uint32_t(scene_.prims.size() - 1)));
+    }
+
+    /// cube(), sphere() or cylinder() as a shape placed by `local` in the node's frame; nothing
+    /// when OpenSCAD makes nothing of it (a zero size).
+    std::optional<Shape> primitiveShape(const Node& n, Transform& local) {
         const std::string& k = n.name;
         Shape shape;
-        Transform local;
         if (k == "cube") {
             Args a(src_, n, {"size", "center"}, {});
             Vec3 size(1.0);
@@ -875,7 +1174,7 @@ class Builder {
                     if (size[i] < 0.0) src_.fail(s->pos, "cube sizes must not be negative");
             }
             bool center = a.boolean("center", false);
-            if (size.x == 0.0 || size.y == 0.0 || size.z == 0.0) return emptyPrimitive();
+            if (size.x == 0.0 || size.y == 0.0 || size.z == 0.0) return std::nullopt;
             Block b;
             b.lo = center ? -0.5 * size : Vec3(0.0);
             b.hi = b.lo + size;
@@ -888,7 +1187,7 @@ class Builder {
                 r = 0.5 * nonNegative(a, "d", *d);  // d takes precedence, as in OpenSCAD
             else if (auto rr = a.number("r"))
                 r = nonNegative(a, "r", *rr);
-            if (r == 0.0) return emptyPrimitive();
+            if (r == 0.0) return std::nullopt;
             shape = Sphere{Vec3(0.0), r};
             ++counts_.spheres;
         } else {
@@ -913,17 +1212,12 @@ class Builder {
             if (rr1) r1 = *rr1;
             if (rr2) r2 = *rr2;
             bool center = a.boolean("center", false);
-            if (h == 0.0 || (r1 == 0.0 && r2 == 0.0)) return emptyPrimitive();
+            if (h == 0.0 || (r1 == 0.0 && r2 == 0.0)) return std::nullopt;
             shape = Cone{r1, r2, h, false};
             if (center) local = Transform::translate({0.0, 0.0, -0.5 * h});
             ++(r1 == r2 ? counts_.cylinders : counts_.cones);
         }
-        Primitive p = makePrimitive(std::move(shape), xf * local, mat);
-        if (!p.worldBox.isBounded())
-            src_.fail(n.pos, k + "() is too large: its bounds overflow a double");
-        p.origin = src_.where(n.pos);
-        scene_.prims.push_back(std::move(p));
-        return Built::of(scene_.tree.leaf(uint32_t(scene_.prims.size() - 1)));
+        return shape;
     }
 
     Built emptyPrimitive() {
@@ -952,11 +1246,13 @@ void buildModel(const SourceText& src, const std::vector<Node>& top, Scene& scen
 namespace lancer {
 
 const std::vector<std::string>& openScadSupportedNodes() {
-    static const std::vector<std::string> nodes = {
-        "group",          "union",     "difference", "intersection", "render",
-        "multmatrix",     "translate", "rotate",     "scale",        "mirror",
-        "color",          "cube",      "sphere",     "cylinder",     "linear_extrude",
-        "rotate_extrude", "square",    "circle",     "polygon"};
+    static const std::vector<std::string> nodes = {"group",          "union",      "difference",
+                                                   "intersection",   "render",     "multmatrix",
+                                                   "translate",      "rotate",     "scale",
+                                                   "mirror",         "color",      "cube",
+                                                   "sphere",         "cylinder",   "linear_extrude",
+                                                   "rotate_extrude", "square",     "circle",
+                                                   "polygon",        "polyhedron", "hull"};
     return nodes;
 }
 
