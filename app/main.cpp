@@ -157,14 +157,19 @@ int main(int argc, char** argv) {
 
     cli::CommonOptions exportOpt;
     cli::ExportOptions eopt;
-    CLI::App* exportCmd =
-        app.add_subcommand("export", "Write the scene for another renderer (POV-Ray 3.7)");
+    CLI::App* exportCmd = app.add_subcommand(
+        "export", "Write the scene for another renderer (POV-Ray 3.7, OpenSCAD)");
     exportCmd->add_option("scene", exportOpt.scene, kSceneHelp)->required();
-    exportCmd
-        ->add_option("--pov", eopt.pov,
-                     "POV-Ray 3.7 scene: the same camera (each pixel's ray through its centre), "
-                     "primitives, CSG and, roughly, materials and lights")
-        ->required();
+    exportCmd->add_option(
+        "--pov", eopt.pov,
+        "POV-Ray 3.7 scene: the same camera (each pixel's ray through its centre), "
+        "primitives, CSG and, roughly, materials and lights");
+    exportCmd->add_option("--scad", eopt.scad,
+                          "OpenSCAD model: the primitives and CSG, curved ones faceted at --fn "
+                          "segments a circle (OpenSCAD's render of it is the mesh it would trace)");
+    exportCmd->add_option("--fn", eopt.fn, "$fn of the OpenSCAD model")
+        ->check(CLI::Range(3, 100000))
+        ->default_val(32);
     exportCmd->add_flag("--pov-depth", eopt.depth,
                         "Surfaces emit their primary hit distance as grey, 1 - distance / range "
                         "(render with +FN16 File_Gamma=1.0): POV-Ray's depth image");
@@ -195,6 +200,7 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     std::string reportDir;
+    bool noMesh = false;
     benchCmd->add_option("--report", reportDir,
                          "Write DIR/index.html, one self-contained page (plots inline as SVG), "
                          "beside the CSV in DIR (instead of --out)");
@@ -205,6 +211,19 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 1000))
         ->capture_default_str()
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+    benchCmd
+        ->add_option("--mesh-scenes", bopt.meshScenes,
+                     "Scenes of the mesh axis: exact CSG against OpenSCAD's mesh of it traced by "
+                     "Embree (none: --no-mesh)")
+        ->capture_default_str();
+    benchCmd->add_flag("--no-mesh", noMesh, "No mesh axis");
+    benchCmd
+        ->add_option("--mesh-fn", bopt.meshFn,
+                     "The meshes' $fn (default 8 16 32 64; --quick: 8 16)")
+        ->check(CLI::Range(3, 4096));
+    benchCmd->add_option("--mesh-timeout", bopt.meshTimeout, "Seconds an openscad run may take")
+        ->check(CLI::Range(1.0, 86400.0))
+        ->capture_default_str();
     benchCmd->add_flag("--quick", bopt.quick, "Fewer knob values (a smoke run)");
     benchCmd->add_flag("--no-plots{false}", bopt.plots, "Write the CSV only");
     benchCmd->add_flag("--schemes-only", bopt.schemesOnly,
@@ -307,6 +326,7 @@ int main(int argc, char** argv) {
             bopt.outDir = reportDir;
             bopt.html = true;
         }
+        if (noMesh) bopt.meshScenes.clear();
         bopt.commandLine.assign(argv, argv + argc);
         return bench::runBench(bopt);
     }

@@ -52,6 +52,7 @@ std::string BenchRow::label() const {
     if (knob == "scheme") return scheme + " (defaults)";
     if (knob.compare(0, 5, "peer ") == 0) return tableName();
     if (knob == "progressive pass") return scheme + " pass stride " + value;
+    if (knob.compare(0, 5, "mesh ") == 0) return scheme == "openscad" ? "mesh " + value : scheme;
     // Knobs named after their scheme ("regular max-level") read as they are; the others
     // ("push delta", "offset", "bsp-heuristic") get the scheme in front.
     if (knob.compare(0, scheme.size(), scheme) == 0) return knob + " " + value;

@@ -16,10 +16,18 @@ struct ImageError {
     /// Root mean square of the colour difference, over the three channels of the pixels compared,
     /// on the 8-bit values scaled to 0..1 (what the viewer shows).
     double colorRmse = 0.0;
-    size_t compared = 0;  ///< pixels compared
+    size_t compared = 0;        ///< pixels compared
+    size_t silhouetteDiff = 0;  ///< pixels hit in one image and missed in the other
+    /// Root mean square of the primary hit distance's difference, over the pixels both hit.
+    double rmsDepthDiff = 0.0;
 };
 
 /// `img` against `ref` on the pixels of `on` (default: every pixel); both are sized alike.
 ImageError compareImages(const Image& ref, const Image& img, const PassLattice& on = {});
+
+/// `img` against `ref` by their surfaces alone, for an image of other primitives (a mesh of the
+/// same solid): a pixel's hit differs when one hits and the other misses, or when the distances
+/// differ by more than 1e-6 of the distance; `maxDepthDiff` is over the pixels both hit.
+ImageError compareSurfaces(const Image& ref, const Image& img);
 
 }  // namespace lancer::bench

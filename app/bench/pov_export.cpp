@@ -1,23 +1,19 @@
 #include "app/bench/pov_export.h"
 
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <ostream>
 #include <stdexcept>
 #include <vector>
 
+#include "app/bench/export_tree.h"
+
 namespace lancer::bench {
 
 namespace {
 
-/// A number as POV-Ray reads it back to the last bit: the shortest form that round-trips.
-std::string n(double v) {
-    if (v == 0.0) return "0";  // and -0
-    char buf[40];
-    const auto end = std::to_chars(buf, buf + sizeof buf, v).ptr;
-    return std::string(buf, end);
-}
+/// A number as POV-Ray reads it back to the last bit.
+std::string n(double v) { return shortest(v); }
 
 std::string vec(const Vec3& v) {
     std::string s = "<";
@@ -37,24 +33,6 @@ std::string matrix(const Mat4& m) {
     for (int i = 0; i < 4; ++i)
         for (int j = 0; j < 3; ++j) s += n(m[i][j]) + (i == 3 && j == 2 ? ">" : ", ");
     return s;
-}
-
-/// A union's or an intersection's operands, its chains of the same operator flattened (a union
-/// of unions is one union), left to right.
-void gather(const CsgTree& tree, int node, std::vector<int>& out) {
-    const Op op = tree.nodes[size_t(node)].op;
-    std::vector<int> stack{tree.nodes[size_t(node)].right, tree.nodes[size_t(node)].left};
-    while (!stack.empty()) {
-        const int i = stack.back();
-        stack.pop_back();
-        const CsgNode& c = tree.nodes[size_t(i)];
-        if (c.op == op) {
-            stack.push_back(c.right);
-            stack.push_back(c.left);
-        } else {
-            out.push_back(i);
-        }
-    }
 }
 
 struct Writer {
@@ -112,20 +90,7 @@ struct Writer {
             primitive(c.prim, indent);
             return;
         }
-        std::vector<int> parts;
-        if (c.op == Op::Difference) {
-            // A left-deep chain of differences: the first solid minus every other.
-            std::vector<int> subtracted;
-            int a = i;
-            while (scene.tree.nodes[size_t(a)].op == Op::Difference) {
-                subtracted.push_back(scene.tree.nodes[size_t(a)].right);
-                a = scene.tree.nodes[size_t(a)].left;
-            }
-            parts.push_back(a);
-            parts.insert(parts.end(), subtracted.rbegin(), subtracted.rend());
-        } else {
-            gather(scene.tree, i, parts);
-        }
+        const std::vector<int> parts = operands(scene.tree, i);
         os << indent
            << (c.op == Op::Union          ? "union"
                : c.op == Op::Intersection ? "intersection"

@@ -15,6 +15,7 @@
 #include "app/bench/html_page.h"
 #include "app/bench/image_error.h"
 #include "app/bench/machine.h"
+#include "app/bench/mesh_peer.h"
 #include "app/bench/plots.h"
 #include "app/bench/pov_peer.h"
 #include "app/cli/param_table.h"
@@ -123,7 +124,7 @@ const char* kHeader =
     "scene,scheme,knob,value,build_ms,memory_bytes,regions,render_ms,speedup,rays,prim_tests_per_"
     "ray,region_visits_per_ray,mailbox_hits,walk_errors,hit_diff_pixels,color_diff_pixels,max_"
     "depth_diff,repeats,build_ms_min,build_ms_max,render_ms_min,render_ms_max,speedup_min,speedup_"
-    "max,color_rmse,note\n";
+    "max,color_rmse,silhouette_diff_pixels,depth_rms,note\n";
 
 /// A CSV field: quoted when it holds a comma or a quote.
 std::string csvField(const std::string& s) {
@@ -138,7 +139,7 @@ void writeCsvRow(std::ostream& csv, const BenchRow& r) {
         << csvField(r.value) << ",";
     if (!r.measured()) {
         // Every figure empty, the reason last.
-        for (int i = 0; i < 21; ++i) csv << ",";
+        for (int i = 0; i < 23; ++i) csv << ",";
         csv << csvField(r.note) << "\n";
         return;
     }
@@ -165,7 +166,8 @@ void writeCsvRow(std::ostream& csv, const BenchRow& r) {
     csv << "," << t.count << "," << num(b.min) << "," << num(b.max) << "," << num(t.min) << ","
         << num(t.max) << "," << opt(s.count > 0, s.min) << "," << opt(s.count > 0, s.max) << ","
         << (r.compared && r.colorCompared ? num(r.error.colorRmse) : none) << ","
-        << csvField(r.csvNote()) << "\n";
+        << (r.compared ? std::to_string(r.error.silhouetteDiff) : none) << ","
+        << (r.compared ? num(r.error.rmsDepthDiff) : none) << "," << csvField(r.csvNote()) << "\n";
 }
 
 using Clock = std::chrono::steady_clock;
@@ -202,10 +204,25 @@ int runBench(const BenchOptions& opt) {
     const bool povray = PovPeer::available();
     int sceneIndex = 0;
 
+    const bool openscad = MeshPeer::available();
+    std::vector<int> meshFn = opt.meshFn;
+    if (meshFn.empty())
+        meshFn = opt.quick ? std::vector<int>{8, 16} : std::vector<int>{8, 16, 32, 64};
+    auto listed = [](const std::vector<std::string>& v, const std::string& s) {
+        return std::find(v.begin(), v.end(), s) != v.end();
+    };
+    std::vector<std::string> allScenes = opt.scenes;
+    if (!opt.schemesOnly)
+        for (const std::string& s : opt.meshScenes)
+            if (!listed(allScenes, s)) allScenes.push_back(s);
+
     std::deque<BenchRow> rows;  // every row of every scene, in the order made (stable addresses)
     std::vector<std::string> done;
-    for (const std::string& spec : opt.scenes) {
+    for (const std::string& spec : allScenes) {
         ++sceneIndex;
+        // A scene of --mesh-scenes only gets the mesh axis; one of --scenes every measure.
+        const bool full = listed(opt.scenes, spec);
+        const bool meshAxis = !opt.schemesOnly && withBrute && listed(opt.meshScenes, spec);
         Scene scene;
         try {
             scene = loadScene(spec);
@@ -283,8 +300,9 @@ int runBench(const BenchOptions& opt) {
             });
             return &row;
         };
-        if (withBrute) bruteRow = bruteReference("scheme", ro, ref);
-        for (const Config& c : sweep(opt.quick, opt.schemesOnly, wanted)) {
+        if (withBrute && full) bruteRow = bruteReference("scheme", ro, ref);
+        for (const Config& c :
+             full ? sweep(opt.quick, opt.schemesOnly, wanted) : std::vector<Config>{}) {
             BenchRow& row = newRow(schemeName(c.build.scheme), c.knob, c.value);
             row.inTable = c.knob == "scheme";
             if (bruteRow) against.push_back({&row, bruteRow});
@@ -299,7 +317,9 @@ int runBench(const BenchOptions& opt) {
         r0.shading.bounces = 0;
         Image ref0(w, h);
         const std::string peer0 = "peer (bounces 0)";
-        if (!EmbreePeer::available() || !EmbreePeer::supports(scene)) {
+        if (!full) {
+            // the mesh axis alone (below)
+        } else if (!EmbreePeer::available() || !EmbreePeer::supports(scene)) {
             BenchRow& row = newRow("embree", peer0, "embree");
             row.inTable = true;
             row.note = !EmbreePeer::available()
@@ -338,7 +358,7 @@ int runBench(const BenchOptions& opt) {
 
         // POV-Ray on the same scene, camera and bounces: its own trace time against our renders.
         const std::string peerN = "peer (bounces " + std::to_string(opt.bounces) + ")";
-        {
+        if (full) {
             BenchRow& row = newRow("povray", peerN, "povray");
             row.inTable = true;
             row.peer = true;
@@ -380,9 +400,80 @@ int runBench(const BenchOptions& opt) {
             }
         }
 
+        // Exact CSG against the mesh an OpenSCAD user would trace: OpenSCAD's CGAL render of the
+        // same model at each $fn, traced by Embree, against every scheme's exact image, all at
+        // --bounces 0 and compared with brute force by their surfaces.
+        Image refMesh(w, h);
+        if (meshAxis) {
+            const std::string knob = "mesh (bounces 0)";
+            BenchRow* const base = bruteReference(knob, r0, refMesh);
+            base->inTable = false;  // the table's brute force is the scene's own
+            for (SchemeKind k : accelerated(wanted)) {
+                BenchRow& row = newRow(schemeName(k), knob, "exact");
+                against.push_back({&row, base});
+                BuildParams b;
+                b.scheme = k;
+                schemeJob(row, b, r0, &refMesh);
+            }
+            std::shared_ptr<MeshPeer> model;
+            std::string why = !openscad ? "not installed (no openscad on the PATH)"
+                              : !EmbreePeer::available()
+                                  ? "not run: this build has no Embree to trace the mesh"
+                                  : "";
+            if (why.empty()) try {
+                    model = std::make_shared<MeshPeer>(
+                        scene, opt.outDir, std::to_string(sceneIndex) + "-" + sceneSlug(spec));
+                } catch (const std::invalid_argument& e) {
+                    why = std::string("not run: ") + e.what();
+                }
+            for (int fn : meshFn) {
+                BenchRow& row = newRow("openscad", knob, "$fn " + std::to_string(fn));
+                row.peer = true;
+                row.note = why;
+                if (!model) continue;
+                against.push_back({&row, base});
+                auto mesh = std::make_shared<Scene>();
+                auto meshMs = std::make_shared<double>(0.0);
+                jobs.push_back([model, mesh, meshMs, fn, &row, &refMesh, r0, w, h, record,
+                                timeout = opt.meshTimeout](int round) {
+                    if (!row.note.empty()) return;
+                    if (round == 0) {
+                        // Meshed once: CGAL takes seconds to minutes, the same each time.
+                        const MeshRun m = model->mesh(fn, timeout);
+                        if (!m.failure.empty()) {
+                            row.note = "failed: " + m.failure;
+                            return;
+                        }
+                        const auto t0 = Clock::now();
+                        *mesh = readStl(m.stl, *model->scene());
+                        *meshMs =
+                            m.meshMs +
+                            std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+                        row.errorNote =
+                            "OpenSCAD's mesh, " + std::to_string(mesh->prims.size()) +
+                            " triangles (its CGAL render and reading: " + fixed(*meshMs, 0) +
+                            " ms, in build_ms with Embree's build); hits compared by "
+                            "surface: silhouette and distance";
+                    }
+                    EmbreePeer peer(*mesh);
+                    Image img(w, h);
+                    const RenderStats s = peer.render(r0, img);
+                    AccelInfo info;
+                    info.buildMs = *meshMs + peer.buildMs();
+                    info.regions = 0;
+                    record(row, info, s, round);
+                    if (round == 0) {
+                        row.error = compareSurfaces(refMesh, img);
+                        row.compared = true;
+                        row.colorCompared = false;  // flat facets shade otherwise, as meant
+                    }
+                });
+            }
+        }
+
         // Progressive passes of the command line's default scheme: error of each pass against
         // the brute-force image, and the time since the first pass started.
-        if (!opt.schemesOnly && bruteRow) {
+        if (!opt.schemesOnly && bruteRow && full) {
             std::vector<BenchRow*> passes;
             BuildParams b;
             b.scheme = cli::Knobs{}.build.scheme;
@@ -492,6 +583,13 @@ int runBench(const BenchOptions& opt) {
                                               std::to_string(opt.bounces) +
                                               ": its parse and trace times"
                                         : "POV-Ray: not installed (no povray on the PATH)");
+        if (!opt.schemesOnly)
+            settings.peers.push_back(openscad
+                                         ? MeshPeer::version() + " (" + MeshPeer::executable() +
+                                               "), meshing the mesh axis' scenes, traced "
+                                               "by Embree"
+                                         : "OpenSCAD: not installed (no openscad on the "
+                                           "PATH)");
         const std::string page = opt.outDir + "/index.html";
         if (!writeHtmlPage(page, run, settings, rows, figures)) {
             std::cerr << "error: could not write " << page << "\n";

@@ -29,6 +29,13 @@ struct BenchOptions {
     /// Write OUT/index.html, one self-contained page (plots inline as SVG) with the machine, the
     /// commit, the date and the command line.
     bool html = false;
+    /// Scenes of the mesh axis (exact CSG against OpenSCAD's mesh of it, traced by Embree);
+    /// measured beside `scenes`, not with --schemes-only. CGAL's time grows as $fn^2 and with the
+    /// primitives, so these are small.
+    std::vector<std::string> meshScenes{"builtin:lattice:2"};
+    /// The $fn of each mesh; empty: 8, 16, 32, 64 (--quick: 8, 16).
+    std::vector<int> meshFn;
+    double meshTimeout = 120.0;  ///< seconds an openscad run may take before it is stopped
     /// The command line that started the run (for the page), argv[0] first.
     std::vector<std::string> commandLine;
 };

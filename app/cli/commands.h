@@ -27,11 +27,13 @@ int runStructure(const CommonOptions& o, const StructureOptions& s);
 
 struct ExportOptions {
     std::string pov;     ///< --pov FILE.pov
+    std::string scad;    ///< --scad FILE.scad
+    int fn = 32;         ///< --fn: the OpenSCAD model's $fn
     bool depth = false;  ///< --pov-depth: surfaces emit their distance (a depth image)
     bool quiet = false;
 };
-/// Write the scene for POV-Ray 3.7 with the same camera (docs/design.md section 6, "Export and
-/// report").
+/// Write the scene for POV-Ray 3.7 with the same camera, and/or as an OpenSCAD model
+/// (docs/design.md section 6, "Export and report").
 int runExport(const CommonOptions& o, const ExportOptions& e);
 
 }  // namespace lancer::cli

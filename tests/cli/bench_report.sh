@@ -35,7 +35,18 @@ if command -v gnuplot >/dev/null; then
     awk -v id="$f" 'index($0, "<figure id=\"" id "\">") { on = 1; next } on && /<svg/ { found = 1; exit }
                     on && /<\/figure>/ { exit } END { exit !found }' "$page" || fail "plot $f is not an inline SVG"
   done
-  [ "$(grep -c '<svg' "$page")" -eq 6 ] || fail "expected 6 SVGs, found $(grep -c '<svg' "$page")"
+  svgs=6
+  if command -v openscad >/dev/null && grep -q ',embree,peer (bounces 0),[^,]*,[0-9]' "$csv"; then
+    svgs=7  # the mesh axis: exact CSG against OpenSCAD's meshes traced by Embree
+    f=exact_vs_mesh-lattice-2
+    awk -v id="$f" 'index($0, "<figure id=\"" id "\">") { on = 1; next } on && /<svg/ { found = 1; exit }
+                    on && /<\/figure>/ { exit } END { exit !found }' "$page" || fail "plot $f is not an inline SVG"
+    for label in "mesh \$fn 8" "mesh \$fn 16" "regular" "bvh" "Pareto front" "pixels hit in one image only" \
+                 "RMS depth difference"; do
+      grep -q "$label" "$tmp/r/$f.svg" || fail "$f has no \"$label\""
+    done
+  fi
+  [ "$(grep -c '<svg' "$page")" -eq $svgs ] || fail "expected $svgs SVGs, found $(grep -c '<svg' "$page")"
   for label in "regular (defaults)" "irregular (defaults)" "regular max-level 6" "push delta 0.01" \
                "Pareto front" "pixels whose primary hit differs" "largest depth difference"; do
     grep -q "$label" "$tmp/r/speed_vs_error-balls-1.svg" || fail "speed_vs_error has no \"$label\""
@@ -70,6 +81,30 @@ if command -v povray >/dev/null; then
 else
   grep -q "povray (bounces 3)</td><td class=\"note\" colspan=\"9\">not installed" "$page" || fail "no POV-Ray \"not installed\""
 fi
+# The mesh axis (builtin:lattice:2 by default): every scheme traces the exact solid (no silhouette
+# or depth difference from brute force); OpenSCAD's meshes differ, less at the finer $fn.
+mesh() { awk -F, -v v="$1" -v c="$2" '$1=="builtin:lattice:2" && $3=="mesh (bounces 0)" && $4==v { print $c }' "$csv"; }
+if command -v openscad >/dev/null && [ -n "$(mesh '$fn 8' 26)" ]; then
+  for s in regular irregular bvh; do
+    awk -F, -v s="$s" '$3=="mesh (bounces 0)" && $2==s { found = 1; if ($15 != 0 || $26 != 0 || $27 != 0) exit 1 }
+                       END { exit !found }' "$csv" || fail "the exact $s differs from brute force on the mesh axis"
+  done
+  awk -v a="$(mesh '$fn 8' 27)" -v b="$(mesh '$fn 16' 27)" 'BEGIN { exit !(a > 0 && b > 0 && b < a) }' \
+    || fail "the mesh's RMS depth error does not fall from \$fn 8 ($(mesh '$fn 8' 27)) to 16 ($(mesh '$fn 16' 27))"
+  [ "$(mesh '$fn 8' 18)" = 3 ] || fail "the mesh rows were not repeated 3 times"
+  [ -s "$tmp/r/openscad/3-lattice-2.scad" ] || fail "the OpenSCAD model is not kept beside the page"
+else
+  grep -q '^builtin:lattice:2,openscad,mesh (bounces 0),$fn 8,.*\(not installed\|no Embree\)' "$csv" \
+    || fail "no mesh row and no reason"
+fi
+LANCER_OPENSCAD=/nonexistent/openscad "$LANCER" bench --quick --no-plots --out "$tmp/m" --scenes builtin:default \
+  --mesh-scenes builtin:drilled:1 --width 16 --height 12 --threads 2 --repeats 1 >/dev/null 2>"$tmp/log" \
+  || { cat "$tmp/log"; fail "bench without openscad exited non-zero"; }
+grep -q '^builtin:drilled:1,openscad,mesh (bounces 0),$fn 16,.*not installed' "$tmp/m/report.csv" \
+  || fail "without openscad: no \"not installed\" mesh row"
+grep -q '^builtin:drilled:1,regular,mesh (bounces 0),exact,' "$tmp/m/report.csv" || fail "no exact row on the mesh axis"
+if grep -q '^builtin:drilled:1,regular,scheme,' "$tmp/m/report.csv"; then fail "a mesh-axis scene got the sweeps"; fi
+
 # Absent, POV-Ray's rows say so.
 LANCER_POVRAY=/nonexistent/povray "$LANCER" bench --schemes-only --no-plots --report "$tmp/n" \
   --scenes builtin:default --width 16 --height 12 --threads 2 --repeats 1 >/dev/null 2>"$tmp/log" \
@@ -93,4 +128,12 @@ awk -F, 'NR > 1 && $18 != "" { if ($18 != 3 || $8 < $21 || $8 > $22) { print; ex
   || fail "a row's median is not within its range, or not 3 repeats"
 
 fails "--repeats" "$LANCER" bench --repeats 0 --report "$tmp/z"
+
+# `lancer export --scad`: the OpenSCAD model the mesh axis meshes; surfaces refused, no file left.
+"$LANCER" export builtin:lattice:2 --scad "$tmp/l.scad" --fn 12 >"$tmp/out" || fail "export --scad failed"
+grep -q '^\$fn = 12;' "$tmp/l.scad" || fail "export --scad: no \$fn = 12"
+grep -q 'difference() {' "$tmp/l.scad" || fail "export --scad: no difference"
+fails "give --pov FILE.pov, --scad FILE.scad" "$LANCER" export builtin:default
+fails "OpenSCAD models solids only" "$LANCER" export "$SRC/assets/spd/balls1.nff" --scad "$tmp/s.scad"
+[ ! -e "$tmp/s.scad" ] || fail "a refused export left a file"
 echo ok
