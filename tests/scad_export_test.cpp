@@ -219,6 +219,8 @@ TEST(ScadExport, OpenScadMeshConvergesOnTheExactSolid) {
         EXPECT_GT(e.rmsDepthDiff, 0.0) << "$fn " << fn;
         EXPECT_LT(e.rmsDepthDiff, fn == 8 ? 0.5 : 0.1) << "$fn " << fn;
         EXPECT_LT(e.rmsDepthDiff, previous) << "$fn " << fn;
+        EXPECT_GT(e.p99DepthDiff, 0.0) << "$fn " << fn;
+        EXPECT_LE(e.p99DepthDiff, e.maxDepthDiff) << "$fn " << fn;
         previous = e.rmsDepthDiff;
     }
     std::filesystem::remove_all(dir);

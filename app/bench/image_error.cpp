@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <vector>
 
 namespace lancer::bench {
 
@@ -14,7 +15,7 @@ ImageError compare(const Image& ref, const Image& img, const PassLattice& on, bo
     ImageError e;
     std::vector<uint8_t> a = ref.rgba8(), b = img.rgba8();
     double squares = 0.0, depthSquares = 0.0;
-    size_t bothHit = 0;
+    std::vector<double> depthDiffs;
     for (int y = 0; y < ref.height; ++y)
         for (int x = 0; x < ref.width; ++x) {
             if (!on.contains(x, y)) continue;
@@ -29,7 +30,7 @@ ImageError compare(const Image& ref, const Image& img, const PassLattice& on, bo
             e.silhouetteDiff += silhouette;
             if (!bothMiss && !silhouette) {
                 depthSquares += dd * dd;
-                ++bothHit;
+                depthDiffs.push_back(dd);
             }
             if ((byPrimitive && ref.hitPrim[i] != img.hitPrim[i]) ||
                 dd > 1e-6 * std::max(1.0, double(da)))
@@ -47,7 +48,12 @@ ImageError compare(const Image& ref, const Image& img, const PassLattice& on, bo
             e.colorDiff += differs;
         }
     if (e.compared) e.colorRmse = std::sqrt(squares / (3.0 * double(e.compared))) / 255.0;
-    if (bothHit) e.rmsDepthDiff = std::sqrt(depthSquares / double(bothHit));
+    if (!depthDiffs.empty()) {
+        e.rmsDepthDiff = std::sqrt(depthSquares / double(depthDiffs.size()));
+        const auto k = depthDiffs.begin() + ptrdiff_t((depthDiffs.size() - 1) * 99 / 100);
+        std::nth_element(depthDiffs.begin(), k, depthDiffs.end());
+        e.p99DepthDiff = *k;
+    }
     return e;
 }
 

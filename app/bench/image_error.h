@@ -20,6 +20,9 @@ struct ImageError {
     size_t silhouetteDiff = 0;  ///< pixels hit in one image and missed in the other
     /// Root mean square of the primary hit distance's difference, over the pixels both hit.
     double rmsDepthDiff = 0.0;
+    /// The 99th percentile of that difference: what a pixel's depth error is but for the 1% of
+    /// pixels on a depth edge (where one image sees past an edge the other does not).
+    double p99DepthDiff = 0.0;
 };
 
 /// `img` against `ref` on the pixels of `on` (default: every pixel); both are sized alike.

@@ -124,7 +124,7 @@ const char* kHeader =
     "scene,scheme,knob,value,build_ms,memory_bytes,regions,render_ms,speedup,rays,prim_tests_per_"
     "ray,region_visits_per_ray,mailbox_hits,walk_errors,hit_diff_pixels,color_diff_pixels,max_"
     "depth_diff,repeats,build_ms_min,build_ms_max,render_ms_min,render_ms_max,speedup_min,speedup_"
-    "max,color_rmse,silhouette_diff_pixels,depth_rms,note\n";
+    "max,color_rmse,silhouette_diff_pixels,depth_rms,depth_p99,note\n";
 
 /// A CSV field: quoted when it holds a comma or a quote.
 std::string csvField(const std::string& s) {
@@ -139,7 +139,7 @@ void writeCsvRow(std::ostream& csv, const BenchRow& r) {
         << csvField(r.value) << ",";
     if (!r.measured()) {
         // Every figure empty, the reason last.
-        for (int i = 0; i < 23; ++i) csv << ",";
+        for (int i = 0; i < 24; ++i) csv << ",";
         csv << csvField(r.note) << "\n";
         return;
     }
@@ -167,7 +167,8 @@ void writeCsvRow(std::ostream& csv, const BenchRow& r) {
         << num(t.max) << "," << opt(s.count > 0, s.min) << "," << opt(s.count > 0, s.max) << ","
         << (r.compared && r.colorCompared ? num(r.error.colorRmse) : none) << ","
         << (r.compared ? std::to_string(r.error.silhouetteDiff) : none) << ","
-        << (r.compared ? num(r.error.rmsDepthDiff) : none) << "," << csvField(r.csvNote()) << "\n";
+        << (r.compared ? num(r.error.rmsDepthDiff) : none) << ","
+        << (r.compared ? num(r.error.p99DepthDiff) : none) << "," << csvField(r.csvNote()) << "\n";
 }
 
 using Clock = std::chrono::steady_clock;
