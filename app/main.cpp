@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
         ->needs(frames);
     view->add_option("--show", vopt.show,
                      "Layers drawn, a comma list of bsp, zones, slabs, leaves, grid, boxes, "
-                     "frustum, inspector, ray, visited, none")
+                     "frustum, inspector, ray, visited, worst, none")
         ->check([](const std::string& list) {
             viewer::overlay::OverlayOptions o;
             try {

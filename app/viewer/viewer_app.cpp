@@ -393,6 +393,9 @@ std::vector<std::string> ViewerApp::applyShow(const std::string& list) {
         } else if (item == "visited") {
             state_.settings().showRay = true;
             state_.settings().rayRegionsOnly = true;
+        } else if (item == "worst") {
+            state_.settings().showRay = true;
+            state_.notes().worstOpen = true;
         } else {
             left.push_back(std::move(item));
         }

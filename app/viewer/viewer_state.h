@@ -17,6 +17,7 @@
 #include "app/viewer/colormap.h"
 #include "app/viewer/compare/rebuild_diff.h"
 #include "app/viewer/image_view.h"
+#include "app/viewer/playback/worst_rays.h"
 #include "app/viewer/structure_builder.h"
 #include "app/viewer/viewer_settings.h"
 #include "engine/render/progressive.h"
@@ -33,6 +34,14 @@ struct PanelNotes {
     std::string pendingScreenshot;  ///< taken once the frame is drawn
     int screenshotCount = 0;
     int speedupStride = 4;  ///< the Statistics panel's sample: 1 pixel in stride x stride
+    /// The Ray panel's "Worst rays": open, ranked by what (playback::RayCost), the list of the
+    /// complete image of job `worstJob`, and where its first row was drawn (screen pixels).
+    bool worstOpen = false;
+    int worstBy = 0;
+    uint64_t worstJob = 0;
+    int worstListedBy = -1;
+    std::vector<playback::CostlyPixel> worst;
+    float worstFirstRow[2] = {-1.0f, -1.0f};
 };
 
 /// The totals of an A/B over the rows it compares (ViewerState::abTotals()).
@@ -93,6 +102,10 @@ class ViewerState {
     const Camera& home() const { return home_; }
     /// The image on screen (the last snapshot taken).
     const Image& shown() const { return shown_; }
+    /// The shown image has every row at full resolution: its counters are the render's.
+    bool shownComplete() const { return shownComplete_; }
+    /// The render job the shown image comes from (a new one for each change).
+    uint64_t shownJob() const { return shownJob_; }
     /// Size of the render: the image viewport's (panels/layout.h), in pixels.
     int width() const { return jobWidth_; }
     int height() const { return jobHeight_; }

@@ -79,6 +79,17 @@ class ViewerHarness {
         frame();
     }
 
+    /// A left click at (x, y): pressed for one frame, released for one.
+    void click(float x, float y) {
+        ImGuiIO& io = ImGui::GetIO();
+        io.MousePos = ImVec2(x, y);
+        frame();  // hovered first, as a real pointer is
+        io.MouseDown[0] = true;
+        frame();
+        io.MouseDown[0] = false;
+        frame();
+    }
+
   private:
     int w_, h_;
     ViewerSettings s_;

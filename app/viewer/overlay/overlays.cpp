@@ -471,13 +471,13 @@ std::vector<std::string> applyShowList(const std::string& list, OverlayOptions& 
         else if (item == "none")
             continue;
         else if (item == "boxes" || item == "frustum" || item == "inspector" || item == "ray" ||
-                 item == "visited")
+                 item == "visited" || item == "worst")
             notDrawn.push_back(item);
         else
             throw std::invalid_argument(
                 "unknown item '" + item +
                 "' (expected bsp, zones, slabs, leaves, grid, boxes, frustum, inspector, ray, "
-                "visited, none)");
+                "visited, worst, none)");
     }
     o = out;
     return notDrawn;

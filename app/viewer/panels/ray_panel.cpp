@@ -236,6 +236,65 @@ void rayCsgStrip(playback::RayPlayer& player) {
 
 }  // namespace
 
+/// Rows of the "Worst rays" list.
+constexpr size_t kWorstRays = 20;
+
+/// The costliest pixels of the complete image on screen, ranked by tests, region visits or
+/// time; a row picks its pixel (its ray tree is then traced and played).
+void worstRays(ViewerState& st, playback::RayPlayer& player) {
+    PanelNotes& notes = st.notes();
+    ImGui::SetNextItemOpen(notes.worstOpen);
+    notes.worstOpen = ImGui::CollapsingHeader("Worst rays");
+    notes.worstFirstRow[0] = notes.worstFirstRow[1] = -1.0f;
+    if (!notes.worstOpen) return;
+    static const char* by[] = {"prim tests", "region visits", "time"};
+    ImGui::SetNextItemWidth(140);
+    ImGui::Combo("ranked by", &notes.worstBy, by, 3);
+    if (!st.shownComplete()) {
+        hintText("listed once the image is complete");
+        return;
+    }
+    if (notes.worstJob != st.shownJob() || notes.worstListedBy != notes.worstBy) {
+        notes.worst =
+            playback::costliestPixels(st.shown(), playback::RayCost(notes.worstBy), kWorstRays);
+        notes.worstJob = st.shownJob();
+        notes.worstListedBy = notes.worstBy;
+    }
+    const float rowH = ImGui::GetTextLineHeightWithSpacing();
+    const ImGuiTableFlags flags = ImGuiTableFlags_Borders | ImGuiTableFlags_RowBg |
+                                  ImGuiTableFlags_ScrollY | ImGuiTableFlags_SizingStretchProp;
+    if (!ImGui::BeginTable("worst", 4, flags, ImVec2(0, rowH * 8.5f))) return;
+    ImGui::TableSetupScrollFreeze(0, 1);
+    ImGui::TableSetupColumn("pixel");
+    ImGui::TableSetupColumn("tests");
+    ImGui::TableSetupColumn("visits");
+    ImGui::TableSetupColumn("µs");
+    ImGui::TableHeadersRow();
+    const playback::RayPlayback& play = player.playback();
+    for (size_t i = 0; i < notes.worst.size(); ++i) {
+        const playback::CostlyPixel& p = notes.worst[i];
+        ImGui::TableNextRow();
+        ImGui::TableNextColumn();
+        char label[32];
+        std::snprintf(label, sizeof label, "%d %d##w%zu", p.x, p.y, i);
+        const bool picked = !play.empty() && play.pixel().x == p.x && play.pixel().y == p.y;
+        if (ImGui::Selectable(label, picked, ImGuiSelectableFlags_SpanAllColumns))
+            player.pick(p.x, p.y);
+        if (i == 0) {
+            const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+            notes.worstFirstRow[0] = 0.5f * (lo.x + hi.x);
+            notes.worstFirstRow[1] = 0.5f * (lo.y + hi.y);
+        }
+        ImGui::TableNextColumn();
+        ImGui::Text("%u", p.tests);
+        ImGui::TableNextColumn();
+        ImGui::Text("%u", p.visits);
+        ImGui::TableNextColumn();
+        ImGui::Text("%.1f", double(p.us));
+    }
+    ImGui::EndTable();
+}
+
 /// The step list's least height, in lines: a user reads the steps around the current one.
 constexpr float kStepLines = 8.5f;
 
@@ -260,6 +319,7 @@ void rayPanel(ViewerState& st, playback::RayPlayer& player, bool* open) {
     if (ImGui::GetContentRegionAvail().x < ImGui::CalcTextSize(hint).x) ImGui::NewLine();
     hintText(hint);
     errorText(player.note().rfind("pixel", 0) == 0 ? player.note() : "");
+    worstRays(st, player);
     if (play.empty()) {
         ImGui::End();
         return;
