@@ -1240,8 +1240,8 @@ class Builder {
                 if (into == w) return;
                 list += std::string(list.empty() ? "" : ", ") + w;
             }
-            src_.fail(v->pos, std::string("unknown ") + name + " '" + into + "' of text() (expected " +
-                                  list + ")");
+            src_.fail(v->pos, std::string("unknown ") + name + " '" + into +
+                                  "' of text() (expected " + list + ")");
         };
         if (const Value* v = a.get("text"); v && v->kind == Value::Kind::Number)
             p.text = twistText(v->number);  // OpenSCAD writes a number as its text
@@ -1259,13 +1259,17 @@ class Builder {
             p.size = *s;
         }
         if (auto s = a.number("spacing")) {
-            if (!std::isfinite(*s)) src_.fail(a.get("spacing")->pos, "'spacing' of text() is not finite");
+            if (!std::isfinite(*s))
+                src_.fail(a.get("spacing")->pos, "'spacing' of text() is not finite");
             p.spacing = *s;
         }
         // $fn, $fa, $fs decide the curves' segments (OpenSCAD's defaults when absent).
         double fn = 0.0, fa = 12.0, fs = 2.0;
         for (const Arg& arg : n.args) {
-            double* into = arg.name == "$fn" ? &fn : arg.name == "$fa" ? &fa : arg.name == "$fs" ? &fs : nullptr;
+            double* into = arg.name == "$fn"   ? &fn
+                           : arg.name == "$fa" ? &fa
+                           : arg.name == "$fs" ? &fs
+                                               : nullptr;
             if (into) *into = a.number(arg.value, "'" + arg.name + "' of text()");
         }
         p.segments = textCurveSegments(p.size, fn, fa, fs);
@@ -1279,7 +1283,8 @@ class Builder {
         for (const auto& g : t.glyphs)
             for (const auto& c : g) edges += c.size();
         if (edges > 200000)
-            src_.fail(n.pos, "text() has more than 200000 outline edges, which Lancer does not cut");
+            src_.fail(n.pos,
+                      "text() has more than 200000 outline edges, which Lancer does not cut");
         std::vector<int> items;
         for (auto& g : t.glyphs) {
             for (auto& c : g)
@@ -1317,14 +1322,12 @@ void buildModel(const SourceText& src, const std::vector<Node>& top, Scene& scen
 namespace lancer {
 
 const std::vector<std::string>& openScadSupportedNodes() {
-    static const std::vector<std::string> nodes = {"group",          "union",      "difference",
-                                                   "intersection",   "render",     "multmatrix",
-                                                   "translate",      "rotate",     "scale",
-                                                   "mirror",         "color",      "cube",
-                                                   "sphere",         "cylinder",   "linear_extrude",
-                                                   "rotate_extrude", "square",     "circle",
-                                                   "polygon",        "polyhedron", "hull",
-                                                   "text"};
+    static const std::vector<std::string> nodes = {
+        "group",          "union",     "difference", "intersection", "render",
+        "multmatrix",     "translate", "rotate",     "scale",        "mirror",
+        "color",          "cube",      "sphere",     "cylinder",     "linear_extrude",
+        "rotate_extrude", "square",    "circle",     "polygon",      "polyhedron",
+        "hull",           "text"};
     return nodes;
 }
 

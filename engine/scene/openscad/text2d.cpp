@@ -88,7 +88,8 @@ std::pair<std::string, int> findFont(const std::string& pattern) {
     FcChar8* file = nullptr;
     int index = 0;
     if (!match || FcPatternGetString(match.get(), FC_FILE, 0, &file) != FcResultMatch || !file)
-        throw TextError("fontconfig finds no font for '" + pattern + "' (is fonts-liberation "
+        throw TextError("fontconfig finds no font for '" + pattern +
+                        "' (is fonts-liberation "
                         "installed?)");
     FcPatternGetInteger(match.get(), FC_INDEX, 0, &index);
     return {reinterpret_cast<const char*>(file), index};
@@ -128,9 +129,9 @@ TextLayout layoutText(const TextParams& p) {
         throw TextError("FreeType cannot set the size " + std::to_string(p.size) + " for " + file);
 
     std::unique_ptr<hb_font_t, decltype(&hb_font_destroy)> font(hb_ft_font_create(face, nullptr),
-                                                                  hb_font_destroy);
+                                                                hb_font_destroy);
     std::unique_ptr<hb_buffer_t, decltype(&hb_buffer_destroy)> buf(hb_buffer_create(),
-                                                                     hb_buffer_destroy);
+                                                                   hb_buffer_destroy);
     hb_buffer_add_utf8(buf.get(), p.text.c_str(), int(p.text.size()), 0, int(p.text.size()));
     if (!p.direction.empty())
         hb_buffer_set_direction(buf.get(), hb_direction_from_string(p.direction.c_str(), -1));
@@ -155,8 +156,10 @@ TextLayout layoutText(const TextParams& p) {
         for (Glyph& g : glyphs) FT_Done_Glyph(g.glyph);
     };
     for (unsigned i = 0; i < count; ++i) {
-        // A glyph FreeType cannot load is skipped, as OpenSCAD does (it warns).
-        if (FT_Load_Glyph(face, info[i].codepoint, FT_LOAD_DEFAULT)) continue;
+        // A glyph FreeType cannot load is skipped, as OpenSCAD does (it warns). Unhinted: Debian's
+        // OpenSCAD 2021.01 meshes unhinted outlines (its L is 1409 font units tall, not the
+        // hinted 9.536 at size 10), and hinting would move stems by up to 0.03 at size 10.
+        if (FT_Load_Glyph(face, info[i].codepoint, FT_LOAD_NO_HINTING)) continue;
         FT_Glyph g = nullptr;
         if (FT_Get_Glyph(face->glyph, &g)) continue;
         if (g->format != FT_GLYPH_FORMAT_OUTLINE) {
@@ -170,7 +173,9 @@ TextLayout layoutText(const TextParams& p) {
     double width = 0.0, ascend = 0.0, descend = 0.0;
     for (const Glyph& g : glyphs) {
         FT_BBox box;
-        FT_Glyph_Get_CBox(g.glyph, FT_GLYPH_BBOX_GRIDFIT, &box);
+        // Not grid-fitted: Debian's OpenSCAD 2021.01 aligns on the outline's own box (its
+        // valign = "top" puts an L's top at 9.5548 - 9.3312, the unrounded yMax / 1024).
+        FT_Glyph_Get_CBox(g.glyph, FT_GLYPH_BBOX_UNSCALED, &box);
         if (horizontal) {
             width += g.pos->x_advance / kMetricScale * p.spacing;
             ascend = std::max(ascend, std::max(0.0, box.yMax / kMetricScale));
@@ -195,8 +200,9 @@ TextLayout layoutText(const TextParams& p) {
     for (const Glyph& g : glyphs) {
         Pen pen;
         pen.segments = p.segments;
-        pen.origin = Vec2(dx + g.pos->x_offset / kMetricScale, dy + g.pos->y_offset / kMetricScale) +
-                     advance;
+        pen.origin =
+            Vec2(dx + g.pos->x_offset / kMetricScale, dy + g.pos->y_offset / kMetricScale) +
+            advance;
         FT_Outline outline = reinterpret_cast<FT_OutlineGlyph>(g.glyph)->outline;
         FT_Outline_Decompose(&outline, &funcs, &pen);
         advance += Vec2(g.pos->x_advance, g.pos->y_advance) * (p.spacing / kMetricScale);

@@ -13,10 +13,10 @@ namespace lancer::openscad {
 
 /// text()'s arguments, already checked (halign, valign and direction among OpenSCAD's words).
 struct TextParams {
-    std::string text;                ///< UTF-8
-    double size = 10.0;              ///< > 0
-    std::string font;                ///< a fontconfig pattern; "" means "Liberation Sans"
-    std::string halign = "left";     ///< left, center, right
+    std::string text;                 ///< UTF-8
+    double size = 10.0;               ///< > 0
+    std::string font;                 ///< a fontconfig pattern; "" means "Liberation Sans"
+    std::string halign = "left";      ///< left, center, right
     std::string valign = "baseline";  ///< top, center, baseline, bottom
     double spacing = 1.0;
     std::string direction;  ///< ltr, rtl, ttb, btt, or "" (from the script)
