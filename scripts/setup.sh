@@ -10,6 +10,7 @@ LANCER_PACKAGES=(
   libtbb-dev nlohmann-json3-dev libcli11-dev libstb-dev
   libgtest-dev libbenchmark-dev libembree-dev gnuplot-nox povray
   clang clang-format libclang-rt-14-dev
+  libharfbuzz-dev libfreetype-dev libfontconfig-dev fonts-liberation
 )
 
 lancer_install_packages() {

@@ -238,7 +238,8 @@ TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
         "group() {\n\tminkowski() {\n\t\tcube(size = [1, 1, 1], center = false);\n\t}\n}",
         "mem.csg:2:2: the node 'minkowski' is not supported (supported: group, union, difference, "
         "intersection, render, multmatrix, translate, rotate, scale, mirror, color, cube, sphere, "
-        "cylinder, linear_extrude, rotate_extrude, square, circle, polygon, polyhedron, hull)");
+        "cylinder, linear_extrude, rotate_extrude, square, circle, polygon, polyhedron, hull, "
+        "text)");
     // A non-convex polyhedron and a hull of spheres of two radii are refused by name.
     expectCsgError(
         "polyhedron(points = [[0, 0, 0], [4, 0, 0], [0, 4, 0], [1, 1, 3], [1, 1, 1]], "

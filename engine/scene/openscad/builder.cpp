@@ -10,6 +10,7 @@
 #include "engine/scene/openscad/colors.h"
 #include "engine/scene/openscad/hull3d.h"
 #include "engine/scene/openscad/region2d.h"
+#include "engine/scene/openscad/text2d.h"
 
 namespace lancer::openscad {
 
@@ -298,14 +299,14 @@ class Builder {
                 src_.fail(n.pos, k + "() flattens its 2D children to nothing");
             return regionUnion(n.children, t, extrude);
         }
-        if (k == "square" || k == "circle" || k == "polygon") {
+        if (k == "square" || k == "circle" || k == "polygon" || k == "text") {
             if (!n.children.empty()) src_.fail(n.children.front().pos, k + "() takes no children");
             return shape2(n, af);
         }
         if (is2DNode(k))
             src_.fail(n.pos, "the 2D node '" + k +
                                  "' is not supported (supported in 2D: square, "
-                                 "circle, polygon, their booleans and transforms)");
+                                 "circle, polygon, text, their booleans and transforms)");
         if (k == "linear_extrude" || k == "rotate_extrude" || k == "cube" || k == "sphere" ||
             k == "cylinder")
             src_.fail(n.pos, "the 3D node '" + k + "' is inside " + extrude.name + "() at " +
@@ -341,6 +342,7 @@ class Builder {
 
     Built shape2(const Node& n, const glm::dmat3& af) {
         const std::string& k = n.name;
+        if (k == "text") return text(n, af);
         auto apply = [&](Vec2 p) { return Vec2(af * glm::dvec3(p, 1.0)); };
         if (k == "square") {
             Args a(src_, n, {"size", "center"}, {});
@@ -1220,6 +1222,80 @@ class Builder {
         return shape;
     }
 
+    /// text(): its glyphs laid out by text2d.cpp, each glyph's contours cut into pieces.
+    Built text(const Node& n, const glm::dmat3& af) {
+        Args a(src_, n, {"text", "size", "font"},
+               {"direction", "language", "script", "halign", "valign", "spacing"});
+        TextParams p;
+        auto word = [&](const char* name, std::string& into,
+                        std::initializer_list<const char*> allowed) {
+            const Value* v = a.get(name);
+            if (!v) return;
+            if (v->kind != Value::Kind::String)
+                src_.fail(v->pos, std::string("expected a string for '") + name + "' of text()");
+            into = v->str;
+            if (allowed.size() == 0) return;
+            std::string list;
+            for (const char* w : allowed) {
+                if (into == w) return;
+                list += std::string(list.empty() ? "" : ", ") + w;
+            }
+            src_.fail(v->pos, std::string("unknown ") + name + " '" + into +
+                                  "' of text() (expected " + list + ")");
+        };
+        if (const Value* v = a.get("text"); v && v->kind == Value::Kind::Number)
+            p.text = twistText(v->number);  // OpenSCAD writes a number as its text
+        else
+            word("text", p.text, {});
+        word("font", p.font, {});
+        word("halign", p.halign, {"left", "center", "right"});
+        word("valign", p.valign, {"top", "center", "baseline", "bottom"});
+        word("direction", p.direction, {"ltr", "rtl", "ttb", "btt", ""});
+        word("language", p.language, {});
+        word("script", p.script, {});
+        if (auto s = a.number("size")) {
+            if (!(*s > 0.0) || !std::isfinite(*s))
+                src_.fail(a.get("size")->pos, "'size' of text() must be positive");
+            p.size = *s;
+        }
+        if (auto s = a.number("spacing")) {
+            if (!std::isfinite(*s))
+                src_.fail(a.get("spacing")->pos, "'spacing' of text() is not finite");
+            p.spacing = *s;
+        }
+        // $fn, $fa, $fs decide the curves' segments (OpenSCAD's defaults when absent).
+        double fn = 0.0, fa = 12.0, fs = 2.0;
+        for (const Arg& arg : n.args) {
+            double* into = arg.name == "$fn"   ? &fn
+                           : arg.name == "$fa" ? &fa
+                           : arg.name == "$fs" ? &fs
+                                               : nullptr;
+            if (into) *into = a.number(arg.value, "'" + arg.name + "' of text()");
+        }
+        p.segments = textCurveSegments(p.size, fn, fa, fs);
+        TextLayout t;
+        try {
+            t = layoutText(p);
+        } catch (const TextError& e) {
+            src_.fail(n.pos, std::string("text(): ") + e.what());
+        }
+        size_t edges = 0;
+        for (const auto& g : t.glyphs)
+            for (const auto& c : g) edges += c.size();
+        if (edges > 200000)
+            src_.fail(n.pos,
+                      "text() has more than 200000 outline edges, which Lancer does not cut");
+        std::vector<int> items;
+        for (auto& g : t.glyphs) {
+            for (auto& c : g)
+                for (Vec2& q : c) q = Vec2(af * glm::dvec3(q, 1.0));
+            Built b = pieces(g, n.pos);
+            if (b.kind == Built::Kind::Node) items.push_back(b.node);
+        }
+        if (items.empty()) return emptyPrimitive();
+        return Built::of(regionOp(Region::Kind::Union, items, n.pos));
+    }
+
     Built emptyPrimitive() {
         ++counts_.empty;
         return Built::empty();
@@ -1246,13 +1322,12 @@ void buildModel(const SourceText& src, const std::vector<Node>& top, Scene& scen
 namespace lancer {
 
 const std::vector<std::string>& openScadSupportedNodes() {
-    static const std::vector<std::string> nodes = {"group",          "union",      "difference",
-                                                   "intersection",   "render",     "multmatrix",
-                                                   "translate",      "rotate",     "scale",
-                                                   "mirror",         "color",      "cube",
-                                                   "sphere",         "cylinder",   "linear_extrude",
-                                                   "rotate_extrude", "square",     "circle",
-                                                   "polygon",        "polyhedron", "hull"};
+    static const std::vector<std::string> nodes = {
+        "group",          "union",     "difference", "intersection", "render",
+        "multmatrix",     "translate", "rotate",     "scale",        "mirror",
+        "color",          "cube",      "sphere",     "cylinder",     "linear_extrude",
+        "rotate_extrude", "square",    "circle",     "polygon",      "polyhedron",
+        "hull",           "text"};
     return nodes;
 }
 
