@@ -302,6 +302,7 @@ class Builder {
             if (!n.children.empty()) src_.fail(n.children.front().pos, k + "() takes no children");
             return shape2(n, af);
         }
+        if (k == "offset") return offsetNode(n, af, extrude);
         if (is2DNode(k))
             src_.fail(n.pos, "the 2D node '" + k +
                                  "' is not supported (supported in 2D: square, "
@@ -311,6 +312,79 @@ class Builder {
             src_.fail(n.pos, "the 3D node '" + k + "' is inside " + extrude.name + "() at " +
                                  src_.where(extrude.pos) + ", which extrudes 2D children only");
         refuse(n);
+    }
+
+    // ---- offset ----
+
+    /// offset(r > 0): the Minkowski sum of the child with a disk of radius r, exact. The sum
+    /// distributes over union, and a convex piece's sum is the piece, a rectangle outward of each
+    /// edge and a disk at each vertex; a disk's sum is the disk of radius + r. Negative r, delta
+    /// and children made by intersection or difference are refused by name.
+    Built offsetNode(const Node& n, const glm::dmat3& af, const Node& extrude) {
+        Args a(src_, n, {}, {"r", "delta", "chamfer"});
+        if (a.get("delta") && !a.get("r"))
+            src_.fail(a.get("delta")->pos, "offset(delta = ...) is not supported (only r > 0)");
+        double r = 0.0;
+        if (auto v = a.number("r")) r = *v;
+        if (!std::isfinite(r) || r < 0.0)
+            src_.fail(a.get("r") ? a.get("r")->pos : n.pos,
+                      "offset(r) with r < 0 is not supported (only r > 0)");
+        // The radius in the parent frame: af must be a similarity for the disk to stay a disk.
+        Vec2 ex(af[0][0], af[0][1]), ey(af[1][0], af[1][1]);
+        double sx = glm::length(ex), sy = glm::length(ey);
+        if (std::abs(sx - sy) > 1e-12 * std::max(sx, sy) ||
+            std::abs(glm::dot(ex, ey)) > 1e-12 * sx * sy)
+            src_.fail(n.pos, "offset() under a non-uniform scale or shear is not supported");
+        double rr = r * sx;
+        Built b = regionUnion(n.children, af, extrude);
+        if (b.kind != Built::Kind::Node || rr == 0.0) return b;
+        std::vector<int> items;
+        grow(b.node, rr, n.pos, items);
+        return Built::of(regionOp(Region::Kind::Union, items, n.pos));
+    }
+
+    void grow(int id, double r, size_t pos, std::vector<int>& out) {
+        Region reg = regions_[size_t(id)];
+        if (reg.kind == Region::Kind::Union) {
+            grow(reg.a, r, pos, out);
+            grow(reg.b, r, pos, out);
+            return;
+        }
+        if (reg.kind == Region::Kind::Intersection || reg.kind == Region::Kind::Difference)
+            src_.fail(pos,
+                      "offset() of an intersection or difference (made at " +
+                          src_.where(reg.pos) + ") is not supported (only of unions)");
+        if (reg.kind == Region::Kind::Disk) {
+            Vec2 ex(reg.disk[0][0], reg.disk[0][1]), ey(reg.disk[1][0], reg.disk[1][1]);
+            double sx = glm::length(ex), sy = glm::length(ey);
+            if (std::abs(sx - sy) > 1e-12 * std::max(sx, sy) ||
+                std::abs(glm::dot(ex, ey)) > 1e-12 * sx * sy)
+                src_.fail(pos, "offset() of an ellipse (the circle at " + src_.where(reg.pos) +
+                                   " under a non-uniform scale) is not supported");
+            glm::dmat3 d = reg.disk;
+            d[0] = glm::dvec3(ex * ((sx + r) / sx), 0.0);
+            d[1] = glm::dvec3(ey * ((sy + r) / sy), 0.0);
+            out.push_back(region({Region::Kind::Disk, {}, d, -1, -1, pos}));
+            return;
+        }
+        out.push_back(id);
+        const std::vector<Vec2>& v = reg.piece.vertices;
+        for (size_t i = 0; i < v.size(); ++i) {
+            Vec2 p = v[i], q = v[(i + 1) % v.size()];
+            Vec2 e = q - p;
+            double len = glm::length(e);
+            if (!(len > 0.0)) continue;
+            Vec2 o = Vec2(e.y, -e.x) * (r / len);  // outward of a counter-clockwise polygon
+            std::vector<std::vector<Vec2>> rect{{p, p + o, q + o, q}};
+            std::vector<ConvexPiece> ps = convexPieces(rect);
+            for (ConvexPiece& c : ps)
+                out.push_back(
+                    region({Region::Kind::Piece, std::move(c), glm::dmat3(1.0), -1, -1, pos}));
+            glm::dmat3 d(1.0);
+            d[0][0] = d[1][1] = r;
+            d[2] = glm::dvec3(p, 1.0);
+            out.push_back(region({Region::Kind::Disk, {}, d, -1, -1, pos}));
+        }
     }
 
     Built regionUnion(const std::vector<Node>& kids, const glm::dmat3& af, const Node& extrude) {
