@@ -326,9 +326,7 @@ class Builder {
             src_.fail(a.get("delta")->pos, "offset(delta = ...) is not supported (only r > 0)");
         double r = 0.0;
         if (auto v = a.number("r")) r = *v;
-        if (!std::isfinite(r) || r < 0.0)
-            src_.fail(a.get("r") ? a.get("r")->pos : n.pos,
-                      "offset(r) with r < 0 is not supported (only r > 0)");
+        if (!std::isfinite(r)) src_.fail(a.get("r")->pos, "offset(r) must be finite");
         // The radius in the parent frame: af must be a similarity for the disk to stay a disk.
         Vec2 ex(af[0][0], af[0][1]), ey(af[1][0], af[1][1]);
         double sx = glm::length(ex), sy = glm::length(ey);
@@ -338,9 +336,70 @@ class Builder {
         double rr = r * sx;
         Built b = regionUnion(n.children, af, extrude);
         if (b.kind != Built::Kind::Node || rr == 0.0) return b;
+        if (rr < 0.0) return erode(b.node, -rr, n.pos);
         std::vector<int> items;
         grow(b.node, rr, n.pos, items);
         return Built::of(regionOp(Region::Kind::Union, items, n.pos));
+    }
+
+    /// offset(r < 0) of one circle (the circle of radius - |r|) or of one square or polygon: the
+    /// shape minus the Minkowski sum of its complement (within a box well beyond it) with the
+    /// disk of radius |r|, exact. Erosion does not distribute over union, so anything else is
+    /// refused by name.
+    Built erode(int id, double r, size_t pos) {
+        const Region root = regions_[size_t(id)];
+        if (root.kind == Region::Kind::Disk) {
+            Vec2 ex(root.disk[0][0], root.disk[0][1]), ey(root.disk[1][0], root.disk[1][1]);
+            double sx = glm::length(ex), sy = glm::length(ey);
+            if (std::abs(sx - sy) > 1e-12 * std::max(sx, sy) ||
+                std::abs(glm::dot(ex, ey)) > 1e-12 * sx * sy)
+                src_.fail(pos, "offset() of an ellipse (the circle at " + src_.where(root.pos) +
+                                   " under a non-uniform scale) is not supported");
+            if (sx <= r) return Built::empty();
+            glm::dmat3 d = root.disk;
+            d[0] = glm::dvec3(ex * ((sx - r) / sx), 0.0);
+            d[1] = glm::dvec3(ey * ((sy - r) / sy), 0.0);
+            return Built::of(region({Region::Kind::Disk, {}, d, -1, -1, pos}));
+        }
+        std::vector<int> leaves, stack{id};
+        while (!stack.empty()) {
+            int i = stack.back();
+            stack.pop_back();
+            const Region& g = regions_[size_t(i)];
+            if (g.kind == Region::Kind::Union) {
+                stack.push_back(g.a);
+                stack.push_back(g.b);
+            } else if (g.kind == Region::Kind::Piece && g.pos == root.pos) {
+                leaves.push_back(i);
+            } else {
+                src_.fail(pos,
+                          "offset(r < 0) is supported of one square, polygon or circle only "
+                          "(its child made at " +
+                              src_.where(g.pos) + " is another shape or a boolean)");
+            }
+        }
+        // The shape's pieces are disjoint: even-odd of a box and their outlines is the box
+        // minus the shape.
+        Vec2 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+        std::vector<std::vector<Vec2>> paths(1);
+        for (int i : leaves) {
+            paths.push_back(regions_[size_t(i)].piece.vertices);
+            for (const Vec2& v : paths.back()) {
+                lo = glm::min(lo, v);
+                hi = glm::max(hi, v);
+            }
+        }
+        double m = 2.0 * r + 0.1 * std::max(hi.x - lo.x, hi.y - lo.y);
+        lo -= Vec2(m);
+        hi += Vec2(m);
+        paths[0] = {lo, {hi.x, lo.y}, hi, {lo.x, hi.y}};
+        std::vector<int> items;
+        for (ConvexPiece& c : convexPieces(paths))
+            grow(region({Region::Kind::Piece, std::move(c), glm::dmat3(1.0), -1, -1, pos}), r,
+                 pos, items);
+        if (items.empty()) return Built::of(id);
+        int cut = regionOp(Region::Kind::Union, items, pos);
+        return Built::of(regionOp(Region::Kind::Difference, {id, cut}, pos));
     }
 
     void grow(int id, double r, size_t pos, std::vector<int>& out) {
