@@ -368,8 +368,9 @@ TEST(OpenScadExtrusions, SchemesAgreeWithBruteForce) {
 }
 
 TEST(OpenScadOffset, RoundOffsetEqualsItsMinkowskiTwin) {
-    const std::string ex = "linear_extrude(height = 3, center = false, convexity = 1, scale = [1, "
-                           "1]) { ";
+    const std::string ex =
+        "linear_extrude(height = 3, center = false, convexity = 1, scale = [1, "
+        "1]) { ";
     // offset(r) of a square: the square grown by r with round corners, exactly.
     expectSameSolid(ex + "offset(r = 1, $fn = 40) { square(size = [2, 4]); } }",
                     "union() { translate([-1, 0, 0]) cube(size = [4, 4, 3]); translate([0, -1, "
@@ -395,8 +396,9 @@ TEST(OpenScadOffset, RoundOffsetEqualsItsMinkowskiTwin) {
                     "} }",
                     false);
     // Of a union: the union of the offsets (two far squares stay two rounded squares).
-    const Scene s = csgText(ex + "offset(r = 1) { square(size = [2, 2]); translate([10, 0]) "
-                                 "square(size = [2, 2]); } }");
+    const Scene s = csgText(ex +
+                            "offset(r = 1) { square(size = [2, 2]); translate([10, 0]) "
+                            "square(size = [2, 2]); } }");
     const Scene far = csgText(ex + "square(size = [2, 2]); }");
     EXPECT_NEAR(s.bounds.lo.x, -1.0, 1e-6);
     EXPECT_NEAR(s.bounds.hi.x, 13.0, 1e-6);

@@ -395,8 +395,8 @@ class Builder {
         paths[0] = {lo, {hi.x, lo.y}, hi, {lo.x, hi.y}};
         std::vector<int> items;
         for (ConvexPiece& c : convexPieces(paths))
-            grow(region({Region::Kind::Piece, std::move(c), glm::dmat3(1.0), -1, -1, pos}), r,
-                 pos, items);
+            grow(region({Region::Kind::Piece, std::move(c), glm::dmat3(1.0), -1, -1, pos}), r, pos,
+                 items);
         if (items.empty()) return Built::of(id);
         int cut = regionOp(Region::Kind::Union, items, pos);
         return Built::of(regionOp(Region::Kind::Difference, {id, cut}, pos));
@@ -410,9 +410,8 @@ class Builder {
             return;
         }
         if (reg.kind == Region::Kind::Intersection || reg.kind == Region::Kind::Difference)
-            src_.fail(pos,
-                      "offset() of an intersection or difference (made at " +
-                          src_.where(reg.pos) + ") is not supported (only of unions)");
+            src_.fail(pos, "offset() of an intersection or difference (made at " +
+                               src_.where(reg.pos) + ") is not supported (only of unions)");
         if (reg.kind == Region::Kind::Disk) {
             Vec2 ex(reg.disk[0][0], reg.disk[0][1]), ey(reg.disk[1][0], reg.disk[1][1]);
             double sx = glm::length(ex), sy = glm::length(ey);
