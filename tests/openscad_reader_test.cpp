@@ -285,11 +285,12 @@ TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
 
 /// Two models have the same bounds (within a hair: a polytope's box is grown by one) and the
 /// same depth image from the first one's camera, pixel for pixel; they hit something.
-void expectSameSolid(const std::string& model, const std::string& twin) {
+/// With `bounds` false only the images are compared (a difference keeps its first operand's box).
+void expectSameSolid(const std::string& model, const std::string& twin, bool bounds = true) {
     SCOPED_TRACE(model);
     const Scene a = csgText(model);
     Scene b = csgText(twin);
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < 3 && bounds; ++k) {
         EXPECT_NEAR(a.bounds.lo[k], b.bounds.lo[k], 1e-6 * a.scale());
         EXPECT_NEAR(a.bounds.hi[k], b.bounds.hi[k], 1e-6 * a.scale());
     }
@@ -357,6 +358,77 @@ TEST(OpenScadExtrusions, SchemesAgreeWithBruteForce) {
         "[0, -1, 0], [0, 0, 1.5]], faces = [[0, 1, 2, 3], [4, 1, 0], [4, 2, 1], [4, 3, 2], [4, "
         "0, 3]]); }");
     const std::vector<Ray> rays = test::randomRays(s, 5, 3000);
+    for (const SchemeInfo& info : kSchemeTable) {
+        BuildParams p;
+        p.scheme = info.kind;
+        auto accel = buildAccelerator(s, p);
+        const auto bad = test::compareWithBrute(s, *accel, rays);
+        EXPECT_TRUE(bad.empty()) << info.name << ": " << bad.size() << " mismatches, first:\n"
+                                 << (bad.empty() ? "" : bad[0].toString(s));
+    }
+}
+
+TEST(OpenScadOffset, RoundOffsetEqualsItsMinkowskiTwin) {
+    const std::string ex =
+        "linear_extrude(height = 3, center = false, convexity = 1, scale = [1, "
+        "1]) { ";
+    // offset(r) of a square: the square grown by r with round corners, exactly.
+    expectSameSolid(ex + "offset(r = 1, $fn = 40) { square(size = [2, 4]); } }",
+                    "union() { translate([-1, 0, 0]) cube(size = [4, 4, 3]); translate([0, -1, "
+                    "0]) cube(size = [2, 6, 3]); cylinder(h = 3, r = 1); translate([2, 0, 0]) "
+                    "cylinder(h = 3, r = 1); translate([2, 4, 0]) cylinder(h = 3, r = 1); "
+                    "translate([0, 4, 0]) cylinder(h = 3, r = 1); }");
+    // Of a circle: the circle of radius + r; under a uniform scale, r scales too.
+    expectSameSolid(ex + "offset(r = 0.5) { circle(r = 1.5); } }", "cylinder(h = 3, r = 2);");
+    expectSameSolid(ex + "scale([2, 2, 1]) offset(r = 0.5) { circle(r = 1); } }",
+                    "cylinder(h = 3, r = 3);");
+    // offset(r < 0): a circle shrinks; a square shrinks with its corners still square.
+    expectSameSolid(ex + "offset(r = -0.5) { circle(r = 1.5); } }", "cylinder(h = 3, r = 1);");
+    expectSameSolid(ex + "offset(r = -0.5) { square(size = [2, 4]); } }",
+                    "translate([0.5, 0.5, 0]) cube(size = [1, 3, 3]);", false);
+    // An L's reflex corner rounds: eroded by 0.5, the L (4 x 4 minus its 2 x 2 corner) is its
+    // two arms' cores and, at the reflex corner (2, 2), the square [1.5, 2]^2 minus the disk of
+    // radius 0.5 around it.
+    expectSameSolid(ex + "offset(r = -0.5) { polygon(points = [[0, 0], [4, 0], [4, 2], [2, 2], "
+                         "[2, 4], [0, 4]]); } }",
+                    "union() { translate([0.5, 0.5, 0]) cube(size = [1, 3, 3]); translate([0.5, "
+                    "0.5, 0]) cube(size = [3, 1, 3]); difference() { translate([1.5, 1.5, 0]) "
+                    "cube(size = [0.5, 0.5, 3]); translate([2, 2, -1]) cylinder(h = 5, r = 0.5); "
+                    "} }",
+                    false);
+    // Of a union: the union of the offsets (two far squares stay two rounded squares).
+    const Scene s = csgText(ex +
+                            "offset(r = 1) { square(size = [2, 2]); translate([10, 0]) "
+                            "square(size = [2, 2]); } }");
+    const Scene far = csgText(ex + "square(size = [2, 2]); }");
+    EXPECT_NEAR(s.bounds.lo.x, -1.0, 1e-6);
+    EXPECT_NEAR(s.bounds.hi.x, 13.0, 1e-6);
+    EXPECT_NEAR(far.bounds.hi.x, 2.0, 1e-6);
+}
+
+TEST(OpenScadOffset, UnsupportedOffsetsAreRefusedByName) {
+    const std::string ex = "linear_extrude(height = 3) { ";
+    expectCsgError(ex + "offset(r = -1) { square(2); circle(1); } }",
+                   "mem.csg:1:30: offset(r < 0) is supported of one square, polygon or circle "
+                   "only (its child made at mem.csg:1:58 is another shape or a boolean)");
+    expectCsgError(ex + "offset(delta = 1, chamfer = false) square(2); }",
+                   "mem.csg:1:45: offset(delta = ...) is not supported (only r > 0)");
+    expectCsgError(ex + "offset(r = 1) difference() { square(2); circle(1); } }",
+                   "mem.csg:1:30: offset() of an intersection or difference (made at "
+                   "mem.csg:1:44) is not supported (only of unions)");
+    expectCsgError(ex + "offset(r = 1) scale([2, 1]) circle(1); }",
+                   "mem.csg:1:30: offset() of an ellipse (the circle at mem.csg:1:58 under a "
+                   "non-uniform scale) is not supported");
+}
+
+TEST(OpenScadOffset, SchemesAgreeWithBruteForce) {
+    const Scene s = csgText(
+        "difference() { linear_extrude(height = 2, center = true) { offset(r = 0.4) { "
+        "polygon(points = [[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); circle(r = 0.5); } } "
+        "translate([1.5, 1, 0]) sphere(r = 0.8); }\n"
+        "translate([0, 4, 0]) linear_extrude(height = 1) { offset(r = -0.3) { polygon(points = "
+        "[[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); } }");
+    const std::vector<Ray> rays = test::randomRays(s, 7, 3000);
     for (const SchemeInfo& info : kSchemeTable) {
         BuildParams p;
         p.scheme = info.kind;

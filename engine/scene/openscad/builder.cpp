@@ -303,6 +303,7 @@ class Builder {
             if (!n.children.empty()) src_.fail(n.children.front().pos, k + "() takes no children");
             return shape2(n, af);
         }
+        if (k == "offset") return offsetNode(n, af, extrude);
         if (is2DNode(k))
             src_.fail(n.pos, "the 2D node '" + k +
                                  "' is not supported (supported in 2D: square, "
@@ -312,6 +313,137 @@ class Builder {
             src_.fail(n.pos, "the 3D node '" + k + "' is inside " + extrude.name + "() at " +
                                  src_.where(extrude.pos) + ", which extrudes 2D children only");
         refuse(n);
+    }
+
+    // ---- offset ----
+
+    /// offset(r > 0): the Minkowski sum of the child with a disk of radius r, exact. The sum
+    /// distributes over union, and a convex piece's sum is the piece, a rectangle outward of each
+    /// edge and a disk at each vertex; a disk's sum is the disk of radius + r. Negative r, delta
+    /// and children made by intersection or difference are refused by name.
+    Built offsetNode(const Node& n, const glm::dmat3& af, const Node& extrude) {
+        Args a(src_, n, {}, {"r", "delta", "chamfer"});
+        if (a.get("delta") && !a.get("r"))
+            src_.fail(a.get("delta")->pos, "offset(delta = ...) is not supported (only r > 0)");
+        double r = 0.0;
+        if (auto v = a.number("r")) r = *v;
+        if (!std::isfinite(r)) src_.fail(a.get("r")->pos, "offset(r) must be finite");
+        // The radius in the parent frame: af must be a similarity for the disk to stay a disk.
+        Vec2 ex(af[0][0], af[0][1]), ey(af[1][0], af[1][1]);
+        double sx = glm::length(ex), sy = glm::length(ey);
+        if (std::abs(sx - sy) > 1e-12 * std::max(sx, sy) ||
+            std::abs(glm::dot(ex, ey)) > 1e-12 * sx * sy)
+            src_.fail(n.pos, "offset() under a non-uniform scale or shear is not supported");
+        double rr = r * sx;
+        Built b = regionUnion(n.children, af, extrude);
+        if (b.kind != Built::Kind::Node || rr == 0.0) return b;
+        if (rr < 0.0) return erode(b.node, -rr, n.pos);
+        std::vector<int> items;
+        grow(b.node, rr, n.pos, items);
+        return Built::of(regionOp(Region::Kind::Union, items, n.pos));
+    }
+
+    /// offset(r < 0) of one circle (the circle of radius - |r|) or of one square or polygon: the
+    /// shape minus the Minkowski sum of its complement (within a box well beyond it) with the
+    /// disk of radius |r|, exact. Erosion does not distribute over union, so anything else is
+    /// refused by name.
+    Built erode(int id, double r, size_t pos) {
+        const Region root = regions_[size_t(id)];
+        if (root.kind == Region::Kind::Disk) {
+            Vec2 ex(root.disk[0][0], root.disk[0][1]), ey(root.disk[1][0], root.disk[1][1]);
+            double sx = glm::length(ex), sy = glm::length(ey);
+            if (std::abs(sx - sy) > 1e-12 * std::max(sx, sy) ||
+                std::abs(glm::dot(ex, ey)) > 1e-12 * sx * sy)
+                src_.fail(pos, "offset() of an ellipse (the circle at " + src_.where(root.pos) +
+                                   " under a non-uniform scale) is not supported");
+            if (sx <= r) return Built::empty();
+            glm::dmat3 d = root.disk;
+            d[0] = glm::dvec3(ex * ((sx - r) / sx), 0.0);
+            d[1] = glm::dvec3(ey * ((sy - r) / sy), 0.0);
+            return Built::of(region({Region::Kind::Disk, {}, d, -1, -1, pos}));
+        }
+        std::vector<int> leaves, stack{id};
+        while (!stack.empty()) {
+            int i = stack.back();
+            stack.pop_back();
+            const Region& g = regions_[size_t(i)];
+            if (g.kind == Region::Kind::Union) {
+                stack.push_back(g.a);
+                stack.push_back(g.b);
+            } else if (g.kind == Region::Kind::Piece && g.pos == root.pos) {
+                leaves.push_back(i);
+            } else {
+                src_.fail(pos,
+                          "offset(r < 0) is supported of one square, polygon or circle only "
+                          "(its child made at " +
+                              src_.where(g.pos) + " is another shape or a boolean)");
+            }
+        }
+        // The shape's pieces are disjoint: even-odd of a box and their outlines is the box
+        // minus the shape.
+        Vec2 lo(std::numeric_limits<double>::infinity()), hi(-lo);
+        std::vector<std::vector<Vec2>> paths(1);
+        for (int i : leaves) {
+            paths.push_back(regions_[size_t(i)].piece.vertices);
+            for (const Vec2& v : paths.back()) {
+                lo = glm::min(lo, v);
+                hi = glm::max(hi, v);
+            }
+        }
+        double m = 2.0 * r + 0.1 * std::max(hi.x - lo.x, hi.y - lo.y);
+        lo -= Vec2(m);
+        hi += Vec2(m);
+        paths[0] = {lo, {hi.x, lo.y}, hi, {lo.x, hi.y}};
+        std::vector<int> items;
+        for (ConvexPiece& c : convexPieces(paths))
+            grow(region({Region::Kind::Piece, std::move(c), glm::dmat3(1.0), -1, -1, pos}), r, pos,
+                 items);
+        if (items.empty()) return Built::of(id);
+        int cut = regionOp(Region::Kind::Union, items, pos);
+        return Built::of(regionOp(Region::Kind::Difference, {id, cut}, pos));
+    }
+
+    void grow(int id, double r, size_t pos, std::vector<int>& out) {
+        Region reg = regions_[size_t(id)];
+        if (reg.kind == Region::Kind::Union) {
+            grow(reg.a, r, pos, out);
+            grow(reg.b, r, pos, out);
+            return;
+        }
+        if (reg.kind == Region::Kind::Intersection || reg.kind == Region::Kind::Difference)
+            src_.fail(pos, "offset() of an intersection or difference (made at " +
+                               src_.where(reg.pos) + ") is not supported (only of unions)");
+        if (reg.kind == Region::Kind::Disk) {
+            Vec2 ex(reg.disk[0][0], reg.disk[0][1]), ey(reg.disk[1][0], reg.disk[1][1]);
+            double sx = glm::length(ex), sy = glm::length(ey);
+            if (std::abs(sx - sy) > 1e-12 * std::max(sx, sy) ||
+                std::abs(glm::dot(ex, ey)) > 1e-12 * sx * sy)
+                src_.fail(pos, "offset() of an ellipse (the circle at " + src_.where(reg.pos) +
+                                   " under a non-uniform scale) is not supported");
+            glm::dmat3 d = reg.disk;
+            d[0] = glm::dvec3(ex * ((sx + r) / sx), 0.0);
+            d[1] = glm::dvec3(ey * ((sy + r) / sy), 0.0);
+            out.push_back(region({Region::Kind::Disk, {}, d, -1, -1, pos}));
+            return;
+        }
+        out.push_back(id);
+        const std::vector<Vec2>& v = reg.piece.vertices;
+        for (size_t i = 0; i < v.size(); ++i) {
+            Vec2 p = v[i], q = v[(i + 1) % v.size()];
+            Vec2 e = q - p;
+            double len = glm::length(e);
+            if (!(len > 0.0)) continue;
+            Vec2 o = Vec2(e.y, -e.x) * (r / len);  // outward of a counter-clockwise polygon
+            std::vector<std::vector<Vec2>> rect{{p, p + o, q + o, q}};
+            std::vector<ConvexPiece> ps = convexPieces(rect);
+            for (ConvexPiece& c : ps)
+                out.push_back(
+                    region({Region::Kind::Piece, std::move(c), glm::dmat3(1.0), -1, -1, pos}));
+            glm::dmat3 d(1.0);
+            d[0][0] = d[1][1] = r;
+            d[2] = glm::dvec3(p, 1.0);
+            out.push_back(region({Region::Kind::Disk, {}, d, -1, -1, pos}));
+        }
     }
 
     Built regionUnion(const std::vector<Node>& kids, const glm::dmat3& af, const Node& extrude) {
