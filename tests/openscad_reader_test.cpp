@@ -358,14 +358,7 @@ TEST(OpenScadExtrusions, SchemesAgreeWithBruteForce) {
         "[0, -1, 0], [0, 0, 1.5]], faces = [[0, 1, 2, 3], [4, 1, 0], [4, 2, 1], [4, 3, 2], [4, "
         "0, 3]]); }");
     const std::vector<Ray> rays = test::randomRays(s, 5, 3000);
-    for (const SchemeInfo& info : kSchemeTable) {
-        BuildParams p;
-        p.scheme = info.kind;
-        auto accel = buildAccelerator(s, p);
-        const auto bad = test::compareWithBrute(s, *accel, rays);
-        EXPECT_TRUE(bad.empty()) << info.name << ": " << bad.size() << " mismatches, first:\n"
-                                 << (bad.empty() ? "" : bad[0].toString(s));
-    }
+    test::expectEverySchemeSame(s, rays);
 }
 
 TEST(OpenScadOffset, RoundOffsetEqualsItsMinkowskiTwin) {
@@ -429,14 +422,7 @@ TEST(OpenScadOffset, SchemesAgreeWithBruteForce) {
         "translate([0, 4, 0]) linear_extrude(height = 1) { offset(r = -0.3) { polygon(points = "
         "[[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); } }");
     const std::vector<Ray> rays = test::randomRays(s, 7, 3000);
-    for (const SchemeInfo& info : kSchemeTable) {
-        BuildParams p;
-        p.scheme = info.kind;
-        auto accel = buildAccelerator(s, p);
-        const auto bad = test::compareWithBrute(s, *accel, rays);
-        EXPECT_TRUE(bad.empty()) << info.name << ": " << bad.size() << " mismatches, first:\n"
-                                 << (bad.empty() ? "" : bad[0].toString(s));
-    }
+    test::expectEverySchemeSame(s, rays);
 }
 
 }  // namespace

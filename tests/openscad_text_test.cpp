@@ -182,14 +182,7 @@ TEST(OpenScadText, SchemesAgreeWithBruteForceOnAnExtrudedWord) {
         "32); }");
     ASSERT_FALSE(s.prims.empty());
     const std::vector<Ray> rays = test::randomRays(s, 11, 3000);
-    for (const SchemeInfo& info : kSchemeTable) {
-        BuildParams p;
-        p.scheme = info.kind;
-        auto accel = buildAccelerator(s, p);
-        const auto bad = test::compareWithBrute(s, *accel, rays);
-        EXPECT_TRUE(bad.empty()) << info.name << ": " << bad.size() << " mismatches, first:\n"
-                                 << (bad.empty() ? "" : bad[0].toString(s));
-    }
+    test::expectEverySchemeSame(s, rays);
 }
 
 }  // namespace

@@ -255,6 +255,14 @@ void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<
                              << (bad.empty() ? "" : bad[0].toString(scene));
 }
 
+void expectEverySchemeSame(const Scene& scene, const std::vector<Ray>& rays) {
+    for (const SchemeInfo& info : kSchemeTable) {
+        BuildParams p;
+        p.scheme = info.kind;
+        expectSame(scene, *buildAccelerator(scene, p), rays, info.name);
+    }
+}
+
 void expectSamePixelsAndSecondaries(const Scene& scene, const Accelerator& accel, int n,
                                     uint64_t seed, const std::string& what) {
     const std::vector<Ray> rays = pixelRays(scene, n, n);

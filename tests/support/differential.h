@@ -72,6 +72,9 @@ std::vector<Ray> pixelRays(const Scene& scene, int w, int h);
 void expectSame(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
                 const std::string& what, double tmin = 0.0);
 
+/// expectSame for every scheme of kSchemeTable at its defaults, on `rays`.
+void expectEverySchemeSame(const Scene& scene, const std::vector<Ray>& rays);
+
 /// expectSame on the scene camera's n x n pixel rays, and on secondaryRays(seed) from their hits
 /// (t > a hair of the scene's size).
 void expectSamePixelsAndSecondaries(const Scene& scene, const Accelerator& accel, int n,
