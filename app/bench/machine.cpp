@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <sstream>
@@ -49,6 +50,24 @@ std::string shellQuote(const std::string& arg) {
     std::string out = "'";
     for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
     return out + "'";
+}
+
+std::string peerExecutable(const char* envVar, const char* fallback) {
+    const char* env = std::getenv(envVar);
+    return env && *env ? env : fallback;
+}
+
+bool canRun(const std::string& executable) {
+    bool ok = false;
+    captureCommand("command -v " + shellQuote(executable), ok);
+    return ok;
+}
+
+std::string readWholeFile(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
 }
 
 std::string captureCommand(const std::string& command, bool& ok, bool keepStderr) {

@@ -28,6 +28,13 @@ RunInfo collectRunInfo(const std::vector<std::string>& argv);
 /// quotes.
 std::string shellQuote(const std::string& arg);
 
+/// A peer's executable: $`envVar` when set and not empty, else `fallback` (found on the PATH).
+std::string peerExecutable(const char* envVar, const char* fallback);
+/// True when `executable` can be run (a path, or a name on the PATH).
+bool canRun(const std::string& executable);
+/// The whole of a file's bytes; empty when it cannot be read.
+std::string readWholeFile(const std::string& path);
+
 /// Run `command` with /bin/sh and return what it wrote on stdout (its stderr discarded unless
 /// `keepStderr`); `ok` false when it could not be run or exited non-zero.
 std::string captureCommand(const std::string& command, bool& ok, bool keepStderr = false);

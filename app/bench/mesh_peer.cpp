@@ -18,13 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 /// Binary STL: an 80-byte header, a triangle count, then 50 bytes a triangle. Told from ASCII
 /// by its size, which matches the count exactly (an ASCII file may begin with "solid" too).
 bool isBinaryStl(const std::string& bytes) {
@@ -47,16 +40,9 @@ void addTriangle(Scene& s, const Vec3& a, const Vec3& b, const Vec3& c) {
 
 }  // namespace
 
-std::string MeshPeer::executable() {
-    const char* env = std::getenv("LANCER_OPENSCAD");
-    return env && *env ? env : "openscad";
-}
+std::string MeshPeer::executable() { return peerExecutable("LANCER_OPENSCAD", "openscad"); }
 
-bool MeshPeer::available() {
-    bool ok = false;
-    captureCommand("command -v " + shellQuote(executable()), ok);
-    return ok;
-}
+bool MeshPeer::available() { return canRun(executable()); }
 
 std::string MeshPeer::version() {
     if (!available()) return {};
@@ -101,7 +87,7 @@ MeshRun MeshPeer::mesh(int fn, double timeoutSeconds) const {
 }
 
 Scene readStl(const std::string& path, const Scene& like) {
-    const std::string bytes = slurp(path);
+    const std::string bytes = readWholeFile(path);
     Scene s;
     s.name = path;
     s.materials = like.materials;

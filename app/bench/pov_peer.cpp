@@ -40,13 +40,6 @@ uint64_t countAfter(const std::string& log, const std::string& key) {
     return std::strtoull(log.c_str() + k + key.size(), nullptr, 10);
 }
 
-std::string readFile(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 /// The last lines of a log that say what went wrong.
 std::string tail(const std::string& log) {
     std::string t = log.size() > 300 ? log.substr(log.size() - 300) : log;
@@ -57,16 +50,9 @@ std::string tail(const std::string& log) {
 
 }  // namespace
 
-std::string PovPeer::executable() {
-    const char* env = std::getenv("LANCER_POVRAY");
-    return env && *env ? env : "povray";
-}
+std::string PovPeer::executable() { return peerExecutable("LANCER_POVRAY", "povray"); }
 
-bool PovPeer::available() {
-    bool ok = false;
-    captureCommand("command -v " + shellQuote(executable()), ok);
-    return ok;
-}
+bool PovPeer::available() { return canRun(executable()); }
 
 std::string PovPeer::version() {
     if (!available()) return {};
@@ -118,7 +104,7 @@ PovRun PovPeer::render(const Image* ref) const {
         const double ms =
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
-        log = readFile(dir_ + "/" + base + ".log");
+        log = readWholeFile(dir_ + "/" + base + ".log");
         if (!ok || log.find("POV-Ray finished") == std::string::npos)
             r.failure = "povray on povray/" + base + ".pov: " + tail(log);
         return ms;

@@ -318,8 +318,7 @@ int runBench(const BenchOptions& opt) {
         r0.shading.bounces = 0;
         Image ref0(w, h);
         const std::string peer0 = "peer (bounces 0)";
-        if (!full) {
-            // the mesh axis alone (below)
+        if (!full) {  // a scene of the mesh axis alone: no Embree row
         } else if (!EmbreePeer::available() || !EmbreePeer::supports(scene)) {
             BenchRow& row = newRow("embree", peer0, "embree");
             row.inTable = true;
@@ -404,7 +403,7 @@ int runBench(const BenchOptions& opt) {
         // Exact CSG against the mesh an OpenSCAD user would trace: OpenSCAD's CGAL render of the
         // same model at each $fn, traced by Embree, against every scheme's exact image, all at
         // --bounces 0 and compared with brute force by their surfaces.
-        Image refMesh(w, h);
+        Image refMesh(meshAxis ? w : 0, meshAxis ? h : 0);
         if (meshAxis) {
             const std::string knob = "mesh (bounces 0)";
             BenchRow* const base = bruteReference(knob, r0, refMesh);

@@ -343,6 +343,23 @@ class Builder {
         return Built::of(regionOp(Region::Kind::Union, items, n.pos));
     }
 
+    /// The circle `disk` (a Disk region) offset by `r` (either sign) as a new Disk region; -1
+    /// when a negative offset leaves nothing. An ellipse is refused by name: its offset is no
+    /// ellipse.
+    int offsetCircle(const Region& disk, double r, size_t pos) {
+        const Vec2 ex(disk.disk[0][0], disk.disk[0][1]), ey(disk.disk[1][0], disk.disk[1][1]);
+        const double sx = glm::length(ex), sy = glm::length(ey);
+        if (std::abs(sx - sy) > 1e-12 * std::max(sx, sy) ||
+            std::abs(glm::dot(ex, ey)) > 1e-12 * sx * sy)
+            src_.fail(pos, "offset() of an ellipse (the circle at " + src_.where(disk.pos) +
+                               " under a non-uniform scale) is not supported");
+        if (sx + r <= 0.0) return -1;
+        glm::dmat3 d = disk.disk;
+        d[0] = glm::dvec3(ex * ((sx + r) / sx), 0.0);
+        d[1] = glm::dvec3(ey * ((sy + r) / sy), 0.0);
+        return region({Region::Kind::Disk, {}, d, -1, -1, pos});
+    }
+
     /// offset(r < 0) of one circle (the circle of radius - |r|) or of one square or polygon: the
     /// shape minus the Minkowski sum of its complement (within a box well beyond it) with the
     /// disk of radius |r|, exact. Erosion does not distribute over union, so anything else is
@@ -350,17 +367,8 @@ class Builder {
     Built erode(int id, double r, size_t pos) {
         const Region root = regions_[size_t(id)];
         if (root.kind == Region::Kind::Disk) {
-            Vec2 ex(root.disk[0][0], root.disk[0][1]), ey(root.disk[1][0], root.disk[1][1]);
-            double sx = glm::length(ex), sy = glm::length(ey);
-            if (std::abs(sx - sy) > 1e-12 * std::max(sx, sy) ||
-                std::abs(glm::dot(ex, ey)) > 1e-12 * sx * sy)
-                src_.fail(pos, "offset() of an ellipse (the circle at " + src_.where(root.pos) +
-                                   " under a non-uniform scale) is not supported");
-            if (sx <= r) return Built::empty();
-            glm::dmat3 d = root.disk;
-            d[0] = glm::dvec3(ex * ((sx - r) / sx), 0.0);
-            d[1] = glm::dvec3(ey * ((sy - r) / sy), 0.0);
-            return Built::of(region({Region::Kind::Disk, {}, d, -1, -1, pos}));
+            const int d = offsetCircle(root, -r, pos);
+            return d < 0 ? Built::empty() : Built::of(d);
         }
         std::vector<int> leaves, stack{id};
         while (!stack.empty()) {
@@ -414,16 +422,7 @@ class Builder {
             src_.fail(pos, "offset() of an intersection or difference (made at " +
                                src_.where(reg.pos) + ") is not supported (only of unions)");
         if (reg.kind == Region::Kind::Disk) {
-            Vec2 ex(reg.disk[0][0], reg.disk[0][1]), ey(reg.disk[1][0], reg.disk[1][1]);
-            double sx = glm::length(ex), sy = glm::length(ey);
-            if (std::abs(sx - sy) > 1e-12 * std::max(sx, sy) ||
-                std::abs(glm::dot(ex, ey)) > 1e-12 * sx * sy)
-                src_.fail(pos, "offset() of an ellipse (the circle at " + src_.where(reg.pos) +
-                                   " under a non-uniform scale) is not supported");
-            glm::dmat3 d = reg.disk;
-            d[0] = glm::dvec3(ex * ((sx + r) / sx), 0.0);
-            d[1] = glm::dvec3(ey * ((sy + r) / sy), 0.0);
-            out.push_back(region({Region::Kind::Disk, {}, d, -1, -1, pos}));
+            out.push_back(offsetCircle(reg, r, pos));
             return;
         }
         out.push_back(id);
