@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cassert>
+#include <optional>
+#include <span>
 #include <vector>
 
 #include "engine/accel/observer.h"
@@ -276,14 +278,20 @@ template <class Obs, class Test>
 /// its right side untested, instead of testing every primitive first for the pending check. On
 /// OpenSCAD's example024 (a turned sponge whose one leaf holds 221 primitives) the up-front
 /// tests made 120 tests per ray against brute force's 61 (docs/model.md, "Large leaves").
+/// `tests` (none: `prims`) are the primitives to fetch for the pending
+/// check, when the walk knows that the others are already in their mailboxes: the irregular
+/// walk stepping in depth to the next slab of a zone fetches only the primitives that slab adds
+/// (docs/irregular.md, "Entering lists"). `prims` must then be a subset of what this walk has
+/// fetched together with `tests`.
 inline constexpr uint32_t kLazyLeafPrims = 16;
 
 template <class Obs>
 [[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree* tree, int root,
                                              const uint32_t* prims, uint32_t count, const Ray& ray,
                                              double tmin, double t0, double t1, TraceContext& ctx,
-                                             Obs& obs, Hit& hit, bool unionOnly = false) {
-    if (tree ? root < 0 : count == 0) return false;
+                                             Obs& obs, Hit& hit, bool unionOnly = false,
+                                             std::optional<std::span<const uint32_t>> tests = {},
+                                             bool lazyTree = false) {
     PendingBoundaries& pend = ctx.pending;
     if (!ctx.useMailboxes) {
         ctx.newStamp();
@@ -291,27 +299,45 @@ template <class Obs>
     } else if (pend.next < t0) {
         pend.advance(t0);
     }
-    if (tree && !unionOnly && count > kLazyLeafPrims) {
-        pend.incomplete = true;
-        evalTree<Obs, Fetch::Counted>(scene, *tree, root, ray, ctx, obs, 0, ctx.result);
-        if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
-        const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
-        if (b) hit = {b->t, b->prim, b->part, b->flip};
-        return b != nullptr;
+    pend.tested = true;
+    if (tree ? root < 0 : count == 0) return false;
+    const uint32_t* fetch = prims;
+    uint32_t fetchCount = count;
+    if (tests && ctx.useMailboxes) {  // without mailboxes each region fetches all again
+        fetch = tests->data();
+        fetchCount = uint32_t(tests->size());
     }
     const double from = std::max(t0, tmin);  // boundaries must be >= t0 and > tmin
-    for (uint32_t i = 0; i < count; ++i) {
-        bool fresh;
-        const Mailbox& m = mailboxSpans(scene, prims[i], ray, ctx, obs, &fresh);
-        if (!fresh) continue;
+    auto addBoundaries = [&](const Mailbox& m) {
         for (int k = 0; k < m.count; ++k) {
             const Span& s = m.spans[k];
             if (s.in.t >= from && s.in.t > tmin) pend.add(s.in.t);
             if (s.out.t >= from && s.out.t > tmin) pend.add(s.out.t);
         }
+    };
+    const bool csg = tree && !unionOnly;
+    bool lazy = csg && count > kLazyLeafPrims;
+    if (csg && lazyTree && !lazy) {
+        for (uint32_t i = 0; i < fetchCount && !lazy; ++i) lazy = !ctx.heldMailbox(fetch[i]);
     }
-    if (!(pend.next <= t1) && !pend.incomplete && !Obs::kActive)
-        return false;  // the observer is shown the spans anyway
+    if (lazy) {
+        // The spans the evaluation fetches go to the mailboxes filled after `filled` (in order),
+        // whose boundaries join the pending ones: later regions may still be left by the check.
+        pend.tested = false;
+        const size_t filled = ctx.held.size();
+        evalTree<Obs, Fetch::Counted>(scene, *tree, root, ray, ctx, obs, 0, ctx.result);
+        for (size_t j = filled; j < ctx.held.size(); ++j) addBoundaries(ctx.held[j]);
+        if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
+        const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1);
+        if (b) hit = {b->t, b->prim, b->part, b->flip};
+        return b != nullptr;
+    }
+    for (uint32_t i = 0; i < fetchCount; ++i) {
+        bool fresh;
+        const Mailbox& m = mailboxSpans(scene, fetch[i], ray, ctx, obs, &fresh);
+        if (fresh) addBoundaries(m);
+    }
+    if (!(pend.next <= t1) && !Obs::kActive) return false;  // the observer is shown the spans
     if (!tree || (unionOnly && !Obs::kActive)) {
         mergeHeldSpans(prims, count, ctx);
     } else {

@@ -43,14 +43,14 @@ struct Mailbox {
 struct PendingBoundaries {
     std::vector<double> t;  ///< unordered; those behind the walk are dropped lazily
     double next = kInf;     ///< the least of t
-    /// A leaf of this ray evaluated its tree lazily (hitInLeaf, kLazyLeafPrims): the primitives
-    /// it tested added nothing here, so `next` no longer bounds the boundaries to come.
-    bool incomplete = false;
+    /// The last region hitInLeaf was given has every primitive it lists in a mailbox of this
+    /// walk (false after a lazy evaluation, which fetches only what the tree needs).
+    bool tested = true;
 
     void clear() {
         t.clear();
         next = kInf;
-        incomplete = false;
+        tested = true;
     }
     void add(double x) {
         t.push_back(x);

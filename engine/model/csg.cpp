@@ -86,10 +86,10 @@ int CsgTree::depth() const {
     return deepest;
 }
 
-std::vector<uint32_t> CsgTree::primitives() const {
+std::vector<uint32_t> CsgTree::primitives(int from) const {
     std::vector<uint32_t> out;
-    if (root < 0) return out;
-    std::vector<int> stack{root};
+    if (from < 0) return out;
+    std::vector<int> stack{from};
     while (!stack.empty()) {
         int n = stack.back();
         stack.pop_back();

@@ -57,7 +57,9 @@ struct CsgTree {
     /// Whether every node is a primitive or a union (then every restriction of it is too).
     bool unionOnly() const;
     /// Primitives reachable from the root, in leaf order.
-    std::vector<uint32_t> primitives() const;
+    std::vector<uint32_t> primitives() const { return primitives(root); }
+    /// Primitives reachable from node `from` (-1: none), in leaf order.
+    std::vector<uint32_t> primitives(int from) const;
     std::string toString() const;
 };
 

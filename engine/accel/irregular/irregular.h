@@ -194,8 +194,7 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
     if constexpr (Obs::kActive)
         obs.locate(frame_.toWorld(glm::clamp(rc.at(t), bounds_.lo, bounds_.hi)), r);
     size_t budget = budget_;
-    int lastRoot = -1;
-    if (flat_) ctx.beginLeafWalk();
+    ctx.beginLeafWalk();
     for (;;) {
         const IrregularRegion& R = regions_[r];
         int axis, ties;
@@ -204,8 +203,8 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         double t1 = std::min(te, tend);
         ++ctx.counters.regionVisits;
         obs.region(r, t, t1);
-        if (hitInIrregularRegion(*scene_, flat_, primitives(r), pool_, R.root, lastRoot, ray, tmin,
-                                 t, t1, ctx, obs, hit))
+        if (hitInIrregularRegion(*scene_, flat_, primitives(r), pool_, R.root, ray, tmin, t, t1,
+                                 ctx, obs, hit))
             return true;
         if (te >= tend) return false;
         if constexpr (Obs::kActive) obs.regionExit(te, frame_.toWorld(p), axis, ties);

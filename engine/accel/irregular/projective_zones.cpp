@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/depth_slabs.h"
@@ -88,6 +89,7 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     s.listFirst_ = std::move(slabs.listFirst);
     s.listPrims_ = std::move(slabs.listPrims);
     s.flat_ = slabs.flat;
+    s.buildEntering();
     std::sort(nearPrims.begin(), nearPrims.end());
     if (!nearPrims.empty() && !s.flat_)
         s.nearRoot_ = TreeRestrictor(scene.tree).restrict(nearPrims, s.pool_);
@@ -104,13 +106,41 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     return s;
 }
 
+void ProjectiveZones::buildEntering() {
+    // A slab's tree primitives: a restriction drops those that cannot change its result, so a
+    // walk need not fetch them (its list keeps every primitive whose box overlaps it).
+    auto treePrims = [&](uint32_t i, std::vector<uint32_t>& out) {
+        if (flat_) {
+            std::span<const uint32_t> l = slabPrimitives(i);
+            out.assign(l.begin(), l.end());
+        } else {
+            out = pool_.primitives(slabRoot_[i]);
+            std::sort(out.begin(), out.end());
+            out.erase(std::unique(out.begin(), out.end()), out.end());
+        }
+    };
+    enterFirst_.assign(1, 0);
+    enterPrims_.clear();
+    std::vector<uint32_t> before, here;
+    for (size_t z = 0; z < zones_; ++z) {
+        before.clear();
+        for (uint32_t i = zoneFirst_[z]; i < zoneFirst_[z + 1]; ++i) {
+            treePrims(i, here);
+            std::set_difference(here.begin(), here.end(), before.begin(), before.end(),
+                                std::back_inserter(enterPrims_));
+            enterFirst_.push_back(uint32_t(enterPrims_.size()));
+            std::swap(before, here);
+        }
+    }
+}
+
 size_t ProjectiveZones::memoryBytes() const {
     return bsp_.memoryBytes() + zoneFirst_.size() * sizeof(uint32_t) +
            slabLo_.size() * sizeof(double) + slabRoot_.size() * sizeof(int32_t) +
            pool_.nodes.size() * sizeof(CsgNode) +
-           (flat_ ? (slabList_.size() + listFirst_.size() + listPrims_.size() + nearPrims_.size()) *
-                        sizeof(uint32_t)
-                  : 0);
+           (slabList_.size() + listFirst_.size() + listPrims_.size() + nearPrims_.size() +
+            enterFirst_.size() + enterPrims_.size()) *
+               sizeof(uint32_t);
 }
 
 }  // namespace lancer

@@ -80,10 +80,18 @@ class ProjectiveZones {
         uint32_t l = slabList_[i];
         return {listPrims_.data() + listFirst_[l], listPrims_.data() + listFirst_[l + 1]};
     }
+    /// What slab i adds to the slab before it in its zone (all of the first slab's): the
+    /// primitives of its restricted tree (union-only: its list) that the tree of the slab before
+    /// lacks. A walk stepping from slab i - 1 fetches only these; the others it already holds.
+    std::span<const uint32_t> slabEntering(uint32_t i) const {
+        return {enterPrims_.data() + enterFirst_[i], enterPrims_.data() + enterFirst_[i + 1]};
+    }
     /// Primitives of the near region.
     std::span<const uint32_t> nearPrimitives() const { return nearPrims_; }
 
   private:
+    void buildEntering();
+
     const Scene* scene_ = nullptr;
     CameraFrame frame_;  ///< the camera frame the walk's events are told in the world from
     Vec3 eye_{0.0};
@@ -96,11 +104,11 @@ class ProjectiveZones {
     std::vector<double> slabLo_;       ///< depth where each slab starts; the last one ends at zFar_
     std::vector<int32_t> slabRoot_;    ///< restricted tree of each slab (-1: empty)
     CsgTree pool_;
-    // The slabs' primitive lists: the walk reads them when flat_, the trees otherwise (then
-    // they are kept for inspection only and memoryBytes() leaves them out).
+    // The slabs' primitive lists, which the walk tests (hitInIrregularRegion), and their trees.
     std::vector<uint32_t> slabList_;  ///< list of each slab
     std::vector<uint32_t> listFirst_, listPrims_;
     std::vector<uint32_t> nearPrims_;
+    std::vector<uint32_t> enterFirst_, enterPrims_;  ///< slab i's entering list (slabEntering)
     bool flat_ = false;
 };
 
@@ -128,8 +136,7 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         }
     };
     double t = tmin;
-    int lastRoot = -1;  // the tree whose spans ctx.result holds (hitInIrregularRegion)
-    if (flat_) ctx.beginLeafWalk();
+    ctx.beginLeafWalk();
     if (hasNearRegion()) {
         double t1 = std::min(zNear_ / dz, tmax);
         if (t <= t1) {
@@ -137,8 +144,8 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
             enter(id, t);
             ++ctx.counters.regionVisits;
             obs.region(id, t, t1);
-            if (hitInIrregularRegion(scene, flat_, nearPrims_, pool_, nearRoot_, lastRoot, ray,
-                                     tmin, t, t1, ctx, obs, hit))
+            if (hitInIrregularRegion(scene, flat_, nearPrims_, pool_, nearRoot_, ray, tmin, t, t1,
+                                     ctx, obs, hit))
                 return true;
             leave(zNear_);
         }
@@ -147,6 +154,9 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
     uint32_t i = zoneFirst_[zone], last = zoneFirst_[zone + 1];
     // Skip the slabs wholly before tmin (a primary ray has tmin = 0: none).
     while (i + 1 < last && slabLo_[i + 1] / dz < t) ++i;
+    // The first slab walked fetches its whole list, each later one what it adds, unless the
+    // slab before it was evaluated lazily (hitInLeaf), fetching only part.
+    bool heldBefore = false;
     for (; i < last; ++i) {
         double t0 = std::max(slabLo_[i] / dz, t);
         double z1 = i + 1 < last ? slabLo_[i + 1] : zFar_;
@@ -155,9 +165,13 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         enter(firstId + i, t0);
         ++ctx.counters.regionVisits;
         obs.region(firstId + i, t0, t1);
-        if (hitInIrregularRegion(scene, flat_, slabPrimitives(i), pool_, slabRoot_[i], lastRoot,
-                                 ray, tmin, t0, t1, ctx, obs, hit))
+        const std::span<const uint32_t> prims = slabPrimitives(i);
+        std::optional<std::span<const uint32_t>> tests;
+        if (heldBefore) tests = slabEntering(i);
+        if (hitInIrregularRegion(scene, flat_, prims, pool_, slabRoot_[i], ray, tmin, t0, t1, ctx,
+                                 obs, hit, tests))
             return true;
+        heldBefore = ctx.pending.tested;
         leave(z1);
     }
     return false;

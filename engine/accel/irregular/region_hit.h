@@ -11,40 +11,27 @@
 namespace lancer {
 
 /// The visible hit of a region the ray crosses on [t0, t1] (after tmin), ctx.beginLeafWalk()
-/// called at the walk's start when `flat`. `flat`: the region keeps its primitives `prims`
-/// alone, their union (a union-only scene), and hitInLeaf merges their spans when a boundary of
-/// theirs lies in the window. The regular walk's path for union-only leaves (hitInUnionLeaf,
-/// which scans the held spans of every listed primitive in every region) costs more here: the
-/// irregular walk visits many thin regions whose primitives are already held, which the pending
-/// boundaries skip in one comparison (docs/irregular.md, "One region test for both walks").
-/// Otherwise `root` is its restricted tree in `pool` (-1: an empty region); `lastRoot` is the
-/// tree a region before it on this walk evaluated last, whose spans along the whole line are
-/// still in ctx.result, so a region sharing it only reads them on its own interval (the walk
-/// starts it at -1).
+/// called at the walk's start. `prims` are the region's primitives; `root` its restricted tree
+/// in `pool` (-1: an empty region, or, `flat`, none: the scene is union-only and hitInLeaf
+/// merges the listed primitives' spans). Both go through hitInLeaf's pending boundaries: a
+/// region where no boundary of a primitive this walk has tested lies in the window holds no hit
+/// and is left in one comparison, its tree not evaluated. The irregular walk crosses many thin
+/// regions whose primitives an earlier region tested, so most are left that way (docs/
+/// irregular.md, "One region test for both walks"). `tests`: the primitives to fetch
+/// (hitInLeaf's `tests`; none: `prims`), the entering list of a slab the walk stepped into
+/// from the slab before it in depth. The regular walk's path for union-only
+/// leaves (hitInUnionLeaf, which scans the held spans of every listed primitive in every
+/// region) costs more here for the same reason.
 template <class Obs>
-[[gnu::always_inline]] inline bool hitInIrregularRegion(const Scene& scene, bool flat,
-                                                        std::span<const uint32_t> prims,
-                                                        const CsgTree& pool, int root,
-                                                        int& lastRoot, const Ray& ray, double tmin,
-                                                        double t0, double t1, TraceContext& ctx,
-                                                        Obs& obs, Hit& hit) {
-    if (flat) {
+[[gnu::always_inline]] inline bool hitInIrregularRegion(
+    const Scene& scene, bool flat, std::span<const uint32_t> prims, const CsgTree& pool, int root,
+    const Ray& ray, double tmin, double t0, double t1, TraceContext& ctx, Obs& obs, Hit& hit,
+    std::optional<std::span<const uint32_t>> tests = {}) {
+    if (flat)
         return hitInLeaf(scene, nullptr, -1, prims.data(), uint32_t(prims.size()), ray, tmin, t0,
-                         t1, ctx, obs, hit);
-    }
-    if (root < 0) return false;
-    if (root != lastRoot) {
-        if (hitInRegion(scene, pool, root, ray, tmin, t0, t1, ctx, obs, hit)) return true;
-        lastRoot = root;
-        return false;
-    }
-    // The same tree as the region before (a shared restriction): only the interval changed.
-    if constexpr (Obs::kActive) obs.regionSpans(ctx.result);
-    if (const Boundary* b = firstBoundary(ctx.result, tmin, t0, t1)) {
-        hit = {b->t, b->prim, b->part, b->flip};
-        return true;
-    }
-    return false;
+                         t1, ctx, obs, hit, false, tests);
+    return hitInLeaf(scene, &pool, root, prims.data(), uint32_t(prims.size()), ray, tmin, t0, t1,
+                     ctx, obs, hit, false, tests, true);
 }
 
 }  // namespace lancer
