@@ -158,6 +158,9 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
         for (size_t j = 0; j < span.size(); j += 2)
             for (uint32_t i = span[j]; i < span[j + 1]; ++i) slabPrims[fill[i]++] = first[j / 2];
         for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+            // A zone of a thousand boxes makes two thousand slabs, each restricted and shared
+            // (balls:5: half a second): a cancellation must not wait for the zone's end.
+            if (guard && (i & 63) == 63) guard->poll();
             r.box.lo.z = cuts[i];
             r.box.hi.z = cuts[i + 1];
             inSlab.assign(slabPrims.begin() + slabFirst[i], slabPrims.begin() + slabFirst[i + 1]);
