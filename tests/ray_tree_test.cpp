@@ -72,6 +72,33 @@ RayCounters sumOfRays(const RayTree& t) {
     return c;
 }
 
+// RayCounters::fields() drives +=, -, toString and toJson: each counter, set alone, is summed
+// and subtracted by itself, written under its own key, and the text keeps its layout.
+TEST(RayTree, CounterFieldsAreSummedAndWrittenOnce) {
+    RayCounters base;
+    for (const RayCounters::Field& f : RayCounters::fields()) base.*f.member = 100;
+    uint64_t n = 0;
+    for (const RayCounters::Field& f : RayCounters::fields()) {
+        SCOPED_TRACE(f.key);
+        RayCounters one;
+        one.*f.member = ++n;
+        RayCounters sum = base;
+        sum += one;
+        for (const RayCounters::Field& g : RayCounters::fields())
+            EXPECT_EQ(sum.*g.member, g.member == f.member ? 100 + n : 100u) << g.key;
+        EXPECT_EQ(sum - one, base);
+        const nlohmann::json j = toJson(one);
+        EXPECT_EQ(j.size(), RayCounters::fields().size());
+        EXPECT_EQ(j.at(f.key).get<uint64_t>(), n);
+    }
+    RayCounters c;
+    n = 0;
+    for (const RayCounters::Field& f : RayCounters::fields()) c.*f.member = ++n;
+    EXPECT_EQ(c.toString(),
+              "rays 1 (2 primary, 3 shadow), prim tests 4, mailbox hits 5, regions 6, pointer "
+              "steps 7, walk errors 8, light buffer skips 9");
+}
+
 // Every pixel of small images: the tree's counts are the render's per-pixel counters (tests and
 // regions, the viewer's heat maps), its colour and depth the render's, and over the image the
 // trees' counters add up to the render's totals (mailbox hits included).

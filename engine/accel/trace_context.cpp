@@ -8,39 +8,34 @@
 namespace lancer {
 
 RayCounters& RayCounters::operator+=(const RayCounters& o) {
-    rays += o.rays;
-    primaryRays += o.primaryRays;
-    shadowRays += o.shadowRays;
-    primTests += o.primTests;
-    mailboxHits += o.mailboxHits;
-    regionVisits += o.regionVisits;
-    pointerSteps += o.pointerSteps;
-    walkErrors += o.walkErrors;
-    lightBufferSkips += o.lightBufferSkips;
+    for (const Field& f : fields()) this->*f.member += o.*f.member;
     return *this;
 }
 
 RayCounters RayCounters::operator-(const RayCounters& o) const {
     RayCounters r = *this;
-    r.rays -= o.rays;
-    r.primaryRays -= o.primaryRays;
-    r.shadowRays -= o.shadowRays;
-    r.primTests -= o.primTests;
-    r.mailboxHits -= o.mailboxHits;
-    r.regionVisits -= o.regionVisits;
-    r.pointerSteps -= o.pointerSteps;
-    r.walkErrors -= o.walkErrors;
-    r.lightBufferSkips -= o.lightBufferSkips;
+    for (const Field& f : fields()) r.*f.member -= o.*f.member;
     return r;
 }
 
 std::string RayCounters::toString() const {
-    return "rays " + std::to_string(rays) + " (" + std::to_string(primaryRays) + " primary, " +
-           std::to_string(shadowRays) + " shadow), prim tests " + std::to_string(primTests) +
-           ", mailbox hits " + std::to_string(mailboxHits) + ", regions " +
-           std::to_string(regionVisits) + ", pointer steps " + std::to_string(pointerSteps) +
-           ", walk errors " + std::to_string(walkErrors) + ", light buffer skips " +
-           std::to_string(lightBufferSkips);
+    // "rays 3 (1 primary, 2 shadow), prim tests 9, ...": the kinds of ray inside rays' brackets.
+    std::string s;
+    bool inRays = false;
+    for (const Field& f : fields()) {
+        if (f.partOfRays) {
+            s += inRays ? ", " : " (";
+            inRays = true;
+            s += std::to_string(this->*f.member) + " " + f.label;
+            continue;
+        }
+        if (inRays) s += ")";
+        inRays = false;
+        if (!s.empty()) s += ", ";
+        s += std::string(f.label) + " " + std::to_string(this->*f.member);
+    }
+    if (inRays) s += ")";
+    return s;
 }
 
 std::ostream& operator<<(std::ostream& os, const RayCounters& c) { return os << c.toString(); }

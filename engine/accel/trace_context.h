@@ -1,6 +1,7 @@
 // Per-thread state of ray tracing: mailboxes, span scratch buffers and counters.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <iosfwd>
 #include <string>
@@ -22,12 +23,38 @@ struct RayCounters {
     uint64_t walkErrors = 0;        ///< walks that could not advance and were ended
     uint64_t lightBufferSkips = 0;  ///< shadow rays the light buffer found unblocked, no walk
 
+    /// One counter: its key in `--stats` and the trace JSON, its words in toString, its member.
+    struct Field {
+        const char* key;                ///< "prim_tests"
+        const char* label;              ///< "prim tests"
+        uint64_t RayCounters::*member;  ///< &RayCounters::primTests
+        bool partOfRays;                ///< written in parentheses after `rays` (a kind of ray)
+    };
+    /// Every counter, once: +=, -, toString and the JSON writers (toJson, statsJson) loop over
+    /// it, so a counter added to the struct and here is summed, printed and written everywhere.
+    static constexpr std::array<Field, 9> fields() {
+        return {
+            {{"rays", "rays", &RayCounters::rays, false},
+             {"primary_rays", "primary", &RayCounters::primaryRays, true},
+             {"shadow_rays", "shadow", &RayCounters::shadowRays, true},
+             {"prim_tests", "prim tests", &RayCounters::primTests, false},
+             {"mailbox_hits", "mailbox hits", &RayCounters::mailboxHits, false},
+             {"region_visits", "regions", &RayCounters::regionVisits, false},
+             {"pointer_steps", "pointer steps", &RayCounters::pointerSteps, false},
+             {"walk_errors", "walk errors", &RayCounters::walkErrors, false},
+             {"light_buffer_skips", "light buffer skips", &RayCounters::lightBufferSkips, false}}};
+    }
+
     RayCounters& operator+=(const RayCounters& o);
     RayCounters operator-(const RayCounters& o) const;
     bool operator==(const RayCounters&) const = default;
     /// "rays 3 (1 primary, 2 shadow), prim tests 9, mailbox hits 2, regions 3, ..." (no newline).
     std::string toString() const;
 };
+
+// A member left out of fields() makes the struct larger than the list: the compiler says so.
+static_assert(sizeof(RayCounters) == RayCounters::fields().size() * sizeof(uint64_t),
+              "every RayCounters member is listed in RayCounters::fields()");
 
 std::ostream& operator<<(std::ostream& os, const RayCounters& c);
 

@@ -674,15 +674,9 @@ nlohmann::json toJson(const TracedRay& r, const Scene& scene, const RegionCorner
 }
 
 nlohmann::json toJson(const RayCounters& c) {
-    return {{"rays", c.rays},
-            {"primary_rays", c.primaryRays},
-            {"shadow_rays", c.shadowRays},
-            {"prim_tests", c.primTests},
-            {"mailbox_hits", c.mailboxHits},
-            {"region_visits", c.regionVisits},
-            {"pointer_steps", c.pointerSteps},
-            {"walk_errors", c.walkErrors},
-            {"light_buffer_skips", c.lightBufferSkips}};
+    nlohmann::json j = nlohmann::json::object();
+    for (const RayCounters::Field& f : RayCounters::fields()) j[f.key] = c.*f.member;
+    return j;
 }
 
 std::ostream& operator<<(std::ostream& os, const TracedRay& r) { return os << r.toString(); }

@@ -15,15 +15,7 @@ nlohmann::json statsJson(const Scene& scene, const Accelerator& accel, const Ren
     j["threads"] = rs.threads;
     j["build_ms"] = info.buildMs;
     j["render_ms"] = rs.renderMs;
-    j["rays"] = c.rays;
-    j["primary_rays"] = c.primaryRays;
-    j["shadow_rays"] = c.shadowRays;
-    j["prim_tests"] = c.primTests;
-    j["mailbox_hits"] = c.mailboxHits;
-    j["region_visits"] = c.regionVisits;
-    j["pointer_steps"] = c.pointerSteps;
-    j["walk_errors"] = c.walkErrors;
-    j["light_buffer_skips"] = c.lightBufferSkips;
+    for (const RayCounters::Field& f : RayCounters::fields()) j[f.key] = c.*f.member;
     j["regions"] = info.regions;
     j["memory_bytes"] = info.memoryBytes;
     // The scheme's own max-objects (the automatic one's count); the regular scheme's other
