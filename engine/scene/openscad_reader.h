@@ -24,6 +24,11 @@ struct OpenScadCounts {
     int polyhedra = 0;  ///< convex polyhedra modelled
     int hulls = 0;      ///< hull() nodes modelled
     int leftOut2D = 0;  ///< 2D nodes beside solids, not part of the solid model (as OpenSCAD)
+    int twistedExtrudes = 0;  ///< linear_extrude nodes with a twist, cut into slices
+    int twistSlices = 0;      ///< slices made for them, summed
+    /// The largest distance (model units) between a twisted extrusion's exact surface and its
+    /// slices' walls, over all of them; 0 when nothing is twisted.
+    double twistError = 0.0;
 };
 
 /// Nodes the reader models exactly; every other node is refused naming the node and position.

@@ -581,11 +581,8 @@ class Builder {
                           "supported");
             h = d.z;
         }
-        if (auto t = a.number("twist"); t && *t != 0.0)
-            src_.fail(n.pos, "linear_extrude with twist = " + twistText(*t) +
-                                 " is not supported: a twisted wall is a ruled surface that "
-                                 "Lancer does not trace exactly");
-        a.number("slices");
+        const double twist = a.number("twist").value_or(0.0);
+        const std::optional<double> slicesArg = a.number("slices");
         a.number("segments");
         Vec2 scale(1.0);
         if (const Value* s = a.get("scale")) {
@@ -600,7 +597,259 @@ class Builder {
         if (!(h > 0.0)) return emptyPrimitive();  // OpenSCAD makes nothing of it
         ++counts_.linearExtrudes;
         Transform local = center ? xf * Transform::translate({0.0, 0.0, -0.5 * h}) : xf;
+        if (twist != 0.0) {
+            if (!std::isfinite(twist))
+                src_.fail(a.get("twist")->pos, "'twist' of linear_extrude() must be finite");
+            const int slices = twistSlices(n, slicesArg, r.node, h, twist, scale);
+            ++counts_.twistedExtrudes;
+            counts_.twistSlices += slices;
+            const TwistedExtrusion tw{local, mat, h, glm::radians(twist), scale, slices,
+                                      stretch(local)};
+            return twistRegion(r.node, n, tw);
+        }
         return extrudeRegion(r.node, n, local, mat, h, (scale - 1.0) / h);
+    }
+
+    // ---- linear_extrude with twist ----
+
+    /// A twisted extrusion: the section at height z = h t (0 <= t <= 1) is the region rotated by
+    /// -twist t (OpenSCAD turns clockwise seen from +z for a positive twist), then scaled by
+    /// 1 - (1 - scale) t per axis. Lancer, like OpenSCAD, cuts it into `slices` equal slices
+    /// and makes each convex piece's slice the convex hull of its two end sections.
+    struct TwistedExtrusion {
+        Transform xf;
+        int mat;
+        double h, twist;  ///< height, total twist in radians
+        Vec2 scale;       ///< the top section's scale
+        int slices;
+        double norm;  ///< the most xf stretches a length (stretch)
+    };
+
+    /// The most `xf` stretches a length: its linear part's largest singular value (power
+    /// iteration on M^T M, which converges from above on the Rayleigh quotient's root).
+    static double stretch(const Transform& xf) {
+        glm::dmat3 m(0.0);
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) m[c][r] = xf.m[c][r];
+        const glm::dmat3 g = glm::transpose(m) * m;
+        Vec3 v(0.577, 0.578, 0.579);
+        double e = 0.0;
+        for (int i = 0; i < 100; ++i) {
+            const Vec3 w = g * v;
+            const double len = glm::length(w);
+            if (!(len > 0.0)) return 0.0;
+            e = len / glm::length(v);
+            v = w / len;
+        }
+        return std::sqrt(e) * (1.0 + 1e-9);
+    }
+
+    /// The linear map of the section at fraction t of the height.
+    static glm::dmat2 twistSection(const TwistedExtrusion& tw, double t) {
+        const double a = -tw.twist * t, c = std::cos(a), s = std::sin(a);
+        const Vec2 sc = Vec2(1.0) - (Vec2(1.0) - tw.scale) * t;
+        return glm::dmat2(sc.x * c, sc.y * s, -sc.x * s, sc.y * c);  // columns: S R
+    }
+
+    /// The largest squared distance from the axis of the region's parts' vertices (a circle's
+    /// facets lie on it): OpenSCAD's radius for its default slice count. It is OpenSCAD's own
+    /// value for unions of pieces and circles; for an intersection or difference it is the
+    /// larger bound of the parts (OpenSCAD measures the outline left after the boolean).
+    double regionMaxR2(int id) const {
+        const Region& r = regions_[size_t(id)];
+        if (r.kind == Region::Kind::Piece) {
+            double m = 0.0;
+            for (const Vec2& v : r.piece.vertices) m = std::max(m, glm::dot(v, v));
+            return m;
+        }
+        if (r.kind == Region::Kind::Disk) {
+            const double c = std::hypot(r.disk[2][0], r.disk[2][1]);
+            const double e = std::max(std::hypot(r.disk[0][0], r.disk[0][1]),
+                                      std::hypot(r.disk[1][0], r.disk[1][1]));
+            return (c + e) * (c + e);
+        }
+        const double a = regionMaxR2(r.a), b = regionMaxR2(r.b);
+        if (r.kind == Region::Kind::Union) return std::max(a, b);
+        if (r.kind == Region::Kind::Intersection) return std::min(a, b);
+        return a;
+    }
+
+    /// A special variable ($fn, $fa, $fs) given on the node, or OpenSCAD's default.
+    double special(const Node& n, const char* name, double fallback) const {
+        for (const Arg& g : n.args)
+            if (g.name == name) {
+                if (g.value.kind != Value::Kind::Number)
+                    src_.fail(g.value.pos, std::string("expected a number for ") + name);
+                return g.value.number;
+            }
+        return fallback;
+    }
+
+    /// The slice count: `slices` when it is a positive integer (OpenSCAD truncates it), else
+    /// OpenSCAD 2021.01's rule for a twist without scale (Calc::get_helix_slices): at least
+    /// ceil(|twist| / 120); with $fn > 0, ceil(|twist| / 360 $fn); else the fewer of
+    /// ceil(|twist| / $fa) and ceil(helix length / $fs), the helix of the largest radius.
+    int twistSlices(const Node& n, const std::optional<double>& given, int region, double h,
+                    double twist, const Vec2& scale) const {
+        if (given && std::isfinite(*given) && *given >= 1.0) {
+            if (*given > double(kMaxTwistSlices))
+                src_.fail(n.pos, "linear_extrude with slices = " + twistText(*given) +
+                                     ": Lancer makes at most " +
+                                     std::to_string(kMaxTwistSlices) + " slices");
+            return int(*given);
+        }
+        if (scale != Vec2(1.0))
+            src_.fail(n.pos, "linear_extrude with twist = " + twistText(twist) +
+                                 " and scale without 'slices': OpenSCAD's default slice count "
+                                 "for a scaled twist (its conical-helix rule) is not "
+                                 "implemented; give 'slices'");
+        const double fn = special(n, "$fn", 0.0), fa = special(n, "$fa", 12.0),
+                     fs = special(n, "$fs", 2.0);
+        const double tw = std::abs(twist), r2 = regionMaxR2(region);
+        double s = std::max(std::ceil(tw / 120.0), 1.0);
+        if (std::sqrt(r2) >= 1e-10 && std::isfinite(fn)) {  // 1e-10: OpenSCAD's GRID_FINE
+            if (fn > 0.0) {
+                s = std::max(std::ceil(tw / 360.0 * fn), s);
+            } else {
+                const double T = glm::radians(tw), c = h / T;
+                const double helix = T * std::sqrt(r2 + c * c);
+                s = std::max(std::min(std::ceil(tw / fa), std::ceil(helix / fs)), s);
+            }
+        }
+        if (!(s <= double(kMaxTwistSlices)))
+            src_.fail(n.pos, "linear_extrude with twist = " + twistText(twist) + " needs " +
+                                 twistText(s) + " slices by OpenSCAD's rule: Lancer makes at "
+                                 "most " + std::to_string(kMaxTwistSlices));
+        return int(s);
+    }
+
+    static constexpr int kMaxTwistSlices = 10000;  ///< slices beyond this are refused
+
+    /// The twisted extrusion of the region's node: as extrudeRegion, the booleans of the 2D
+    /// node become booleans of the twisted leaves (each height's section is the region under
+    /// one linear map, which commutes with them).
+    Built twistRegion(int id, const Node& n, const TwistedExtrusion& tw) {
+        const Region& r = regions_[size_t(id)];
+        if (r.kind == Region::Kind::Union || r.kind == Region::Kind::Intersection ||
+            r.kind == Region::Kind::Difference) {
+            Built a = twistRegion(r.a, n, tw);
+            Built b = twistRegion(r.b, n, tw);
+            Op op = r.kind == Region::Kind::Union          ? Op::Union
+                    : r.kind == Region::Kind::Intersection ? Op::Intersection
+                                                           : Op::Difference;
+            return Built::of(scene_.tree.combine(op, a.node, b.node));
+        }
+        if (r.kind == Region::Kind::Disk) {
+            // A round circle centred on the axis turns into itself: the extrusion is the
+            // untwisted one, traced exactly. Any other circle or ellipse would sweep a helical
+            // tube, which is refused.
+            const glm::dmat3& d = r.disk;
+            const Vec2 u(d[0][0], d[0][1]), v(d[1][0], d[1][1]);
+            const double tol = 1e-12 * (glm::dot(u, u) + glm::dot(v, v));
+            if (d[2][0] != 0.0 || d[2][1] != 0.0 || std::abs(glm::dot(u, v)) > tol ||
+                std::abs(glm::dot(u, u) - glm::dot(v, v)) > tol || tw.scale.x != tw.scale.y)
+                src_.fail(n.pos, "linear_extrude with twist of a circle (at " +
+                                     src_.where(r.pos) +
+                                     ") that is off the twist axis, not round or scaled "
+                                     "unevenly: its wall is a helical sweep, which Lancer "
+                                     "does not trace");
+            return extrudeRegion(id, n, tw.xf, tw.mat, tw.h, (tw.scale - 1.0) / tw.h);
+        }
+        const std::vector<Vec2>& base = r.piece.vertices;
+        if (2 * base.size() + 2 > 255)
+            src_.fail(n.pos, "linear_extrude with twist of a convex piece of " +
+                                 std::to_string(base.size()) + " corners (of the 2D node at " +
+                                 src_.where(r.pos) +
+                                 "): a slice would need more than the 255 planes of a polytope");
+        // The piece about its centre c: every corner within w of it (docs/scenes.md, "Twisted
+        // extrusions", for the bound below).
+        Vec2 c(0.0);
+        for (const Vec2& p : base) c += p;
+        c /= double(base.size());
+        double w = 0.0, rho = 0.0;
+        for (const Vec2& p : base) {
+            w = std::max(w, glm::length(p - c));
+            rho = std::max(rho, glm::length(p));
+        }
+        const double dA = std::abs(tw.twist) / tw.slices;
+        Built all = Built::empty();
+        for (int j = 0; j < tw.slices; ++j) {
+            const double t0 = double(j) / tw.slices, t1 = double(j + 1) / tw.slices;
+            const Built s =
+                twistSlice(base, twistSection(tw, t0), twistSection(tw, t1), tw.h * t0,
+                           tw.h * t1, tw, r.pos);
+            if (s.kind != Built::Kind::Node) continue;
+            all = all.kind == Built::Kind::Node
+                      ? Built::of(scene_.tree.combine(Op::Union, all.node, s.node))
+                      : s;
+            // How far the slice (the hull of its end sections) is from the exact twisted
+            // piece, at any height, both ways: s ((|c| + w) dA^2 / 8 + w dA / 2) for the turn,
+            // plus rho |dS| dA / 4 for a uniform change of scale dS over the slice, or
+            // rho (s dA + |dS|) / 2 when the scale is not uniform; then stretched by xf.
+            const Vec2 s0 = Vec2(1.0) - (Vec2(1.0) - tw.scale) * t0;
+            const Vec2 s1 = Vec2(1.0) - (Vec2(1.0) - tw.scale) * t1;
+            const double smax = std::max({s0.x, s0.y, s1.x, s1.y});
+            const double dS = std::max(std::abs(s1.x - s0.x), std::abs(s1.y - s0.y));
+            const double e =
+                tw.scale.x == tw.scale.y
+                    ? smax * ((glm::length(c) + w) * dA * dA / 8.0 + w * dA / 2.0) +
+                          rho * dS * dA / 4.0
+                    : rho * (smax * dA + dS) / 2.0;
+            counts_.twistError = std::max(counts_.twistError, tw.norm * e);
+        }
+        return all.kind == Built::Kind::Node ? all : emptyPrimitive();
+    }
+
+    /// One slice of a convex piece: the convex hull of the piece under `a0` at height z0 and
+    /// under `a1` at z1. Its side faces are, per edge of either end, the plane through the edge
+    /// and the other end's corner farthest out along the edge's normal.
+    Built twistSlice(const std::vector<Vec2>& base, const glm::dmat2& a0, const glm::dmat2& a1,
+                     double z0, double z1, const TwistedExtrusion& tw, size_t pos) {
+        const size_t m = base.size();
+        std::vector<Vec3> p0(m), p1(m);
+        for (size_t i = 0; i < m; ++i) {
+            p0[i] = Vec3(a0 * base[i], z0);
+            p1[i] = Vec3(a1 * base[i], z1);
+        }
+        Vec3 centre(0.0);
+        for (size_t i = 0; i < m; ++i) centre += p0[i] + p1[i];
+        centre /= double(2 * m);
+        Polytope pt;
+        auto sides = [&](const std::vector<Vec3>& ring, const std::vector<Vec3>& other) {
+            for (size_t i = 0; i < m; ++i) {
+                const Vec3 &p = ring[i], &q = ring[(i + 1) % m];
+                const Vec2 e(q.x - p.x, q.y - p.y);
+                if (e == Vec2(0.0)) continue;  // a zero scale collapses the end
+                // The edge's outward normal in the end's plane (either winding: the centre is
+                // inside), then the other end's farthest corner that way.
+                Vec2 out(e.y, -e.x);
+                if (glm::dot(out, Vec2(centre) - Vec2(p)) > 0.0) out = -out;
+                size_t best = 0;
+                for (size_t k = 1; k < m; ++k)
+                    if (glm::dot(out, Vec2(other[k])) > glm::dot(out, Vec2(other[best])))
+                        best = k;
+                Vec3 nn = glm::cross(q - p, other[best] - p);
+                if (glm::dot(nn, centre - p) > 0.0) nn = -nn;
+                const double len = glm::length(nn);
+                if (!(len > 0.0)) continue;
+                nn /= len;
+                pt.planes.push_back(glm::dvec4(nn, glm::dot(nn, p)));
+            }
+        };
+        sides(p0, p1);
+        sides(p1, p0);
+        if (pt.planes.empty()) return Built::empty();  // both ends collapsed
+        pt.planes.push_back({0.0, 0.0, -1.0, -z0});
+        pt.planes.push_back({0.0, 0.0, 1.0, z1});
+        for (size_t i = 0; i < m; ++i) {
+            pt.bounds.expand(p0[i]);
+            pt.bounds.expand(p1[i]);
+        }
+        Vec3 pad = 1e-9 * (glm::abs(pt.bounds.lo) + glm::abs(pt.bounds.hi)) + Vec3(1e-300);
+        pt.bounds.lo -= pad;
+        pt.bounds.hi += pad;
+        ++counts_.polytopes;
+        return place(std::move(pt), tw.xf, tw.mat, pos, "linear_extrude()");
     }
 
     /// The region's node extruded: 2D booleans become 3D booleans of the extruded leaves (the
