@@ -24,8 +24,11 @@ struct OpenScadCounts {
     int polyhedra = 0;  ///< convex polyhedra modelled
     int hulls = 0;      ///< hull() nodes modelled
     int leftOut2D = 0;  ///< 2D nodes beside solids, not part of the solid model (as OpenSCAD)
+    int dxfImports = 0;     ///< import() nodes of DXF drawings read
+    int dxfOpenChains = 0;  ///< open paths among them, closed by their ends (as OpenSCAD)
     int twistedExtrudes = 0;  ///< linear_extrude nodes with a twist, cut into slices
-    int twistSlices = 0;      ///< slices made for them, summed
+    int twistSlices = 0;      ///< OpenSCAD's slices for them, summed
+    int twistSubSlices = 0;   ///< the most parts a slice of theirs is cut into
     /// The largest distance (model units) between a twisted extrusion's exact surface and its
     /// slices' walls, over all of them; 0 when nothing is twisted.
     double twistError = 0.0;

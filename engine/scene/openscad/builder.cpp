@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <tuple>
 
 #include "engine/scene/openscad/colors.h"
+#include "engine/scene/openscad/dxf.h"
 #include "engine/scene/openscad/hull3d.h"
 #include "engine/scene/openscad/region2d.h"
 #include "engine/scene/openscad/text2d.h"
@@ -202,7 +204,11 @@ class Builder {
         if (k == "hull") return hullNode(n, xf, mat);
         if (k == "linear_extrude") return linearExtrude(n, xf, mat);
         if (k == "rotate_extrude") return rotateExtrude(n, xf, mat);
-        if (is2DNode(k)) {
+        if (k == "import" && !importsDxf(n))
+            src_.fail(n.pos, "import() of '" + importFile(n) +
+                                 "': Lancer imports DXF drawings (inside an extrusion); STL, "
+                                 "OFF and other meshes are not supported");
+        if (is2DNode(k) || k == "import") {
             // As OpenSCAD's render: a 2D object beside solids is not part of the solid model.
             if (!first2D_) first2D_ = &n;
             ++counts_.leftOut2D;
@@ -304,6 +310,7 @@ class Builder {
             return shape2(n, af);
         }
         if (k == "offset") return offsetNode(n, af, extrude);
+        if (k == "import") return importDxf(n, af);
         if (is2DNode(k))
             src_.fail(n.pos, "the 2D node '" + k +
                                  "' is not supported (supported in 2D: square, "
@@ -313,6 +320,69 @@ class Builder {
             src_.fail(n.pos, "the 3D node '" + k + "' is inside " + extrude.name + "() at " +
                                  src_.where(extrude.pos) + ", which extrudes 2D children only");
         refuse(n);
+    }
+
+    // ---- import() of DXF drawings ----
+
+    /// The file an import() names (its 'file' argument), as written.
+    std::string importFile(const Node& n) const {
+        for (size_t i = 0; i < n.args.size(); ++i)
+            if (n.args[i].name == "file" || (i == 0 && n.args[i].name.empty()))
+                if (n.args[i].value.kind == Value::Kind::String) return n.args[i].value.str;
+        return "";
+    }
+
+    bool importsDxf(const Node& n) const {
+        std::string e = std::filesystem::path(importFile(n)).extension().string();
+        for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
+        return e == ".dxf";
+    }
+
+    /// import() of a DXF file: the closed outlines of its layer (dxf.cpp), read as OpenSCAD
+    /// reads them, arcs and circles cut by $fn, $fa, $fs; the file is found beside the .csg.
+    Built importDxf(const Node& n, const glm::dmat3& af) {
+        Args a(src_, n, {"file", "layer", "convexity", "origin", "scale"},
+               {"timestamp", "center", "dpi", "id", "width", "height"});
+        const Value* f = a.get("file");
+        if (!f || f->kind != Value::Kind::String)
+            src_.fail(n.pos, "import() needs a 'file' string");
+        if (!importsDxf(n))
+            src_.fail(f->pos, "import() of '" + f->str +
+                                  "' inside a 2D context: only DXF drawings are 2D imports");
+        std::string layer;
+        if (const Value* l = a.get("layer")) {
+            if (l->kind != Value::Kind::String)
+                src_.fail(l->pos, "expected a string for 'layer' of import()");
+            layer = l->str;
+        }
+        Vec2 origin(0.0);
+        if (const Value* o = a.get("origin")) origin = vec2(a, *o, "'origin' of import()");
+        const double scale = a.number("scale").value_or(1.0);
+        if (!(std::isfinite(scale) && scale > 0.0))
+            src_.fail(a.get("scale")->pos, "'scale' of import() must be a positive number");
+        openscad::Fragments frag{special(n, "$fn", 0.0), special(n, "$fa", 12.0),
+                                 special(n, "$fs", 2.0)};
+        if (!(frag.fa > 0.0 && frag.fs > 0.0 && std::isfinite(frag.fn)))
+            src_.fail(n.pos, "import() needs $fa > 0 and $fs > 0 to cut arcs");
+        std::filesystem::path path(f->str);
+        if (path.is_relative()) path = std::filesystem::path(src_.path()).parent_path() / path;
+        openscad::DxfOutlines d;
+        try {
+            d = openscad::readDxf(path.string(), layer, origin, scale, frag);
+        } catch (const SceneError& e) {
+            src_.fail(f->pos, std::string("import(): ") + e.what());
+        }
+        ++counts_.dxfImports;
+        counts_.dxfOpenChains += d.openChains;
+        std::vector<std::vector<Vec2>> loops = std::move(d.loops);
+        for (auto& loop : loops)
+            for (Vec2& p : loop) p = Vec2(af * glm::dvec3(p, 1.0));
+        size_t edges = 0;
+        for (const auto& q : loops) edges += q.size();
+        if (edges > 20000)
+            src_.fail(n.pos, "import() of '" + f->str +
+                                 "' has more than 20000 edges, which Lancer does not cut");
+        return pieces(loops, n.pos);
     }
 
     // ---- offset ----
@@ -603,8 +673,10 @@ class Builder {
             const int slices = twistSlices(n, slicesArg, r.node, h, twist, scale);
             ++counts_.twistedExtrudes;
             counts_.twistSlices += slices;
-            const TwistedExtrusion tw{local, mat, h, glm::radians(twist), scale, slices,
-                                      stretch(local)};
+            TwistedExtrusion tw{local, mat, h, glm::radians(twist), scale, slices, 1,
+                                stretch(local)};
+            tw.sub = twistSubSlices(r.node, tw, std::sqrt(regionMaxR2(r.node)));
+            counts_.twistSubSlices = std::max(counts_.twistSubSlices, tw.sub);
             return twistRegion(r.node, n, tw);
         }
         return extrudeRegion(r.node, n, local, mat, h, (scale - 1.0) / h);
@@ -622,6 +694,7 @@ class Builder {
         double h, twist;  ///< height, total twist in radians
         Vec2 scale;       ///< the top section's scale
         int slices;
+        int sub;      ///< each slice cut again into this many (twistSubSlices)
         double norm;  ///< the most xf stretches a length (stretch)
     };
 
@@ -724,6 +797,28 @@ class Builder {
     }
 
     static constexpr int kMaxTwistSlices = 10000;  ///< slices beyond this are refused
+    static constexpr int kMaxTwistSubSlices = 16;  ///< the most a slice is cut again
+
+    /// How many parts each of OpenSCAD's slices is cut into: a piece's hull strays from the
+    /// twisted piece by w dA / 2 to first order (w its corners' reach from their mean, dA the
+    /// turn), which for a long piece of a non-convex region is its own width at OpenSCAD's
+    /// slices (example009's fan: 1.7 on arms 4 wide). Cut until that is 0.2% of the region's
+    /// radius `rho`, at most 16 times; the same for every piece, so their slices meet.
+    int twistSubSlices(int id, const TwistedExtrusion& tw, double rho) const {
+        const Region& r = regions_[size_t(id)];
+        if (r.kind == Region::Kind::Disk) return 1;  // exact: no slices
+        if (r.kind != Region::Kind::Piece)
+            return std::max(twistSubSlices(r.a, tw, rho), twistSubSlices(r.b, tw, rho));
+        const std::vector<Vec2>& v = r.piece.vertices;
+        Vec2 c(0.0);
+        for (const Vec2& p : v) c += p;
+        c /= double(v.size());
+        double w = 0.0;
+        for (const Vec2& p : v) w = std::max(w, glm::length(p - c));
+        const double first = w * std::abs(tw.twist) / tw.slices / 2.0;
+        if (!(rho > 0.0)) return 1;
+        return int(std::clamp(std::ceil(first / (0.002 * rho)), 1.0, double(kMaxTwistSubSlices)));
+    }
 
     /// The twisted extrusion of the region's node: as extrudeRegion, the booleans of the 2D
     /// node become booleans of the twisted leaves (each height's section is the region under
@@ -771,10 +866,11 @@ class Builder {
             w = std::max(w, glm::length(p - c));
             rho = std::max(rho, glm::length(p));
         }
-        const double dA = std::abs(tw.twist) / tw.slices;
+        const int parts = tw.slices * tw.sub;
+        const double dA = std::abs(tw.twist) / parts;
         Built all = Built::empty();
-        for (int j = 0; j < tw.slices; ++j) {
-            const double t0 = double(j) / tw.slices, t1 = double(j + 1) / tw.slices;
+        for (int j = 0; j < parts; ++j) {
+            const double t0 = double(j) / parts, t1 = double(j + 1) / parts;
             const Built s =
                 twistSlice(base, twistSection(tw, t0), twistSection(tw, t1), tw.h * t0,
                            tw.h * t1, tw, r.pos);
@@ -816,14 +912,19 @@ class Builder {
         centre /= double(2 * m);
         Polytope pt;
         auto sides = [&](const std::vector<Vec3>& ring, const std::vector<Vec3>& other) {
+            // The edge's outward side is away from its own end's centre: the centre of both
+            // ends may lie outside a thin piece that moves more than its width over the slice.
+            Vec2 mid(0.0);
+            for (const Vec3& q : ring) mid += Vec2(q);
+            mid /= double(m);
             for (size_t i = 0; i < m; ++i) {
                 const Vec3 &p = ring[i], &q = ring[(i + 1) % m];
                 const Vec2 e(q.x - p.x, q.y - p.y);
                 if (e == Vec2(0.0)) continue;  // a zero scale collapses the end
-                // The edge's outward normal in the end's plane (either winding: the centre is
-                // inside), then the other end's farthest corner that way.
+                // The edge's outward normal in the end's plane (either winding), then the other
+                // end's farthest corner that way.
                 Vec2 out(e.y, -e.x);
-                if (glm::dot(out, Vec2(centre) - Vec2(p)) > 0.0) out = -out;
+                if (glm::dot(out, mid - Vec2(p)) > 0.0) out = -out;
                 size_t best = 0;
                 for (size_t k = 1; k < m; ++k)
                     if (glm::dot(out, Vec2(other[k])) > glm::dot(out, Vec2(other[best])))
@@ -1707,7 +1808,7 @@ const std::vector<std::string>& openScadSupportedNodes() {
         "multmatrix",     "translate", "rotate",     "scale",        "mirror",
         "color",          "cube",      "sphere",     "cylinder",     "linear_extrude",
         "rotate_extrude", "square",    "circle",     "polygon",      "polyhedron",
-        "hull",           "text"};
+        "hull",           "text",      "import"};
     return nodes;
 }
 
