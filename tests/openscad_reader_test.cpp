@@ -3,7 +3,6 @@
 #include "engine/scene/openscad_reader.h"
 
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <cmath>
@@ -386,9 +385,10 @@ double twistedOutlineDistance(const Vec3& p, double a, double b, double twist, d
 TEST(OpenScadTwist, SlicesFollowOpenScadsRule) {
     OpenScadCounts n;
     // $fa 12: ceil(90 / 12) = 8 slices, fewer than the helix rule's ceil(26.6 / 2) = 14.
-    csgText("linear_extrude(height = 20, twist = 90, $fn = 0, $fa = 12, $fs = 2) { "
-            "square(size = [20, 10], center = true); }",
-            &n);
+    csgText(
+        "linear_extrude(height = 20, twist = 90, $fn = 0, $fa = 12, $fs = 2) { "
+        "square(size = [20, 10], center = true); }",
+        &n);
     EXPECT_EQ(n.twistedExtrudes, 1);
     EXPECT_EQ(n.twistSlices, 8);
     // $fn > 0: ceil(twist / 360 $fn); 'slices' given wins; at least ceil(twist / 120).
@@ -504,14 +504,16 @@ TEST(OpenScadDxf, LayersLinesCirclesPolylinesAndBlocksMatchTheirPolygonTwins) {
         octagon += ", [" + std::to_string(2.0 + std::cos(t)) + ", " +
                    std::to_string(1.5 + std::sin(t)) + "]";
     }
-    expectSameSolid(imp("a"), "linear_extrude(height = 2) { polygon(points = [[0, 0], [4, 0], "
-                              "[4, 3], [0, 3]" + octagon +
-                                  "], paths = [[0, 1, 2, 3], [4, 5, 6, 7, 8, 9, 10, 11]]); }");
+    expectSameSolid(imp("a"),
+                    "linear_extrude(height = 2) { polygon(points = [[0, 0], [4, 0], "
+                    "[4, 3], [0, 3]" +
+                        octagon + "], paths = [[0, 1, 2, 3], [4, 5, 6, 7, 8, 9, 10, 11]]); }");
     expectSameSolid(imp("b"),
                     "linear_extrude(height = 2) { polygon(points = [[0, 5], [3, 5], [0, 7]]); }");
     // The block's (0, 0), (1, 0), (0, 1), scaled 2, turned 90 degrees, moved to (10, 0).
-    expectSameSolid(imp("c"), "linear_extrude(height = 2) { polygon(points = [[10, 0], [10, 2], "
-                              "[8, 0]]); }");
+    expectSameSolid(imp("c"),
+                    "linear_extrude(height = 2) { polygon(points = [[10, 0], [10, 2], "
+                    "[8, 0]]); }");
     // origin and scale: (p - origin) scale.
     expectSameSolid(imp("b", ", origin = [0, 5], scale = 2"),
                     "linear_extrude(height = 2) { polygon(points = [[0, 0], [6, 0], [0, 4]]); }");
@@ -520,17 +522,17 @@ TEST(OpenScadDxf, LayersLinesCirclesPolylinesAndBlocksMatchTheirPolygonTwins) {
     EXPECT_EQ(n.dxfImports, 1);
     EXPECT_EQ(n.dxfOpenChains, 1);
     // Every scheme, ray for ray, on the layers together under a difference.
-    const Scene s = csgText("difference() { " + imp("") +
-                            " translate([2, 1.5, 1]) sphere(r = 1.2); }");
+    const Scene s =
+        csgText("difference() { " + imp("") + " translate([2, 1.5, 1]) sphere(r = 1.2); }");
     test::expectEverySchemeSame(s, test::randomRays(s, 13, 2000));
 }
 
 TEST(OpenScadDxf, FilesAreFoundBesideTheCsgAndBadOnesAreNamed) {
-    const std::string dxf = writeTemp("beside.dxf", dxfText(dxfLine("0", {0, 0}, {2, 0}) +
-                                                            dxfLine("0", {2, 0}, {0, 2}) +
-                                                            dxfLine("0", {0, 2}, {0, 0})));
-    const std::string csg = writeTemp(
-        "beside.csg", "linear_extrude(height = 1) { import(file = \"beside.dxf\"); }\n");
+    const std::string dxf = writeTemp(
+        "beside.dxf", dxfText(dxfLine("0", {0, 0}, {2, 0}) + dxfLine("0", {2, 0}, {0, 2}) +
+                              dxfLine("0", {0, 2}, {0, 0})));
+    const std::string csg =
+        writeTemp("beside.csg", "linear_extrude(height = 1) { import(file = \"beside.dxf\"); }\n");
     const Scene s = readOpenScadFile(csg);
     EXPECT_EQ(s.livePrimitives().size(), 1u);
     EXPECT_NEAR(s.bounds.hi.x, 2.0, 1e-6);
@@ -538,8 +540,9 @@ TEST(OpenScadDxf, FilesAreFoundBesideTheCsgAndBadOnesAreNamed) {
     expectCsgError("linear_extrude(height = 1) { import(file = \"/no/such.dxf\"); }",
                    "mem.csg:1:44: import(): /no/such.dxf: no such file");
     // A malformed DXF names its own line.
-    const std::string bad = writeTemp("bad.dxf", "0\nSECTION\n2\nENTITIES\n0\nLINE\n10\n"
-                                                 "x1\n0\nENDSEC\n0\nEOF\n");
+    const std::string bad = writeTemp("bad.dxf",
+                                      "0\nSECTION\n2\nENTITIES\n0\nLINE\n10\n"
+                                      "x1\n0\nENDSEC\n0\nEOF\n");
     expectCsgError("linear_extrude(height = 1) { import(file = \"" + bad + "\"); }",
                    "mem.csg:1:44: import(): " + bad +
                        ":8:1: expected a number for DXF group code 10, found 'x1'");

@@ -20,12 +20,12 @@ struct OpenScadCounts {
     int empty = 0;    ///< zero-size primitives (OpenSCAD makes nothing of them)
     int squares = 0, circles = 0, polygons = 0;  ///< 2D nodes read inside extrusions
     int linearExtrudes = 0, rotateExtrudes = 0;  ///< extrusions modelled
-    int polytopes = 0;  ///< convex polytopes made (extruded pieces, partial-sweep wedges)
-    int polyhedra = 0;  ///< convex polyhedra modelled
-    int hulls = 0;      ///< hull() nodes modelled
-    int leftOut2D = 0;  ///< 2D nodes beside solids, not part of the solid model (as OpenSCAD)
-    int dxfImports = 0;     ///< import() nodes of DXF drawings read
-    int dxfOpenChains = 0;  ///< open paths among them, closed by their ends (as OpenSCAD)
+    int polytopes = 0;        ///< convex polytopes made (extruded pieces, partial-sweep wedges)
+    int polyhedra = 0;        ///< convex polyhedra modelled
+    int hulls = 0;            ///< hull() nodes modelled
+    int leftOut2D = 0;        ///< 2D nodes beside solids, not part of the solid model (as OpenSCAD)
+    int dxfImports = 0;       ///< import() nodes of DXF drawings read
+    int dxfOpenChains = 0;    ///< open paths among them, closed by their ends (as OpenSCAD)
     int twistedExtrudes = 0;  ///< linear_extrude nodes with a twist, cut into slices
     int twistSlices = 0;      ///< OpenSCAD's slices for them, summed
     int twistSubSlices = 0;   ///< the most parts a slice of theirs is cut into

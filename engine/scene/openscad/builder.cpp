@@ -673,8 +673,8 @@ class Builder {
             const int slices = twistSlices(n, slicesArg, r.node, h, twist, scale);
             ++counts_.twistedExtrudes;
             counts_.twistSlices += slices;
-            TwistedExtrusion tw{local, mat, h, glm::radians(twist), scale, slices, 1,
-                                stretch(local)};
+            TwistedExtrusion tw{local, mat,    h, glm::radians(twist),
+                                scale, slices, 1, stretch(local)};
             tw.sub = twistSubSlices(r.node, tw, std::sqrt(regionMaxR2(r.node)));
             counts_.twistSubSlices = std::max(counts_.twistSubSlices, tw.sub);
             return twistRegion(r.node, n, tw);
@@ -767,8 +767,8 @@ class Builder {
         if (given && std::isfinite(*given) && *given >= 1.0) {
             if (*given > double(kMaxTwistSlices))
                 src_.fail(n.pos, "linear_extrude with slices = " + twistText(*given) +
-                                     ": Lancer makes at most " +
-                                     std::to_string(kMaxTwistSlices) + " slices");
+                                     ": Lancer makes at most " + std::to_string(kMaxTwistSlices) +
+                                     " slices");
             return int(*given);
         }
         if (scale != Vec2(1.0))
@@ -791,8 +791,10 @@ class Builder {
         }
         if (!(s <= double(kMaxTwistSlices)))
             src_.fail(n.pos, "linear_extrude with twist = " + twistText(twist) + " needs " +
-                                 twistText(s) + " slices by OpenSCAD's rule: Lancer makes at "
-                                 "most " + std::to_string(kMaxTwistSlices));
+                                 twistText(s) +
+                                 " slices by OpenSCAD's rule: Lancer makes at "
+                                 "most " +
+                                 std::to_string(kMaxTwistSlices));
         return int(s);
     }
 
@@ -843,8 +845,7 @@ class Builder {
             const double tol = 1e-12 * (glm::dot(u, u) + glm::dot(v, v));
             if (d[2][0] != 0.0 || d[2][1] != 0.0 || std::abs(glm::dot(u, v)) > tol ||
                 std::abs(glm::dot(u, u) - glm::dot(v, v)) > tol || tw.scale.x != tw.scale.y)
-                src_.fail(n.pos, "linear_extrude with twist of a circle (at " +
-                                     src_.where(r.pos) +
+                src_.fail(n.pos, "linear_extrude with twist of a circle (at " + src_.where(r.pos) +
                                      ") that is off the twist axis, not round or scaled "
                                      "unevenly: its wall is a helical sweep, which Lancer "
                                      "does not trace");
@@ -871,9 +872,8 @@ class Builder {
         Built all = Built::empty();
         for (int j = 0; j < parts; ++j) {
             const double t0 = double(j) / parts, t1 = double(j + 1) / parts;
-            const Built s =
-                twistSlice(base, twistSection(tw, t0), twistSection(tw, t1), tw.h * t0,
-                           tw.h * t1, tw, r.pos);
+            const Built s = twistSlice(base, twistSection(tw, t0), twistSection(tw, t1), tw.h * t0,
+                                       tw.h * t1, tw, r.pos);
             if (s.kind != Built::Kind::Node) continue;
             all = all.kind == Built::Kind::Node
                       ? Built::of(scene_.tree.combine(Op::Union, all.node, s.node))
@@ -886,11 +886,10 @@ class Builder {
             const Vec2 s1 = Vec2(1.0) - (Vec2(1.0) - tw.scale) * t1;
             const double smax = std::max({s0.x, s0.y, s1.x, s1.y});
             const double dS = std::max(std::abs(s1.x - s0.x), std::abs(s1.y - s0.y));
-            const double e =
-                tw.scale.x == tw.scale.y
-                    ? smax * ((glm::length(c) + w) * dA * dA / 8.0 + w * dA / 2.0) +
-                          rho * dS * dA / 4.0
-                    : rho * (smax * dA + dS) / 2.0;
+            const double e = tw.scale.x == tw.scale.y
+                                 ? smax * ((glm::length(c) + w) * dA * dA / 8.0 + w * dA / 2.0) +
+                                       rho * dS * dA / 4.0
+                                 : rho * (smax * dA + dS) / 2.0;
             counts_.twistError = std::max(counts_.twistError, tw.norm * e);
         }
         return all.kind == Built::Kind::Node ? all : emptyPrimitive();
@@ -927,8 +926,7 @@ class Builder {
                 if (glm::dot(out, mid - Vec2(p)) > 0.0) out = -out;
                 size_t best = 0;
                 for (size_t k = 1; k < m; ++k)
-                    if (glm::dot(out, Vec2(other[k])) > glm::dot(out, Vec2(other[best])))
-                        best = k;
+                    if (glm::dot(out, Vec2(other[k])) > glm::dot(out, Vec2(other[best]))) best = k;
                 Vec3 nn = glm::cross(q - p, other[best] - p);
                 if (glm::dot(nn, centre - p) > 0.0) nn = -nn;
                 const double len = glm::length(nn);
@@ -1804,11 +1802,10 @@ namespace lancer {
 
 const std::vector<std::string>& openScadSupportedNodes() {
     static const std::vector<std::string> nodes = {
-        "group",          "union",     "difference", "intersection", "render",
-        "multmatrix",     "translate", "rotate",     "scale",        "mirror",
-        "color",          "cube",      "sphere",     "cylinder",     "linear_extrude",
-        "rotate_extrude", "square",    "circle",     "polygon",      "polyhedron",
-        "hull",           "text",      "import"};
+        "group",     "union",      "difference",     "intersection",   "render", "multmatrix",
+        "translate", "rotate",     "scale",          "mirror",         "color",  "cube",
+        "sphere",    "cylinder",   "linear_extrude", "rotate_extrude", "square", "circle",
+        "polygon",   "polyhedron", "hull",           "text",           "import"};
     return nodes;
 }
 

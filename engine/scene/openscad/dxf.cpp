@@ -144,7 +144,8 @@ class Reader {
         std::unordered_map<int64_t, std::vector<uint32_t>> cells;
         auto cellKey = [](int64_t x, int64_t y) { return (x << 32) ^ (y & 0xffffffff); };
         auto point = [&](const Vec2& p) {
-            const int64_t cx = int64_t(std::floor(p.x / kGrid)), cy = int64_t(std::floor(p.y / kGrid));
+            const int64_t cx = int64_t(std::floor(p.x / kGrid)),
+                          cy = int64_t(std::floor(p.y / kGrid));
             for (int64_t dx = -1; dx <= 1; ++dx)
                 for (int64_t dy = -1; dy <= 1; ++dy) {
                     auto it = cells.find(cellKey(cx + dx, cy + dy));
@@ -212,8 +213,8 @@ class Reader {
         std::vector<Segment> segs;
         const std::string& t = e.type;
         if (t == "LINE") {
-            segs.push_back({{first(e, 10, 0.0), first(e, 20, 0.0)},
-                            {first(e, 11, 0.0), first(e, 21, 0.0)}});
+            segs.push_back(
+                {{first(e, 10, 0.0), first(e, 20, 0.0)}, {first(e, 11, 0.0), first(e, 21, 0.0)}});
         } else if (t == "CIRCLE" || t == "ARC") {
             const Vec2 c(first(e, 10, 0.0), first(e, 20, 0.0));
             const double r = first(e, 40, 0.0);
@@ -239,15 +240,17 @@ class Reader {
                     if (g->code == 10) p.push_back({number(*g), 0.0});
                     if (g->code == 20 && !p.empty()) p.back().y = number(*g);
                     if (g->code == 42 && number(*g) != 0.0)
-                        src_.fail(g->pos, "a polyline with an arc (bulge) segment is not "
-                                          "supported: OpenSCAD reads its ends as a straight edge");
+                        src_.fail(g->pos,
+                                  "a polyline with an arc (bulge) segment is not "
+                                  "supported: OpenSCAD reads its ends as a straight edge");
                 }
             } else {
                 for (size_t k = 1; vertices && k < vertices->size(); ++k) {
                     const Entity& v = (*vertices)[k];
                     if (first(v, 42, 0.0) != 0.0)
-                        src_.fail(v.pos, "a polyline with an arc (bulge) segment is not "
-                                         "supported: OpenSCAD reads its ends as a straight edge");
+                        src_.fail(v.pos,
+                                  "a polyline with an arc (bulge) segment is not "
+                                  "supported: OpenSCAD reads its ends as a straight edge");
                     p.push_back({first(v, 10, 0.0), first(v, 20, 0.0)});
                 }
             }
@@ -257,7 +260,8 @@ class Reader {
             const std::string name = text(e, 2);
             auto it = blocks_.find(name);
             if (it == blocks_.end())
-                src_.fail(e.pos, "INSERT of the block '" + name + "', which is not defined before it");
+                src_.fail(e.pos,
+                          "INSERT of the block '" + name + "', which is not defined before it");
             const Vec2 at(first(e, 10, 0.0), first(e, 20, 0.0));
             const Vec2 s(first(e, 41, 1.0), first(e, 42, 1.0));
             const double a = glm::radians(first(e, 50, 0.0)), c = std::cos(a), sn = std::sin(a);
