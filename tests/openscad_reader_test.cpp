@@ -267,6 +267,15 @@ TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
     expectCsgError(
         "linear_extrude(height = 10, twist = 90, slices = 20000) { square(size = [1, 1]); }",
         "mem.csg:1:1: linear_extrude with slices = 20000: Lancer makes at most 10000 slices");
+    // 10,000 slices of a comb of 40 teeth (80 convex pieces) would be 800,000 polytopes.
+    std::string comb = "[[0, 0], [80, 0]";
+    for (int i = 39; i >= 0; --i)
+        comb += ", [" + std::to_string(2 * i + 1) + ", 1], [" + std::to_string(2 * i + 1) +
+                ", 3], [" + std::to_string(2 * i) + ", 3], [" + std::to_string(2 * i) + ", 1]";
+    expectCsgError("linear_extrude(height = 10, twist = 90, slices = 10000) { polygon(points = " +
+                       comb + ", [0, 1]]); }",
+                   "mem.csg:1:1: linear_extrude with twist: 10000 slices of 80 convex pieces is "
+                   "over the 200000 polytopes Lancer makes of a twisted extrusion");
     expectCsgError(
         "rotate_extrude(angle = 360, convexity = 2) {\n\tmultmatrix([[1, 0, 0, 2], [0, 1, 0, 0], "
         "[0, 0, 1, 0], [0, 0, 0, 1]]) {\n\t\tcircle(r = 1);\n\t}\n}",
@@ -550,6 +559,13 @@ TEST(OpenScadDxf, FilesAreFoundBesideTheCsgAndBadOnesAreNamed) {
                        "/missing.stl\"); }",
                    "mem.csg:1:44: import() of '" + bad.substr(0, bad.size() - 7) +
                        "/missing.stl' inside a 2D context: only DXF drawings are 2D imports");
+    // A curve cut finer than a polygon may be is refused, not made.
+    const std::string fine =
+        writeTemp("fine.dxf", dxfText("0\nCIRCLE\n8\n0\n10\n0\n20\n0\n40\n1\n"));
+    expectCsgError("linear_extrude(height = 1) { import(file = \"" + fine + "\", $fn = 1e20); }",
+                   "mem.csg:1:44: import(): " + fine +
+                       ":6:1: a CIRCLE of 1000000000 segments (by $fn, $fa, $fs): Lancer cuts a "
+                       "curve into at most 20000");
     // A device is refused, not read for ever.
     const std::string zero = dxf.substr(0, dxf.size() - 10) + "zero.dxf";
     std::filesystem::remove(zero);

@@ -675,7 +675,17 @@ class Builder {
             counts_.twistSlices += slices;
             TwistedExtrusion tw{local, mat,    h, glm::radians(twist),
                                 scale, slices, 1, stretch(local)};
-            tw.sub = twistSubSlices(r.node, tw, std::sqrt(regionMaxR2(r.node)));
+            // Every piece makes a polytope per part: within the budget, fewer parts, and a
+            // model whose OpenSCAD slices alone are over it is refused.
+            const double pieces = double(countPieces(r.node));
+            if (double(slices) * pieces > double(kMaxTwistPolytopes))
+                src_.fail(n.pos, "linear_extrude with twist: " + std::to_string(slices) +
+                                     " slices of " + twistText(pieces) +
+                                     " convex pieces is over the " +
+                                     std::to_string(kMaxTwistPolytopes) +
+                                     " polytopes Lancer makes of a twisted extrusion");
+            tw.sub = std::min(twistSubSlices(r.node, tw, std::sqrt(regionMaxR2(r.node))),
+                              std::max(1, int(double(kMaxTwistPolytopes) / (slices * pieces))));
             counts_.twistSubSlices = std::max(counts_.twistSubSlices, tw.sub);
             return twistRegion(r.node, n, tw);
         }
@@ -800,6 +810,16 @@ class Builder {
 
     static constexpr int kMaxTwistSlices = 10000;  ///< slices beyond this are refused
     static constexpr int kMaxTwistSubSlices = 16;  ///< the most a slice is cut again
+    /// The most polytopes one twisted extrusion makes (example020's spring: 20,480).
+    static constexpr int kMaxTwistPolytopes = 200000;
+
+    /// The convex pieces of a region (its disks are not sliced).
+    size_t countPieces(int id) const {
+        const Region& r = regions_[size_t(id)];
+        if (r.kind == Region::Kind::Piece) return 1;
+        if (r.kind == Region::Kind::Disk) return 0;
+        return countPieces(r.a) + countPieces(r.b);
+    }
 
     /// How many parts each of OpenSCAD's slices is cut into: a piece's hull strays from the
     /// twisted piece by w dA / 2 to first order (w its corners' reach from their mean, dA the

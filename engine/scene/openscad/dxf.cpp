@@ -13,8 +13,9 @@ namespace lancer::openscad {
 
 int Fragments::of(double r) const {
     if (r < 1e-10) return 3;  // OpenSCAD's GRID_FINE
-    if (fn > 0.0) return fn >= 3.0 ? int(fn) : 3;
-    return int(std::ceil(std::max(std::min(360.0 / fa, r * 2.0 * M_PI / fs), 5.0)));
+    // Clamped before the cast: a $fn of 1e20 is a count no int holds (the caller refuses it).
+    if (fn > 0.0) return fn >= 3.0 ? int(std::min(fn, 1e9)) : 3;
+    return int(std::min(std::ceil(std::max(std::min(360.0 / fa, r * 2.0 * M_PI / fs), 5.0)), 1e9));
 }
 
 namespace {
@@ -66,6 +67,9 @@ struct Entity {
     size_t pos;
     std::vector<const Group*> g;
 };
+
+/// The most segments one circle or arc is cut into (a polygon's edges are capped at 20,000).
+constexpr int kMaxCurveSegments = 20000;
 
 class Reader {
   public:
@@ -221,13 +225,19 @@ class Reader {
             double a0 = 0.0, a1 = 360.0;
             int n = frag_.of(r);
             if (t == "ARC") {
-                a0 = first(e, 50, 0.0);
-                a1 = first(e, 51, 0.0);
-                while (a0 < 0.0) a0 += 360.0;
-                while (a1 < 0.0) a1 += 360.0;
+                // Angles into [0, 360) (OpenSCAD adds 360 until they are; fmod does it at once).
+                a0 = std::fmod(first(e, 50, 0.0), 360.0);
+                a1 = std::fmod(first(e, 51, 0.0), 360.0);
+                if (a0 < 0.0) a0 += 360.0;
+                if (a1 < 0.0) a1 += 360.0;
                 if (a0 > a1) a1 += 360.0;
                 n = int(std::ceil(std::max(n * (a1 - a0) / 360.0, 1.0)));
             }
+            if (n > kMaxCurveSegments)
+                src_.fail(e.pos, "a " + t + " of " + std::to_string(n) +
+                                     " segments (by $fn, $fa, "
+                                     "$fs): Lancer cuts a curve into at most " +
+                                     std::to_string(kMaxCurveSegments));
             auto on = [&](int i) {
                 const double a = glm::radians(a0 + (a1 - a0) * i / n);
                 return c + r * Vec2(std::cos(a), std::sin(a));
