@@ -566,6 +566,14 @@ TEST(OpenScadDxf, FilesAreFoundBesideTheCsgAndBadOnesAreNamed) {
                    "mem.csg:1:44: import(): " + fine +
                        ":6:1: a CIRCLE of 1000000000 segments (by $fn, $fa, $fs): Lancer cuts a "
                        "curve into at most 20000");
+    // An arc segment of a polyline is refused, not drawn straight.
+    const std::string bulge = writeTemp(
+        "bulge.dxf",
+        dxfText("0\nLWPOLYLINE\n8\n0\n90\n2\n70\n1\n10\n0\n20\n0\n42\n0.5\n10\n1\n20\n0\n"));
+    expectCsgError("linear_extrude(height = 1) { import(file = \"" + bulge + "\"); }",
+                   "mem.csg:1:44: import(): " + bulge +
+                       ":18:1: a polyline with an arc (bulge) segment is not supported: OpenSCAD "
+                       "reads its ends as a straight edge");
     // A device is refused, not read for ever.
     const std::string zero = dxf.substr(0, dxf.size() - 10) + "zero.dxf";
     std::filesystem::remove(zero);

@@ -210,6 +210,13 @@ class Reader {
   private:
     using Segment = std::pair<Vec2, Vec2>;
 
+    /// A polyline's arc segment (its bulge, group 42): OpenSCAD would draw a straight edge.
+    [[noreturn]] void refuseBulge(size_t pos) const {
+        src_.fail(pos,
+                  "a polyline with an arc (bulge) segment is not supported: OpenSCAD reads "
+                  "its ends as a straight edge");
+    }
+
     /// An entity's segments, in drawing units: into a block's list, or (on the layer) into the
     /// drawing's, with the origin and scale applied.
     void entity(const Entity& e, const std::vector<Entity>* vertices, bool inBlock,
@@ -249,18 +256,12 @@ class Reader {
                 for (const Group* g : e.g) {
                     if (g->code == 10) p.push_back({number(*g), 0.0});
                     if (g->code == 20 && !p.empty()) p.back().y = number(*g);
-                    if (g->code == 42 && number(*g) != 0.0)
-                        src_.fail(g->pos,
-                                  "a polyline with an arc (bulge) segment is not "
-                                  "supported: OpenSCAD reads its ends as a straight edge");
+                    if (g->code == 42 && number(*g) != 0.0) refuseBulge(g->pos);
                 }
             } else {
                 for (size_t k = 1; vertices && k < vertices->size(); ++k) {
                     const Entity& v = (*vertices)[k];
-                    if (first(v, 42, 0.0) != 0.0)
-                        src_.fail(v.pos,
-                                  "a polyline with an arc (bulge) segment is not "
-                                  "supported: OpenSCAD reads its ends as a straight edge");
+                    if (first(v, 42, 0.0) != 0.0) refuseBulge(v.pos);
                     p.push_back({first(v, 10, 0.0), first(v, 20, 0.0)});
                 }
             }
