@@ -790,7 +790,7 @@ class Builder {
                      fs = special(n, "$fs", 2.0);
         const double tw = std::abs(twist), r2 = regionMaxR2(region);
         double s = std::max(std::ceil(tw / 120.0), 1.0);
-        if (std::sqrt(r2) >= 1e-10 && std::isfinite(fn)) {  // 1e-10: OpenSCAD's GRID_FINE
+        if (std::sqrt(r2) >= openscad::kGridFine && std::isfinite(fn)) {
             if (fn > 0.0) {
                 s = std::max(std::ceil(tw / 360.0 * fn), s);
             } else {
@@ -813,6 +813,16 @@ class Builder {
     /// The most polytopes one twisted extrusion makes (example020's spring: 20,480).
     static constexpr int kMaxTwistPolytopes = 200000;
 
+    /// A convex piece's centre (its corners' mean) and its corners' farthest distance from it.
+    static std::pair<Vec2, double> pieceReach(const std::vector<Vec2>& v) {
+        Vec2 c(0.0);
+        for (const Vec2& p : v) c += p;
+        c /= double(v.size());
+        double w = 0.0;
+        for (const Vec2& p : v) w = std::max(w, glm::length(p - c));
+        return {c, w};
+    }
+
     /// The convex pieces of a region (its disks are not sliced).
     size_t countPieces(int id) const {
         const Region& r = regions_[size_t(id)];
@@ -831,12 +841,7 @@ class Builder {
         if (r.kind == Region::Kind::Disk) return 1;  // exact: no slices
         if (r.kind != Region::Kind::Piece)
             return std::max(twistSubSlices(r.a, tw, rho), twistSubSlices(r.b, tw, rho));
-        const std::vector<Vec2>& v = r.piece.vertices;
-        Vec2 c(0.0);
-        for (const Vec2& p : v) c += p;
-        c /= double(v.size());
-        double w = 0.0;
-        for (const Vec2& p : v) w = std::max(w, glm::length(p - c));
+        const auto [c, w] = pieceReach(r.piece.vertices);
         const double first = w * std::abs(tw.twist) / tw.slices / 2.0;
         if (!(rho > 0.0)) return 1;
         return int(std::clamp(std::ceil(first / (0.002 * rho)), 1.0, double(kMaxTwistSubSlices)));
@@ -851,10 +856,7 @@ class Builder {
             r.kind == Region::Kind::Difference) {
             Built a = twistRegion(r.a, n, tw);
             Built b = twistRegion(r.b, n, tw);
-            Op op = r.kind == Region::Kind::Union          ? Op::Union
-                    : r.kind == Region::Kind::Intersection ? Op::Intersection
-                                                           : Op::Difference;
-            return Built::of(scene_.tree.combine(op, a.node, b.node));
+            return Built::of(scene_.tree.combine(csgOp(r.kind), a.node, b.node));
         }
         if (r.kind == Region::Kind::Disk) {
             // A round circle centred on the axis turns into itself: the extrusion is the
@@ -877,16 +879,11 @@ class Builder {
                                  std::to_string(base.size()) + " corners (of the 2D node at " +
                                  src_.where(r.pos) +
                                  "): a slice would need more than the 255 planes of a polytope");
-        // The piece about its centre c: every corner within w of it (docs/scenes.md, "Twisted
-        // extrusions", for the bound below).
-        Vec2 c(0.0);
-        for (const Vec2& p : base) c += p;
-        c /= double(base.size());
-        double w = 0.0, rho = 0.0;
-        for (const Vec2& p : base) {
-            w = std::max(w, glm::length(p - c));
-            rho = std::max(rho, glm::length(p));
-        }
+        // The piece about its centre c: every corner within w of it, and rho from the axis
+        // (docs/scenes.md, "Twisted extrusions", for the bound below).
+        const auto [c, w] = pieceReach(base);
+        double rho = 0.0;
+        for (const Vec2& p : base) rho = std::max(rho, glm::length(p));
         const int parts = tw.slices * tw.sub;
         const double dA = std::abs(tw.twist) / parts;
         Built all = Built::empty();
@@ -971,6 +968,13 @@ class Builder {
         return place(std::move(pt), tw.xf, tw.mat, pos, "linear_extrude()");
     }
 
+    /// The 3D boolean of a 2D boolean region.
+    static Op csgOp(Region::Kind k) {
+        return k == Region::Kind::Union          ? Op::Union
+               : k == Region::Kind::Intersection ? Op::Intersection
+                                                 : Op::Difference;
+    }
+
     /// The region's node extruded: 2D booleans become 3D booleans of the extruded leaves (the
     /// extrusion maps each height's section one to one, so it commutes with them). `k`: the
     /// section at height z is the base scaled by 1 + k z about the origin.
@@ -981,10 +985,7 @@ class Builder {
             r.kind == Region::Kind::Difference) {
             Built a = extrudeRegion(r.a, n, xf, mat, h, k);
             Built b = extrudeRegion(r.b, n, xf, mat, h, k);
-            Op op = r.kind == Region::Kind::Union          ? Op::Union
-                    : r.kind == Region::Kind::Intersection ? Op::Intersection
-                                                           : Op::Difference;
-            return Built::of(scene_.tree.combine(op, a.node, b.node));
+            return Built::of(scene_.tree.combine(csgOp(r.kind), a.node, b.node));
         }
         if (r.kind == Region::Kind::Disk) {
             if (k.x != k.y)

@@ -12,10 +12,8 @@
 namespace lancer::openscad {
 
 int Fragments::of(double r) const {
-    if (r < 1e-10) return 3;  // OpenSCAD's GRID_FINE
     // Clamped before the cast: a $fn of 1e20 is a count no int holds (the caller refuses it).
-    if (fn > 0.0) return fn >= 3.0 ? int(std::min(fn, 1e9)) : 3;
-    return int(std::min(std::ceil(std::max(std::min(360.0 / fa, r * 2.0 * M_PI / fs), 5.0)), 1e9));
+    return int(std::min(fragmentsFromR(r, fn, fa, fs), 1e9));
 }
 
 namespace {

@@ -11,7 +11,7 @@ namespace lancer::openscad {
 /// How curves are cut into segments: OpenSCAD's $fn, $fa, $fs.
 struct Fragments {
     double fn = 0.0, fa = 12.0, fs = 2.0;
-    /// OpenSCAD 2021.01's get_fragments_from_r: segments of a full circle of radius r.
+    /// fragmentsFromR: the segments of a full circle of radius r, at most 1e9.
     int of(double r) const;
 };
 

@@ -163,4 +163,15 @@ std::vector<ConvexPiece> convexPieces(const std::vector<std::vector<Vec2>>& path
     return trapezoids(paths);
 }
 
+double fragmentsFromR(double r, double fn, double fa, double fs) {
+    double f = 3.0;
+    if (r < kGridFine || !std::isfinite(fn))
+        f = 3.0;
+    else if (fn > 0.0)
+        f = std::floor(fn >= 3.0 ? fn : 3.0);
+    else
+        f = std::ceil(std::fmax(std::fmin(360.0 / fa, r * 2.0 * M_PI / fs), 5.0));
+    return std::isfinite(f) ? f : 5.0;
+}
+
 }  // namespace lancer::openscad

@@ -36,4 +36,11 @@ constexpr size_t kMaxPieceSides = 250;
 /// x-coordinates of the vertices and crossings, merged along each pair of edges.
 std::vector<ConvexPiece> convexPieces(const std::vector<std::vector<Vec2>>& paths);
 
+/// OpenSCAD's GRID_FINE: a circle of smaller radius is cut into 3 segments.
+constexpr double kGridFine = 0.00000095367431640625;
+
+/// OpenSCAD 2021.01's get_fragments_from_r (calc.cc): the segments of a full circle of radius
+/// r by $fn, $fa, $fs, as a double (a $fn of 1e20 stays one); 5 where it is not finite.
+double fragmentsFromR(double r, double fn, double fa, double fs);
+
 }  // namespace lancer::openscad

@@ -99,14 +99,7 @@ std::pair<std::string, int> findFont(const std::string& pattern) {
 
 int textCurveSegments(double size, double fn, double fa, double fs) {
     // OpenSCAD's get_fragments_from_r(size, fn, fs, fa), then text.cc's fraction of it.
-    double fragments = 3.0;
-    if (size < 0.00000095367431640625 || !std::isfinite(fn))
-        fragments = 3.0;
-    else if (fn > 0.0)
-        fragments = double(int(fn >= 3.0 ? fn : 3.0));
-    else
-        fragments = std::ceil(std::fmax(std::fmin(360.0 / fa, size * 2.0 * M_PI / fs), 5.0));
-    if (!std::isfinite(fragments)) fragments = 5.0;
+    const double fragments = fragmentsFromR(size, fn, fa, fs);
     return int(std::min(std::max(std::floor(fragments / 8.0) + 1.0, 2.0), 1000.0));
 }
 
