@@ -12,7 +12,9 @@
 #include "engine/accel/build_guard.h"
 #include "engine/accel/eval.h"
 #include "engine/accel/regular/directory.h"
+#include "engine/accel/structure_view.h"
 #include "engine/render/renderer.h"
+#include "engine/scene/builtin_scenes.h"
 #include "engine/scene/loader.h"
 #include "tests/support/differential.h"
 
@@ -57,22 +59,44 @@ std::vector<Vec3> gridPoints(const RegularGrid& g, uint64_t seed, size_t leavesW
         for (int x = 0; x < 3; ++x)
             for (int y = 0; y < 3; ++y)
                 for (int z = 0; z < 3; ++z)
-                    if (x != 1 || y != 1 || z != 1) pts.push_back({c[0][x], c[1][y], c[2][z]});
+                    if (x != 1 || y != 1 || z != 1)
+                        pts.push_back(g.frame().toWorld({c[0][x], c[1][y], c[2][z]}));
     }
     std::mt19937_64 rng(seed);
     for (int k = 0; k < 400; ++k) {
         Vec3 p;
         for (int a = 0; a < 3; ++a) p[a] = g.plane(a, uint32_t(rng() % (g.cells(a) + 1)));
-        pts.push_back(p);
+        pts.push_back(g.frame().toWorld(p));
     }
     return pts;
 }
 
-/// Random rays plus rays through the grid's hard points, for one built scheme.
+/// The grid's box in the world (its frame's box when the frame is the world's).
+Box3 worldBox(const RegularGrid& g) {
+    Box3 b;
+    for (int c = 0; c < 8; ++c)
+        b.expand(g.frame().toWorld({c & 1 ? g.box().hi.x : g.box().lo.x,
+                                    c & 2 ? g.box().hi.y : g.box().lo.y,
+                                    c & 4 ? g.box().hi.z : g.box().lo.z}));
+    return b;
+}
+
+/// Random rays plus rays through the grid's hard points, for one built scheme; in a turned
+/// frame also rays along the frame's axes through them, which run along its planes.
 std::vector<Ray> hardRays(const Scene& s, const RegularGrid& g, uint64_t seed, int random) {
     std::vector<Ray> rays = test::randomRays(s, seed, random);
-    std::vector<Ray> grid = test::raysThroughPoints(gridPoints(g, seed), g.box(), seed + 1);
+    const std::vector<Vec3> pts = gridPoints(g, seed);
+    std::vector<Ray> grid = test::raysThroughPoints(pts, worldBox(g), seed + 1);
     rays.insert(rays.end(), grid.begin(), grid.end());
+    if (g.frame().turned) {
+        const double far = 2.0 * glm::length(worldBox(g).extent());
+        for (const Vec3& p : pts)
+            for (int a = 0; a < 3; ++a)
+                for (double sign : {-1.0, 1.0}) {
+                    const Vec3 d = sign * g.frame().axes[a];
+                    rays.push_back({p - far * d, d});
+                }
+    }
     return rays;
 }
 
@@ -171,6 +195,145 @@ void randomScenesMatchBrute(StepMethod step, int seeds) {
         }
     }
     EXPECT_GE(total, 100000u);
+}
+
+/// A random CSG tree over bars (blocks long on one axis), cylinders along an axis and spheres,
+/// the whole turned by one random rotation: a turned subtree whose frame the grid can follow.
+/// `degrees`: the turn's angle (negative: a random one from 30 to 150).
+Scene turnedBars(uint64_t seed, int count = 16, double degrees = -1.0) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0), thin(0.05, 0.25), len(2.5, 4.5);
+    const double angle = 30.0 + 120.0 * std::abs(u(rng));
+    const Transform turn =
+        Transform::translate(Vec3(u(rng), u(rng), u(rng))) *
+        Transform::rotate(degrees < 0.0 ? angle : degrees, {u(rng), u(rng), u(rng) + 1.5});
+    Scene s;
+    s.name = "turned-bars:" + std::to_string(seed);
+    std::vector<int> nodes;
+    for (int i = 0; i < count; ++i) {
+        const int axis = int(rng() % 3);
+        Transform xf = turn * Transform::translate(2.5 * Vec3(u(rng), u(rng), u(rng)));
+        Shape shape;
+        switch (rng() % 3) {
+            case 0: {
+                Vec3 h(thin(rng));
+                h[axis] = len(rng);
+                shape = Block{-h, h};
+                break;
+            }
+            case 1: {
+                const double r = thin(rng);
+                shape = Cone{r, r, 2.0 * len(rng), false};
+                if (axis < 2)
+                    xf = xf * Transform::rotate(90.0, axis == 0 ? Vec3(0, 1, 0) : Vec3(1, 0, 0));
+                break;
+            }
+            default:
+                shape = Sphere{Vec3(0.0), 0.5 + thin(rng)};
+        }
+        s.prims.push_back(makePrimitive(shape, xf, 0));
+        nodes.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
+    }
+    while (nodes.size() > 1) {
+        const size_t i = rng() % nodes.size();
+        const int a = nodes[i];
+        nodes.erase(nodes.begin() + long(i));
+        const size_t j = rng() % nodes.size();
+        // Mostly unions and differences: intersections of thin bars are mostly empty.
+        const Op op =
+            std::array<Op, 6>{Op::Union,      Op::Union,      Op::Union,
+                              Op::Difference, Op::Difference, Op::Intersection}[rng() % 6];
+        nodes[j] = s.tree.combine(op, a, nodes[j]);
+    }
+    s.tree.root = nodes[0];
+    s.prepare();
+    s.frameCamera({-1.0, 2.0, -1.0}, {0, 0, 1});
+    return s;
+}
+
+// A grid in a turned frame walks the mapped ray and tests the world one: every hit equal to
+// brute force's, on random rays, rays through its cells' corners, edges and faces and rays
+// along its own axes (which run along its planes), for both step methods and stop rules.
+TEST(RegularFrame, RandomTurnedSubtreesRayForRay) {
+    int turned = 0;
+    for (uint64_t seed = 1; seed <= 8; ++seed) {
+        Scene s = turnedBars(seed * 13 + 5, 24);
+        for (StepMethod step : {StepMethod::Exact, StepMethod::Push}) {
+            BuildParams p = regular(step);
+            if (seed % 2) {
+                p.regular.maxObjects = 1 + int(seed % 3);
+                p.regular.maxLevel = 10 + int(seed % 6);
+            }
+            auto accel = buildAccelerator(s, p);
+            const RegularGrid& g = gridOf(*accel);
+            turned += g.frame().turned;
+            auto rays = hardRays(s, g, seed, 2000);
+            auto bad = test::compareWithBrute(s, *accel, rays);
+            ASSERT_TRUE(bad.empty()) << s.name << " " << stepName(step) << ": " << bad.size()
+                                     << " of " << rays.size() << " rays differ\n"
+                                     << describe(s, bad);
+            ASSERT_EQ(walkErrors(s, *accel, rays), 0u) << s.name;
+            auto secondary = test::compareWithBrute(s, *accel, rays, 1e-3 * s.scale());
+            ASSERT_TRUE(secondary.empty()) << s.name << " tmin > 0\n" << describe(s, secondary);
+        }
+    }
+    // Bars turned off the axes: the frame is the turn's in most of them.
+    EXPECT_GE(turned, 12);
+}
+
+// builtin:sponge (OpenSCAD's example024): the grid follows the sponge's frame, its axes those of
+// the turn; every pixel and secondary ray hits as brute force, with a fifth of the tests per ray
+// of brute force and of the same build along the world's axes (one region of 221 primitives).
+TEST(RegularFrame, TurnedSpongeIsBuiltInItsOwnFrame) {
+    Scene s = makeBuiltin("sponge", 3);
+    auto accel = buildAccelerator(s, regular());
+    const RegularGrid& g = gridOf(*accel);
+    ASSERT_TRUE(g.frame().turned);
+    // Every frame axis is one of the turned cube's edges.
+    const Mat3 turn = Mat3(s.prims[s.tree.primitives().front()].xf.m);
+    for (int a = 0; a < 3; ++a) {
+        double best = 0.0;
+        for (int b = 0; b < 3; ++b)
+            best = std::max(best, std::abs(glm::dot(g.frame().axes[a], glm::normalize(turn[b]))));
+        EXPECT_GT(best, 1.0 - 1e-9) << "axis " << a;
+    }
+    test::expectSamePixelsAndSecondaries(s, *accel, 96, 7, "sponge, turned frame");
+    BuildParams world = regular();
+    world.regular.turnedFrame = false;
+    auto flat = buildAccelerator(s, world);
+    EXPECT_FALSE(gridOf(*flat).frame().turned);
+    const std::vector<Ray> rays = test::pixelRays(s, 96, 96);
+    const RayCounters own = test::traceCounters(s, *accel, rays);
+    const RayCounters axes = test::traceCounters(s, *flat, rays);
+    const RayCounters brute = test::traceCounters(s, *buildAccelerator(s, {}), rays);
+    EXPECT_LT(5 * own.primTests, brute.primTests)
+        << own.primTests << " against " << brute.primTests;
+    EXPECT_LT(5 * own.primTests, axes.primTests) << own.primTests << " against " << axes.primTests;
+    // The structure's description is in the world: a leaf's corners are its frame box's.
+    const StructureView view(s, *accel);
+    for (uint32_t id = 0; id < view.regionCount(); id += 7) {
+        const RegionInfo r = view.region(id);
+        const std::array<Vec3, 8> c = view.regionCorners(id);
+        const Vec3 lo = g.frame().toFrame(c[0]), hi = g.frame().toFrame(c[7]);
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_NEAR(lo[a], r.frameBox.lo[a], 1e-12);
+            EXPECT_NEAR(hi[a], r.frameBox.hi[a], 1e-12);
+        }
+        EXPECT_EQ(view.regionAt(0.5 * (c[0] + c[7])), id);
+    }
+}
+
+// Scenes with no turned primitive, and a turn too small to pay, keep the world's axes.
+TEST(RegularFrame, WorldAxesKeptWhereNoTurnPays) {
+    for (const char* name : {"default", "lattice", "drilled"}) {
+        Scene s = makeBuiltin(name, -1);
+        auto accel = buildAccelerator(s, regular());
+        EXPECT_FALSE(gridOf(*accel).frame().turned) << name;
+    }
+    // Bars turned by two degrees: their boxes grow by a third, short of what a frame needs.
+    Scene s = turnedBars(3, 16, 2.0);
+    EXPECT_FALSE(gridOf(*buildAccelerator(s, regular())).frame().turned);
+    EXPECT_TRUE(gridOf(*buildAccelerator(turnedBars(3, 16, 40.0), regular())).frame().turned);
 }
 
 TEST(RegularExact, RandomCsgScenesRayForRay) { randomScenesMatchBrute(StepMethod::Exact, 6); }

@@ -159,6 +159,20 @@ std::vector<ParamDesc> makeTable() {
     d.get = [](const K& k) { return double(k.build.regular.fullTable); };
     d.set = [](K& k, double v) { k.build.regular.fullTable = v != 0.0; };
     add(d);
+    d = {.flag = "--world-frame",
+         .metavar = "",
+         .iniKey = "turned_frame",
+         .label = "turned frame",
+         .help =
+             "Build the grid along the world's axes even where a turned subtree's own axes "
+             "give its primitives much smaller boxes (docs/regular.md, \"Turned scenes\")",
+         .kind = ParamKind::Switch};
+    d.flagValue = false;
+    d.schemes = kRegular;
+    d.effect = ChangeEffect::Rebuild;
+    d.get = [](const K& k) { return double(k.build.regular.turnedFrame); };
+    d.set = [](K& k, double v) { k.build.regular.turnedFrame = v != 0.0; };
+    add(d);
     d = {.flag = "--no-cost-stop",
          .metavar = "",
          .iniKey = "cost_stop",

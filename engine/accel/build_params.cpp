@@ -75,6 +75,7 @@ std::string toString(const BuildParams& p) {
         if (r.step == StepMethod::Push) os << " --delta " << r.delta;
         os << " --split-axes " << splitAxesName(r.splitAxes);
         if (r.fullTable) os << " --full-table";
+        if (!r.turnedFrame) os << " --world-frame";
         if (!r.costStop) os << " --no-cost-stop";
     } else if (p.scheme == SchemeKind::Irregular) {
         const IrregularConfig& i = p.irregular;

@@ -97,6 +97,9 @@ struct RegularConfig {
     double delta = 1e-6;                    ///< push distance, relative to the box's extent
     SplitAxes splitAxes = SplitAxes::Cost;  ///< the axis each BSP level cuts
     bool fullTable = false;                 ///< one full directory instead of sub-tables
+    /// Build in a turned subtree's frame when chooseGridFrame() finds one (false: --world-frame,
+    /// the world's axes always; docs/regular.md, "Turned scenes").
+    bool turnedFrame = true;
     /// In the automatic mode, stop a cell where no split lowers the estimated cost (false: the
     /// report's rule alone, max-objects and max-level, with cells inside all their primitives'
     /// boxes kept whole). An explicit max-level or max-objects turns it off (usesCostStop()).

@@ -129,6 +129,22 @@ void writeRegular(Writer& w, const StructureView& v, bool summary) {
     const RegularGrid& g = *v.regular();
     w.raw(",\"regular\":{\"bounds\":");
     w.box(g.box());
+    // A grid following a turned subtree gives its frame's axes: bounds, leaf boxes and planes
+    // are then coordinates along them (x = dot(axes[0], world point), ...).
+    if (g.frame().turned) {
+        w.raw(",\"axes\":[");
+        for (int a = 0; a < 3; ++a) {
+            const Vec3 v = g.frame().axes[a];
+            w.raw(a ? ",[" : "[");
+            w.num(v.x);
+            w.raw(",");
+            w.num(v.y);
+            w.raw(",");
+            w.num(v.z);
+            w.raw("]");
+        }
+        w.raw("]");
+    }
     w.raw(",\"directory\":[");
     for (int a = 0; a < 3; ++a) {
         if (a) w.raw(",");

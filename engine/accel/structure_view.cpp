@@ -219,8 +219,7 @@ size_t StructureView::regionCount() const {
 std::array<Vec3, 8> StructureView::regionCorners(uint32_t id) const {
     if (const RegularGrid* g = regular()) {
         const RegularLeaf& L = g->leaves().at(id);
-        return boxCorners(
-            {{L.plane[0], L.plane[1], L.plane[2]}, {L.plane[3], L.plane[4], L.plane[5]}});
+        return gridCorners(L.lo, L.hi);
     }
     if (const Bvh* b = bvh()) return boxCorners(b->nodes().at(id).box());
     const IrregularSubdivision* s = irregular();
@@ -361,7 +360,11 @@ uint32_t StructureView::regionAt(const Vec3& world) const {
 }
 
 std::array<Vec3, 8> StructureView::structureCorners() const {
-    if (const RegularGrid* g = regular()) return boxCorners(g->box());
+    if (const RegularGrid* g = regular()) {
+        std::array<Vec3, 8> c = boxCorners(g->box());
+        for (Vec3& p : c) p = g->frame().toWorld(p);
+        return c;
+    }
     if (const Bvh* b = bvh()) return boxCorners(b->regionCount() ? b->box() : scene_->bounds);
     const IrregularSubdivision* s = irregular();
     if (!s) return boxCorners(scene_->bounds);
@@ -374,6 +377,19 @@ Box3 StructureView::worldBounds() const {
     Box3 b;
     for (const Vec3& p : structureCorners()) b.expand(p);
     return b;
+}
+
+std::array<Vec3, 8> StructureView::gridCorners(const uint32_t lo[3], const uint32_t hi[3]) const {
+    const RegularGrid* g = regular();
+    if (!g) return {};
+    Box3 b;
+    for (int a = 0; a < 3; ++a) {
+        b.lo[a] = g->plane(a, lo[a]);
+        b.hi[a] = g->plane(a, hi[a]);
+    }
+    std::array<Vec3, 8> c = boxCorners(b);
+    for (Vec3& p : c) p = g->frame().toWorld(p);
+    return c;
 }
 
 int StructureView::directoryLog2(int axis) const {

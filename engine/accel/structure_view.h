@@ -54,8 +54,8 @@ inline constexpr int64_t kNotLinked = -3;          ///< the scheme keeps no link
 struct RegionInfo {
     uint32_t id = 0;
     RegionKind kind = RegionKind::SceneBox;
-    /// The region's box in its own frame: world (brute force, regular), camera frame (x, y,
-    /// depth; slabs), projective (u, v, depth; projective slabs and the near region).
+    /// The region's box in its own frame: world (brute force), the grid's (regular), camera frame
+    /// (x, y, depth; slabs), projective (u, v, depth; projective slabs and the near region).
     Box3 frameBox;
     int level = -1;  ///< regular: BSP level of the leaf; BVH: the node's depth; -1 otherwise
     uint32_t cellLo[3] = {}, cellHi[3] = {};  ///< regular: directory cells [lo, hi) per axis
@@ -78,9 +78,9 @@ struct RegionInfo {
 /// Regular scheme: one cut of the BSP, a plane across the cell of an inner node.
 struct CutPlane {
     int axis = 0;        ///< 0 x, 1 y, 2 z
-    double value = 0.0;  ///< world coordinate of the plane
+    double value = 0.0;  ///< coordinate of the plane in the grid's frame
     int level = 0;       ///< the node's level (the root is level 0)
-    Box3 cell;           ///< world box of the node's cell (the plane's rectangle is its section)
+    Box3 cell;  ///< the node's cell in the grid's frame (the plane's rectangle is its section)
     uint32_t cellLo[3] = {}, cellHi[3] = {};  ///< the cell in directory cells, [lo, hi)
 };
 
@@ -209,8 +209,12 @@ class StructureView {
     /// axis-aligned in the world).
     std::array<Vec3, 8> structureCorners() const;
 
-    // Regular scheme (nullptr / empty otherwise).
+    // Regular scheme (nullptr / empty otherwise). Its boxes, planes and cells are in the grid's
+    // frame (RegularGrid::frame(): the world's axes unless the grid follows a turned subtree);
+    // corners are the world's.
     const RegularGrid* regular() const;
+    /// Directory cells [lo, hi) per axis as 8 world corners (the regionCorners order).
+    std::array<Vec3, 8> gridCorners(const uint32_t lo[3], const uint32_t hi[3]) const;
     /// log2 of the directory's size on each axis.
     int directoryLog2(int axis) const;
     /// BSP level of a leaf, from its cell counts and the axis schedule.

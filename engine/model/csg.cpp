@@ -135,9 +135,14 @@ Box3 nodeBox(const CsgTree& tree, int node, const std::vector<Box3>& primBox) {
 }
 
 MinimizedBoxes minimizeBoxes(const CsgTree& tree, const std::vector<Primitive>& prims) {
+    std::vector<Box3> start(prims.size());
+    for (size_t i = 0; i < prims.size(); ++i) start[i] = prims[i].worldBox;
+    return minimizeBoxes(tree, std::move(start));
+}
+
+MinimizedBoxes minimizeBoxes(const CsgTree& tree, std::vector<Box3> start) {
     MinimizedBoxes r;
-    r.box.resize(prims.size());
-    for (size_t i = 0; i < prims.size(); ++i) r.box[i] = prims[i].worldBox;
+    r.box = std::move(start);
     if (tree.root < 0) return r;
 
     std::vector<Box3> nb(tree.nodes.size());

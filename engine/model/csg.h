@@ -73,6 +73,9 @@ struct MinimizedBoxes {
 /// Boxes of the report's Fig. 1, iterated to a fixed point: under A ∩ B each primitive of A is
 /// clipped to box(B) and the reverse; under A − B each primitive of B is clipped to box(A).
 MinimizedBoxes minimizeBoxes(const CsgTree& tree, const std::vector<Primitive>& prims);
+/// The same fixed point from the boxes `start` (one per primitive, each holding what of its
+/// primitive can contribute, in any one frame: the rules hold for boxes along any three axes).
+MinimizedBoxes minimizeBoxes(const CsgTree& tree, std::vector<Box3> start);
 
 /// Node boxes bottom-up from primitive boxes: union hull, intersection overlap, difference box(A).
 Box3 nodeBox(const CsgTree& tree, int node, const std::vector<Box3>& primBox);

@@ -151,8 +151,8 @@ std::string primText(uint32_t p, const Scene* scene) {
 }
 
 /// How a region step's frame runs along the ray: per axis +1 (the ray goes to the high side),
-/// -1 or 0; regular and brute force in the world's axes, camera-frame slabs in the camera
-/// frame's, projective regions in depth alone (a ray from the eye keeps its u and v).
+/// -1 or 0; brute force in the world's axes, regular in its grid's, camera-frame slabs in the
+/// camera frame's, projective regions in depth alone (a ray from the eye keeps its u and v).
 struct FrameSides {
     int sign[3] = {0, 0, 0};
     bool irregular = false;
@@ -162,6 +162,7 @@ FrameSides sidesOf(const StructureView& view, RegionKind kind, const Vec3& dir) 
     FrameSides f;
     Vec3 d = dir;
     if (kind == RegionKind::Slab) d = view.irregular()->frame().vector(dir);
+    if (kind == RegionKind::Leaf) d = view.regular()->frame().toFrame(dir);
     if (kind == RegionKind::ProjectiveSlab || kind == RegionKind::NearRegion) d = Vec3(0, 0, 1);
     f.irregular = kind == RegionKind::Slab || kind == RegionKind::ProjectiveSlab ||
                   kind == RegionKind::NearRegion;

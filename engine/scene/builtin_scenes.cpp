@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <functional>
+#include <numbers>
 
 namespace lancer {
 
@@ -182,6 +183,42 @@ Scene latticeScene(int n) {
                           {0.1, 0.1, 0.12}, {-1.0, 2.0, -1.2});
 }
 
+// OpenSCAD's example024: a Menger sponge of `level` levels (a cube less three sets of bars,
+// 3 (8^level - 1) / 7 of them), turned so that a diagonal stands up, then cut by the plane
+// z = 0. Every primitive sits under one rotation, and none is aligned with the world's axes.
+Scene spongeScene(int level) {
+    SceneBuilder b;
+    const double d = 2.0;
+    const int m = b.material(mat({0.85, 0.75, 0.45}, 0.8, 0.3, 40.0));
+    // OpenSCAD's rotate([45, atan(1 / sqrt(2)), 0]): about x, then about y.
+    const Transform turn =
+        Transform::rotate(std::atan(1.0 / std::sqrt(2.0)) * 180.0 / std::numbers::pi, {0, 1, 0}) *
+        Transform::rotate(45.0, {1, 0, 0});
+    std::vector<int> bars;
+    // Bars along `axis` of side `side` centred at (u, v) on the other two axes, and the eight
+    // around each at the next level, as OpenSCAD's menger_negative().
+    std::function<void(int, double, double, double, int)> negative =
+        [&](int axis, double side, double u, double v, int left) {
+            const double l = side / 3.0;
+            Vec3 c(0.0), h(0.0);
+            c[(axis + 1) % 3] = u;
+            c[(axis + 2) % 3] = v;
+            h[axis] = 0.55 * d;
+            h[(axis + 1) % 3] = h[(axis + 2) % 3] = 0.5 * l;
+            bars.push_back(b.prim(Block{c - h, c + h}, m, turn));
+            if (left > 1)
+                for (int i = -1; i <= 1; ++i)
+                    for (int j = -1; j <= 1; ++j)
+                        if (i || j) negative(axis, l, u + i * l, v + j * l, left - 1);
+        };
+    for (int axis = 0; axis < 3; ++axis) negative(axis, d, 0.0, 0.0, level);
+    const int sponge =
+        b.op(Op::Difference, b.prim(cube(Vec3(0.0), 0.5 * d), m, turn), b.all(Op::Union, bars));
+    const int below = b.prim(Block{{-d, -d, -2.0 * d}, {d, d, 0.0}}, m);
+    return b.finishFramed(b.op(Op::Difference, sponge, below), "sponge", level, {0.1, 0.1, 0.12},
+                          {-0.8, 1.6, -2.0});
+}
+
 // SPD-style "tetra": a Sierpinski tetrahedron of 4^SIZE triangles (surfaces in one union).
 Scene tetraScene(int size) {
     SceneBuilder b;
@@ -258,6 +295,9 @@ const std::vector<BuiltinInfo>& builtinScenes() {
         {"lattice", 6, 1, 30,
          "SIZE^3 cells of (cube ∩ sphere) − cylinder, cut by a slab (CSG stress)"},
         {"tetra", 3, 1, 7, "SPD-style Sierpinski tetrahedron: 4^SIZE triangles"},
+        {"sponge", 3, 1, 5,
+         "OpenSCAD's example024: a Menger sponge of SIZE levels turned on its diagonal, cut by "
+         "a plane (turned CSG)"},
         {"rings", 3, 1, 20,
          "SPD-style rings: SIZE^2 chains of 10 spheres and 10 open cylinders, a floor"},
     };
@@ -314,6 +354,7 @@ Scene makeBuiltin(const BuiltinSpec& spec) {
     if (name == "drilled") return drilledScene(size);
     if (name == "lattice") return latticeScene(size);
     if (name == "tetra") return tetraScene(size);
+    if (name == "sponge") return spongeScene(size);
     return ringsScene(size);
 }
 

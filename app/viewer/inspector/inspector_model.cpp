@@ -138,20 +138,14 @@ void irregularRegions(InspectorModel& m, const StructureView& view, const Inspec
 
 void directoryBlocks(InspectorModel& m, const StructureView& view, const InspectorOptions& opt,
                      const InspectorView& insp) {
-    const RegularGrid& g = *view.regular();
     size_t drawn = 0;
     for (const DirectoryBlock& b : view.directoryBlocks()) {
         // The level range as for the leaves: an entry by its leaf's BSP level, a sub-table by
         // its node's.
         if (!inLevelRange(b.level, opt.levelLo, opt.levelHi)) continue;
-        Box3 box;
         bool single = true;
-        for (int a = 0; a < 3; ++a) {
-            box.lo[a] = g.plane(a, b.lo[a]);
-            box.hi[a] = g.plane(a, b.hi[a]);
-            single = single && b.hi[a] - b.lo[a] == 1;
-        }
-        const Corners c = boxCorners(box);
+        for (int a = 0; a < 3; ++a) single = single && b.hi[a] - b.lo[a] == 1;
+        const Corners c = view.gridCorners(b.lo, b.hi);
         if (!opt.slab.keeps(c) || !maybeVisible(insp.camera, insp.width, insp.height, c)) continue;
         ++m.blocks;
         if (drawn++ >= size_t(std::max(opt.cap, 0))) continue;

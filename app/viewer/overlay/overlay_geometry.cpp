@@ -14,6 +14,11 @@ namespace lancer::viewer::overlay {
 namespace {
 
 glm::vec3 toF(const Vec3& v) { return glm::vec3(v); }
+std::array<glm::vec3, 8> toF(const std::array<Vec3, 8>& c) {
+    std::array<glm::vec3, 8> f;
+    for (size_t i = 0; i < 8; ++i) f[i] = toF(c[i]);
+    return f;
+}
 
 /// A frame point (x, y) at depth z in world coordinates: the camera frame's (x, y, z), or the
 /// projective (u, v, z), the camera point (u z, v z, z).
@@ -168,10 +173,7 @@ void irregularLayers(const StructureView& sv, const gl::ImageProjector& proj, in
                 if (!o.only.keeps(slabs[k].region)) continue;
                 ++g.regionsTotal;
                 if (g.regionsDrawn >= o.cap) break;
-                std::array<glm::vec3, 8> c;
-                const std::array<Vec3, 8> wc = sv.regionCorners(slabs[k].region);
-                for (size_t i = 0; i < 8; ++i) c[i] = toF(wc[i]);
-                g.wires.box(c, gl::rgba8(levelColor(int(k))));
+                g.wires.box(toF(sv.regionCorners(slabs[k].region)), gl::rgba8(levelColor(int(k))));
                 g.slabMax = std::max(g.slabMax, int(k));
                 ++g.regionsDrawn;
             }
@@ -208,25 +210,16 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
                 g.noteLevel(sv.leafLevel(i));
             else
                 g.countMax = std::max(g.countMax, size_t(grid.leaves()[i].prims));
-            g.wires.box(toF(wc[0]), toF(wc[7]), gl::rgba8(col));
+            g.wires.box(toF(wc), gl::rgba8(col));
         }
         g.regionsDrawn += picked.size();
     }
     if (o.grid) {
-        const Box3 b = sv.worldBounds();
-        Vec3 cell;
-        for (int a = 0; a < 3; ++a)
-            cell[a] = (b.hi[a] - b.lo[a]) / double(1u << sv.directoryLog2(a));
         const std::vector<DirectoryBlock> blocks = sv.directoryBlocks();
         for (const DirectoryBlock& blk : blocks) {
             if (blk.level < o.levelMin || blk.level > o.levelMax) continue;
             ++g.regionsTotal;
             if (g.regionsDrawn >= o.cap) continue;
-            Vec3 lo, hi;
-            for (int a = 0; a < 3; ++a) {
-                lo[a] = b.lo[a] + cell[a] * blk.lo[a];
-                hi[a] = b.lo[a] + cell[a] * blk.hi[a];
-            }
             // By kind: sub-table blocks in orange, single entries in grey-blue.
             const glm::vec3 col = o.gridColor == GridColor::Level        ? levelColor(blk.level)
                                   : o.gridColor == GridColor::TableDepth ? levelColor(blk.depth)
@@ -234,7 +227,7 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
                                                  : glm::vec3(0.55f, 0.65f, 0.8f);
             if (o.gridColor == GridColor::Level) g.noteLevel(blk.level);
             if (o.gridColor == GridColor::TableDepth) g.noteLevel(blk.depth);
-            g.wires.box(toF(lo), toF(hi), gl::rgba8(col));
+            g.wires.box(toF(sv.gridCorners(blk.lo, blk.hi)), gl::rgba8(col));
             ++g.regionsDrawn;
         }
     }

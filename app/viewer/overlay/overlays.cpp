@@ -374,9 +374,11 @@ void Overlays::selectionPanel(bool* open) {
     if (r.level >= 0) ImGui::Text("level %d", r.level);
     if (r.zone >= 0) ImGui::Text("zone %lld, slab %u", static_cast<long long>(r.zone), r.slab);
     ImGui::TextWrapped("box (%s frame): %s",
-                       r.kind == RegionKind::Leaf || r.kind == RegionKind::SceneBox ? "world"
-                       : r.kind == RegionKind::Slab                                 ? "camera"
-                                                                                    : "projective",
+                       r.kind == RegionKind::Leaf
+                           ? (view_->regular()->frame().turned ? "grid" : "world")
+                       : r.kind == RegionKind::SceneBox ? "world"
+                       : r.kind == RegionKind::Slab     ? "camera"
+                                                        : "projective",
                        boxText(r.frameBox).c_str());
     if (ImGui::Button("clear")) selection_.reset();
     if (!selection_) {

@@ -93,9 +93,18 @@ bool paramControl(const cli::ParamDesc& d, cli::Knobs& k, int maxThreads) {
 
 bool paramControls(cli::ChangeEffect effect, cli::Knobs& k, int maxThreads) {
     bool changed = false;
-    for (const cli::ParamDesc& d : cli::paramTable())
-        if (d.reach == cli::ViewerReach::Panel && d.effect == effect)
-            changed |= paramControl(d, k, maxThreads);
+    // Switches that follow each other go two to a line, the second at the middle: the panel
+    // keeps its height at 1280 x 720 as switches are added.
+    const float lineStart = ImGui::GetCursorPosX();
+    const float middle = lineStart + 0.5f * ImGui::GetContentRegionAvail().x;
+    bool rightFree = false;  // the last control was a switch at the start of its line
+    for (const cli::ParamDesc& d : cli::paramTable()) {
+        if (d.reach != cli::ViewerReach::Panel || d.effect != effect) continue;
+        const bool sw = d.kind == cli::ParamKind::Switch;
+        if (sw && rightFree) ImGui::SameLine(middle);
+        changed |= paramControl(d, k, maxThreads);
+        rightFree = sw && !rightFree;
+    }
     return changed;
 }
 

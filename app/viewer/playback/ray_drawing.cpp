@@ -142,12 +142,11 @@ gl::Batch rayBatch(const RayPlayback& play, const StructureView& view) {
                 bool inside = true;
                 for (int a = 0; a < 3; ++a) inside = inside && e.cell[a] < g->cells(a);
                 if (inside) {
-                    Vec3 lo, hi;
-                    for (int a = 0; a < 3; ++a) {
-                        lo[a] = g->plane(a, e.cell[a]);
-                        hi[a] = g->plane(a, e.cell[a] + 1);
-                    }
-                    b.box(f(lo), f(hi), gl::rgba8(kCellColor));
+                    const uint32_t hi[3] = {e.cell[0] + 1, e.cell[1] + 1, e.cell[2] + 1};
+                    const std::array<Vec3, 8> c = view.gridCorners(e.cell, hi);
+                    std::array<glm::vec3, 8> fc;
+                    for (size_t i = 0; i < 8; ++i) fc[i] = f(c[i]);
+                    b.box(fc, gl::rgba8(kCellColor));
                 }
             }
             if (e.kind == WalkEvent::Lookup) cross(b, e.point, mark, gl::rgba8(kCellColor));

@@ -144,9 +144,10 @@ void sortedUnique(std::vector<uint32_t>& v) {
 
 /// A cell inside every one of its primitives' boxes: every sub-cell would hold the same
 /// primitives, hence the same tree, so it is not split.
-bool coveredByAll(const Scene& scene, std::span<const uint32_t> prims, const Box3& cell) {
+bool coveredByAll(const std::vector<Box3>& boxes, std::span<const uint32_t> prims,
+                  const Box3& cell) {
     for (uint32_t p : prims) {
-        const Box3& b = scene.minBox[p];
+        const Box3& b = boxes[p];
         if (!(b.lo.x <= cell.lo.x && b.lo.y <= cell.lo.y && b.lo.z <= cell.lo.z &&
               b.hi.x >= cell.hi.x && b.hi.y >= cell.hi.y && b.hi.z >= cell.hi.z))
             return false;
@@ -204,9 +205,9 @@ constexpr int kRestrictorDepth = 64;
 /// evenly spread primitives this is the report's x, y, z; on a flat scene (balls4: 24 x 24 x 1.5)
 /// it cuts x and y until the cells are about cubes, where the report's order makes them 16 times
 /// flatter than wide.
-AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector<uint32_t>& live,
-                          const std::vector<uint32_t>& quarters, int maxLevel, int maxObjects,
-                          const BuildGuard& guard) {
+AxisSchedule planSchedule(const std::vector<Box3>& primBoxes, const Box3& box,
+                          const std::vector<uint32_t>& live, const std::vector<uint32_t>& quarters,
+                          int maxLevel, int maxObjects, const BuildGuard& guard) {
     // The cells of a level, their primitives in one array: cell c holds refs[begin, end).
     struct Cell {
         Box3 box;
@@ -247,7 +248,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
             guard.poll();
             const Cell& c = cells[k];
             open[k] = c.end - c.begin > size_t(maxObjects) &&
-                      !coveredByAll(scene, {refs.data() + c.begin, c.end - c.begin}, c.box);
+                      !coveredByAll(primBoxes, {refs.data() + c.begin, c.end - c.begin}, c.box);
         }));
         fence.acquire();
         size_t kept = 0;
@@ -271,7 +272,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
             // every store. Tests in quarters (testQuarters()).
             uint64_t tests[3] = {0, 0, 0};
             size_t count[3][2] = {};
-            const Box3* const boxes = scene.minBox.data();
+            const Box3* const boxes = primBoxes.data();
             const uint32_t* const weights = quarters.data();
             for (size_t i = ch.begin; i < ch.end; ++i) {
                 const Box3& b = boxes[refs[i]];
@@ -328,7 +329,7 @@ AxisSchedule planSchedule(const Scene& scene, const Box3& box, const std::vector
             Chunk& ch = chunks[k];
             const Box3& cb = cells[ch.cell].box;
             const double mid = 0.5 * (cb.lo[axis] + cb.hi[axis]);
-            const Box3* const boxes = scene.minBox.data();
+            const Box3* const boxes = primBoxes.data();
             uint32_t* lo = nextRefs.data() + ch.out[0];
             uint32_t* hi = nextRefs.data() + ch.out[1];
             for (size_t i = ch.begin; i < ch.end; ++i) {
@@ -536,7 +537,7 @@ struct RegularBuilder {
         double tests[2] = {0.0, 0.0};
         size_t count[2] = {0, 0};
         for (uint32_t p : prims) {
-            const Box3& b = scene.minBox[p];
+            const Box3& b = grid.boxes()[p];
             if (coord(b.lo, axis) <= mid) tests[0] += weight[p], ++count[0];
             if (coord(b.hi, axis) >= mid) tests[1] += weight[p], ++count[1];
         }
@@ -552,10 +553,10 @@ struct RegularBuilder {
                 PrimList& in = f.look[depth];
                 in.clear();
                 for (uint32_t p : prims)
-                    if (side ? coord(scene.minBox[p].hi, axis) >= mid
-                             : coord(scene.minBox[p].lo, axis) <= mid)
+                    if (side ? coord(grid.boxes()[p].hi, axis) >= mid
+                             : coord(grid.boxes()[p].lo, axis) <= mid)
                         in.push_back(p);
-                if (!coveredByAll(scene, in, child[side]))
+                if (!coveredByAll(grid.boxes(), in, child[side]))
                     c = std::min(c, splitCost(f, child[side], in, level + 1, depth - 1));
             }
             cost += area(child[side]) / parentArea * c;
@@ -694,7 +695,7 @@ struct RegularBuilder {
         out.clear();
         out.resize(prims.size());
         uint32_t* o = out.data();
-        const Box3* const boxes = scene.minBox.data();
+        const Box3* const boxes = grid.boxes().data();
         if (level == 0) {
             for (uint32_t p : prims) *o = p, o += boxes[p].overlaps(child);
         } else if (side == 0) {
@@ -752,7 +753,7 @@ struct RegularBuilder {
         // hold the same primitives, hence the same tree, so splitting only adds leaves. (The
         // report stops at max-objects or max-level only; cells inside the overlap of more than
         // max-objects boxes would then split down to max-level: millions of identical leaves.)
-        if (coveredByAll(scene, prims, box)) {
+        if (coveredByAll(grid.boxes(), prims, box)) {
             ++f.coveredLeaves;
             makeLeaf(f, id, level, pos, tree, prims);
             return;
@@ -778,7 +779,7 @@ struct RegularBuilder {
             in0.resize(prims.size());
             in1.resize(prims.size());
             uint32_t *lo = in0.data(), *hi = in1.data();
-            const Box3* const boxes = scene.minBox.data();
+            const Box3* const boxes = grid.boxes().data();
             if (unitWeights) {
                 for (uint32_t p : prims) {
                     const Box3& b = boxes[p];
@@ -983,8 +984,26 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
         throw std::invalid_argument("--delta " + std::to_string(params.delta) +
                                     ": must be in (0, 1) (relative to the scene size)");
 
+    // The frame: a turned subtree's where its boxes are much smaller (grid_frame.h).
+    Box3 bounds = scene.bounds;
+    nlohmann::json frameStats = {{"turned", false}};
+    if (params.turnedFrame) {
+        FrameChoice fc = chooseGridFrame(scene);
+        frameStats["candidates"] = fc.candidates;
+        frameStats["world_box_area"] = fc.worldArea;
+        frameStats["frame_box_area"] = fc.frameArea;
+        if (fc.frame.turned) {
+            frame_ = fc.frame;
+            frameBoxes_ = std::move(fc.boxes);
+            bounds = fc.bounds;
+            frameStats["turned"] = true;
+            for (int a = 0; a < 3; ++a)
+                frameStats["axes"].push_back(
+                    {frame_.axes[a].x, frame_.axes[a].y, frame_.axes[a].z});
+        }
+    }
     // The grid box: the scene bounds, widened where they are flat so every axis can be cut.
-    box_ = scene.bounds.isEmpty() ? Box3{Vec3(-1.0), Vec3(1.0)} : scene.bounds;
+    box_ = bounds.isEmpty() ? Box3{Vec3(-1.0), Vec3(1.0)} : bounds;
     Vec3 e = box_.extent();
     double largest = std::max({e.x, e.y, e.z});
     double pad = largest > 0.0 ? 1e-3 * largest
@@ -1004,7 +1023,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     RegularBuilder b(scene, params, *this, guard, live.size());
     if (params.splitAxes == SplitAxes::Cost)
         schedule_ =
-            planSchedule(scene, box_, live, b.quarters, b.maxLevel, params.objects(), guard);
+            planSchedule(boxes(), box_, live, b.quarters, b.maxLevel, params.objects(), guard);
     b.setGainArea();
     const uint32_t origin[3] = {0, 0, 0};
     RegularBuilder::Fragment root(b.maxLevel);
@@ -1152,6 +1171,7 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
     };
     if (unionOnly_ && !quadsFit)
         extra_["sphere_quads_left_out"] = formatBytes(quadBytes) + " would pass the memory budget";
+    extra_["frame"] = std::move(frameStats);
 }
 
 void RegularGrid::makeSphereQuads() {

@@ -19,6 +19,7 @@
 #include "engine/accel/build_params.h"
 #include "engine/accel/eval.h"
 #include "engine/accel/regular/directory.h"
+#include "engine/accel/regular/grid_frame.h"
 
 namespace lancer {
 
@@ -109,8 +110,13 @@ class RegularGrid {
     /// Primitives of the leaves' trees: leaf L's are primList()[L.first, L.first + L.prims).
     const std::vector<uint32_t>& primList() const { return primList_; }
     const Directory& directory() const { return dir_; }
-    /// The grid's box: the scene bounds, widened on an axis where they are flat.
+    /// The grid's box in its frame: the scene bounds, widened on an axis where they are flat.
     const Box3& box() const { return box_; }
+    /// The frame the grid's cells, box, planes and leaves are in (grid_frame.h): the world's
+    /// axes, or a turned subtree's.
+    const GridFrame& frame() const { return frame_; }
+    /// Each primitive's minimized box in the grid's frame (the scene's minBox when not turned).
+    const std::vector<Box3>& boxes() const { return frame_.turned ? frameBoxes_ : scene_->minBox; }
     /// Directory cells per axis, 2^n.
     uint32_t cells(int axis) const { return n_[axis]; }
     /// The axis each level of the BSP cuts.
@@ -127,8 +133,9 @@ class RegularGrid {
     }
     /// "leaf 12 cells [8,12)x[0,8)x[8,16) Box3{..} 2 prims (p1 − p11)": for messages and traces.
     std::string describeLeaf(uint32_t id) const;
-    /// Leaf holding a point (clamped into the grid).
-    uint32_t leafAt(const Vec3& p) const {
+    /// Leaf holding a world point (clamped into the grid).
+    uint32_t leafAt(const Vec3& world) const {
+        const Vec3 p = frame_.toFrame(world);
         return dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
     }
 
@@ -187,6 +194,8 @@ class RegularGrid {
     bool exact_ = true;       ///< --step exact (else push)
     bool unionOnly_ = false;  ///< the scene's tree has only unions: so has every leaf's
     double delta_ = 0.0;      ///< absolute push distance
+    GridFrame frame_;
+    std::vector<Box3> frameBoxes_;  ///< boxes() when the frame is turned
     Box3 box_;
     Box3 clipBox_;  ///< box_ grown by a hair: a grazing ray whose hit rounds outside still enters
     Vec3 ext_{0.0};
@@ -216,30 +225,35 @@ bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceConte
 template <bool kExact, class Obs>
 bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                        Hit& hit) const {
+    // The cells are walked with the ray in the grid's frame (`fr`, the same t for the same
+    // point), the primitives tested with the world ray; points told are the world's.
+    Ray mapped;
+    if (frame_.turned) mapped = frame_.toFrame(ray);
+    const Ray& fr = frame_.turned ? mapped : ray;
     double tA, tB;
-    if (!clipLine(ray, clipBox_, tA, tB)) return false;
+    if (!clipLine(fr, clipBox_, tA, tB)) return false;
     const double tStart = std::max(tmin, tA), tEnd = std::min(tmax, tB);
     if (!(tStart <= tEnd)) return false;
-    Vec3 p = std::isfinite(tStart) ? ray.at(tStart) : ray.o;
+    Vec3 p = std::isfinite(tStart) ? fr.at(tStart) : fr.o;
     uint32_t leaf = dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
     if constexpr (Obs::kActive) {
         const uint32_t cell[3] = {locate(0, p.x), locate(1, p.y), locate(2, p.z)};
-        obs.lookup(p, cell, leaf);
+        obs.lookup(frame_.toWorld(p), cell, leaf);
     }
     // Per ray, held locally (the loop's stores to mailboxes and counters could otherwise alias
     // the ray and the arrays, and each step would reload them): the origin, 1/d, so each exit
     // plane costs a product, not a division, and the side a cell is left by on each axis. An axis
     // the ray runs parallel to is never an exit: its plane gets a factor 0 and a bias of +inf;
     // on the others the bias is 0, which leaves the product bit for bit unchanged.
-    const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
-    const bool up[3] = {ray.d.x > 0.0, ray.d.y > 0.0, ray.d.z > 0.0};
+    const double o[3] = {fr.o.x, fr.o.y, fr.o.z};
+    const bool up[3] = {fr.d.x > 0.0, fr.d.y > 0.0, fr.d.z > 0.0};
     double inv[3], bias[3];
     uint32_t
         side[3];  // where a leaf's exit plane on each axis is in RegularLeaf::plane: lo a, hi 3 + a
     uint32_t rope[3];  // the rope across that plane
     for (int a = 0; a < 3; ++a) {
-        const bool parallel = ray.d[a] == 0.0;
-        inv[a] = parallel ? 0.0 : 1.0 / ray.d[a];
+        const bool parallel = fr.d[a] == 0.0;
+        inv[a] = parallel ? 0.0 : 1.0 / fr.d[a];
         bias[a] = parallel ? kInf : 0.0;
         side[a] = up[a] ? 3 + a : a;
         rope[a] = 2 * a + up[a];
@@ -256,7 +270,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
     [[maybe_unused]] double tShown = tStart;
     if constexpr (Obs::kActive) {
         double a, b;
-        if (clipLine(ray, box_, a, b)) tShown = std::max(tStart, a);
+        if (clipLine(fr, box_, a, b)) tShown = std::max(tStart, a);
     }
     ctx.pending.clear();
     const size_t maxSteps = maxSteps_;
@@ -297,7 +311,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
                     nextLeaf = across;
                     if constexpr (Obs::kActive) how = 1;
                 } else {
-                    const Vec3 q = ray.at(tExit);
+                    const Vec3 q = fr.at(tExit);
                     next[a] = up[a] ? L.hi[a] : L.lo[a] - 1;
                     for (int b = 0; b < 3; ++b)
                         if (b != a) next[b] = std::clamp(locate(b, q[b]), L.lo[b], L.hi[b] - 1);
@@ -309,7 +323,7 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
                 // ray.at(tExit) a hair outside it), is pushed by delta across every face it
                 // leaves through, then located. Off the pushed axes it stays in the cell's range,
                 // so the walk cannot bounce back into the previous cell.
-                const Vec3 q = ray.at(tExit);
+                const Vec3 q = fr.at(tExit);
                 for (int a = 0; a < 3; ++a) {
                     double x = std::clamp(q[a], P[a], P[3 + a]);
                     if (tAxis[a] == tExit) {
@@ -362,8 +376,9 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
             if (leaves) obs.regionExit(tExit, ray.at(tExit), exitAxis, ties);
             if (how == 1) obs.rope(leaf, int(rope[exitAxis]), nextLeaf);
             if (how == 2) obs.indexStep(exitAxis, next);
-            if (how == 3) obs.push(pushed, ties);
-            if (how >= 2) obs.lookup(how == 3 ? pushed : ray.at(tExit), next, nextLeaf);
+            if (how == 3) obs.push(frame_.toWorld(pushed), ties);
+            if (how >= 2)
+                obs.lookup(how == 3 ? frame_.toWorld(pushed) : ray.at(tExit), next, nextLeaf);
         }
         if (last) return false;
         if (stalled) {
