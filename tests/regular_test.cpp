@@ -8,10 +8,12 @@
 #include <limits>
 #include <random>
 #include <set>
+#include <sstream>
 
 #include "engine/accel/build_guard.h"
 #include "engine/accel/eval.h"
 #include "engine/accel/regular/directory.h"
+#include "engine/accel/structure_dump.h"
 #include "engine/accel/structure_view.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/builtin_scenes.h"
@@ -321,6 +323,17 @@ TEST(RegularFrame, TurnedSpongeIsBuiltInItsOwnFrame) {
         }
         EXPECT_EQ(view.regionAt(0.5 * (c[0] + c[7])), id);
     }
+    // `lancer structure` names the frame: its axes, as the grid holds them.
+    std::ostringstream dump;
+    writeStructureJson(view, {.width = 64, .height = 64}, dump);
+    const nlohmann::json j = nlohmann::json::parse(dump.str());
+    ASSERT_TRUE(j["regular"].contains("axes"));
+    for (int a = 0; a < 3; ++a)
+        for (int k = 0; k < 3; ++k)
+            EXPECT_DOUBLE_EQ(j["regular"]["axes"][a][k].get<double>(), g.frame().axes[a][k]);
+    std::ostringstream flatDump;
+    writeStructureJson(StructureView(s, *flat), {.width = 64, .height = 64}, flatDump);
+    EXPECT_FALSE(nlohmann::json::parse(flatDump.str())["regular"].contains("axes"));
 }
 
 // Scenes with no turned primitive, and a turn too small to pay, keep the world's axes.

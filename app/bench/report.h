@@ -11,7 +11,8 @@
 namespace lancer::bench {
 
 struct BenchOptions {
-    std::vector<std::string> scenes{"builtin:balls:3", "builtin:drilled:6", "builtin:lattice:6"};
+    std::vector<std::string> scenes{"builtin:balls:3", "builtin:drilled:6", "builtin:lattice:6",
+                                    "builtin:sponge:3"};
     int width = 256, height = 256;
     int threads = 0;
     int bounces = 3;
