@@ -1193,14 +1193,15 @@ size_t stopSum(const Accelerator& a) {
 }
 
 TEST(RegularKnobs, ExplicitMaxLevelAndMaxObjectsChangeTheStructure) {
-    // builtin:default at the defaults: the cost stop leaves 2 leaves, whatever a cap would say.
-    // An explicit knob builds by the report's rule (docs/regular.md, "Explicit knobs").
+    // builtin:default at the defaults: the cost stop splits down to max-objects (6 leaves, each
+    // of 4 primitives or fewer). An explicit knob builds by the report's rule (docs/regular.md,
+    // "Explicit knobs").
     Scene s = loadScene("builtin:default");
     BuildParams p = regular();
     auto automatic = buildAccelerator(s, p);
-    EXPECT_EQ(automatic->info().regions, 2u);
+    EXPECT_EQ(automatic->info().regions, 6u);
     EXPECT_EQ(automatic->info().extra["cost_stop"], true);
-    EXPECT_EQ(size_t(automatic->info().extra["stop_reasons"]["cost"]), 2u);
+    EXPECT_EQ(size_t(automatic->info().extra["stop_reasons"]["max_objects"]), 6u);
     stopSum(*automatic);
     p.regular.maxObjects = 1;
     size_t last = 0;
@@ -1222,13 +1223,15 @@ TEST(RegularKnobs, ExplicitMaxLevelAndMaxObjectsChangeTheStructure) {
     p = regular();
     p.regular.maxObjects = 1;
     auto objects = buildAccelerator(s, p);
-    EXPECT_GT(objects->info().regions, 2u);
+    EXPECT_GT(objects->info().regions, automatic->info().regions);
     EXPECT_EQ(int(objects->info().extra["effective_max_level"]), automaticMaxLevel(s.prims.size()));
     stopSum(*objects);
     p = regular();
     p.regular.maxLevel = 8;
     auto level = buildAccelerator(s, p);
     EXPECT_GT(level->info().regions, 2u);
+    p.regular.maxObjects = 1;
+    EXPECT_GT(buildAccelerator(s, p)->info().regions, level->info().regions);
     EXPECT_GT(size_t(level->info().extra["stop_reasons"]["max_objects"]), 0u);
     stopSum(*level);
     // auto is the default; kAutoObjectsCount is what the cells stop at.

@@ -364,6 +364,8 @@ struct RegularBuilder {
     /// bars parallel to it (the sponge's) separates nothing, while the cuts across them do; a
     /// decision on one level would stop there.
     static constexpr int kLookahead = 3;
+    /// A mailbox hit in tests: a tag compared and the spans read back (retestSaving()).
+    static constexpr double kMailboxHitCost = 0.25;
     /// BspNodes::Node::first of a node whose subtree is another fragment's root (node 0 there):
     /// fragment `leaf` among the children of the fragment holding the node.
     static constexpr int32_t kLinked = -2;
@@ -534,15 +536,16 @@ struct RegularBuilder {
         Box3 child[2] = {box, box};
         child[0].hi[axis] = child[1].lo[axis] = mid;
         // The primitives overlap the cell, so a child's test is on the cut axis alone.
-        double tests[2] = {0.0, 0.0};
+        double tests[2] = {0.0, 0.0}, all = 0.0;
         size_t count[2] = {0, 0};
         for (uint32_t p : prims) {
             const Box3& b = grid.boxes()[p];
+            all += weight[p];
             if (coord(b.lo, axis) <= mid) tests[0] += weight[p], ++count[0];
             if (coord(b.hi, axis) >= mid) tests[1] += weight[p], ++count[1];
         }
         const double parentArea = area(box);
-        double cost = 0.0;
+        double cost = -retestSaving(child, parentArea, tests[0] + tests[1] - all);
         for (int side = 0; side < 2; ++side) {
             double c = params.stepCost + params.testCost * tests[side];
             // The look-ahead stops at the gain floor's level, below which a split needs the
@@ -564,12 +567,23 @@ struct RegularBuilder {
         return cost;
     }
 
+    /// What the mailboxes spare a split: a primitive in both children (`both`: their tests) is
+    /// counted in each child's estimate, but a ray crossing both (the chance P0 + P1 - 1, every
+    /// ray through the cell crossing one) tests it once and finds it in its mailbox in the
+    /// other, for kMailboxHitCost of a test. Without this, a cell of long primitives (the bars
+    /// of a Menger sponge) is kept whole where splitting it across them pays.
+    double retestSaving(const Box3 child[2], double parentArea, double both) const {
+        const double crossBoth = (area(child[0]) + area(child[1])) / parentArea - 1.0;
+        return params.testCost * (1.0 - kMailboxHitCost) * both * std::max(crossBoth, 0.0);
+    }
+
     /// splitCost() at depth 1 from the tests of the children's primitives, the cut at `mid`.
-    double splitCostOf(const Box3& box, int axis, double mid, const double tests[2]) const {
+    double splitCostOf(const Box3& box, int axis, double mid, const double tests[2],
+                       double all) const {
         Box3 child[2] = {box, box};
         child[0].hi[axis] = child[1].lo[axis] = mid;
         const double parentArea = area(box);
-        double cost = 0.0;
+        double cost = -retestSaving(child, parentArea, tests[0] + tests[1] - all);
         for (int side = 0; side < 2; ++side)
             cost +=
                 area(child[side]) / parentArea * (params.stepCost + params.testCost * tests[side]);
@@ -812,7 +826,7 @@ struct RegularBuilder {
             // A split that does not lower the estimated cost within kLookahead levels is not
             // made (splitPays(), its first estimate from these sums).
             const double leaf = params.stepCost + params.testCost * all;
-            const double split = splitCostOf(box, axis, mid, tests);
+            const double split = splitCostOf(box, axis, mid, tests, all);
             if (params.usesCostStop()) {
                 const bool gainStop = belowGainFloor(level, box, leaf - split);
                 if (gainStop ||
