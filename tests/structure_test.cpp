@@ -8,6 +8,7 @@
 #include <random>
 #include <sstream>
 
+#include "engine/accel/regular/grid_frame.h"
 #include "engine/accel/structure_dump.h"
 #include "engine/accel/structure_view.h"
 #include "engine/model/restriction.h"
@@ -292,6 +293,20 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
         const std::vector<uint32_t> live = scene.livePrimitives();
         const double margin = 1e-7 * scene.scale();
         const IrregularSubdivision* s = v.irregular();
+        // A scene turned off the world's axes: each primitive also has a minimized box along
+        // the turn's axes (grid_frame.h), which the regular grid is built in and which cuts the
+        // irregular scheme's camera-frame bound.
+        const FrameChoice fc = chooseGridFrame(scene);
+        const auto cameraBound = [&](uint32_t p) {
+            Box3 b = s->frame().box(scene.minBox[p]);
+            if (!fc.frame.turned) return b;
+            const Box3& f = fc.boxes[p];
+            Box3 c;
+            for (int i = 0; i < 8 && !f.isEmpty(); ++i)
+                c.expand(s->frame().point(fc.frame.toWorld(
+                    {i & 1 ? f.hi.x : f.lo.x, i & 2 ? f.hi.y : f.lo.y, i & 4 ? f.hi.z : f.lo.z})));
+            return overlap(b, c);
+        };
         for (uint32_t id = 0; id < v.regionCount(); ++id) {
             RegionInfo r = v.region(id);
             std::vector<uint32_t> crossed;
@@ -300,22 +315,24 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
                 bool crossing = false;
                 switch (r.kind) {
                     case RegionKind::SceneBox:
-                    case RegionKind::Leaf:
                     case RegionKind::BvhLeaf:
                     case RegionKind::BvhInner:
                         crossing = crosses(box, r.frameBox, margin);
                         break;
+                    case RegionKind::Leaf:  // both in the grid's frame
+                        crossing = crosses(v.regular()->boxes()[p], r.frameBox, margin);
+                        break;
                     case RegionKind::Slab:
                         // The box's bound in the camera frame: a region of the camera frame that
                         // misses it misses the box.
-                        crossing = crosses(s->frame().box(box), r.frameBox, margin);
+                        crossing = crosses(cameraBound(p), r.frameBox, margin);
                         break;
                     case RegionKind::NearRegion:
-                        crossing = s->frame().box(box).lo.z < r.frameBox.hi.z - margin;
+                        crossing = cameraBound(p).lo.z < r.frameBox.hi.z - margin;
                         break;
                     case RegionKind::ProjectiveSlab: {
                         // The box in (u, v, depth), in front of the first slab's depth.
-                        Box3 cb = s->frame().box(box);
+                        Box3 cb = cameraBound(p);
                         const double zn = s->projective().zNear();
                         if (!(cb.hi.z > zn)) break;
                         Box3 q;

@@ -10,6 +10,7 @@
 #include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/corner_pointers.h"
 #include "engine/accel/irregular/depth_slabs.h"
+#include "engine/accel/regular/grid_frame.h"
 #include "engine/util/format.h"
 #include "engine/util/task_fence.h"
 
@@ -88,8 +89,21 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     double eps = 1e-9 * scale;
     std::vector<Box3> box(scene.prims.size());
     guard.poll();
+    // In a scene turned off the world's axes, each primitive's minimized box along the turn's
+    // own axes (grid_frame.h) is an oriented box of the world much smaller than its world box:
+    // the camera-frame box of its corners cuts the camera-frame box of the world one.
+    const FrameChoice turned = chooseGridFrame(scene);
     for (uint32_t p : live) {
         box[p] = s.frame_.box(scene.minBox[p]);
+        if (turned.frame.turned) {
+            const Box3& fb = turned.boxes[p];
+            Box3 c;
+            for (int i = 0; i < 8 && !fb.isEmpty(); ++i)
+                c.expand(s.frame_.point(
+                    turned.frame.toWorld({i & 1 ? fb.hi.x : fb.lo.x, i & 2 ? fb.hi.y : fb.lo.y,
+                                          i & 4 ? fb.hi.z : fb.lo.z})));
+            box[p] = overlap(box[p], c);
+        }
         box[p].lo -= eps;
         box[p].hi += eps;
     }
