@@ -134,14 +134,8 @@ void writeRegular(Writer& w, const StructureView& v, bool summary) {
     if (g.frame().turned) {
         w.raw(",\"axes\":[");
         for (int a = 0; a < 3; ++a) {
-            const Vec3 v = g.frame().axes[a];
-            w.raw(a ? ",[" : "[");
-            w.num(v.x);
-            w.raw(",");
-            w.num(v.y);
-            w.raw(",");
-            w.num(v.z);
-            w.raw("]");
+            if (a) w.raw(",");
+            w.vec(g.frame().axes[a]);
         }
         w.raw("]");
     }
