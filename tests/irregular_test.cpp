@@ -659,6 +659,23 @@ TEST(IrregularFrame, TurnedSpongeBoundsFollowTheTurn) {
     }
 }
 
+// Random CSG trees of bars turned by one rotation: the bounds cut by the turned boxes lose no
+// hit, in both frames, on random rays, the pixels' rays and secondary rays (tmin > 0).
+TEST(IrregularFrame, RandomTurnedSubtreesRayForRay) {
+    for (uint64_t seed = 1; seed <= 6; ++seed) {
+        Scene s = test::turnedBars(seed * 17 + 3, 24);
+        std::vector<Ray> rays = test::randomRays(s, seed, 3000);
+        const std::vector<Ray> pixels = test::pixelRays(s, 32, 32);
+        rays.insert(rays.end(), pixels.begin(), pixels.end());
+        for (IrregularFrame frame : {IrregularFrame::Projective, IrregularFrame::Camera}) {
+            auto a = buildIrregular(s, BspHeuristic::Balanced, kAutoObjects, frame);
+            const std::string what = s.name + " " + irregularFrameName(frame);
+            expectSame(s, *a, rays, what);
+            expectSame(s, *a, rays, what + ", tmin > 0", 1e-3 * s.scale());
+        }
+    }
+}
+
 TEST(Irregular, SparseRestrictionEqualsRestrictTree) {
     std::mt19937_64 rng(17);
     for (uint64_t seed = 50; seed < 70; ++seed) {

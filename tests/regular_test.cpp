@@ -199,67 +199,13 @@ void randomScenesMatchBrute(StepMethod step, int seeds) {
     EXPECT_GE(total, 100000u);
 }
 
-/// A random CSG tree over bars (blocks long on one axis), cylinders along an axis and spheres,
-/// the whole turned by one random rotation: a turned subtree whose frame the grid can follow.
-/// `degrees`: the turn's angle (negative: a random one from 30 to 150).
-Scene turnedBars(uint64_t seed, int count = 16, double degrees = -1.0) {
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> u(-1.0, 1.0), thin(0.05, 0.25), len(2.5, 4.5);
-    const double angle = 30.0 + 120.0 * std::abs(u(rng));
-    const Transform turn =
-        Transform::translate(Vec3(u(rng), u(rng), u(rng))) *
-        Transform::rotate(degrees < 0.0 ? angle : degrees, {u(rng), u(rng), u(rng) + 1.5});
-    Scene s;
-    s.name = "turned-bars:" + std::to_string(seed);
-    std::vector<int> nodes;
-    for (int i = 0; i < count; ++i) {
-        const int axis = int(rng() % 3);
-        Transform xf = turn * Transform::translate(2.5 * Vec3(u(rng), u(rng), u(rng)));
-        Shape shape;
-        switch (rng() % 3) {
-            case 0: {
-                Vec3 h(thin(rng));
-                h[axis] = len(rng);
-                shape = Block{-h, h};
-                break;
-            }
-            case 1: {
-                const double r = thin(rng);
-                shape = Cone{r, r, 2.0 * len(rng), false};
-                if (axis < 2)
-                    xf = xf * Transform::rotate(90.0, axis == 0 ? Vec3(0, 1, 0) : Vec3(1, 0, 0));
-                break;
-            }
-            default:
-                shape = Sphere{Vec3(0.0), 0.5 + thin(rng)};
-        }
-        s.prims.push_back(makePrimitive(shape, xf, 0));
-        nodes.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
-    }
-    while (nodes.size() > 1) {
-        const size_t i = rng() % nodes.size();
-        const int a = nodes[i];
-        nodes.erase(nodes.begin() + long(i));
-        const size_t j = rng() % nodes.size();
-        // Mostly unions and differences: intersections of thin bars are mostly empty.
-        const Op op =
-            std::array<Op, 6>{Op::Union,      Op::Union,      Op::Union,
-                              Op::Difference, Op::Difference, Op::Intersection}[rng() % 6];
-        nodes[j] = s.tree.combine(op, a, nodes[j]);
-    }
-    s.tree.root = nodes[0];
-    s.prepare();
-    s.frameCamera({-1.0, 2.0, -1.0}, {0, 0, 1});
-    return s;
-}
-
 // A grid in a turned frame walks the mapped ray and tests the world one: every hit equal to
 // brute force's, on random rays, rays through its cells' corners, edges and faces and rays
 // along its own axes (which run along its planes), for both step methods and stop rules.
 TEST(RegularFrame, RandomTurnedSubtreesRayForRay) {
     int turned = 0;
     for (uint64_t seed = 1; seed <= 8; ++seed) {
-        Scene s = turnedBars(seed * 13 + 5, 24);
+        Scene s = test::turnedBars(seed * 13 + 5, 24);
         for (StepMethod step : {StepMethod::Exact, StepMethod::Push}) {
             BuildParams p = regular(step);
             if (seed % 2) {
@@ -336,6 +282,24 @@ TEST(RegularFrame, TurnedSpongeIsBuiltInItsOwnFrame) {
     EXPECT_FALSE(nlohmann::json::parse(flatDump.str())["regular"].contains("axes"));
 }
 
+// A primitive flattened by a scale of 1e-300 beside turned bars: every box of the frame is
+// finite (or empty), and every hit is brute force's.
+TEST(RegularFrame, NearlySingularTransformKeepsFiniteBoxes) {
+    Scene s = test::turnedBars(5, 16, 40.0);
+    const Primitive& p0 = s.prims[0];
+    s.prims[0] = makePrimitive(p0.shape, p0.xf * Transform::scale({1e-300, 1.0, 1.0}), 0);
+    s.prepare();
+    auto accel = buildAccelerator(s, regular());
+    const RegularGrid& g = gridOf(*accel);
+    for (const Box3& b : g.boxes()) {
+        if (b.isEmpty()) continue;
+        for (int a = 0; a < 3; ++a)
+            EXPECT_TRUE(std::isfinite(b.lo[a]) && std::isfinite(b.hi[a])) << b.toString();
+    }
+    for (int a = 0; a < 3; ++a) EXPECT_TRUE(std::isfinite(g.box().lo[a] + g.box().hi[a]));
+    test::expectSame(s, *accel, hardRays(s, g, 5, 2000), "flattened primitive");
+}
+
 // Scenes with no turned primitive, and a turn too small to pay, keep the world's axes.
 TEST(RegularFrame, WorldAxesKeptWhereNoTurnPays) {
     for (const char* name : {"default", "lattice", "drilled"}) {
@@ -344,9 +308,9 @@ TEST(RegularFrame, WorldAxesKeptWhereNoTurnPays) {
         EXPECT_FALSE(gridOf(*accel).frame().turned) << name;
     }
     // Bars turned by two degrees: their boxes grow by a third, short of what a frame needs.
-    Scene s = turnedBars(3, 16, 2.0);
+    Scene s = test::turnedBars(3, 16, 2.0);
     EXPECT_FALSE(gridOf(*buildAccelerator(s, regular())).frame().turned);
-    EXPECT_TRUE(gridOf(*buildAccelerator(turnedBars(3, 16, 40.0), regular())).frame().turned);
+    EXPECT_TRUE(gridOf(*buildAccelerator(test::turnedBars(3, 16, 40.0), regular())).frame().turned);
 }
 
 TEST(RegularExact, RandomCsgScenesRayForRay) { randomScenesMatchBrute(StepMethod::Exact, 6); }

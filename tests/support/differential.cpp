@@ -92,6 +92,57 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
     return s;
 }
 
+Scene turnedBars(uint64_t seed, int count, double degrees) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1.0, 1.0), thin(0.05, 0.25), len(2.5, 4.5);
+    const double angle = 30.0 + 120.0 * std::abs(u(rng));
+    const Transform turn =
+        Transform::translate(Vec3(u(rng), u(rng), u(rng))) *
+        Transform::rotate(degrees < 0.0 ? angle : degrees, {u(rng), u(rng), u(rng) + 1.5});
+    Scene s;
+    s.name = "turned-bars:" + std::to_string(seed);
+    std::vector<int> nodes;
+    for (int i = 0; i < count; ++i) {
+        const int axis = int(rng() % 3);
+        Transform xf = turn * Transform::translate(2.5 * Vec3(u(rng), u(rng), u(rng)));
+        Shape shape;
+        switch (rng() % 3) {
+            case 0: {
+                Vec3 h(thin(rng));
+                h[axis] = len(rng);
+                shape = Block{-h, h};
+                break;
+            }
+            case 1: {
+                const double r = thin(rng);
+                shape = Cone{r, r, 2.0 * len(rng), false};
+                if (axis < 2)
+                    xf = xf * Transform::rotate(90.0, axis == 0 ? Vec3(0, 1, 0) : Vec3(1, 0, 0));
+                break;
+            }
+            default:
+                shape = Sphere{Vec3(0.0), 0.5 + thin(rng)};
+        }
+        s.prims.push_back(makePrimitive(shape, xf, 0));
+        nodes.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
+    }
+    while (nodes.size() > 1) {
+        const size_t i = rng() % nodes.size();
+        const int a = nodes[i];
+        nodes.erase(nodes.begin() + long(i));
+        const size_t j = rng() % nodes.size();
+        // Mostly unions and differences: intersections of thin bars are mostly empty.
+        const Op op =
+            std::array<Op, 6>{Op::Union,      Op::Union,      Op::Union,
+                              Op::Difference, Op::Difference, Op::Intersection}[rng() % 6];
+        nodes[j] = s.tree.combine(op, a, nodes[j]);
+    }
+    s.tree.root = nodes[0];
+    s.prepare();
+    s.frameCamera({-1.0, 2.0, -1.0}, {0, 0, 1});
+    return s;
+}
+
 Scene randomGlassyCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
     Scene scene = randomCsgScene(seed, opt);
     scene.materials[0].reflect = 0.3;

@@ -26,6 +26,11 @@ struct RandomSceneOptions {
 /// A random binary CSG tree over random solids (spheres, boxes, cylinders, cones), prepared.
 Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt = {});
 
+/// A random CSG tree over bars (blocks long on one axis), cylinders along an axis and spheres,
+/// the whole turned by one rotation of `degrees` (negative: a random angle from 30 to 150): a
+/// turned subtree whose frame a scheme can follow (grid_frame.h). Prepared, camera framed.
+Scene turnedBars(uint64_t seed, int count = 16, double degrees = -1.0);
+
 /// randomCsgScene with a material that reflects and refracts, a framed camera and the default
 /// lights: a pixel's ray tree holds every ray kind (primary, shadow, reflection, refraction).
 Scene randomGlassyCsgScene(uint64_t seed, const RandomSceneOptions& opt = {});

@@ -35,6 +35,8 @@ bool permutesAxes(const Mat3& m, double tol) {
 /// Rotations from transforms built of six-digit matrices (OpenSCAD's .csg) agree to about
 /// 1e-6: frames that close are one frame.
 constexpr double kSameFrame = 1e-4;
+/// Distinct turned rotations kept while counting.
+constexpr size_t kMaxDistinct = 16;
 
 double area(const Box3& b) {
     const Vec3 e = b.extent();
@@ -92,8 +94,9 @@ FrameChoice chooseGridFrame(const Scene& scene) {
     out.frameArea = out.worldArea;
     if (!std::isfinite(out.worldArea) || !(out.worldArea > 0.0)) return out;
 
-    // Distinct turned rotations among the transforms, counted; past 64 distinct ones only the
-    // known ones are counted (a scene of randomly turned parts has no frame of its own).
+    // Distinct turned rotations among the transforms, counted; past kMaxDistinct distinct ones
+    // only the known ones are counted (a scene of randomly turned parts has no frame of its own,
+    // and each primitive is compared with at most that many).
     struct Candidate {
         Mat3 axes;
         size_t count;
@@ -108,12 +111,17 @@ FrameChoice chooseGridFrame(const Scene& scene) {
         });
         if (it != cands.end())
             ++it->count;
-        else if (cands.size() < 64)
+        else if (cands.size() < kMaxDistinct)
             cands.push_back({r, 1});
     }
     out.candidates = int(cands.size());
     std::stable_sort(cands.begin(), cands.end(),
                      [](const Candidate& a, const Candidate& b) { return a.count > b.count; });
+    // Scored: the most frequent, each shared by 1% of the live primitives at least (a score
+    // minimizes every box again: on a scene of many parts turned each its own way, one
+    // minimization per part would cost more than the build).
+    const size_t least = std::max<size_t>(1, live.size() / 100);
+    while (!cands.empty() && cands.back().count < least) cands.pop_back();
     if (cands.size() > size_t(kMaxFrameCandidates)) cands.resize(kMaxFrameCandidates);
 
     // Boxes mapped into a frame round by an ulp or so: each is widened by a hair of the scene's

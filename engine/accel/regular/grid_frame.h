@@ -43,13 +43,15 @@ struct FrameChoice {
 
 /// A turned frame is chosen when its boxes' total area is below this share of the world's.
 inline constexpr double kTurnedAreaShare = 0.5;
-/// Turned frames scored at most (the most frequent among the primitives' transforms).
+/// Turned frames scored at most (the most frequent among the primitives' transforms, each the
+/// rotation of 1% of the live primitives at least).
 inline constexpr int kMaxFrameCandidates = 8;
 
 /// The frame of least total minimized-box surface area (the surface area heuristic's cost of a
 /// ray crossing every primitive's box), among the world's axes and the rotations of the
 /// primitives' transforms (each orthonormalized; frames equal up to the order and sign of their
-/// axes are one), chosen over the world's only below kTurnedAreaShare of its area.
+/// axes are one), chosen over the world's only below kTurnedAreaShare of its area. Its cost: a
+/// pass over the transforms, and one minimization of the boxes per frame scored.
 FrameChoice chooseGridFrame(const Scene& scene);
 
 /// A primitive's box in `frame`: its shape's bounds (vertices for triangles and polygons, the

@@ -1190,9 +1190,15 @@ RegularGrid::RegularGrid(const Scene& scene, const RegularConfig& params, BuildG
 
 void RegularGrid::makeSphereQuads() {
     const Scene& scene = *scene_;
+    // The world's largest coordinate in the grid (the quads test world points): the largest of
+    // its corners' coordinates, which along the world's axes is the box's own.
     quadScale_ = 0.0;
-    for (int a = 0; a < 3; ++a)
-        quadScale_ = std::max({quadScale_, std::abs(clipBox_.lo[a]), std::abs(clipBox_.hi[a])});
+    for (int c = 0; c < 8; ++c) {
+        const Vec3 w = glm::abs(frame_.toWorld({c & 1 ? clipBox_.hi.x : clipBox_.lo.x,
+                                                c & 2 ? clipBox_.hi.y : clipBox_.lo.y,
+                                                c & 4 ? clipBox_.hi.z : clipBox_.lo.z}));
+        quadScale_ = std::max({quadScale_, w.x, w.y, w.z});
+    }
     // A centre and the walk's point in floats are each off by 2^-24 of the largest coordinate:
     // the radius is grown by ten times their sum, and by ten times the floats' relative
     // rounding of the comparison.
