@@ -112,6 +112,44 @@ TEST(Bvh, RandomScenesAndHardRays) {
 }
 
 // Without mailboxes every leaf tests its primitives again: the same hits, more tests.
+// A turned scene: the BVH is built along the turn's axes (the rule of the regular grid,
+// grid_frame.h) and walks the ray mapped into them; every hit is brute force's, on random turned
+// trees and on the sponge, where it visits a quarter of the nodes of the world-axes build.
+TEST(Bvh, TurnedScenesAreBuiltInTheirFrame) {
+    for (uint64_t seed = 1; seed <= 6; ++seed) {
+        Scene s = test::turnedBars(seed * 7 + 2, 24);
+        std::vector<Ray> rays = test::randomRays(s, seed, 3000);
+        auto a = buildAccelerator(s, bvhParams());
+        test::expectSame(s, *a, rays, s.name);
+        test::expectSame(s, *a, rays, s.name + ", tmin > 0", 1e-3 * s.scale());
+    }
+    Scene s = loadScene("builtin:sponge:3");
+    auto own = buildAccelerator(s, bvhParams());
+    const Bvh& b = std::get<Bvh>(own->impl());
+    ASSERT_TRUE(b.frame().turned);
+    test::expectSamePixelsAndSecondaries(s, *own, 64, 5, "sponge, bvh");
+    BuildParams world = bvhParams();
+    world.bvh.turnedFrame = false;
+    auto flat = buildAccelerator(s, world);
+    EXPECT_FALSE(std::get<Bvh>(flat->impl()).frame().turned);
+    const std::vector<Ray> rays = test::pixelRays(s, 64, 64);
+    const RayCounters c = test::traceCounters(s, *own, rays);
+    const RayCounters w = test::traceCounters(s, *flat, rays);
+    EXPECT_LT(2 * c.regionVisits, w.regionVisits)
+        << c.regionVisits << " against " << w.regionVisits;
+    // Its nodes' corners are the world's: each node's centre is picked back.
+    const StructureView view(s, *own);
+    for (uint32_t id = 0; id < view.regionCount(); ++id) {
+        if (!b.nodes()[id].leaf) continue;
+        const std::array<Vec3, 8> k = view.regionCorners(id);
+        const Vec3 lo = b.frame().toFrame(k[0]), hi = b.frame().toFrame(k[7]);
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_NEAR(lo[a], b.nodes()[id].box().lo[a], 1e-12);
+            EXPECT_NEAR(hi[a], b.nodes()[id].box().hi[a], 1e-12);
+        }
+    }
+}
+
 TEST(Bvh, MailboxesSpareRepeatedTestsOnly) {
     Scene scene = loadScene("builtin:lattice:4");
     BuildParams with = bvhParams(), without = bvhParams();

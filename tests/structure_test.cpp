@@ -315,9 +315,12 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
                 bool crossing = false;
                 switch (r.kind) {
                     case RegionKind::SceneBox:
-                    case RegionKind::BvhLeaf:
-                    case RegionKind::BvhInner:
                         crossing = crosses(box, r.frameBox, margin);
+                        break;
+                    case RegionKind::BvhLeaf:  // both in the BVH's frame
+                    case RegionKind::BvhInner:
+                        crossing = crosses(v.bvh()->frame().turned ? fc.boxes[p] : box, r.frameBox,
+                                           margin);
                         break;
                     case RegionKind::Leaf:  // both in the grid's frame
                         crossing = crosses(v.regular()->boxes()[p], r.frameBox, margin);

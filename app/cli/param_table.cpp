@@ -164,14 +164,20 @@ std::vector<ParamDesc> makeTable() {
          .iniKey = "turned_frame",
          .label = "turned frame",
          .help =
-             "Build the grid along the world's axes even where a turned subtree's own axes "
-             "give its primitives much smaller boxes (docs/regular.md, \"Turned scenes\")",
+             "Build the regular grid or the BVH along the world's axes even where a turned "
+             "subtree's own axes give its primitives much smaller boxes (docs/regular.md, "
+             "\"Turned scenes\")",
          .kind = ParamKind::Switch};
     d.flagValue = false;
-    d.schemes = kRegular;
+    d.schemes = kRegular | schemeBit(SchemeKind::Bvh);
     d.effect = ChangeEffect::Rebuild;
-    d.get = [](const K& k) { return double(k.build.regular.turnedFrame); };
-    d.set = [](K& k, double v) { k.build.regular.turnedFrame = v != 0.0; };
+    d.get = [](const K& k) {
+        return double(k.build.scheme == SchemeKind::Bvh ? k.build.bvh.turnedFrame
+                                                        : k.build.regular.turnedFrame);
+    };
+    d.set = [](K& k, double v) {
+        k.build.regular.turnedFrame = k.build.bvh.turnedFrame = v != 0.0;
+    };
     add(d);
     d = {.flag = "--no-cost-stop",
          .metavar = "",

@@ -86,6 +86,7 @@ std::string toString(const BuildParams& p) {
         const BvhConfig& b = p.bvh;
         os << " --max-level " << b.maxLevel << " --max-objects " << maxObjectsText(b.maxObjects);
         if (!b.costStop) os << " --no-cost-stop";
+        if (!b.turnedFrame) os << " --world-frame";
     }
     if (p.scheme != SchemeKind::Brute) {
         if (!p.mailboxes) os << " --no-mailbox";

@@ -88,11 +88,24 @@ class Writer {
     std::string buf_;
 };
 
+/// A structure following a turned subtree gives its frame's axes: its bounds and boxes are
+/// then coordinates along them (x = dot(axes[0], world point), ...); nothing along the world's.
+void writeAxes(Writer& w, const GridFrame& f) {
+    if (!f.turned) return;
+    w.raw(",\"axes\":[");
+    for (int a = 0; a < 3; ++a) {
+        if (a) w.raw(",");
+        w.vec(f.axes[a]);
+    }
+    w.raw("]");
+}
+
 /// docs/design.md section 6: "bvh": {"bounds", "nodes": [{"id", "depth", "box", "children"} or
 /// {"id", "depth", "box", "prims"}]}.
 void writeBvh(Writer& w, const Bvh& b, bool summary) {
     w.raw(",\"bvh\":{\"bounds\":");
     w.box(b.box());
+    writeAxes(w, b.frame());
     w.raw(",\"node_count\":");
     w.num(uint64_t(b.nodes().size()));
     w.raw(",\"depth\":");
@@ -129,16 +142,7 @@ void writeRegular(Writer& w, const StructureView& v, bool summary) {
     const RegularGrid& g = *v.regular();
     w.raw(",\"regular\":{\"bounds\":");
     w.box(g.box());
-    // A grid following a turned subtree gives its frame's axes: bounds, leaf boxes and planes
-    // are then coordinates along them (x = dot(axes[0], world point), ...).
-    if (g.frame().turned) {
-        w.raw(",\"axes\":[");
-        for (int a = 0; a < 3; ++a) {
-            if (a) w.raw(",");
-            w.vec(g.frame().axes[a]);
-        }
-        w.raw("]");
-    }
+    writeAxes(w, g.frame());
     w.raw(",\"directory\":[");
     for (int a = 0; a < 3; ++a) {
         if (a) w.raw(",");

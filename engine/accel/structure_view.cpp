@@ -221,7 +221,11 @@ std::array<Vec3, 8> StructureView::regionCorners(uint32_t id) const {
         const RegularLeaf& L = g->leaves().at(id);
         return gridCorners(L.lo, L.hi);
     }
-    if (const Bvh* b = bvh()) return boxCorners(b->nodes().at(id).box());
+    if (const Bvh* b = bvh()) {
+        std::array<Vec3, 8> c = boxCorners(b->nodes().at(id).box());
+        for (Vec3& p : c) p = b->frame().toWorld(p);
+        return c;
+    }
     const IrregularSubdivision* s = irregular();
     if (!s) return boxCorners(scene_->bounds);
     const CameraFrame& f = s->frame();
@@ -365,7 +369,12 @@ std::array<Vec3, 8> StructureView::structureCorners() const {
         for (Vec3& p : c) p = g->frame().toWorld(p);
         return c;
     }
-    if (const Bvh* b = bvh()) return boxCorners(b->regionCount() ? b->box() : scene_->bounds);
+    if (const Bvh* b = bvh()) {
+        if (!b->regionCount()) return boxCorners(scene_->bounds);
+        std::array<Vec3, 8> c = boxCorners(b->box());
+        for (Vec3& p : c) p = b->frame().toWorld(p);
+        return c;
+    }
     const IrregularSubdivision* s = irregular();
     if (!s) return boxCorners(scene_->bounds);
     std::array<Vec3, 8> c = boxCorners(s->bounds());

@@ -34,10 +34,15 @@ fails "--show zones: the regular scheme has no zones" \
 fails "--ab diff: .* needs --change" "$lancer" view builtin:default --ab diff --frames 1 --ini none
 fails "--step first: a playback step" "$lancer" view builtin:default --step first --frames 1 --ini none
 fails "--step last: a playback step" "$lancer" view builtin:default --step last --frames 1 --ini none
-# help-options is listed in the help, and prints the options table.
-"$lancer" --help | grep -q "help-options" || { echo "help-options not in lancer --help" >&2; exit 1; }
-"$lancer" help-options | grep -q -- "| \`--max-objects N\` |" || { echo "help-options output" >&2; exit 1; }
+# help-options is listed in the help, and prints the options table. Each output is read from a
+# file: `grep -q` quits at its match, and with pipefail the writer's SIGPIPE would fail the test.
+"$lancer" --help > "$tmp/help.txt"
+grep -q "help-options" "$tmp/help.txt" || { echo "help-options not in lancer --help" >&2; exit 1; }
+"$lancer" help-options > "$tmp/options.md"
+grep -q -- "| \`--max-objects N\` |" "$tmp/options.md" || { echo "help-options output" >&2; exit 1; }
 # --step's two meanings are told apart in view's help.
-"$lancer" view --help | tr -s ' \n' ' ' | grep -q "Without --pick: the regular scheme's next-cell method" \
+"$lancer" view --help > "$tmp/view.txt"
+tr -s ' \n' ' ' < "$tmp/view.txt" > "$tmp/view1.txt"
+grep -q "Without --pick: the regular scheme's next-cell method" "$tmp/view1.txt" \
   || { echo "view --help does not tell --step's meanings apart" >&2; exit 1; }
 echo ok

@@ -18,7 +18,9 @@ grep -q "error: .*c.bmp.*unknown image format" <<<"$out" || fail "-o c.bmp: $out
 [ ! -e "$tmp/c.bmp" ] || fail "c.bmp written"
 
 # view --help names every scene format.
-"$LANCER" view --help | grep -q "\.csg" || fail "view --help does not mention .csg"
+# From a file: with pipefail, `grep -q` quitting at its match could fail the writer (SIGPIPE).
+"$LANCER" view --help > "$tmp/view-help.txt"
+grep -q "\.csg" "$tmp/view-help.txt" || fail "view --help does not mention .csg"
 
 # Without a display, --screenshot receives the headless render.
 out=$(env -u DISPLAY -u WAYLAND_DISPLAY "$LANCER" view builtin:default --width 64 --height 40 \

@@ -267,8 +267,7 @@ void bvhLayer(const StructureView& sv, const gl::ImageProjector& proj, int w, in
             g.noteLevel(n.depth);
         else
             g.countMax = std::max(g.countMax, size_t(n.leaf ? n.count : 0));
-        g.wires.box(toF(Vec3(n.lo[0], n.lo[1], n.lo[2])), toF(Vec3(n.hi[0], n.hi[1], n.hi[2])),
-                    gl::rgba8(col));
+        g.wires.box(toF(sv.regionCorners(i)), gl::rgba8(col));
     }
     g.regionsDrawn += picked.size();
 }

@@ -266,11 +266,16 @@ Bvh Bvh::build(const Scene& scene, const BvhConfig& config, nlohmann::json& extr
     b.hair = 1e-9 * scene.scale();
     b.boxes.assign(scene.prims.size(), Box3());
     b.centres.assign(scene.prims.size(), Vec3(0.0));
+    // Along a turned subtree's axes where its boxes are much smaller (grid_frame.h).
+    FrameChoice fc;
+    if (config.turnedFrame) fc = chooseGridFrame(scene);
+    out.frame_ = fc.frame;
+    const std::vector<Box3>& from = fc.frame.turned ? fc.boxes : scene.minBox;
     for (uint32_t p : scene.livePrimitives()) {
-        if (scene.minBox[p].isEmpty()) continue;
+        if (from[p].isEmpty()) continue;
         b.ids.push_back(p);
-        b.boxes[p] = scene.minBox[p];
-        b.centres[p] = scene.minBox[p].center();
+        b.boxes[p] = from[p];
+        b.centres[p] = from[p].center();
     }
     if (!b.ids.empty()) {
         out.nodes_.reserve(2 * b.ids.size());
@@ -282,6 +287,10 @@ Bvh Bvh::build(const Scene& scene, const BvhConfig& config, nlohmann::json& extr
         b.fillLeaves();
         b.estimateCost();
     }
+    extra["frame"] = {{"turned", fc.frame.turned}};
+    for (int a = 0; a < 3 && fc.frame.turned; ++a)
+        extra["frame"]["axes"].push_back(
+            {fc.frame.axes[a].x, fc.frame.axes[a].y, fc.frame.axes[a].z});
     extra["nodes"] = out.nodes_.size();
     extra["leaves"] = b.leaves.size();
     extra["depth"] = out.depth_;
@@ -296,8 +305,9 @@ Bvh Bvh::build(const Scene& scene, const BvhConfig& config, nlohmann::json& extr
     return out;
 }
 
-uint32_t Bvh::leafAt(const Vec3& p) const {
+uint32_t Bvh::leafAt(const Vec3& world) const {
     if (nodes_.empty()) return kNoNode;
+    const Vec3 p = frame_.toFrame(world);
     uint32_t best = kNoNode;
     double bestVolume = kInf, bestDist = kInf;
     for (uint32_t i = 0; i < nodes_.size(); ++i) {

@@ -20,6 +20,7 @@
 
 #include "engine/accel/build_params.h"
 #include "engine/accel/eval.h"
+#include "engine/accel/regular/grid_frame.h"
 
 namespace lancer {
 
@@ -62,20 +63,25 @@ class Bvh {
         if (nodes_.empty()) return false;
         // An axis the ray runs parallel to is tested by the origin's place, not by a product
         // with an infinite inverse (0 times infinity is NaN on a box face).
-        const bool parallel = ray.d.x == 0.0 || ray.d.y == 0.0 || ray.d.z == 0.0;
+        // The boxes are the frame's (the world's unless the scene is turned): the walk reads
+        // them with the ray in the frame, `fr` (the same t), the leaves test the world ray.
+        Ray mapped;
+        if (frame_.turned) mapped = frame_.toFrame(ray);
+        const Ray& fr = frame_.turned ? mapped : ray;
+        const bool parallel = fr.d.x == 0.0 || fr.d.y == 0.0 || fr.d.z == 0.0;
         if (unionOnly_) {
-            const int r = parallel ? walkFirstStart<true>(ray, tmin, tmax, ctx, obs, hit)
-                                   : walkFirstStart<false>(ray, tmin, tmax, ctx, obs, hit);
+            const int r = parallel ? walkFirstStart<true>(ray, fr, tmin, tmax, ctx, obs, hit)
+                                   : walkFirstStart<false>(ray, fr, tmin, tmax, ctx, obs, hit);
             if (r >= 0) return r == 1;
             if constexpr (Obs::kActive)
                 obs.walkRestart(
                     "bvh: the ray begins inside a primitive "
                     "or two starts tie; walked in order");
-            return parallel ? walkUnion<true>(ray, tmin, tmax, ctx, obs, hit)
-                            : walkUnion<false>(ray, tmin, tmax, ctx, obs, hit);
+            return parallel ? walkUnion<true>(ray, fr, tmin, tmax, ctx, obs, hit)
+                            : walkUnion<false>(ray, fr, tmin, tmax, ctx, obs, hit);
         }
-        return parallel ? walk<true>(ray, tmin, tmax, ctx, obs, hit)
-                        : walk<false>(ray, tmin, tmax, ctx, obs, hit);
+        return parallel ? walk<true>(ray, fr, tmin, tmax, ctx, obs, hit)
+                        : walk<false>(ray, fr, tmin, tmax, ctx, obs, hit);
     }
 
     /// Regions are the nodes, inner and leaf: the ids the walk reports.
@@ -95,30 +101,34 @@ class Bvh {
     /// The leaves' restricted trees (empty for a union-only scene: its leaves merge their
     /// primitives' spans).
     const CsgTree& treePool() const { return pool_; }
-    /// The structure's box: the root's.
+    /// The frame its boxes are in (grid_frame.h): the world's axes, or a turned subtree's.
+    const GridFrame& frame() const { return frame_; }
+    /// The structure's box, in its frame: the root's.
     Box3 box() const { return nodes_.empty() ? Box3() : nodes_[0].box(); }
     /// Deepest level reached.
     int depth() const { return depth_; }
-    /// The leaf holding a point, for picking: the deepest leaf whose box contains it (the
+    /// The leaf holding a world point, for picking: the deepest leaf whose box contains it (the
     /// nearest leaf's box when none does); kNoNode for an empty structure.
     uint32_t leafAt(const Vec3& p) const;
     /// "leaf 12 depth 5 Box3{..} 3 prims (2 assigned)" or "node 3 depth 1 Box3{..} children 4, 5".
     std::string describe(uint32_t id) const;
 
   private:
+    // Each walk takes the world ray (`ray`: the leaves' tests) and the same ray in the frame
+    // (`fr`: the boxes').
     /// The walk of a scene with intersections or differences: leaves list every primitive
     /// meeting their box, with its restricted tree; front to back by a stack, each leaf's hit
     /// inside its box, the nearest kept.
     template <bool kParallel, class Obs>
-    bool walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+    bool walk(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx, Obs& obs,
               Hit& hit) const;
     /// A union-only scene's walk for a ray that begins outside every primitive, most rays: the
     /// union's first boundary is then the first start of a span after tmin, and the walk is a
     /// closest-hit walk (a stack, nodes beyond the nearest start culled). Returns 1 (hit), 0
     /// (none), or -1 when a span holds tmin or two starts tie for the first: walkUnion decides.
     template <bool kParallel, class Obs>
-    int walkFirstStart(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
-                       Hit& hit) const;
+    int walkFirstStart(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx,
+                       Obs& obs, Hit& hit) const;
     /// The walk of a union-only scene: each primitive in one leaf only, leaves in order of the
     /// t their box is entered at (a heap), their primitives' spans merged as they come. When a
     /// node is entered at t, every span that starts before t is known (its primitive's box lies
@@ -127,8 +137,8 @@ class Bvh {
     /// either is final once the next node is entered beyond it. (A stretch grows as spans join
     /// it, so a node is culled when taken from the heap, never when pushed.)
     template <bool kParallel, class Obs>
-    bool walkUnion(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
-                   Hit& hit) const;
+    bool walkUnion(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx,
+                   Obs& obs, Hit& hit) const;
     /// The ray as the box tests read it: its origin, and its inverse direction (0 along an
     /// axis it is parallel to).
     struct SlabRay {
@@ -160,6 +170,7 @@ class Bvh {
                       TraceContext& ctx, Obs& obs, Hit& hit) const;
 
     const Scene* scene_ = nullptr;
+    GridFrame frame_;
     bool unionOnly_ = false;  ///< the scene's tree has only unions: leaves keep no tree
     int depth_ = 0;
     std::vector<BvhNode> nodes_;
@@ -266,9 +277,9 @@ template <bool kParallel, class Obs>
 }
 
 template <bool kParallel, class Obs>
-int Bvh::walkFirstStart(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
-                        Hit& hit) const {
-    const SlabRay slab(ray);
+int Bvh::walkFirstStart(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx,
+                        Obs& obs, Hit& hit) const {
+    const SlabRay slab(fr);
     const double *const o = slab.o, *const inv = slab.inv;
     const BvhNode* const nodes = nodes_.data();
     using Entry = StackEntry;
@@ -328,9 +339,9 @@ int Bvh::walkFirstStart(const Ray& ray, double tmin, double tmax, TraceContext& 
 }
 
 template <bool kParallel, class Obs>
-bool Bvh::walkUnion(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
-                    Hit& hit) const {
-    const SlabRay slab(ray);
+bool Bvh::walkUnion(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx,
+                    Obs& obs, Hit& hit) const {
+    const SlabRay slab(fr);
     const double *const o = slab.o, *const inv = slab.inv;
     const BvhNode* const nodes = nodes_.data();
     struct Entry {
@@ -414,9 +425,9 @@ bool Bvh::walkUnion(const Ray& ray, double tmin, double tmax, TraceContext& ctx,
 }
 
 template <bool kParallel, class Obs>
-bool Bvh::walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+bool Bvh::walk(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                Hit& hit) const {
-    const SlabRay slab(ray);
+    const SlabRay slab(fr);
     const double *const o = slab.o, *const inv = slab.inv;
     const BvhNode* const nodes = nodes_.data();
     using Entry = StackEntry;

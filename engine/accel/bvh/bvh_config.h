@@ -19,6 +19,9 @@ struct BvhConfig {
     /// surface-area estimate of its cost, for nodes of at most kCostLeafPrims primitives
     /// (false: split down to max-objects). An explicit max-objects splits down to it.
     bool costStop = true;
+    /// Build along a turned subtree's axes when chooseGridFrame() finds them (false:
+    /// --world-frame; docs/regular.md, "Turned scenes").
+    bool turnedFrame = true;
     /// The max-objects the build uses.
     int objects() const { return maxObjects < 0 ? kAutoBvhObjects : maxObjects; }
     /// Whether the surface-area estimate stops nodes.

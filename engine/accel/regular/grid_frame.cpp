@@ -38,11 +38,6 @@ constexpr double kSameFrame = 1e-4;
 /// Distinct turned rotations kept while counting.
 constexpr size_t kMaxDistinct = 16;
 
-double area(const Box3& b) {
-    const Vec3 e = b.extent();
-    return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
-}
-
 /// The frame box of a world box: the hull of its eight corners in the frame.
 Box3 frameHull(const Box3& world, const GridFrame& f, double hair) {
     Box3 b;
@@ -90,7 +85,7 @@ FrameChoice chooseGridFrame(const Scene& scene) {
     std::sort(live.begin(), live.end());
     live.erase(std::unique(live.begin(), live.end()), live.end());
     for (uint32_t p : live)
-        if (!scene.minBox[p].isEmpty()) out.worldArea += area(scene.minBox[p]);
+        if (!scene.minBox[p].isEmpty()) out.worldArea += surfaceArea(scene.minBox[p]);
     out.frameArea = out.worldArea;
     if (!std::isfinite(out.worldArea) || !(out.worldArea > 0.0)) return out;
 
@@ -145,7 +140,7 @@ FrameChoice chooseGridFrame(const Scene& scene) {
         Box3 bounds = Box3::empty();
         for (uint32_t p : live) {
             if (mb.box[p].isEmpty()) continue;
-            a += area(mb.box[p]);
+            a += surfaceArea(mb.box[p]);
             bounds.expand(mb.box[p]);
         }
         if (a < best) {

@@ -12,6 +12,12 @@
 
 namespace lancer {
 
+/// Surface area of a box: the surface area heuristic's measure of the rays that cross it.
+inline double surfaceArea(const Box3& b) {
+    const Vec3 e = b.extent();
+    return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
+}
+
 /// An orthonormal frame: the world's axes, or those of a turned subtree.
 struct GridFrame {
     Mat3 axes{1.0};       ///< columns: the frame's x, y, z axes in world coordinates

@@ -178,12 +178,6 @@ std::vector<uint32_t> testQuarters(const std::vector<float>& weights) {
     return q;
 }
 
-/// Surface area of a box.
-double area(const Box3& b) {
-    const Vec3 e = b.extent();
-    return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
-}
-
 /// Levels --split-axes cost plans (4 cuts per axis on a cube: they fix the cells' shape); deeper
 /// ones cut the longest axis of the level's cells, as the report's order
 /// does on a cube. Planning every level cost up to 40% more build time on scenes of thousands of
@@ -544,7 +538,7 @@ struct RegularBuilder {
             if (coord(b.lo, axis) <= mid) tests[0] += weight[p], ++count[0];
             if (coord(b.hi, axis) >= mid) tests[1] += weight[p], ++count[1];
         }
-        const double parentArea = area(box);
+        const double parentArea = surfaceArea(box);
         double cost = -retestSaving(child, parentArea, tests[0] + tests[1] - all);
         for (int side = 0; side < 2; ++side) {
             double c = params.stepCost + params.testCost * tests[side];
@@ -562,7 +556,7 @@ struct RegularBuilder {
                 if (!coveredByAll(grid.boxes(), in, child[side]))
                     c = std::min(c, splitCost(f, child[side], in, level + 1, depth - 1));
             }
-            cost += area(child[side]) / parentArea * c;
+            cost += surfaceArea(child[side]) / parentArea * c;
         }
         return cost;
     }
@@ -573,7 +567,7 @@ struct RegularBuilder {
     /// other, for kMailboxHitCost of a test. Without this, a cell of long primitives (the bars
     /// of a Menger sponge) is kept whole where splitting it across them pays.
     double retestSaving(const Box3 child[2], double parentArea, double both) const {
-        const double crossBoth = (area(child[0]) + area(child[1])) / parentArea - 1.0;
+        const double crossBoth = (surfaceArea(child[0]) + surfaceArea(child[1])) / parentArea - 1.0;
         return params.testCost * (1.0 - kMailboxHitCost) * both * std::max(crossBoth, 0.0);
     }
 
@@ -582,11 +576,11 @@ struct RegularBuilder {
                        double all) const {
         Box3 child[2] = {box, box};
         child[0].hi[axis] = child[1].lo[axis] = mid;
-        const double parentArea = area(box);
+        const double parentArea = surfaceArea(box);
         double cost = -retestSaving(child, parentArea, tests[0] + tests[1] - all);
         for (int side = 0; side < 2; ++side)
-            cost +=
-                area(child[side]) / parentArea * (params.stepCost + params.testCost * tests[side]);
+            cost += surfaceArea(child[side]) / parentArea *
+                    (params.stepCost + params.testCost * tests[side]);
         return cost;
     }
 
@@ -605,7 +599,7 @@ struct RegularBuilder {
     /// cuts every cell alike, so without it the depth that separates the clusters of small
     /// primitives (a sphereflake's) is the depth of every cell that holds a few of them.
     bool belowGainFloor(int level, const Box3& box, double saving) const {
-        return level >= gainLevel && saving * area(box) < params.minGain * gainArea;
+        return level >= gainLevel && saving * surfaceArea(box) < params.minGain * gainArea;
     }
 
     /// Whether splitting the cell lowers the estimated cost: at once with its children as
