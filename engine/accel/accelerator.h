@@ -63,7 +63,7 @@ class Accelerator {
           params_(params),
           info_(std::move(info)),
           lightBuffer_(std::move(lightBuffer)),
-          eye_(std::move(eye)),
+          eyeBuffer_(std::move(eye)),
           eyeFrom_(eyeFrom) {}
 
     /// Nearest visible hit with t in (tmin, tmax]; reports the walk to `obs`.
@@ -111,7 +111,8 @@ class Accelerator {
     /// where they meet their first region). The one built with the structure for the scene's
     /// camera when `cam` has its eye; else built now. Never null.
     std::shared_ptr<const LightBuffer> eyeBuffer(const Scene& scene, const Camera& cam) const {
-        if (eye_ && cam.projection == Projection::Perspective && cam.from == eyeFrom_) return eye_;
+        if (eyeBuffer_ && cam.projection == Projection::Perspective && cam.from == eyeFrom_)
+            return eyeBuffer_;
         return std::make_shared<const LightBuffer>(makeEyeBuffer(scene, cam, params_));
     }
     /// Whether a scheme built with `params` gives `cam` an eye buffer.
@@ -139,9 +140,9 @@ class Accelerator {
     Impl impl_;
     BuildParams params_;
     AccelInfo info_;
-    LightBuffer lightBuffer_;                 ///< empty for brute force and with --no-light-buffer
-    std::shared_ptr<const LightBuffer> eye_;  ///< the scene camera's eye buffer, or null
-    Vec3 eyeFrom_;                            ///< where eye_ was built from
+    LightBuffer lightBuffer_;  ///< empty for brute force and with --no-light-buffer
+    std::shared_ptr<const LightBuffer> eyeBuffer_;  ///< the scene camera's eye buffer, or null
+    Vec3 eyeFrom_;                                  ///< where eyeBuffer_ was built from
 };
 
 // Each alternative of Accelerator::Impl is a scheme, at its SchemeKind's index: a scheme added

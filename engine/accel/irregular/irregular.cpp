@@ -136,8 +136,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     if (params.frame == IrregularFrame::Projective) {
         tasks.run(fence.task([&] {
             auto t3 = Clock::now();
-            s.eye_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, eyeExtra, slabBytes,
-                                            maxRegions);
+            s.projective_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, eyeExtra,
+                                                   slabBytes, maxRegions);
             eyeMs = ms(t3);
         }));
     }
@@ -305,7 +305,7 @@ int64_t IrregularSubdivision::walkTo(uint32_t from, const Vec3& p) const {
 size_t IrregularSubdivision::memoryBytes() const {
     return sizeof(*this) + regions_.size() * sizeof(IrregularRegion) + bsp_.memoryBytes() +
            zoneFirstRegion_.size() * sizeof(uint32_t) + pool_.nodes.size() * sizeof(CsgNode) +
-           (listFirst_.size() + listPrims_.size()) * sizeof(uint32_t) + eye_.memoryBytes();
+           (listFirst_.size() + listPrims_.size()) * sizeof(uint32_t) + projective_.memoryBytes();
 }
 
 }  // namespace lancer

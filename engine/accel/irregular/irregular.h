@@ -61,7 +61,7 @@ class IrregularSubdivision {
     bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                    Hit& hit) const;
 
-    size_t regionCount() const { return regions_.size() + eye_.regionCount(); }
+    size_t regionCount() const { return regions_.size() + projective_.regionCount(); }
     size_t memoryBytes() const;
     bool usesMailboxes() const { return true; }
 
@@ -72,7 +72,7 @@ class IrregularSubdivision {
     const std::vector<IrregularRegion>& regions() const { return regions_; }
     const ScreenBsp& screen() const { return bsp_; }
     /// The projective zones that primary rays walk (empty with --irregular-frame camera).
-    const ProjectiveZones& projective() const { return eye_; }
+    const ProjectiveZones& projective() const { return projective_; }
     /// Zone z's regions are [zoneFirstRegion()[z], zoneFirstRegion()[z + 1]), by depth.
     const std::vector<uint32_t>& zoneFirstRegion() const { return zoneFirstRegion_; }
     /// The pool of the regions' restricted trees (empty when flat()).
@@ -126,7 +126,7 @@ class IrregularSubdivision {
     CameraFrame frame_;
     Box3 bounds_;
     ScreenBsp bsp_;
-    ProjectiveZones eye_;  ///< primary rays (region ids from regions_.size() on)
+    ProjectiveZones projective_;  ///< primary rays (region ids from regions_.size() on)
     std::vector<IrregularRegion> regions_;
     std::vector<uint32_t> zoneFirstRegion_;  ///< zone z: regions [zoneFirstRegion_[z], [z + 1])
     CsgTree pool_;
@@ -184,8 +184,9 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
                                      Obs& obs, Hit& hit) const {
     if (regions_.empty()) return false;
     Ray rc = frame_.ray(ray);
-    if (double u, v; eye_.covers(ray, rc, u, v))
-        return eye_.intersect(ray, rc, u, v, tmin, tmax, uint32_t(regions_.size()), ctx, obs, hit);
+    if (double u, v; projective_.covers(ray, rc, u, v))
+        return projective_.intersect(ray, rc, u, v, tmin, tmax, uint32_t(regions_.size()), ctx, obs,
+                                     hit);
     double tw0, tw1;
     if (!clipLine(rc, bounds_, tw0, tw1)) return false;
     double t = std::max(tw0, tmin), tend = std::min(tw1, tmax);

@@ -18,7 +18,7 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     ProjectiveZones s;
     s.scene_ = &scene;
     s.frame_ = frame;
-    s.eye_ = frame.origin;
+    s.eyePoint_ = frame.origin;
     const Camera& cam = scene.camera;
     if (cam.projection != Projection::Perspective) return s;
 

@@ -40,7 +40,7 @@ class ProjectiveZones {
     /// This structure answers the ray: it starts exactly at the eye and its (u, v) is inside the
     /// screen rectangle. `rc` is the ray in the camera frame.
     bool covers(const Ray& world, const Ray& rc, double& u, double& v) const {
-        if (zones_ == 0 || world.o != eye_ || !(rc.d.z > 0.0)) return false;
+        if (zones_ == 0 || world.o != eyePoint_ || !(rc.d.z > 0.0)) return false;
         u = rc.d.x / rc.d.z;
         v = rc.d.y / rc.d.z;
         return u >= lo_.x && u <= hi_.x && v >= lo_.y && v <= hi_.y;
@@ -94,7 +94,7 @@ class ProjectiveZones {
 
     const Scene* scene_ = nullptr;
     CameraFrame frame_;  ///< the camera frame the walk's events are told in the world from
-    Vec3 eye_{0.0};
+    Vec3 eyePoint_{0.0};
     glm::dvec2 lo_{0.0}, hi_{0.0};     ///< the screen rectangle in (u, v)
     double zNear_ = 0.0, zFar_ = 0.0;  ///< depth range of the slabs
     int nearRoot_ = -1;  ///< restricted tree of the primitives reaching in front of zNear
