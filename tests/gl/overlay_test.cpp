@@ -68,7 +68,9 @@ gl::Batch leafEdges(const StructureView& sv, int lo = 0, int hi = 64) {
         const int level = sv.leafLevel(i);
         if (level < lo || level > hi) continue;
         const std::array<Vec3, 8> c = sv.regionCorners(i);
-        b.box(glm::vec3(c[0]), glm::vec3(c[7]), gl::rgba8(levelColor(level)));
+        std::array<glm::vec3, 8> f;
+        for (size_t k = 0; k < 8; ++k) f[k] = glm::vec3(c[k]);
+        b.box(f, gl::rgba8(levelColor(level)));
     }
     return b;
 }
@@ -224,6 +226,91 @@ std::vector<uint8_t> drawn(const OffscreenGl& gl, Overlays& ov, const Camera& ca
     gl.clear(0, 0, 0);
     ov.draw(cam, kW, kH);
     return gl.read();
+}
+
+/// Bars 8 long turned by 30 degrees about z, seen from +z by the orthographic camera of
+/// twoBoxes: the regular grid follows their frame, so its leaves project as turned rectangles.
+std::shared_ptr<SceneBuild> turnedBarsFromAbove() {
+    auto scene = std::make_shared<Scene>();
+    const Transform turn = Transform::rotate(30.0, {0, 0, 1});
+    for (const Vec3& c : {Vec3(0.0, -1.5, 0.0), Vec3(0.0, 1.5, 0.0), Vec3(0.5, 0.0, 0.3)})
+        scene->prims.push_back(
+            makePrimitive(Block{c - Vec3(4.0, 0.2, 0.2), c + Vec3(4.0, 0.2, 0.2)}, turn));
+    // Small blocks between them, so the BSP cuts to several levels.
+    for (const Vec3& c : {Vec3(-3.0, 0.8, 0.0), Vec3(2.5, -0.7, 0.1), Vec3(1.0, 2.6, -0.1)})
+        scene->prims.push_back(makePrimitive(Block{c - Vec3(0.3), c + Vec3(0.3)}, turn));
+    std::vector<int> leaves;
+    for (uint32_t i = 0; i < scene->prims.size(); ++i) leaves.push_back(scene->tree.leaf(i));
+    scene->tree.root = scene->tree.balanced(Op::Union, leaves);
+    scene->camera.from = {0.0, 0.0, 10.0};
+    scene->camera.at = {0.0, 0.0, 0.0};
+    scene->camera.up = {0.0, 1.0, 0.0};
+    scene->camera.projection = Projection::Orthographic;
+    scene->camera.orthoHeight = 10.0;
+    scene->width = kW;
+    scene->height = kH;
+    scene->prepare();
+    BuildParams p;
+    p.scheme = SchemeKind::Regular;
+    p.regular.maxLevel = 6;
+    p.regular.maxObjects = 1;
+    auto s = std::make_shared<SceneBuild>();
+    s->spec = "turned bars";
+    s->scene = scene;
+    s->accel = buildAccelerator(*scene, p);
+    return s;
+}
+
+/// Distance from the point p to the segment [a, b].
+double segmentDistance(glm::dvec2 p, glm::dvec2 a, glm::dvec2 b) {
+    const glm::dvec2 d = b - a;
+    const double len2 = glm::dot(d, d);
+    const double t = len2 > 0.0 ? std::clamp(glm::dot(p - a, d) / len2, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + t * d));
+}
+
+// A grid in a turned frame is drawn turned: every lit pixel lies within a pixel and a half of a
+// leaf's projected edge, and every edge's middle is lit.
+TEST(Overlays, TurnedLeavesAreDrawnOnTheirProjectedEdges) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = turnedBarsFromAbove();
+    ASSERT_TRUE(std::get<RegularGrid>(s->accel->impl()).frame().turned);
+    const Camera& cam = s->scene->camera;
+    Overlays ov;
+    ov.options.leaves = true;
+    ov.update(s, cam, kW, kH);
+    const StructureView& sv = *ov.view();
+    ASSERT_GT(sv.regionCount(), 8u);
+    EXPECT_TRUE(viewer::testing::sameLineCover(leafEdges(sv), ov.geometry().wires));
+    const gl::ImageProjector proj(cam, kW, kH);
+    std::vector<std::pair<glm::dvec2, glm::dvec2>> edges;  // the x and y edges, in the image
+    for (uint32_t i = 0; i < sv.regionCount(); ++i) {
+        const std::array<Vec3, 8> c = sv.regionCorners(i);
+        for (int k = 0; k < 8; ++k)
+            for (int bit : {1, 2})
+                if (!(k & bit)) edges.push_back({*proj.toImage(c[k]), *proj.toImage(c[k | bit])});
+    }
+    const std::vector<uint8_t> px = drawn(gl, ov, cam);
+    size_t litCount = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            if (!lit(px, x, y)) continue;
+            ++litCount;
+            double best = 1e9;
+            for (const auto& [a, b] : edges)
+                best = std::min(best, segmentDistance({x + 0.5, y + 0.5}, a, b));
+            ASSERT_LT(best, 1.5) << "pixel " << x << "," << y << " lit off every leaf edge";
+        }
+    EXPECT_GT(litCount, 0u);
+    for (const auto& [a, b] : edges) {
+        const glm::dvec2 m = 0.5 * (a + b);
+        if (m.x < 1 || m.y < 1 || m.x > kW - 2 || m.y > kH - 2) continue;
+        bool near = false;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) near = near || lit(px, int(m.x) + dx, int(m.y) + dy);
+        EXPECT_TRUE(near) << "edge middle " << m.x << "," << m.y << " not drawn";
+    }
 }
 
 TEST(Overlays, TheLevelRangeHidesTheLevelsOutsideIt) {
