@@ -55,30 +55,6 @@ void operator delete(void* p, std::align_val_t) noexcept { release(p); }
 void operator delete[](void* p, std::align_val_t) noexcept { release(p); }
 void operator delete(void* p, size_t, std::align_val_t) noexcept { release(p); }
 void operator delete[](void* p, size_t, std::align_val_t) noexcept { release(p); }
-// The nothrow forms too (std::stable_sort's buffer takes one): AddressSanitizer serves its own
-// for those, which the replaced delete would then free with free().
-void* operator new(size_t n, const std::nothrow_t&) noexcept {
-    try {
-        return allocate(n, 0);
-    } catch (...) {
-        return nullptr;
-    }
-}
-void* operator new[](size_t n, const std::nothrow_t& t) noexcept { return operator new(n, t); }
-void* operator new(size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
-    try {
-        return allocate(n, size_t(a));
-    } catch (...) {
-        return nullptr;
-    }
-}
-void* operator new[](size_t n, std::align_val_t a, const std::nothrow_t& t) noexcept {
-    return operator new(n, a, t);
-}
-void operator delete(void* p, const std::nothrow_t&) noexcept { release(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { release(p); }
-void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { release(p); }
-void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { release(p); }
 
 namespace lancer {
 namespace {

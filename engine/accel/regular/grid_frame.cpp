@@ -95,6 +95,7 @@ FrameChoice chooseGridFrame(const Scene& scene) {
     struct Candidate {
         Mat3 axes;
         size_t count;
+        size_t first;  ///< its place among the candidates found, for a stable order
     };
     std::vector<Candidate> cands;
     for (uint32_t p : live) {
@@ -107,11 +108,14 @@ FrameChoice chooseGridFrame(const Scene& scene) {
         if (it != cands.end())
             ++it->count;
         else if (cands.size() < kMaxDistinct)
-            cands.push_back({r, 1});
+            cands.push_back({r, 1, cands.size()});
     }
     out.candidates = int(cands.size());
-    std::stable_sort(cands.begin(), cands.end(),
-                     [](const Candidate& a, const Candidate& b) { return a.count > b.count; });
+    // By count, then as found (std::sort: no temporary buffer, which a build under a replaced
+    // operator new, as the bounds tests', would take from the nothrow form).
+    std::sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) {
+        return a.count != b.count ? a.count > b.count : a.first < b.first;
+    });
     // Scored: the most frequent, each shared by 1% of the live primitives at least (a score
     // minimizes every box again: on a scene of many parts turned each its own way, one
     // minimization per part would cost more than the build).
