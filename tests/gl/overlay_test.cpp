@@ -22,6 +22,22 @@ using viewer::testing::OffscreenGl;
 
 constexpr int kW = 100, kH = 100;
 
+/// The union of the scene's primitives, prepared, seen from +z by an orthographic camera of 10
+/// pixels a unit centred on the origin, in a kW x kH image.
+void unionSeenFromAbove(Scene& scene) {
+    std::vector<int> leaves;
+    for (uint32_t i = 0; i < scene.prims.size(); ++i) leaves.push_back(scene.tree.leaf(i));
+    scene.tree.root = scene.tree.balanced(Op::Union, leaves);
+    scene.camera.from = {0.0, 0.0, 10.0};
+    scene.camera.at = {0.0, 0.0, 0.0};
+    scene.camera.up = {0.0, 1.0, 0.0};
+    scene.camera.projection = Projection::Orthographic;
+    scene.camera.orthoHeight = 10.0;
+    scene.width = kW;
+    scene.height = kH;
+    scene.prepare();
+}
+
 /// Two blocks (the irregular BSP cut while a zone holds any primitive: maxObjects 0) seen from +z
 /// by an orthographic camera, 10 pixels a unit, whose x and y faces project half a pixel off the
 /// pixel grid, onto pixel centres: x = -2.95 is column 20, and so on (columns 20, 40, 60, 80; rows
@@ -37,17 +53,7 @@ std::shared_ptr<SceneBuild> twoBoxes(SchemeKind scheme, int maxLevel = 24) {
                               Vec3(0.1, 3.6, 0.0), Vec3(-4.2, -3.9, 0.1)})
             scene->prims.push_back(makePrimitive(Block{c - 0.4, c + 0.4}, {}));
     }
-    std::vector<int> leaves;
-    for (uint32_t i = 0; i < scene->prims.size(); ++i) leaves.push_back(scene->tree.leaf(i));
-    scene->tree.root = scene->tree.balanced(Op::Union, leaves);
-    scene->camera.from = {0.0, 0.0, 10.0};
-    scene->camera.at = {0.0, 0.0, 0.0};
-    scene->camera.up = {0.0, 1.0, 0.0};
-    scene->camera.projection = Projection::Orthographic;
-    scene->camera.orthoHeight = 10.0;
-    scene->width = kW;
-    scene->height = kH;
-    scene->prepare();
+    unionSeenFromAbove(*scene);
     BuildParams p;
     p.scheme = scheme;
     p.regular.maxLevel = maxLevel;
@@ -239,17 +245,7 @@ std::shared_ptr<SceneBuild> turnedBarsFromAbove() {
     // Small blocks between them, so the BSP cuts to several levels.
     for (const Vec3& c : {Vec3(-3.0, 0.8, 0.0), Vec3(2.5, -0.7, 0.1), Vec3(1.0, 2.6, -0.1)})
         scene->prims.push_back(makePrimitive(Block{c - Vec3(0.3), c + Vec3(0.3)}, turn));
-    std::vector<int> leaves;
-    for (uint32_t i = 0; i < scene->prims.size(); ++i) leaves.push_back(scene->tree.leaf(i));
-    scene->tree.root = scene->tree.balanced(Op::Union, leaves);
-    scene->camera.from = {0.0, 0.0, 10.0};
-    scene->camera.at = {0.0, 0.0, 0.0};
-    scene->camera.up = {0.0, 1.0, 0.0};
-    scene->camera.projection = Projection::Orthographic;
-    scene->camera.orthoHeight = 10.0;
-    scene->width = kW;
-    scene->height = kH;
-    scene->prepare();
+    unionSeenFromAbove(*scene);
     BuildParams p;
     p.scheme = SchemeKind::Regular;
     p.regular.maxLevel = 6;
