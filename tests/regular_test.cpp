@@ -76,10 +76,7 @@ std::vector<Vec3> gridPoints(const RegularGrid& g, uint64_t seed, size_t leavesW
 /// The grid's box in the world (its frame's box when the frame is the world's).
 Box3 worldBox(const RegularGrid& g) {
     Box3 b;
-    for (int c = 0; c < 8; ++c)
-        b.expand(g.frame().toWorld({c & 1 ? g.box().hi.x : g.box().lo.x,
-                                    c & 2 ? g.box().hi.y : g.box().lo.y,
-                                    c & 4 ? g.box().hi.z : g.box().lo.z}));
+    for (int c = 0; c < 8; ++c) b.expand(g.frame().toWorld(boxCorner(g.box(), c)));
     return b;
 }
 

@@ -303,8 +303,7 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
             const Box3& f = fc.boxes[p];
             Box3 c;
             for (int i = 0; i < 8 && !f.isEmpty(); ++i)
-                c.expand(s->frame().point(fc.frame.toWorld(
-                    {i & 1 ? f.hi.x : f.lo.x, i & 2 ? f.hi.y : f.lo.y, i & 4 ? f.hi.z : f.lo.z})));
+                c.expand(s->frame().point(fc.frame.toWorld(boxCorner(f, i))));
             return overlap(b, c);
         };
         for (uint32_t id = 0; id < v.regionCount(); ++id) {

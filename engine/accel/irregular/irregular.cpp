@@ -99,9 +99,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
             const Box3& fb = turned.boxes[p];
             Box3 c;
             for (int i = 0; i < 8 && !fb.isEmpty(); ++i)
-                c.expand(s.frame_.point(
-                    turned.frame.toWorld({i & 1 ? fb.hi.x : fb.lo.x, i & 2 ? fb.hi.y : fb.lo.y,
-                                          i & 4 ? fb.hi.z : fb.lo.z})));
+                c.expand(s.frame_.point(turned.frame.toWorld(boxCorner(fb, i))));
             box[p] = overlap(box[p], c);
         }
         box[p].lo -= eps;

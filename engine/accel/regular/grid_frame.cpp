@@ -41,9 +41,7 @@ constexpr size_t kMaxDistinct = 16;
 /// The frame box of a world box: the hull of its eight corners in the frame.
 Box3 frameHull(const Box3& world, const GridFrame& f, double hair) {
     Box3 b;
-    for (int c = 0; c < 8; ++c)
-        b.expand(f.toFrame({c & 1 ? world.hi.x : world.lo.x, c & 2 ? world.hi.y : world.lo.y,
-                            c & 4 ? world.hi.z : world.lo.z}));
+    for (int c = 0; c < 8; ++c) b.expand(f.toFrame(boxCorner(world, c)));
     return {b.lo - Vec3(hair), b.hi + Vec3(hair)};
 }
 
@@ -71,8 +69,7 @@ Box3 frameBoxOf(const Primitive& p, const GridFrame& f, double hair) {
         for (const Vec3& v : g->p) add(v);
     } else {
         const Box3 l = shapeBounds(p.shape);
-        for (int c = 0; c < 8; ++c)
-            add({c & 1 ? l.hi.x : l.lo.x, c & 2 ? l.hi.y : l.lo.y, c & 4 ? l.hi.z : l.lo.z});
+        for (int c = 0; c < 8; ++c) add(boxCorner(l, c));
     }
     return {b.lo - Vec3(hair), b.hi + Vec3(hair)};
 }

@@ -18,6 +18,12 @@ inline double surfaceArea(const Box3& b) {
     return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
+/// Corner `c` of a box: bit 0 the high x, bit 1 the high y, bit 2 the high z (the order of
+/// StructureView::regionCorners).
+inline Vec3 boxCorner(const Box3& b, int c) {
+    return {c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z};
+}
+
 /// An orthonormal frame: the world's axes, or those of a turned subtree.
 struct GridFrame {
     Mat3 axes{1.0};       ///< columns: the frame's x, y, z axes in world coordinates

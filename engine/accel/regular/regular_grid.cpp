@@ -1188,9 +1188,7 @@ void RegularGrid::makeSphereQuads() {
     // its corners' coordinates, which along the world's axes is the box's own.
     quadScale_ = 0.0;
     for (int c = 0; c < 8; ++c) {
-        const Vec3 w = glm::abs(frame_.toWorld({c & 1 ? clipBox_.hi.x : clipBox_.lo.x,
-                                                c & 2 ? clipBox_.hi.y : clipBox_.lo.y,
-                                                c & 4 ? clipBox_.hi.z : clipBox_.lo.z}));
+        const Vec3 w = glm::abs(frame_.toWorld(boxCorner(clipBox_, c)));
         quadScale_ = std::max({quadScale_, w.x, w.y, w.z});
     }
     // A centre and the walk's point in floats are each off by 2^-24 of the largest coordinate:
