@@ -580,7 +580,7 @@ TEST(Irregular, UnionOnlyWalkEqualsObservedWalkAndBruteForce) {
                 bool inside = false;
                 for (uint32_t p = 0; p < sc.prims.size() && !inside; ++p) {
                     Span sp[2];
-                    const int k = sc.primSpans(p, ray, sp);
+                    const int k = sc.primSpans(p, ray, sp, Precision::Double);
                     for (int j = 0; j < k; ++j) inside |= sp[j].in.t < tmin && sp[j].out.t > tmin;
                 }
                 merged += inside;

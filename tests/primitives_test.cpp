@@ -268,7 +268,7 @@ TEST(PackedSpheres, SameSpansAsThePrimitivesBitForBit) {
         for (const Ray& ray : test::randomRays(scene, 5, 300)) {
             for (uint32_t p = 0; p < scene.prims.size(); ++p) {
                 Span a[2] = {}, b[2] = {};
-                const int na = scene.primSpans(p, ray, a);
+                const int na = scene.primSpans(p, ray, a, Precision::Double);
                 const int nb = scene.prims[p].spans(ray, p, b);
                 ASSERT_EQ(na, nb) << "primitive " << p << " ray " << ray.toString();
                 for (int k = 0; k < na; ++k) EXPECT_EQ(a[k], b[k]);

@@ -155,7 +155,7 @@ struct Line {
     /// The primitive's test as the walk records it.
     void test(uint32_t p) {
         Span s[2];
-        const int n = scene.primSpans(p, Ray{ray.origin, ray.direction}, s);
+        const int n = scene.primSpans(p, Ray{ray.origin, ray.direction}, s, Precision::Double);
         WalkEvent& e = add(WalkEvent::PrimTest);
         e.a = p;
         e.spans.assign(s, s + n);

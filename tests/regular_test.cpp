@@ -547,7 +547,7 @@ TEST(RegularUnion, SphereQuadsRejectOnlyMisses) {
                     for (size_t j = 0; j < 4 && 4 * k + j < list.size(); ++j) {
                         Span spans[2];
                         const uint32_t p = list[4 * k + j];
-                        const int n = s.primSpans(p, ray, spans);
+                        const int n = s.primSpans(p, ray, spans, Precision::Double);
                         if (misses >> j & 1) {
                             ASSERT_EQ(n, 0) << "sphere " << p << " rejected, but the ray "
                                             << ray.toString() << " meets it";

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include "app/bench/machine.h"
@@ -615,6 +616,57 @@ std::vector<Figure> drawPlots(const std::string& dir, const std::deque<BenchRow>
                                                      num(ax.map(double(r.error.colorDiff)))};
                  },
                  {"using 1:2 with linespoints pt 7 @C title @T"});
+    }
+    {
+        // Float against double: each configuration's render time against its primary hits'
+        // depth error (the 99th percentile filled, the largest open), the double rows on the
+        // dotted zero line. Labels name the float rows' scheme, moved down where they crowd.
+        std::vector<double> depths;
+        double tLo = kInf, tHi = 0.0;
+        for (const BenchRow& r : rows)
+            if (r.knob == "precision" && r.measured() && r.compared) {
+                for (double d : {r.error.p99DepthDiff, r.error.maxDepthDiff}) depths.push_back(d);
+                tLo = std::min(tLo, spreadOf(r.renderMs).median);
+                tHi = std::max(tHi, spreadOf(r.renderMs).median);
+            }
+        const LogAxis ax = LogAxis::fit(depths, 0.0, 0.05);
+        auto placed = std::make_shared<std::vector<std::pair<double, double>>>();
+        const double yStep = std::log10(ax.hi / ax.lo) / 24.0;
+        const std::string xRange = tHi > 0.0
+                                       ? "set xrange [" + num(tLo / 1.6) + ":" + num(tHi * 3.0) +
+                                             "]\n" + logTics("x", tLo / 1.6, tHi * 3.0)
+                                       : std::string();
+        knobPlot("precision", "precision", "Float against double: render time against depth error",
+                 "Each scene's primitive tests in double and in single precision (the walk, the "
+                 "transforms and the CSG in double), in the regular scheme and in brute force: "
+                 "render time (median of the repeats) against the primary hits' distance error "
+                 "against brute force in double, its 99th percentile (filled) and its largest "
+                 "(open; a pixel on an edge may see another surface, inf: a pixel hit in one "
+                 "image and missed in the other). The regular scheme in double is on the dotted "
+                 "zero line.",
+                 "set logscale x\nset xlabel 'render time (ms)'\nset ylabel 'depth error "
+                 "(scene units)'\n" +
+                     xRange + ax.commands(),
+                 [ax, placed, yStep](const BenchRow& r) {
+                     const double t = spreadOf(r.renderMs).median, y = ax.map(r.error.p99DepthDiff);
+                     double ly = std::log10(y);
+                     for (bool moved = true; moved && r.value == "float";) {
+                         moved = false;
+                         for (const auto& [px, py] : *placed)
+                             if (std::abs(px - std::log10(t)) < 0.25 &&
+                                 std::abs(py - ly) < 0.99 * yStep) {
+                                 ly = py - yStep;
+                                 moved = true;
+                             }
+                     }
+                     if (r.value == "float") placed->push_back({std::log10(t), ly});
+                     return std::vector<std::string>{
+                         num(t), num(y), num(ax.map(r.error.maxDepthDiff)),
+                         r.value == "float" ? r.scheme : "", num(std::pow(10.0, ly))};
+                 },
+                 {"using 1:2 with points pt 7 ps 1.3 @C title @T",
+                  "using 1:3 with points pt 6 ps 1.3 @C notitle",
+                  "using 1:5:4 with labels left offset char 0.8,0 font ',9' notitle"});
     }
     return wr.figures;
 }

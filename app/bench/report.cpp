@@ -117,6 +117,17 @@ std::vector<Config> sweep(bool quick, bool schemesOnly,
             add("offset", num(o), regular, s);
         }
     }
+    // The primitives' tests in double against float, in the regular scheme and in brute force
+    // (where the tests are all the time): the speed single precision buys, against its depth
+    // error (docs/benchmarks.md, "Float against double").
+    for (Precision p : {Precision::Double, Precision::Float}) {
+        ShadingOptions s;
+        s.precision = p;
+        const char* name = p == Precision::Float ? "float" : "double";
+        if (regularOn) add("precision", name, regular, s);
+        if (p == Precision::Float && wanted(SchemeKind::Brute))
+            add("precision", name, BuildParams{}, s);
+    }
     return out;
 }
 
@@ -309,6 +320,7 @@ int runBench(const BenchOptions& opt) {
             if (bruteRow) against.push_back({&row, bruteRow});
             RenderOptions r = ro;
             r.shading.offsetScale = c.shading.offsetScale;
+            r.shading.precision = c.shading.precision;
             schemeJob(row, c.build, r, bruteRow ? &ref : nullptr);
         }
 

@@ -305,6 +305,19 @@ std::vector<ParamDesc> makeTable() {
     d.get = [](const K& k) { return k.shading.offsetScale; };
     d.set = [](K& k, double v) { k.shading.offsetScale = v; };
     add(d);
+    d = {.flag = "--precision",
+         .metavar = "P",
+         .iniKey = "precision",
+         .label = "precision",
+         .help =
+             "Arithmetic of the primitives' tests: double, or float (single precision, to measure "
+             "the depth error it makes; the walk and the CSG stay in double)",
+         .kind = ParamKind::Enum};
+    d.names = {"double", "float"};
+    d.effect = ChangeEffect::Rerender;
+    d.get = [](const K& k) { return double(k.shading.precision); };
+    d.set = [](K& k, double v) { k.shading.precision = Precision(int(v)); };
+    add(d);
     d = {.flag = "--no-shadows",
          .metavar = "",
          .iniKey = "shadows",

@@ -28,7 +28,7 @@ template <class Obs>
         return *held;
     }
     Span spans[2];
-    const int n = scene.primSpans(p, ray, spans);
+    const int n = scene.primSpans(p, ray, spans, ctx.precision);
     ++ctx.counters.primTests;
     obs.primTest(p, spans, n);
     if (fresh) *fresh = true;
@@ -51,11 +51,19 @@ inline int primitiveSpans(const Scene& scene, uint32_t p, const Ray& ray, TraceC
         out = m.spans;
         return m.count;
     }
-    int n = scene.primSpans(p, ray, local);
+    int n = scene.primSpans(p, ray, local, ctx.precision);
     ++ctx.counters.primTests;
     obs.primTest(p, local, n);
     out = local;
     return n;
+}
+
+/// A region's window [t0, t1] widened by floatSlack (--precision float): a scheme whose regions
+/// are its primitives' boxes (the BVH's leaves) would otherwise lose a hit on a face that
+/// bounds its box when the float t rounds to just before the box.
+inline void widenForFloat(const Ray& ray, double& t0, double& t1) {
+    t0 -= floatSlack(ray, t0);
+    t1 += floatSlack(ray, t1);
 }
 
 /// How evalTree fetches a primitive's spans: through primitiveSpans (tested or taken from the
@@ -202,11 +210,14 @@ struct UnionFirstStart {
 struct ScenePrimTest {
     const Scene* scene;
     const Ray* ray;
+    Precision precision;
     uint32_t prim(uint32_t p) const { return p; }
     void prefetch(uint32_t p) const {
         if (p < scene->packedSpheres.size()) __builtin_prefetch(&scene->packedSpheres[p]);
     }
-    int operator()(uint32_t p, Span* out) const { return scene->primSpans(p, *ray, out); }
+    int operator()(uint32_t p, Span* out) const {
+        return scene->primSpans(p, *ray, out, precision);
+    }
 };
 
 /// The visible hit in a region whose tree is a union of its primitives, without an active

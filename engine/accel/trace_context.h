@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/model/shapes.h"
 #include "engine/model/span.h"
 
 namespace lancer {
@@ -117,6 +118,7 @@ struct TraceContext {
     SpanList leafSpans;             ///< the spans of a region's primitives (hitInLeaf's union)
     uint32_t rayId = 0;
     bool useMailboxes = true;
+    Precision precision = Precision::Double;  ///< of the primitives' tests (--precision)
     RayCounters counters;
 
     TraceContext() = default;

@@ -28,6 +28,12 @@ struct Primitive {
     int spans(const Ray& r, uint32_t id, Span* out) const {
         return hasXf ? shapeSpans(shape, xf.toLocal(r), id, out) : shapeSpans(shape, r, id, out);
     }
+    /// spans() with the shape's test in single precision (the ray mapped to the shape's frame in
+    /// double, then rounded).
+    int spansFloat(const Ray& r, uint32_t id, Span* out) const {
+        const Ray l = hasXf ? xf.toLocal(r) : r;
+        return shapeSpans(shape, RayF{glm::vec3(l.o), glm::vec3(l.d)}, id, out);
+    }
     /// Unit world normal at world point p on part `part` (outward for solids).
     Vec3 normal(const Vec3& p, uint8_t part) const;
     std::string toString() const;

@@ -1,6 +1,7 @@
 #include "engine/model/shapes.h"
 
 #include <cmath>
+#include <limits>
 
 namespace lancer {
 namespace {
@@ -12,16 +13,27 @@ struct Overloaded : Ts... {
 template <class... Ts>
 Overloaded(Ts...) -> Overloaded<Ts...>;  // clang 14 lacks C++20 aggregate deduction
 
-int blockSpans(const Block& b, const Ray& r, uint32_t prim, Span* out) {
-    double t0 = -kInf, t1 = kInf;
+// Each test is written once over its ray's scalar T (double, or float for --precision float):
+// the shape's parameters are rounded to T where they are read, and the spans' t widened back.
+template <class R>
+using ScalarOf = typename decltype(R::o)::value_type;
+template <class T>
+using V3 = glm::vec<3, T>;
+template <class T>
+constexpr T tInf = std::numeric_limits<T>::infinity();
+
+template <class R, class T = ScalarOf<R>>
+int blockSpans(const Block& b, const R& r, uint32_t prim, Span* out) {
+    T t0 = -tInf<T>, t1 = tInf<T>;
     uint8_t p0 = 0, p1 = 0;
     for (int a = 0; a < 3; ++a) {
-        if (r.d[a] == 0.0) {
-            if (r.o[a] < b.lo[a] || r.o[a] > b.hi[a]) return 0;
+        const T lo = T(b.lo[a]), hi = T(b.hi[a]);
+        if (r.d[a] == T(0)) {
+            if (r.o[a] < lo || r.o[a] > hi) return 0;
             continue;
         }
-        double inv = 1.0 / r.d[a];
-        double ta = (b.lo[a] - r.o[a]) * inv, tb = (b.hi[a] - r.o[a]) * inv;
+        T inv = T(1) / r.d[a];
+        T ta = (lo - r.o[a]) * inv, tb = (hi - r.o[a]) * inv;
         uint8_t pa = uint8_t(2 * a), pb = uint8_t(2 * a + 1);
         if (ta > tb) {
             std::swap(ta, tb);
@@ -31,161 +43,172 @@ int blockSpans(const Block& b, const Ray& r, uint32_t prim, Span* out) {
         if (tb < t1) t1 = tb, p1 = pb;
     }
     if (!(t0 < t1)) return 0;
-    out[0] = {{t0, prim, p0, false}, {t1, prim, p1, false}};
+    out[0] = {{double(t0), prim, p0, false}, {double(t1), prim, p1, false}};
     return 1;
 }
 
 // Parametric interval where a*t^2 + b*t + c <= 0, as up to two pieces.
-int quadricInside(double a, double b, double c, double* lo, double* hi) {
-    if (a == 0.0) {
-        if (b == 0.0) {
-            if (c <= 0.0) {
-                lo[0] = -kInf;
-                hi[0] = kInf;
+template <class T>
+int quadricInside(T a, T b, T c, T* lo, T* hi) {
+    if (a == T(0)) {
+        if (b == T(0)) {
+            if (c <= T(0)) {
+                lo[0] = -tInf<T>;
+                hi[0] = tInf<T>;
                 return 1;
             }
             return 0;
         }
-        double t = -c / b;
-        if (b > 0.0) {
-            lo[0] = -kInf;
+        T t = -c / b;
+        if (b > T(0)) {
+            lo[0] = -tInf<T>;
             hi[0] = t;
         } else {
             lo[0] = t;
-            hi[0] = kInf;
+            hi[0] = tInf<T>;
         }
         return 1;
     }
-    double disc = b * b - 4.0 * a * c;
-    if (disc <= 0.0) {
-        if (a < 0.0) {
-            lo[0] = -kInf;
-            hi[0] = kInf;
+    T disc = b * b - T(4) * a * c;
+    if (disc <= T(0)) {
+        if (a < T(0)) {
+            lo[0] = -tInf<T>;
+            hi[0] = tInf<T>;
             return 1;
         }
         return 0;
     }
-    double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
-    double t0 = q / a, t1 = (q != 0.0) ? c / q : -t0;
+    T q = T(-0.5) * (b + std::copysign(std::sqrt(disc), b));
+    T t0 = q / a, t1 = (q != T(0)) ? c / q : -t0;
     if (t0 > t1) std::swap(t0, t1);
-    if (a > 0.0) {
+    if (a > T(0)) {
         lo[0] = t0;
         hi[0] = t1;
         return 1;
     }
-    lo[0] = -kInf;
+    lo[0] = -tInf<T>;
     hi[0] = t0;
     lo[1] = t1;
-    hi[1] = kInf;
+    hi[1] = tInf<T>;
     return 2;
 }
 
+template <class T>
 struct ConeQuadric {
-    double a, b, c;
+    T a, b, c;
 };
-ConeQuadric coneQuadric(const Cone& k, const Ray& r) {
-    double s = (k.r2 - k.r1) / k.h;  // radius slope
-    double rz = k.r1 + s * r.o.z;    // radius at the origin's height
-    double a = r.d.x * r.d.x + r.d.y * r.d.y - s * s * r.d.z * r.d.z;
-    double b = 2.0 * (r.o.x * r.d.x + r.o.y * r.d.y - s * r.d.z * rz);
-    double c = r.o.x * r.o.x + r.o.y * r.o.y - rz * rz;
+template <class R, class T = ScalarOf<R>>
+ConeQuadric<T> coneQuadric(const Cone& k, const R& r) {
+    T s = T((k.r2 - k.r1) / k.h);  // radius slope
+    T rz = T(k.r1) + s * r.o.z;    // radius at the origin's height
+    T a = r.d.x * r.d.x + r.d.y * r.d.y - s * s * r.d.z * r.d.z;
+    T b = T(2) * (r.o.x * r.d.x + r.o.y * r.d.y - s * r.d.z * rz);
+    T c = r.o.x * r.o.x + r.o.y * r.o.y - rz * rz;
     return {a, b, c};
 }
 
-int coneSpans(const Cone& k, const Ray& r, uint32_t prim, Span* out) {
-    ConeQuadric q = coneQuadric(k, r);
+template <class R, class T = ScalarOf<R>>
+int coneSpans(const Cone& k, const R& r, uint32_t prim, Span* out) {
+    ConeQuadric<T> q = coneQuadric(k, r);
+    const T h = T(k.h);
     // Slab 0 <= z <= h.
-    double z0 = -kInf, z1 = kInf;
+    T z0 = -tInf<T>, z1 = tInf<T>;
     uint8_t c0 = 0, c1 = 0;
-    if (r.d.z == 0.0) {
-        if (r.o.z < 0.0 || r.o.z > k.h) return 0;
+    if (r.d.z == T(0)) {
+        if (r.o.z < T(0) || r.o.z > h) return 0;
     } else {
         z0 = -r.o.z / r.d.z;
-        z1 = (k.h - r.o.z) / r.d.z;
+        z1 = (h - r.o.z) / r.d.z;
         c0 = 1, c1 = 2;
         if (z0 > z1) std::swap(z0, z1), std::swap(c0, c1);
     }
     if (k.open) {
         // The side surface only: roots of the quadric inside the slab.
-        double disc = q.b * q.b - 4.0 * q.a * q.c;
-        if (q.a == 0.0 || !(disc > 0.0)) return 0;
-        double qq = -0.5 * (q.b + std::copysign(std::sqrt(disc), q.b));
-        double t[2] = {qq / q.a, qq != 0.0 ? q.c / qq : -qq / q.a};
+        T disc = q.b * q.b - T(4) * q.a * q.c;
+        if (q.a == T(0) || !(disc > T(0))) return 0;
+        T qq = T(-0.5) * (q.b + std::copysign(std::sqrt(disc), q.b));
+        T t[2] = {qq / q.a, qq != T(0) ? q.c / qq : -qq / q.a};
         if (t[0] > t[1]) std::swap(t[0], t[1]);
         int n = 0;
-        for (double ti : t)
-            if (ti >= z0 && ti <= z1) out[n++] = {{ti, prim, 0, false}, {ti, prim, 0, false}};
+        for (T ti : t)
+            if (ti >= z0 && ti <= z1)
+                out[n++] = {{double(ti), prim, 0, false}, {double(ti), prim, 0, false}};
         return n;
     }
-    double lo[2], hi[2];
+    T lo[2], hi[2];
     int pieces = quadricInside(q.a, q.b, q.c, lo, hi);
     // Within the slab the radius is non-negative, so only one nappe lies there and the solid is
     // convex: the hull of the pieces clipped to the slab is its one span.
-    double t0 = kInf, t1 = -kInf;
+    T t0 = tInf<T>, t1 = -tInf<T>;
     uint8_t p0 = 0, p1 = 0;
     for (int i = 0; i < pieces; ++i) {
-        double a = std::max(lo[i], z0), b = std::min(hi[i], z1);
+        T a = std::max(lo[i], z0), b = std::min(hi[i], z1);
         if (!(a < b)) continue;
         if (a < t0) t0 = a, p0 = (lo[i] >= z0) ? 0 : c0;
         if (b > t1) t1 = b, p1 = (hi[i] <= z1) ? 0 : c1;
     }
     if (!(t0 < t1) || !std::isfinite(t0) || !std::isfinite(t1)) return 0;
-    out[0] = {{t0, prim, p0, false}, {t1, prim, p1, false}};
+    out[0] = {{double(t0), prim, p0, false}, {double(t1), prim, p1, false}};
     return 1;
 }
 
-int triangleSpans(const Triangle& tr, const Ray& r, uint32_t prim, Span* out) {
+template <class R, class T = ScalarOf<R>>
+int triangleSpans(const Triangle& tr, const R& r, uint32_t prim, Span* out) {
     // Möller-Trumbore, both sides.
-    Vec3 e1 = tr.p[1] - tr.p[0], e2 = tr.p[2] - tr.p[0];
-    Vec3 pv = glm::cross(r.d, e2);
-    double det = glm::dot(e1, pv);
-    if (det == 0.0 || !std::isfinite(det)) return 0;
-    double inv = 1.0 / det;
-    Vec3 tv = r.o - tr.p[0];
-    double u = glm::dot(tv, pv) * inv;
-    if (u < 0.0 || u > 1.0) return 0;
-    Vec3 qv = glm::cross(tv, e1);
-    double v = glm::dot(r.d, qv) * inv;
-    if (v < 0.0 || u + v > 1.0) return 0;
-    double t = glm::dot(e2, qv) * inv;
+    const V3<T> p0(tr.p[0]);
+    V3<T> e1 = V3<T>(tr.p[1]) - p0, e2 = V3<T>(tr.p[2]) - p0;
+    V3<T> pv = glm::cross(r.d, e2);
+    T det = glm::dot(e1, pv);
+    if (det == T(0) || !std::isfinite(det)) return 0;
+    T inv = T(1) / det;
+    V3<T> tv = r.o - p0;
+    T u = glm::dot(tv, pv) * inv;
+    if (u < T(0) || u > T(1)) return 0;
+    V3<T> qv = glm::cross(tv, e1);
+    T v = glm::dot(r.d, qv) * inv;
+    if (v < T(0) || u + v > T(1)) return 0;
+    double t = double(glm::dot(e2, qv) * inv);
     out[0] = {{t, prim, 0, false}, {t, prim, 0, false}};
     return 1;
 }
 
-int polygonSpans(const Polygon& pg, const Ray& r, uint32_t prim, Span* out) {
-    double dn = glm::dot(pg.n, r.d);
-    if (dn == 0.0) return 0;
-    double t = (pg.d - glm::dot(pg.n, r.o)) / dn;
-    Vec3 p = r.at(t);
+template <class R, class T = ScalarOf<R>>
+int polygonSpans(const Polygon& pg, const R& r, uint32_t prim, Span* out) {
+    const V3<T> pn(pg.n);
+    T dn = glm::dot(pn, r.d);
+    if (dn == T(0)) return 0;
+    T t = (T(pg.d) - glm::dot(pn, r.o)) / dn;
+    V3<T> p = r.o + t * r.d;
     int ax = (pg.drop + 1) % 3, ay = (pg.drop + 2) % 3;
-    double px = p[ax], py = p[ay];
+    T px = p[ax], py = p[ay];
     bool inside = false;
     size_t n = pg.p.size();
     for (size_t i = 0, j = n - 1; i < n; j = i++) {
-        double xi = pg.p[i][ax], yi = pg.p[i][ay], xj = pg.p[j][ax], yj = pg.p[j][ay];
+        T xi = T(pg.p[i][ax]), yi = T(pg.p[i][ay]), xj = T(pg.p[j][ax]), yj = T(pg.p[j][ay]);
         if ((yi > py) != (yj > py) && px < (xj - xi) * (py - yi) / (yj - yi) + xi) inside = !inside;
     }
     if (!inside) return 0;
-    out[0] = {{t, prim, 0, false}, {t, prim, 0, false}};
+    out[0] = {{double(t), prim, 0, false}, {double(t), prim, 0, false}};
     return 1;
 }
 
-int polytopeSpans(const Polytope& k, const Ray& r, uint32_t prim, Span* out) {
+template <class R, class T = ScalarOf<R>>
+int polytopeSpans(const Polytope& k, const R& r, uint32_t prim, Span* out) {
     // Kay and Kajiya's slab clipping, one plane at a time: the ray enters where it crosses a
     // plane whose normal faces it and leaves where it crosses one facing away.
-    double t0 = -kInf, t1 = kInf;
+    T t0 = -tInf<T>, t1 = tInf<T>;
     uint8_t p0 = 0, p1 = 0;
     for (size_t i = 0; i < k.planes.size(); ++i) {
         const glm::dvec4& pl = k.planes[i];
-        const Vec3 n(pl);
-        double dn = glm::dot(n, r.d);
-        double dist = pl.w - glm::dot(n, r.o);
-        if (dn == 0.0) {
-            if (dist < 0.0) return 0;
+        const V3<T> n(pl);
+        T dn = glm::dot(n, r.d);
+        T dist = T(pl.w) - glm::dot(n, r.o);
+        if (dn == T(0)) {
+            if (dist < T(0)) return 0;
             continue;
         }
-        double t = dist / dn;
-        if (dn < 0.0) {
+        T t = dist / dn;
+        if (dn < T(0)) {
             if (t > t0) t0 = t, p0 = uint8_t(i);
         } else if (t < t1) {
             t1 = t, p1 = uint8_t(i);
@@ -193,21 +216,30 @@ int polytopeSpans(const Polytope& k, const Ray& r, uint32_t prim, Span* out) {
         if (!(t0 < t1)) return 0;
     }
     if (!std::isfinite(t0) || !std::isfinite(t1)) return 0;
-    out[0] = {{t0, prim, p0, false}, {t1, prim, p1, false}};
+    out[0] = {{double(t0), prim, p0, false}, {double(t1), prim, p1, false}};
     return 1;
 }
 
-}  // namespace
-
-int shapeSpans(const Shape& s, const Ray& r, uint32_t prim, Span* out) {
+template <class R, class T = ScalarOf<R>>
+int spansOf(const Shape& s, const R& r, uint32_t prim, Span* out) {
     return std::visit(
-        Overloaded{[&](const Sphere& x) { return sphereSpans(x.c, x.r, r, prim, out); },
+        Overloaded{[&](const Sphere& x) { return sphereSpansOf(V3<T>(x.c), T(x.r), r, prim, out); },
                    [&](const Block& x) { return blockSpans(x, r, prim, out); },
                    [&](const Cone& x) { return coneSpans(x, r, prim, out); },
                    [&](const Triangle& x) { return triangleSpans(x, r, prim, out); },
                    [&](const Polygon& x) { return polygonSpans(x, r, prim, out); },
                    [&](const Polytope& x) { return polytopeSpans(x, r, prim, out); }},
         s);
+}
+
+}  // namespace
+
+int shapeSpans(const Shape& s, const Ray& r, uint32_t prim, Span* out) {
+    return spansOf(s, r, prim, out);
+}
+
+int shapeSpans(const Shape& s, const RayF& r, uint32_t prim, Span* out) {
+    return spansOf(s, r, prim, out);
 }
 
 Vec3 shapeNormal(const Shape& s, const Vec3& p, uint8_t part) {

@@ -3,7 +3,9 @@
 // zero-length spans. `normal` is the outward (solids) or geometric (surfaces) normal.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -18,21 +20,44 @@ struct Sphere {
     double r = 1.0;
 };
 
-/// Spans of the sphere (c, r) along `ray`: inline, for shapeSpans and for the scene's packed
-/// sphere table (Scene::primSpans), which must give the same bits.
-inline int sphereSpans(const Vec3& c, double r, const Ray& ray, uint32_t prim, Span* out) {
+/// The arithmetic of a primitive's test (--precision): the line-shape computation, in the
+/// primitive's own frame, in double (the reference) or in single precision (what a float
+/// tracer such as Embree computes; the transform, the walk and the CSG stay in double).
+enum class Precision : uint8_t { Double, Float };
+
+/// How far a float test's t can stray from the double one at parameter t of `ray`: 1e-5 (some
+/// 170 times single precision's rounding) of the magnitudes the test reads, the ray's origin
+/// and the distance along the ray, in units of t. The bounds that double tests may meet exactly
+/// (a region's window, a box's near depth) are widened by it under Precision::Float.
+inline double floatSlack(const Ray& ray, double t) {
+    const Vec3 ad = glm::abs(ray.d), ao = glm::abs(ray.o);
+    const double d = std::max({ad.x, ad.y, ad.z}), o = std::max({ao.x, ao.y, ao.z});
+    return d > 0.0 ? 1e-5 * (o / d + std::abs(t)) : 0.0;
+}
+
+/// A ray in single precision: what a primitive's float test reads.
+struct RayF {
+    glm::vec3 o{0.0f};
+    glm::vec3 d{0.0f, 0.0f, 1.0f};
+};
+
+/// Spans of the sphere (c, r) along `ray`, in the ray's precision (Ray: double, RayF: float):
+/// inline, for shapeSpans and for the scene's packed sphere table (Scene::primSpans), which
+/// must give the same bits.
+template <class R, class T = typename decltype(R::o)::value_type>
+inline int sphereSpansOf(const glm::vec<3, T>& c, T r, const R& ray, uint32_t prim, Span* out) {
     // Robust form (Haines et al., Ray Tracing Gems ch. 7): the discriminant from the distance
     // between the centre and the line, which keeps precision for far or grazing rays.
-    const Vec3 f = ray.o - c;
-    const double a = glm::dot(ray.d, ray.d);
-    const double b = -glm::dot(f, ray.d);
-    const Vec3 l = f + (b / a) * ray.d;
-    const double disc = a * (r * r - glm::dot(l, l));
-    if (!(disc > 0.0)) return 0;
-    const double cc = glm::dot(f, f) - r * r;
-    const double q = b + std::copysign(std::sqrt(disc), b);
-    double t0, t1;
-    if (q == 0.0) {
+    const glm::vec<3, T> f = ray.o - c;
+    const T a = glm::dot(ray.d, ray.d);
+    const T b = -glm::dot(f, ray.d);
+    const glm::vec<3, T> l = f + (b / a) * ray.d;
+    const T disc = a * (r * r - glm::dot(l, l));
+    if (!(disc > T(0))) return 0;
+    const T cc = glm::dot(f, f) - r * r;
+    const T q = b + std::copysign(std::sqrt(disc), b);
+    T t0, t1;
+    if (q == T(0)) {
         t0 = t1 = b / a;
     } else {
         t0 = cc / q;
@@ -40,8 +65,13 @@ inline int sphereSpans(const Vec3& c, double r, const Ray& ray, uint32_t prim, S
     }
     if (t0 > t1) std::swap(t0, t1);
     if (!(t0 < t1)) return 0;
-    out[0] = {{t0, prim, 0, false}, {t1, prim, 0, false}};
+    out[0] = {{double(t0), prim, 0, false}, {double(t1), prim, 0, false}};
     return 1;
+}
+
+/// sphereSpansOf in double precision.
+inline int sphereSpans(const Vec3& c, double r, const Ray& ray, uint32_t prim, Span* out) {
+    return sphereSpansOf(c, r, ray, prim, out);
 }
 
 /// Axis-aligned box [lo, hi] with lo < hi on every axis. Parts 0..5: -x, +x, -y, +y, -z, +z.
@@ -83,6 +113,8 @@ using Shape = std::variant<Sphere, Block, Cone, Triangle, Polygon, Polytope>;
 
 /// Spans of the line `r` (in the shape's frame) through the shape, written to `out` (capacity 2).
 int shapeSpans(const Shape& s, const Ray& r, uint32_t prim, Span* out);
+/// The same test in single precision (the shape's parameters rounded to float).
+int shapeSpans(const Shape& s, const RayF& r, uint32_t prim, Span* out);
 /// Normal at local point `p` on part `part` (not normalised for transformed shapes' sake).
 Vec3 shapeNormal(const Shape& s, const Vec3& p, uint8_t part);
 /// Local bounds.

@@ -495,6 +495,7 @@ RayTree tracePixel(const Scene& scene, const Accelerator& accel, const ShadingOp
     const std::shared_ptr<const LightBuffer> eye = accel.eyeBuffer(scene, cam);
     TraceContext ctx(scene.prims.size(), scene.tree.depth());
     ctx.useMailboxes = accel.usesMailboxes();
+    ctx.precision = shading.precision;
     RayTreeRecorder rec;
     Hit hit;
     RayTree tree;

@@ -55,6 +55,7 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
     tbb::enumerable_thread_specific<TraceContext> contexts([&] {
         TraceContext c(scene.prims.size(), depth);
         c.useMailboxes = mailboxes;
+        c.precision = opt.shading.precision;
         return c;
     });
     auto start = Clock::now();

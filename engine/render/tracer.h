@@ -17,6 +17,9 @@ struct ShadingOptions {
     /// towards, eps = offsetScale * max(scene scale, |p|_inf): a relative offset that follows
     /// floating-point spacing, so far-from-origin scenes need no retuning.
     double offsetScale = 1e-9;
+    /// Arithmetic of the primitives' tests (--precision): float measures what single precision
+    /// costs in depth error (docs/benchmarks.md, "Float against double").
+    Precision precision = Precision::Double;
 };
 
 /// A hit resolved to a point, its normals and material.
@@ -77,7 +80,11 @@ class Tracer {
                Obs& obs, Hit& hit) const {
         const Ray ray = primary(x, y);
         ++ctx.counters.primaryRays;
-        return radiance(ray, 0, ctx, obs, &hit, eye.nearFrom(ray.d, 0));
+        double near = eye.nearFrom(ray.d, 0);
+        // A float test may put a hit on the nearest box's face a little before it.
+        if (ctx.precision == Precision::Float && near > 0.0)
+            near = std::max(0.0, near - floatSlack(ray, near));
+        return radiance(ray, 0, ctx, obs, &hit, near);
     }
 
     /// Colour seen along `ray`; depth counts reflection/refraction bounces already taken.

@@ -33,6 +33,13 @@ void Scene::prepare() {
     prepared = true;
 }
 
+int Scene::primSpansFloat(uint32_t p, const Ray& ray, Span* out) const {
+    if (p < packedSpheres.size() && packedSpheres[p].r >= 0.0)
+        return sphereSpansOf(glm::vec3(packedSpheres[p].c), float(packedSpheres[p].r),
+                             RayF{glm::vec3(ray.o), glm::vec3(ray.d)}, p, out);
+    return prims[p].spansFloat(ray, p, out);
+}
+
 void Scene::frameCamera(const Vec3& dir, const Vec3& upv) {
     Box3 b = bounds.isEmpty() ? Box3{Vec3(-1.0), Vec3(1.0)} : bounds;
     Vec3 c = b.center();

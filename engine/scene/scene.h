@@ -64,11 +64,16 @@ struct Scene {
     /// contribute (restricting the tree to the rest). Throws SceneError.
     void prepare();
     /// Spans of primitive `p` along `ray`: Primitive::spans, from the packed table for spheres.
-    int primSpans(uint32_t p, const Ray& ray, Span* out) const {
+    /// With Precision::Float, the shape's test in single precision (TraceContext::precision).
+    int primSpans(uint32_t p, const Ray& ray, Span* out, Precision precision) const {
+        if (precision == Precision::Float) [[unlikely]]
+            return primSpansFloat(p, ray, out);
         if (p < packedSpheres.size() && packedSpheres[p].r >= 0.0)
             return sphereSpans(packedSpheres[p].c, packedSpheres[p].r, ray, p, out);
         return prims[p].spans(ray, p, out);
     }
+    /// primSpans in single precision.
+    int primSpansFloat(uint32_t p, const Ray& ray, Span* out) const;
     /// Primitives present in the prepared tree.
     std::vector<uint32_t> livePrimitives() const { return tree.primitives(); }
     /// A camera framed on the bounds, looking along `dir` (from the camera toward the scene).

@@ -29,15 +29,15 @@ grep -q "3 repeats (round-robin)" "$page" || fail "the repeats are not said"
 if grep -q -E '<(img|script|link|iframe)[ >]' "$page"; then fail "the page loads another file"; fi
 
 # Every plot, each an inline SVG; the speed-against-error plots name their points.
-figures="speed_vs_error-default speed_vs_error-balls-1 progressive regular_max_level push_delta offset"
+figures="speed_vs_error-default speed_vs_error-balls-1 progressive regular_max_level push_delta offset precision"
 if command -v gnuplot >/dev/null; then
   for f in $figures; do
     awk -v id="$f" 'index($0, "<figure id=\"" id "\">") { on = 1; next } on && /<svg/ { found = 1; exit }
                     on && /<\/figure>/ { exit } END { exit !found }' "$page" || fail "plot $f is not an inline SVG"
   done
-  svgs=6
+  svgs=7
   if command -v openscad >/dev/null && grep -q ',embree,peer (bounces 0),[^,]*,[0-9]' "$csv"; then
-    svgs=7  # the mesh axis: exact CSG against OpenSCAD's meshes traced by Embree
+    svgs=8  # the mesh axis: exact CSG against OpenSCAD's meshes traced by Embree
     f=exact_vs_mesh-lattice-2
     awk -v id="$f" 'index($0, "<figure id=\"" id "\">") { on = 1; next } on && /<svg/ { found = 1; exit }
                     on && /<\/figure>/ { exit } END { exit !found }' "$page" || fail "plot $f is not an inline SVG"
@@ -53,6 +53,10 @@ if command -v gnuplot >/dev/null; then
     grep -q "$label" "$page" || fail "the page's speed_vs_error has no \"$label\""
   done
   grep -q "stride 16" "$tmp/r/progressive.svg" || fail "progressive passes are not named"
+  # Float against double: the regular scheme in both, brute force in float, named on the plot.
+  for label in "render time (ms)" "depth error" ">regular<" ">brute<"; do
+    grep -q "$label" "$tmp/r/precision.svg" || fail "precision plot has no \"$label\""
+  done
   grep -q "colour RMSE" "$tmp/r/progressive.svg" || fail "progressive plot is not against RMSE"
 else
   for f in $figures; do grep -q "<figure id=\"$f\">" "$page" || fail "no figure $f"; done
@@ -125,6 +129,16 @@ while IFS=$'\t' read -r n scene scheme knob value; do
   grep -qF "<tr data-row=\"$n\"><td>$scene</td><td>$scheme</td><td>$knob</td><td>$value</td>" "$page" \
     || fail "CSV row $n ($scene $scheme $knob $value) is not on the page"
 done || exit 1
+# Float against double: the regular scheme in double makes no error; in float (and brute force
+# in float) its hits move by single precision's rounding, on every scene.
+for s in "${scenes[@]}"; do
+  awk -F, -v s="$s" '$1==s && $3=="precision" && $2=="regular" && $4=="double" { found = 1; if ($15 != 0 || $17 != 0) exit 1 }
+                     END { exit !found }' "$csv" || fail "$s: the regular scheme in double differs from brute force"
+  for scheme in regular brute; do
+    awk -F, -v s="$s" -v k="$scheme" '$1==s && $3=="precision" && $2==k && $4=="float" { found = 1; if (!($28 > 0 && $28 < 1e-3)) exit 1 }
+                       END { exit !found }' "$csv" || fail "$s: $scheme in float has no row or no small depth error"
+  done
+done
 # Measured rows: three repeats, a median within its range.
 awk -F, 'NR > 1 && $18 != "" { if ($18 != 3 || $8 < $21 || $8 > $22) { print; exit 1 } }' "$csv" \
   || fail "a row's median is not within its range, or not 3 repeats"

@@ -242,7 +242,7 @@ std::string RayMismatch::toString(const Scene& scene) const {
 
 std::vector<RayMismatch> compareWithBrute(const Scene& scene, const Accelerator& accel,
                                           const std::vector<Ray>& rays, double tmin, double relTol,
-                                          size_t maxReport) {
+                                          size_t maxReport, Precision precision) {
     BuildParams bp;
     bp.scheme = SchemeKind::Brute;
     auto brute = buildAccelerator(scene, bp);
@@ -250,6 +250,7 @@ std::vector<RayMismatch> compareWithBrute(const Scene& scene, const Accelerator&
         ca(scene.prims.size(), scene.tree.depth());
     cb.useMailboxes = brute->usesMailboxes();
     ca.useMailboxes = accel.usesMailboxes();
+    cb.precision = ca.precision = precision;
     NullObserver obs;
     std::vector<RayMismatch> out;
     for (const Ray& r : rays) {

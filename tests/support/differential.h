@@ -57,10 +57,12 @@ struct RayMismatch {
 
 /// Nearest hits of `accel` and of brute force for each ray with t in (tmin, inf). Two hits
 /// agree when both miss, or both hit the same primitive at the same t within `relTol`.
-/// Returns the mismatches (at most `maxReport`).
+/// Returns the mismatches (at most `maxReport`). Both trace with the primitives' tests in
+/// `precision`.
 std::vector<RayMismatch> compareWithBrute(const Scene& scene, const Accelerator& accel,
                                           const std::vector<Ray>& rays, double tmin = 0.0,
-                                          double relTol = 1e-9, size_t maxReport = 20);
+                                          double relTol = 1e-9, size_t maxReport = 20,
+                                          Precision precision = Precision::Double);
 
 /// Counters of `accel` tracing every ray with t in (tmin, inf), one context, mailboxes as the
 /// structure uses them (compareWithBrute checks the hits, this the walks and the tests).

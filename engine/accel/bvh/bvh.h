@@ -207,9 +207,12 @@ template <class Obs>
                                                      double t0, double t1, TraceContext& ctx,
                                                      Obs& obs, Hit& hit) const {
     const uint32_t* const prims = primList_.data() + n.first;
+    if (ctx.precision == Precision::Float) [[unlikely]]
+        widenForFloat(ray, t0, t1);
     if (unionOnly_) {
-        const bool found = hitInUnionLeaf(prims, n.count, ScenePrimTest{scene_, &ray}, tmin, t0, t1,
-                                          ctx, obs, hit);
+        const bool found =
+            hitInUnionLeaf(prims, n.count, ScenePrimTest{scene_, &ray, ctx.precision}, tmin, t0, t1,
+                           ctx, obs, hit);
         if constexpr (Obs::kActive) {
             mergeHeldSpans(prims, n.count, ctx);  // the leaf's spans, as the other schemes show
             obs.regionSpans(ctx.result);
@@ -308,7 +311,7 @@ int Bvh::walkFirstStart(const Ray& ray, const Ray& fr, double tmin, double tmax,
             const uint32_t* const prims = primList_.data() + n.first;
             for (uint32_t i = 0; i < n.count; ++i) {
                 Span local[2];
-                const int k = scene_->primSpans(prims[i], ray, local);
+                const int k = scene_->primSpans(prims[i], ray, local, ctx.precision);
                 ++ctx.counters.primTests;
                 obs.primTest(prims[i], local, k);
                 for (int j = 0; j < k; ++j) {
@@ -400,7 +403,7 @@ bool Bvh::walkUnion(const Ray& ray, const Ray& fr, double tmin, double tmax, Tra
         bool added = false;
         for (uint32_t i = 0; i < n.count; ++i) {
             Span local[2];
-            const int k = scene_->primSpans(prims[i], ray, local);
+            const int k = scene_->primSpans(prims[i], ray, local, ctx.precision);
             ++ctx.counters.primTests;
             obs.primTest(prims[i], local, k);
             for (int j = 0; j < k; ++j)

@@ -360,11 +360,11 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         if (quads) {
             found = L.prims != 0 && hitInSphereLeaf(L, qr, ray, tmin, tIn, t0, t1, ctx, obs, hit);
         } else if constexpr (!Obs::kActive) {
-            found = unionOnly_
-                        ? hitInUnionLeaf(L.primitives(primList), L.prims,
-                                         ScenePrimTest{scene_, &ray}, tmin, t0, t1, ctx, obs, hit)
-                        : hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList), L.prims, ray,
-                                    tmin, t0, t1, ctx, obs, hit);
+            found = unionOnly_ ? hitInUnionLeaf(L.primitives(primList), L.prims,
+                                                ScenePrimTest{scene_, &ray, ctx.precision}, tmin,
+                                                t0, t1, ctx, obs, hit)
+                               : hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList), L.prims,
+                                           ray, tmin, t0, t1, ctx, obs, hit);
         } else {
             found = hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList), L.prims, ray, tmin,
                               t0, t1, ctx, obs, hit, unionOnly_);
@@ -482,7 +482,7 @@ template <class Obs>
                 // have defaults: a declared array costs its clearing in each test).
                 alignas(Span) std::byte room[2 * sizeof(Span)];
                 Span* const spans = reinterpret_cast<Span*>(room);
-                const int k = scene_->primSpans(key, ray, spans);
+                const int k = scene_->primSpans(key, ray, spans, ctx.precision);
                 obs.primTest(key, spans, k);
                 if (k == 0) {
                     tag = {rayId, 0};  // the empty mailbox, as ctx.heldEmpty
