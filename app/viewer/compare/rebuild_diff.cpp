@@ -16,7 +16,8 @@ bool sameCamera(const Camera& a, const Camera& b) {
 
 bool sameShading(const ShadingOptions& a, const ShadingOptions& b) {
     return a.bounces == b.bounces && a.shadows == b.shadows && a.reflections == b.reflections &&
-           a.refractions == b.refractions && a.offsetScale == b.offsetScale;
+           a.refractions == b.refractions && a.offsetScale == b.offsetScale &&
+           a.precision == b.precision;
 }
 
 template <class Counters>

@@ -139,6 +139,9 @@ TEST(RebuildDiff, APartialOldImageIsNeverComparedAndAnotherViewDoesNotCompare) {
     RenderKey shaded = keyOf(w, h);
     shaded.shading.bounces = 0;
     EXPECT_FALSE(d.status(shaded, h).comparable);
+    RenderKey single = keyOf(w, h);
+    single.shading.precision = Precision::Float;  // the same rays, other hits
+    EXPECT_FALSE(d.status(single, h).comparable);
     EXPECT_FALSE(d.status(keyOf(w + 1, h), h).comparable);
     d.clear();
     EXPECT_EQ(d.old(), nullptr);
