@@ -93,10 +93,7 @@ class Accelerator {
                     if (i > 0) ctx.newStamp();
                     obs.stretch(i, seg[i].t0, seg[i].t1);
                     double t0 = seg[i].t0, t1 = seg[i].t1;
-                    if (ctx.precision == Precision::Float) {  // the stretches are boxes' depths
-                        t0 = std::max(0.0, t0 - floatSlack(ray, t0));
-                        t1 = std::min(tmax, t1 + floatSlack(ray, t1));
-                    }
+                    if (ctx.precision == Precision::Float) widenForFloat(ray, t0, t1, 0.0, tmax);
                     if (intersect(ray, t0, t1, ctx, obs, hit)) {
                         obs.blocker(hit);
                         return true;

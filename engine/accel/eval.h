@@ -58,12 +58,13 @@ inline int primitiveSpans(const Scene& scene, uint32_t p, const Ray& ray, TraceC
     return n;
 }
 
-/// A region's window [t0, t1] widened by floatSlack (--precision float): a scheme whose regions
-/// are its primitives' boxes (the BVH's leaves) would otherwise lose a hit on a face that
-/// bounds its box when the float t rounds to just before the box.
-inline void widenForFloat(const Ray& ray, double& t0, double& t1) {
-    t0 -= floatSlack(ray, t0);
-    t1 += floatSlack(ray, t1);
+/// A window [t0, t1] from boxes widened by floatSlack (--precision float), kept within
+/// [lo, hi]: a BVH leaf whose box is its primitives' boxes, or a light-buffer stretch, would
+/// otherwise lose a hit on a face that bounds a box when the float t rounds to just outside it.
+inline void widenForFloat(const Ray& ray, double& t0, double& t1, double lo = -kInf,
+                          double hi = kInf) {
+    t0 = std::max(lo, t0 - floatSlack(ray, t0));
+    t1 = std::min(hi, t1 + floatSlack(ray, t1));
 }
 
 /// How evalTree fetches a primitive's spans: through primitiveSpans (tested or taken from the
