@@ -251,14 +251,15 @@ TEST(Bvh, ObservedWalkEqualsTheRender) {
         const RecordingObserver rec = test::recordWalk(*accel, r, ctx);
         observed += ctx.counters - before;
         for (const WalkEvent& e : rec.events) {
-            if (e.kind != WalkEvent::Region) continue;
-            ASSERT_LT(e.a, b.nodes().size());
-            if (std::isfinite(e.t0) && e.t0 <= e.t1) {
-                Box3 box = b.nodes()[e.a].box();
+            const walk::Region* g = e.get<walk::Region>();
+            if (!g) continue;
+            ASSERT_LT(g->region, b.nodes().size());
+            if (std::isfinite(g->t0) && g->t0 <= g->t1) {
+                Box3 box = b.nodes()[g->region].box();
                 const Vec3 pad(1e-6 * scene.scale());
                 box.lo -= pad;
                 box.hi += pad;
-                EXPECT_TRUE(box.contains(r.at(0.5 * (e.t0 + e.t1)))) << "node " << e.a;
+                EXPECT_TRUE(box.contains(r.at(0.5 * (g->t0 + g->t1)))) << "node " << g->region;
             }
         }
     }

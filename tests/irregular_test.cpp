@@ -404,17 +404,17 @@ TEST(Irregular, ObserverSeesRegionsPointersAndMailboxes) {
         int regions = 0;
         uint64_t seen = 0;
         for (const WalkEvent& e : obs.events) {
-            if (e.kind == WalkEvent::Region) {
+            if (const walk::Region* g = e.get<walk::Region>()) {
                 if (regions > 0) {
-                    EXPECT_EQ(e.t0, last) << "intervals not contiguous";
+                    EXPECT_EQ(g->t0, last) << "intervals not contiguous";
                 }
-                EXPECT_LE(e.t0, e.t1);
-                last = e.t1;
+                EXPECT_LE(g->t0, g->t1);
+                last = g->t1;
                 ++regions;
-            } else if (e.kind == WalkEvent::Pointer) {
+            } else if (const walk::Pointer* p = e.get<walk::Pointer>()) {
                 ++seen;
-                EXPECT_GE(e.corner, 0);
-            } else if (e.kind == WalkEvent::MailboxHit) {
+                EXPECT_GE(p->corner, 0);
+            } else if (e.kind() == WalkEvent::MailboxHit) {
                 ++mailbox;
             }
         }
@@ -466,8 +466,8 @@ TEST(Irregular, UnionOnlyRegionsKeepListsNotTrees) {
         RecordingObserver obs = test::recordWalk(*ortho, ray, ctx);
         uint64_t regions = 0, prims = 0;
         for (const WalkEvent& e : obs.events) {
-            regions += e.kind == WalkEvent::Region;
-            prims += e.kind == WalkEvent::PrimTest;
+            regions += e.kind() == WalkEvent::Region;
+            prims += e.kind() == WalkEvent::PrimTest;
         }
         EXPECT_EQ(regions, ctx.counters.regionVisits - before.regionVisits);
         EXPECT_EQ(prims, ctx.counters.primTests - before.primTests);
@@ -568,9 +568,9 @@ TEST(Irregular, UnionOnlyWalkEqualsObservedWalkAndBruteForce) {
                 << what;
             uint64_t regions = 0, tests = 0, mailboxHits = 0;
             for (const WalkEvent& e : obs.events) {
-                regions += e.kind == WalkEvent::Region;
-                tests += e.kind == WalkEvent::PrimTest;
-                mailboxHits += e.kind == WalkEvent::MailboxHit;
+                regions += e.kind() == WalkEvent::Region;
+                tests += e.kind() == WalkEvent::PrimTest;
+                mailboxHits += e.kind() == WalkEvent::MailboxHit;
             }
             ASSERT_EQ(regions, seen.counters.regionVisits - b.regionVisits) << what;
             ASSERT_EQ(tests, seen.counters.primTests - b.primTests) << what;
@@ -625,13 +625,14 @@ TEST(Irregular, ProjectiveWalkIsADepthRun) {
         RecordingObserver obs = test::recordWalk(*accel, ray, ctx);
         double last = 0.0;
         for (const WalkEvent& e : obs.events) {
-            EXPECT_NE(e.kind, WalkEvent::Pointer);
-            if (e.kind != WalkEvent::Region) continue;
-            EXPECT_EQ(e.t0, last) << "intervals not contiguous";
-            EXPECT_LE(e.t0, e.t1);
-            EXPECT_GE(e.a, s.regions().size());  // ids after the camera-frame regions
-            EXPECT_LT(e.a, accel->info().regions);
-            last = e.t1;
+            EXPECT_NE(e.kind(), WalkEvent::Pointer);
+            const walk::Region* g = e.get<walk::Region>();
+            if (!g) continue;
+            EXPECT_EQ(g->t0, last) << "intervals not contiguous";
+            EXPECT_LE(g->t0, g->t1);
+            EXPECT_GE(g->region, s.regions().size());  // ids after the camera-frame regions
+            EXPECT_LT(g->region, accel->info().regions);
+            last = g->t1;
             ++visits;
         }
     }

@@ -128,7 +128,7 @@ struct Line {
         ray.direction = Vec3(1, 0, 0);
         ray.tmin = 0.0;
         ray.tmax = kInf;
-        add(WalkEvent::RayBegin);
+        add(walk::RayBegin{});
     }
     /// Prepares the scene under a union of every primitive (so that none is dropped: prepare
     /// would restrict A − B to A where B's box misses A's), then puts the tree built back.
@@ -141,27 +141,16 @@ struct Line {
         scene.prepare();
         scene.tree = tree;
     }
-    WalkEvent& add(WalkEvent::Kind k) {
-        ray.events.emplace_back();
-        ray.events.back().kind = k;
-        return ray.events.back();
-    }
-    void region(uint32_t id, double t0, double t1) {
-        WalkEvent& e = add(WalkEvent::Region);
-        e.a = id;
-        e.t0 = t0;
-        e.t1 = t1;
-    }
+    void add(WalkEvent::Data e) { ray.events.push_back(WalkEvent{std::move(e)}); }
+    void region(uint32_t id, double t0, double t1) { add(walk::Region{id, t0, t1}); }
     /// The primitive's test as the walk records it.
     void test(uint32_t p) {
         Span s[2];
         const int n = scene.primSpans(p, Ray{ray.origin, ray.direction}, s, Precision::Double);
-        WalkEvent& e = add(WalkEvent::PrimTest);
-        e.a = p;
-        e.spans.assign(s, s + n);
+        add(walk::PrimTest{p, SpanList(s, s + n)});
         ++ray.counters.primTests;
     }
-    void mailbox(uint32_t p) { add(WalkEvent::MailboxHit).a = p; }
+    void mailbox(uint32_t p) { add(walk::MailboxHit{p}); }
     /// The tree's result the walk records: evalTree on the scene's tree.
     void spans() {
         TraceContext ctx(scene.prims.size(), scene.tree.depth());
@@ -170,7 +159,7 @@ struct Line {
         SpanList out;
         evalTree(scene, scene.tree, scene.tree.root, Ray{ray.origin, ray.direction}, ctx, obs, 0,
                  out);
-        add(WalkEvent::Spans).spans = out;
+        add(walk::Spans{out});
     }
     std::vector<StepCsg> steps() const {
         return rayCsg(
@@ -183,7 +172,7 @@ struct Line {
     /// The class of the n-th PrimTest event.
     Waste wasteOfTest(const RayWaste& w, int n) const {
         for (size_t i = 0; i < ray.events.size(); ++i)
-            if (ray.events[i].kind == WalkEvent::PrimTest && n-- == 0) return w.perEvent[i];
+            if (ray.events[i].kind() == WalkEvent::PrimTest && n-- == 0) return w.perEvent[i];
         return Waste::None;
     }
 };

@@ -202,8 +202,8 @@ TEST(RayTree, KindsAndParentsFollowTheShading) {
                 for (size_t i = 0; i < t.rays.size(); ++i) {
                     const TracedRay& r = t.rays[i];
                     SCOPED_TRACE(t.toString(&scene));
-                    ASSERT_EQ(r.events.front().kind, WalkEvent::RayBegin);
-                    ASSERT_EQ(r.events.back().kind, WalkEvent::RayEnd);
+                    ASSERT_EQ(r.events.front().kind(), WalkEvent::RayBegin);
+                    ASSERT_EQ(r.events.back().kind(), WalkEvent::RayEnd);
                     if (i > 0) {
                         ASSERT_GE(r.parent, 0);
                         ASSERT_LT(size_t(r.parent), i);
@@ -276,8 +276,8 @@ TEST(RayTree, RecordingIsRepeatable) {
 /// walk of its own).
 int64_t nextRegion(const std::vector<WalkEvent>& ev, size_t i) {
     for (size_t k = i + 1; k < ev.size(); ++k) {
-        if (ev[k].kind == WalkEvent::Stretch) return -1;
-        if (ev[k].kind == WalkEvent::Region) return ev[k].a;
+        if (ev[k].kind() == WalkEvent::Stretch) return -1;
+        if (const walk::Region* g = ev[k].get<walk::Region>()) return g->region;
     }
     return -1;
 }
@@ -305,51 +305,53 @@ TEST(RayTree, EachStepSaysHowTheNextRegionIsReached) {
                     for (size_t i = 0; i < ev.size(); ++i) {
                         const WalkEvent& e = ev[i];
                         SCOPED_TRACE(e.toString());
-                        if (e.kind == WalkEvent::Region) current = e.a;
-                        if (e.kind == WalkEvent::Stretch) current = -1;
-                        if (e.kind != WalkEvent::Exit) continue;
+                        if (const walk::Region* g = e.get<walk::Region>()) current = g->region;
+                        if (e.kind() == WalkEvent::Stretch) current = -1;
+                        const walk::Exit* x = e.get<walk::Exit>();
+                        if (!x) continue;
                         ++exits;
                         ASSERT_GE(current, 0);
-                        ASSERT_NE(e.ties, 0);
-                        ASSERT_TRUE(e.ties >> e.axis & 1);
-                        const Vec3 at = ray.at(e.t0);
+                        ASSERT_NE(x->ties, 0);
+                        ASSERT_TRUE(x->ties >> x->axis & 1);
+                        const Vec3 at = ray.at(x->t);
                         const double tol = 1e-7 * std::max(scene.scale(), glm::length(at));
-                        for (int a = 0; a < 3; ++a) ASSERT_NEAR(e.point[a], at[a], tol);
+                        for (int a = 0; a < 3; ++a) ASSERT_NEAR(x->point[a], at[a], tol);
                         const int64_t next = nextRegion(ev, i);
                         if (next < 0) continue;  // out of the structure, or the stretch's end
                         const WalkEvent& how = ev[i + 1];
                         if (c.scheme == SchemeKind::Regular) {
-                            if (c.step == StepMethod::Exact && how.kind == WalkEvent::Rope) {
+                            if (const walk::Rope* rope = how.get<walk::Rope>();
+                                c.step == StepMethod::Exact && rope) {
                                 ++ropes;
-                                ASSERT_EQ(how.a, current);
-                                ASSERT_EQ(int64_t(how.b), next);
-                                ASSERT_EQ(how.axis / 2, e.axis);
+                                ASSERT_EQ(rope->from, current);
+                                ASSERT_EQ(int64_t(rope->to), next);
+                                ASSERT_EQ(rope->face / 2, x->axis);
                             } else {
-                                ASSERT_EQ(how.kind, c.step == StepMethod::Exact
-                                                        ? WalkEvent::IndexStep
-                                                        : WalkEvent::Push);
-                                (how.kind == WalkEvent::Push ? pushes : steps)++;
-                                ASSERT_EQ(ev[i + 2].kind, WalkEvent::Lookup);
-                                ASSERT_EQ(int64_t(ev[i + 2].b), next);
-                                for (int a = 0; a < 3; ++a) {
-                                    if (how.kind == WalkEvent::IndexStep) {
-                                        ASSERT_EQ(ev[i + 2].cell[a], how.cell[a]);
-                                    }
+                                ASSERT_EQ(how.kind(), c.step == StepMethod::Exact
+                                                          ? WalkEvent::IndexStep
+                                                          : WalkEvent::Push);
+                                (how.kind() == WalkEvent::Push ? pushes : steps)++;
+                                const walk::Lookup* look = ev[i + 2].get<walk::Lookup>();
+                                ASSERT_NE(look, nullptr);
+                                ASSERT_EQ(int64_t(look->leaf), next);
+                                if (const walk::IndexStep* is = how.get<walk::IndexStep>()) {
+                                    ASSERT_EQ(look->cell, is->cell);
                                 }
                             }
-                        } else if (how.kind == WalkEvent::Pointer) {
+                        } else if (how.kind() == WalkEvent::Pointer) {
                             int64_t at = current;
                             size_t k = i + 1;
-                            for (; k < ev.size() && ev[k].kind == WalkEvent::Pointer; ++k) {
-                                ASSERT_EQ(int64_t(ev[k].a), at);
-                                at = ev[k].b;
+                            for (; k < ev.size() && ev[k].kind() == WalkEvent::Pointer; ++k) {
+                                const walk::Pointer& p = ev[k].as<walk::Pointer>();
+                                ASSERT_EQ(int64_t(p.from), at);
+                                at = p.to;
                                 ++pointers;
                             }
-                            ASSERT_EQ(ev[k].kind, WalkEvent::Region);
+                            ASSERT_EQ(ev[k].kind(), WalkEvent::Region);
                             ASSERT_EQ(at, next);
                         } else {
                             // Projective zones: the next slab in depth, no pointer.
-                            ASSERT_EQ(how.kind, WalkEvent::Region);
+                            ASSERT_EQ(how.kind(), WalkEvent::Region);
                         }
                     }
                 }
@@ -381,14 +383,15 @@ size_t checkCorners(const StructureView& view, const Ray& ray, const std::vector
     size_t n = 0;
     const double hair = clipHair(view);
     for (const WalkEvent& e : ev) {
-        if (e.kind != WalkEvent::Region) continue;
-        const std::array<Vec3, 8> c = view.regionCorners(e.a);
-        for (double t : {e.t0, 0.5 * (e.t0 + e.t1), e.t1}) {
+        const walk::Region* g = e.get<walk::Region>();
+        if (!g) continue;
+        const std::array<Vec3, 8> c = view.regionCorners(g->region);
+        for (double t : {g->t0, 0.5 * (g->t0 + g->t1), g->t1}) {
             const Vec3 p = ray.at(t);
             const double tol = 1e-9 * std::max(scale, glm::length(p)) + hair;
             EXPECT_LE(test::outside(c, p), tol)
-                << ray.toString() << " region " << e.a << " t = " << t << " of [" << e.t0 << ", "
-                << e.t1 << "] " << view.toString(e.a);
+                << ray.toString() << " region " << g->region << " t = " << t << " of [" << g->t0
+                << ", " << g->t1 << "] " << view.toString(g->region);
         }
         ++n;
     }
@@ -458,8 +461,8 @@ TEST(RayTree, RegionCornersHoldTheRaysStretch) {
 /// starts a walk of its own), or -1.
 int64_t nextRegionEvent(const std::vector<WalkEvent>& ev, size_t i) {
     for (size_t k = i + 1; k < ev.size(); ++k) {
-        if (ev[k].kind == WalkEvent::Stretch) return -1;
-        if (ev[k].kind == WalkEvent::Region) return int64_t(k);
+        if (ev[k].kind() == WalkEvent::Stretch) return -1;
+        if (ev[k].kind() == WalkEvent::Region) return int64_t(k);
     }
     return -1;
 }
@@ -495,49 +498,54 @@ TEST(RayTree, ProjectiveWalkTellsItsExitsAndLocates) {
                 int64_t current = -1;
                 for (size_t i = 0; i < ev.size(); ++i) {
                     const WalkEvent& e = ev[i];
-                    if (e.kind == WalkEvent::Region) current = int64_t(i);
-                    if (e.kind == WalkEvent::Stretch) current = -1;
-                    if (e.kind != WalkEvent::Locate && e.kind != WalkEvent::Exit) continue;
-                    SCOPED_TRACE(e.toString() + " of " + r.toString());
-                    const double tol = 1e-9 * std::max(scene.scale(), glm::length(e.point));
-                    const int64_t n = nextRegionEvent(ev, i);
-                    if (e.kind == WalkEvent::Locate) {
+                    if (e.kind() == WalkEvent::Region) current = int64_t(i);
+                    if (e.kind() == WalkEvent::Stretch) current = -1;
+                    if (const walk::Locate* loc = e.get<walk::Locate>()) {
+                        SCOPED_TRACE(e.toString() + " of " + r.toString());
+                        const double tol = 1e-9 * std::max(scene.scale(), glm::length(loc->point));
+                        const int64_t n = nextRegionEvent(ev, i);
                         ASSERT_GE(n, 0);
-                        ASSERT_EQ(ev[size_t(n)].a, e.b);
-                        EXPECT_LE(test::outside(view.regionCorners(e.b), e.point), tol);
-                        const Vec3 at = ray.at(ev[size_t(n)].t0);
-                        EXPECT_LE(glm::length(at - e.point), tol);
-                        projectiveLocates += e.b >= firstProjective;
+                        const walk::Region& first = ev[size_t(n)].as<walk::Region>();
+                        ASSERT_EQ(first.region, loc->region);
+                        EXPECT_LE(test::outside(view.regionCorners(loc->region), loc->point), tol);
+                        const Vec3 at = ray.at(first.t0);
+                        EXPECT_LE(glm::length(at - loc->point), tol);
+                        projectiveLocates += loc->region >= firstProjective;
                         continue;
                     }
+                    const walk::Exit* x = e.get<walk::Exit>();
+                    if (!x) continue;
+                    SCOPED_TRACE(e.toString() + " of " + r.toString());
+                    const double tol = 1e-9 * std::max(scene.scale(), glm::length(x->point));
+                    const int64_t n = nextRegionEvent(ev, i);
                     ASSERT_GE(current, 0);
-                    const WalkEvent& left = ev[size_t(current)];
-                    const std::array<Vec3, 8> c = view.regionCorners(left.a);
-                    EXPECT_LE(test::outside(c, e.point), tol);
-                    EXPECT_LE(test::toBoundary(c, e.point), tol);
-                    EXPECT_LE(glm::length(ray.at(e.t0) - e.point), tol);
-                    EXPECT_EQ(left.t1, e.t0);
-                    if (left.a >= firstProjective) {
+                    const walk::Region& left = ev[size_t(current)].as<walk::Region>();
+                    const std::array<Vec3, 8> c = view.regionCorners(left.region);
+                    EXPECT_LE(test::outside(c, x->point), tol);
+                    EXPECT_LE(test::toBoundary(c, x->point), tol);
+                    EXPECT_LE(glm::length(ray.at(x->t) - x->point), tol);
+                    EXPECT_EQ(left.t1, x->t);
+                    if (left.region >= firstProjective) {
                         ++projectiveExits;
-                        EXPECT_EQ(e.axis, 2);
-                        EXPECT_EQ(e.ties, 4);
-                        nearExits += view.region(left.a).kind == RegionKind::NearRegion;
+                        EXPECT_EQ(x->axis, 2);
+                        EXPECT_EQ(x->ties, 4);
+                        nearExits += view.region(left.region).kind == RegionKind::NearRegion;
                     } else {
                         ++cameraExits;
                     }
                     if (n < 0) continue;  // out of the structure
-                    const WalkEvent& next = ev[size_t(n)];
-                    EXPECT_EQ(next.t0, e.t0);
-                    if (left.a >= firstProjective) {
+                    const walk::Region& next = ev[size_t(n)].as<walk::Region>();
+                    EXPECT_EQ(next.t0, x->t);
+                    if (left.region >= firstProjective) {
                         EXPECT_EQ(size_t(n), i + 1) << "a projective step follows no pointer";
                     }
                     if (!(next.t1 > next.t0)) continue;  // an edge or corner's zero-length step
                     const double past =
-                        e.t0 + std::min(1e-6 * scene.scale(), 0.5 * (next.t1 - next.t0));
+                        x->t + std::min(1e-6 * scene.scale(), 0.5 * (next.t1 - next.t0));
                     const Vec3 q = ray.at(past);
-                    EXPECT_LE(test::outside(view.regionCorners(next.a), q),
+                    EXPECT_LE(test::outside(view.regionCorners(next.region), q),
                               1e-9 * std::max(scene.scale(), glm::length(q)))
-                        << view.toString(next.a);
+                        << view.toString(next.region);
                 }
             }
         }
@@ -645,7 +653,7 @@ TEST(RayTree, GrazingRaysAtTheStructureBorder) {
                         checked += n;
                         if (c.scheme == SchemeKind::Irregular) cameraChecked += n;
                         for (const WalkEvent& e : obs.events)
-                            EXPECT_NE(e.kind, WalkEvent::Error)
+                            EXPECT_NE(e.kind(), WalkEvent::Error)
                                 << e.toString() << " " << ray.toString();
                         all.push_back(ray);
                         ++rays;
@@ -742,10 +750,11 @@ TEST(RayTree, RaysEnteringAtACameraFrameRegionCorner) {
                         RecordingObserver obs = test::recordWalk(*accel, ray, ctx);
                         checkCorners(view, ray, obs.events, scale);
                         for (const WalkEvent& ev : obs.events) {
-                            EXPECT_NE(ev.kind, WalkEvent::Error)
+                            EXPECT_NE(ev.kind(), WalkEvent::Error)
                                 << ev.toString() << " " << ray.toString();
-                            if (ev.kind != WalkEvent::Region || !(ev.t1 > ev.t0)) continue;
-                            const Vec3 x = s->regions()[ev.a].box.extent();
+                            const walk::Region* g = ev.get<walk::Region>();
+                            if (!g || !(g->t1 > g->t0)) continue;
+                            const Vec3 x = s->regions()[g->region].box.extent();
                             sliverStretches += std::min({x.x, x.y, x.z}) < 1e-6 * scale;
                         }
                         all.push_back(ray);
@@ -776,7 +785,7 @@ void checkReasons(const StructureView& view, const TracedRay& r, const Scene& sc
         ASSERT_EQ(text.find('\n'), std::string::npos);
         const size_t arrow = text.rfind("-> ");
         if (k + 1 < steps.size()) {
-            const uint32_t next = r.events[steps[k + 1]].a;
+            const uint32_t next = r.events[steps[k + 1]].as<walk::Region>().region;
             ASSERT_EQ(why[k].next, int64_t(next));
             ASSERT_NE(arrow, std::string::npos);
             const std::string name = regionName(view, next);
@@ -931,7 +940,7 @@ TEST(RayTree, StepReasonsOfAKnownRayNameTheFaceCellAndNextLeaf) {
     ASSERT_GE(why.size(), 2u);
     for (size_t k = 0; k + 1 < why.size(); ++k) {
         SCOPED_TRACE(why[k].text);
-        const RegionInfo a = view.region(r.events[r.regionSteps()[k]].a);
+        const RegionInfo a = view.region(r.events[r.regionSteps()[k]].as<walk::Region>().region);
         const RegionInfo b = view.region(uint32_t(why[k].next));
         if (a.zone == b.zone) {
             EXPECT_NE(why[k].text.find("through its far depth plane"), std::string::npos);

@@ -676,23 +676,24 @@ TEST(RegularWalk, RegionsAreContiguousAndInRayOrder) {
         double prev = -kInf;
         bool first = true;
         for (const WalkEvent& e : obs.events) {
-            if (e.kind != WalkEvent::Region) continue;
-            ASSERT_LT(e.a, g.regionCount());
-            ASSERT_LE(e.t0, e.t1);
+            const walk::Region* w = e.get<walk::Region>();
+            if (!w) continue;
+            ASSERT_LT(w->region, g.regionCount());
+            ASSERT_LE(w->t0, w->t1);
             if (!first) {
-                ASSERT_EQ(e.t0, prev) << r.toString();
+                ASSERT_EQ(w->t0, prev) << r.toString();
             }
             // The cell contains the ray's points of its interval (up to rounding).
-            const RegularLeaf& L = g.leaves()[e.a];
-            Vec3 mid = r.at(0.5 * (e.t0 + e.t1));
+            const RegularLeaf& L = g.leaves()[w->region];
+            Vec3 mid = r.at(0.5 * (w->t0 + w->t1));
             for (int a = 0; a < 3; ++a) {
                 double slack = 1e-9 * g.box().extent()[a];
                 ASSERT_GE(mid[a], g.plane(a, L.lo[a]) - slack)
-                    << r.toString() << g.describeLeaf(e.a);
+                    << r.toString() << g.describeLeaf(w->region);
                 ASSERT_LE(mid[a], g.plane(a, L.hi[a]) + slack)
-                    << r.toString() << g.describeLeaf(e.a);
+                    << r.toString() << g.describeLeaf(w->region);
             }
-            prev = e.t1;
+            prev = w->t1;
             first = false;
         }
         walks += !first;

@@ -210,8 +210,9 @@ TEST(StructureView, ProjectiveZonesMapToThePixelsTheirRaysCross) {
                 RecordingObserver obs =
                     test::recordWalk(*b.accel, b.scene.camera.primaryRay(x, y, kW, kH), ctx);
                 for (const WalkEvent& e : obs.events) {
-                    if (e.kind != WalkEvent::Region) continue;
-                    RegionInfo r = v.region(e.a);
+                    const walk::Region* g = e.get<walk::Region>();
+                    if (!g) continue;
+                    RegionInfo r = v.region(g->region);
                     if (r.kind == RegionKind::ProjectiveSlab) {
                         EXPECT_EQ(r.zone, z) << "pixel " << x << ", " << y;
                     }
@@ -393,13 +394,13 @@ TEST(StructureView, CornersHoldTheStretchOfRayTheWalkReports) {
         for (const Ray& ray : rays) {
             RecordingObserver obs = test::recordWalk(*b.accel, ray, ctx);
             for (const WalkEvent& e : obs.events) {
-                if (e.kind != WalkEvent::Region || !std::isfinite(e.t1) || !(e.t0 <= e.t1))
-                    continue;
-                const std::array<Vec3, 8> corners = v.regionCorners(e.a);
+                const walk::Region* g = e.get<walk::Region>();
+                if (!g || !std::isfinite(g->t1) || !(g->t0 <= g->t1)) continue;
+                const std::array<Vec3, 8> corners = v.regionCorners(g->region);
                 for (double f : {0.0, 0.3, 0.7, 1.0}) {
-                    Vec3 p = ray.at(e.t0 + f * (e.t1 - e.t0));
+                    Vec3 p = ray.at(g->t0 + f * (g->t1 - g->t0));
                     ASSERT_LE(test::outside(corners, p), tol)
-                        << v.toString(e.a) << " t " << e.t0 << ".." << e.t1 << " "
+                        << v.toString(g->region) << " t " << g->t0 << ".." << g->t1 << " "
                         << ray.toString();
                     ++checked;
                 }

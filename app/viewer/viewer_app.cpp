@@ -167,8 +167,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     const double dt = std::chrono::duration<double>(now - lastFrame_).count();
     lastFrame_ = now;
     player_.update(state_, std::min(dt, 0.5));
-    const WalkEvent* region = player_.playback().region();
-    const int64_t played = region ? int64_t(region->a) : -1;
+    const walk::Region* region = player_.playback().region();
+    const int64_t played = region ? int64_t(region->region) : -1;
     if (played != playedRegion_) {
         if (played >= 0 || selectedRegion() == playedRegion_) selectRegion(played);
         playedRegion_ = played;

@@ -70,66 +70,90 @@ std::string Hit::toString() const {
            (flip ? ", flipped" : "") + ")";
 }
 
-std::string WalkEvent::toString(const Scene* scene) const {
-    switch (kind) {
-        case Region:
-            return "region " + std::to_string(a) + "  " + interval(t0, t1);
-        case Pointer:
-            return "pointer " + std::to_string(a) + " -> " + std::to_string(b) + " (corner " +
-                   std::to_string(corner) + ")";
-        case PrimTest:
-            return "test " + prim(a, scene) + "  spans " + lancer::toString(spans);
-        case MailboxHit:
-            return "mailbox hit p" + std::to_string(a);
-        case Spans:
-            return "region tree spans " + lancer::toString(spans);
-        case Error:
-            return "WALK ERROR: " + what;
-        case Locate:
-            return "start at " + pt(point) + " in region " + std::to_string(b);
-        case Exit: {
-            const int n = (ties & 1) + (ties >> 1 & 1) + (ties >> 2 & 1);
-            const char* through = n == 1 ? "face" : n == 2 ? "edge" : "corner";
-            return "exit at t = " + num(t0) + " " + pt(point) + " through " + through + " " +
-                   axes(ties);
-        }
-        case Lookup:
-            return "directory cell " + cells(cell) + " of " + pt(point) + " -> leaf " +
-                   std::to_string(b);
-        case Push:
-            return "pushed across " + axes(ties) + " to " + pt(point);
-        case IndexStep:
-            return "index step on " + axes(1 << axis) + " to cell " + cells(cell);
-        case Rope:
-            return "rope " + std::to_string(a) + " -> " + std::to_string(b) + " across face " +
-                   (axis % 2 ? "+" : "-") + axes(1 << (axis / 2));
-        case Children: {
-            const std::string node = "node " + std::to_string(corner);
-            if (a == kNoNodeId) return node + ": the ray meets neither child's box";
-            std::string s = node + ": child " + std::to_string(a) + " at t = " + num(t0);
-            if (b != kNoNodeId) s += ", then child " + std::to_string(b) + " at t = " + num(t1);
-            return s;
-        }
-        case Restart:
-            return "walk restarts: " + what;
-        case Culled:
-            return "node " + std::to_string(a) + " skipped: its box begins at t = " + num(t0) +
-                   ", beyond the hit at t = " + num(t1);
-        case Stretch:
-            return "light buffer stretch " + std::to_string(a) + "  " + interval(t0, t1);
-        case LightBufferClear:
-            return "light buffer: nothing can block it, no walk";
-        case Blocker:
-            return "blocked at t = " + num(t0) + " by " + prim(a, scene);
-        case RayBegin:
-            return std::string(rayKindName(RayKind(axis))) + " ray begins at " + pt(point) + "  " +
-                   interval(t0, t1);
-        case RayEnd:
-            if (axis == int(RayKind::Shadow)) return b ? "ray ends: occluded" : "ray ends: lit";
-            if (a == kNoPrim) return "ray ends: no hit";
-            return "ray ends: hit t = " + num(t0) + " on " + prim(a, scene) + " at " + pt(point);
+namespace {
+
+/// Each event's line (WalkEvent::toString).
+struct EventText {
+    const Scene* scene;
+
+    std::string operator()(const walk::Region& e) const {
+        return "region " + std::to_string(e.region) + "  " + interval(e.t0, e.t1);
     }
-    return "?";
+    std::string operator()(const walk::Pointer& e) const {
+        return "pointer " + std::to_string(e.from) + " -> " + std::to_string(e.to) + " (corner " +
+               std::to_string(e.corner) + ")";
+    }
+    std::string operator()(const walk::PrimTest& e) const {
+        return "test " + prim(e.prim, scene) + "  spans " + lancer::toString(e.spans);
+    }
+    std::string operator()(const walk::MailboxHit& e) const {
+        return "mailbox hit p" + std::to_string(e.prim);
+    }
+    std::string operator()(const walk::Spans& e) const {
+        return "region tree spans " + lancer::toString(e.spans);
+    }
+    std::string operator()(const walk::Error& e) const { return "WALK ERROR: " + e.what; }
+    std::string operator()(const walk::Locate& e) const {
+        return "start at " + pt(e.point) + " in region " + std::to_string(e.region);
+    }
+    std::string operator()(const walk::Exit& e) const {
+        const int n = (e.ties & 1) + (e.ties >> 1 & 1) + (e.ties >> 2 & 1);
+        const char* through = n == 1 ? "face" : n == 2 ? "edge" : "corner";
+        return "exit at t = " + num(e.t) + " " + pt(e.point) + " through " + through + " " +
+               axes(e.ties);
+    }
+    std::string operator()(const walk::Lookup& e) const {
+        return "directory cell " + cells(e.cell.data()) + " of " + pt(e.point) + " -> leaf " +
+               std::to_string(e.leaf);
+    }
+    std::string operator()(const walk::Push& e) const {
+        return "pushed across " + axes(e.axes) + " to " + pt(e.point);
+    }
+    std::string operator()(const walk::IndexStep& e) const {
+        return "index step on " + axes(1 << e.axis) + " to cell " + cells(e.cell.data());
+    }
+    std::string operator()(const walk::Rope& e) const {
+        return "rope " + std::to_string(e.from) + " -> " + std::to_string(e.to) + " across face " +
+               (e.face % 2 ? "+" : "-") + axes(1 << (e.face / 2));
+    }
+    std::string operator()(const walk::Children& e) const {
+        const std::string node = "node " + std::to_string(e.node);
+        if (e.first == kNoNodeId) return node + ": the ray meets neither child's box";
+        std::string s = node + ": child " + std::to_string(e.first) + " at t = " + num(e.firstT);
+        if (e.second != kNoNodeId)
+            s += ", then child " + std::to_string(e.second) + " at t = " + num(e.secondT);
+        return s;
+    }
+    std::string operator()(const walk::Culled& e) const {
+        return "node " + std::to_string(e.node) + " skipped: its box begins at t = " + num(e.t0) +
+               ", beyond the hit at t = " + num(e.hitT);
+    }
+    std::string operator()(const walk::Restart& e) const { return "walk restarts: " + e.why; }
+    std::string operator()(const walk::Stretch& e) const {
+        return "light buffer stretch " + std::to_string(e.index) + "  " + interval(e.t0, e.t1);
+    }
+    std::string operator()(const walk::LightBufferClear&) const {
+        return "light buffer: nothing can block it, no walk";
+    }
+    std::string operator()(const walk::Blocker& e) const {
+        return "blocked at t = " + num(e.t) + " by " + prim(e.prim, scene);
+    }
+    std::string operator()(const walk::RayBegin& e) const {
+        return std::string(rayKindName(e.kind)) + " ray begins at " + pt(e.origin) + "  " +
+               interval(e.tmin, e.tmax);
+    }
+    std::string operator()(const walk::RayEnd& e) const {
+        if (e.kind == RayKind::Shadow) return e.occluded ? "ray ends: occluded" : "ray ends: lit";
+        if (e.prim == kNoPrim) return "ray ends: no hit";
+        return "ray ends: hit t = " + num(e.t) + " on " + prim(e.prim, scene) + " at " +
+               pt(e.point);
+    }
+};
+
+}  // namespace
+
+std::string WalkEvent::toString(const Scene* scene) const {
+    return std::visit(EventText{scene}, data);
 }
 
 std::ostream& operator<<(std::ostream& os, const Hit& h) { return os << h.toString(); }

@@ -5,9 +5,13 @@
 // RecordingObserver, or the ray tree's recorder built on it (engine/render/ray_tree.h).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <iosfwd>
 #include <string>
+#include <type_traits>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include "engine/model/span.h"
@@ -81,160 +85,251 @@ struct NullObserver {
     void rayEnd(const RayEnd& /*end*/) {}
 };
 
-/// One event of a walk, in order. Which fields are set depends on the kind (see each kind).
-struct WalkEvent {
-    enum Kind : uint8_t {
-        Region,      ///< a: region id; t0, t1: the ray's interval in it
-        Pointer,     ///< a -> b by the corner pointer at `corner` (bit 0 x, 1 y, 2 z high)
-        PrimTest,    ///< a: primitive; spans: its spans along the whole line
-        MailboxHit,  ///< a: primitive whose spans the mailbox held
-        Spans,       ///< spans: the region's tree along the whole line
-        Error,       ///< what: why the walk ended
-        Locate,      ///< point: where the walk starts (world); b: its region
-        Exit,        ///< t0: where the region is left; point (world); axis; ties: axes mask
-        Lookup,      ///< point: the point located (world); cell: directory cell; b: leaf
-        Push,        ///< point: the exit point pushed across the axes in `ties` (world)
-        IndexStep,   ///< axis: the exit axis; cell: the next cell's indices
-        Rope,        ///< a -> b by the rope of face `axis` (2 * axis + 1 for the high face)
-        Children,    ///< BVH: node `corner`'s children met, a (entered at t0) then b (at t1)
-        Culled,      ///< BVH: node a not entered: its box begins at t0, beyond the hit at t1
-        Restart,     ///< what: why the walk starts again another way (BVH: in box-entry order)
-        Stretch,     ///< a: index; t0, t1: a stretch the light buffer leaves to walk
-        LightBufferClear,  ///< the light buffer shows nothing can block: no walk
-        Blocker,           ///< a: the primitive that blocks a shadow ray; t0: where
-        RayBegin,  ///< point: origin; t0, t1: [tmin, tmax]; axis: RayKind; b: depth; corner: light
-        RayEnd,  ///< axis: RayKind; a: hit primitive (kNoPrim: none); t0: hit t; point; b: occluded
-    } kind = Region;
-    uint32_t a = 0, b = 0;
-    int corner = -1;
+/// The events of a walk, each with its own named fields; a WalkEvent holds one of them.
+namespace walk {
+/// A region entered, with the ray's interval in it (regions are the playback's steps).
+struct Region {
+    uint32_t region = 0;
     double t0 = 0.0, t1 = 0.0;
+    bool operator==(const Region&) const = default;
+};
+/// Irregular: from region `from` to `to` by the corner pointer at `corner` (bit 0 x, 1 y, 2 z
+/// high).
+struct Pointer {
+    uint32_t from = 0, to = 0;
+    int corner = 0;
+    bool operator==(const Pointer&) const = default;
+};
+/// A primitive tested, with its spans along the whole line.
+struct PrimTest {
+    uint32_t prim = 0;
     SpanList spans;
+    bool operator==(const PrimTest&) const = default;
+};
+/// A primitive whose spans the mailbox held.
+struct MailboxHit {
+    uint32_t prim = 0;
+    bool operator==(const MailboxHit&) const = default;
+};
+/// The region's tree evaluated along the whole line.
+struct Spans {
+    SpanList spans;
+    bool operator==(const Spans&) const = default;
+};
+/// Why the walk ended early.
+struct Error {
     std::string what;
+    bool operator==(const Error&) const = default;
+};
+/// Irregular: where the walk starts (world) and the region found there.
+struct Locate {
     Vec3 point{0.0};
-    uint32_t cell[3] = {0, 0, 0};
+    uint32_t region = 0;
+    bool operator==(const Locate&) const = default;
+};
+/// Where the region is left: t, the point (world), the exit axis and the tied axes' mask (one
+/// bit: a face, two: an edge, three: a corner).
+struct Exit {
+    double t = 0.0;
+    Vec3 point{0.0};
     int axis = -1;
     int ties = 0;
+    bool operator==(const Exit&) const = default;
+};
+/// Regular: the point located (world), its directory cell and the leaf found.
+struct Lookup {
+    Vec3 point{0.0};
+    std::array<uint32_t, 3> cell{};
+    uint32_t leaf = 0;
+    bool operator==(const Lookup&) const = default;
+};
+/// Regular, push step: the exit point pushed across the axes in `axes` (world).
+struct Push {
+    Vec3 point{0.0};
+    int axes = 0;
+    bool operator==(const Push&) const = default;
+};
+/// Regular, exact step: the exit axis and the next cell's indices.
+struct IndexStep {
+    int axis = -1;
+    std::array<uint32_t, 3> cell{};
+    bool operator==(const IndexStep&) const = default;
+};
+/// Regular, exact step: from leaf `from` to `to` by the rope of face `face` (2 * axis, + 1 for
+/// the high face), a face one leaf covers.
+struct Rope {
+    uint32_t from = 0;
+    int face = 0;
+    uint32_t to = 0;
+    bool operator==(const Rope&) const = default;
+};
+/// BVH: inner node `node`'s children met, `first` (entered at firstT) then `second` (at
+/// secondT); kNoNode where one or none is met.
+struct Children {
+    uint32_t node = 0;
+    uint32_t first = 0;
+    double firstT = 0.0;
+    uint32_t second = 0;
+    double secondT = 0.0;
+    bool operator==(const Children&) const = default;
+};
+/// BVH: node `node` not entered: its box begins at t0, beyond the hit at hitT.
+struct Culled {
+    uint32_t node = 0;
+    double t0 = 0.0, hitT = 0.0;
+    bool operator==(const Culled&) const = default;
+};
+/// Why the walk starts again another way (BVH: in box-entry order).
+struct Restart {
+    std::string why;
+    bool operator==(const Restart&) const = default;
+};
+/// A stretch [t0, t1] the light buffer leaves to walk, the `index`th of the ray.
+struct Stretch {
+    int index = 0;
+    double t0 = 0.0, t1 = 0.0;
+    bool operator==(const Stretch&) const = default;
+};
+/// The light buffer shows nothing can block the shadow ray: no walk.
+struct LightBufferClear {
+    bool operator==(const LightBufferClear&) const = default;
+};
+/// The primitive that blocks a shadow ray, and where.
+struct Blocker {
+    uint32_t prim = 0;
+    double t = 0.0;
+    bool operator==(const Blocker&) const = default;
+};
+/// A ray of the pixel's tree begins: why it was cast, the bounces before it, the shadow ray's
+/// light (else -1), its origin and interval.
+struct RayBegin {
+    RayKind kind = RayKind::Primary;
+    int depth = 0;
+    int light = -1;
+    Vec3 origin{0.0};
+    double tmin = 0.0, tmax = 0.0;
+    bool operator==(const RayBegin&) const = default;
+};
+/// A ray of the pixel's tree ends: the primitive hit (kNoPrim: none) at t and point; for a
+/// shadow ray, whether it is occluded.
+struct RayEnd {
+    RayKind kind = RayKind::Primary;
+    uint32_t prim = kNoPrim;
+    double t = 0.0;
+    Vec3 point{0.0};
+    bool occluded = false;
+    bool operator==(const RayEnd&) const = default;
+};
+}  // namespace walk
 
+/// One event of a walk, in order: one of walk::*, told apart by kind().
+struct WalkEvent {
+    /// The alternatives, in the order of Kind.
+    using Data = std::variant<walk::Region, walk::Pointer, walk::PrimTest, walk::MailboxHit,
+                              walk::Spans, walk::Error, walk::Locate, walk::Exit, walk::Lookup,
+                              walk::Push, walk::IndexStep, walk::Rope, walk::Children, walk::Culled,
+                              walk::Restart, walk::Stretch, walk::LightBufferClear, walk::Blocker,
+                              walk::RayBegin, walk::RayEnd>;
+    /// Data's alternative index, by name (for switches).
+    enum Kind : uint8_t {
+        Region,
+        Pointer,
+        PrimTest,
+        MailboxHit,
+        Spans,
+        Error,
+        Locate,
+        Exit,
+        Lookup,
+        Push,
+        IndexStep,
+        Rope,
+        Children,
+        Culled,
+        Restart,
+        Stretch,
+        LightBufferClear,
+        Blocker,
+        RayBegin,
+        RayEnd,
+    };
+    Data data;  ///< the event's own fields
+
+    /// Which event this is.
+    Kind kind() const { return Kind(data.index()); }
+    /// The event as E; E must be the one held.
+    template <class E>
+    const E& as() const {
+        return std::get<E>(data);
+    }
+    /// The event as E, or null when it is another.
+    template <class E>
+    const E* get() const {
+        return std::get_if<E>(&data);
+    }
     /// One line, no newline: "region 12 t = [0.5, 1.25]", "test p3 spans {...}". With a scene,
     /// a primitive's description follows its number.
     std::string toString(const Scene* scene = nullptr) const;
     bool operator==(const WalkEvent&) const = default;
     /// The event opens a region's stretch of the walk (regions are the playback's steps).
-    bool isRegion() const { return kind == Region; }
+    bool isRegion() const { return kind() == Region; }
 };
+
+static_assert(
+    std::is_same_v<std::variant_alternative_t<WalkEvent::Region, WalkEvent::Data>, walk::Region> &&
+        std::is_same_v<std::variant_alternative_t<WalkEvent::Rope, WalkEvent::Data>, walk::Rope> &&
+        std::is_same_v<std::variant_alternative_t<WalkEvent::RayEnd, WalkEvent::Data>,
+                       walk::RayEnd> &&
+        std::variant_size_v<WalkEvent::Data> == WalkEvent::RayEnd + 1,
+    "WalkEvent::Kind names Data's alternatives in order");
 
 struct RecordingObserver {
     static constexpr bool kActive = true;
     std::vector<WalkEvent> events;
 
-    void region(uint32_t id, double t0, double t1) {
-        WalkEvent& e = add(WalkEvent::Region);
-        e.a = id;
-        e.t0 = t0;
-        e.t1 = t1;
-    }
+    void region(uint32_t id, double t0, double t1) { add(walk::Region{id, t0, t1}); }
     void primTest(uint32_t prim, const Span* spans, int n) {
-        WalkEvent& e = add(WalkEvent::PrimTest);
-        e.a = prim;
-        e.spans.assign(spans, spans + n);
+        add(walk::PrimTest{prim, SpanList(spans, spans + n)});
     }
-    void mailboxHit(uint32_t prim) { add(WalkEvent::MailboxHit).a = prim; }
-    void regionSpans(const SpanList& s) { add(WalkEvent::Spans).spans = s; }
+    void mailboxHit(uint32_t prim) { add(walk::MailboxHit{prim}); }
+    void regionSpans(const SpanList& s) { add(walk::Spans{s}); }
     /// Not recorded: a walk's events keep the primitives' spans and the tree's, from which
     /// evalNodes (engine/render/ray_csg.h) gets every node's again with evalTree.
     void csgNode(int /*node*/, const SpanList& /*spans*/) {}
-    void walkError(const char* what) { add(WalkEvent::Error).what = what; }
-    void locate(const Vec3& point, uint32_t region) {
-        WalkEvent& e = add(WalkEvent::Locate);
-        e.point = point;
-        e.b = region;
-    }
+    void walkError(const char* what) { add(walk::Error{what}); }
+    void locate(const Vec3& point, uint32_t region) { add(walk::Locate{point, region}); }
     void regionExit(double t, const Vec3& point, int axis, int ties) {
-        WalkEvent& e = add(WalkEvent::Exit);
-        e.t0 = t;
-        e.point = point;
-        e.axis = axis;
-        e.ties = ties;
+        add(walk::Exit{t, point, axis, ties});
     }
-    void pointer(uint32_t from, uint32_t to, int corner) {
-        WalkEvent& e = add(WalkEvent::Pointer);
-        e.a = from;
-        e.b = to;
-        e.corner = corner;
-    }
+    void pointer(uint32_t from, uint32_t to, int corner) { add(walk::Pointer{from, to, corner}); }
     void lookup(const Vec3& point, const uint32_t cell[3], uint32_t leaf) {
-        WalkEvent& e = add(WalkEvent::Lookup);
-        e.point = point;
-        for (int i = 0; i < 3; ++i) e.cell[i] = cell[i];
-        e.b = leaf;
+        add(walk::Lookup{point, {cell[0], cell[1], cell[2]}, leaf});
     }
-    void push(const Vec3& point, int axes) {
-        WalkEvent& e = add(WalkEvent::Push);
-        e.point = point;
-        e.ties = axes;
-    }
+    void push(const Vec3& point, int axes) { add(walk::Push{point, axes}); }
     void indexStep(int axis, const uint32_t cell[3]) {
-        WalkEvent& e = add(WalkEvent::IndexStep);
-        e.axis = axis;
-        for (int i = 0; i < 3; ++i) e.cell[i] = cell[i];
+        add(walk::IndexStep{axis, {cell[0], cell[1], cell[2]}});
     }
-    void rope(uint32_t from, int face, uint32_t to) {
-        WalkEvent& e = add(WalkEvent::Rope);
-        e.a = from;
-        e.b = to;
-        e.axis = face;
-    }
+    void rope(uint32_t from, int face, uint32_t to) { add(walk::Rope{from, face, to}); }
     void nodeChildren(uint32_t node, uint32_t first, double t0First, uint32_t second,
                       double t0Second) {
-        WalkEvent& e = add(WalkEvent::Children);
-        e.corner = int(node);
-        e.a = first;
-        e.t0 = t0First;
-        e.b = second;
-        e.t1 = t0Second;
+        add(walk::Children{node, first, t0First, second, t0Second});
     }
-    void nodeCulled(uint32_t node, double t0, double best) {
-        WalkEvent& e = add(WalkEvent::Culled);
-        e.a = node;
-        e.t0 = t0;
-        e.t1 = best;
-    }
-    void walkRestart(const char* why) { add(WalkEvent::Restart).what = why; }
-    void stretch(int index, double t0, double t1) {
-        WalkEvent& e = add(WalkEvent::Stretch);
-        e.a = uint32_t(index);
-        e.t0 = t0;
-        e.t1 = t1;
-    }
-    void lightBufferClear() { add(WalkEvent::LightBufferClear); }
-    void blocker(const Hit& hit) {
-        WalkEvent& e = add(WalkEvent::Blocker);
-        e.a = hit.prim;
-        e.t0 = hit.t;
-    }
+    void nodeCulled(uint32_t node, double t0, double best) { add(walk::Culled{node, t0, best}); }
+    void walkRestart(const char* why) { add(walk::Restart{why}); }
+    void stretch(int index, double t0, double t1) { add(walk::Stretch{index, t0, t1}); }
+    void lightBufferClear() { add(walk::LightBufferClear{}); }
+    void blocker(const Hit& hit) { add(walk::Blocker{hit.prim, hit.t}); }
     void rayBegin(RayKind kind, int depth, int light, const Ray& ray, double tmin, double tmax) {
-        WalkEvent& e = add(WalkEvent::RayBegin);
-        e.axis = int(kind);
-        e.b = uint32_t(depth);
-        e.corner = light;
-        e.point = ray.o;
-        e.t0 = tmin;
-        e.t1 = tmax;
+        add(walk::RayBegin{kind, depth, light, ray.o, tmin, tmax});
     }
     void rayEnd(const RayEnd& end) {
-        WalkEvent& e = add(WalkEvent::RayEnd);
-        e.a = end.hit.prim;
-        e.t0 = end.hit.t;
-        e.point = end.point;
-        e.b = end.occluded;
-        e.axis = int(end.kind);
+        add(walk::RayEnd{end.kind, end.hit.prim, end.hit.t, end.point, end.occluded});
     }
 
   private:
-    WalkEvent& add(WalkEvent::Kind k) {
-        events.emplace_back();
-        events.back().kind = k;
-        return events.back();
+    template <class E>
+    void add(E&& e) {
+        events.push_back(WalkEvent{std::forward<E>(e)});
     }
 };
 

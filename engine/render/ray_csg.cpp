@@ -113,25 +113,26 @@ std::vector<StepCsg> rayCsg(const Scene& scene, const TracedRay& ray, const Regi
         const size_t end = k + 1 < starts.size() ? starts[k + 1] : ev.size();
         StepCsg s;
         s.event = begin;
-        s.region = ev[begin].a;
-        s.t0 = ev[begin].t0;
-        s.t1 = ev[begin].t1;
+        const walk::Region& region = ev[begin].as<walk::Region>();
+        s.region = region.region;
+        s.t0 = region.t0;
+        s.t1 = region.t1;
         s.lo = k == 0 ? std::min(s.t0, ray.tmin) : s.t0;
         s.hi = k + 1 == starts.size() && toTmaxInLast ? std::max(s.t1, ray.tmax) : s.t1;
         const RegionTree tree = treeOf(s.region);
         s.pool = tree.pool;
         s.root = tree.root;
         for (size_t i = begin + 1; i < end; ++i) {
-            const WalkEvent& e = ev[i];
-            if (e.kind == WalkEvent::PrimTest) {
-                s.inputs.push_back({e.a, e.spans, false});
-                lastTest[e.a] = &e.spans;
-            } else if (e.kind == WalkEvent::MailboxHit) {
-                auto it = lastTest.find(e.a);
-                s.inputs.push_back({e.a, it != lastTest.end() ? *it->second : SpanList{}, true});
-            } else if (e.kind == WalkEvent::Spans) {
+            if (const auto* test = ev[i].get<walk::PrimTest>()) {
+                s.inputs.push_back({test->prim, test->spans, false});
+                lastTest[test->prim] = &test->spans;
+            } else if (const auto* mail = ev[i].get<walk::MailboxHit>()) {
+                auto it = lastTest.find(mail->prim);
+                s.inputs.push_back(
+                    {mail->prim, it != lastTest.end() ? *it->second : SpanList{}, true});
+            } else if (const auto* spans = ev[i].get<walk::Spans>()) {
                 s.evaluated = true;
-                s.result = e.spans;
+                s.result = spans->spans;
             }
         }
         // A region sharing the previous region's tree reads nothing: the walk keeps the spans.
@@ -233,11 +234,12 @@ RayWaste wastedWork(const Scene& scene, const TracedRay& ray, const std::vector<
     };
     std::unordered_map<uint32_t, size_t> tested;  // primitive -> its first test's event
     for (size_t i = 0; i < ray.events.size(); ++i) {
-        const WalkEvent& e = ray.events[i];
-        if (e.kind != WalkEvent::PrimTest || stepOf[i] < 0) continue;
+        const walk::PrimTest* test = ray.events[i].get<walk::PrimTest>();
+        if (!test || stepOf[i] < 0) continue;
+        const walk::PrimTest& e = *test;
         const size_t k = size_t(stepOf[i]);
         Waste cls = Waste::None;
-        if (tested.count(e.a)) {
+        if (tested.count(e.prim)) {
             cls = Waste::Repeat;
         } else if (e.spans.empty()) {
             cls = Waste::Miss;
@@ -249,8 +251,8 @@ RayWaste wastedWork(const Scene& scene, const TracedRay& ray, const std::vector<
             for (size_t j = k; j < steps.size() && !useful; ++j) {
                 if (!steps[j].evaluated) continue;
                 for (const PrimSpans& p : steps[j].inputs)
-                    if (p.prim == e.a) {
-                        useful = matters(j, e.a);
+                    if (p.prim == e.prim) {
+                        useful = matters(j, e.prim);
                         break;
                     }
             }
@@ -261,7 +263,7 @@ RayWaste wastedWork(const Scene& scene, const TracedRay& ray, const std::vector<
                 cls = beyond ? Waste::BeyondExit : Waste::NoEffect;
             }
         }
-        tested.emplace(e.a, i);
+        tested.emplace(e.prim, i);
         w.perEvent[i] = cls;
         w.perStep[k].add(cls);
         w.total.add(cls);

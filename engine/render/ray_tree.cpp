@@ -1,5 +1,6 @@
 #include "engine/render/ray_tree.h"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <ostream>
@@ -18,7 +19,7 @@ RayCounters countEvents(RayKind kind, const std::vector<WalkEvent>& events) {
     c.primaryRays = kind == RayKind::Primary;
     c.shadowRays = kind == RayKind::Shadow;
     for (const WalkEvent& e : events) {
-        switch (e.kind) {
+        switch (e.kind()) {
             case WalkEvent::Region:
                 ++c.regionVisits;
                 break;
@@ -137,7 +138,7 @@ std::string pt10(const Vec3& p) {
     return buf;
 }
 
-std::string cellText(const uint32_t c[3]) {
+std::string cellText(const std::array<uint32_t, 3>& c) {
     std::string s = "(";
     s.append(std::to_string(c[0])).append(", ").append(std::to_string(c[1])).append(", ");
     return s.append(std::to_string(c[2])).append(")");
@@ -187,7 +188,7 @@ std::string exitFace(const FrameSides& f, int ties) {
 }
 
 /// " -> sub-table 3 -> sub-table 9": the sub-tables a lookup of `cell` passes through.
-std::string subTables(const StructureView& view, const uint32_t cell[3]) {
+std::string subTables(const StructureView& view, const std::array<uint32_t, 3>& cell) {
     std::string s;
     if (const RegularGrid* g = view.regular())
         for (uint32_t t : g->directory().subTablesOf(cell[0], cell[1], cell[2]))
@@ -208,8 +209,8 @@ std::string nextName(const StructureView& view, uint32_t id) {
 /// How a walk (the ray's, or a light-buffer stretch's) finds its first region: by the directory
 /// (regular), the screen BSP and the zone's slabs (camera frame), the pixel's zone (projective).
 /// `arrow`: name the region after "-> " (a next step), else as the step's own.
-std::string startText(const StructureView& view, const WalkEvent* locate, const WalkEvent* lookup,
-                      uint32_t region, bool arrow) {
+std::string startText(const StructureView& view, const walk::Locate* locate,
+                      const walk::Lookup* lookup, uint32_t region, bool arrow) {
     std::string s;
     if (lookup) {
         s = "starts at " + pt6(lookup->point) + ": directory cell " + cellText(lookup->cell);
@@ -219,7 +220,7 @@ std::string startText(const StructureView& view, const WalkEvent* locate, const 
                regionName(view, region);
     }
     if (locate) {
-        const RegionKind k = view.region(locate->b).kind;
+        const RegionKind k = view.region(locate->region).kind;
         s = "starts at " + pt6(locate->point) +
             (k == RegionKind::Slab ? ", located by the screen BSP and the zone's depth slabs"
                                    : " in its pixel's projective zone");
@@ -265,29 +266,30 @@ std::vector<StepReason> explainBvhSteps(const TracedRay& r, const StructureView&
     const std::vector<size_t> steps = r.regionSteps();
     std::vector<StepReason> out(steps.size());
     for (size_t k = 0; k < steps.size(); ++k) {
-        const WalkEvent& reg = ev[steps[k]];
+        const walk::Region& reg = ev[steps[k]].as<walk::Region>();
         const size_t end = k + 1 < steps.size() ? steps[k + 1] : ev.size();
-        const RegionInfo info = view.region(reg.a);
-        std::string s = (k == 0 ? "the walk starts at the root, " : "") + regionName(view, reg.a) +
-                        ", its box met on t = [" + num6(reg.t0) + ", " + num6(reg.t1) + "]: ";
+        const RegionInfo info = view.region(reg.region);
+        std::string s = (k == 0 ? "the walk starts at the root, " : "") +
+                        regionName(view, reg.region) + ", its box met on t = [" + num6(reg.t0) +
+                        ", " + num6(reg.t1) + "]: ";
         std::vector<std::string> culled;
         bool told = false;
         for (size_t i = steps[k] + 1; i < end; ++i) {
-            const WalkEvent& e = ev[i];
-            if (e.kind == WalkEvent::Children) {
+            if (const auto* c = ev[i].get<walk::Children>()) {
                 told = true;
-                if (e.a == kNoNode)
+                if (c->first == kNoNode)
                     s += "the ray meets neither child's box";
-                else if (e.b == kNoNode)
-                    s += "only child " + std::to_string(e.a) +
-                         "'s box is met (at t = " + num6(e.t0) + ")";
+                else if (c->second == kNoNode)
+                    s += "only child " + std::to_string(c->first) +
+                         "'s box is met (at t = " + num6(c->firstT) + ")";
                 else
-                    s += "both children's boxes are met; the nearer, " + std::to_string(e.a) +
-                         " (at t = " + num6(e.t0) + "), first, then " + std::to_string(e.b) +
-                         " (at t = " + num6(e.t1) + ") unless a hit comes before it";
-            } else if (e.kind == WalkEvent::Culled) {
-                culled.push_back(std::to_string(e.a) + " (its box begins at t = " + num6(e.t0) +
-                                 ")");
+                    s += "both children's boxes are met; the nearer, " + std::to_string(c->first) +
+                         " (at t = " + num6(c->firstT) + "), first, then " +
+                         std::to_string(c->second) + " (at t = " + num6(c->secondT) +
+                         ") unless a hit comes before it";
+            } else if (const auto* u = ev[i].get<walk::Culled>()) {
+                culled.push_back(std::to_string(u->node) +
+                                 " (its box begins at t = " + num6(u->t0) + ")");
             }
         }
         if (!told && info.kind == RegionKind::BvhLeaf) {
@@ -303,7 +305,8 @@ std::vector<StepReason> explainBvhSteps(const TracedRay& r, const StructureView&
             for (size_t i = 0; i < culled.size(); ++i) s += (i ? ", node " : " node ") + culled[i];
         }
         out[k].text = std::move(s);
-        out[k].next = k + 1 < steps.size() ? int64_t(ev[steps[k + 1]].a) : -1;
+        out[k].next =
+            k + 1 < steps.size() ? int64_t(ev[steps[k + 1]].as<walk::Region>().region) : -1;
     }
     return out;
 }
@@ -317,96 +320,83 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
     const std::vector<size_t> steps = r.regionSteps();
     std::vector<StepReason> out(steps.size());
     for (size_t k = 0; k < steps.size(); ++k) {
-        const WalkEvent& reg = ev[steps[k]];
+        const walk::Region& reg = ev[steps[k]].as<walk::Region>();
         const size_t end = k + 1 < steps.size() ? steps[k + 1] : ev.size();
-        const RegionInfo info = view.region(reg.a);
+        const RegionInfo info = view.region(reg.region);
         const FrameSides sides = sidesOf(view, info.kind, r.direction);
-        const std::string here = regionName(view, reg.a);
+        const std::string here = regionName(view, reg.region);
         std::string s;
 
         // The walk's start: what came before its first region.
         if (k == 0) {
-            const WalkEvent *locate = nullptr, *lookup = nullptr, *stretch = nullptr;
+            const walk::Locate* locate = nullptr;
+            const walk::Lookup* lookup = nullptr;
+            const walk::Stretch* stretch = nullptr;
             for (size_t i = 0; i < steps[0]; ++i) {
-                if (ev[i].kind == WalkEvent::Locate) locate = &ev[i];
-                if (ev[i].kind == WalkEvent::Lookup) lookup = &ev[i];
-                if (ev[i].kind == WalkEvent::Stretch) stretch = &ev[i];
+                if (const auto* e = ev[i].get<walk::Locate>()) locate = e;
+                if (const auto* e = ev[i].get<walk::Lookup>()) lookup = e;
+                if (const auto* e = ev[i].get<walk::Stretch>()) stretch = e;
             }
             if (stretch)
-                s += "light-buffer stretch " + std::to_string(stretch->a) + " t = [" +
+                s += "light-buffer stretch " + std::to_string(stretch->index) + " t = [" +
                      num6(stretch->t0) + ", " + num6(stretch->t1) + "] ";
             else
                 s += "the walk ";
-            s += startText(view, locate, lookup, reg.a, false) + "; ";
+            s += startText(view, locate, lookup, reg.region, false) + "; ";
         }
 
         // What follows the region's own events: its exit and the way to the next region, or
         // the ray's end; then, for a shadow ray, the next light-buffer stretch's start.
-        const WalkEvent *exit = nullptr, *rope = nullptr, *index = nullptr, *push = nullptr,
-                        *lookup = nullptr, *error = nullptr, *blocker = nullptr, *stretch = nullptr,
-                        *locate = nullptr;
-        std::vector<const WalkEvent*> pointers;
+        const walk::Exit* exit = nullptr;
+        const walk::Rope* rope = nullptr;
+        const walk::IndexStep* index = nullptr;
+        const walk::Push* push = nullptr;
+        const walk::Lookup* lookup = nullptr;
+        const walk::Error* error = nullptr;
+        const walk::Blocker* blocker = nullptr;
+        const walk::Stretch* stretch = nullptr;
+        const walk::Locate* locate = nullptr;
+        std::vector<const walk::Pointer*> pointers;
         for (size_t i = steps[k] + 1; i < end; ++i) {
             const WalkEvent& e = ev[i];
-            switch (e.kind) {
-                case WalkEvent::Exit:
-                    exit = &e;
-                    break;
-                case WalkEvent::Rope:
-                    rope = &e;
-                    break;
-                case WalkEvent::IndexStep:
-                    index = &e;
-                    break;
-                case WalkEvent::Push:
-                    push = &e;
-                    break;
-                case WalkEvent::Lookup:
-                    lookup = &e;
-                    break;
-                case WalkEvent::Pointer:
-                    pointers.push_back(&e);
-                    break;
-                case WalkEvent::Error:
-                    error = &e;
-                    break;
-                case WalkEvent::Blocker:
-                    blocker = &e;
-                    break;
-                case WalkEvent::Stretch:
-                    stretch = &e;
-                    lookup = locate = nullptr;  // one after it starts the stretch's walk
-                    break;
-                case WalkEvent::Locate:
-                    locate = &e;
-                    break;
-                default:
-                    break;
+            if (const auto* x = e.get<walk::Exit>()) exit = x;
+            if (const auto* x = e.get<walk::Rope>()) rope = x;
+            if (const auto* x = e.get<walk::IndexStep>()) index = x;
+            if (const auto* x = e.get<walk::Push>()) push = x;
+            if (const auto* x = e.get<walk::Lookup>()) lookup = x;
+            if (const auto* x = e.get<walk::Pointer>()) pointers.push_back(x);
+            if (const auto* x = e.get<walk::Error>()) error = x;
+            if (const auto* x = e.get<walk::Blocker>()) blocker = x;
+            if (const auto* x = e.get<walk::Locate>()) locate = x;
+            if (const auto* x = e.get<walk::Stretch>()) {
+                stretch = x;
+                lookup = nullptr;  // one after it starts the stretch's walk
+                locate = nullptr;
             }
         }
         const bool hasNext = k + 1 < steps.size();
-        const uint32_t next = hasNext ? ev[steps[k + 1]].a : 0;
+        const uint32_t next = hasNext ? ev[steps[k + 1]].as<walk::Region>().region : 0;
         const bool nextInWalk = hasNext && !stretch;
         StepReason& reason = out[k];
         reason.next = hasNext ? int64_t(next) : -1;
 
         if (exit) {
             s += "left " + here + " through its " + exitFace(sides, exit->ties) +
-                 " at t = " + num6(exit->t0) + " (point " + pt6(exit->point) + ")";
+                 " at t = " + num6(exit->t) + " (point " + pt6(exit->point) + ")";
             if (rope) {
-                s += "; the leaf's rope across that face " + nextName(view, rope->b);
+                s += "; the leaf's rope across that face " + nextName(view, rope->to);
             } else if (index && lookup) {
                 s += "; exact index step " + signedAxis(sides, index->axis) +
                      " to directory cell " + cellText(lookup->cell) +
-                     subTables(view, lookup->cell) + " " + nextName(view, lookup->b);
+                     subTables(view, lookup->cell) + " " + nextName(view, lookup->leaf);
             } else if (push && lookup) {
                 const int a = exit->axis;
                 s += "; pushed by delta " + num6(std::abs(push->point[a] - exit->point[a])) +
-                     " across " + exitFace(sides, push->ties) + " to " + pt10(push->point) +
+                     " across " + exitFace(sides, push->axes) + " to " + pt10(push->point) +
                      ": directory cell " + cellText(lookup->cell) + subTables(view, lookup->cell) +
-                     " " + nextName(view, lookup->b);
+                     " " + nextName(view, lookup->leaf);
             } else if (!pointers.empty() && !error) {
-                const RegionInfo to = view.region(pointers.back()->b);
+                const RegionInfo to = view.region(pointers.back()->to);
                 if (exit->ties == 4 && pointers.size() == 1) {
                     s += ": the next slab of the same zone, by corner pointer " +
                          std::to_string(pointers[0]->corner);
@@ -415,16 +405,16 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
                          std::to_string(info.zone) + " by corner pointer";
                     if (pointers.size() > 1) s += "s";
                     for (size_t i = 0; i < pointers.size(); ++i) {
-                        const WalkEvent& p = *pointers[i];
-                        const Box3 b = view.region(p.a).frameBox;
+                        const walk::Pointer& p = *pointers[i];
+                        const Box3 b = view.region(p.from).frameBox;
                         const int c = p.corner;
                         s += std::string(i ? "," : "") + " " + std::to_string(c) + " of region " +
-                             std::to_string(p.a) + " (its corner at screen (" +
+                             std::to_string(p.from) + " (its corner at screen (" +
                              num6(c & 1 ? b.hi.x : b.lo.x) + ", " + num6(c & 2 ? b.hi.y : b.lo.y) +
                              "), depth " + num6(c & 4 ? b.hi.z : b.lo.z) + ")";
                     }
                 }
-                s += " " + nextName(view, pointers.back()->b);
+                s += " " + nextName(view, pointers.back()->to);
             } else if (nextInWalk) {
                 s += info.kind == RegionKind::NearRegion
                          ? ": the first slab of the pixel's zone " + nextName(view, next)
@@ -437,8 +427,8 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
         if (!exit && !error) {
             const bool last = k + 1 == steps.size();
             if (blocker && !stretch) {
-                s += "blocked by " + primText(blocker->a, scene) + " at t = " + num6(blocker->t0) +
-                     " inside this region: the light is hidden";
+                s += "blocked by " + primText(blocker->prim, scene) +
+                     " at t = " + num6(blocker->t) + " inside this region: the light is hidden";
             } else if (last && r.kind != RayKind::Shadow && r.hit.valid()) {
                 s += "hit " + primText(r.hit.prim, scene) + " at t = " + num6(r.hit.t) +
                      " inside this region";
@@ -454,7 +444,7 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
             }
         }
         if (stretch) {
-            s += "; light-buffer stretch " + std::to_string(stretch->a) + " t = [" +
+            s += "; light-buffer stretch " + std::to_string(stretch->index) + " t = [" +
                  num6(stretch->t0) + ", " + num6(stretch->t1) + "] ";
             s += hasNext ? startText(view, locate, lookup, next, true)
                          : std::string("meets no region");
@@ -478,8 +468,8 @@ std::string RayTree::toString(const Scene* scene, const StructureView* view) con
             view ? explainSteps(r, *view, scene) : std::vector<StepReason>();
         size_t step = 0;
         for (const WalkEvent& e : r.events) {
-            const bool inRegion = e.kind == WalkEvent::PrimTest ||
-                                  e.kind == WalkEvent::MailboxHit || e.kind == WalkEvent::Spans;
+            const bool inRegion = e.kind() == WalkEvent::PrimTest ||
+                                  e.kind() == WalkEvent::MailboxHit || e.kind() == WalkEvent::Spans;
             os << indent << (inRegion ? "    " : "  ") << e.toString(scene) << "\n";
             if (e.isRegion() && step < why.size())
                 os << indent << "    why: " << why[step++].text << "\n";
@@ -542,102 +532,115 @@ nlohmann::json axesJson(int mask) {
 
 }  // namespace
 
-nlohmann::json toJson(const WalkEvent& e, const RegionCornersFn& corners) {
-    nlohmann::json j;
-    switch (e.kind) {
-        case WalkEvent::Region:
-            j = {{"event", "region"}, {"region", e.a}, {"t0", tJson(e.t0)}, {"t1", tJson(e.t1)}};
-            if (corners) {
-                nlohmann::json c = nlohmann::json::array();
-                for (const Vec3& p : corners(e.a)) c.push_back(vec(p));
-                j["corners"] = c;
-            }
-            break;
-        case WalkEvent::Pointer:
-            j = {{"event", "pointer"}, {"from", e.a}, {"to", e.b}, {"corner", e.corner}};
-            break;
-        case WalkEvent::PrimTest:
-            j = {{"event", "prim_test"}, {"prim", e.a}, {"spans", spansJson(e.spans)}};
-            break;
-        case WalkEvent::MailboxHit:
-            j = {{"event", "mailbox_hit"}, {"prim", e.a}};
-            break;
-        case WalkEvent::Spans:
-            j = {{"event", "region_spans"}, {"spans", spansJson(e.spans)}};
-            break;
-        case WalkEvent::Error:
-            j = {{"event", "walk_error"}, {"what", e.what}};
-            break;
-        case WalkEvent::Locate:
-            j = {{"event", "locate"}, {"point", vec(e.point)}, {"region", e.b}};
-            break;
-        case WalkEvent::Exit:
-            j = {{"event", "exit"},
-                 {"t", tJson(e.t0)},
-                 {"point", vec(e.point)},
-                 {"axis", e.axis},
-                 {"ties", axesJson(e.ties)}};
-            break;
-        case WalkEvent::Lookup:
-            j = {{"event", "lookup"},
-                 {"point", vec(e.point)},
-                 {"cell", {e.cell[0], e.cell[1], e.cell[2]}},
-                 {"leaf", e.b}};
-            break;
-        case WalkEvent::Push:
-            j = {{"event", "push"}, {"point", vec(e.point)}, {"axes", axesJson(e.ties)}};
-            break;
-        case WalkEvent::IndexStep:
-            j = {{"event", "index_step"},
-                 {"axis", e.axis},
-                 {"cell", {e.cell[0], e.cell[1], e.cell[2]}}};
-            break;
-        case WalkEvent::Rope:
-            j = {{"event", "rope"},
-                 {"from", e.a},
-                 {"to", e.b},
-                 {"axis", e.axis / 2},
-                 {"side", e.axis % 2 ? "high" : "low"}};
-            break;
-        case WalkEvent::Children:
-            j = {{"event", "children"}, {"node", e.corner}};
-            j["first"] = e.a == kNoNode ? nlohmann::json(nullptr) : nlohmann::json(e.a);
-            j["first_t"] = tJson(e.t0);
-            j["second"] = e.b == kNoNode ? nlohmann::json(nullptr) : nlohmann::json(e.b);
-            j["second_t"] = tJson(e.t1);
-            break;
-        case WalkEvent::Restart:
-            j = {{"event", "restart"}, {"what", e.what}};
-            break;
-        case WalkEvent::Culled:
-            j = {{"event", "culled"}, {"node", e.a}, {"t0", tJson(e.t0)}, {"hit_t", tJson(e.t1)}};
-            break;
-        case WalkEvent::Stretch:
-            j = {{"event", "stretch"}, {"index", e.a}, {"t0", tJson(e.t0)}, {"t1", tJson(e.t1)}};
-            break;
-        case WalkEvent::LightBufferClear:
-            j = {{"event", "light_buffer_clear"}};
-            break;
-        case WalkEvent::Blocker:
-            j = {{"event", "blocker"}, {"prim", e.a}, {"t", tJson(e.t0)}};
-            break;
-        case WalkEvent::RayBegin:
-            j = {{"event", "ray_begin"},
-                 {"kind", rayKindName(RayKind(e.axis))},
-                 {"tmin", tJson(e.t0)},
-                 {"tmax", tJson(e.t1)}};
-            break;
-        case WalkEvent::RayEnd:
-            j = {{"event", "ray_end"}, {"kind", rayKindName(RayKind(e.axis))}};
-            if (RayKind(e.axis) == RayKind::Shadow)
-                j["occluded"] = e.b != 0;
-            else if (e.a != kNoPrim)
-                j["hit"] = {{"t", e.t0}, {"prim", e.a}, {"point", vec(e.point)}};
-            else
-                j["hit"] = nullptr;
-            break;
+namespace {
+
+nlohmann::json cellJson(const std::array<uint32_t, 3>& c) { return {c[0], c[1], c[2]}; }
+
+nlohmann::json nodeJson(uint32_t node) {
+    return node == kNoNode ? nlohmann::json(nullptr) : nlohmann::json(node);
+}
+
+/// Each event's object in the trace JSON (its keys are the contract in DESIGN.md).
+struct EventJson {
+    const RegionCornersFn& corners;
+
+    nlohmann::json operator()(const walk::Region& e) const {
+        nlohmann::json j = {
+            {"event", "region"}, {"region", e.region}, {"t0", tJson(e.t0)}, {"t1", tJson(e.t1)}};
+        if (corners) {
+            nlohmann::json c = nlohmann::json::array();
+            for (const Vec3& p : corners(e.region)) c.push_back(vec(p));
+            j["corners"] = c;
+        }
+        return j;
     }
-    return j;
+    nlohmann::json operator()(const walk::Pointer& e) const {
+        return {{"event", "pointer"}, {"from", e.from}, {"to", e.to}, {"corner", e.corner}};
+    }
+    nlohmann::json operator()(const walk::PrimTest& e) const {
+        return {{"event", "prim_test"}, {"prim", e.prim}, {"spans", spansJson(e.spans)}};
+    }
+    nlohmann::json operator()(const walk::MailboxHit& e) const {
+        return {{"event", "mailbox_hit"}, {"prim", e.prim}};
+    }
+    nlohmann::json operator()(const walk::Spans& e) const {
+        return {{"event", "region_spans"}, {"spans", spansJson(e.spans)}};
+    }
+    nlohmann::json operator()(const walk::Error& e) const {
+        return {{"event", "walk_error"}, {"what", e.what}};
+    }
+    nlohmann::json operator()(const walk::Locate& e) const {
+        return {{"event", "locate"}, {"point", vec(e.point)}, {"region", e.region}};
+    }
+    nlohmann::json operator()(const walk::Exit& e) const {
+        return {{"event", "exit"},
+                {"t", tJson(e.t)},
+                {"point", vec(e.point)},
+                {"axis", e.axis},
+                {"ties", axesJson(e.ties)}};
+    }
+    nlohmann::json operator()(const walk::Lookup& e) const {
+        return {{"event", "lookup"},
+                {"point", vec(e.point)},
+                {"cell", cellJson(e.cell)},
+                {"leaf", e.leaf}};
+    }
+    nlohmann::json operator()(const walk::Push& e) const {
+        return {{"event", "push"}, {"point", vec(e.point)}, {"axes", axesJson(e.axes)}};
+    }
+    nlohmann::json operator()(const walk::IndexStep& e) const {
+        return {{"event", "index_step"}, {"axis", e.axis}, {"cell", cellJson(e.cell)}};
+    }
+    nlohmann::json operator()(const walk::Rope& e) const {
+        return {{"event", "rope"},
+                {"from", e.from},
+                {"to", e.to},
+                {"axis", e.face / 2},
+                {"side", e.face % 2 ? "high" : "low"}};
+    }
+    nlohmann::json operator()(const walk::Children& e) const {
+        return {{"event", "children"},          {"node", e.node},
+                {"first", nodeJson(e.first)},   {"first_t", tJson(e.firstT)},
+                {"second", nodeJson(e.second)}, {"second_t", tJson(e.secondT)}};
+    }
+    nlohmann::json operator()(const walk::Culled& e) const {
+        return {
+            {"event", "culled"}, {"node", e.node}, {"t0", tJson(e.t0)}, {"hit_t", tJson(e.hitT)}};
+    }
+    nlohmann::json operator()(const walk::Restart& e) const {
+        return {{"event", "restart"}, {"what", e.why}};
+    }
+    nlohmann::json operator()(const walk::Stretch& e) const {
+        return {{"event", "stretch"}, {"index", e.index}, {"t0", tJson(e.t0)}, {"t1", tJson(e.t1)}};
+    }
+    nlohmann::json operator()(const walk::LightBufferClear&) const {
+        return {{"event", "light_buffer_clear"}};
+    }
+    nlohmann::json operator()(const walk::Blocker& e) const {
+        return {{"event", "blocker"}, {"prim", e.prim}, {"t", tJson(e.t)}};
+    }
+    nlohmann::json operator()(const walk::RayBegin& e) const {
+        return {{"event", "ray_begin"},
+                {"kind", rayKindName(e.kind)},
+                {"tmin", tJson(e.tmin)},
+                {"tmax", tJson(e.tmax)}};
+    }
+    nlohmann::json operator()(const walk::RayEnd& e) const {
+        nlohmann::json j = {{"event", "ray_end"}, {"kind", rayKindName(e.kind)}};
+        if (e.kind == RayKind::Shadow)
+            j["occluded"] = e.occluded;
+        else if (e.prim != kNoPrim)
+            j["hit"] = {{"t", e.t}, {"prim", e.prim}, {"point", vec(e.point)}};
+        else
+            j["hit"] = nullptr;
+        return j;
+    }
+};
+
+}  // namespace
+
+nlohmann::json toJson(const WalkEvent& e, const RegionCornersFn& corners) {
+    return std::visit(EventJson{corners}, e.data);
 }
 
 nlohmann::json toJson(const TracedRay& r, const Scene& scene, const RegionCornersFn& corners,

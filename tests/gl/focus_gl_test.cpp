@@ -101,7 +101,7 @@ TEST(ViewerFocus, PlaybackKeysStepTheRay) {
     h.press(ImGuiKey_Home);
     EXPECT_EQ(play.state().step, 0);
     // The selection follows the played step, as with the panel's buttons.
-    EXPECT_EQ(h.app().selectedRegion(), int64_t(play.region()->a));
+    EXPECT_EQ(h.app().selectedRegion(), int64_t(play.region()->region));
     h.press(ImGuiKey_Space);
     EXPECT_TRUE(play.playing());
     h.press(ImGuiKey_Space);

@@ -81,7 +81,7 @@ std::string rowLabel(const playback::StripRow& r) {
 /// (a difference's subtrahend exposing its inside) as small ticks. Returns the step of the
 /// band clicked, or -1.
 int drawStrip(const std::vector<playback::StripRow>& rows,
-              const std::vector<playback::StripBand>& bands, const WalkEvent* stretch, double lo,
+              const std::vector<playback::StripBand>& bands, const walk::Region* stretch, double lo,
               double hi, const TracedRay& ray, int currentStep, const char* id) {
     const float labelW = 118.0f, rowH = 14.0f;
     const float top = bands.empty() ? 0.0f : rowH;
@@ -197,7 +197,7 @@ int drawStrip(const std::vector<playback::StripRow>& rows,
 /// covering the region's stretch (shaded) and every finite span end; the hit's chain marked.
 void regionCsgStrip(playback::RayPlayer& player) {
     const playback::RayPlayback& play = player.playback();
-    const WalkEvent* region = play.region();
+    const walk::Region* region = play.region();
     if (!region) return;
     const std::vector<StepCsg>& steps = player.csgSteps();
     const int k = play.state().step;

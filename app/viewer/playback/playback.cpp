@@ -10,9 +10,9 @@ namespace lancer::viewer::playback {
 WalkCounts countsOf(const TracedRay& r) {
     WalkCounts c;
     for (const WalkEvent& e : r.events) {
-        if (e.kind == WalkEvent::PrimTest) ++c.primTests;
-        if (e.kind == WalkEvent::MailboxHit) ++c.mailboxHits;
-        if (e.kind == WalkEvent::Region) ++c.regions;
+        if (e.kind() == WalkEvent::PrimTest) ++c.primTests;
+        if (e.kind() == WalkEvent::MailboxHit) ++c.mailboxHits;
+        if (e.kind() == WalkEvent::Region) ++c.regions;
     }
     return c;
 }
@@ -116,9 +116,9 @@ bool RayPlayback::advance(double seconds) {
     return moved;
 }
 
-const WalkEvent* RayPlayback::region() const {
+const walk::Region* RayPlayback::region() const {
     if (empty() || state_.step < 0) return nullptr;
-    return &ray().events[state_.eventBegin];
+    return &ray().events[state_.eventBegin].as<walk::Region>();
 }
 
 std::optional<WalkCounts> RayPlayback::previousCounts(int k) const {
@@ -129,7 +129,7 @@ std::optional<WalkCounts> RayPlayback::previousCounts(int k) const {
 std::vector<uint32_t> visitedRegions(const RayPlayback& play) {
     std::vector<uint32_t> ids;
     if (play.empty()) return ids;
-    for (size_t e : play.steps()) ids.push_back(play.ray().events[e].a);
+    for (size_t e : play.steps()) ids.push_back(play.ray().events[e].as<walk::Region>().region);
     std::sort(ids.begin(), ids.end());
     ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
     return ids;
@@ -140,20 +140,21 @@ std::vector<SpanRow> stepSpans(const RayPlayback& play) {
     if (play.empty() || play.state().step < 0) return rows;
     const std::vector<WalkEvent>& ev = play.ray().events;
     for (size_t i = play.state().eventBegin; i < play.state().eventEnd; ++i) {
-        const WalkEvent& e = ev[i];
-        if (e.kind == WalkEvent::PrimTest) {
-            rows.push_back({e.a, false, e.spans});
-        } else if (e.kind == WalkEvent::MailboxHit) {
+        if (const auto* test = ev[i].get<walk::PrimTest>()) {
+            rows.push_back({test->prim, false, test->spans});
+        } else if (const auto* mail = ev[i].get<walk::MailboxHit>()) {
             // The mailbox holds the spans of this primitive's last test along the ray.
-            SpanRow r{e.a, true, {}};
-            for (size_t j = i; j-- > 0;)
-                if (ev[j].kind == WalkEvent::PrimTest && ev[j].a == e.a) {
-                    r.spans = ev[j].spans;
+            SpanRow r{mail->prim, true, {}};
+            for (size_t j = i; j-- > 0;) {
+                const auto* earlier = ev[j].get<walk::PrimTest>();
+                if (earlier && earlier->prim == mail->prim) {
+                    r.spans = earlier->spans;
                     break;
                 }
+            }
             rows.push_back(std::move(r));
-        } else if (e.kind == WalkEvent::Spans) {
-            rows.push_back({kNoPrim, false, e.spans});
+        } else if (const auto* spans = ev[i].get<walk::Spans>()) {
+            rows.push_back({kNoPrim, false, spans->spans});
         }
     }
     return rows;
@@ -203,9 +204,11 @@ std::vector<StripRow> regionStrip(const std::vector<StepCsg>& steps, const RayWa
         r.spans = p.spans;
         r.onHit = hitHere && p.prim == ray.hit.prim && holdsHit(p.spans, ray.hit);
         if (!r.mailbox) {
-            while (next < ray.events.size() &&
-                   !(ray.events[next].kind == WalkEvent::PrimTest && ray.events[next].a == p.prim))
-                ++next;
+            auto testOf = [&](size_t i) {
+                const auto* test = ray.events[i].get<walk::PrimTest>();
+                return test && test->prim == p.prim;
+            };
+            while (next < ray.events.size() && !testOf(next)) ++next;
             if (next < waste.perEvent.size()) r.waste = waste.perEvent[next++];
         }
         rows.push_back(std::move(r));
@@ -255,9 +258,9 @@ RayStrip rayStrip(const std::vector<StepCsg>& steps, const RayWaste& waste, cons
     }
     // Each primitive's first test: tested (not only read from the mailbox), and its class.
     for (size_t i = 0; i < ray.events.size(); ++i) {
-        const WalkEvent& e = ray.events[i];
-        if (e.kind != WalkEvent::PrimTest) continue;
-        auto it = rowOf.find(e.a);
+        const auto* test = ray.events[i].get<walk::PrimTest>();
+        if (!test) continue;
+        auto it = rowOf.find(test->prim);
         if (it == rowOf.end()) continue;
         StripRow& r = out.rows[it->second];
         if (!r.mailbox) continue;
@@ -276,10 +279,12 @@ std::vector<TestedBox> testedBoxes(const RayPlayback& play, const Scene& scene) 
     if (play.empty() || play.state().step < 0) return out;
     const std::vector<WalkEvent>& ev = play.ray().events;
     for (size_t i = play.state().eventBegin; i < play.state().eventEnd; ++i) {
-        const WalkEvent& e = ev[i];
-        if (e.kind != WalkEvent::PrimTest && e.kind != WalkEvent::MailboxHit) continue;
-        if (e.a >= scene.minBox.size() || scene.minBox[e.a].isEmpty()) continue;
-        out.push_back({e.a, scene.minBox[e.a], e.kind == WalkEvent::MailboxHit});
+        const auto* test = ev[i].get<walk::PrimTest>();
+        const auto* mail = ev[i].get<walk::MailboxHit>();
+        if (!test && !mail) continue;
+        const uint32_t prim = test ? test->prim : mail->prim;
+        if (prim >= scene.minBox.size() || scene.minBox[prim].isEmpty()) continue;
+        out.push_back({prim, scene.minBox[prim], mail != nullptr});
     }
     return out;
 }

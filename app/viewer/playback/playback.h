@@ -78,8 +78,8 @@ class RayPlayback {
     /// True when the step changed.
     bool advance(double seconds);
 
-    /// The current step's Region event (nullptr when the ray walks no region).
-    const WalkEvent* region() const;
+    /// The current step's region event (nullptr when the ray walks no region).
+    const walk::Region* region() const;
     /// Index in the ray's events of each step's Region event.
     const std::vector<size_t>& steps() const { return steps_; }
 

@@ -109,16 +109,16 @@ TEST_P(PlaybackTrace, StepKIsTheKthRegionEventOfLancerTrace) {
             const std::vector<StepReason> why = explainSteps(play.ray(), view, &scene);
             for (int s = 0; s < play.stepCount(); ++s) {
                 play.seek(s);
-                const WalkEvent* e = play.region();
+                const walk::Region* e = play.region();
                 ASSERT_NE(e, nullptr);
-                EXPECT_EQ(e->a, regions[size_t(s)]["region"].get<uint32_t>());
+                EXPECT_EQ(e->region, regions[size_t(s)]["region"].get<uint32_t>());
                 EXPECT_EQ(e->t0, regions[size_t(s)]["t0"].get<double>());
                 if (!regions[size_t(s)]["t1"].is_null()) {
                     EXPECT_EQ(e->t1, regions[size_t(s)]["t1"].get<double>());
                 }
                 EXPECT_EQ(why[size_t(s)].text, regions[size_t(s)]["why"].get<std::string>());
                 // The region drawn is the one the trace describes: the same 8 corners.
-                const std::array<Vec3, 8> c = view.regionCorners(e->a);
+                const std::array<Vec3, 8> c = view.regionCorners(e->region);
                 const nlohmann::json& jc = regions[size_t(s)]["corners"];
                 ASSERT_EQ(jc.size(), 8u);
                 for (size_t i = 0; i < 8; ++i)
@@ -176,7 +176,7 @@ void backAndForth(RayPlayback& play) {
     EXPECT_FALSE(play.back());
     // Steps tile the ray's events from its first region on, each opening with its Region event.
     for (size_t k = 0; k < forward.size(); ++k) {
-        EXPECT_EQ(play.ray().events[forward[k].eventBegin].kind, WalkEvent::Region);
+        EXPECT_EQ(play.ray().events[forward[k].eventBegin].kind(), WalkEvent::Region);
         if (k + 1 < forward.size()) {
             EXPECT_EQ(forward[k].eventEnd, forward[k + 1].eventBegin);
         }
@@ -284,8 +284,8 @@ TEST(Playback, StepSpansAreTheStepsTestsAndTheRegionTree) {
         rows += r.size();
         for (size_t i = play.state().eventBegin; i < play.state().eventEnd; ++i) {
             const WalkEvent& e = play.ray().events[i];
-            tests += e.kind == WalkEvent::PrimTest || e.kind == WalkEvent::MailboxHit;
-            combined += e.kind == WalkEvent::Spans;
+            tests += e.kind() == WalkEvent::PrimTest || e.kind() == WalkEvent::MailboxHit;
+            combined += e.kind() == WalkEvent::Spans;
         }
         for (const SpanRow& row : r)
             if (row.prim != kNoPrim && !row.mailbox) {
@@ -293,8 +293,8 @@ TEST(Playback, StepSpansAreTheStepsTestsAndTheRegionTree) {
                 bool seen = false;
                 for (size_t i = play.state().eventBegin; i < play.state().eventEnd; ++i) {
                     const WalkEvent& e = play.ray().events[i];
-                    seen = seen || (e.kind == WalkEvent::PrimTest && e.a == row.prim &&
-                                    e.spans == row.spans);
+                    const walk::PrimTest* t = e.get<walk::PrimTest>();
+                    seen = seen || (t && t->prim == row.prim && t->spans == row.spans);
                 }
                 EXPECT_TRUE(seen);
             }

@@ -57,9 +57,9 @@ double endT(const TracedRay& r, const StructureView& view) {
 
 std::optional<std::array<Vec3, 8>> currentCorners(const RayPlayback& play,
                                                   const StructureView& view) {
-    const WalkEvent* e = play.region();
-    if (!e || e->a >= view.regionCount()) return std::nullopt;
-    return view.regionCorners(e->a);
+    const walk::Region* e = play.region();
+    if (!e || e->region >= view.regionCount()) return std::nullopt;
+    return view.regionCorners(e->region);
 }
 
 gl::Batch testedBoxesBatch(const RayPlayback& play, const StructureView& view) {
@@ -101,7 +101,7 @@ gl::Batch rayBatch(const RayPlayback& play, const StructureView& view) {
     b.lines.insert(b.lines.end(), tested.lines.begin(), tested.lines.end());
 
     // The ray's stretch inside the region.
-    const WalkEvent& region = *play.region();
+    const walk::Region& region = *play.region();
     const double t1 = std::isfinite(region.t1) ? region.t1 : farT(ray, *corners);
     b.line(f(ray.origin + region.t0 * ray.direction), f(ray.origin + t1 * ray.direction),
            gl::rgba8(kSegmentColor));
@@ -109,47 +109,51 @@ gl::Batch rayBatch(const RayPlayback& play, const StructureView& view) {
     // The step's scheme events: why the next region is the next.
     const PlaybackState& s = play.state();
     for (size_t i = s.eventBegin; i < s.eventEnd; ++i) {
-        const WalkEvent& e = ray.events[i];
-        if (e.kind == WalkEvent::Exit) {
-            cross(b, e.point, mark, gl::rgba8(kPointerColor));
+        const WalkEvent& ev = ray.events[i];
+        if (const auto* exit = ev.get<walk::Exit>()) {
+            cross(b, exit->point, mark, gl::rgba8(kPointerColor));
             // A projective slab follows no pointer: its next region is the next slab of the
             // pixel's zone, the next step's region.
-            const RegionKind kind = view.region(region.a).kind;
+            const RegionKind kind = view.region(region.region).kind;
             const std::vector<size_t>& steps = play.steps();
             if ((kind == RegionKind::ProjectiveSlab || kind == RegionKind::NearRegion) &&
                 s.step >= 0 && size_t(s.step) + 1 < steps.size()) {
-                const std::array<Vec3, 8> next =
-                    view.regionCorners(ray.events[steps[size_t(s.step) + 1]].a);
+                const std::array<Vec3, 8> next = view.regionCorners(
+                    ray.events[steps[size_t(s.step) + 1]].as<walk::Region>().region);
                 Vec3 centre(0.0);
                 for (const Vec3& p : next) centre += p / 8.0;
-                b.line(f(e.point), f(centre), gl::rgba8(kPointerColor, 0.8f));
+                b.line(f(exit->point), f(centre), gl::rgba8(kPointerColor, 0.8f));
             }
-        } else if (e.kind == WalkEvent::Pointer && e.corner >= 0 && e.corner < 8) {
+        } else if (const auto* ptr = ev.get<walk::Pointer>();
+                   ptr && ptr->corner >= 0 && ptr->corner < 8) {
             // The corner whose pointer the walk followed, and the step to the next region.
-            const Vec3 c = (*corners)[size_t(e.corner)];
+            const Vec3 c = (*corners)[size_t(ptr->corner)];
             cross(b, c, 2.0 * mark, gl::rgba8(kPointerColor));
-            if (e.b < view.regionCount()) {
-                const std::array<Vec3, 8> next = view.regionCorners(e.b);
+            if (ptr->to < view.regionCount()) {
+                const std::array<Vec3, 8> next = view.regionCorners(ptr->to);
                 Vec3 centre(0.0);
                 for (const Vec3& p : next) centre += p / 8.0;
                 b.line(f(c), f(centre), gl::rgba8(kPointerColor, 0.8f));
             }
-        } else if (e.kind == WalkEvent::Push) {
-            cross(b, e.point, mark, gl::rgba8(kCellColor));
-        } else if (e.kind == WalkEvent::Lookup || e.kind == WalkEvent::IndexStep) {
+        } else if (const auto* push = ev.get<walk::Push>()) {
+            cross(b, push->point, mark, gl::rgba8(kCellColor));
+        } else if (ev.kind() == WalkEvent::Lookup || ev.kind() == WalkEvent::IndexStep) {
             // The directory cell looked up (or stepped into), as a box of the grid's planes.
+            const auto* lookup = ev.get<walk::Lookup>();
+            const std::array<uint32_t, 3>& cell =
+                lookup ? lookup->cell : ev.as<walk::IndexStep>().cell;
             if (const RegularGrid* g = view.regular()) {
                 bool inside = true;
-                for (int a = 0; a < 3; ++a) inside = inside && e.cell[a] < g->cells(a);
+                for (int a = 0; a < 3; ++a) inside = inside && cell[size_t(a)] < g->cells(a);
                 if (inside) {
-                    const uint32_t hi[3] = {e.cell[0] + 1, e.cell[1] + 1, e.cell[2] + 1};
-                    const std::array<Vec3, 8> c = view.gridCorners(e.cell, hi);
+                    const uint32_t hi[3] = {cell[0] + 1, cell[1] + 1, cell[2] + 1};
+                    const std::array<Vec3, 8> c = view.gridCorners(cell.data(), hi);
                     std::array<glm::vec3, 8> fc;
                     for (size_t i = 0; i < 8; ++i) fc[i] = f(c[i]);
                     b.box(fc, gl::rgba8(kCellColor));
                 }
             }
-            if (e.kind == WalkEvent::Lookup) cross(b, e.point, mark, gl::rgba8(kCellColor));
+            if (lookup) cross(b, lookup->point, mark, gl::rgba8(kCellColor));
         }
     }
     return b;

@@ -296,8 +296,8 @@ bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& c
         uint32_t nextLeaf = leaf;
         // How the walk leaves the leaf, told to an active observer after the leaf's own events.
         [[maybe_unused]] const bool leaves = !last;
-        [[maybe_unused]] int how = 0;  // 1 rope, 2 index step + lookup, 3 push + lookup
-        [[maybe_unused]] Vec3 pushed;
+        [[maybe_unused]] int how = 0;    // 1 rope, 2 index step + lookup, 3 push + lookup
+        [[maybe_unused]] Vec3 pushed{};  // set before use; initialised for -Wmaybe-uninitialized
         if (!last) {
             if constexpr (kExact) {
                 // The exit face lies on grid plane L.hi or L.lo of exitAxis: the next index there
