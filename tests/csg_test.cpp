@@ -128,7 +128,7 @@ TEST(Restriction, InPlaceWritesTheAppendedNodesAndUnionSizeCountsThem) {
         EXPECT_EQ(out[size].prim, 12345u);
         EXPECT_EQ(marks, std::vector<char>(marks.size(), 0));
         // The same nodes from the kept leaves alone.
-        ASSERT_TRUE(restrictor.unionsOnly());
+        ASSERT_TRUE(restrictor.unionOnly());
         std::vector<CsgNode> direct(size + 1);
         direct[size].prim = 12345u;
         std::vector<int> scratch;
@@ -164,7 +164,7 @@ TEST(Restriction, UnionsFromTheKeptLeavesAsTheWalkOnRandomShapes) {
         }
         t.root = parts[0];
         const TreeRestrictor restrictor(t);
-        ASSERT_TRUE(restrictor.unionsOnly());
+        ASSERT_TRUE(restrictor.unionOnly());
         std::vector<char> marks(restrictor.nodeCount(), 0);
         std::vector<int> scratch;
         for (int set = 0; set < 20; ++set) {

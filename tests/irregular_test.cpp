@@ -435,8 +435,8 @@ TEST(Irregular, UnionOnlyRegionsKeepListsNotTrees) {
     ASSERT_TRUE(scene.tree.unionOnly());
     auto accel = buildIrregular(scene);
     const IrregularSubdivision& s = irregularOf(*accel);
-    EXPECT_TRUE(s.flat());
-    EXPECT_TRUE(s.projective().flat());
+    EXPECT_TRUE(s.unionOnly());
+    EXPECT_TRUE(s.projective().unionOnly());
     EXPECT_TRUE(s.treePool().nodes.empty());
     EXPECT_TRUE(s.projective().treePool().nodes.empty());
     EXPECT_EQ(accel->info().extra["distinct_trees"].get<size_t>(), 0u);
@@ -479,7 +479,7 @@ TEST(Irregular, UnionOnlyRegionsKeepListsNotTrees) {
     ASSERT_FALSE(csg.tree.unionOnly());
     auto withTrees = buildIrregular(csg);
     const IrregularSubdivision& t = irregularOf(*withTrees);
-    EXPECT_FALSE(t.flat());
+    EXPECT_FALSE(t.unionOnly());
     EXPECT_FALSE(t.treePool().nodes.empty());
     EXPECT_TRUE(std::any_of(t.regions().begin(), t.regions().end(),
                             [](const IrregularRegion& r) { return r.root >= 0; }));
@@ -591,9 +591,9 @@ TEST(Irregular, UnionOnlyWalkEqualsObservedWalkAndBruteForce) {
     for (IrregularFrame frame : {IrregularFrame::Projective, IrregularFrame::Camera}) {
         auto accel = buildIrregular(scene, BspHeuristic::Balanced, 4, frame);
         const IrregularSubdivision& s = irregularOf(*accel);
-        ASSERT_TRUE(s.flat());
+        ASSERT_TRUE(s.unionOnly());
         if (frame == IrregularFrame::Projective) {
-            ASSERT_TRUE(s.projective().flat());
+            ASSERT_TRUE(s.projective().unionOnly());
             EXPECT_TRUE(s.projective().hasNearRegion());  // the eye's sphere
         }
         const std::string name = irregularFrameName(frame);

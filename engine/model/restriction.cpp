@@ -96,8 +96,8 @@ TreeRestrictor::TreeRestrictor(const CsgTree& tree) : tree_(&tree) {
     // A union-only tree's depth-first places, for restrictUnions(), from a stack rather than a
     // recursion (a chain of unions may be deep): a node is placed when first met, and its
     // subtree's end set when ~node, pushed under its children, comes back up.
-    unionsOnly_ = tree.unionOnly();
-    if (!unionsOnly_ || tree.root < 0) return;
+    unionOnly_ = tree.unionOnly();
+    if (!unionOnly_ || tree.root < 0) return;
     reserveHuge(places_, tree.nodes.size());
     places_.assign(tree.nodes.size(), Place{});
     for (size_t n = 0; n < tree.nodes.size(); ++n) places_[n].parent = parent_[n];

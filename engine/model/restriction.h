@@ -53,7 +53,7 @@ class TreeRestrictor {
     /// Nodes of the tree: the size of the marks.
     size_t nodeCount() const { return parent_.size(); }
     /// The tree has only unions (and primitives): restrictUnions() applies.
-    bool unionsOnly() const { return unionsOnly_; }
+    bool unionOnly() const { return unionOnly_; }
     /// For a tree of unions only, the same nodes as restrict(prims, out, base, live), from the
     /// kept leaves alone: the restriction of a union keeps each kept leaf and each union whose
     /// two sides keep one, which is where two leaves next in depth-first order meet. No marks
@@ -67,14 +67,14 @@ class TreeRestrictor {
 
     const CsgTree* tree_;
     std::vector<int> parent_;
-    bool unionsOnly_ = false;
+    bool unionOnly_ = false;
     /// A node's place in a depth-first walk from the root (left side first), -1 where the
     /// root does not reach it; its subtree takes places pre .. last - 1. With its parent:
     /// restrictUnions() climbs from node to parent reading both.
     struct Place {
         int pre = -1, last = -1, parent = -1;
     };
-    std::vector<Place> places_;  ///< per node, with unionsOnly_ (together: one cache line)
+    std::vector<Place> places_;  ///< per node, with unionOnly_ (together: one cache line)
     /// Leaves of primitive p: leafNodes_[leafFirst_[p] .. leafFirst_[p + 1]) (one array rather
     /// than a list per primitive: 600,000 small allocations on the largest scenes).
     std::vector<uint32_t> leafFirst_;

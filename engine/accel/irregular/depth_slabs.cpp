@@ -14,10 +14,10 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
     DepthSlabs out;
     // A union-only scene's region is the union of its primitives: the walk merges their spans
     // (hitInLeaf), so no tree is made, and each reference costs its list entries alone.
-    out.flat = scene.tree.unionOnly();
-    const size_t refBytes = mergedRefBytes(out.flat);
+    out.unionOnly = scene.tree.unionOnly();
+    const size_t refBytes = mergedRefBytes(out.unionOnly);
     std::optional<TreeRestrictor> restrictor;
-    if (!out.flat) restrictor.emplace(scene.tree);
+    if (!out.unionOnly) restrictor.emplace(scene.tree);
     // One tree and one list per distinct primitive set; list 0 is the empty set.
     RestrictedTreePool pool;
     auto share = [&](std::vector<uint32_t>& prims, IrregularRegion& r) {

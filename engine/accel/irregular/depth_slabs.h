@@ -18,10 +18,10 @@ namespace lancer {
 struct DepthSlabs {
     std::vector<IrregularRegion> regions;   ///< zone by zone, slabs by increasing depth
     std::vector<uint32_t> zoneFirstRegion;  ///< zone z: regions [zoneFirstRegion[z], [z + 1])
-    CsgTree pool;                           ///< the restricted trees (none when flat)
+    CsgTree pool;                           ///< the restricted trees (none when unionOnly)
     /// The scene is union-only: regions keep their primitive lists alone, no restricted tree
     /// (root -1 everywhere; a region is empty when its list is 0, the empty set).
-    bool flat = false;
+    bool unionOnly = false;
     std::vector<uint32_t> listFirst;  ///< list l: listPrims[listFirst[l] .. [l + 1])
     std::vector<uint32_t> listPrims;
     size_t slabs = 0;        ///< regions cut in non-empty zones
@@ -35,12 +35,14 @@ class BuildGuard;  // build_guard.h
 
 /// Bytes a zone's slabs cost at least, merged into one: a region, a pool entry, and per primitive
 /// its list entry (kept twice: the list and the pool's index) and, unless the scene is union-only
-/// (`flat`: no tree is made), about two tree nodes.
+/// (`unionOnly`: no tree is made), about two tree nodes.
 inline constexpr size_t kMergedZoneBytes =
     sizeof(IrregularRegion) + RestrictedTreePool::kEntryBytes;
 inline constexpr size_t kMergedRefBytes = 2 * sizeof(uint32_t) + 2 * sizeof(CsgNode);
-inline constexpr size_t kFlatRefBytes = 2 * sizeof(uint32_t);
-inline constexpr size_t mergedRefBytes(bool flat) { return flat ? kFlatRefBytes : kMergedRefBytes; }
+inline constexpr size_t kUnionOnlyRefBytes = 2 * sizeof(uint32_t);
+inline constexpr size_t mergedRefBytes(bool unionOnly) {
+    return unionOnly ? kUnionOnlyRefBytes : kMergedRefBytes;
+}
 
 /// Cut every zone of `bsp` along depth inside [zlo, zhi]; box[p] is primitive p's camera box.
 /// A zone whose slabs would take the structure past `maxBytes` bytes or `maxRegions` regions

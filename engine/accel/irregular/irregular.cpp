@@ -187,7 +187,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     s.pool_ = std::move(slabs.pool);
     s.listFirst_ = std::move(slabs.listFirst);
     s.listPrims_ = std::move(slabs.listPrims);
-    s.flat_ = slabs.flat;
+    s.unionOnly_ = slabs.unionOnly;
     s.budget_ = 16 * s.regions_.size() + 1024;
     extra["frame"] = irregularFrameName(params.frame);
 
@@ -221,9 +221,9 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     extra["merged_zones"] = slabs.mergedZones;
     extra["coarse_zones"] = slabs.coarseZones;
     // Union-only scenes: regions hold their primitive lists alone (no tree, distinct_trees 0).
-    extra["flat_regions"] = s.flat_;
+    extra["flat_regions"] = s.unionOnly_;
     extra["distinct_lists"] = s.listFirst_.size() - 1;
-    extra["distinct_trees"] = s.flat_ ? 0 : s.listFirst_.size() - 1;
+    extra["distinct_trees"] = s.unionOnly_ ? 0 : s.listFirst_.size() - 1;
     extra["pool_nodes"] = s.pool_.nodes.size();
     extra["prims_per_region"] = double(refs) / double(s.regions_.size());
     extra["max_prims_per_region"] = most;

@@ -75,11 +75,11 @@ class IrregularSubdivision {
     const ProjectiveZones& projective() const { return projective_; }
     /// Zone z's regions are [zoneFirstRegion()[z], zoneFirstRegion()[z + 1]), by depth.
     const std::vector<uint32_t>& zoneFirstRegion() const { return zoneFirstRegion_; }
-    /// The pool of the regions' restricted trees (empty when flat()).
+    /// The pool of the regions' restricted trees (empty when unionOnly()).
     const CsgTree& treePool() const { return pool_; }
     /// The scene is union-only: regions keep their primitive lists and no tree (root -1); the
     /// walk merges the listed primitives' spans (hitInLeaf, flatUnion).
-    bool flat() const { return flat_; }
+    bool unionOnly() const { return unionOnly_; }
     /// Primitives of a region.
     std::span<const uint32_t> primitives(uint32_t region) const {
         uint32_t l = regions_[region].list;
@@ -132,7 +132,7 @@ class IrregularSubdivision {
     CsgTree pool_;
     std::vector<uint32_t> listFirst_, listPrims_;
     size_t budget_ = 0;  ///< steps allowed to one walk
-    bool flat_ = false;
+    bool unionOnly_ = false;
 };
 
 template <class Obs>
@@ -204,8 +204,8 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         double t1 = std::min(te, tend);
         ++ctx.counters.regionVisits;
         obs.region(r, t, t1);
-        if (hitInIrregularRegion(*scene_, flat_, primitives(r), pool_, R.root, ray, tmin, t, t1,
-                                 ctx, obs, hit))
+        if (hitInIrregularRegion(*scene_, unionOnly_, primitives(r), pool_, R.root, ray, tmin, t,
+                                 t1, ctx, obs, hit))
             return true;
         if (te >= tend) return false;
         if constexpr (Obs::kActive) obs.regionExit(te, frame_.toWorld(p), axis, ties);

@@ -88,10 +88,10 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     s.pool_ = std::move(slabs.pool);
     s.listFirst_ = std::move(slabs.listFirst);
     s.listPrims_ = std::move(slabs.listPrims);
-    s.flat_ = slabs.flat;
+    s.unionOnly_ = slabs.unionOnly;
     s.buildEntering();
     std::sort(nearPrims.begin(), nearPrims.end());
-    if (!nearPrims.empty() && !s.flat_)
+    if (!nearPrims.empty() && !s.unionOnly_)
         s.nearRoot_ = TreeRestrictor(scene.tree).restrict(nearPrims, s.pool_);
     s.nearPrims_ = nearPrims;
 
@@ -110,7 +110,7 @@ void ProjectiveZones::buildEntering() {
     // A slab's tree primitives: a restriction drops those that cannot change its result, so a
     // walk need not fetch them (its list keeps every primitive whose box overlaps it).
     auto treePrims = [&](uint32_t i, std::vector<uint32_t>& out) {
-        if (flat_) {
+        if (unionOnly_) {
             std::span<const uint32_t> l = slabPrimitives(i);
             out.assign(l.begin(), l.end());
         } else {

@@ -59,9 +59,9 @@ class ProjectiveZones {
     /// The zones, in (u, v).
     const ScreenBsp& screen() const { return bsp_; }
     /// Primitives listed in the near region [0, zNear].
-    bool hasNearRegion() const { return flat_ ? !nearPrims_.empty() : nearRoot_ >= 0; }
+    bool hasNearRegion() const { return unionOnly_ ? !nearPrims_.empty() : nearRoot_ >= 0; }
     /// The scene is union-only: slabs keep their primitive lists and no tree (roots -1).
-    bool flat() const { return flat_; }
+    bool unionOnly() const { return unionOnly_; }
 
     // Inspection (structure_view.h).
     /// The screen rectangle in (u, v) that the zones tile.
@@ -109,7 +109,7 @@ class ProjectiveZones {
     std::vector<uint32_t> listFirst_, listPrims_;
     std::vector<uint32_t> nearPrims_;
     std::vector<uint32_t> enterFirst_, enterPrims_;  ///< slab i's entering list (slabEntering)
-    bool flat_ = false;
+    bool unionOnly_ = false;
 };
 
 template <class Obs>
@@ -144,8 +144,8 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
             enter(id, t);
             ++ctx.counters.regionVisits;
             obs.region(id, t, t1);
-            if (hitInIrregularRegion(scene, flat_, nearPrims_, pool_, nearRoot_, ray, tmin, t, t1,
-                                     ctx, obs, hit))
+            if (hitInIrregularRegion(scene, unionOnly_, nearPrims_, pool_, nearRoot_, ray, tmin, t,
+                                     t1, ctx, obs, hit))
                 return true;
             leave(zNear_);
         }
@@ -168,8 +168,8 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         const std::span<const uint32_t> prims = slabPrimitives(i);
         std::optional<std::span<const uint32_t>> tests;
         if (heldBefore) tests = slabEntering(i);
-        if (hitInIrregularRegion(scene, flat_, prims, pool_, slabRoot_[i], ray, tmin, t0, t1, ctx,
-                                 obs, hit, tests))
+        if (hitInIrregularRegion(scene, unionOnly_, prims, pool_, slabRoot_[i], ray, tmin, t0, t1,
+                                 ctx, obs, hit, tests))
             return true;
         heldBefore = ctx.pending.tested;
         leave(z1);

@@ -12,7 +12,7 @@ namespace lancer {
 
 /// The visible hit of a region the ray crosses on [t0, t1] (after tmin), ctx.beginLeafWalk()
 /// called at the walk's start. `prims` are the region's primitives; `root` its restricted tree
-/// in `pool` (-1: an empty region, or, `flat`, none: the scene is union-only and hitInLeaf
+/// in `pool` (-1: an empty region, or, `unionOnly`, none: the scene is union-only and hitInLeaf
 /// merges the listed primitives' spans). Both go through hitInLeaf's pending boundaries: a
 /// region where no boundary of a primitive this walk has tested lies in the window holds no hit
 /// and is left in one comparison, its tree not evaluated. The irregular walk crosses many thin
@@ -24,10 +24,10 @@ namespace lancer {
 /// region) costs more here for the same reason.
 template <class Obs>
 [[gnu::always_inline]] inline bool hitInIrregularRegion(
-    const Scene& scene, bool flat, std::span<const uint32_t> prims, const CsgTree& pool, int root,
-    const Ray& ray, double tmin, double t0, double t1, TraceContext& ctx, Obs& obs, Hit& hit,
-    std::optional<std::span<const uint32_t>> tests = {}) {
-    if (flat)
+    const Scene& scene, bool unionOnly, std::span<const uint32_t> prims, const CsgTree& pool,
+    int root, const Ray& ray, double tmin, double t0, double t1, TraceContext& ctx, Obs& obs,
+    Hit& hit, std::optional<std::span<const uint32_t>> tests = {}) {
+    if (unionOnly)
         return hitInLeaf(scene, nullptr, -1, prims.data(), uint32_t(prims.size()), ray, tmin, t0,
                          t1, ctx, obs, hit, false, tests);
     return hitInLeaf(scene, &pool, root, prims.data(), uint32_t(prims.size()), ray, tmin, t0, t1,
