@@ -150,6 +150,77 @@ TEST(Bvh, TurnedScenesAreBuiltInTheirFrame) {
     }
 }
 
+/// How many of `rays` Bvh::occluded answers as brute force's intersect does, each with
+/// t in (tmin, tmax] for tmax a quarter, a half and the whole of brute force's hit distance (or
+/// the scene's size past it), the rays' ends landing before, at and after their hits. Counts the
+/// blocked answers in `blocked`.
+size_t occludedAsBrute(const Scene& scene, const Accelerator& accel, const std::vector<Ray>& rays,
+                       double tmin, const std::string& what, size_t& blocked) {
+    auto brute = buildAccelerator(scene, BuildParams{});
+    const Bvh& bvh = bvhOf(accel);
+    TraceContext cb(scene.prims.size(), scene.tree.depth()),
+        ca(scene.prims.size(), scene.tree.depth());
+    ca.useMailboxes = accel.usesMailboxes();
+    NullObserver obs;
+    size_t same = 0, failures = 0;
+    for (const Ray& r : rays) {
+        Hit near;
+        cb.beginRay();
+        const double reach = brute->intersect(r, tmin, kInf, cb, obs, near)
+                                 ? near.t
+                                 : glm::length(scene.bounds.extent()) + 1.0;
+        for (double f : {0.25, 0.5, 1.0, 1.5}) {
+            const double tmax = std::max(tmin, f * reach);
+            Hit hb, ha;
+            cb.beginRay();
+            ca.beginRay();
+            const bool fb = brute->intersect(r, tmin, tmax, cb, obs, hb);
+            const bool fa = bvh.occluded(r, tmin, tmax, ca, obs, ha);
+            blocked += fa;
+            // A blocked answer's boundary is one of the scene's: inside (tmin, tmax].
+            const bool inside = !fa || (ha.t > tmin && ha.t <= tmax);
+            if (fa == fb && inside)
+                ++same;
+            else if (failures++ < 3)
+                ADD_FAILURE() << what << ": " << r.toString() << " on (" << tmin << ", " << tmax
+                              << "]: occluded " << fa << " at t = " << ha.t << ", brute force "
+                              << fb << " at t = " << hb.t;
+        }
+    }
+    return same;
+}
+
+// Shadow rays take Bvh::occluded, which stops at the first boundary it is sure of: on union-only
+// scenes (rays that begin outside every primitive, inside one, and on a surface) and on random
+// CSG scenes, it answers as brute force's nearest hit does, for ends before, at and past the hit.
+TEST(Bvh, OccludedAnswersAsTheNearestHit) {
+    size_t rays = 0, same = 0, blocked = 0;
+    for (const char* f : {"balls2.nff", "rings2.nff", "gears1.nff", "tetra3.nff"}) {
+        Scene scene = loadScene(std::string(LANCER_SPD_DIR) + "/" + f);
+        auto accel = buildAccelerator(scene, bvhParams());
+        std::vector<Ray> r = test::pixelRays(scene, 24, 24);
+        const std::vector<Ray> sec = test::secondaryRays(scene, r, 3);
+        const std::vector<Ray> rnd = test::randomRays(scene, 5, 400);
+        r.insert(r.end(), rnd.begin(), rnd.end());
+        same += occludedAsBrute(scene, *accel, r, 0.0, f, blocked);
+        same += occludedAsBrute(scene, *accel, sec, 1e-9 * scene.scale(), f, blocked);
+        rays += 4 * (r.size() + sec.size());
+    }
+    for (uint64_t seed = 1; seed <= 12; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.groups = seed % 3 == 0 ? 3 : 1;
+        Scene scene = test::randomCsgScene(seed, opt);
+        if (scene.bounds.isEmpty()) continue;
+        auto accel = buildAccelerator(scene, bvhParams(seed % 2 ? -1 : 1));
+        const std::vector<Ray> r = test::randomRays(scene, seed, 500);
+        same += occludedAsBrute(scene, *accel, r, 0.0, "seed " + std::to_string(seed), blocked);
+        rays += 4 * r.size();
+    }
+    EXPECT_EQ(same, rays);
+    EXPECT_GT(blocked, rays / 8);
+    EXPECT_LT(blocked, rays);
+}
+
 TEST(Bvh, MailboxesSpareRepeatedTestsOnly) {
     Scene scene = loadScene("builtin:lattice:4");
     BuildParams with = bvhParams(), without = bvhParams();

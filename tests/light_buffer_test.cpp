@@ -65,9 +65,11 @@ Tally checkShadowRays(const std::string& name, const Scene& s, const std::vector
         p.regular.step = step;
         schemes.push_back(buildAccelerator(s, p));
     }
-    BuildParams irr;
-    irr.scheme = SchemeKind::Irregular;
-    schemes.push_back(buildAccelerator(s, irr));
+    for (SchemeKind kind : {SchemeKind::Irregular, SchemeKind::Bvh}) {
+        BuildParams p;
+        p.scheme = kind;
+        schemes.push_back(buildAccelerator(s, p));
+    }
     size_t failures = 0;
     for (const ShadowRay& sr : rays) {
         ++tally.rays;

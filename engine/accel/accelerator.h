@@ -24,7 +24,9 @@ namespace lancer {
 /// What every scheme is: built from the scene and its own knobs (`S::config` picks them out of
 /// BuildParams; the scheme's figures go to `extra`, the guard bounds and cancels the build),
 /// it walks a ray with any observer (the render's null one, the trace's recording one) and
-/// reports its regions and bytes. Its regions' description lives in structure_view.h.
+/// reports its regions and bytes. Its regions' description lives in structure_view.h. A scheme
+/// may also have `occluded(ray, tmin, tmax, ctx, obs, hit)`, intersect()'s answer by a walk
+/// that stops at the first boundary it is sure of (shadow rays take it when it is there).
 template <class S>
 concept AccelerationScheme = requires(const S& s, const Scene& scene, const BuildParams& p,
                                       nlohmann::json& extra, BuildGuard* guard, const Ray& ray,
@@ -94,7 +96,7 @@ class Accelerator {
                     obs.stretch(i, seg[i].t0, seg[i].t1);
                     double t0 = seg[i].t0, t1 = seg[i].t1;
                     if (ctx.precision == Precision::Float) widenForFloat(ray, t0, t1, 0.0, tmax);
-                    if (intersect(ray, t0, t1, ctx, obs, hit)) {
+                    if (blockedIn(ray, t0, t1, ctx, obs, hit)) {
                         obs.blocker(hit);
                         return true;
                     }
@@ -102,7 +104,7 @@ class Accelerator {
                 return false;
             }
         }
-        const bool blocked = intersect(ray, 0.0, tmax, ctx, obs, hit);
+        const bool blocked = blockedIn(ray, 0.0, tmax, ctx, obs, hit);
         if constexpr (Obs::kActive)
             if (blocked) obs.blocker(hit);
         return blocked;
@@ -139,6 +141,21 @@ class Accelerator {
     const Impl& impl() const { return impl_; }
 
   private:
+    /// intersect()'s answer for a shadow ray's stretch: by the scheme's own `occluded` walk
+    /// when it has one (it may stop at any boundary, `hit`, rather than the nearest).
+    template <class Obs>
+    bool blockedIn(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                   Hit& hit) const {
+        return std::visit(
+            [&](const auto& s) {
+                if constexpr (requires { s.occluded(ray, tmin, tmax, ctx, obs, hit); })
+                    return s.occluded(ray, tmin, tmax, ctx, obs, hit);
+                else
+                    return s.intersect(ray, tmin, tmax, ctx, obs, hit);
+            },
+            impl_);
+    }
+
     Impl impl_;
     BuildParams params_;
     AccelInfo info_;

@@ -125,6 +125,10 @@ struct EventText {
         return s;
     }
     std::string operator()(const walk::Culled& e) const {
+        if (e.blocked)
+            return "node " + std::to_string(e.node) +
+                   " skipped: blocked (a span starts at t = " + num(e.hitT) +
+                   "), and its box does not hold the ray's start";
         return "node " + std::to_string(e.node) + " skipped: its box begins at t = " + num(e.t0) +
                ", beyond the hit at t = " + num(e.hitT);
     }

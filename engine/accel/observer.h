@@ -69,10 +69,11 @@ struct NullObserver {
     void rope(uint32_t /*from*/, int /*face*/, uint32_t /*to*/) {}
     // BVH: an inner node's children the ray's interval meets, in the order they are visited
     // (`second` kNoNode when one or none is met), with the t each box is entered at; a node
-    // left unvisited because its box begins beyond the hit found.
+    // left unvisited because its box begins beyond the hit found (`blocked`: a shadow ray's
+    // walk that knows it is blocked, and skips every box not holding the ray's start).
     void nodeChildren(uint32_t /*node*/, uint32_t /*first*/, double /*t0First*/,
                       uint32_t /*second*/, double /*t0Second*/) {}
-    void nodeCulled(uint32_t /*node*/, double /*t0*/, double /*best*/) {}
+    void nodeCulled(uint32_t /*node*/, double /*t0*/, double /*best*/, bool /*blocked*/) {}
     void walkRestart(const char* /*why*/) {}
     // Shadow rays and the light buffer: each stretch walked, none to walk, what blocked it.
     void stretch(int /*index*/, double /*t0*/, double /*t1*/) {}
@@ -173,10 +174,13 @@ struct Children {
     double secondT = 0.0;
     bool operator==(const Children&) const = default;
 };
-/// BVH: node `node` not entered: its box begins at t0, beyond the hit at hitT.
+/// BVH: node `node` not entered: its box begins at t0, beyond the hit at hitT; or, `blocked`, a
+/// shadow ray known to be blocked (a span starts at hitT) skips a box that does not hold its
+/// start, being left only to rule out that the ray begins inside a primitive.
 struct Culled {
     uint32_t node = 0;
     double t0 = 0.0, hitT = 0.0;
+    bool blocked = false;
     bool operator==(const Culled&) const = default;
 };
 /// Why the walk starts again another way (BVH: in box-entry order).
@@ -314,7 +318,9 @@ struct RecordingObserver {
                       double t0Second) {
         add(walk::Children{node, first, t0First, second, t0Second});
     }
-    void nodeCulled(uint32_t node, double t0, double best) { add(walk::Culled{node, t0, best}); }
+    void nodeCulled(uint32_t node, double t0, double best, bool blocked) {
+        add(walk::Culled{node, t0, best, blocked});
+    }
     void walkRestart(const char* why) { add(walk::Restart{why}); }
     void stretch(int index, double t0, double t1) { add(walk::Stretch{index, t0, t1}); }
     void lightBufferClear() { add(walk::LightBufferClear{}); }

@@ -272,7 +272,7 @@ std::vector<StepReason> explainBvhSteps(const TracedRay& r, const StructureView&
         std::string s = (k == 0 ? "the walk starts at the root, " : "") +
                         regionName(view, reg.region) + ", its box met on t = [" + num6(reg.t0) +
                         ", " + num6(reg.t1) + "]: ";
-        std::vector<std::string> culled;
+        std::vector<std::string> culled, unheld;  // beyond the hit; not holding a blocked start
         bool told = false;
         for (size_t i = steps[k] + 1; i < end; ++i) {
             if (const auto* c = ev[i].get<walk::Children>()) {
@@ -288,8 +288,9 @@ std::vector<StepReason> explainBvhSteps(const TracedRay& r, const StructureView&
                          std::to_string(c->second) + " (at t = " + num6(c->secondT) +
                          ") unless a hit comes before it";
             } else if (const auto* u = ev[i].get<walk::Culled>()) {
-                culled.push_back(std::to_string(u->node) +
-                                 " (its box begins at t = " + num6(u->t0) + ")");
+                (u->blocked ? unheld : culled)
+                    .push_back(std::to_string(u->node) + " (its box begins at t = " + num6(u->t0) +
+                               ")");
             }
         }
         if (!told && info.kind == RegionKind::BvhLeaf) {
@@ -300,10 +301,17 @@ std::vector<StepReason> explainBvhSteps(const TracedRay& r, const StructureView&
                                  " at t = " + num6(r.hit.t) + " inside its box"
                            : "no boundary of its tree lies inside its box";
         }
-        if (!culled.empty()) {
-            s += "; then skipped, beyond the hit found:";
-            for (size_t i = 0; i < culled.size(); ++i) s += (i ? ", node " : " node ") + culled[i];
-        }
+        auto skipped = [&s](const char* why, const std::vector<std::string>& nodes) {
+            if (nodes.empty()) return;
+            s += why;
+            for (size_t i = 0; i < nodes.size(); ++i) s += (i ? ", node " : " node ") + nodes[i];
+        };
+        skipped("; then skipped, beyond the hit found:", culled);
+        skipped(
+            "; then skipped, the shadow ray being blocked by a span that starts after its "
+            "start, and these boxes not holding that start (only a primitive there could "
+            "hold it):",
+            unheld);
         out[k].text = std::move(s);
         out[k].next =
             k + 1 < steps.size() ? int64_t(ev[steps[k + 1]].as<walk::Region>().region) : -1;
@@ -604,8 +612,11 @@ struct EventJson {
                 {"second", nodeJson(e.second)}, {"second_t", tJson(e.secondT)}};
     }
     nlohmann::json operator()(const walk::Culled& e) const {
-        return {
-            {"event", "culled"}, {"node", e.node}, {"t0", tJson(e.t0)}, {"hit_t", tJson(e.hitT)}};
+        return {{"event", "culled"},
+                {"node", e.node},
+                {"t0", tJson(e.t0)},
+                {"hit_t", tJson(e.hitT)},
+                {"blocked", e.blocked}};
     }
     nlohmann::json operator()(const walk::Restart& e) const {
         return {{"event", "restart"}, {"what", e.why}};

@@ -19,26 +19,13 @@
 #include <vector>
 
 #include "engine/accel/build_params.h"
+#include "engine/accel/bvh/bvh_boxes.h"
 #include "engine/accel/eval.h"
 #include "engine/accel/regular/grid_frame.h"
 
 namespace lancer {
 
 class BuildGuard;  // engine/accel/build_guard.h
-
-/// One node, in one cache line: its box (grown by a hair, BvhBuilder), and either its two
-/// children (next to each other) or its leaf's primitives and restricted tree.
-struct alignas(64) BvhNode {
-    double lo[3] = {}, hi[3] = {};
-    uint32_t first = 0;    ///< inner: the left child (the right one is first + 1); leaf: primList
-    uint32_t count = 0;    ///< leaf: primitives listed (primList[first, first + count))
-    int32_t root = -1;     ///< leaf: restricted tree in the pool; -1: none (union-only, or empty)
-    uint16_t depth = 0;    ///< the root is depth 0
-    uint8_t leaf = 0;      ///< 1: a leaf
-    uint8_t assigned = 0;  ///< leaf: primitives the splits gave it (at most 255 shown; see count)
-    Box3 box() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
-};
-static_assert(sizeof(BvhNode) == 64);
 
 /// A node id meaning "no node" in the walk's events.
 inline constexpr uint32_t kNoNode = 0xffffffffu;
@@ -60,28 +47,15 @@ class Bvh {
     template <class Obs>
     bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                    Hit& hit) const {
-        if (nodes_.empty()) return false;
-        // An axis the ray runs parallel to is tested by the origin's place, not by a product
-        // with an infinite inverse (0 times infinity is NaN on a box face).
-        // The boxes are the frame's (the world's unless the scene is turned): the walk reads
-        // them with the ray in the frame, `fr` (the same t), the leaves test the world ray.
-        Ray mapped;
-        if (frame_.turned) mapped = frame_.toFrame(ray);
-        const Ray& fr = frame_.turned ? mapped : ray;
-        const bool parallel = fr.d.x == 0.0 || fr.d.y == 0.0 || fr.d.z == 0.0;
-        if (unionOnly_) {
-            const int r = parallel ? walkFirstStart<true>(ray, fr, tmin, tmax, ctx, obs, hit)
-                                   : walkFirstStart<false>(ray, fr, tmin, tmax, ctx, obs, hit);
-            if (r >= 0) return r == 1;
-            if constexpr (Obs::kActive)
-                obs.walkRestart(
-                    "bvh: the ray begins inside a primitive "
-                    "or two starts tie; walked in order");
-            return parallel ? walkUnion<true>(ray, fr, tmin, tmax, ctx, obs, hit)
-                            : walkUnion<false>(ray, fr, tmin, tmax, ctx, obs, hit);
-        }
-        return parallel ? walk<true>(ray, fr, tmin, tmax, ctx, obs, hit)
-                        : walk<false>(ray, fr, tmin, tmax, ctx, obs, hit);
+        return query<false>(ray, tmin, tmax, ctx, obs, hit);
+    }
+    /// Whether the ray meets a visible boundary with t in (tmin, tmax], intersect()'s answer,
+    /// for shadow rays: the walk ends at the first boundary it is sure of, not the nearest
+    /// (`hit` is that boundary).
+    template <class Obs>
+    bool occluded(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+                  Hit& hit) const {
+        return query<true>(ray, tmin, tmax, ctx, obs, hit);
     }
 
     /// Regions are the nodes, inner and leaf: the ids the walk reports.
@@ -114,21 +88,66 @@ class Bvh {
     std::string describe(uint32_t id) const;
 
   private:
-    // Each walk takes the world ray (`ray`: the leaves' tests) and the same ray in the frame
-    // (`fr`: the boxes').
+    /// intersect() (kAnyHit false) or occluded() (true).
+    template <bool kAnyHit, class Obs>
+    bool query(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
+               Hit& hit) const {
+        if (nodes_.empty()) return false;
+        // An axis the ray runs parallel to is tested by the origin's place, not by a product
+        // with an infinite inverse (0 times infinity is NaN on a box face).
+        // The boxes are the frame's (the world's unless the scene is turned): the walk reads
+        // them with the ray in the frame, `fr` (the same t), the leaves test the world ray.
+        Ray mapped;
+        if (frame_.turned) mapped = frame_.toFrame(ray);
+        const Ray& fr = frame_.turned ? mapped : ray;
+        const bool parallel = fr.d.x == 0.0 || fr.d.y == 0.0 || fr.d.z == 0.0;
+        if (unionOnly_) {
+            if (parallel)
+                return unionQuery<kAnyHit>(DoubleBoxes<true>{nodes_.data(), SlabRay(fr)}, ray, tmin,
+                                           tmax, ctx, obs, hit);
+            return unionQuery<kAnyHit>(DoubleBoxes<false>{nodes_.data(), SlabRay(fr)}, ray, tmin,
+                                       tmax, ctx, obs, hit);
+        }
+        if (parallel)
+            return walk<kAnyHit>(DoubleBoxes<true>{nodes_.data(), SlabRay(fr)}, ray, tmin, tmax,
+                                 ctx, obs, hit);
+        return walk<kAnyHit>(DoubleBoxes<false>{nodes_.data(), SlabRay(fr)}, ray, tmin, tmax, ctx,
+                             obs, hit);
+    }
+    /// A union-only scene's query: the first-start walk, and the walk in box-entry order when
+    /// that one cannot decide.
+    template <bool kAnyHit, class Boxes, class Obs>
+    bool unionQuery(const Boxes& boxes, const Ray& ray, double tmin, double tmax, TraceContext& ctx,
+                    Obs& obs, Hit& hit) const {
+        BvhEntry root;
+        if (!boxes.root(tmin, tmax, root)) return false;
+        const int r = walkFirstStart<kAnyHit>(boxes, root, ray, tmin, tmax, ctx, obs, hit);
+        if (r >= 0) return r == 1;
+        if constexpr (Obs::kActive)
+            obs.walkRestart(
+                "bvh: the ray begins inside a primitive "
+                "or two starts tie; walked in order");
+        return walkUnion(boxes, root, ray, tmin, tmax, ctx, obs, hit);
+    }
+    // Each walk reads the boxes through `boxes` (bvh_boxes.h: the ray in the BVH's frame) and
+    // tests the leaves' primitives with the world ray `ray`.
     /// The walk of a scene with intersections or differences: leaves list every primitive
     /// meeting their box, with its restricted tree; front to back by a stack, each leaf's hit
-    /// inside its box, the nearest kept.
-    template <bool kParallel, class Obs>
-    bool walk(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx, Obs& obs,
-              Hit& hit) const;
+    /// inside its box, the nearest kept. Each leaf's hit is a boundary of the whole scene (its
+    /// tree agrees with the scene's inside its box), so with kAnyHit the first one ends it.
+    template <bool kAnyHit, class Boxes, class Obs>
+    bool walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, TraceContext& ctx,
+              Obs& obs, Hit& hit) const;
     /// A union-only scene's walk for a ray that begins outside every primitive, most rays: the
     /// union's first boundary is then the first start of a span after tmin, and the walk is a
     /// closest-hit walk (a stack, nodes beyond the nearest start culled). Returns 1 (hit), 0
     /// (none), or -1 when a span holds tmin or two starts tie for the first: walkUnion decides.
-    template <bool kParallel, class Obs>
-    int walkFirstStart(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx,
-                       Obs& obs, Hit& hit) const;
+    /// With kAnyHit, any start in (tmin, tmax] proves a boundary there once the ray is known to
+    /// begin outside every primitive: from then on only the nodes whose box holds the ray's
+    /// start (entered at tmin) are walked, to rule out a span holding tmin; ties do not matter.
+    template <bool kAnyHit, class Boxes, class Obs>
+    int walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
+                       double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const;
     /// The walk of a union-only scene: each primitive in one leaf only, leaves in order of the
     /// t their box is entered at (a heap), their primitives' spans merged as they come. When a
     /// node is entered at t, every span that starts before t is known (its primitive's box lies
@@ -136,34 +155,14 @@ class Bvh {
     /// when the ray begins outside every primitive, else the end of the stretch it begins in;
     /// either is final once the next node is entered beyond it. (A stretch grows as spans join
     /// it, so a node is culled when taken from the heap, never when pushed.)
-    template <bool kParallel, class Obs>
-    bool walkUnion(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx,
-                   Obs& obs, Hit& hit) const;
-    /// The ray as the box tests read it: its origin, and its inverse direction (0 along an
-    /// axis it is parallel to).
-    struct SlabRay {
-        double o[3], inv[3];
-        explicit SlabRay(const Ray& r) {
-            for (int a = 0; a < 3; ++a) {
-                o[a] = r.o[a];
-                inv[a] = r.d[a] == 0.0 ? 0.0 : 1.0 / r.d[a];
-            }
-        }
-    };
-    /// A node waiting on a stack walk's stack, with the ray's interval in its box.
-    struct StackEntry {
-        uint32_t node;
-        double t0, t1;
-    };
-    /// Inner node `e`'s children the ray meets within [tmin, tmax], pushed far one first so
+    template <class Boxes, class Obs>
+    bool walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
+                   double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const;
+    /// Inner entry `e`'s children the ray meets within [tmin, tmax], pushed far one first so
     /// that the near one is walked next; told to the observer.
-    template <bool kParallel, class Obs>
-    void pushChildren(const StackEntry& e, const double o[3], const double inv[3], double tmin,
-                      double tmax, StackEntry* stack, int& sp, Obs& obs) const;
-    /// The ray's interval in node `n`'s box, within [tmin, tmax]: false when empty.
-    template <bool kParallel>
-    static bool clip(const BvhNode& n, const double o[3], const double inv[3], double tmin,
-                     double tmax, double& t0, double& t1);
+    template <class Boxes, class Obs>
+    void pushChildren(const Boxes& boxes, const BvhEntry& e, double tmin, double tmax,
+                      BvhEntry* stack, int& sp, Obs& obs) const;
     /// The leaf's visible hit inside [t0, t1] (t > tmin).
     template <class Obs>
     bool hitInLeafBox(const BvhNode& n, const Ray& ray, double tmin, double t0, double t1,
@@ -180,27 +179,6 @@ class Bvh {
 
     friend struct BvhBuilder;
 };
-
-template <bool kParallel>
-[[gnu::always_inline]] inline bool Bvh::clip(const BvhNode& n, const double o[3],
-                                             const double inv[3], double tmin, double tmax,
-                                             double& t0, double& t1) {
-    t0 = tmin;
-    t1 = tmax;
-    for (int a = 0; a < 3; ++a) {
-        if constexpr (kParallel) {
-            if (inv[a] == 0.0) {  // parallel: inside the slab or not at all
-                if (o[a] < n.lo[a] || o[a] > n.hi[a]) return false;
-                continue;
-            }
-        }
-        const double ta = (n.lo[a] - o[a]) * inv[a], tb = (n.hi[a] - o[a]) * inv[a];
-        const double near = ta < tb ? ta : tb, far = ta < tb ? tb : ta;
-        t0 = near > t0 ? near : t0;
-        t1 = far < t1 ? far : t1;
-    }
-    return t0 <= t1;
-}
 
 template <class Obs>
 [[gnu::always_inline]] inline bool Bvh::hitInLeafBox(const BvhNode& n, const Ray& ray, double tmin,
@@ -253,25 +231,23 @@ template <class Obs>
     return b != nullptr;
 }
 
-template <bool kParallel, class Obs>
-[[gnu::always_inline]] inline void Bvh::pushChildren(const StackEntry& e, const double o[3],
-                                                     const double inv[3], double tmin, double tmax,
-                                                     StackEntry* stack, int& sp, Obs& obs) const {
-    const BvhNode* const nodes = nodes_.data();
-    const uint32_t l = nodes[e.node].first, r = l + 1;
-    double l0, l1, r0, r1;
-    const bool hl = clip<kParallel>(nodes[l], o, inv, tmin, tmax, l0, l1);
-    const bool hr = clip<kParallel>(nodes[r], o, inv, tmin, tmax, r0, r1);
-    if (hl && hr) {
-        const bool leftFirst = l0 <= r0;
-        const StackEntry nearE = leftFirst ? StackEntry{l, l0, l1} : StackEntry{r, r0, r1};
-        const StackEntry farE = leftFirst ? StackEntry{r, r0, r1} : StackEntry{l, l0, l1};
+template <class Boxes, class Obs>
+[[gnu::always_inline]] inline void Bvh::pushChildren(const Boxes& boxes, const BvhEntry& e,
+                                                     double tmin, double tmax, BvhEntry* stack,
+                                                     int& sp, Obs& obs) const {
+    BvhEntry c[2];
+    bool met[2];
+    boxes.children(e, tmin, tmax, c, met);
+    if (met[0] && met[1]) {
+        const bool leftFirst = c[0].t0 <= c[1].t0;
+        const BvhEntry& nearE = c[leftFirst ? 0 : 1];
+        const BvhEntry& farE = c[leftFirst ? 1 : 0];
         if constexpr (Obs::kActive)
             obs.nodeChildren(e.node, nearE.node, nearE.t0, farE.node, farE.t0);
         stack[sp++] = farE;
         stack[sp++] = nearE;
-    } else if (hl || hr) {
-        const StackEntry only = hl ? StackEntry{l, l0, l1} : StackEntry{r, r0, r1};
+    } else if (met[0] || met[1]) {
+        const BvhEntry& only = c[met[0] ? 0 : 1];
         if constexpr (Obs::kActive) obs.nodeChildren(e.node, only.node, only.t0, kNoNode, kInf);
         stack[sp++] = only;
     } else if constexpr (Obs::kActive) {
@@ -279,129 +255,110 @@ template <bool kParallel, class Obs>
     }
 }
 
-template <bool kParallel, class Obs>
-int Bvh::walkFirstStart(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx,
-                        Obs& obs, Hit& hit) const {
-    const SlabRay slab(fr);
-    const double *const o = slab.o, *const inv = slab.inv;
-    const BvhNode* const nodes = nodes_.data();
-    using Entry = StackEntry;
-    Entry stack[kAutomaticBvhDepth + 2];
+template <bool kAnyHit, class Boxes, class Obs>
+int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
+                        double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const {
+    BvhEntry stack[kAutomaticBvhDepth + 2];
     int sp = 0;
-    {
-        double t0, t1;
-        if (!clip<kParallel>(nodes[0], o, inv, tmin, tmax, t0, t1)) return 0;
-        stack[sp++] = {0, t0, t1};
-    }
+    stack[sp++] = root;
     // The first start after tmin so far. The ray begins outside every primitive as long as no
     // span holds tmin; a primitive whose box holds the ray's start is in a leaf entered at
     // tmin, never culled, so a span holding tmin is always met.
     Boundary first{tmax};
     bool found = false, tie = false;
+    // Nodes whose box begins beyond `reach` are culled: the nearest start found; with kAnyHit,
+    // tmin once a start is found (only the boxes holding the ray's start are left to walk).
+    double reach = tmax;
     while (sp > 0) {
-        const Entry e = stack[--sp];
-        if (e.t0 > first.t) {
-            if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, first.t);
+        const BvhEntry e = stack[--sp];
+        if (e.t0 > reach) {
+            if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, first.t, kAnyHit && found);
             continue;
         }
-        const BvhNode& n = nodes[e.node];
         ++ctx.counters.regionVisits;
         obs.region(e.node, e.t0, std::min(e.t1, first.t));
-        if (n.leaf) {
-            const uint32_t* const prims = primList_.data() + n.first;
-            for (uint32_t i = 0; i < n.count; ++i) {
-                Span local[2];
-                const int k = scene_->primSpans(prims[i], ray, local, ctx.precision);
-                ++ctx.counters.primTests;
-                obs.primTest(prims[i], local, k);
-                for (int j = 0; j < k; ++j) {
-                    const Span& sp2 = local[j];
-                    if (!(sp2.out.t > tmin)) continue;
-                    if (!(sp2.in.t > tmin)) return -1;  // the ray begins inside it
-                    if (sp2.in.t < first.t) {
-                        first = sp2.in;
-                        found = true;
-                        tie = false;
-                    } else if (found && sp2.in.t == first.t) {
-                        tie = true;
-                    }
-                }
-            }
-            if constexpr (Obs::kActive) {
-                ctx.result.clear();
-                if (found) ctx.result.push_back({first, first});
-                obs.regionSpans(ctx.result);
-            }
+        if (!e.leaf()) {
+            pushChildren(boxes, e, tmin, reach, stack, sp, obs);
             continue;
         }
-        pushChildren<kParallel>(e, o, inv, tmin, first.t, stack, sp, obs);
+        const uint32_t* const prims = primList_.data() + e.first;
+        for (uint32_t i = 0; i < e.count; ++i) {
+            Span local[2];
+            const int k = scene_->primSpans(prims[i], ray, local, ctx.precision);
+            ++ctx.counters.primTests;
+            obs.primTest(prims[i], local, k);
+            for (int j = 0; j < k; ++j) {
+                const Span& sp2 = local[j];
+                if (!(sp2.out.t > tmin)) continue;
+                if (!(sp2.in.t > tmin)) return -1;  // the ray begins inside it
+                // (tmin, tmax] holds the first start found; then only a nearer one.
+                if (found ? sp2.in.t < first.t : sp2.in.t <= tmax) {
+                    first = sp2.in;
+                    found = true;
+                    tie = false;
+                    reach = kAnyHit ? tmin : first.t;
+                } else if (found && sp2.in.t == first.t) {
+                    tie = !kAnyHit;
+                }
+            }
+        }
+        if constexpr (Obs::kActive) {
+            ctx.result.clear();
+            if (found) ctx.result.push_back({first, first});
+            obs.regionSpans(ctx.result);
+        }
     }
     if (tie) return -1;
     if (found) hit = {first.t, first.prim, first.part, first.flip};
     return found ? 1 : 0;
 }
 
-template <bool kParallel, class Obs>
-bool Bvh::walkUnion(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx,
-                    Obs& obs, Hit& hit) const {
-    const SlabRay slab(fr);
-    const double *const o = slab.o, *const inv = slab.inv;
-    const BvhNode* const nodes = nodes_.data();
-    struct Entry {
-        double t0, t1;
-        uint32_t node;
-    };
+template <class Boxes, class Obs>
+bool Bvh::walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
+                    double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const {
     // A min-heap by entry t, one per thread, reused from ray to ray.
-    auto later = [](const Entry& a, const Entry& b) { return a.t0 > b.t0; };
-    thread_local std::vector<Entry> heap;
-    heap.clear();
-    {
-        double t0, t1;
-        if (!clip<kParallel>(nodes[0], o, inv, tmin, tmax, t0, t1)) return false;
-        heap.push_back({t0, t1, 0});
-    }
+    auto later = [](const BvhEntry& a, const BvhEntry& b) { return a.t0 > b.t0; };
+    thread_local std::vector<BvhEntry> heap;
+    heap.assign(1, root);
     SpanList& spans = ctx.leafSpans;  // the spans met so far that end after tmin
     spans.clear();
     double best = tmax;  // the union's first boundary after tmin among the spans known
     bool found = false;
     while (!heap.empty()) {
         std::pop_heap(heap.begin(), heap.end(), later);
-        const Entry e = heap.back();
+        const BvhEntry e = heap.back();
         heap.pop_back();
         if (e.t0 > best) {  // every node left begins beyond it: the boundary is final
-            if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, best);
+            if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, best, false);
             break;
         }
-        const BvhNode& n = nodes[e.node];
         ++ctx.counters.regionVisits;
         obs.region(e.node, e.t0, std::min(e.t1, best));
-        if (!n.leaf) {
-            const uint32_t l = n.first, r = n.first + 1;
-            double l0, l1, r0, r1;
-            const bool hl = clip<kParallel>(nodes[l], o, inv, tmin, tmax, l0, l1);
-            const bool hr = clip<kParallel>(nodes[r], o, inv, tmin, tmax, r0, r1);
-            if (hl) {
-                heap.push_back({l0, l1, l});
-                std::push_heap(heap.begin(), heap.end(), later);
-            }
-            if (hr) {
-                heap.push_back({r0, r1, r});
-                std::push_heap(heap.begin(), heap.end(), later);
-            }
+        if (!e.leaf()) {
+            BvhEntry c[2];
+            bool met[2];
+            boxes.children(e, tmin, tmax, c, met);
+            for (int k = 0; k < 2; ++k)
+                if (met[k]) {
+                    heap.push_back(c[k]);
+                    std::push_heap(heap.begin(), heap.end(), later);
+                }
             if constexpr (Obs::kActive) {
-                const bool leftFirst = hl && (!hr || l0 <= r0);
-                if (hl && hr)
-                    obs.nodeChildren(e.node, leftFirst ? l : r, leftFirst ? l0 : r0,
-                                     leftFirst ? r : l, leftFirst ? r0 : l0);
+                const bool leftFirst = met[0] && (!met[1] || c[0].t0 <= c[1].t0);
+                if (met[0] && met[1])
+                    obs.nodeChildren(e.node, c[leftFirst ? 0 : 1].node, c[leftFirst ? 0 : 1].t0,
+                                     c[leftFirst ? 1 : 0].node, c[leftFirst ? 1 : 0].t0);
+                else if (met[0] || met[1])
+                    obs.nodeChildren(e.node, c[met[0] ? 0 : 1].node, c[met[0] ? 0 : 1].t0, kNoNode,
+                                     kInf);
                 else
-                    obs.nodeChildren(e.node, hl ? l : (hr ? r : kNoNode),
-                                     hl ? l0 : (hr ? r0 : kInf), kNoNode, kInf);
+                    obs.nodeChildren(e.node, kNoNode, kInf, kNoNode, kInf);
             }
             continue;
         }
-        const uint32_t* const prims = primList_.data() + n.first;
+        const uint32_t* const prims = primList_.data() + e.first;
         bool added = false;
-        for (uint32_t i = 0; i < n.count; ++i) {
+        for (uint32_t i = 0; i < e.count; ++i) {
             Span local[2];
             const int k = scene_->primSpans(prims[i], ray, local, ctx.precision);
             ++ctx.counters.primTests;
@@ -427,43 +384,36 @@ bool Bvh::walkUnion(const Ray& ray, const Ray& fr, double tmin, double tmax, Tra
     return found;
 }
 
-template <bool kParallel, class Obs>
-bool Bvh::walk(const Ray& ray, const Ray& fr, double tmin, double tmax, TraceContext& ctx, Obs& obs,
-               Hit& hit) const {
-    const SlabRay slab(fr);
-    const double *const o = slab.o, *const inv = slab.inv;
-    const BvhNode* const nodes = nodes_.data();
-    using Entry = StackEntry;
+template <bool kAnyHit, class Boxes, class Obs>
+bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, TraceContext& ctx,
+               Obs& obs, Hit& hit) const {
     // Push the far child, go on with the near one: at most one entry a level waits.
-    Entry stack[kAutomaticBvhDepth + 2];
+    BvhEntry stack[kAutomaticBvhDepth + 2];
     int sp = 0;
     double best = tmax;  // the leaves' windows end at the nearest hit found so far
     bool found = false;
-    {
-        double t0, t1;
-        if (!clip<kParallel>(nodes[0], o, inv, tmin, tmax, t0, t1)) return false;
-        stack[sp++] = {0, t0, t1};
-    }
+    if (!boxes.root(tmin, tmax, stack[sp++])) return false;
     while (sp > 0) {
-        const Entry e = stack[--sp];
+        const BvhEntry e = stack[--sp];
         if (e.t0 > best) {  // its box begins beyond the hit: nothing nearer in it
-            if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, best);
+            if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, best, false);
             continue;
         }
-        const BvhNode& n = nodes[e.node];
         const double t1 = std::min(e.t1, best);
         ++ctx.counters.regionVisits;
         obs.region(e.node, e.t0, t1);
-        if (n.leaf) {
+        if (e.leaf()) {
             Hit h;
-            if (hitInLeafBox(n, ray, tmin, e.t0, t1, ctx, obs, h) && (!found || h.t < best)) {
+            if (hitInLeafBox(nodes_[e.node], ray, tmin, e.t0, t1, ctx, obs, h) &&
+                (!found || h.t < best)) {
                 hit = h;
                 best = h.t;
                 found = true;
+                if constexpr (kAnyHit) return true;
             }
             continue;
         }
-        pushChildren<kParallel>(e, o, inv, tmin, best, stack, sp, obs);
+        pushChildren(boxes, e, tmin, best, stack, sp, obs);
     }
     return found;
 }
