@@ -416,11 +416,12 @@ void Overlays::selectionPanel(bool* open) {
         else {
             const bool played =
                 evalRegion_ == int64_t(r.id) && evalPool_ == r.pool && !evalNodes_.empty();
-            if (played)
+            if (played) {
                 ImGui::PushStyleColor(ImGuiCol_Text,
                                       ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
-            ImGui::TextWrapped("the played ray's evaluation: nodes reached lit, with spans");
-            ImGui::PopStyleColor();
+                ImGui::TextWrapped("the played ray's evaluation: nodes reached lit, with spans");
+                ImGui::PopStyleColor();
+            }
             csgTreeNode(*r.pool, r.root, scene, played ? &evalNodes_ : nullptr);
         }
     }
