@@ -817,36 +817,37 @@ std::string StructureView::describe(const TreeNode& n) const {
     char buf[160];
     switch (n.kind) {
         case TreeNodeKind::Cell:
-            std::snprintf(buf, sizeof buf, "level %d, cut %c", n.depth, kAxis[n.axis]);
+            std::snprintf(buf, sizeof buf, "L%d cut %c", n.depth, kAxis[n.axis]);
             break;
         case TreeNodeKind::Leaf:
-            std::snprintf(buf, sizeof buf, "leaf %lld", static_cast<long long>(n.region));
+            std::snprintf(buf, sizeof buf, "leaf %lld L%d", static_cast<long long>(n.region),
+                          n.depth);
             break;
         case TreeNodeKind::Table: {
             const int bits = std::countr_zero(uint32_t(n.children));
-            std::snprintf(buf, sizeof buf, "%s %u: %zu entries (2^%d)",
-                          n.depth == 0 ? "top table" : "sub-table", n.index, n.children, bits);
+            std::snprintf(buf, sizeof buf, "%s %u: 2^%d", n.depth == 0 ? "top table" : "table",
+                          n.index, bits);
             break;
         }
         case TreeNodeKind::Entry:
-            std::snprintf(buf, sizeof buf, "entry %u: leaf %lld", n.index,
+            std::snprintf(buf, sizeof buf, "%u: leaf %lld", n.index,
                           static_cast<long long>(n.region));
             break;
         case TreeNodeKind::Cut:
-            std::snprintf(buf, sizeof buf, "%c = %.4g", kAxis[n.axis], n.value);
+            std::snprintf(buf, sizeof buf, "%c=%.4g d%d", kAxis[n.axis], n.value, n.depth);
             break;
         case TreeNodeKind::Zone:
             std::snprintf(buf, sizeof buf, "zone %u", n.index);
             break;
         case TreeNodeKind::Slab:
-            std::snprintf(buf, sizeof buf, "slab %u: region %lld, z %.4g..%.4g", n.index,
-                          static_cast<long long>(n.region), n.value, n.value2);
+            std::snprintf(buf, sizeof buf, "slab %u: %lld", n.index,
+                          static_cast<long long>(n.region));
             break;
         case TreeNodeKind::BvhInner:
-            std::snprintf(buf, sizeof buf, "node %u", n.index);
+            std::snprintf(buf, sizeof buf, "node %u d%d", n.index, n.depth);
             break;
         case TreeNodeKind::BvhLeaf:
-            std::snprintf(buf, sizeof buf, "leaf node %u", n.index);
+            std::snprintf(buf, sizeof buf, "leaf %u d%d", n.index, n.depth);
             break;
     }
     return buf;

@@ -316,7 +316,9 @@ class StructureView {
     /// directory, the entry holding the leaf's first cell); nullopt when the tree has no node
     /// for it (another frame's slab, the near region).
     std::optional<std::vector<size_t>> treePath(const StructureTree& tree, uint32_t id) const;
-    /// One line naming the node: "cut x (level 3)", "leaf 12", "zone 4", "table 2: 4x4x4".
+    /// A short name for the node, for a narrow column: "L3 cut x" (a BSP cell at level 3),
+    /// "leaf 12 L5", "x=0.25 d2" (a screen cut at depth 2), "zone 4", "slab 1: 97" (its region),
+    /// "table 2: 2^6" (entries), "5: leaf 9" (entry 5), "node 3 d1", "leaf 8 d3" (BVH).
     std::string describe(const TreeNode& node) const;
 
   private:
