@@ -67,8 +67,8 @@ int main(int argc, char** argv) {
                      "when a file is dropped on the window")
         ->needs(frames);
     view->add_option("--show", vopt.show,
-                     "Layers drawn, a comma list of bsp, zones, slabs, leaves, grid, boxes, "
-                     "frustum, inspector, ray, visited, worst, none")
+                     "Layers drawn, a comma list of bsp, zones, slabs, leaves, grid, visits, "
+                     "tests, boxes, frustum, inspector, ray, visited, worst, tree, none")
         ->check([](const std::string& list) {
             viewer::overlay::OverlayOptions o;
             try {

@@ -83,6 +83,16 @@ float countPosition(double count) {
 
 glm::vec3 countColor(double count) { return colormap(0.3f + 0.7f * countPosition(count)); }
 
+float costPosition(double count) {
+    if (!(count > 1.0)) return 0.0f;
+    return std::clamp(float(std::log10(count)) / float(kCostDecades), 0.0f, 1.0f);
+}
+
+glm::vec3 costColor(double count) {
+    if (!(count > 0.0)) return kNoCostColor;
+    return colormap(0.3f + 0.7f * costPosition(count));
+}
+
 float decadeScale(float p99) {
     if (!(p99 > 1.0f)) return 1.0f;
     const float d = std::pow(10.0f, std::ceil(std::log10(p99) - 1e-6f));

@@ -52,6 +52,17 @@ float countPosition(double count);
 /// Its colour: colormap(0.3 + 0.7 * countPosition(count)) (the map's dark third does not read
 /// as a line on a dark image).
 glm::vec3 countColor(double count);
+/// Costs on the structure (region visits, primitive tests of the last complete image, per
+/// region, leaf, zone or slab) on a fixed log scale: 1 to 10^kCostDecades by decade over the
+/// same stretch of the colour map as counts, so a key read before a rebuild reads after it; a
+/// region no ray reached is kNoCostColor, apart from the map.
+inline constexpr int kCostDecades = 6;
+inline const glm::vec3 kNoCostColor{0.42f, 0.45f, 0.5f};
+/// Where `count` falls on that scale, in [0, 1] (1 and below at 0, 10^kCostDecades and above
+/// at 1).
+float costPosition(double count);
+/// Its colour: colormap(0.3 + 0.7 * costPosition(count)), kNoCostColor for 0.
+glm::vec3 costColor(double count);
 /// The heat maps' automatic scale: the power of ten at or above `p99` (at least 1), so the
 /// key's ends are whole decades and a rebuild whose 99th percentile stays within the decade
 /// keeps the scale.

@@ -135,6 +135,9 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     area.y1 = std::clamp(area.y1, area.y0, fbHeight);
     state_.setImageArea(area);
     const int imageW = area.x1 - area.x0, imageH = area.y1 - area.y0;
+    // Counts that arrived in the poll: the overlays take them before the keys read them.
+    overlays_->setCosts(state_.costs());
+    overlays_->update(state_.sceneBuild(), state_.camera(), imageW, imageH);
     inspector_->setShown(s.showInspector);
     inspector_->update(state_.sceneBuild(),
                        {state_.camera(), std::max(state_.width(), 1), std::max(state_.height(), 1)},
@@ -187,6 +190,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     more.selection = [this](bool* open) { overlays_->selectionPanel(open); };
     more.inspector = [this](bool* open) { inspector_->panel(open); };
     more.ray = [this](bool* open) { rayPanel(state_, player_, open); };
+    more.tree = [this](bool* open) { treePanel(open); };
     drawPanels(state_, layout_, panelHeights_, more);
     // The keys of the overlays and the heat map, in the image viewport's corner.
     KeyInput keys;
@@ -200,7 +204,13 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     keys.logScale = s.logScale;
     keys.diverging = state_.heatDiverging();
     keys_ = drawKeys(keys);
+    // The counts per region of the complete image, for what shows them (a cost colouring, the
+    // tree), counted once the image is complete; the overlays take them at their update.
+    const overlay::OverlayOptions& oo = overlays_->options;
+    if ((oo.any() && oo.usesCosts()) || (s.showTree && !state_.panelsHidden()))
+        state_.requestCosts(oo.costRays);
     state_.startWork(imageW, imageH);
+    overlays_->setCosts(state_.costs());
     ImGui::Render();
 
     // 4. Image: the traced image or a heat map, the size of its viewport, copied there only
@@ -288,6 +298,23 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     settled_ = state_.settledSince() && inspector_->settled() && !player_.pending() &&
                !player_.playback().playing();
     keepSettings();
+}
+
+void ViewerApp::treePanel(bool* open) {
+    if (ImGui::Begin(panelTitle(PanelId::Tree), open,
+                     ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize)) {
+        overlay::OverlayOptions& o = overlays_->options;
+        int rays = int(o.costRays);
+        const char* which[] = {"all rays", "primary rays"};
+        if (ImGui::Combo("cost of", &rays, which, 2)) o.costRays = CostRays(rays);
+        const ImageCosts* c = state_.costs().get();
+        const RegionCosts* counts =
+            costsFit(c, overlays_->structure(), o.costRays) ? &c->costs : nullptr;
+        if (const std::optional<uint32_t> r =
+                tree_.draw(overlays_->view(), counts, selectedRegion()))
+            selectRegion(int64_t(*r));
+    }
+    ImGui::End();
 }
 
 void ViewerApp::uploadImage(int rowBegin, int rowEnd) {
@@ -393,6 +420,8 @@ std::vector<std::string> ViewerApp::applyShow(const std::string& list) {
         } else if (item == "visited") {
             state_.settings().showRay = true;
             state_.settings().rayRegionsOnly = true;
+        } else if (item == "tree") {
+            state_.settings().showTree = true;
         } else if (item == "worst") {
             state_.settings().showRay = true;
             state_.notes().worstOpen = true;

@@ -18,6 +18,7 @@
 #include "app/viewer/panel_cache.h"
 #include "app/viewer/panels/keys.h"
 #include "app/viewer/panels/panels.h"
+#include "app/viewer/panels/tree_panel.h"
 #include "app/viewer/playback/ray_player.h"
 #include "app/viewer/viewer_state.h"
 
@@ -125,6 +126,10 @@ class ViewerApp {
     /// soon as a structure is on screen (`--pick X Y --ray K --step N`); shows the Ray panel.
     void pickPixel(int x, int y, int ray = 0, int step = 0);
 
+    /// The structure tree panel's browser (its open nodes, where it drew the regions' rows).
+    const TreeBrowser& treeBrowser() const { return tree_; }
+    TreeBrowser& treeBrowser() { return tree_; }
+
     /// What is built, rendered and shown (what the panels read).
     ViewerState& state() { return state_; }
     const ViewerState& state() const { return state_; }
@@ -149,6 +154,8 @@ class ViewerApp {
     /// The overlays' and the inspector's region filter: the played ray's regions while
     /// settings().rayRegionsOnly, else all.
     void syncRegionFilter();
+    /// The structure tree panel (panels/tree_panel.h), its window Begin to End.
+    void treePanel(bool* open);
     /// --log-timings: the overlays' work in this frame (`layerDrawn`: it drew the layers).
     void logOverlayTiming(double ms, bool layerDrawn);
 
@@ -164,6 +171,7 @@ class ViewerApp {
     } overlayStat_;
     std::unique_ptr<inspector::Inspector> inspector_;
     playback::RayPlayer player_;
+    TreeBrowser tree_;
     std::unique_ptr<gl::BatchRenderer> rayRenderer_;
     Clock::time_point lastFrame_ = Clock::now();
     /// The region the playback selected last (-1: none), so a click elsewhere is not undone.

@@ -4,11 +4,17 @@
 #include <imgui_internal.h>
 
 #include <algorithm>
+#include <iterator>
 #include <sstream>
 
 namespace lancer::viewer {
 
 namespace {
+
+/// The ini's words for the overlays' colourings, in the enums' order.
+constexpr const char* kZoneFillWords[] = {"prims", "slabs", "visits", "tests"};
+constexpr const char* kLeafColorWords[] = {"level", "prims", "visits", "tests"};
+constexpr const char* kSlabColorWords[] = {"order", "visits", "tests"};
 
 const char* viewModeKey(ViewMode m) {
     static const char* keys[] = {"color", "prim_tests", "region_visits", "time"};
@@ -93,8 +99,10 @@ std::string settingsLines(const ViewerSettings& s) {
       << "log_scale=" << s.logScale << "\n";
     const overlay::OverlayOptions& ov = s.overlays;
     o << "overlay_layers=" << flagsText({ov.bsp, ov.zones, ov.slabs, ov.leaves, ov.grid}) << "\n"
-      << "overlay_fill=" << (ov.zoneFill == overlay::ZoneFill::Slabs ? "slabs" : "prims") << "\n"
-      << "overlay_color=" << (ov.leafColor == overlay::LeafColor::Prims ? "prims" : "level") << "\n"
+      << "overlay_fill=" << kZoneFillWords[size_t(ov.zoneFill)] << "\n"
+      << "overlay_color=" << kLeafColorWords[size_t(ov.leafColor)] << "\n"
+      << "overlay_slab_color=" << kSlabColorWords[size_t(ov.slabColor)] << "\n"
+      << "overlay_cost_rays=" << (ov.costRays == CostRays::Primary ? "primary" : "all") << "\n"
       << "overlay_grid_color=" << gridColorWord(ov.gridColor) << "\n"
       << "overlay_projective=" << ov.projective << "\n"
       << "overlay_levels=" << ov.levelMin << " " << ov.levelMax << "\n"
@@ -181,13 +189,17 @@ void readSettingsLine(ViewerSettings& s, const std::string& line) {
         overlay::OverlayOptions& o = s.overlays;
         readFlags(in, {&o.bsp, &o.zones, &o.slabs, &o.leaves, &o.grid});
     } else if (key == "overlay_fill") {
-        if (value == "prims" || value == "slabs")
-            s.overlays.zoneFill =
-                value == "slabs" ? overlay::ZoneFill::Slabs : overlay::ZoneFill::Prims;
+        for (size_t i = 0; i < std::size(kZoneFillWords); ++i)
+            if (value == kZoneFillWords[i]) s.overlays.zoneFill = overlay::ZoneFill(i);
     } else if (key == "overlay_color") {
-        if (value == "level" || value == "prims")
-            s.overlays.leafColor =
-                value == "prims" ? overlay::LeafColor::Prims : overlay::LeafColor::Level;
+        for (size_t i = 0; i < std::size(kLeafColorWords); ++i)
+            if (value == kLeafColorWords[i]) s.overlays.leafColor = overlay::LeafColor(i);
+    } else if (key == "overlay_slab_color") {
+        for (size_t i = 0; i < std::size(kSlabColorWords); ++i)
+            if (value == kSlabColorWords[i]) s.overlays.slabColor = overlay::SlabColor(i);
+    } else if (key == "overlay_cost_rays") {
+        if (value == "all" || value == "primary")
+            s.overlays.costRays = value == "primary" ? CostRays::Primary : CostRays::All;
     } else if (key == "overlay_grid_color") {
         for (overlay::GridColor c :
              {overlay::GridColor::Kind, overlay::GridColor::Level, overlay::GridColor::TableDepth})

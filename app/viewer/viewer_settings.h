@@ -27,6 +27,8 @@ struct ViewerSettings {
     bool showParameters = true, showStatistics = true, showCamera = true, showView = true;
     bool showOverlays = true;
     bool showSelection = false;  ///< opened by a pick or --select
+    /// The structure tree (opened from the Panels menu or `--show tree`; not saved).
+    bool showTree = false;
     /// The 3D inspector, beside the image (the right half of what the panels leave).
     bool showInspector = false;
     /// The Ray panel (not saved: it opens with the first pick).

@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "app/viewer/camera_control.h"
+#include "engine/accel/structure_view.h"
 #include "engine/scene/builtin_scenes.h"
 
 namespace lancer::viewer {
@@ -20,7 +21,7 @@ double msSince(ViewerState::Clock::time_point t) {
 }  // namespace
 
 ViewerState::ViewerState(ViewerSettings& settings, bool logTimings, std::function<void()> wake)
-    : s_(settings), logTimings_(logTimings) {
+    : s_(settings), logTimings_(logTimings), wake_(wake) {
     if (wake) {
         renderer_.setOnPass(wake);
         builder_.setOnReady(wake);
@@ -32,6 +33,8 @@ ViewerState::ViewerState(ViewerSettings& settings, bool logTimings, std::functio
 ViewerState::~ViewerState() {
     if (speedup_) speedup_->cancel = true;
     if (speedupThread_.joinable()) speedupThread_.join();
+    if (costJob_) costJob_->cancel = true;
+    if (costThread_.joinable()) costThread_.join();
     renderer_.cancel();
 }
 
@@ -201,6 +204,9 @@ void ViewerState::restartRender(const char* why) {
     job.options.shading = s_.shading;
     job.options.camera = camera_;
     if (speedup_ && !speedup_->done) speedup_->cancel = true;  // its view is gone
+    if (costJob_ && !costJob_->done) costJob_->cancel = true;  // its image is gone
+    jobOptions_ = job.options;
+    jobBuild_ = sceneBuild_;
     jobKey_ = {sceneBuild_->spec, camera_, jobWidth_, jobHeight_, s_.shading};
     jobParams_ = sceneBuild_->accel->params();
     renderer_.start(std::move(job), changeAt_);
@@ -217,6 +223,7 @@ void ViewerState::poll() {
     builtBefore_ = !builder_.busy();
     pollBuilder();
     takeSnapshot();
+    takeCosts();
     // The A/B's status follows the job and snapshot; its totals and the scale only change with
     // a snapshot or what is compared.
     if (updateAb() || snapped_) updateAutoScale();
@@ -351,10 +358,69 @@ void ViewerState::startWork(int fbWidth, int fbHeight) {
         // frame, saved about 5 ms of latency on balls4 and cost a frame of up to 40 ms at
         // every change: below 60 frames a second.)
     }
+    updateCosts();
+}
+
+void ViewerState::takeCosts() {
+    if (costJob_ && costJob_->done) {
+        if (costThread_.joinable()) costThread_.join();
+        if (!costJob_->cancel) {
+            costsTriedJob_ = costJob_->job;
+            costsTriedRays_ = costJob_->rays;
+            costsError_ = costJob_->error;
+            if (costJob_->result) costs_ = costJob_->result;
+            if (costJob_->result)
+                logTiming("region costs counted in " + std::to_string(costs_->ms) + " ms");
+        }
+        costJob_.reset();
+    }
+}
+
+void ViewerState::updateCosts() {
+    takeCosts();
+    costsDue_ = false;
+    if (!costsWanted_) return;
+    const CostRays rays = *costsWanted_;
+    costsWanted_.reset();
+    // Only a complete image: its counts are the render's (a coarse pass's are not the image's).
+    const bool complete = jobBuild_ && shownComplete_ && shownJob_ == startedJob_ &&
+                          !renderDirty_ && renderer_.finished() && jobBuild_ == sceneBuild_;
+    if (!complete) return;
+    if (costsTriedJob_ == shownJob_ && costsTriedRays_ == rays) return;  // done (or failed)
+    costsDue_ = true;
+    if (costJob_ && costJob_->job == shownJob_ && costJob_->rays == rays) return;  // under way
+    if (costJob_) costJob_->cancel = true;
+    if (costThread_.joinable()) costThread_.join();
+    auto job = std::make_shared<CostJob>();
+    job->job = shownJob_;
+    job->rays = rays;
+    costJob_ = job;
+    std::shared_ptr<const SceneBuild> build = jobBuild_;
+    RenderOptions opt = jobOptions_;
+    std::function<void()> wake = wake_;
+    costThread_ = std::thread([job, build, opt, wake] {
+        lowerThreadPriority();
+        try {
+            const auto t0 = Clock::now();
+            auto r = std::make_shared<ImageCosts>();
+            r->build = build;
+            r->job = job->job;
+            const size_t regions = StructureView(*build->scene, *build->accel).regionCount();
+            if (countRegionCosts(*build->scene, *build->accel, opt, regions, job->rays, r->costs,
+                                 &job->cancel)) {
+                r->ms = msSince(t0);
+                job->result = r;
+            }
+        } catch (const std::exception& e) {
+            job->error = e.what();
+        }
+        job->done = true;
+        if (wake) wake();
+    });
 }
 
 bool ViewerState::settledSince() const {
-    return builtBefore_ && !builder_.busy() &&
+    return builtBefore_ && !builder_.busy() && !costsDue_ &&
            (!sceneBuild_ || (!renderDirty_ && finishedBefore_ && renderer_.finished()));
 }
 

@@ -16,6 +16,7 @@
 #include "app/bench/speedup.h"
 #include "app/viewer/colormap.h"
 #include "app/viewer/compare/rebuild_diff.h"
+#include "app/viewer/image_costs.h"
 #include "app/viewer/image_view.h"
 #include "app/viewer/playback/worst_rays.h"
 #include "app/viewer/structure_builder.h"
@@ -164,6 +165,17 @@ class ViewerState {
     std::vector<float> heatRows(int rowBegin, int rowEnd) const;
     /// The heat map is a signed difference, drawn on the diverging map.
     bool heatDiverging() const;
+    /// Ask, for this frame, for the counts per region of the last complete image (`rays`' visits
+    /// and tests: the overlays' cost colourings and the tree browser call it each frame they
+    /// show them). Once the image on screen is complete they are counted by an observer of the
+    /// render's walk (countRegionCosts) on a worker thread at low priority, once per image; a
+    /// new render cancels a count under way. Until the count is done the run is not settled.
+    void requestCosts(CostRays rays) { costsWanted_ = rays; }
+    /// The last counts done (null: none yet); they may be of a structure no longer on screen
+    /// (costsFit() tells).
+    const std::shared_ptr<const ImageCosts>& costs() const { return costs_; }
+    /// Why the last count failed ("" when it did not).
+    const std::string& costsError() const { return costsError_; }
     /// Measure the speedup over brute force on the current view, on a worker thread, with one
     /// pixel in `stride` x `stride`. Nothing happens before the first structure.
     void measureSpeedup(int stride);
@@ -253,6 +265,30 @@ class ViewerState {
 
     std::shared_ptr<SpeedupJob> speedup_;
     std::thread speedupThread_;
+
+    // The counts per region of the last complete image (requestCosts).
+    struct CostJob {
+        std::atomic<bool> cancel{false}, done{false};
+        uint64_t job = 0;
+        CostRays rays = CostRays::All;
+        std::shared_ptr<const ImageCosts> result;  ///< null when cancelled or failed
+        std::string error;
+    };
+    /// Take a finished count (poll: the frame's overlays and keys see it at once).
+    void takeCosts();
+    /// Start counting the shown image's costs when asked and not yet done for it.
+    void updateCosts();
+    std::function<void()> wake_;
+    RenderOptions jobOptions_;                    ///< what the latest job renders
+    std::shared_ptr<const SceneBuild> jobBuild_;  ///< with this structure
+    std::optional<CostRays> costsWanted_;         ///< asked for in this frame
+    bool costsDue_ = false;                       ///< asked for, and not done for the image
+    std::shared_ptr<const ImageCosts> costs_;
+    std::string costsError_;
+    uint64_t costsTriedJob_ = 0;               ///< the job and rays of the last count
+    CostRays costsTriedRays_ = CostRays::All;  ///< finished (done, failed)
+    std::shared_ptr<CostJob> costJob_;
+    std::thread costThread_;
 };
 
 }  // namespace lancer::viewer

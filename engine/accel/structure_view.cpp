@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace lancer {
@@ -15,6 +16,11 @@ std::array<Vec3, 8> boxCorners(const Box3& b) {
         c[i] = {(i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z};
     return c;
 }
+
+template <class... Ts>
+struct Overloaded : Ts... {
+    using Ts::operator()...;
+};
 
 int64_t ropeNeighbour(uint32_t rope) {
     if (rope == kBorder) return kNoNeighbour;
@@ -40,6 +46,30 @@ const char* regionKindName(RegionKind k) {
             return "node";
         case RegionKind::BvhLeaf:
             return "bvh leaf";
+    }
+    return "?";
+}
+
+const char* treeNodeKindName(TreeNodeKind k) {
+    switch (k) {
+        case TreeNodeKind::Cell:
+            return "cell";
+        case TreeNodeKind::Leaf:
+            return "leaf";
+        case TreeNodeKind::Table:
+            return "table";
+        case TreeNodeKind::Entry:
+            return "entry";
+        case TreeNodeKind::Cut:
+            return "cut";
+        case TreeNodeKind::Zone:
+            return "zone";
+        case TreeNodeKind::Slab:
+            return "slab";
+        case TreeNodeKind::BvhInner:
+            return "node";
+        case TreeNodeKind::BvhLeaf:
+            return "leaf node";
     }
     return "?";
 }
@@ -130,6 +160,44 @@ std::vector<SlabInfo> ZoneFrameView::slabs(uint32_t z) const {
                            pz.slabPrimitives(i)});
     }
     return out;
+}
+
+std::pair<uint32_t, uint32_t> ZoneFrameView::zoneRegions(uint32_t z0, uint32_t z1) const {
+    if (kind_ == ZoneFrameKind::Camera) {
+        const std::vector<uint32_t>& first = s_->zoneFirstRegion();
+        return {first[z0], first[z1]};
+    }
+    const std::vector<uint32_t>& first = s_->projective().zoneFirst();
+    return {first_ + first[z0], first_ + first[z1]};
+}
+
+std::pair<uint32_t, uint32_t> ZoneFrameView::zoneSpan(int32_t ref) const {
+    if (ref < 0) return {uint32_t(~ref), uint32_t(~ref)};
+    std::call_once(spans_->once, [&] {
+        // Children before parents: a node's span joins its children's.
+        const ScreenBsp& bsp = *bsp_;
+        std::vector<std::pair<uint32_t, uint32_t>>& out = spans_->node;
+        out.assign(bsp.nodes.size(), {0u, 0u});
+        std::vector<std::pair<int32_t, bool>> stack;
+        if (bsp.root >= 0) stack.push_back({bsp.root, false});
+        while (!stack.empty()) {
+            const auto [n, childrenDone] = stack.back();
+            stack.pop_back();
+            const ScreenBsp::Node& node = bsp.nodes[size_t(n)];
+            if (!childrenDone) {
+                stack.push_back({n, true});
+                for (int32_t c : node.child)
+                    if (c >= 0) stack.push_back({c, false});
+                continue;
+            }
+            auto span = [&](int32_t c) {
+                return c < 0 ? std::pair{uint32_t(~c), uint32_t(~c)} : out[size_t(c)];
+            };
+            const auto a = span(node.child[0]), b = span(node.child[1]);
+            out[size_t(n)] = {std::min(a.first, b.first), std::max(a.second, b.second)};
+        }
+    });
+    return spans_->node[size_t(ref)];
 }
 
 std::array<Vec3, 8> ZoneFrameView::zoneCorners(uint32_t z) const {
@@ -481,6 +549,308 @@ std::vector<DirectoryBlock> StructureView::directoryBlocks() const {
         out.push_back(b);
     });
     return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Trees
+
+std::vector<StructureTree> StructureView::trees() const {
+    std::vector<StructureTree> out;
+    std::visit(
+        Overloaded{
+            [](const BruteForce&) {},
+            [&](const RegularGrid& g) {
+                const uint32_t lo[3] = {0, 0, 0};
+                const uint32_t hi[3] = {g.cells(0), g.cells(1), g.cells(2)};
+                out.push_back(
+                    {TreeKind::RegularBsp, ZoneFrameKind::Camera, "BSP", regularCell(lo, hi, 0)});
+                if (g.directory().tableCount() > 0)
+                    out.push_back({TreeKind::Directory, ZoneFrameKind::Camera, "directory",
+                                   directoryTable(0, lo, hi, 0)});
+            },
+            [&](const IrregularSubdivision&) {
+                for (ZoneFrameKind k : {ZoneFrameKind::Projective, ZoneFrameKind::Camera}) {
+                    const ZoneFrameView* f = frame(k);
+                    if (!f || f->zoneCount() == 0) continue;
+                    out.push_back({TreeKind::ScreenBsp, k,
+                                   k == ZoneFrameKind::Projective ? "screen BSP (projective)"
+                                                                  : "screen BSP (camera frame)",
+                                   screenRef(*f, f->bsp().root, 0)});
+                }
+            },
+            [&](const Bvh& b) {
+                if (!b.nodes().empty())
+                    out.push_back({TreeKind::Bvh, ZoneFrameKind::Camera, "BVH", bvhNode(0)});
+            },
+        },
+        accel_->impl());
+    return out;
+}
+
+TreeNode StructureView::regularCell(const uint32_t lo[3], const uint32_t hi[3], int depth) const {
+    const RegularGrid& g = *regular();
+    TreeNode n;
+    n.tree = TreeKind::RegularBsp;
+    n.depth = depth;
+    std::copy_n(lo, 3, n.lo);
+    std::copy_n(hi, 3, n.hi);
+    const uint32_t first = g.directory().lookup(lo[0], lo[1], lo[2]);
+    const RegularLeaf& L = g.leaves()[first];
+    if (std::equal(lo, lo + 3, L.lo) && std::equal(hi, hi + 3, L.hi)) {
+        n.kind = TreeNodeKind::Leaf;
+        n.region = first;
+        n.prims = L.prims;
+        n.ranged = true;
+        n.regionLo = first;
+        n.regionHi = first + 1;
+        return n;
+    }
+    // Leaves are numbered depth first, the low half first: a cell's leaves run from the one at
+    // its low corner to the one at its high corner.
+    n.kind = TreeNodeKind::Cell;
+    n.axis = g.schedule().axis(depth);
+    n.children = 2;
+    n.ranged = true;
+    n.regionLo = first;
+    n.regionHi = g.directory().lookup(hi[0] - 1, hi[1] - 1, hi[2] - 1) + 1;
+    return n;
+}
+
+TreeNode StructureView::directoryTable(uint32_t table, const uint32_t lo[3], const uint32_t hi[3],
+                                       int depth) const {
+    const RegularGrid& g = *regular();
+    TreeNode n;
+    n.tree = TreeKind::Directory;
+    n.kind = TreeNodeKind::Table;
+    n.depth = depth;
+    n.index = table;
+    std::copy_n(lo, 3, n.lo);
+    std::copy_n(hi, 3, n.hi);
+    n.children = g.directory().tableSize(table);
+    // A table stores a BSP node's cell: its leaves are consecutive (regularCell).
+    n.ranged = true;
+    n.regionLo = g.directory().lookup(lo[0], lo[1], lo[2]);
+    n.regionHi = g.directory().lookup(hi[0] - 1, hi[1] - 1, hi[2] - 1) + 1;
+    return n;
+}
+
+TreeNode StructureView::directoryEntry(uint32_t table, const uint32_t origin[3], size_t i,
+                                       int depth) const {
+    const RegularGrid& g = *regular();
+    uint32_t lo[3], hi[3], value = 0;
+    bool sub = false;
+    g.directory().tableEntry(table, origin, i, lo, hi, sub, value);
+    if (sub) return directoryTable(value, lo, hi, depth);
+    TreeNode n;
+    n.tree = TreeKind::Directory;
+    n.kind = TreeNodeKind::Entry;
+    n.depth = depth;
+    n.index = uint32_t(i);
+    std::copy_n(lo, 3, n.lo);
+    std::copy_n(hi, 3, n.hi);
+    n.region = value;
+    n.prims = g.leaves()[value].prims;
+    n.ranged = true;
+    n.regionLo = value;
+    n.regionHi = value + 1;
+    return n;
+}
+
+TreeNode StructureView::screenRef(const ZoneFrameView& f, int32_t ref, int depth) const {
+    const ScreenBsp& bsp = f.bsp();
+    TreeNode n;
+    n.tree = TreeKind::ScreenBsp;
+    n.frame = f.kind();
+    n.depth = depth;
+    const auto [z0, z1] = f.zoneSpan(ref);
+    const auto [r0, r1] = f.zoneRegions(z0, z1 + 1);
+    n.ranged = true;
+    n.regionLo = r0;
+    n.regionHi = r1;
+    if (ref >= 0) {
+        const ScreenBsp::Node& node = bsp.nodes[size_t(ref)];
+        n.kind = TreeNodeKind::Cut;
+        n.index = uint32_t(ref);
+        n.axis = node.axis;
+        n.value = node.value;
+        n.children = 2;
+        return n;
+    }
+    n.kind = TreeNodeKind::Zone;
+    n.index = z0;
+    n.prims = int64_t(f.zonePrims(z0).size());
+    n.children = r1 - r0;
+    return n;
+}
+
+TreeNode StructureView::bvhNode(uint32_t id) const {
+    const BvhNode& b = bvh()->nodes()[id];
+    TreeNode n;
+    n.tree = TreeKind::Bvh;
+    n.kind = b.leaf ? TreeNodeKind::BvhLeaf : TreeNodeKind::BvhInner;
+    n.depth = b.depth;
+    n.index = id;
+    n.region = id;
+    n.children = b.leaf ? 0 : 2;
+    if (b.leaf) n.prims = b.count;
+    return n;
+}
+
+TreeNode StructureView::treeChild(const TreeNode& node, size_t i) const {
+    if (i >= node.children) throw std::out_of_range("tree node has no child " + std::to_string(i));
+    switch (node.kind) {
+        case TreeNodeKind::Cell: {
+            const int a = node.axis;
+            const uint32_t mid = (node.lo[a] + node.hi[a]) / 2;
+            uint32_t lo[3], hi[3];
+            std::copy_n(node.lo, 3, lo);
+            std::copy_n(node.hi, 3, hi);
+            (i == 0 ? hi : lo)[a] = mid;
+            return regularCell(lo, hi, node.depth + 1);
+        }
+        case TreeNodeKind::Table:
+            return directoryEntry(node.index, node.lo, i, node.depth + 1);
+        case TreeNodeKind::Cut: {
+            const ZoneFrameView& f = *frame(node.frame);
+            return screenRef(f, f.bsp().nodes[node.index].child[i], node.depth + 1);
+        }
+        case TreeNodeKind::Zone: {
+            TreeNode n;
+            n.tree = TreeKind::ScreenBsp;
+            n.frame = node.frame;
+            n.kind = TreeNodeKind::Slab;
+            n.depth = node.depth + 1;
+            n.index = uint32_t(i);
+            const uint32_t id = node.regionLo + uint32_t(i);
+            n.region = id;
+            n.ranged = true;
+            n.regionLo = id;
+            n.regionHi = id + 1;
+            const RegionInfo r = region(id);
+            n.prims = int64_t(r.prims.size());
+            n.value = r.frameBox.lo.z;
+            n.value2 = r.frameBox.hi.z;
+            return n;
+        }
+        case TreeNodeKind::BvhInner:
+            return bvhNode(bvh()->nodes()[node.index].first + uint32_t(i));
+        case TreeNodeKind::Leaf:
+        case TreeNodeKind::Entry:
+        case TreeNodeKind::Slab:
+        case TreeNodeKind::BvhLeaf:
+            break;
+    }
+    throw std::logic_error("tree node without children");
+}
+
+std::optional<std::vector<size_t>> StructureView::treePath(const StructureTree& tree,
+                                                           uint32_t id) const {
+    if (id >= regionCount()) return std::nullopt;
+    std::vector<size_t> path;
+    switch (tree.kind) {
+        case TreeKind::RegularBsp: {
+            const RegularLeaf& L = regular()->leaves()[id];
+            TreeNode n = tree.root;
+            while (n.kind == TreeNodeKind::Cell) {
+                const uint32_t mid = (n.lo[n.axis] + n.hi[n.axis]) / 2;
+                const size_t side = L.lo[n.axis] >= mid ? 1 : 0;
+                path.push_back(side);
+                n = treeChild(n, side);
+            }
+            if (n.region != int64_t(id)) return std::nullopt;
+            return path;
+        }
+        case TreeKind::Directory: {
+            const RegularLeaf& L = regular()->leaves()[id];
+            TreeNode n = tree.root;
+            while (n.kind == TreeNodeKind::Table) {
+                const size_t i = regular()->directory().tableEntryAt(n.index, n.lo, L.lo);
+                path.push_back(i);
+                n = treeChild(n, i);
+            }
+            if (n.region != int64_t(id)) return std::nullopt;
+            return path;
+        }
+        case TreeKind::ScreenBsp: {
+            const RegionInfo r = region(id);
+            const bool inFrame = tree.frame == ZoneFrameKind::Camera
+                                     ? r.kind == RegionKind::Slab
+                                     : r.kind == RegionKind::ProjectiveSlab;
+            if (!inFrame || r.zone < 0) return std::nullopt;
+            const ZoneFrameView& f = *frame(tree.frame);
+            const uint32_t z = uint32_t(r.zone);
+            const glm::dvec2 c = 0.5 * (f.zoneLo(z) + f.zoneHi(z));
+            TreeNode n = tree.root;
+            while (n.kind == TreeNodeKind::Cut) {
+                const size_t side = c[n.axis] >= n.value ? 1 : 0;
+                path.push_back(side);
+                n = treeChild(n, side);
+            }
+            if (n.index != z) return std::nullopt;
+            path.push_back(r.slab);
+            return path;
+        }
+        case TreeKind::Bvh: {
+            // Parents are not stored: walk down from the root, depth first, to the node.
+            const std::vector<BvhNode>& nodes = bvh()->nodes();
+            std::vector<std::pair<uint32_t, std::vector<size_t>>> stack{{0u, {}}};
+            while (!stack.empty()) {
+                auto [node, p] = std::move(stack.back());
+                stack.pop_back();
+                if (node == id) return p;
+                const BvhNode& b = nodes[node];
+                if (b.leaf) continue;
+                for (size_t side : {size_t(1), size_t(0)}) {
+                    std::vector<size_t> q = p;
+                    q.push_back(side);
+                    stack.push_back({b.first + uint32_t(side), std::move(q)});
+                }
+            }
+            return std::nullopt;
+        }
+    }
+    return std::nullopt;
+}
+
+std::string StructureView::describe(const TreeNode& n) const {
+    static const char* kAxis = "xyz";
+    char buf[160];
+    switch (n.kind) {
+        case TreeNodeKind::Cell:
+            std::snprintf(buf, sizeof buf, "L%d cut %c", n.depth, kAxis[n.axis]);
+            break;
+        case TreeNodeKind::Leaf:
+            std::snprintf(buf, sizeof buf, "leaf %lld L%d", static_cast<long long>(n.region),
+                          n.depth);
+            break;
+        case TreeNodeKind::Table: {
+            const int bits = std::countr_zero(uint32_t(n.children));
+            std::snprintf(buf, sizeof buf, "%s %u: 2^%d", n.depth == 0 ? "top table" : "table",
+                          n.index, bits);
+            break;
+        }
+        case TreeNodeKind::Entry:
+            std::snprintf(buf, sizeof buf, "%u: leaf %lld", n.index,
+                          static_cast<long long>(n.region));
+            break;
+        case TreeNodeKind::Cut:
+            std::snprintf(buf, sizeof buf, "%c=%.4g d%d", kAxis[n.axis], n.value, n.depth);
+            break;
+        case TreeNodeKind::Zone:
+            std::snprintf(buf, sizeof buf, "zone %u", n.index);
+            break;
+        case TreeNodeKind::Slab:
+            std::snprintf(buf, sizeof buf, "slab %u: %lld", n.index,
+                          static_cast<long long>(n.region));
+            break;
+        case TreeNodeKind::BvhInner:
+            std::snprintf(buf, sizeof buf, "node %u d%d", n.index, n.depth);
+            break;
+        case TreeNodeKind::BvhLeaf:
+            std::snprintf(buf, sizeof buf, "leaf %u d%d", n.index, n.depth);
+            break;
+    }
+    return buf;
 }
 
 }  // namespace lancer

@@ -13,6 +13,8 @@
 #pragma once
 
 #include <array>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
@@ -143,6 +145,13 @@ class ZoneFrameView {
     std::span<const uint32_t> zonePrims(uint32_t z) const;
     /// Zone z's slabs, by increasing depth.
     std::vector<SlabInfo> slabs(uint32_t z) const;
+    /// The region ids of the slabs of zones [z0, z1): [first, last), zones' slabs being
+    /// numbered in zone order.
+    std::pair<uint32_t, uint32_t> zoneRegions(uint32_t z0, uint32_t z1) const;
+    /// The first and last zone below BSP reference `ref` (a node, or ~zone): the BSP numbers
+    /// its zones depth first (screen_bsp.cpp, renumber), so a node's are consecutive. The
+    /// nodes' spans are found in one pass on the first call (thread-safe), then read.
+    std::pair<uint32_t, uint32_t> zoneSpan(int32_t ref) const;
     /// Zone z's whole column as 8 world corners (the regionCorners order): its rectangle through
     /// the depth of its slabs; a box of the camera frame, or a frustum of the projective frame.
     std::array<Vec3, 8> zoneCorners(uint32_t z) const;
@@ -174,6 +183,64 @@ class ZoneFrameView {
     glm::dvec2 lo_{0.0}, hi_{0.0};
     uint32_t first_ = 0;  ///< region id of the first slab of zone 0
     double half_ = 1.0;   ///< half the image height in frame units (ortho height / 2, tan(fov/2))
+    /// Each node's first and last zone (zoneSpan), made on first use.
+    struct Spans {
+        std::once_flag once;
+        std::vector<std::pair<uint32_t, uint32_t>> node;
+    };
+    std::shared_ptr<Spans> spans_ = std::make_shared<Spans>();
+};
+
+/// The trees a structure is made of, as the viewer's tree browser lists them.
+enum class TreeKind : uint8_t {
+    RegularBsp,  ///< regular: the BSP, from the scene box down to the leaves
+    Directory,   ///< regular: the directory's top table, its entries and sub-tables
+    ScreenBsp,   ///< irregular: a screen frame's 2D BSP, its zones and their slabs
+    Bvh,         ///< BVH: the nodes from the root
+};
+/// What a node of a structure's tree is.
+enum class TreeNodeKind : uint8_t {
+    Cell,      ///< regular BSP: an inner node's cell, cut in two
+    Leaf,      ///< regular BSP: a leaf (a region)
+    Table,     ///< directory: a table (the top one, or a sub-table an entry names)
+    Entry,     ///< directory: an entry naming a leaf
+    Cut,       ///< screen BSP: an inner node, its line
+    Zone,      ///< screen BSP: a zone (a leaf of the 2D BSP), its slabs below it
+    Slab,      ///< screen BSP: a slab of a zone (a region)
+    BvhInner,  ///< BVH: an inner node (a region)
+    BvhLeaf,   ///< BVH: a leaf (a region)
+};
+const char* treeNodeKindName(TreeNodeKind k);
+
+/// One node of a structure's tree, read from the structure on demand (only the nodes a caller
+/// asks for are made, so a tree of millions of nodes costs what is listed). Plain data: what
+/// locates the node in its scheme travels with it, for its children.
+struct TreeNode {
+    TreeKind tree = TreeKind::RegularBsp;
+    ZoneFrameKind frame = ZoneFrameKind::Camera;  ///< ScreenBsp: the frame it belongs to
+    TreeNodeKind kind = TreeNodeKind::Cell;
+    int depth = 0;        ///< the root is 0
+    size_t children = 0;  ///< child count (treeChild(node, i) for i < children)
+    int64_t region = -1;  ///< the region this node is (a leaf, a slab, a BVH node, an entry's
+                          ///< leaf); -1 for a group of regions
+    /// The regions under it (itself included) are ids [regionLo, regionHi) when `ranged`: the
+    /// regular leaves, the zones' slabs are numbered depth first, so a subtree's are together.
+    bool ranged = false;
+    uint32_t regionLo = 0, regionHi = 0;
+    int64_t prims = -1;  ///< primitives listed (a leaf's, a zone's, a slab's); -1 for none
+    uint32_t index = 0;  ///< its number in its scheme: BVH node, screen BSP node, zone, table
+    uint32_t lo[3] = {}, hi[3] = {};  ///< regular and directory: directory cells [lo, hi)
+    int axis = -1;                    ///< Cell, Cut: the axis cut (Cut: 0 x, 1 y)
+    double value = 0.0;               ///< Cut: the line's coordinate; Slab: its near depth
+    double value2 = 0.0;              ///< Slab: its far depth
+};
+
+/// One tree of a structure: its name for people and its root.
+struct StructureTree {
+    TreeKind kind = TreeKind::RegularBsp;
+    ZoneFrameKind frame = ZoneFrameKind::Camera;
+    std::string name;  ///< "BSP", "directory", "screen BSP (projective)", "BVH"
+    TreeNode root;
 };
 
 /// The description of a built structure; holds references to the scene and the accelerator,
@@ -237,7 +304,31 @@ class StructureView {
     /// The frame of `kind`, or nullptr when absent.
     const ZoneFrameView* frame(ZoneFrameKind kind) const;
 
+    // Trees, for every scheme (brute force has none): read on demand, node by node.
+    /// The scheme's trees: regular, the BSP and the directory; irregular, each screen frame's
+    /// BSP (projective first when present); BVH, its nodes. A scheme added to Accelerator::Impl
+    /// without an answer here does not compile.
+    std::vector<StructureTree> trees() const;
+    /// Child `i` (< node.children) of `node`, in the scheme's order (low half first; below
+    /// the line first; slabs by depth; a table's entries in forEachEntry's order).
+    TreeNode treeChild(const TreeNode& node, size_t i) const;
+    /// The child indices from `tree`'s root down to the node that is region `id` (for the
+    /// directory, the entry holding the leaf's first cell); nullopt when the tree has no node
+    /// for it (another frame's slab, the near region).
+    std::optional<std::vector<size_t>> treePath(const StructureTree& tree, uint32_t id) const;
+    /// A short name for the node, for a narrow column: "L3 cut x" (a BSP cell at level 3),
+    /// "leaf 12 L5", "x=0.25 d2" (a screen cut at depth 2), "zone 4", "slab 1: 97" (its region),
+    /// "table 2: 2^6" (entries), "5: leaf 9" (entry 5), "node 3 d1", "leaf 8 d3" (BVH).
+    std::string describe(const TreeNode& node) const;
+
   private:
+    TreeNode regularCell(const uint32_t lo[3], const uint32_t hi[3], int depth) const;
+    TreeNode directoryEntry(uint32_t table, const uint32_t origin[3], size_t i, int depth) const;
+    TreeNode directoryTable(uint32_t table, const uint32_t lo[3], const uint32_t hi[3],
+                            int depth) const;
+    TreeNode screenRef(const ZoneFrameView& f, int32_t ref, int depth) const;
+    TreeNode bvhNode(uint32_t node) const;
+
     const Scene* scene_;
     const Accelerator* accel_;
     std::vector<uint32_t> live_;  ///< brute force: the one region's primitives

@@ -56,6 +56,15 @@ std::optional<double> entry(const Box3& b, const Ray& r) {
     return t0;
 }
 
+/// The count a cost colouring of kind `k` gives regions [lo, hi), noted in `g` for the key; 0
+/// without counts.
+uint64_t costOf(const RegionCosts* c, CostKind k, uint32_t lo, uint32_t hi, OverlayGeometry& g) {
+    if (!c || k == CostKind::None || hi > c->regions()) return 0;
+    const uint64_t v = k == CostKind::Visits ? c->visits(lo, hi) : c->tests(lo, hi);
+    g.costMax = std::max(g.costMax, v);
+    return v;
+}
+
 /// The depths the irregular frame's lines and fills are drawn at: one depth where every depth
 /// projects alike (orthographic camera frame, projective), else the structure's near and far.
 struct FrameDepths {
@@ -78,7 +87,7 @@ FrameDepths frameDepths(const IrregularSubdivision& s, const ZoneFrameView& fr) 
 }
 
 void irregularLayers(const StructureView& sv, const gl::ImageProjector& proj, int w, int h,
-                     const OverlayOptions& o, OverlayGeometry& g) {
+                     const OverlayOptions& o, const RegionCosts* costs, OverlayGeometry& g) {
     const IrregularSubdivision& s = *sv.irregular();
     const ZoneFrameView* fr = overlayFrame(sv, o.projective);
     if (!fr) return;
@@ -150,7 +159,18 @@ void irregularLayers(const StructureView& sv, const gl::ImageProjector& proj, in
         rects.push_back({lo, hi});
     }
     g.zonesDrawn = shown.size();
-    if (o.zones) {
+    const CostKind zoneCost = costKindOf(o.zoneFill);
+    if (o.zones && zoneCost != CostKind::None) {
+        // By cost: a zone's slabs' counts; a zone no ray reached is drawn apart from the map.
+        g.zoneCost = zoneCost;
+        for (size_t i = 0; i < shown.size(); ++i) {
+            const auto [lo, hi] = rects[i];
+            const glm::vec3 quad[4] = {world(lo, d.near), world({hi.x, lo.y}, d.near),
+                                       world(hi, d.near), world({lo.x, hi.y}, d.near)};
+            const auto [r0, r1] = fr->zoneRegions(shown[i], shown[i] + 1);
+            g.fills.fill(quad, gl::rgba8(costColor(double(costOf(costs, zoneCost, r0, r1, g)))));
+        }
+    } else if (o.zones) {
         std::vector<size_t> count(shown.size());
         for (size_t i = 0; i < shown.size(); ++i) {
             count[i] = o.zoneFill == ZoneFill::Prims ? fr->zonePrims(shown[i]).size()
@@ -173,8 +193,17 @@ void irregularLayers(const StructureView& sv, const gl::ImageProjector& proj, in
                 if (!o.only.keeps(slabs[k].region)) continue;
                 ++g.regionsTotal;
                 if (g.regionsDrawn >= o.cap) break;
-                g.wires.box(toF(sv.regionCorners(slabs[k].region)), gl::rgba8(levelColor(int(k))));
-                g.slabMax = std::max(g.slabMax, int(k));
+                const CostKind cost = costKindOf(o.slabColor);
+                if (cost != CostKind::None) {
+                    g.slabCost = cost;
+                    const uint32_t r = slabs[k].region;
+                    g.wires.box(toF(sv.regionCorners(r)),
+                                gl::rgba8(costColor(double(costOf(costs, cost, r, r + 1, g)))));
+                } else {
+                    g.wires.box(toF(sv.regionCorners(slabs[k].region)),
+                                gl::rgba8(levelColor(int(k))));
+                    g.slabMax = std::max(g.slabMax, int(k));
+                }
                 ++g.regionsDrawn;
             }
         }
@@ -182,7 +211,7 @@ void irregularLayers(const StructureView& sv, const gl::ImageProjector& proj, in
 }
 
 void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int w, int h,
-                   const OverlayOptions& o, OverlayGeometry& g) {
+                   const OverlayOptions& o, const RegionCosts* costs, OverlayGeometry& g) {
     const RegularGrid& grid = *sv.regular();
     if (o.leaves) {
         const size_t n = grid.leaves().size();
@@ -201,8 +230,15 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
             }
             picked.push_back(i);
         }
+        const CostKind cost = costKindOf(o.leafColor);
+        if (cost != CostKind::None) g.leafCost = cost;
         for (uint32_t i : picked) {
             const std::array<Vec3, 8> wc = sv.regionCorners(i);
+            if (cost != CostKind::None) {
+                g.wires.box(toF(wc),
+                            gl::rgba8(costColor(double(costOf(costs, cost, i, i + 1, g)))));
+                continue;
+            }
             const glm::vec3 col = o.leafColor == LeafColor::Level
                                       ? levelColor(sv.leafLevel(i))
                                       : countColor(double(grid.leaves()[i].prims));
@@ -240,7 +276,7 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
 /// The BVH's node boxes ("leaves" layer): every node whose depth lies in the level range, the
 /// visible ones first under the cap, coloured by depth or by the primitives a leaf lists.
 void bvhLayer(const StructureView& sv, const gl::ImageProjector& proj, int w, int h,
-              const OverlayOptions& o, OverlayGeometry& g) {
+              const OverlayOptions& o, const RegionCosts* costs, OverlayGeometry& g) {
     const Bvh& bvh = *sv.bvh();
     const std::vector<BvhNode>& nodes = bvh.nodes();
     std::vector<uint32_t> picked;
@@ -258,8 +294,16 @@ void bvhLayer(const StructureView& sv, const gl::ImageProjector& proj, int w, in
         }
         picked.push_back(i);
     }
+    const CostKind cost = costKindOf(o.leafColor);
+    if (cost != CostKind::None) g.leafCost = cost;
     for (uint32_t i : picked) {
         const BvhNode& n = nodes[i];
+        if (cost != CostKind::None) {
+            // A node's own count: an inner node is entered (visits) but tests nothing.
+            g.wires.box(toF(sv.regionCorners(i)),
+                        gl::rgba8(costColor(double(costOf(costs, cost, i, i + 1, g)))));
+            continue;
+        }
         const glm::vec3 col = o.leafColor == LeafColor::Level
                                   ? levelColor(n.depth)
                                   : countColor(double(n.leaf ? n.count : 0));
@@ -297,16 +341,31 @@ std::pair<double, double> clipDepths(const StructureView& sv, const Camera& view
     return {std::max(far * 1e-5, 1e-9), far};
 }
 
+const char* costKindName(CostKind k) {
+    switch (k) {
+        case CostKind::None:
+            break;
+        case CostKind::Visits:
+            return "region visits";
+        case CostKind::Tests:
+            return "prim tests";
+    }
+    return "";
+}
+
 OverlayGeometry buildOverlayGeometry(const StructureView& sv, const Camera& view, int width,
-                                     int height, const OverlayOptions& options) {
+                                     int height, const OverlayOptions& options,
+                                     const RegionCosts* costs) {
     OverlayGeometry g;
     if (width <= 0 || height <= 0) return g;
+    if (costs && costs->regions() != sv.regionCount()) costs = nullptr;  // another structure's
+    g.costsKnown = costs != nullptr;
     const gl::ImageProjector proj(view, width, height);
     if (sv.irregular() && (options.bsp || options.zones || options.slabs))
-        irregularLayers(sv, proj, width, height, options, g);
+        irregularLayers(sv, proj, width, height, options, costs, g);
     if (sv.regular() && (options.leaves || options.grid))
-        regularLayers(sv, proj, width, height, options, g);
-    if (sv.bvh() && options.leaves) bvhLayer(sv, proj, width, height, options, g);
+        regularLayers(sv, proj, width, height, options, costs, g);
+    if (sv.bvh() && options.leaves) bvhLayer(sv, proj, width, height, options, costs, g);
     // The longest lines show the structure's coarse shape: drawn first while the camera moves.
     std::vector<size_t> order(g.wires.lineCount());
     for (size_t k = 0; k < order.size(); ++k) order[k] = k;

@@ -14,13 +14,37 @@
 #include "app/viewer/region_filter.h"
 #include "engine/accel/structure_view.h"
 #include "engine/render/image.h"
+#include "engine/render/region_costs.h"
 
 namespace lancer::viewer::overlay {
 
-/// What colours a zone's fill.
-enum class ZoneFill : uint8_t { Prims, Slabs };
-/// What colours a leaf's wireframe.
-enum class LeafColor : uint8_t { Level, Prims };
+/// What colours a zone's fill: its primitives, its slabs, or the cost of the last complete
+/// image in its slabs (region visits, primitive tests; region_costs.h).
+enum class ZoneFill : uint8_t { Prims, Slabs, Visits, Tests };
+/// What colours a leaf's (or BVH node's) wireframe: its level, its primitives, or the cost of
+/// the last complete image in it.
+enum class LeafColor : uint8_t { Level, Prims, Visits, Tests };
+/// What colours a slab's wireframe: its order in depth in its zone, or the cost in it.
+enum class SlabColor : uint8_t { Order, Visits, Tests };
+/// What a layer's colouring counts: nothing of the image, its region visits or its tests.
+enum class CostKind : uint8_t { None, Visits, Tests };
+inline CostKind costKindOf(ZoneFill f) {
+    return f == ZoneFill::Visits  ? CostKind::Visits
+           : f == ZoneFill::Tests ? CostKind::Tests
+                                  : CostKind::None;
+}
+inline CostKind costKindOf(LeafColor c) {
+    return c == LeafColor::Visits  ? CostKind::Visits
+           : c == LeafColor::Tests ? CostKind::Tests
+                                   : CostKind::None;
+}
+inline CostKind costKindOf(SlabColor c) {
+    return c == SlabColor::Visits  ? CostKind::Visits
+           : c == SlabColor::Tests ? CostKind::Tests
+                                   : CostKind::None;
+}
+/// "region visits", "prim tests" (the names of the heat maps' counters).
+const char* costKindName(CostKind k);
 /// What colours the directory grid's blocks: sub-table blocks against single entries, the BSP
 /// level (an entry's leaf's, a sub-table's node's), or the depth of the table holding the entry.
 enum class GridColor : uint8_t { Kind, Level, TableDepth };
@@ -34,6 +58,9 @@ struct OverlayOptions {
     bool grid = false;    ///< regular: the directory's entries and sub-table blocks
     ZoneFill zoneFill = ZoneFill::Prims;
     LeafColor leafColor = LeafColor::Level;
+    SlabColor slabColor = SlabColor::Order;
+    /// The rays whose cost the Visits and Tests colourings count.
+    CostRays costRays = CostRays::All;
     /// Irregular: the projective zones (when primary rays walk them), else the camera frame.
     bool projective = true;
     GridColor gridColor = GridColor::Kind;
@@ -47,6 +74,12 @@ struct OverlayOptions {
     bool operator==(const OverlayOptions&) const = default;
     /// Any layer on.
     bool any() const { return bsp || zones || slabs || leaves || grid; }
+    /// A layer on is coloured by the image's cost on the structure (it needs the counts).
+    bool usesCosts() const {
+        return (zones && costKindOf(zoneFill) != CostKind::None) ||
+               (slabs && costKindOf(slabColor) != CostKind::None) ||
+               (leaves && costKindOf(leafColor) != CostKind::None);
+    }
 };
 
 /// The batches of one structure, camera, image size and options.
@@ -71,6 +104,11 @@ struct OverlayGeometry {
     int levelLo = 1 << 30, levelHi = -1;
     size_t countMax = 0;
     int slabMax = -1;
+    /// The cost colourings drawn (each layer's; None: none), and whether their counts were
+    /// there (else every region is drawn in kNoCostColor, the key saying so).
+    CostKind leafCost = CostKind::None, zoneCost = CostKind::None, slabCost = CostKind::None;
+    bool costsKnown = false;
+    uint64_t costMax = 0;  ///< the largest count drawn
     /// Record that level `l` was drawn in its level colour.
     void noteLevel(int l) {
         levelLo = std::min(levelLo, l);
@@ -78,9 +116,12 @@ struct OverlayGeometry {
     }
 };
 
-/// Build the layers `options` asks for, for a width x height image seen by `view`.
+/// Build the layers `options` asks for, for a width x height image seen by `view`. `costs`:
+/// the last complete image's counts on this structure (options.costRays'), null when there
+/// are none (yet): a cost colouring then draws its regions in kNoCostColor.
 OverlayGeometry buildOverlayGeometry(const StructureView& sv, const Camera& view, int width,
-                                     int height, const OverlayOptions& options);
+                                     int height, const OverlayOptions& options,
+                                     const RegionCosts* costs = nullptr);
 
 /// Near and far depths that keep the whole structure inside the clip volume of `view`.
 std::pair<double, double> clipDepths(const StructureView& sv, const Camera& view);

@@ -76,13 +76,19 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
         }
     }
     if (!view_) return;
+    // The counts a cost colouring reads: the last complete image's, on this structure.
+    std::shared_ptr<const ImageCosts> costs;
+    if (options.usesCosts() && costsFit(costs_.get(), structure_.get(), options.costRays))
+        costs = costs_;
     const bool stale = !built_ || builtOptions_ != options || builtWidth_ != width ||
-                       builtHeight_ != height ||
+                       builtHeight_ != height || costs != builtCosts_ ||
                        (geometry_.cameraDependent && !sameCamera(builtCamera_, view));
     if (!stale) return;
     const auto t0 = std::chrono::steady_clock::now();
-    geometry_ = options.any() ? buildOverlayGeometry(*view_, view, width, height, options)
+    geometry_ = options.any() ? buildOverlayGeometry(*view_, view, width, height, options,
+                                                     costs ? &costs->costs : nullptr)
                               : OverlayGeometry{};
+    builtCosts_ = costs;
     cuts_->upload(geometry_.cuts);
     fills_->upload(geometry_.fills);
     wires_->upload(geometry_.wires);
@@ -216,8 +222,34 @@ void Overlays::tooltip(const Camera& view, int width, int height, double x, doub
     }
     ImGui::Text("%s %u: %zu primitives", regionKindName(r.kind), r.id, r.prims.size());
     if (r.level >= 0) ImGui::Text("level %d", r.level);
+    if (builtCosts_ && r.id < builtCosts_->costs.regions())
+        ImGui::Text("%llu visits, %llu tests (%s)",
+                    static_cast<unsigned long long>(builtCosts_->costs.visits(r.id)),
+                    static_cast<unsigned long long>(builtCosts_->costs.tests(r.id)),
+                    costRaysName(builtCosts_->costs.rays));
     ImGui::TextDisabled("Ctrl+click selects");
     ImGui::EndTooltip();
+}
+
+void Overlays::leafColorCombo(const char* label) {
+    int color = int(options.leafColor);
+    const char* by[] = {"level", "primitives", "region visits", "prim tests"};
+    if (ImGui::Combo(label, &color, by, 4)) options.leafColor = LeafColor(color);
+}
+
+void Overlays::costLine() {
+    OverlayOptions& o = options;
+    if (!o.usesCosts()) return;
+    int rays = int(o.costRays);
+    const char* which[] = {"all rays", "primary rays"};
+    if (ImGui::Combo("cost of", &rays, which, 2)) o.costRays = CostRays(rays);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("The rays of the last complete image whose visits and tests count");
+    if (builtCosts_)
+        ImGui::TextDisabled("counts of the last complete image (%d x %d, %.0f ms to count)",
+                            builtCosts_->costs.width, builtCosts_->costs.height, builtCosts_->ms);
+    else
+        ImGui::TextDisabled("counting once the image is complete...");
 }
 
 void Overlays::panel(bool* open) {
@@ -254,11 +286,14 @@ void Overlays::panel(bool* open) {
         }
         if (o.zones) {
             int fill = int(o.zoneFill);
-            ImGui::RadioButton("fill by primitives", &fill, int(ZoneFill::Prims));
-            ImGui::SameLine();
-            ImGui::RadioButton("by slabs", &fill, int(ZoneFill::Slabs));
-            o.zoneFill = ZoneFill(fill);
+            const char* fills[] = {"primitives", "slabs", "region visits", "prim tests"};
+            if (ImGui::Combo("zones by", &fill, fills, 4)) o.zoneFill = ZoneFill(fill);
             ImGui::SliderFloat("fill opacity", &look.fillOpacity, 0.0f, 1.0f);
+        }
+        if (o.slabs) {
+            int sc = int(o.slabColor);
+            const char* by[] = {"order in depth", "region visits", "prim tests"};
+            if (ImGui::Combo("slabs by", &sc, by, 3)) o.slabColor = SlabColor(sc);
         }
         if (o.zones || o.slabs)
             ImGui::Text("zones drawn: %zu of %zu", geometry_.zonesDrawn, geometry_.zonesTotal);
@@ -266,11 +301,7 @@ void Overlays::panel(bool* open) {
         ImGui::Checkbox("leaves", &o.leaves);
         ImGui::SameLine();
         ImGui::Checkbox("directory grid", &o.grid);
-        int color = int(o.leafColor);
-        ImGui::RadioButton("colour by level", &color, int(LeafColor::Level));
-        ImGui::SameLine();
-        ImGui::RadioButton("by primitives", &color, int(LeafColor::Prims));
-        o.leafColor = LeafColor(color);
+        leafColorCombo("leaves by");
         const auto& extra = view_->accelerator().info().extra;
         const int top = std::max(1, extra.value("effective_max_level", 1));
         ImGui::DragIntRange2("levels", &o.levelMin, &o.levelMax, 0.1f, 0, top, "from %d", "to %d");
@@ -288,9 +319,13 @@ void Overlays::panel(bool* open) {
             o.gridColor = GridColor(gc);
         }
         ImGui::TextDisabled("levels: BSP levels (a grid entry's leaf's)");
+    } else if (view_->bvh()) {
+        ImGui::Checkbox("nodes", &o.leaves);
+        leafColorCombo("nodes by");
     } else {
         ImGui::TextDisabled("brute force has no subdivision to draw");
     }
+    costLine();
     ImGui::SliderFloat("line opacity", &look.lineOpacity, 0.0f, 1.0f);
     int moving = int(std::min<size_t>(look.movingLines, 10000000));
     // Short labels: the columns are 250 units wide at least, the hover says the rest.
@@ -416,11 +451,12 @@ void Overlays::selectionPanel(bool* open) {
         else {
             const bool played =
                 evalRegion_ == int64_t(r.id) && evalPool_ == r.pool && !evalNodes_.empty();
-            if (played)
+            if (played) {
                 ImGui::PushStyleColor(ImGuiCol_Text,
                                       ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
-            ImGui::TextWrapped("the played ray's evaluation: nodes reached lit, with spans");
-            ImGui::PopStyleColor();
+                ImGui::TextWrapped("the played ray's evaluation: nodes reached lit, with spans");
+                ImGui::PopStyleColor();
+            }
             csgTreeNode(*r.pool, r.root, scene, played ? &evalNodes_ : nullptr);
         }
     }
@@ -470,16 +506,22 @@ std::vector<std::string> applyShowList(const std::string& list, OverlayOptions& 
             out.leaves = true;
         else if (item == "grid")
             out.grid = true;
-        else if (item == "none")
+        else if (item == "visits" || item == "tests") {
+            // The layers that colour regions, by the last complete image's cost in them.
+            const bool v = item == "visits";
+            out.leafColor = v ? LeafColor::Visits : LeafColor::Tests;
+            out.zoneFill = v ? ZoneFill::Visits : ZoneFill::Tests;
+            out.slabColor = v ? SlabColor::Visits : SlabColor::Tests;
+        } else if (item == "none")
             continue;
         else if (item == "boxes" || item == "frustum" || item == "inspector" || item == "ray" ||
-                 item == "visited" || item == "worst")
+                 item == "visited" || item == "worst" || item == "tree")
             notDrawn.push_back(item);
         else
             throw std::invalid_argument(
                 "unknown item '" + item +
-                "' (expected bsp, zones, slabs, leaves, grid, boxes, frustum, inspector, ray, "
-                "visited, worst, none)");
+                "' (expected bsp, zones, slabs, leaves, grid, visits, tests, boxes, frustum, "
+                "inspector, ray, visited, worst, tree, none)");
     }
     o = out;
     return notDrawn;

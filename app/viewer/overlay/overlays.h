@@ -10,6 +10,7 @@
 #include <string>
 
 #include "app/viewer/gl/batch.h"
+#include "app/viewer/image_costs.h"
 #include "app/viewer/overlay/overlay_geometry.h"
 #include "app/viewer/structure_builder.h"
 #include "engine/render/ray_csg.h"
@@ -57,6 +58,12 @@ class Overlays {
         drawLayers(view, width, height);
         drawSelection(view, width, height);
     }
+    /// The last complete image's counts (null: none yet). A cost colouring uses them when they
+    /// are of the structure on screen and of options.costRays; the batches are rebuilt when
+    /// they change.
+    void setCosts(std::shared_ptr<const ImageCosts> costs) { costs_ = std::move(costs); }
+    /// The counts the batches were last built with (null: none).
+    const ImageCosts* builtCosts() const { return builtCosts_.get(); }
     /// The layers alone (cut lines, fills, wireframes), blended into the current framebuffer.
     void drawLayers(const Camera& view, int width, int height) {
         drawLayers(view, width, height, SIZE_MAX);
@@ -113,6 +120,8 @@ class Overlays {
     void clearSelection() { selection_.reset(); }
     /// The description of the structure on screen (null before the first).
     const StructureView* view() const { return view_.get(); }
+    /// The structure it describes (null before the first).
+    const SceneBuild* structure() const { return structure_.get(); }
     /// The cached geometry (what the last update built).
     const OverlayGeometry& geometry() const { return geometry_; }
     /// Times the batches were rebuilt (tests: a change rebuilds, nothing else does).
@@ -121,13 +130,20 @@ class Overlays {
     double lastBuildMs() const { return lastBuildMs_; }
 
   private:
+    /// The Overlays panel's colour choice of leaves or BVH nodes, and its cost line (which
+    /// rays, whether the counts are there).
+    void leafColorCombo(const char* label);
+    void costLine();
+
     std::shared_ptr<const SceneBuild> structure_;
     std::unique_ptr<StructureView> view_;
     std::unique_ptr<gl::BatchRenderer> renderer_;
     std::unique_ptr<gl::GpuBatch> cuts_, fills_, wires_, wiresLongestFirst_;
     OverlayGeometry geometry_;
+    std::shared_ptr<const ImageCosts> costs_;
     // What the batches were built for.
     OverlayOptions builtOptions_;
+    std::shared_ptr<const ImageCosts> builtCosts_;  ///< the counts used (null: none)
     Camera builtCamera_;
     int builtWidth_ = 0, builtHeight_ = 0;
     bool built_ = false;

@@ -40,6 +40,26 @@ Key countKey(const std::string& title) {
     return k;
 }
 
+/// The fixed log scale of costs on the structure, by decade, and 0 (no ray) apart.
+Key costKey(const std::string& what, overlay::CostKind kind, CostRays rays, bool known) {
+    Key k;
+    k.title.append(what)
+        .append(" by ")
+        .append(overlay::costKindName(kind))
+        .append(", ")
+        .append(costRaysName(rays))
+        .append(known ? " (log)" : " (counting...)");
+    k.swatches.push_back({{}, costColor(0.0), "0"});
+    double decade = 1.0;
+    for (int d = 0; d <= kCostDecades; ++d, decade *= 10.0) {
+        std::string label = decade >= 1e6   ? number(decade / 1e6) + "M"
+                            : decade >= 1e3 ? number(decade / 1e3) + "k"
+                                            : number(decade);
+        k.swatches.push_back({{}, costColor(decade), label + (d == kCostDecades ? "+" : "")});
+    }
+    return k;
+}
+
 Key heatKey(const KeyInput& in) {
     const float s = in.heatScale > 0.0f ? in.heatScale : 1.0f;
     const char* unit = in.mode == ViewMode::TimeUs ? " us" : "";
@@ -85,12 +105,18 @@ std::vector<Key> keysFor(const KeyInput& in) {
         const overlay::OverlayGeometry& g = *in.geometry;
         const bool levels = g.levelLo <= g.levelHi;
         if (o.bsp && levels) keys.push_back(levelKey("BSP cut depth", g.levelLo, g.levelHi));
-        if (o.zones)
+        if (o.zones && g.zoneCost != overlay::CostKind::None)
+            keys.push_back(costKey("zones", g.zoneCost, o.costRays, g.costsKnown));
+        else if (o.zones)
             keys.push_back(countKey(o.zoneFill == overlay::ZoneFill::Prims ? "primitives per zone"
                                                                            : "slabs per zone"));
-        if (o.slabs && g.slabMax >= 0)
+        if (o.slabs && g.slabCost != overlay::CostKind::None)
+            keys.push_back(costKey("slabs", g.slabCost, o.costRays, g.costsKnown));
+        else if (o.slabs && g.slabMax >= 0)
             keys.push_back(levelKey("slab order in depth (0 nearest)", 0, g.slabMax));
-        if (o.leaves) {
+        if (o.leaves && g.leafCost != overlay::CostKind::None) {
+            keys.push_back(costKey("leaves", g.leafCost, o.costRays, g.costsKnown));
+        } else if (o.leaves) {
             if (o.leafColor == overlay::LeafColor::Prims)
                 keys.push_back(countKey("primitives per leaf"));
             else if (levels)

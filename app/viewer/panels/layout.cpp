@@ -25,14 +25,15 @@ constexpr float kMinViewWidth = 400.0f;
 /// these typical heights, not with what the contents ask for frame by frame, so a panel moves
 /// only when a panel opens, closes or folds, never as a table grows.
 enum class Side : uint8_t { Left, Right, Roomier };
-constexpr Side kSide[kPanelCount] = {Side::Left,    Side::Right,   Side::Right,   Side::Roomier,
-                                     Side::Roomier, Side::Roomier, Side::Roomier, Side::Roomier};
+constexpr Side kSide[kPanelCount] = {Side::Left,    Side::Right,   Side::Right,
+                                     Side::Roomier, Side::Roomier, Side::Roomier,
+                                     Side::Roomier, Side::Roomier, Side::Roomier};
 /// With the inspector shown, the second column stands right of the inspector's view and holds
 /// the panels about what the inspector shows: its own, the selection's, the ray's.
-constexpr Side kSideBesideInspector[kPanelCount] = {Side::Left,  Side::Left, Side::Left,
-                                                    Side::Left,  Side::Left, Side::Right,
-                                                    Side::Right, Side::Right};
-constexpr float kTypical[kPanelCount] = {640, 110, 300, 180, 240, 320, 420, 400};
+constexpr Side kSideBesideInspector[kPanelCount] = {Side::Left,  Side::Left,  Side::Left,
+                                                    Side::Left,  Side::Left,  Side::Right,
+                                                    Side::Right, Side::Right, Side::Right};
+constexpr float kTypical[kPanelCount] = {640, 110, 300, 180, 240, 320, 420, 420, 400};
 
 /// The panels a column cuts last: the Ray panel's step list and the Selection panel's lists
 /// are what a user reads while the others are set once.
@@ -153,8 +154,9 @@ void stack(const std::vector<PanelId>& ids, const Rect& col, const LayoutInput& 
 }  // namespace
 
 const char* panelTitle(PanelId id) {
-    static const char* titles[kPanelCount] = {"Parameters", "View",      "Statistics", "Camera",
-                                              "Overlays",   "Inspector", "Selection",  "Ray"};
+    static const char* titles[kPanelCount] = {"Parameters", "View",           "Statistics",
+                                              "Camera",     "Overlays",       "Inspector",
+                                              "Selection",  "Structure tree", "Ray"};
     return titles[size_t(id)];
 }
 

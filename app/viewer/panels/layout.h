@@ -19,9 +19,10 @@ enum class PanelId : uint8_t {
     Overlays,
     Inspector,
     Selection,
+    Tree,
     Ray,
 };
-inline constexpr int kPanelCount = 8;
+inline constexpr int kPanelCount = 9;
 /// Its window's title (ImGui's name for it).
 const char* panelTitle(PanelId id);
 

@@ -12,16 +12,17 @@
 namespace lancer::viewer {
 namespace {
 
-/// Every panel open, asking for the heights their contents take (the first four as measured at
-/// 900 x 720 on builtin:default, and typical ones for the others; the Ray panel asks for all it
-/// can get).
+/// Every panel open but the structure tree (opened on demand), asking for the heights their
+/// contents take (the first four as measured at 900 x 720 on builtin:default, and typical ones
+/// for the others; the Ray panel asks for all it can get).
 LayoutInput everyPanel(float w, float h, bool inspector) {
     LayoutInput in;
     in.width = w;
     in.height = h;
     in.inspector = inspector;
-    const float wants[kPanelCount] = {639, 121, 272, 189, 240, 330, 450, 1.0e6f};
+    const float wants[kPanelCount] = {639, 121, 272, 189, 240, 330, 450, 420, 1.0e6f};
     for (int i = 0; i < kPanelCount; ++i) in.panels[size_t(i)] = {true, false, wants[i]};
+    in[PanelId::Tree].open = false;
     return in;
 }
 
@@ -95,6 +96,19 @@ TEST(PanelLayout, PanelsThatFitGetTheirHeightAndTheRayPanelTakesWhatIsLeft) {
     EXPECT_GT(f[PanelId::Ray].height(), 600.0f);
     for (PanelId id : {PanelId::Parameters, PanelId::View, PanelId::Statistics})
         EXPECT_EQ(f[id].height(), folded.titleHeight) << panelTitle(id);
+}
+
+TEST(PanelLayout, TheStructureTreeOpenKeepsEveryPanelApart) {
+    for (const auto& [w, h] : {std::pair{1280.0f, 720.0f}, std::pair{1920.0f, 1080.0f}})
+        for (bool inspector : {false, true}) {
+            SCOPED_TRACE(testing::Message() << w << " x " << h << (inspector ? ", inspector" : ""));
+            LayoutInput in = everyPanel(w, h, inspector);
+            in[PanelId::Tree].open = true;
+            const PanelLayout l = layoutPanels(in);
+            expectApart(in, l);
+            EXPECT_GE(l[PanelId::Tree].height(), in.titleHeight);
+            EXPECT_GE(l[PanelId::Ray].height(), kUsablePanelHeight);
+        }
 }
 
 TEST(PanelLayout, HiddenPanelsLeaveTheWindowToTheImageAndTheInspectorItsRightHalf) {
@@ -262,6 +276,7 @@ TEST(PanelLayout, ASmallWindowKeepsEveryPanelInside) {
         const PanelLayout l = layoutPanels(in);
         EXPECT_FALSE(l.twoColumns);
         for (int i = 0; i < kPanelCount; ++i) {
+            if (!in.panels[size_t(i)].open) continue;
             const Rect& r = l.panels[size_t(i)];
             EXPECT_GE(r.x0, 0.0f);
             EXPECT_LE(r.x1, w);

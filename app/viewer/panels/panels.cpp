@@ -31,6 +31,8 @@ auto openFlag(Settings& s, PanelId id) -> decltype((s.showRay)) {
             return s.showInspector;
         case PanelId::Selection:
             return s.showSelection;
+        case PanelId::Tree:
+            return s.showTree;
         case PanelId::Ray:
             break;
     }
@@ -129,6 +131,7 @@ void menuBar(ViewerState& st) {
         ImGui::MenuItem("View", nullptr, &s.showView);
         ImGui::MenuItem("Overlays", nullptr, &s.showOverlays);
         ImGui::MenuItem("Selection", nullptr, &s.showSelection);
+        ImGui::MenuItem("Structure tree", nullptr, &s.showTree);
         ImGui::MenuItem("Ray", nullptr, &s.showRay);
         ImGui::MenuItem("3D inspector", "I", &s.showInspector);
         ImGui::Separator();
@@ -204,6 +207,9 @@ void drawPanels(ViewerState& st, const PanelLayout& layout, PanelHeights& height
                 break;
             case PanelId::Selection:
                 if (more.selection) more.selection(&open);
+                break;
+            case PanelId::Tree:
+                if (more.tree) more.tree(&open);
                 break;
             case PanelId::Ray:
                 if (more.ray) more.ray(&open);

@@ -15,9 +15,10 @@ namespace lancer::viewer {
 using PanelHeights = std::array<PanelRequest, kPanelCount>;
 
 /// The panels of the viewer's other rooms, each drawing its own window (Begin to End) when
-/// called with its open flag: the overlays', the selection's, the inspector's, the ray's.
+/// called with its open flag: the overlays', the selection's, the inspector's, the structure
+/// tree's, the ray's.
 struct PanelContents {
-    std::function<void(bool*)> overlays, selection, inspector, ray;
+    std::function<void(bool*)> overlays, selection, inspector, tree, ray;
 };
 
 /// What the layout is given for a width x height window: the panels `s` shows, at `heights`.

@@ -107,6 +107,35 @@ class Directory {
         if (!tables_.empty()) visitTable(0, 0, 0, 0, 0, f);
     }
     size_t entryCount() const { return entries_.size(); }
+    /// Entries of table `t` (a block of 2^bits cells per axis of the table's own level).
+    size_t tableSize(uint32_t t) const {
+        const Table& T = tables_[t];
+        return size_t(T.mask[0] + 1) * (T.mask[1] + 1) * (T.mask[2] + 1);
+    }
+    /// Entry `i` of table `t` (forEachEntry's order inside the table) whose block starts at
+    /// finest cell `origin`: its block [lo, hi) of finest cells, whether it names a sub-table,
+    /// and the leaf or sub-table it names.
+    void tableEntry(uint32_t t, const uint32_t origin[3], size_t i, uint32_t lo[3], uint32_t hi[3],
+                    bool& subTable, uint32_t& value) const {
+        const Table& T = tables_[t];
+        const uint32_t idx[3] = {uint32_t(i >> T.lowBits), uint32_t(i >> T.bits[2]) & T.mask[1],
+                                 uint32_t(i) & T.mask[2]};
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = origin[k] + (idx[k] << T.shift[k]);
+            hi[k] = lo[k] + (1u << T.shift[k]);
+        }
+        const uint32_t e = entries_[T.offset + i];
+        subTable = (e & kSubTable) != 0;
+        value = subTable ? e & ~kSubTable : e;
+    }
+    /// The entry of table `t` (block at `origin`) holding finest cell `cell`.
+    size_t tableEntryAt(uint32_t t, const uint32_t origin[3], const uint32_t cell[3]) const {
+        const Table& T = tables_[t];
+        const uint32_t a = (cell[0] - origin[0]) >> T.shift[0],
+                       b = (cell[1] - origin[1]) >> T.shift[1],
+                       c = (cell[2] - origin[2]) >> T.shift[2];
+        return (size_t(a) << T.lowBits) + (size_t(b) << T.bits[2]) + c;
+    }
 
   private:
     /// Tag of an entry that names a sub-table rather than a leaf.
