@@ -62,7 +62,7 @@ std::vector<std::string> schemeNames();
 enum class StepMethod : uint8_t { Exact, Push };
 enum class BspHeuristic : uint8_t { First, Balanced, FewestCuts };
 /// Regular scheme: the axis each level of the BSP cuts. Cycle: x, y, z in turn (the report's);
-/// cost: per level, the axis of least estimated cost (regular_grid.cpp, planSchedule).
+/// cost: per level, the axis of least estimated cost (axis_planner.cpp, planSchedule).
 enum class SplitAxes : uint8_t { Cycle, Cost };
 /// Irregular scheme: primary rays walk the camera-frame structure, or the projective zones.
 enum class IrregularFrame : uint8_t { Camera, Projective };

@@ -9,12 +9,15 @@
 //    the exit face's range. No epsilon: no skipped cell, no stall. Across a face that one leaf
 //    covers, the leaf's rope names it and the directory is not consulted.
 // In each leaf, the tree is evaluated only when a primitive boundary lies in the leaf's interval.
+//
+// Its files: regular_grid.cpp builds the grid step by step; regular_builder.h the BSP (with
+// axis_planner.h, the axes of --split-axes cost, and set_pool.h, the leaves' primitive sets);
+// directory.h the directory; grid_frame.h a turned scene's frame; sphere_quads.cpp the quads;
+// regular_walk.h the walk.
 #pragma once
 
+#include <cmath>
 #include <nlohmann/json.hpp>
-#if defined(__SSE2__)
-#include <xmmintrin.h>
-#endif
 
 #include "engine/accel/build_params.h"
 #include "engine/accel/eval.h"
@@ -173,10 +176,46 @@ class RegularGrid {
     }
 
   private:
+    // The walk's steps (regular_walk.h).
+    struct WalkExit;
+    struct WalkStep;
     /// intersect() for one step method.
     template <bool kExact, class Obs>
     bool walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
               Hit& hit) const;
+    /// The leaf holding the walk's first point, at `tStart` on `fr` (the ray in the grid's frame).
+    template <class Obs>
+    uint32_t startLeaf(const Ray& fr, double tStart, Obs& obs) const;
+    /// Where the stretches told to an active observer start: where the ray enters the grid's
+    /// own box, at or after `tStart`.
+    template <class Obs>
+    double shownStart(const Ray& fr, double tStart) const;
+    /// A walk error counted and told: false, the walk's end without a hit.
+    template <class Obs>
+    static bool walkError(TraceContext& ctx, Obs& obs, const char* what);
+    /// The leaf across the exit face by --step exact, into `s` (`up`: the ray goes up the exit
+    /// axis, `rope`: the rope across the face): the rope's leaf when one leaf covers the face,
+    /// else the directory's; `s.last` at the grid's border.
+    template <class Obs>
+    void stepExact(const RegularLeaf& L, const Ray& fr, const WalkExit& exit, bool up,
+                   uint32_t rope, WalkStep& s) const;
+    /// The leaf across the exit by --step push, into `s` (`up`: the ray goes up each axis): the
+    /// exit point pushed by delta and located; `s.last` when it left the grid, `s.stalled` when
+    /// it is still in the leaf.
+    template <class Obs>
+    void stepPush(const RegularLeaf& L, const Ray& fr, const WalkExit& exit, const bool up[3],
+                  WalkStep& s) const;
+    /// The nearest hit in leaf `L` over [t0, t1] (`primList`: primList()'s data), by the leaf
+    /// test the scene and the observer call for.
+    template <class Obs>
+    bool hitInRegion(const RegularLeaf& L, const uint32_t* primList, bool quads, QuadRay& qr,
+                     const Ray& ray, double tmin, double tIn, double t0, double t1,
+                     TraceContext& ctx, Obs& obs, Hit& hit) const;
+    /// How the walk left `leaf` (`exits`: by a face before the ray's end; `rope`: the rope
+    /// across the exit face), told to an active observer after the leaf's own events.
+    template <class Obs>
+    void tellExit(uint32_t leaf, bool exits, const WalkExit& exit, uint32_t rope, const WalkStep& s,
+                  const Ray& ray, Obs& obs) const;
     /// hitInUnionLeaf for leaf `L` of a union-only scene with sphere quads, the same hit: the
     /// leaf's spheres are first looked at in floats four at a time (quadMisses), and only those
     /// the floats cannot reject go through the mailboxes and the exact test. A rejected sphere
@@ -187,8 +226,28 @@ class RegularGrid {
     template <class Obs>
     bool hitInSphereLeaf(const RegularLeaf& L, QuadRay& qr, const Ray& ray, double tmin, double tIn,
                          double t0, double t1, TraceContext& ctx, Obs& obs, Hit& hit) const;
-    /// Fill quads_ from primList_ (union-only scenes with packed spheres).
+
+    // The constructor's steps, in its order (regular_grid.cpp).
+    /// The frame the grid is built in, a turned subtree's where its boxes are much smaller, its
+    /// figures into `stats`: the scene's bounds in that frame.
+    Box3 chooseFrame(const RegularConfig& params, nlohmann::json& stats);
+    /// The grid's box from `bounds`, widened where they are flat, its clip box and push distance.
+    void setBox(const Box3& bounds, double delta);
+    /// The directory's resolution, 2^n cells per axis at the `finest` level, and its planes.
+    void setResolution(int finest);
+    /// The directory of `bsp`, refused over the memory budget: the full table's estimated bytes.
+    size_t buildDirectory(const BspNodes& bsp, int finest, bool full, int maxLevel,
+                          BuildGuard& guard);
+    /// Each leaf's ropes, from the directory.
+    void makeRopes(BuildGuard& guard);
+    /// Fill quads_ from primList_ (union-only scenes with packed spheres; sphere_quads.cpp).
     void makeSphereQuads();
+    /// Plane `i` of the grid cut `cuts` times on `axis` (i in 0..2^cuts); at the finest level the
+    /// same as plane(), since i / 2^c == (i 2^(n-c)) / 2^n exactly in floating point.
+    double planeAt(int axis, uint32_t i, int cuts) const {
+        return i == (1u << cuts) ? box_.hi[axis]
+                                 : box_.lo[axis] + ext_[axis] * std::ldexp(double(i), -cuts);
+    }
 
     const Scene* scene_;
     bool exact_ = true;       ///< --step exact (else push)
@@ -215,289 +274,6 @@ class RegularGrid {
     friend struct RegularBuilder;
 };
 
-template <class Obs>
-bool RegularGrid::intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
-                            Hit& hit) const {
-    return exact_ ? walk<true>(ray, tmin, tmax, ctx, obs, hit)
-                  : walk<false>(ray, tmin, tmax, ctx, obs, hit);
-}
-
-template <bool kExact, class Obs>
-bool RegularGrid::walk(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
-                       Hit& hit) const {
-    // The cells are walked with the ray in the grid's frame (`fr`, the same t for the same
-    // point), the primitives tested with the world ray; points told are the world's.
-    Ray mapped;
-    if (frame_.turned) mapped = frame_.toFrame(ray);
-    const Ray& fr = frame_.turned ? mapped : ray;
-    double tA, tB;
-    if (!clipLine(fr, clipBox_, tA, tB)) return false;
-    const double tStart = std::max(tmin, tA), tEnd = std::min(tmax, tB);
-    if (!(tStart <= tEnd)) return false;
-    Vec3 p = std::isfinite(tStart) ? fr.at(tStart) : fr.o;
-    uint32_t leaf = dir_.lookup(locate(0, p.x), locate(1, p.y), locate(2, p.z));
-    if constexpr (Obs::kActive) {
-        const uint32_t cell[3] = {locate(0, p.x), locate(1, p.y), locate(2, p.z)};
-        obs.lookup(frame_.toWorld(p), cell, leaf);
-    }
-    // Per ray, held locally (the loop's stores to mailboxes and counters could otherwise alias
-    // the ray and the arrays, and each step would reload them): the origin, 1/d, so each exit
-    // plane costs a product, not a division, and the side a cell is left by on each axis. An axis
-    // the ray runs parallel to is never an exit: its plane gets a factor 0 and a bias of +inf;
-    // on the others the bias is 0, which leaves the product bit for bit unchanged.
-    const double o[3] = {fr.o.x, fr.o.y, fr.o.z};
-    const bool up[3] = {fr.d.x > 0.0, fr.d.y > 0.0, fr.d.z > 0.0};
-    double inv[3], bias[3];
-    uint32_t
-        side[3];  // where a leaf's exit plane on each axis is in RegularLeaf::plane: lo a, hi 3 + a
-    uint32_t rope[3];  // the rope across that plane
-    for (int a = 0; a < 3; ++a) {
-        const bool parallel = fr.d[a] == 0.0;
-        inv[a] = parallel ? 0.0 : 1.0 / fr.d[a];
-        bias[a] = parallel ? kInf : 0.0;
-        side[a] = up[a] ? 3 + a : a;
-        rope[a] = 2 * a + up[a];
-    }
-    const RegularLeaf* const leaves = leaves_.data();
-    const uint32_t* const primList = primList_.data();
-    const bool quads = !quads_.empty();
-    QuadRay qr = quads ? quadRay(ray) : QuadRay{};
-    // The first region is evaluated from tmin and the last one up to tmax: every primitive lies
-    // inside the grid, so this only admits hits that rounding puts a hair outside the box.
-    double t0 = tmin, tIn = tStart;
-    // The stretches told start where the ray enters the grid's own box: the clip of the grown
-    // box comes a hair before it, and a grazing ray runs outside the box for that hair.
-    [[maybe_unused]] double tShown = tStart;
-    if constexpr (Obs::kActive) {
-        double a, b;
-        if (clipLine(fr, box_, a, b)) tShown = std::max(tStart, a);
-    }
-    ctx.pending.clear();
-    const size_t maxSteps = maxSteps_;
-    for (size_t step = 0;; ++step) {
-        if (step > maxSteps) {
-            ++ctx.counters.walkErrors;
-            obs.walkError("regular: step bound exceeded");
-            return false;
-        }
-        const RegularLeaf& L = leaves[leaf];
-        // Exit: the nearest of the cell's exit planes; ties are edges and corners.
-        const double* const P = L.plane;
-        double tAxis[3];
-        double tExit = kInf;
-        int exitAxis = 0;
-        for (int a = 0; a < 3; ++a) {
-            tAxis[a] = (P[side[a]] - o[a]) * inv[a] + bias[a];
-            if (tAxis[a] < tExit) tExit = tAxis[a], exitAxis = a;
-        }
-        bool last = !(tExit < tEnd);
-        bool stalled = false;
-        uint32_t next[3];
-        uint32_t nextLeaf = leaf;
-        // How the walk leaves the leaf, told to an active observer after the leaf's own events.
-        [[maybe_unused]] const bool leaves = !last;
-        [[maybe_unused]] int how = 0;    // 1 rope, 2 index step + lookup, 3 push + lookup
-        [[maybe_unused]] Vec3 pushed{};  // set before use; initialised for -Wmaybe-uninitialized
-        if (!last) {
-            if constexpr (kExact) {
-                // The exit face lies on grid plane L.hi or L.lo of exitAxis: the next index there
-                // is exact; the other indices are the exit point's, kept on the face. When one
-                // leaf covers the whole face, the leaf's rope names it and no lookup is needed.
-                const int a = exitAxis;
-                const uint32_t across = L.rope[rope[a]];
-                if (across == kBorder) {
-                    last = true;
-                } else if (across != kSplitFace) {
-                    nextLeaf = across;
-                    if constexpr (Obs::kActive) how = 1;
-                } else {
-                    const Vec3 q = fr.at(tExit);
-                    next[a] = up[a] ? L.hi[a] : L.lo[a] - 1;
-                    for (int b = 0; b < 3; ++b)
-                        if (b != a) next[b] = std::clamp(locate(b, q[b]), L.lo[b], L.hi[b] - 1);
-                    nextLeaf = dir_.lookup(next[0], next[1], next[2]);
-                    if constexpr (Obs::kActive) how = 2;
-                }
-            } else {
-                // The report's method: the exit point, taken on the cell's box (rounding can put
-                // ray.at(tExit) a hair outside it), is pushed by delta across every face it
-                // leaves through, then located. Off the pushed axes it stays in the cell's range,
-                // so the walk cannot bounce back into the previous cell.
-                const Vec3 q = fr.at(tExit);
-                for (int a = 0; a < 3; ++a) {
-                    double x = std::clamp(q[a], P[a], P[3 + a]);
-                    if (tAxis[a] == tExit) {
-                        x += up[a] ? delta_ : -delta_;
-                        if (x < box_.lo[a] || x > box_.hi[a]) last = true;  // left the grid
-                        next[a] = locate(a, x);
-                    } else {
-                        next[a] = std::clamp(locate(a, x), L.lo[a], L.hi[a] - 1);
-                    }
-                    if constexpr (Obs::kActive) pushed[a] = x;
-                }
-                if (!last) {
-                    nextLeaf = dir_.lookup(next[0], next[1], next[2]);
-                    stalled = nextLeaf == leaf;
-                    if constexpr (Obs::kActive) how = 3;
-                }
-            }
-        }
-        const double t1 = last ? tmax : std::max(tExit, tIn);
-        ++ctx.counters.regionVisits;
-        if (!last) __builtin_prefetch(leaves_.data() + nextLeaf);
-        // The stretch told ends where the ray leaves the leaf: at the clip of the grown box only
-        // when that comes first. A ray leaving the grid through an edge or a corner may cross
-        // the tied interior face as it leaves, so past the leaf's exit it is outside the leaf.
-        if constexpr (Obs::kActive) {
-            const double shownEnd = last ? std::min(tEnd, std::max(tExit, tIn)) : t1;
-            obs.region(leaf, std::min(std::max(tIn, tShown), shownEnd), shownEnd);
-        }
-        // A union-only scene's leaf: its hit straight from its primitives' spans, through the
-        // sphere quads when the grid has them, for every observer (what an observer sees is the
-        // walk made: the same tests and mailbox hits); without quads, an active observer is
-        // shown the tree's evaluation (hitInLeaf), with the same counts as hitInUnionLeaf.
-        bool found;
-        if (quads) {
-            found = L.prims != 0 && hitInSphereLeaf(L, qr, ray, tmin, tIn, t0, t1, ctx, obs, hit);
-        } else if constexpr (!Obs::kActive) {
-            found = unionOnly_ ? hitInUnionLeaf(L.primitives(primList), L.prims,
-                                                ScenePrimTest{scene_, &ray, ctx.precision}, tmin,
-                                                t0, t1, ctx, obs, hit)
-                               : hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList), L.prims,
-                                           ray, tmin, t0, t1, ctx, obs, hit);
-        } else {
-            found = hitInLeaf(*scene_, &pool_, L.root, L.primitives(primList), L.prims, ray, tmin,
-                              t0, t1, ctx, obs, hit, unionOnly_);
-        }
-        if (found) return true;
-        if constexpr (Obs::kActive) {
-            int ties = 0;
-            for (int a = 0; a < 3; ++a) ties |= int(tAxis[a] == tExit) << a;
-            if (leaves) obs.regionExit(tExit, ray.at(tExit), exitAxis, ties);
-            if (how == 1) obs.rope(leaf, int(rope[exitAxis]), nextLeaf);
-            if (how == 2) obs.indexStep(exitAxis, next);
-            if (how == 3) obs.push(frame_.toWorld(pushed), ties);
-            if (how >= 2)
-                obs.lookup(how == 3 ? frame_.toWorld(pushed) : ray.at(tExit), next, nextLeaf);
-        }
-        if (last) return false;
-        if (stalled) {
-            ++ctx.counters.walkErrors;
-            obs.walkError("regular push: the pushed exit point is still in the same leaf");
-            return false;
-        }
-        t0 = tIn = t1;
-        leaf = nextLeaf;
-    }
-}
-
-inline RegularGrid::QuadRay RegularGrid::quadRay(const Ray& ray) const {
-    QuadRay r;
-    const Vec3 u = ray.d / glm::length(ray.d);
-    r.at(ray.o);
-    for (int a = 0; a < 3; ++a) r.d[a] = QuadRay::F4{} + float(u[a]);
-    // The exact test computes the line's distance to the centre from the ray's origin: its
-    // rounding grows with that distance, some 1e-15 of it (the allowance is a thousand times
-    // that).
-    const double far = std::max({std::abs(ray.o.x), std::abs(ray.o.y), std::abs(ray.o.z)});
-    r.allowance = QuadRay::F4{} + float(1e-12 * (far + quadScale_));
-    return r;
-}
-
-inline uint32_t RegularGrid::quadMisses(const SphereQuad& q, const QuadRay& r) {
-    using F4 = QuadRay::F4;
-    using I4 = int32_t __attribute__((vector_size(16)));
-    // The vector from the ray's point to each centre, and the line's distance to the centre
-    // as |f x d| (d a unit vector): no cancellation but that of the cross product's terms.
-    const F4 fx = *reinterpret_cast<const F4*>(q.x) - r.p[0];
-    const F4 fy = *reinterpret_cast<const F4*>(q.y) - r.p[1];
-    const F4 fz = *reinterpret_cast<const F4*>(q.z) - r.p[2];
-    const F4 gx = fy * r.d[2] - fz * r.d[1];
-    const F4 gy = fz * r.d[0] - fx * r.d[2];
-    const F4 gz = fx * r.d[1] - fy * r.d[0];
-    const F4 dist2 = gx * gx + gy * gy + gz * gz;
-    // The floats' rounding: a few 1e-7 of |f| (bounded by its 1-norm) from f, d and the cross
-    // product, besides the centre's and the point's own (in the stored radius, see
-    // makeSphereQuads); allowed for ten times over.
-    const I4 absMask = {0x7fffffff, 0x7fffffff, 0x7fffffff, 0x7fffffff};
-    const F4 norm1 = reinterpret_cast<F4>(reinterpret_cast<I4>(fx) & absMask) +
-                     reinterpret_cast<F4>(reinterpret_cast<I4>(fy) & absMask) +
-                     reinterpret_cast<F4>(reinterpret_cast<I4>(fz) & absMask);
-    const F4 reach = *reinterpret_cast<const F4*>(q.r) + r.allowance + 4e-6f * norm1;
-    // NaN and infinities compare false: such a sphere is not rejected.
-    const I4 miss = dist2 > reach * reach;
-#if defined(__SSE2__)
-    return uint32_t(_mm_movemask_ps(reinterpret_cast<__m128>(miss)));
-#else
-    return uint32_t(miss[0] & 1) | uint32_t(miss[1] & 2) | uint32_t(miss[2] & 4) |
-           uint32_t(miss[3] & 8);
-#endif
-}
-
-template <class Obs>
-[[gnu::always_inline]] inline bool RegularGrid::hitInSphereLeaf(const RegularLeaf& L, QuadRay& qr,
-                                                                const Ray& ray, double tmin,
-                                                                double tIn, double t0, double t1,
-                                                                TraceContext& ctx, Obs& obs,
-                                                                Hit& hit) const {
-    if (!ctx.useMailboxes) ctx.newStamp();
-    const uint32_t* const keys = L.primitives(primList_.data());
-    const uint32_t count = L.prims;
-    TraceContext::Tag* const tags = ctx.tags.data();
-    // The quads' floats are near the leaf: the walk's point in it (the ray's origin for a first
-    // leaf entered from an infinite tmin).
-    if (std::isfinite(tIn)) qr.at(ray.at(tIn));
-    const uint32_t rayId = ctx.rayId;
-    UnionFirstStart start{tmin, t0, t1};
-    for (uint32_t from = 0; from < count; from += 60) {
-        const uint32_t n = std::min(count - from, 60u);
-        const uint64_t misses = entryMisses(L.first + from, n, qr);
-        // A rejected sphere has no span: its mailbox is neither read nor written (most of the
-        // tags' cache misses spared), and it is a test each time a leaf lists it. All n are
-        // counted as tests here and the mailbox hits below taken back: without -mpopcnt a
-        // popcount is a call.
-        ctx.counters.primTests += n;
-        const uint64_t take = ~misses & ((uint64_t(1) << n) - 1);
-        // The others' tags and spheres, fetched together rather than one miss at a time.
-        for (uint64_t b = take; b; b &= b - 1) {
-            const uint32_t key = keys[from + uint32_t(__builtin_ctzll(b))];
-            __builtin_prefetch(tags + key);
-            __builtin_prefetch(scene_->packedSpheres.data() + key);
-        }
-        if constexpr (Obs::kActive)
-            for (uint64_t b = misses; b; b &= b - 1)
-                obs.primTest(keys[from + uint32_t(__builtin_ctzll(b))], nullptr, 0);
-        for (uint64_t b = take; b; b &= b - 1) {
-            const uint32_t key = keys[from + uint32_t(__builtin_ctzll(b))];
-            TraceContext::Tag& tag = tags[key];
-            const Mailbox* m;
-            if (tag.stamp == rayId) {
-                --ctx.counters.primTests;
-                ++ctx.counters.mailboxHits;
-                obs.mailboxHit(key);
-                if (tag.slot == 0) continue;  // tested and missed
-                m = &ctx.held[tag.slot];
-            } else {
-                // Storage for the spans the test writes, not cleared first (Span's members
-                // have defaults: a declared array costs its clearing in each test).
-                alignas(Span) std::byte room[2 * sizeof(Span)];
-                Span* const spans = reinterpret_cast<Span*>(room);
-                const int k = scene_->primSpans(key, ray, spans, ctx.precision);
-                obs.primTest(key, spans, k);
-                if (k == 0) {
-                    tag = {rayId, 0};  // the empty mailbox, as ctx.heldEmpty
-                    continue;
-                }
-                m = holdSpans(key, spans, k, ctx);
-            }
-            start.add(*m);
-        }
-    }
-    if constexpr (Obs::kActive) {
-        mergeHeldSpans(keys, count, ctx);  // the leaf's spans, as hitInLeaf shows them
-        obs.regionSpans(ctx.result);
-    }
-    return start.hit(keys, count, ctx, hit);
-}
-
 }  // namespace lancer
+
+#include "engine/accel/regular/regular_walk.h"  // the walk's templates
