@@ -75,13 +75,8 @@ bool countRegionCosts(const Scene& scene, const Accelerator& accel, const Render
     const PrimaryRays primary(cam, w, h);
     const std::shared_ptr<const LightBuffer> eye = accel.eyeBuffer(scene, cam);
     const int depth = accel.info().treeDepth >= 0 ? accel.info().treeDepth : scene.tree.depth();
-    const bool mailboxes = accel.usesMailboxes();
-    tbb::enumerable_thread_specific<TraceContext> contexts([&] {
-        TraceContext c(scene.prims.size(), depth);
-        c.useMailboxes = mailboxes;
-        c.precision = opt.shading.precision;
-        return c;
-    });
+    tbb::enumerable_thread_specific<TraceContext> contexts(
+        [&] { return workerContext(scene, accel, depth, opt.shading.precision); });
     std::vector<uint32_t> visits(regions, 0), tests(regions, 0);
     std::atomic<uint64_t> unplaced{0}, outOfRange{0};
     std::atomic<bool> stopped{false};

@@ -31,6 +31,14 @@ inline uint64_t ticks() {
 
 }  // namespace
 
+TraceContext workerContext(const Scene& scene, const Accelerator& accel, int treeDepth,
+                           Precision precision) {
+    TraceContext c(scene.prims.size(), treeDepth);
+    c.useMailboxes = accel.usesMailboxes();
+    c.precision = precision;
+    return c;
+}
+
 int effectiveThreads(int requested) {
     int cores = tbb::info::default_concurrency();
     return requested > 0 ? requested : cores;
@@ -51,13 +59,8 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
         eyeGiven ? nullptr : accel.eyeBuffer(scene, cam);
     const LightBuffer& eye = eyeGiven ? *eyeGiven : *eyeBuilt;
     const int depth = accel.info().treeDepth >= 0 ? accel.info().treeDepth : scene.tree.depth();
-    const bool mailboxes = accel.usesMailboxes();
-    tbb::enumerable_thread_specific<TraceContext> contexts([&] {
-        TraceContext c(scene.prims.size(), depth);
-        c.useMailboxes = mailboxes;
-        c.precision = opt.shading.precision;
-        return c;
-    });
+    tbb::enumerable_thread_specific<TraceContext> contexts(
+        [&] { return workerContext(scene, accel, depth, opt.shading.precision); });
     auto start = Clock::now();
     std::atomic<bool> stopped{false};
     // oneTBB orders what is written here before the tiles, and the tiles' writes (pixels,

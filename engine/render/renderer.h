@@ -58,4 +58,10 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
 /// Threads a render with `requested` threads uses (0: all cores).
 int effectiveThreads(int requested);
 
+/// A worker's trace context as render() makes it: scratch for a tree of `treeDepth`, mailboxes
+/// as the structure uses them, the primitives' tests in `precision`. Every pass over an image
+/// (the render, the viewer's region costs) takes its contexts from here.
+TraceContext workerContext(const Scene& scene, const Accelerator& accel, int treeDepth,
+                           Precision precision);
+
 }  // namespace lancer
