@@ -27,6 +27,16 @@ std::vector<Case> cases() {
     return out;
 }
 
+/// A w x h render on two threads, `bounces` deep.
+RenderOptions options(int w, int h, int bounces) {
+    RenderOptions ro;
+    ro.width = w;
+    ro.height = h;
+    ro.threads = 2;
+    ro.shading.bounces = bounces;
+    return ro;
+}
+
 // Over the whole image, all rays: the visits and tests counted by region add up to the
 // render's region_visits and prim_tests (what `--stats` writes); primary rays alone, to those of
 // a render that casts no other ray (no shadows, no bounces).
@@ -40,11 +50,7 @@ TEST(RegionCosts, TotalsEqualTheRendersCounters) {
         p.scheme = c.scheme;
         auto accel = buildAccelerator(scene, p);
         const StructureView sv(scene, *accel);
-        RenderOptions ro;
-        ro.width = w;
-        ro.height = h;
-        ro.threads = 2;
-        ro.shading.bounces = c.bounces;
+        const RenderOptions ro = options(w, h, c.bounces);
         Image img(w, h);
         const RenderStats all = render(scene, *accel, ro, img);
         RegionCosts costs;
@@ -78,11 +84,7 @@ TEST(RegionCosts, EachRegionsCountsAreItsRecordedEvents) {
         p.scheme = c.scheme;
         auto accel = buildAccelerator(scene, p);
         const StructureView sv(scene, *accel);
-        RenderOptions ro;
-        ro.width = w;
-        ro.height = h;
-        ro.threads = 2;
-        ro.shading.bounces = c.bounces;
+        const RenderOptions ro = options(w, h, c.bounces);
         for (CostRays rays : {CostRays::All, CostRays::Primary}) {
             std::vector<uint64_t> visits(sv.regionCount()), tests(sv.regionCount());
             for (int y = 0; y < h; ++y)

@@ -163,6 +163,9 @@ class Bvh {
     template <class Boxes, class Obs>
     void pushChildren(const Boxes& boxes, const BvhEntry& e, double tmin, double tmax,
                       BvhEntry* stack, int& sp, Obs& obs) const;
+    /// Tells the observer inner entry `e`'s children met (met[k]), the nearer first.
+    template <class Obs>
+    static void tellChildren(const BvhEntry& e, const BvhEntry c[2], const bool met[2], Obs& obs);
     /// The leaf's visible hit inside [t0, t1] (t > tmin).
     template <class Obs>
     bool hitInLeafBox(const BvhNode& n, const Ray& ray, double tmin, double t0, double t1,
@@ -238,19 +241,27 @@ template <class Boxes, class Obs>
     BvhEntry c[2];
     bool met[2];
     boxes.children(e, tmin, tmax, c, met);
+    if constexpr (Obs::kActive) tellChildren(e, c, met, obs);
+    if (met[0] && met[1]) {
+        const bool leftFirst = c[0].t0 <= c[1].t0;
+        stack[sp++] = c[leftFirst ? 1 : 0];  // the far one waits
+        stack[sp++] = c[leftFirst ? 0 : 1];
+    } else if (met[0] || met[1]) {
+        stack[sp++] = c[met[0] ? 0 : 1];
+    }
+}
+
+template <class Obs>
+void Bvh::tellChildren(const BvhEntry& e, const BvhEntry c[2], const bool met[2], Obs& obs) {
     if (met[0] && met[1]) {
         const bool leftFirst = c[0].t0 <= c[1].t0;
         const BvhEntry& nearE = c[leftFirst ? 0 : 1];
         const BvhEntry& farE = c[leftFirst ? 1 : 0];
-        if constexpr (Obs::kActive)
-            obs.nodeChildren(e.node, nearE.node, nearE.t0, farE.node, farE.t0);
-        stack[sp++] = farE;
-        stack[sp++] = nearE;
+        obs.nodeChildren(e.node, nearE.node, nearE.t0, farE.node, farE.t0);
     } else if (met[0] || met[1]) {
         const BvhEntry& only = c[met[0] ? 0 : 1];
-        if constexpr (Obs::kActive) obs.nodeChildren(e.node, only.node, only.t0, kNoNode, kInf);
-        stack[sp++] = only;
-    } else if constexpr (Obs::kActive) {
+        obs.nodeChildren(e.node, only.node, only.t0, kNoNode, kInf);
+    } else {
         obs.nodeChildren(e.node, kNoNode, kInf, kNoNode, kInf);
     }
 }
@@ -343,17 +354,7 @@ bool Bvh::walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, do
                     heap.push_back(c[k]);
                     std::push_heap(heap.begin(), heap.end(), later);
                 }
-            if constexpr (Obs::kActive) {
-                const bool leftFirst = met[0] && (!met[1] || c[0].t0 <= c[1].t0);
-                if (met[0] && met[1])
-                    obs.nodeChildren(e.node, c[leftFirst ? 0 : 1].node, c[leftFirst ? 0 : 1].t0,
-                                     c[leftFirst ? 1 : 0].node, c[leftFirst ? 1 : 0].t0);
-                else if (met[0] || met[1])
-                    obs.nodeChildren(e.node, c[met[0] ? 0 : 1].node, c[met[0] ? 0 : 1].t0, kNoNode,
-                                     kInf);
-                else
-                    obs.nodeChildren(e.node, kNoNode, kInf, kNoNode, kInf);
-            }
+            if constexpr (Obs::kActive) tellChildren(e, c, met, obs);
             continue;
         }
         const uint32_t* const prims = primList_.data() + e.first;
