@@ -54,7 +54,13 @@ int main(int argc, char** argv) {
     view->add_flag("--hide-panels", vopt.hidePanels,
                    "Start with the panels hidden (Tab shows and hides them)");
     view->add_flag("--log-timings", vopt.logTimings,
-                   "Print the latency of each pass after a change to stderr");
+                   "Print the latency of each pass after a change to stderr, and at the end "
+                   "the frame times (p50, p95, max) since the structure was ready");
+    view->add_option("--orbit", vopt.orbit,
+                     "With --frames: once the structure is ready, turn the camera DEG degrees "
+                     "about its target in each of the first --frames frames, as a drag does")
+        ->check(CLI::Range(-180.0, 180.0))
+        ->needs(frames);
     view->add_flag("--replay-change", vopt.replayChange,
                    "After the first complete image, rebuild the structure once, as a parameter "
                    "change does (to time it)");

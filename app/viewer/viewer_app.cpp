@@ -351,8 +351,9 @@ void ViewerApp::prepareOverlays(int fbWidth, int fbHeight) {
     // While a drag moves the camera the layers are drawn capped (the longest lines; none if
     // the cap is 0) rather than whole each frame: all of balls4's regular leaves take llvmpipe
     // a quarter of a second. They are drawn whole when the drag ends.
-    const bool dragging = ImGui::IsAnyMouseDown() && !ImGui::GetIO().WantCaptureMouse &&
-                          overlays_->layerStale(camera, fbWidth, fbHeight);
+    const bool dragging =
+        (cameraTurning_ || (ImGui::IsAnyMouseDown() && !ImGui::GetIO().WantCaptureMouse)) &&
+        overlays_->layerStale(camera, fbWidth, fbHeight);
     const unsigned layer = overlays_->layerTexture(camera, fbWidth, fbHeight, dragging);
     if (layer != 0 && !overlayShown_ && view_->width() > 0)
         uploadImage(0, -1);  // colour bands bypass colorTex

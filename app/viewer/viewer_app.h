@@ -59,6 +59,9 @@ class ViewerApp {
     /// The frame drawn by the last frame() is on screen (after the window's swap): logs, with
     /// --log-timings, the passes it shows for the first time, with their latency.
     void presented() { state_.presented(); }
+    /// A scripted turn (`lancer view --orbit`) moves the camera in this frame: the overlays are
+    /// drawn as while a drag moves it (capped to the longest lines), and whole once it stops.
+    void setCameraTurning(bool turning) { cameraTurning_ = turning; }
     /// Write the framebuffer as drawn by the last frame() to a PNG or JPEG (by the path's
     /// extension). Throws std::runtime_error.
     void saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const;
@@ -163,7 +166,8 @@ class ViewerApp {
     std::unique_ptr<ImageView> view_;
     std::unique_ptr<overlay::Overlays> overlays_;
     bool logTimings_ = false;
-    bool overlayShown_ = false;  ///< the image view composites the overlays' layer
+    bool overlayShown_ = false;   ///< the image view composites the overlays' layer
+    bool cameraTurning_ = false;  ///< setCameraTurning: a scripted turn moves the camera
     struct OverlayStat {
         double ms = 0.0;
         int frames = 0;

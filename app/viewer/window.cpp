@@ -13,11 +13,14 @@
 #include <filesystem>
 #include <iostream>
 #include <mutex>
+#include <numbers>
 #include <optional>
 #include <thread>
 #include <vector>
 
+#include "app/viewer/camera_control.h"
 #include "app/viewer/panels/panels.h"
+#include "app/viewer/timing/frame_times.h"
 #include "app/viewer/viewer_app.h"
 
 namespace lancer::viewer {
@@ -190,7 +193,11 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
         const auto period =
             std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / 60.0));
         Clock::time_point due = frameStart;
+        // --log-timings: each frame's work once the structure is ready, and --orbit's turns.
+        FrameTimes turningFrames, stillFrames;
+        int turned = 0;
         while (!glfwWindowShouldClose(window)) {
+            const bool turnDue = v.orbit != 0.0 && app.sceneBuild() && turned < v.frames;
             // At most 60 frames per second for input (no swap interval is guaranteed, e.g.
             // under Xvfb); a worker's result ends the wait at once, so a new pass or structure
             // is shown (or a render started on it) without waiting out the frame.
@@ -208,7 +215,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             // bands (and the progress bar) are shown at most kRefineHz times a second: each
             // frame drawn takes CPU from the render threads. A scripted run (--frames) counts
             // its frames quickly once the image is complete.
-            if (v.continuous || (v.frames > 0 && app.settled())) {
+            if (v.continuous || turnDue || (v.frames > 0 && app.settled())) {
                 glfwPollEvents();
             } else if (app.settled()) {
                 glfwWaitEventsTimeout(1.0);
@@ -221,6 +228,7 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             }
             input = false;
             frameStart = Clock::now();
+            const double frameCpuStart = threadCpuMs();
             due += period;
             if (due < frameStart) due = frameStart + period;  // behind (or idle): start afresh
             if (!dropped.empty()) {
@@ -235,6 +243,13 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 settings.windowHeight = wh;
                 ImGui::MarkIniSettingsDirty();
             }
+            if (turnDue) {  // about the target, as a drag to the side does (input.cpp)
+                Camera c = app.state().camera();
+                orbit(c, v.orbit * std::numbers::pi / 180.0, 0.0);
+                app.state().setCamera(c);
+                ++turned;
+            }
+            app.setCameraTurning(turnDue);
             ImGui_ImplGlfw_NewFrame();
             app.frame(fbw, fbh);
             ++frames;
@@ -266,7 +281,8 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 const char* paths[] = {v.drop.c_str()};
                 if (onDrop) onDrop(window, 1, paths);
                 droppedScripted = true;
-            } else if (v.frames > 0 && frames >= v.frames && app.settled()) {
+            } else if (v.frames > 0 && frames >= v.frames && app.settled() &&
+                       (v.orbit == 0.0 || turned >= v.frames)) {
                 if (!app.sceneBuild()) {  // a scripted run on a scene that cannot be shown fails
                     std::cerr << "error: lancer view: the scene could not be shown (see above)\n";
                     status = 2;
@@ -311,8 +327,11 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             statSwapMs +=
                 std::chrono::duration<double, std::milli>(Clock::now() - beforeSwap).count();
             // The UI thread's own cost per frame (the render runs on other threads).
-            statWorkMs +=
+            const double workMs =
                 std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
+            statWorkMs += workMs;
+            if (app.sceneBuild())
+                (turnDue ? turningFrames : stillFrames).add(workMs, threadCpuMs() - frameCpuStart);
             ++statFrames;
             if (v.logTimings && Clock::now() - statStart > std::chrono::seconds(2)) {
                 double secs = std::chrono::duration<double>(Clock::now() - statStart).count();
@@ -324,6 +343,10 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 statStart = Clock::now();
             }
         }
+        if (v.logTimings)
+            std::cerr << "timing: frames since the structure was ready: "
+                      << turningFrames.summary("turning") << "; " << stillFrames.summary("still")
+                      << "\n";
     } catch (const std::exception& e) {  // e.g. a shader the driver refuses
         std::cerr << "error: the viewer failed: " << e.what() << "\n";
         status = 2;

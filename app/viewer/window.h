@@ -24,6 +24,9 @@ struct ViewOptions {
     /// only on input, on a worker's result and at 10 Hz while rendering.
     bool continuous = false;
     bool hidePanels = false;  ///< start with the panels hidden (Tab shows them)
+    /// `--orbit DEG`: once the structure is ready, turn the camera DEG degrees about its target
+    /// in each of the first `frames` frames, as a drag would (to time frames while it moves).
+    double orbit = 0.0;
     /// The layers shown (DESIGN.md section 6: a comma list, "none" for none); empty: the
     /// saved ones.
     int64_t select = -1;  ///< a region id to select once the structure is built; -1: none

@@ -5,6 +5,7 @@
 // (after the GL headers)
 #include <gtest/gtest.h>
 
+#include "app/viewer/camera_control.h"
 #include "app/viewer/gl/transforms.h"
 #include "app/viewer/inspector/inspector.h"
 
@@ -125,6 +126,36 @@ TEST(InspectorGl, LeafDrawnWhereItsCornersProject) {
     EXPECT_GT(dark, 3);
     // The left half of the window is not the inspector's.
     EXPECT_EQ(pixel(img, 10, 10)[0], 0);
+}
+
+/// Whether a line the model drew ends within `tol` of world point `p`.
+bool lineEndsAt(const InspectorModel& m, const Vec3& p, double tol) {
+    for (const gl::BatchVertex& v : m.lines.lines)
+        if (glm::length(Vec3(v.position) - p) < tol) return true;
+    return false;
+}
+
+TEST(InspectorGl, TheMainCameraRebuildsTheModelOnlyForItsFrustum) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    f.draw();
+    // Without the frustum nothing drawn shows the main camera: turning it (a drag over the
+    // image, `--orbit`) keeps the model as it was rather than building it again each frame.
+    const gl::BatchVertex* before = f.insp->model().lines.lines.data();
+    ASSERT_NE(before, nullptr);
+    Camera turned = f.st->scene->camera;
+    orbit(turned, 0.5, 0.0);
+    f.insp->update(f.st, {turned, 64, 48}, kW, kH, -1);
+    EXPECT_EQ(f.insp->model().lines.lines.data(), before);
+    // With it, the frustum follows the main camera: its lines start at the eye.
+    f.insp->options().frustum = true;
+    f.insp->changed();
+    f.insp->update(f.st, {turned, 64, 48}, kW, kH, -1);
+    const double tol = 1e-4 * glm::length(turned.from - turned.at);
+    EXPECT_TRUE(lineEndsAt(f.insp->model(), turned.from, tol));
+    orbit(turned, 0.5, 0.0);
+    f.insp->update(f.st, {turned, 64, 48}, kW, kH, -1);
+    EXPECT_TRUE(lineEndsAt(f.insp->model(), turned.from, tol));
 }
 
 TEST(InspectorGl, LevelRangeHidesTheOtherLevels) {

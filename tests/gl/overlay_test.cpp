@@ -592,5 +592,17 @@ TEST(Overlays, TheShowListTurnsLayersOnAndNamesWhatItDoesNotDraw) {
     }
 }
 
+TEST(Overlays, TheShowListNamesLayersTheSchemeDoesNotHave) {
+    // The BVH draws its nodes as the regular scheme draws its leaves (the Overlays panel's
+    // "nodes"): `--show leaves` is theirs too.
+    EXPECT_EQ(showListMismatch("leaves,tests", SchemeKind::Bvh), "");
+    EXPECT_EQ(showListMismatch("leaves,grid", SchemeKind::Regular), "");
+    EXPECT_EQ(showListMismatch("bsp,zones,slabs", SchemeKind::Irregular), "");
+    EXPECT_NE(showListMismatch("grid", SchemeKind::Bvh).find("no grid"), std::string::npos);
+    EXPECT_NE(showListMismatch("leaves", SchemeKind::Irregular).find("no leaves"),
+              std::string::npos);
+    EXPECT_NE(showListMismatch("slabs", SchemeKind::Regular).find("no slabs"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace lancer::viewer::overlay

@@ -534,6 +534,7 @@ std::string showListMismatch(const std::string& list, SchemeKind scheme) {
         const bool irregular = item == "bsp" || item == "zones" || item == "slabs";
         const bool regular = item == "leaves" || item == "grid";
         if (!irregular && !regular) continue;
+        if (item == "leaves" && scheme == SchemeKind::Bvh) continue;  // the BVH's nodes
         const SchemeKind owner = irregular ? SchemeKind::Irregular : SchemeKind::Regular;
         if (owner == scheme) continue;
         return "--show " + item + ": the " + schemeName(scheme) + " scheme has no " + item +
