@@ -39,6 +39,22 @@ TEST(JsonScene, BuildsTreeMaterialsAndTransforms) {
     EXPECT_EQ(s.prims[0].origin, "scene.json:4:9");
 }
 
+TEST(JsonScene, TorusIsATransformedPrimitive) {
+    const Scene s = read(R"({"scene": {"difference": [
+        {"torus": {"major": 2, "minor": 0.5}, "transform": [{"translate": [0, 0, 3]}]},
+        {"torus": {"major": 1, "minor": 1}}]}})");
+    ASSERT_EQ(s.prims.size(), 2u);
+    const Torus* t = std::get_if<Torus>(&s.prims[0].shape);
+    ASSERT_NE(t, nullptr);
+    EXPECT_EQ(t->R, 2.0);
+    EXPECT_EQ(t->r, 0.5);
+    EXPECT_EQ(s.prims[0].worldBox.lo, Vec3(-2.5, -2.5, 2.5));
+    EXPECT_EQ(s.prims[0].worldBox.hi, Vec3(2.5, 2.5, 3.5));
+    EXPECT_EQ(s.prims[0].origin, "scene.json:2:9");
+    // The horn torus (R = r) is accepted.
+    EXPECT_TRUE(std::holds_alternative<Torus>(s.prims[1].shape));
+}
+
 TEST(JsonScene, MaterialOnAnInnerNodeIsInherited) {
     Scene s = read(
         R"({"scene": {"union": [{"sphere": {"radius": 1}}, {"sphere": {"center": [3, 0, 0], "radius": 1}}],
@@ -77,7 +93,16 @@ TEST(JsonSceneErrors, ValidationErrorsPointAtTheValue) {
                 HasSubstr("unknown material \"nope\""));
     EXPECT_THAT(errorOf(R"({"scene": {"box": {"min": [1, 0, 0], "max": [0, 1, 1]}}})"),
                 HasSubstr("box \"min\" must be below \"max\""));
-    EXPECT_THAT(errorOf(R"({"scene": {"torus": {}}})"), HasSubstr("expected a node"));
+    EXPECT_THAT(errorOf(R"({"scene": {"torus": {}}})"), HasSubstr("missing \"major\""));
+    EXPECT_THAT(errorOf(R"({"scene": {"donut": {}}})"), HasSubstr("expected a node"));
+    // A spindle torus (its tube crossing the axis) is refused at its "minor" value.
+    EXPECT_THAT(errorOf("{\"scene\":\n {\"torus\": {\"major\": 1, \"minor\": 2}}}"),
+                HasSubstr("scene.json:2:25: a torus's \"minor\" radius must not exceed its "
+                          "\"major\" one"));
+    EXPECT_THAT(errorOf(R"({"scene": {"torus": {"major": 2, "minor": 0}}})"),
+                HasSubstr("expected a positive number, got 0"));
+    EXPECT_THAT(errorOf(R"({"scene": {"torus": {"major": 2, "minor": 1, "center": [0, 0, 0]}}})"),
+                HasSubstr("unknown key \"center\""));
     EXPECT_THAT(errorOf(R"({"scene": {"sphere": {"radius": 1}, "box": {"size": 1}}})"),
                 HasSubstr("exactly one of"));
     EXPECT_THAT(

@@ -276,11 +276,22 @@ TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
                        comb + ", [0, 1]]); }",
                    "mem.csg:1:1: linear_extrude with twist: 10000 slices of 80 convex pieces is "
                    "over the 200000 polytopes Lancer makes of a twisted extrusion");
+    // A circle that crosses the axis (OpenSCAD refuses it too), even one subtracted from a
+    // profile that does not, and an ellipse off the axis.
     expectCsgError(
-        "rotate_extrude(angle = 360, convexity = 2) {\n\tmultmatrix([[1, 0, 0, 2], [0, 1, 0, 0], "
-        "[0, 0, 1, 0], [0, 0, 0, 1]]) {\n\t\tcircle(r = 1);\n\t}\n}",
-        "mem.csg:1:1: rotate_extrude() of the circle at mem.csg:3:3 makes a torus, which Lancer "
-        "does not model (a circle centred on the axis, a sphere, is supported)");
+        "rotate_extrude(angle = 360, convexity = 2) {\n\tmultmatrix([[1, 0, 0, 0.5], [0, 1, 0, "
+        "0], [0, 0, 1, 0], [0, 0, 0, 1]]) {\n\t\tcircle(r = 1);\n\t}\n}",
+        "mem.csg:1:1: rotate_extrude(): the profile crosses the axis (x from -0.500000 to "
+        "1.500000); as in OpenSCAD, all of it must lie on one side of x = 0");
+    expectCsgError(
+        "rotate_extrude() {\n\tdifference() {\n\t\ttranslate([2, 0]) square(size = 2, center = "
+        "true);\n\t\ttranslate([1, 0]) circle(r = 1.5);\n\t}\n}",
+        "mem.csg:1:1: rotate_extrude() of the circle at mem.csg:4:21 (centre x = 1.000000, radius "
+        "1.500000) crosses the axis; as in OpenSCAD, all of it must lie on one side of x = 0");
+    expectCsgError(
+        "rotate_extrude() {\n\ttranslate([3, 0]) scale([1, 2]) circle(r = 1);\n}",
+        "mem.csg:1:1: rotate_extrude() of the ellipse at mem.csg:2:34 off the axis sweeps a ring "
+        "of elliptic section, which Lancer does not model (circles off the axis make tori)");
     // A drawing with no solid says what Lancer traces.
     expectCsgError("circle(r = 1);",
                    "mem.csg:1:1: the model is 2D (its first 2D node is 'circle') and has no "
@@ -361,6 +372,77 @@ TEST(OpenScadExtrusions, EachEqualsItsSolidTwin) {
         "2); } }");
 }
 
+TEST(OpenScadExtrusions, CirclesOffTheAxisRevolveIntoTori) {
+    OpenScadCounts n;
+    // A circle at x = 3, y = 1 (rotated in the plane, mirrored to the other side: the same
+    // circle) makes the torus R = 3, r = 1 one unit up; a circle on the axis a sphere.
+    for (const char* profile :
+         {"translate([3, 1]) circle(r = 1);", "translate([3, 1]) rotate(30) circle(r = 1);",
+          "mirror([1, 0]) translate([3, 1]) circle(d = 2);"}) {
+        SCOPED_TRACE(profile);
+        const Scene s = csgText(std::string("rotate_extrude(angle = 360) { ") + profile + " }", &n);
+        ASSERT_EQ(s.prims.size(), 1u);
+        const Torus* t = std::get_if<Torus>(&s.prims[0].shape);
+        ASSERT_NE(t, nullptr);
+        EXPECT_NEAR(t->R, 3.0, 1e-12);
+        EXPECT_NEAR(t->r, 1.0, 1e-12);
+        EXPECT_NEAR(s.bounds.lo.z, 0.0, 1e-9);
+        EXPECT_NEAR(s.bounds.hi.x, 4.0, 1e-9);
+        EXPECT_EQ(n.tori, 1);
+    }
+    // A circle on the axis may only be subtracted (else the profile crosses the axis): turned
+    // in the plane, it still makes a sphere.
+    const Scene ball = csgText(
+        "rotate_extrude() { difference() { translate([0, -2]) square(size = [3, 4]); rotate(30) "
+        "circle(r = 1); } }",
+        &n);
+    ASSERT_EQ(ball.prims.size(), 2u);  // the square's cylinder and the circle's sphere
+    EXPECT_TRUE(std::holds_alternative<Sphere>(ball.prims[1].shape));
+    EXPECT_EQ(n.tori, 0);
+    // Touching the axis: the horn torus.
+    const Scene horn = csgText("rotate_extrude() { translate([1, 0]) circle(r = 1); }");
+    ASSERT_EQ(horn.prims.size(), 1u);
+    EXPECT_TRUE(std::holds_alternative<Torus>(horn.prims[0].shape));
+    // The torus is its JSON twin, pixel for pixel.
+    Scene js = readJsonScene(SourceText("t.json", R"({"scene": {"torus": {"major": 3, "minor": 1},
+                                            "transform": [{"translate": [0, 0, 1]}]}})"));
+    const Scene csg = csgText("rotate_extrude() { translate([3, 1]) circle(r = 1); }");
+    js.camera = csg.camera;
+    int hits = 0;
+    EXPECT_EQ(depthMismatches(depthImage(csg, 64, 48), depthImage(js, 64, 48), hits), 0);
+    EXPECT_GT(hits, 64 * 48 / 20);
+}
+
+TEST(OpenScadExtrusions, PartialSweepOfACircleIsTheTorusCutByTheWedge) {
+    // Rays down through the tube's centre circle at a polar angle: inside the sweep they hit
+    // the tube's top (z = 1), outside they miss.
+    auto hitsAt = [](const Scene& s, double degrees) {
+        const double a = glm::radians(degrees);
+        const Ray ray{{3.0 * std::cos(a), 3.0 * std::sin(a), 10.0}, {0, 0, -1}};
+        auto brute = buildAccelerator(s, BuildParams{});
+        TraceContext ctx(s.prims.size(), s.tree.depth());
+        NullObserver obs;
+        ctx.beginRay();
+        Hit h;
+        if (!brute->intersect(ray, 0.0, kInf, ctx, obs, h)) return false;
+        EXPECT_NEAR(h.t, 9.0, 1e-9) << degrees;
+        return true;
+    };
+    const Scene quarter =
+        csgText("rotate_extrude(angle = 90) { translate([3, 0]) circle(r = 1); }");
+    EXPECT_TRUE(hitsAt(quarter, 45.0));
+    EXPECT_TRUE(hitsAt(quarter, 5.0));
+    EXPECT_FALSE(hitsAt(quarter, 120.0));
+    EXPECT_FALSE(hitsAt(quarter, -30.0));
+    const Scene most = csgText("rotate_extrude(angle = 270) { translate([3, 0]) circle(r = 1); }");
+    EXPECT_TRUE(hitsAt(most, 120.0));
+    EXPECT_TRUE(hitsAt(most, 260.0));
+    EXPECT_FALSE(hitsAt(most, -60.0));
+    const Scene back = csgText("rotate_extrude(angle = -90) { translate([3, 0]) circle(r = 1); }");
+    EXPECT_TRUE(hitsAt(back, -45.0));
+    EXPECT_FALSE(hitsAt(back, 45.0));
+}
+
 TEST(OpenScadExtrusions, SchemesAgreeWithBruteForce) {
     // Extrusions and revolutions under CSG, turned: every scheme, ray for ray.
     const Scene s = csgText(
@@ -375,7 +457,9 @@ TEST(OpenScadExtrusions, SchemesAgreeWithBruteForce) {
         "sphere(r = 0.5); translate([0, 2, 1]) sphere(r = 0.5); translate([1, 1, 2]) sphere(r = "
         "0.5); } translate([1, 6, 0.5]) polyhedron(points = [[1, 0, 0], [0, 1, 0], [-1, 0, 0], "
         "[0, -1, 0], [0, 0, 1.5]], faces = [[0, 1, 2, 3], [4, 1, 0], [4, 2, 1], [4, 3, 2], [4, "
-        "0, 3]]); }");
+        "0, 3]]); }\n"
+        "translate([-4, 0, 0]) difference() { rotate([60, 0, 0]) rotate_extrude(angle = 250) "
+        "translate([2, 0]) circle(r = 0.7); cube(size = [2, 6, 1], center = true); }");
     const std::vector<Ray> rays = test::randomRays(s, 5, 3000);
     test::expectEverySchemeSame(s, rays);
 }

@@ -17,8 +17,8 @@ namespace lancer::bench {
 namespace {
 
 /// A scene of every shape: CSG of solids (a block minus a sphere and a rotated cylinder, a cone
-/// of two radii intersected with a sphere), a scaled and rotated block, and surfaces under the
-/// union (a floor polygon, a triangle, a smooth triangle, an open cone).
+/// of two radii intersected with a sphere), a scaled and rotated block, a tilted torus, and
+/// surfaces under the union (a floor polygon, a triangle, a smooth triangle, an open cone).
 Scene everyShape(Projection projection) {
     Scene s;
     auto prim = [&](Shape shape, const Transform& xf = Transform()) {
@@ -40,6 +40,9 @@ Scene everyShape(Projection projection) {
         prim(Block{{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}},
              Transform::translate({0.2, 1.8, 0.6}) * Transform::rotate(30.0, {0.3, 0.2, 1.0}) *
                  Transform::scale({1.0, 0.6, 0.8})));
+    // A torus tilted towards the camera, its hole in view.
+    parts.push_back(prim(Torus{0.5, 0.18}, Transform::translate({0.5, -1.9, 0.75}) *
+                                               Transform::rotate(40.0, {1.0, 0.0, 0.0})));
     Polygon floor;
     EXPECT_TRUE(makePolygon(
         {{-4, -3, -0.01}, {4, -3, -0.01}, {4, 4, -0.01}, {-3, 4, -0.01}, {-4, 0, -0.01}}, floor));
@@ -85,11 +88,26 @@ Vec3 vectorAfter(const std::string& text, const std::string& key, double& scale)
 
 TEST(PovExport, WritesEveryShapeTheTreeAndTheMatrices) {
     const std::string pov = povText(everyShape(Projection::Perspective));
-    for (const char* s :
-         {"#version 3.7;", "max_trace_level 4", "camera {", "perspective", "light_source {",
-          "difference {", "intersection {", "union {", "sphere {", "box {", "cylinder {", "cone {",
-          " open", "triangle {", "smooth_triangle {", "polygon { 6,", "matrix <", "material { M0 }",
-          "#declare M0 = material"})
+    for (const char* s : {"#version 3.7;",
+                          "max_trace_level 4",
+                          "camera {",
+                          "perspective",
+                          "light_source {",
+                          "difference {",
+                          "intersection {",
+                          "union {",
+                          "sphere {",
+                          "box {",
+                          "cylinder {",
+                          "cone {",
+                          " open",
+                          "triangle {",
+                          "smooth_triangle {",
+                          "polygon { 6,",
+                          "torus { 0.5, 0.18 sturm",
+                          "matrix <",
+                          "material { M0 }",
+                          "#declare M0 = material"})
         EXPECT_NE(pov.find(s), std::string::npos) << s << "\n" << pov;
     // The chain of differences is one difference: the block minus the sphere and the cylinder.
     EXPECT_EQ(pov.find("difference {", pov.find("difference {") + 1), std::string::npos);

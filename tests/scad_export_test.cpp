@@ -22,8 +22,8 @@ namespace lancer::bench {
 namespace {
 
 /// Solids of every shape OpenSCAD models: a block minus a sphere and a rotated cylinder, a cone
-/// of two radii intersected with a sphere, a scaled and rotated block, a tetrahedron (a
-/// polytope of four planes).
+/// of two radii intersected with a sphere, a scaled and rotated block, a tilted torus, a
+/// tetrahedron (a polytope of four planes).
 Scene solidScene() {
     Scene s;
     auto prim = [&](Shape shape, const Transform& xf = Transform()) {
@@ -45,6 +45,9 @@ Scene solidScene() {
         prim(Block{{-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}},
              Transform::translate({0.2, 1.8, 0.6}) * Transform::rotate(30.0, {0.3, 0.2, 1.0}) *
                  Transform::scale({1.0, 0.6, 0.8})));
+    // A torus tilted towards the camera, its hole in view.
+    parts.push_back(prim(Torus{0.5, 0.18}, Transform::translate({0.5, -1.9, 0.75}) *
+                                               Transform::rotate(40.0, {1.0, 0.0, 0.0})));
     Polytope tet;
     const Vec3 v[4] = {{2.5, 1.5, 0.0}, {3.5, 1.5, 0.0}, {3.0, 2.4, 0.0}, {3.0, 1.8, 1.2}};
     const int faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}};
@@ -72,9 +75,10 @@ std::string scadText(const Scene& s, int fn = 32) {
 
 TEST(ScadExport, WritesEveryShapeAndTheTree) {
     const std::string scad = scadText(solidScene(), 24);
-    for (const char* s : {"$fn = 24;", "union() {", "difference() {", "intersection() {",
-                          "sphere(r = 0.9)", "translate([-2, -1, 0]) cube([2, 2, 2])",
-                          "cylinder(h = 2, r1 = 1, r2 = 0.3)", "multmatrix([[", "polyhedron("})
+    for (const char* s :
+         {"$fn = 24;", "union() {", "difference() {", "intersection() {", "sphere(r = 0.9)",
+          "translate([-2, -1, 0]) cube([2, 2, 2])", "cylinder(h = 2, r1 = 1, r2 = 0.3)",
+          "multmatrix([[", "polyhedron(", "rotate_extrude() translate([0.5, 0]) circle(r = 0.18)"})
         EXPECT_NE(scad.find(s), std::string::npos) << s << "\n" << scad;
     // The chain of differences is one difference: the block minus the sphere and the cylinder.
     EXPECT_EQ(scad.find("difference()", scad.find("difference()") + 1), std::string::npos);

@@ -70,6 +70,10 @@ struct Writer {
                     head = "intersection {";
                     for (const glm::dvec4& pl : s.planes)
                         head += " plane { " + vec(Vec3(pl)) + ", " + n(pl.w) + " }";
+                } else if constexpr (std::is_same_v<T, Torus>) {
+                    // POV-Ray's torus turns about y; ours about z. Its Sturm solver is the
+                    // robust one on grazing rays.
+                    head = "torus { " + n(s.R) + ", " + n(s.r) + " sturm rotate <90, 0, 0>";
                 } else {
                     // Closed explicitly: the first point again (an even-odd polygon, as ours).
                     head = "polygon { " + std::to_string(s.p.size() + 1);

@@ -109,6 +109,9 @@ struct ScadWriter {
                         ", r2 = " + shortest(shape.r2) + ")";
                 else if constexpr (std::is_same_v<T, Polytope>)
                     s = polyhedron(shape);
+                else if constexpr (std::is_same_v<T, Torus>)
+                    s = "rotate_extrude() translate([" + shortest(shape.R) +
+                        ", 0]) circle(r = " + shortest(shape.r) + ")";
             },
             p.shape);
         os << indent << (p.hasXf ? multmatrix(p.xf.m) + " " : "") << s << ";\n";

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "engine/model/quartic.h"
+
 namespace lancer {
 namespace {
 
@@ -220,6 +222,86 @@ int polytopeSpans(const Polytope& k, const R& r, uint32_t prim, Span* out) {
     return 1;
 }
 
+// The torus's implicit function along the line, g(s) = ((rho - R)^2 + z^2 - r^2) ((rho + R)^2 +
+// z^2 - r^2) = (|p|^2 + R^2 - r^2)^2 - 4 R^2 (x^2 + y^2) at p = o + s u, is a quartic in s. It is
+// solved in a frame where it is well conditioned: the origin moved to the line's point closest
+// to the torus's centre (a ray from 1e6 away would otherwise carry coefficients of 1e24 whose
+// rounding swamps the roots), lengths divided by R + r (roots then lie in [-1, 1], so one
+// absolute tolerance fits every torus). With the origin there, o is orthogonal to u and the
+// quartic has no cubic term.
+template <class T>
+struct TorusLine {
+    V3<T> o, u;  ///< closest point to the centre and unit direction, in units of R + r
+    T R, r;      ///< radii in units of R + r
+};
+
+// Signed distance to the torus surface at parameter s of the line, and its derivative along
+// u (the cosine between u and the outward normal); false on the axis, where the surface's
+// nearest point is not unique.
+template <class T>
+bool torusDistance(const TorusLine<T>& L, T s, T& dist, T& slope) {
+    const V3<T> p = L.o + s * L.u;
+    const T rho = std::sqrt(p.x * p.x + p.y * p.y);
+    if (!(rho > T(0))) return false;
+    const T dr = rho - L.R, len = std::sqrt(dr * dr + p.z * p.z);
+    if (!(len > T(0))) return false;
+    dist = len - L.r;
+    slope = (dr * (p.x * L.u.x + p.y * L.u.y) / rho + p.z * L.u.z) / len;
+    return true;
+}
+
+// Newton steps on the distance itself (not the expanded quartic): it is exact to rounding near
+// the surface even for a thin tube, where the expanded coefficients cancel down to r^2. A step
+// is kept only while it shrinks the distance and moves less than a quarter of the gap to the
+// neighbouring roots, so that roots keep their order and a grazing pair is left as isolated.
+template <class T>
+void polishTorusRoots(const TorusLine<T>& L, T* s, int n) {
+    for (int i = 0; i < n; ++i) {
+        T gap = tInf<T>;
+        if (i > 0) gap = std::min(gap, s[i] - s[i - 1]);
+        if (i + 1 < n) gap = std::min(gap, s[i + 1] - s[i]);
+        for (int step = 0; step < 2; ++step) {
+            T d0, k0, d1, k1;
+            if (!torusDistance(L, s[i], d0, k0) || d0 == T(0)) break;
+            const T next = s[i] - d0 / k0;
+            if (!(std::abs(next - s[i]) < T(0.25) * gap)) break;
+            if (!torusDistance(L, next, d1, k1) || !(std::abs(d1) < std::abs(d0))) break;
+            s[i] = next;
+        }
+    }
+}
+
+template <class R, class T = ScalarOf<R>>
+int torusSpans(const Torus& k, const R& ray, uint32_t prim, Span* out) {
+    const T len = glm::length(ray.d);
+    if (!(len > T(0)) || !std::isfinite(len)) return 0;
+    const T B = T(k.R) + T(k.r);
+    TorusLine<T> L;
+    L.u = ray.d / len;
+    const T s0 = -glm::dot(ray.o, L.u);
+    L.o = (ray.o + s0 * L.u) / B;
+    L.R = T(k.R) / B, L.r = T(k.r) / B;
+    const T oo = glm::dot(L.o, L.o);
+    if (!(oo < T(1))) return 0;  // the line misses the bounding sphere (or is NaN)
+    const T R2 = L.R * L.R, q = oo + L.R * L.R - L.r * L.r;
+    const T c[5] = {q * q - T(4) * R2 * (L.o.x * L.o.x + L.o.y * L.o.y),
+                    T(-8) * R2 * (L.o.x * L.u.x + L.o.y * L.u.y),
+                    T(2) * q - T(4) * R2 * (L.u.x * L.u.x + L.u.y * L.u.y), T(0), T(1)};
+    // Where |p|^2 = 1.01, g >= (|p|^2 - (R + r)^2)(|p|^2 - (R - r)^2) >= 1e-4 > 0: both ends lie
+    // outside, so the sign changes pair up into spans.
+    const T h = std::sqrt(T(1.01) - oo);
+    T s[4];
+    const int n =
+        poly::signChangeRoots(c, 4, -h, h, s) & ~1;  // an odd count is a rounding artefact
+    polishTorusRoots(L, s, n);
+    int spans = 0;
+    for (int i = 0; i + 1 < n; i += 2) {
+        const double t0 = double((s0 + B * s[i]) / len), t1 = double((s0 + B * s[i + 1]) / len);
+        if (t0 < t1) out[spans++] = {{t0, prim, 0, false}, {t1, prim, 0, false}};
+    }
+    return spans;
+}
+
 template <class R, class T = ScalarOf<R>>
 int spansOf(const Shape& s, const R& r, uint32_t prim, Span* out) {
     return std::visit(
@@ -228,7 +310,8 @@ int spansOf(const Shape& s, const R& r, uint32_t prim, Span* out) {
                    [&](const Cone& x) { return coneSpans(x, r, prim, out); },
                    [&](const Triangle& x) { return triangleSpans(x, r, prim, out); },
                    [&](const Polygon& x) { return polygonSpans(x, r, prim, out); },
-                   [&](const Polytope& x) { return polytopeSpans(x, r, prim, out); }},
+                   [&](const Polytope& x) { return polytopeSpans(x, r, prim, out); },
+                   [&](const Torus& x) { return torusSpans(x, r, prim, out); }},
         s);
 }
 
@@ -273,7 +356,15 @@ Vec3 shapeNormal(const Shape& s, const Vec3& p, uint8_t part) {
                        return glm::dot(n, g) < 0.0 ? -n : n;
                    },
                    [&](const Polygon& x) { return x.n; },
-                   [&](const Polytope& x) { return Vec3(x.planes[part]); }},
+                   [&](const Polytope& x) { return Vec3(x.planes[part]); },
+                   [&](const Torus& x) {
+                       // Away from the tube's centre circle, towards p: the gradient's direction.
+                       const double rho = std::hypot(p.x, p.y);
+                       // The horn torus's point on the axis: the tangent cone's axis.
+                       if (rho == 0.0) return Vec3(0.0, 0.0, p.z >= 0.0 ? 1.0 : -1.0);
+                       const Vec3 n = p - x.R * Vec3(p.x / rho, p.y / rho, 0.0);
+                       return glm::dot(n, n) > 0.0 ? glm::normalize(n) : Vec3(0.0, 0.0, 1.0);
+                   }},
         s);
 }
 
@@ -298,7 +389,11 @@ Box3 shapeBounds(const Shape& s) {
                                      for (const Vec3& p : x.p) b.expand(p);
                                      return b;
                                  },
-                                 [](const Polytope& x) { return x.bounds; }},
+                                 [](const Polytope& x) { return x.bounds; },
+                                 [](const Torus& x) {
+                                     const double b = x.R + x.r;
+                                     return Box3{Vec3(-b, -b, -x.r), Vec3(b, b, x.r)};
+                                 }},
                       s);
 }
 
@@ -308,7 +403,8 @@ bool shapeIsSurface(const Shape& s) {
 }
 
 const char* shapeName(const Shape& s) {
-    static const char* names[] = {"sphere", "box", "cone", "triangle", "polygon", "polytope"};
+    static const char* names[] = {"sphere",  "box",      "cone", "triangle",
+                                  "polygon", "polytope", "torus"};
     if (const Cone* c = std::get_if<Cone>(&s)) {
         if (c->open) return "open cone";
         if (c->r1 == c->r2) return "cylinder";

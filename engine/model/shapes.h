@@ -1,6 +1,6 @@
 // The primitives, each in its own local frame. `spans` returns the ray's spans over the whole
-// line (any t), sorted; solids give at most one span of positive length, surfaces give
-// zero-length spans. `normal` is the outward (solids) or geometric (surfaces) normal.
+// line (any t), sorted; solids give at most one span of positive length (a torus up to two),
+// surfaces give zero-length spans. `normal` is the outward (solids) or geometric (surfaces) normal.
 #pragma once
 
 #include <algorithm>
@@ -109,7 +109,16 @@ struct Polytope {
     Box3 bounds;                     ///< a box holding the solid
 };
 
-using Shape = std::variant<Sphere, Block, Cone, Triangle, Polygon, Polytope>;
+/// Torus about the z axis, centred at the origin: the points within `r` of the circle of radius
+/// `R` in the plane z = 0 (OpenSCAD's rotate_extrude of a circle of radius r centred at x = R).
+/// R >= r > 0: a ring torus, or a horn torus at R = r; a spindle torus (R < r, whose surface
+/// crosses itself) is refused by the readers. One part (0).
+struct Torus {
+    double R = 2.0;  ///< major radius: the centre circle's
+    double r = 1.0;  ///< minor radius: the tube's
+};
+
+using Shape = std::variant<Sphere, Block, Cone, Triangle, Polygon, Polytope, Torus>;
 
 /// Spans of the line `r` (in the shape's frame) through the shape, written to `out` (capacity 2).
 int shapeSpans(const Shape& s, const Ray& r, uint32_t prim, Span* out);

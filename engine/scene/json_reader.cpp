@@ -367,28 +367,43 @@ struct JsonSceneBuilder {
         return scene.tree.leaf(uint32_t(scene.prims.size() - 1));
     }
 
+    /// A torus's radii, checked: R >= r, since the solid of a spindle torus (whose tube crosses
+    /// its axis) is not the inside of its quartic and OpenSCAD refuses it too.
+    static Torus torus(const JsonAt& body) {
+        body.onlyKeys({"major", "minor"});
+        Torus t;
+        t.R = body["major"].positive();
+        t.r = body["minor"].positive();
+        if (t.r > t.R)
+            body["minor"].fail(
+                "a torus's \"minor\" radius must not exceed its \"major\" one (a "
+                "spindle torus, whose tube crosses its axis, is not modelled)");
+        return t;
+    }
+
     static constexpr int kMaxDepth = 2000;  // deeper nesting is refused, not recursed into
 
     int node(const JsonAt& n, const Transform& parentXf, int parentMat, int depth = 0) {
         if (depth > kMaxDepth)
             n.fail("nesting deeper than " + std::to_string(kMaxDepth) + " levels");
-        static const char* kinds[] = {"sphere",  "box",   "cylinder",     "cone",      "triangle",
-                                      "polygon", "union", "intersection", "difference"};
+        static const char* kinds[] = {"sphere",       "box",       "cylinder", "cone",
+                                      "torus",        "triangle",  "polygon",  "union",
+                                      "intersection", "difference"};
         n.object();
         std::string kind;
         for (const char* k : kinds)
             if (n.has(k)) {
                 if (!kind.empty())
                     n.fail(
-                        "a node has exactly one of sphere, box, cylinder, cone, triangle, polygon, "
-                        "union, intersection, difference; found both \"" +
+                        "a node has exactly one of sphere, box, cylinder, cone, torus, triangle, "
+                        "polygon, union, intersection, difference; found both \"" +
                         kind + "\" and \"" + k + "\"");
                 kind = k;
             }
         if (kind.empty())
             n.fail(
-                "expected a node: one of sphere, box, cylinder, cone, triangle, polygon, union, "
-                "intersection, difference");
+                "expected a node: one of sphere, box, cylinder, cone, torus, triangle, polygon, "
+                "union, intersection, difference");
         for (const auto& [k, v] : n.object())
             if (k != kind && k != "transform" && k != "material" && k != "name")
                 n[k].fail("unknown key \"" + k + "\" in a " + kind + " node");
@@ -462,6 +477,7 @@ struct JsonSceneBuilder {
                                   : Transform();
             return primitive(n, c, xf * local, mat);
         }
+        if (kind == "torus") return primitive(n, torus(body), xf, mat);
         // Surfaces: world-space points through the transform.
         std::vector<Vec3> pts = points(body, 3);
         for (Vec3& p : pts) p = xf.point(p);

@@ -13,6 +13,7 @@ namespace lancer {
 /// What a .csg file held, for tests and messages.
 struct OpenScadCounts {
     int cubes = 0, spheres = 0, cylinders = 0, cones = 0;  ///< primitives modelled
+    int tori = 0;        ///< tori modelled (rotate_extrude of a circle off the axis)
     int operators = 0;   ///< union/group/render, intersection, difference nodes read
     int transforms = 0;  ///< multmatrix/translate/rotate/scale/mirror nodes read
     int colors = 0;

@@ -27,7 +27,7 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
         }
         Shape shape;
         Transform xf = Transform::translate(c + opt.offset);
-        switch (rng() % 4) {
+        switch (rng() % (opt.tori ? 5 : 4)) {
             case 0:
                 shape = Sphere{Vec3(0.0), pos(rng)};
                 break;
@@ -40,9 +40,14 @@ Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt) {
                 shape = Cone{r, r, 2.0 * pos(rng), false};
                 break;
             }
-            default:
+            case 3:
                 shape = Cone{pos(rng), (rng() % 3 == 0) ? 0.0 : pos(rng), 2.0 * pos(rng), false};
                 break;
+            default: {  // a ring torus, one in four a horn torus (R = r, its hole closed)
+                const double r = 0.5 * pos(rng);
+                shape = Torus{rng() % 4 == 0 ? r : r + pos(rng), r};
+                break;
+            }
         }
         if (opt.transforms && rng() % 2) {
             xf = xf * Transform::rotate(180.0 * u(rng), {u(rng), u(rng), u(rng) + 1.5}) *

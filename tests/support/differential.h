@@ -21,9 +21,12 @@ struct RandomSceneOptions {
     /// Independent random trees under one union, each over primitives within 1.5 of its centre
     /// (1: one tree over primitives anywhere in the spread).
     int groups = 1;
+    /// Tori among the solids (a fifth kind); off, the scenes of a seed stay what they were.
+    bool tori = false;
 };
 
-/// A random binary CSG tree over random solids (spheres, boxes, cylinders, cones), prepared.
+/// A random binary CSG tree over random solids (spheres, boxes, cylinders, cones, and with
+/// `tori` ring and horn tori), prepared.
 Scene randomCsgScene(uint64_t seed, const RandomSceneOptions& opt = {});
 
 /// A random CSG tree over bars (blocks long on one axis), cylinders along an axis and spheres,

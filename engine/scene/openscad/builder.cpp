@@ -1149,22 +1149,46 @@ class Builder {
                 r.kind == Region::Kind::Intersection ? Op::Intersection : Op::Difference, a.node,
                 b.node));
         }
-        if (r.kind == Region::Kind::Disk) {
-            const glm::dmat3& d = r.disk;
-            // An ellipse centred on the axis with its axes along x and y revolves into an
-            // ellipsoid; any other makes a torus.
-            if (d[2][0] != 0.0 || d[1][0] != 0.0 || d[0][1] != 0.0)
-                src_.fail(n.pos, "rotate_extrude() of the circle at " + src_.where(r.pos) +
-                                     " makes a torus, which Lancer does not model (a circle "
-                                     "centred on the axis, a sphere, is supported)");
-            double rx = std::abs(d[0][0]), ry = std::abs(d[1][1]);
-            ++counts_.spheres;
-            return place(
-                Sphere{Vec3(0.0), 1.0},
-                xf * Transform::translate({0.0, 0.0, d[2][1]}) * Transform::scale({rx, rx, ry}),
-                mat, r.pos, "rotate_extrude()");
-        }
+        if (r.kind == Region::Kind::Disk) return revolveDisk(r, n, xf, mat);
         return revolvePiece(r.piece, xf, mat, r.pos);
+    }
+
+    /// A disk revolved about the profile's y axis: a circle or an ellipse with its axes along x
+    /// and y centred on the axis makes a sphere or an ellipsoid; a circle off the axis a torus.
+    /// Only the part at x >= 0 revolves (the whole region lies there, but a subtracted disk may
+    /// cross the axis: its sweep is a spindle torus's outer solid, not a torus's, and is refused).
+    Built revolveDisk(const Region& r, const Node& n, const Transform& xf, int mat) {
+        const glm::dmat3& d = r.disk;
+        const double ex = std::hypot(d[0][0], d[0][1]), ey = std::hypot(d[1][0], d[1][1]);
+        const double cx = d[2][0], cy = d[2][1];
+        // A circle: the unit disk's axes stay orthogonal and of one length (to rounding, after
+        // rotations in the plane).
+        const double tol = 1e-12 * std::max(ex, ey);
+        const bool circle =
+            std::abs(ex - ey) <= tol && std::abs(d[0][0] * d[1][0] + d[0][1] * d[1][1]) <= tol * ex;
+        const bool aligned = d[1][0] == 0.0 && d[0][1] == 0.0;
+        if (std::abs(cx) <= tol && (circle || aligned)) {
+            const double rx = circle ? ex : std::abs(d[0][0]), ry = circle ? ex : std::abs(d[1][1]);
+            ++counts_.spheres;
+            return place(Sphere{Vec3(0.0), 1.0},
+                         xf * Transform::translate({0.0, 0.0, cy}) * Transform::scale({rx, rx, ry}),
+                         mat, r.pos, "rotate_extrude()");
+        }
+        if (!circle)
+            src_.fail(n.pos, "rotate_extrude() of the ellipse at " + src_.where(r.pos) +
+                                 " off the axis sweeps a ring of elliptic section, which Lancer "
+                                 "does not model (circles off the axis make tori)");
+        const double R = std::abs(cx), rad = 0.5 * (ex + ey);
+        if (cx <= -rad) return Built::empty();  // wholly at x < 0: nothing revolves
+        if (cx < 0.0 || R < rad * (1.0 - 1e-12))
+            src_.fail(n.pos, "rotate_extrude() of the circle at " + src_.where(r.pos) +
+                                 " (centre x = " + std::to_string(cx) + ", radius " +
+                                 std::to_string(rad) +
+                                 ") crosses the axis; as in OpenSCAD, all of it must lie on one "
+                                 "side of x = 0");
+        ++counts_.tori;
+        return place(Torus{std::max(R, rad), rad}, xf * Transform::translate({0.0, 0.0, cy}), mat,
+                     r.pos, "rotate_extrude()");
     }
 
     /// A convex piece a x + b y <= c (x the radius, y the height) revolved: each side with a > 0
