@@ -51,13 +51,13 @@ int automaticMaxLevel(size_t primitives) {
 
 int effectiveMaxLevel(const RegularConfig& config, size_t primitives) {
     if (config.maxLevel > 0) return config.maxLevel;
-    const int base = automaticMaxLevel(primitives);
+    const int base = std::max(automaticMaxLevel(primitives) - config.autoLevelDrop, 1);
     return config.usesCostStop() ? std::min(base + kGainDepth, 48) : base;
 }
 
 int gainLevel(const RegularConfig& config, size_t primitives) {
     if (!config.usesCostStop()) return std::numeric_limits<int>::max();
-    return automaticMaxLevel(primitives);
+    return std::max(automaticMaxLevel(primitives) - config.autoLevelDrop, 1);
 }
 
 std::string maxObjectsText(int maxObjects) {

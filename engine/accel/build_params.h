@@ -117,6 +117,10 @@ struct RegularConfig {
     /// the others (balls:6: 17% fewer tests per ray for 16% more leaves; docs/regular.md,
     /// "Cost-driven splits").
     double minGain = 8.0;
+    /// Levels the automatic depth is lowered by; not a knob: RegularGrid sets it when the
+    /// automatic depth would pass the builder's node limit, and builds again (docs/regular.md,
+    /// "The node limit in the automatic mode").
+    int autoLevelDrop = 0;
 
     /// Neither max-level nor max-objects is set: the depth and the stops are the build's choice.
     bool automatic() const { return maxLevel == 0 && maxObjects == kAutoObjects; }

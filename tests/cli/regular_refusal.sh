@@ -24,6 +24,20 @@ echo "$out" | grep -q -- "--memory-budget" || fail "message does not name the op
 "$LANCER" render "$SRC/assets/spd/balls4.nff" --scheme regular --max-level 30 --max-objects 4 \
     --width 8 --height 8 -o "$tmp/y.png" >/dev/null 2>"$tmp/log" || { cat "$tmp/log"; fail "sub-tables at level 30 refused"; }
 
+# The automatic mode keeps within the builder's node limit: OpenSCAD's example020 (a twisted
+# spring of 25,971 polytopes) would pass it at the automatic depth, and is built shallower
+# ("auto_level_drop" in --stats) with the image of brute force; the same depth given
+# explicitly is refused, naming the options.
+"$LANCER" render "$SRC/assets/openscad/screws.csg" --width 48 --height 48 -o "$tmp/s.png" \
+    --stats "$tmp/s.json" >/dev/null 2>"$tmp/log" || { cat "$tmp/log"; fail "example020 refused at the defaults"; }
+grep -q '"auto_level_drop": [1-9]' "$tmp/s.json" || fail "example020 built at the full automatic depth?"
+"$LANCER" render "$SRC/assets/openscad/screws.csg" --scheme brute --width 48 --height 48 -o "$tmp/sb.png" -q
+cmp -s "$tmp/s.png" "$tmp/sb.png" || fail "example020: the regular image differs from brute force's"
+out=$("$LANCER" render "$SRC/assets/openscad/screws.csg" --max-level 30 --max-objects 4 --width 8 --height 8 \
+      -o "$tmp/e.png" 2>&1) && fail "example020 at an explicit --max-level 30 --max-objects 4 accepted"
+echo "$out" | grep -q -- "--max-level 30 --max-objects 4: the regular subdivision would need more than" \
+  || fail "message does not name the options: $out"
+
 "$LANCER" render builtin:default --scheme regular --width 32 --height 32 --threads 2 \
     -o "$tmp/z.png" --stats "$tmp/s.json" >/dev/null 2>"$tmp/log" || { cat "$tmp/log"; fail "render failed"; }
 for key in '"scheme": "regular"' '"full_table_bytes"' '"directory": "sub-tables"' '"leaves"' '"depth_xyz"' '"memory_bytes"'; do

@@ -118,7 +118,7 @@ bool RegularBuilder::stopsByRule(Fragment& f, int level, const Box3& box, const 
         return true;
     }
     if (nodes.load(std::memory_order_relaxed) + 2 > RegularGrid::kMaxBspNodes)
-        throw std::invalid_argument(refusal());
+        throw NodeLimitError(refusal());
     check(f);
     // A cell inside every one of its primitives' boxes is not split: every sub-cell would
     // hold the same primitives, hence the same tree, so splitting only adds leaves. (The
@@ -197,7 +197,7 @@ void RegularBuilder::split(Fragment& f, int id, int level, const Cut& cut, const
     // The node count only grows: a build over the limit passes it at some split whatever
     // the order the tasks make them in.
     if (nodes.fetch_add(2, std::memory_order_relaxed) + 2 > RegularGrid::kMaxBspNodes)
-        throw std::invalid_argument(refusal());
+        throw NodeLimitError(refusal());
     const int first = int(f.bsp.nodes.size());
     f.bsp.nodes.resize(f.bsp.nodes.size() + 2);
     f.bsp.nodes[size_t(id)].first = first;

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,12 @@
 #include "engine/model/restriction.h"
 
 namespace lancer {
+
+/// A build that would pass RegularGrid::kMaxBspNodes: refused with the options to change, or,
+/// in the automatic mode, made again shallower.
+struct NodeLimitError : std::invalid_argument {
+    using std::invalid_argument::invalid_argument;
+};
 
 /// Builds the BSP depth first. Each node's restricted tree is restricted again for its children
 /// (restriction composes: restricting to P then to Q ⊆ P equals restricting to Q), so a node

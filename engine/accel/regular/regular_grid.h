@@ -74,6 +74,8 @@ class RegularGrid {
     /// most) even under a large memory budget; the largest useful builds measured (lattice at
     /// level 21, max-objects 1) need 2.7M.
     static constexpr size_t kMaxBspNodes = size_t(1) << 22;
+    /// The automatic depth is lowered (buildBsp()) no further than this.
+    static constexpr int kMinAutoLevel = 8;
     /// Primitives of a cell whose two halves the build makes as parallel tasks (on balls:6 a
     /// cell of 4096 spheres is about a millisecond of building, far above a task's cost). The
     /// structure does not depend on it, nor on the threads.
