@@ -137,7 +137,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     const int imageW = area.x1 - area.x0, imageH = area.y1 - area.y0;
     // Counts that arrived in the poll: the overlays take them before the keys read them.
     overlays_->setCosts(state_.costs());
-    overlays_->update(state_.sceneBuild(), state_.camera(), imageW, imageH);
+    overlays_->update(state_.sceneBuild(), state_.camera(), imageW, imageH, cameraMoving());
     inspector_->setShown(s.showInspector);
     inspector_->update(state_.sceneBuild(),
                        {state_.camera(), std::max(state_.width(), 1), std::max(state_.height(), 1)},
@@ -343,17 +343,19 @@ std::vector<std::string> ViewerApp::applyInspectorShow(const std::vector<std::st
     return left;
 }
 
+bool ViewerApp::cameraMoving() const {
+    return cameraTurning_ || (ImGui::IsAnyMouseDown() && !ImGui::GetIO().WantCaptureMouse);
+}
+
 void ViewerApp::prepareOverlays(int fbWidth, int fbHeight) {
     const Clock::time_point start = Clock::now();
     const uint64_t version = overlays_->layerVersion();
     const Camera& camera = state_.camera();
-    overlays_->update(state_.sceneBuild(), camera, fbWidth, fbHeight);
+    overlays_->update(state_.sceneBuild(), camera, fbWidth, fbHeight, cameraMoving());
     // While a drag moves the camera the layers are drawn capped (the longest lines; none if
     // the cap is 0) rather than whole each frame: all of balls4's regular leaves take llvmpipe
     // a quarter of a second. They are drawn whole when the drag ends.
-    const bool dragging =
-        (cameraTurning_ || (ImGui::IsAnyMouseDown() && !ImGui::GetIO().WantCaptureMouse)) &&
-        overlays_->layerStale(camera, fbWidth, fbHeight);
+    const bool dragging = cameraMoving() && overlays_->layerStale(camera, fbWidth, fbHeight);
     const unsigned layer = overlays_->layerTexture(camera, fbWidth, fbHeight, dragging);
     if (layer != 0 && !overlayShown_ && view_->width() > 0)
         uploadImage(0, -1);  // colour bands bypass colorTex

@@ -62,6 +62,8 @@ class ViewerApp {
     /// A scripted turn (`lancer view --orbit`) moves the camera in this frame: the overlays are
     /// drawn as while a drag moves it (capped to the longest lines), and whole once it stops.
     void setCameraTurning(bool turning) { cameraTurning_ = turning; }
+    /// A drag over the image or a scripted turn may move the camera in this frame.
+    bool cameraMoving() const;
     /// Write the framebuffer as drawn by the last frame() to a PNG or JPEG (by the path's
     /// extension). Throws std::runtime_error.
     void saveScreenshot(const std::string& path, int fbWidth, int fbHeight) const;

@@ -468,6 +468,26 @@ TEST(Overlays, ARebuildAtAnotherMaxLevelChangesTheDrawnLeavesAndOnlyThen) {
     EXPECT_GT(changed, 10u);
 }
 
+TEST(Overlays, BatchesCulledForAViewAreCulledAgainOnlyOnceTheCameraRests) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Regular, 8);
+    Camera cam = s->scene->camera;
+    Overlays ov;
+    ov.options.leaves = true;
+    ov.options.cap = 3;  // fewer than the leaves: culled by visibility, for the camera
+    ov.update(s, cam, kW, kH);
+    ASSERT_TRUE(ov.geometry().cameraDependent);
+    const uint64_t builds = ov.rebuilds();
+    cam.from.y += 0.5;
+    ov.update(s, cam, kW, kH, true);
+    EXPECT_EQ(ov.rebuilds(), builds) << "culled again at each step of a drag";
+    ov.update(s, cam, kW, kH, false);
+    EXPECT_EQ(ov.rebuilds(), builds + 1) << "not culled again once the camera rests";
+    ov.update(s, cam, kW, kH, false);
+    EXPECT_EQ(ov.rebuilds(), builds + 1);
+}
+
 TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShows) {
     OffscreenGl gl(kW, kH);
     ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";

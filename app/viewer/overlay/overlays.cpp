@@ -62,7 +62,7 @@ bool Overlays::select(uint32_t id) {
 }
 
 void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const Camera& view,
-                      int width, int height) {
+                      int width, int height, bool moving) {
     if (structure && structure != structure_) {
         // The new structure replaces the old one only now that it is ready: until then the old
         // overlays stayed on screen. Region ids of the old one mean nothing in the new one.
@@ -80,9 +80,12 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
     std::shared_ptr<const ImageCosts> costs;
     if (options.usesCosts() && costsFit(costs_.get(), structure_.get(), options.costRays))
         costs = costs_;
+    // Batches over the cap are culled for a view. Culled again at each step of a drag, balls4's
+    // BVH nodes (over 100,000) took 68 ms of every frame (2026-12-06, scripts/frame-times): the
+    // batches are in world space, so those of an earlier view are drawn right, only fewer.
+    const bool viewMoved = geometry_.cameraDependent && !sameCamera(builtCamera_, view);
     const bool stale = !built_ || builtOptions_ != options || builtWidth_ != width ||
-                       builtHeight_ != height || costs != builtCosts_ ||
-                       (geometry_.cameraDependent && !sameCamera(builtCamera_, view));
+                       builtHeight_ != height || costs != builtCosts_ || (viewMoved && !moving);
     if (!stale) return;
     const auto t0 = std::chrono::steady_clock::now();
     geometry_ = options.any() ? buildOverlayGeometry(*view_, view, width, height, options,

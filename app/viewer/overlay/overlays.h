@@ -49,9 +49,10 @@ class Overlays {
 
     /// Take the structure on screen (null: none yet) and rebuild the batches if the structure,
     /// the camera they depend on, the size or the options changed. Until a new structure
-    /// arrives the previous one's overlays stay.
+    /// arrives the previous one's overlays stay. While the camera is `moving` (a drag), batches
+    /// culled for an earlier view are kept: they are culled again once it rests.
     void update(const std::shared_ptr<const SceneBuild>& structure, const Camera& view, int width,
-                int height);
+                int height, bool moving = false);
     /// Draw the layers and the selection into the current framebuffer (width x height, the
     /// image filling it), as seen by `view`.
     void draw(const Camera& view, int width, int height) {
