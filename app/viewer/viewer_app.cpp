@@ -32,7 +32,8 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
       view_(std::make_unique<ImageView>()),
       overlays_(std::make_unique<overlay::Overlays>()),
       logTimings_(logTimings),
-      inspector_(std::make_unique<inspector::Inspector>(std::move(wake))) {
+      inspector_(std::make_unique<inspector::Inspector>(wake)) {
+    overlays_->buildInBackground(std::move(wake));
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
     // drawn at all, and each is copied from a layer where it is redrawn only when it changes
     // (frame(), PanelCache).
@@ -295,8 +296,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         }
         notes.pendingScreenshot.clear();
     }
-    settled_ = state_.settledSince() && inspector_->settled() && !player_.pending() &&
-               !player_.playback().playing();
+    settled_ = state_.settledSince() && inspector_->settled() && !overlays_->building() &&
+               !overlays_->layerPending() && !player_.pending() && !player_.playback().playing();
     keepSettings();
 }
 
@@ -371,16 +372,15 @@ void ViewerApp::logOverlayTiming(double ms, bool layerDrawn) {
     // change): those are logged one by one.
     if (layerDrawn) {
         const overlay::OverlayGeometry& g = overlays_->geometry();
-        size_t lines = g.cuts.lineCount() + g.wires.lineCount();
-        if (overlays_->layerPartial())
-            lines = std::min(g.cuts.lineCount(), overlays_->look.movingLines) +
-                    std::min(g.wires.lineCount(), overlays_->look.movingLines);
+        const bool moving = overlays_->layerPartial() && !overlays_->layerPending();
         std::fprintf(stderr,
-                     "timing: overlays: layers drawn again%s in %.2f ms (%zu lines, %zu "
+                     "timing: overlays: layers drawn again%s in %.2f ms (%zu of %zu lines, %zu "
                      "triangles; batches built in %.2f ms)\n",
-                     overlays_->layerPartial() ? " while the camera moves" : "",
-                     overlays_->lastLayerMs(), lines, g.fills.triangleCount(),
-                     overlays_->lastBuildMs());
+                     moving                      ? " while the camera moves"
+                     : overlays_->layerPending() ? ", a part"
+                                                 : "",
+                     overlays_->lastLayerMs(), overlays_->layerDrawn(), overlays_->layerLines(),
+                     g.fills.triangleCount(), overlays_->lastBuildMs());
         return;
     }
     overlayStat_.ms += ms;

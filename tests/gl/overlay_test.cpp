@@ -3,7 +3,10 @@
 // project, the level range, a rebuild at another max-level, and the --show list.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <condition_variable>
 #include <map>
+#include <mutex>
 #include <set>
 #include <stdexcept>
 
@@ -486,6 +489,121 @@ TEST(Overlays, BatchesCulledForAViewAreCulledAgainOnlyOnceTheCameraRests) {
     EXPECT_EQ(ov.rebuilds(), builds + 1) << "not culled again once the camera rests";
     ov.update(s, cam, kW, kH, false);
     EXPECT_EQ(ov.rebuilds(), builds + 1);
+}
+
+TEST(Overlays, BuiltInTheBackgroundTheBatchesComeAtALaterUpdateAndEqualTheDirectBuild) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto coarse = twoBoxes(SchemeKind::Regular, 3), fine = twoBoxes(SchemeKind::Regular, 8);
+    const Camera& cam = coarse->scene->camera;
+    Overlays direct;
+    direct.options.leaves = true;
+    direct.update(fine, cam, kW, kH);
+
+    std::mutex m;
+    std::condition_variable cv;
+    int woken = 0;
+    Overlays ov;
+    ov.buildInBackground([&] {
+        std::lock_guard lock(m);
+        ++woken;
+        cv.notify_all();
+    });
+    ov.options.leaves = true;
+    auto waitFor = [&](int n) {
+        std::unique_lock lock(m);
+        return cv.wait_for(lock, std::chrono::seconds(30), [&] { return woken >= n; });
+    };
+    ov.update(coarse, cam, kW, kH);
+    EXPECT_EQ(ov.rebuilds(), 0u) << "update() does not wait for the worker";
+    EXPECT_TRUE(ov.building());
+    ASSERT_TRUE(waitFor(1));
+    // A new structure while nothing is under way: the finished batches are taken, then the new
+    // structure's are begun, and the coarse ones stay until they come.
+    ov.update(fine, cam, kW, kH);
+    EXPECT_EQ(ov.rebuilds(), 1u);
+    EXPECT_TRUE(ov.building());
+    const size_t coarseLines = ov.geometry().wires.lineCount();
+    ASSERT_TRUE(waitFor(2));
+    ov.update(fine, cam, kW, kH);
+    EXPECT_EQ(ov.rebuilds(), 2u);
+    EXPECT_FALSE(ov.building()) << "nothing changed since: no build begun";
+    EXPECT_GT(ov.geometry().wires.lineCount(), coarseLines);
+    EXPECT_EQ(ov.geometry().wires.lineCount(), direct.geometry().wires.lineCount());
+    EXPECT_TRUE(viewer::testing::sameLineCover(leafEdges(*ov.view()), ov.geometry().wires));
+    EXPECT_EQ(drawn(gl, ov, cam), drawn(gl, direct, cam));
+}
+
+TEST(Overlays, AtRestALargeLayerIsDrawnInPartsLongestFirstUntilWhole) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Regular, 8);
+    const Camera& cam = s->scene->camera;
+    Overlays ov;
+    ov.options.leaves = true;
+    ov.look.lineOpacity = 1.0f;
+    ov.update(s, cam, kW, kH);
+    const size_t total = ov.layerLines();
+    ASSERT_GT(total, 12u);
+    ov.look.restLines = total / 4 + 1;  // four parts
+    ov.look.restMs = 0.0;               // one a call
+    Image black(kW, kH);
+    ImageView view;
+    view.upload(black, ViewMode::Color);
+    auto composited = [&](unsigned tex) {
+        view.setOverlay(tex, ov.layerVersion());
+        gl.clear(0, 0, 0);
+        view.draw(kW, kH, ViewMode::Color, 1.0f);
+        return gl.read();
+    };
+    auto litCount = [](const std::vector<uint8_t>& px) {
+        size_t n = 0;
+        for (int y = 0; y < kH; ++y)
+            for (int x = 0; x < kW; ++x) n += lit(px, x, y);
+        return n;
+    };
+    gl.clear(0, 0, 0);
+    ov.drawLayers(cam, kW, kH);
+    const std::vector<uint8_t> whole = gl.read();
+    // The first part: the longest lines only, a layer still pending.
+    unsigned tex = ov.layerTexture(cam, kW, kH);
+    ASSERT_NE(tex, 0u);
+    EXPECT_TRUE(ov.layerPending());
+    EXPECT_TRUE(ov.layerStale(cam, kW, kH));
+    EXPECT_EQ(ov.layerDrawn(), ov.look.restLines);
+    const size_t firstLit = litCount(composited(tex));
+    EXPECT_GT(firstLit, 0u);
+    EXPECT_LT(firstLit, litCount(whole));
+    // Each call draws the next part on it; the fourth ends it.
+    int calls = 1;
+    while (ov.layerPending() && calls < 100) {
+        ov.layerTexture(cam, kW, kH);
+        ++calls;
+        EXPECT_EQ(ov.layerDrawn(), std::min(size_t(calls) * ov.look.restLines, total));
+    }
+    EXPECT_EQ(calls, 4);
+    EXPECT_FALSE(ov.layerPartial());
+    EXPECT_FALSE(ov.layerStale(cam, kW, kH));
+    const uint64_t version = ov.layerVersion();
+    EXPECT_EQ(ov.layerTexture(cam, kW, kH), tex);
+    EXPECT_EQ(ov.layerVersion(), version) << "whole: not drawn again";
+    // Whole, it lights the pixels the layer drawn at once lights (in another order, so where
+    // two colours cross either may be on top).
+    const std::vector<uint8_t> parts = composited(tex);
+    size_t differ = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) differ += lit(parts, x, y) != lit(whole, x, y);
+    EXPECT_EQ(differ, 0u);
+    // A moving camera's cap is the first part: once it rests, the layer goes on from there.
+    Camera moved = cam;
+    moved.from.x += 0.5;
+    ov.look.movingLines = 3;
+    ov.layerTexture(moved, kW, kH, true);
+    EXPECT_EQ(ov.layerDrawn(), 3u);
+    EXPECT_FALSE(ov.layerPending()) << "moving: capped, not pending";
+    ov.layerTexture(moved, kW, kH);
+    EXPECT_EQ(ov.layerDrawn(), 3u + ov.look.restLines);
+    EXPECT_TRUE(ov.layerPending());
 }
 
 TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShows) {

@@ -67,7 +67,7 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
         // The new structure replaces the old one only now that it is ready: until then the old
         // overlays stayed on screen. Region ids of the old one mean nothing in the new one.
         structure_ = structure;
-        view_ = std::make_unique<StructureView>(*structure->scene, *structure->accel);
+        view_ = std::make_shared<const StructureView>(*structure->scene, *structure->accel);
         built_ = false;
         if (selection_ && !select(selection_->region)) selection_.reset();
         if (hasPendingSelect_) {
@@ -76,6 +76,13 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
         }
     }
     if (!view_) return;
+    if (job_.valid()) {  // a build under way: the batches on screen stay until it is done
+        if (job_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+        OverlayGeometry g = job_.get();
+        take(std::move(g), jobInputs_,
+             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - jobStart_)
+                 .count());
+    }
     // The counts a cost colouring reads: the last complete image's, on this structure.
     std::shared_ptr<const ImageCosts> costs;
     if (options.usesCosts() && costsFit(costs_.get(), structure_.get(), options.costRays))
@@ -84,26 +91,93 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
     // BVH nodes (over 100,000) took 68 ms of every frame (2026-12-06, scripts/frame-times): the
     // batches are in world space, so those of an earlier view are drawn right, only fewer.
     const bool viewMoved = geometry_.cameraDependent && !sameCamera(builtCamera_, view);
-    const bool stale = !built_ || builtOptions_ != options || builtWidth_ != width ||
-                       builtHeight_ != height || costs != builtCosts_ || (viewMoved && !moving);
+    const bool stale = !built_ || builtView_ != view_.get() || builtOptions_ != options ||
+                       builtWidth_ != width || builtHeight_ != height || costs != builtCosts_ ||
+                       (viewMoved && !moving);
     if (!stale) return;
-    const auto t0 = std::chrono::steady_clock::now();
-    geometry_ = options.any() ? buildOverlayGeometry(*view_, view, width, height, options,
-                                                     costs ? &costs->costs : nullptr)
-                              : OverlayGeometry{};
-    builtCosts_ = costs;
+    BuildInputs in{view_, view, width, height, options, costs};
+    if (!background_) {
+        const auto t0 = std::chrono::steady_clock::now();
+        OverlayGeometry g = build(in);
+        take(std::move(g), in,
+             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                 .count());
+        return;
+    }
+    // On the worker: balls4's slabs (1.2 M lines) took the UI thread 0.83 s a structure
+    // (2026-12-06, scripts/frame-times). The worker before it has set its result: joined at once.
+    if (worker_.joinable()) worker_.join();
+    std::promise<OverlayGeometry> done;
+    job_ = done.get_future();
+    jobInputs_ = in;
+    jobStart_ = std::chrono::steady_clock::now();
+    worker_ = std::jthread([done = std::move(done), in, wake = wake_]() mutable {
+        try {
+            done.set_value(build(in));
+        } catch (...) {  // rethrown by update(), as when it builds them itself
+            done.set_exception(std::current_exception());
+        }
+        if (wake) wake();
+    });
+}
+
+void Overlays::buildInBackground(std::function<void()> wake) {
+    background_ = true;
+    wake_ = std::move(wake);
+}
+
+OverlayGeometry Overlays::build(const BuildInputs& in) {
+    if (!in.options.any()) return {};
+    return buildOverlayGeometry(*in.view, in.camera, in.width, in.height, in.options,
+                                in.costs ? &in.costs->costs : nullptr);
+}
+
+void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms) {
+    geometry_ = std::move(geometry);
     cuts_->upload(geometry_.cuts);
     fills_->upload(geometry_.fills);
     wires_->upload(geometry_.wires);
     wiresLongestFirst_->upload(geometry_.wiresLongestFirst);
-    lastBuildMs_ =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    builtOptions_ = options;
-    builtCamera_ = view;
-    builtWidth_ = width;
-    builtHeight_ = height;
+    lastBuildMs_ = ms;
+    builtView_ = in.view.get();
+    builtCosts_ = in.costs;
+    builtOptions_ = in.options;
+    builtCamera_ = in.camera;
+    builtWidth_ = in.width;
+    builtHeight_ = in.height;
     built_ = true;
     ++rebuilds_;
+}
+
+void Overlays::drawLayerPart(const Camera& view, int width, int height, size_t first,
+                             size_t count) {
+    if (!view_ || width <= 0 || height <= 0 || !options.any() || count == 0) return;
+    const auto [nearDepth, farDepth] = clipDepths(*view_, view);
+    const glm::mat4 toClip = gl::worldToClip(view, width, height, nearDepth, farDepth);
+    glViewport(0, 0, width, height);
+    const size_t end = count > SIZE_MAX - first ? SIZE_MAX : first + count;
+    gl::DrawOptions fill;
+    fill.opacity = look.fillOpacity;
+    fill.lines = false;
+    fill.firstTriangle = first > SIZE_MAX / 2 ? SIZE_MAX : 2 * first;  // a zone is two triangles
+    fill.triangleLimit = count > SIZE_MAX / 2 ? SIZE_MAX : 2 * count;
+    renderer_->draw(*fills_, toClip, fill);
+    gl::DrawOptions wire;
+    wire.opacity = look.lineOpacity;
+    wire.triangles = false;
+    wire.firstLine = first;
+    wire.lineLimit = count;
+    renderer_->draw(*wiresLongestFirst_, toClip, wire);
+    gl::DrawOptions cuts = wire;  // in cut order: shallow first, up to the replayed cut
+    const size_t replayed =
+        look.replayCuts >= 0 ? size_t(look.replayCuts) * geometry_.linesPerCut : SIZE_MAX;
+    cuts.lineLimit = std::min(replayed, end) > first ? std::min(replayed, end) - first : 0;
+    renderer_->draw(*cuts_, toClip, cuts);
+}
+
+size_t Overlays::layerLines() const {
+    return std::max({geometry_.wires.lineCount(), geometry_.cuts.lineCount(),
+                     geometry_.fills.triangleCount() / 2});
 }
 
 void Overlays::drawLayers(const Camera& view, int width, int height, size_t lines) {
@@ -159,10 +233,10 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
     if (!view_ || !options.any() || width <= 0 || height <= 0) return 0;
     if (!layerStale(view, width, height)) return layerTex_;
     if (moving && look.movingLines == 0) return 0;
-    if (moving && layerTex_ != 0 && layerPartial_ && layerRebuild_ == rebuilds_ &&
-        layerWidth_ == width && layerHeight_ == height && layerLook_ == look &&
-        sameCamera(layerCamera_, view))
-        return layerTex_;  // the capped layer of this very view
+    const bool sameLayer = layerTex_ != 0 && layerRebuild_ == rebuilds_ && layerWidth_ == width &&
+                           layerHeight_ == height && layerLook_ == look &&
+                           sameCamera(layerCamera_, view);
+    if (moving && layerPartial_ && sameLayer) return layerTex_;  // the capped layer of this view
     if (layerTex_ == 0) {
         glGenTextures(1, &layerTex_);
         glGenFramebuffers(1, &layerFbo_);
@@ -185,9 +259,32 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
     glBindFramebuffer(GL_FRAMEBUFFER, layerFbo_);
     glDisable(GL_SCISSOR_TEST);
     glViewport(0, 0, width, height);
-    glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-    glClear(GL_COLOR_BUFFER_BIT);
-    drawLayers(view, width, height, moving ? look.movingLines : SIZE_MAX);
+    // At rest a layer too large for one frame goes on from where the texture stands (a moving
+    // camera's cap is its first part, longest lines first); else it starts afresh.
+    const size_t total = layerLines();
+    const bool inParts = !moving && total > look.restLines;
+    const bool resume = inParts && sameLayer && layerPartial_ && layerDrawn_ < total;
+    if (!resume) {
+        glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        layerDrawn_ = 0;
+    }
+    if (moving) {
+        drawLayers(view, width, height, look.movingLines);
+        layerDrawn_ = std::min(look.movingLines, total);
+    } else if (inParts) {  // parts until the frame's share is spent (GL finished: timed)
+        do {
+            const size_t part = std::min(std::max<size_t>(look.restLines, 1), total - layerDrawn_);
+            drawLayerPart(view, width, height, layerDrawn_, part);
+            layerDrawn_ += part;
+            glFinish();
+        } while (layerDrawn_ < total &&
+                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                         .count() < look.restMs);
+    } else {  // whole in one frame, the wireframe in its own order
+        drawLayers(view, width, height, SIZE_MAX);
+        layerDrawn_ = total;
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     // Finished here, so the time is the drawing's (it happens on a change only).
     glFinish();
@@ -196,7 +293,8 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
     layerRebuild_ = rebuilds_;
     layerLook_ = look;
     layerCamera_ = view;
-    layerPartial_ = moving;
+    layerMoving_ = moving;
+    layerPartial_ = moving || layerDrawn_ < total;
     ++layerVersion_;
     return layerTex_;
 }

@@ -5,9 +5,12 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "app/viewer/gl/batch.h"
 #include "app/viewer/image_costs.h"
@@ -27,6 +30,13 @@ struct OverlayLook {
     /// Wireframe lines drawn while the camera moves (the longest first; cut lines and fills
     /// capped alike): the whole layer is drawn again when it rests. 0: none while it moves.
     size_t movingLines = 2000;
+    /// At rest a layer of more lines than this is drawn in parts of this many, the longest
+    /// lines first (cut lines and fills in step), parts added in a frame until restMs have
+    /// passed, and completed over the next frames: no frame draws it whole (balls4's 1.2 M
+    /// slab lines took one frame 0.43-0.79 s, 2026-12-06).
+    size_t restLines = 2000;
+    /// Milliseconds of a frame at rest given to drawing the layer's parts (0: one part a frame).
+    double restMs = 12.0;
 };
 
 /// The region picked in the image (or set by --select, or by the inspector).
@@ -71,6 +81,10 @@ class Overlays {
     }
     /// The layers with at most `lines` wireframe lines (the longest), cut lines and fills.
     void drawLayers(const Camera& view, int width, int height, size_t lines);
+    /// The layers' part [first, first + count) (OverlayGeometry::wiresLongestFirst's lines,
+    /// the cut lines in cut order and the zones' fills with the same indices): the parts
+    /// [0, a) then [a, b) draw what drawLayers(view, width, height, b) draws.
+    void drawLayerPart(const Camera& view, int width, int height, size_t first, size_t count);
     /// The selection's highlight alone (a few lines and faces: cheap to draw every frame), in
     /// a width x height viewport whose lower-left corner is framebuffer pixel (x0, y0) (GL's
     /// rows: the image viewport).
@@ -81,13 +95,22 @@ class Overlays {
     /// lines cost nothing in a frame where nothing changed. 0 when no layer is on.
     /// With `moving` (the camera is being moved), the texture holds only the first
     /// look.movingLines lines (OverlayGeometry::wiresLongestFirst) and is drawn whole again
-    /// at the first call without; 0 while moving when look.movingLines is 0.
+    /// at the first call without; 0 while moving when look.movingLines is 0. At rest a layer
+    /// of more than look.restLines lines is drawn in parts of look.restLines, longest first,
+    /// for look.restMs at each call, until it is whole (layerPending()).
     unsigned layerTexture(const Camera& view, int width, int height, bool moving = false);
     /// layerTexture() would draw the texture again (or has none to give); a texture drawn
     /// while moving is stale once the camera rests.
     bool layerStale(const Camera& view, int width, int height) const;
-    /// The texture holds a moving camera's capped layer.
+    /// The texture holds a moving camera's capped layer, or a layer not yet drawn whole.
     bool layerPartial() const { return layerPartial_; }
+    /// At rest, the layer is being drawn over several frames: more calls to layerTexture()
+    /// complete it.
+    bool layerPending() const { return layerPartial_ && !layerMoving_ && options.any() && view_; }
+    /// Lines of the layer drawn into the texture so far, of layerLines().
+    size_t layerDrawn() const { return layerDrawn_; }
+    /// The layer's lines (the wireframe's, or the cuts' or zones' when they are more).
+    size_t layerLines() const;
     /// Milliseconds the last drawing of the layers' texture took (to the end of GL's work).
     double lastLayerMs() const { return lastLayerMs_; }
     /// Incremented each time layerTexture() draws the texture again.
@@ -123,6 +146,12 @@ class Overlays {
     const StructureView* view() const { return view_.get(); }
     /// The structure it describes (null before the first).
     const SceneBuild* structure() const { return structure_.get(); }
+    /// Build the batches on a worker thread from now on, `wake` (may be empty) called from it
+    /// when they are ready (the viewer: a frame never waits for them; until they come the
+    /// previous ones are drawn). Otherwise (tests) update() builds them itself.
+    void buildInBackground(std::function<void()> wake);
+    /// A build of the batches is under way on the worker.
+    bool building() const { return job_.valid(); }
     /// The cached geometry (what the last update built).
     const OverlayGeometry& geometry() const { return geometry_; }
     /// Times the batches were rebuilt (tests: a change rebuilds, nothing else does).
@@ -136,8 +165,20 @@ class Overlays {
     void leafColorCombo(const char* label);
     void costLine();
 
+    /// What a build of the batches reads: taken whole, so a worker reads nothing that changes.
+    struct BuildInputs {
+        std::shared_ptr<const StructureView> view;
+        Camera camera;
+        int width = 0, height = 0;
+        OverlayOptions options;
+        std::shared_ptr<const ImageCosts> costs;
+    };
+    static OverlayGeometry build(const BuildInputs& in);
+    /// The built geometry into the GL batches, and what it was built for.
+    void take(OverlayGeometry geometry, const BuildInputs& in, double ms);
+
     std::shared_ptr<const SceneBuild> structure_;
-    std::unique_ptr<StructureView> view_;
+    std::shared_ptr<const StructureView> view_;
     std::unique_ptr<gl::BatchRenderer> renderer_;
     std::unique_ptr<gl::GpuBatch> cuts_, fills_, wires_, wiresLongestFirst_;
     OverlayGeometry geometry_;
@@ -148,6 +189,7 @@ class Overlays {
     Camera builtCamera_;
     int builtWidth_ = 0, builtHeight_ = 0;
     bool built_ = false;
+    const StructureView* builtView_ = nullptr;  ///< the structure's description they show
     uint64_t rebuilds_ = 0;
     double lastBuildMs_ = 0.0;
     // The layers' texture and what it was drawn for.
@@ -156,6 +198,8 @@ class Overlays {
     uint64_t layerVersion_ = 0, layerRebuild_ = ~uint64_t(0);
     double lastLayerMs_ = 0.0;
     bool layerPartial_ = false;
+    bool layerMoving_ = false;  ///< the partial texture is a moving camera's cap
+    size_t layerDrawn_ = 0;     ///< layerDrawn()
     Camera layerCamera_;
     OverlayLook layerLook_;
     std::optional<Selection> selection_;
@@ -164,6 +208,13 @@ class Overlays {
     std::vector<NodeSpans> evalNodes_;
     uint32_t pendingSelect_ = 0;
     bool hasPendingSelect_ = false;
+    // buildInBackground(): the build under way, what it reads and when it began.
+    bool background_ = false;
+    std::function<void()> wake_;
+    std::future<OverlayGeometry> job_;
+    BuildInputs jobInputs_;
+    std::chrono::steady_clock::time_point jobStart_;
+    std::jthread worker_;  ///< last: joined before the rest is destroyed
 };
 
 /// The names --show accepts (DESIGN.md section 6), and which of them the overlays draw.
