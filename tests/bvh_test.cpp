@@ -394,7 +394,8 @@ TEST(Bvh, WideBoxTestHoldsTheDoubleOne) {
                     for (uint32_t w = 0; w < b.wides().size(); ++w) {
                         const BvhWideNode& wn = b.wides()[w];
                         BvhEntry c[kBvhWidth];
-                        const int n = boxes.children({kNoNode, w, 0.0f, 0.0f}, tmin, kInf, c);
+                        const int n =
+                            boxes.children({kNoNode, w, 0.0f, 0.0f}, floatDown(tmin), INFINITY, c);
                         for (int k = 0; k < kBvhWidth; ++k) {
                             if (wn.node[k] == kNoNode) continue;
                             double t0, t1;

@@ -272,8 +272,8 @@ struct BvhBuilder {
             // Outward: the float nearest below (above) the box's side less the anchor, then
             // one float further, for the double subtraction's own rounding.
             for (int a = 0; a < 3; ++a) {
-                wn.lo[a][k] = std::nextafter(floatDown(c.lo[a] - out.anchor_[a]), -INFINITY);
-                wn.hi[a][k] = std::nextafter(floatUp(c.hi[a] - out.anchor_[a]), INFINITY);
+                wn.lo[a][k] = floatBelow(floatDown(c.lo[a] - out.anchor_[a]));
+                wn.hi[a][k] = floatAbove(floatUp(c.hi[a] - out.anchor_[a]));
             }
             if (!c.leaf) {
                 wn.wide[k] = uint32_t(out.wides_.size());

@@ -162,10 +162,11 @@ class Bvh {
     template <class Boxes, class Obs>
     bool walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
                    double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const;
-    /// Inner entry `e`'s children the ray may meet within [tmin, tmax], pushed far ones first
-    /// so that the nearest is walked next; told to the observer.
+    /// Inner entry `e`'s children the ray may meet within [tmin, tmax] (float bounds, rounded
+    /// outward), pushed far ones first so that the nearest is walked next; told to the
+    /// observer.
     template <class Boxes, class Obs>
-    void pushChildren(const Boxes& boxes, const BvhEntry& e, double tmin, double tmax,
+    void pushChildren(const Boxes& boxes, const BvhEntry& e, float tmin, float tmax,
                       BvhEntry* stack, int& sp, Obs& obs) const;
     /// Tells the observer inner entry `e`'s children met: c[0, n), the nearest first.
     template <class Obs>
@@ -242,7 +243,7 @@ template <class Obs>
 
 template <class Boxes, class Obs>
 [[gnu::always_inline]] inline void Bvh::pushChildren(const Boxes& boxes, const BvhEntry& e,
-                                                     double tmin, double tmax, BvhEntry* stack,
+                                                     float tmin, float tmax, BvhEntry* stack,
                                                      int& sp, Obs& obs) const {
     BvhEntry* const c = stack + sp;
     const int n = boxes.children(e, tmin, tmax, c);
@@ -284,6 +285,8 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
     // Nodes whose box begins beyond `reach` are culled: the nearest start found; with kAnyHit,
     // tmin once a start is found (only the boxes holding the ray's start are left to walk).
     double reach = tmax;
+    const float tminF = floatDown(tmin);
+    float reachF = floatUp(reach);  // for the float box tests
     while (sp > 0) {
         const BvhEntry e = stack[--sp];
         if (e.t0 > reach) {
@@ -293,7 +296,7 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
         ++ctx.counters.regionVisits;
         obs.region(e.node, e.t0, std::min(double(e.t1), first.t));
         if (!e.leaf()) {
-            pushChildren(boxes, e, tmin, reach, stack, sp, obs);
+            pushChildren(boxes, e, tminF, reachF, stack, sp, obs);
             continue;
         }
         const BvhNode& n = nodes_[e.node];
@@ -313,6 +316,7 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
                     found = true;
                     tie = false;
                     reach = kAnyHit ? tmin : first.t;
+                    reachF = floatUp(reach);
                 } else if (found && sp2.in.t == first.t) {
                     tie = !kAnyHit;
                 }
@@ -340,6 +344,7 @@ bool Bvh::walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, do
     SpanList& spans = ctx.leafSpans;  // the spans met so far that end after tmin
     spans.clear();
     double best = tmax;  // the union's first boundary after tmin among the spans known
+    const float tminF = floatDown(tmin), tmaxF = floatUp(tmax);  // for the float box tests
     bool found = false;
     while (!heap.empty()) {
         std::pop_heap(heap.begin(), heap.end(), later);
@@ -353,7 +358,7 @@ bool Bvh::walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, do
         obs.region(e.node, e.t0, std::min(double(e.t1), best));
         if (!e.leaf()) {
             BvhEntry c[kBvhWidth];
-            const int n = boxes.children(e, tmin, tmax, c);
+            const int n = boxes.children(e, tminF, tmaxF, c);
             for (int k = 0; k < n; ++k) {
                 heap.push_back(c[k]);
                 std::push_heap(heap.begin(), heap.end(), later);
@@ -401,6 +406,8 @@ bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, Tra
     BvhEntry stack[kWalkStack];
     int sp = 0;
     double best = tmax;  // the leaves' windows end at the nearest hit found so far
+    const float tminF = floatDown(tmin);
+    float bestF = floatUp(best);  // for the float box tests
     bool found = false;
     if (!boxes.root(tmin, tmax, stack[sp++])) return false;
     while (sp > 0) {
@@ -426,6 +433,7 @@ bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, Tra
             if (hitInLeafBox(n, ray, tmin, t0, t1, ctx, obs, h) && (!found || h.t < best)) {
                 hit = h;
                 best = h.t;
+                bestF = floatUp(best);
                 found = true;
                 if constexpr (kAnyHit) return true;
             }
@@ -433,7 +441,7 @@ bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, Tra
         }
         ++ctx.counters.regionVisits;
         obs.region(e.node, e.t0, std::min(double(e.t1), best));
-        pushChildren(boxes, e, tmin, best, stack, sp, obs);
+        pushChildren(boxes, e, tminF, bestF, stack, sp, obs);
     }
     return found;
 }
