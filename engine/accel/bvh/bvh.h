@@ -163,9 +163,9 @@ class Bvh {
     bool walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
                    double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const;
     /// Inner entry `e`'s children the ray may meet within [tmin, tmax] (float bounds, rounded
-    /// outward), pushed far ones first so that the nearest is walked next; told to the
-    /// observer.
-    template <class Boxes, class Obs>
+    /// outward), pushed far ones first so that the nearest is walked next (kNearFirst; else in
+    /// the node's order); told to the observer.
+    template <bool kNearFirst, class Boxes, class Obs>
     void pushChildren(const Boxes& boxes, const BvhEntry& e, float tmin, float tmax,
                       BvhEntry* stack, int& sp, Obs& obs) const;
     /// Tells the observer inner entry `e`'s children met: c[0, n), the nearest first.
@@ -241,14 +241,14 @@ template <class Obs>
     return b != nullptr;
 }
 
-template <class Boxes, class Obs>
+template <bool kNearFirst, class Boxes, class Obs>
 [[gnu::always_inline]] inline void Bvh::pushChildren(const Boxes& boxes, const BvhEntry& e,
                                                      float tmin, float tmax, BvhEntry* stack,
                                                      int& sp, Obs& obs) const {
     BvhEntry* const c = stack + sp;
     const int n = boxes.children(e, tmin, tmax, c);
     // Far to near: the nearest on top. At most four, so an insertion sort in place.
-    for (int i = 1; i < n; ++i) {
+    for (int i = 1; kNearFirst && i < n; ++i) {
         const BvhEntry x = c[i];
         int j = i;
         for (; j > 0 && c[j - 1].t0 < x.t0; --j) c[j] = c[j - 1];
@@ -296,7 +296,8 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
         ++ctx.counters.regionVisits;
         obs.region(e.node, e.t0, std::min(double(e.t1), first.t));
         if (!e.leaf()) {
-            pushChildren(boxes, e, tminF, reachF, stack, sp, obs);
+            // A shadow ray's walk ends at any start: the order only costs.
+            pushChildren<!kAnyHit>(boxes, e, tminF, reachF, stack, sp, obs);
             continue;
         }
         const BvhNode& n = nodes_[e.node];
@@ -441,7 +442,7 @@ bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, Tra
         }
         ++ctx.counters.regionVisits;
         obs.region(e.node, e.t0, std::min(double(e.t1), best));
-        pushChildren(boxes, e, tminF, bestF, stack, sp, obs);
+        pushChildren<!kAnyHit>(boxes, e, tminF, bestF, stack, sp, obs);
     }
     return found;
 }

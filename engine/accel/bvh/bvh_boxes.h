@@ -106,21 +106,19 @@ inline float floatUp(double x) {
     return double(f) < x ? floatAbove(f) : f;
 }
 
-/// Whether the ray's inverse direction along axis `a` does not fit a float (a zero or denormal
-/// direction): the float walk tests that axis by the origin's place.
-inline bool flatAxis(const Ray& r, int a) {
-    return r.d[a] == 0.0 || !(std::abs(1.0 / r.d[a]) <= double(FLT_MAX));
-}
+/// Whether the ray's direction along axis `a` is too small for its inverse to fit a float
+/// (zero, or below 2^-126): the float walk tests that axis by the origin's place.
+inline bool flatAxis(const Ray& r, int a) { return !(std::abs(r.d[a]) >= 0x1p-126); }
 /// Whether some axis of the ray is flatAxis().
 inline bool hasFlatAxis(const Ray& r) { return flatAxis(r, 0) || flatAxis(r, 1) || flatAxis(r, 2); }
 
 /// Reads the wide nodes with the ray in float. Each child's interval is computed from the near
 /// and far face along each axis (chosen once per ray by the direction's sign), with an origin
-/// rounded toward the side that makes the near t smaller and the far t larger; the float
+/// moved to the side that makes the near t smaller and the far t larger; the float
 /// subtraction, product and inverse add a relative error of at most 3 ulps, covered by
-/// widening the interval by kSlack of its ends. kParallel: some axis's inverse direction does
-/// not fit a float (a zero or denormal direction); such an axis is tested by the origin's place,
-/// which would miss only a box the ray enters beyond t = 2^126 times the box's distance.
+/// widening the interval by kSlack of its ends. kParallel: some axis is flatAxis(); it is
+/// tested by the origin's place, which would miss only a box the ray enters beyond t = 2^126
+/// times the box's distance along that axis.
 template <bool kParallel>
 struct WideBoxes {
     const BvhNode* nodes;
@@ -140,19 +138,19 @@ struct WideBoxes {
     WideBoxes(const BvhNode* n, const BvhWideNode* w, const Ray& r, const Vec3& anchor)
         : nodes(n), wides(w), slab(r) {
         for (int a = 0; a < 3; ++a) {
-            const double rel = r.o[a] - anchor[a];
-            // The subtraction's own rounding, 2^-53 of the result, is covered by rounding past it.
-            const double up = rel + std::abs(rel) * 0x1p-50, down = rel - std::abs(rel) * 0x1p-50;
+            // The floats one step either side of the nearest to the origin less the anchor
+            // hold the true origin between them: the nearest is within half a step of the
+            // difference, which the subtraction rounds by far less.
+            const float f = float(r.o[a] - anchor[a]), up = floatAbove(f), down = floatBelow(f);
             const bool flat = flatAxis(r, a);
-            const double invD = flat ? 0.0 : 1.0 / r.d[a];
             parallel[a] = flat;
-            const bool neg = !flat && invD < 0.0;
+            const bool neg = !flat && r.d[a] < 0.0;
             // Near face: lo when the ray goes up the axis (a larger origin makes its t smaller),
             // hi when it goes down (a smaller origin does). The far face the other way round.
-            oNear[a] = _mm_set1_ps(neg ? floatDown(down) : floatUp(up));
-            oFar[a] = _mm_set1_ps(neg ? floatUp(up) : floatDown(down));
-            // |invD| rounds to float with 1 ulp of relative error, part of the 3 covered.
-            inv[a] = _mm_set1_ps(flat ? 0.0f : float(invD));
+            oNear[a] = _mm_set1_ps(neg ? down : up);
+            oFar[a] = _mm_set1_ps(neg ? up : down);
+            // The inverse rounds to float with 1 ulp of relative error, part of the 3 covered.
+            inv[a] = _mm_set1_ps(flat ? 0.0f : float(1.0 / r.d[a]));
             const int lo = int(offsetof(BvhWideNode, lo)) + a * 16,
                       hi = int(offsetof(BvhWideNode, hi)) + a * 16;
             nearOff[a] = neg ? hi : lo;
