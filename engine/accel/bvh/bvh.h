@@ -168,7 +168,7 @@ class Bvh {
     template <bool kNearFirst, class Boxes, class Obs>
     void pushChildren(const Boxes& boxes, const BvhEntry& e, float tmin, float tmax,
                       BvhEntry* stack, int& sp, Obs& obs) const;
-    /// Tells the observer inner entry `e`'s children met: c[0, n), the nearest first.
+    /// Tells the observer inner entry `e`'s children met: c[0, n), in the order walked.
     template <class Obs>
     static void tellChildren(const BvhEntry& e, const BvhEntry* c, int n, Obs& obs);
     /// The leaf's visible hit inside [t0, t1] (t > tmin).
@@ -255,9 +255,9 @@ template <bool kNearFirst, class Boxes, class Obs>
         c[j] = x;
     }
     if constexpr (Obs::kActive) {
-        BvhEntry nearFirst[kBvhWidth];
-        for (int i = 0; i < n; ++i) nearFirst[i] = c[n - 1 - i];
-        tellChildren(e, nearFirst, n, obs);
+        BvhEntry walked[kBvhWidth];  // the top of the stack first
+        for (int i = 0; i < n; ++i) walked[i] = c[n - 1 - i];
+        tellChildren(e, walked, n, obs);
     }
     sp += n;
 }

@@ -135,13 +135,15 @@ struct WideBoxes {
     static constexpr float kSlack = 0x1p-21f;
 
     /// `anchor`: what the wide nodes' boxes are relative to.
-    WideBoxes(const BvhNode* n, const BvhWideNode* w, const Ray& r, const Vec3& anchor)
+    [[gnu::always_inline]] WideBoxes(const BvhNode* n, const BvhWideNode* w, const Ray& r,
+                                     const Vec3& anchor)
         : nodes(n), wides(w), slab(r) {
         for (int a = 0; a < 3; ++a) {
-            // The floats one step either side of the nearest to the origin less the anchor
-            // hold the true origin between them: the nearest is within half a step of the
-            // difference, which the subtraction rounds by far less.
-            const float f = float(r.o[a] - anchor[a]), up = floatAbove(f), down = floatBelow(f);
+            // The origin less the anchor, moved by 2^-22 of itself either way (and a hair, for
+            // 0) before rounding to the nearest float: the rounding moves it back by at most
+            // 2^-24 of it, the subtraction's own by far less, so the true origin lies between.
+            const double rel = r.o[a] - anchor[a], pad = std::abs(rel) * 0x1p-22 + 1e-30;
+            const float up = float(rel + pad), down = float(rel - pad);
             const bool flat = flatAxis(r, a);
             parallel[a] = flat;
             const bool neg = !flat && r.d[a] < 0.0;
