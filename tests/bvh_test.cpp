@@ -308,8 +308,122 @@ TEST(Bvh, KnobsChangeTheStructure) {
                   x.at("stop_reasons").at("unsplittable").get<size_t>());
 }
 
+// The wide nodes the walks read stand for the binary tree: every slot's float box, put back by
+// the anchor, holds its binary node's double box; a wide node's slots are descendants of its
+// binary node; every leaf is in exactly one slot, every unused slot is empty. Random
+// scenes, some far from the origin (where a float cannot hold a coordinate's digits).
+TEST(Bvh, WideNodesHoldTheirChildrensBoxes) {
+    int checked = 0;
+    for (uint64_t seed = 60; seed <= 71; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.primitives = 40;
+        opt.groups = seed % 2 ? 4 : 2;
+        opt.surfaces = seed % 3 == 0;
+        if (seed % 4 == 0) opt.offset = Vec3(1e6, -1e6, 5e5);
+        Scene scene = test::randomCsgScene(seed, opt);
+        auto accel = buildAccelerator(scene, bvhParams(1));
+        const Bvh& b = bvhOf(*accel);
+        const std::vector<BvhNode>& nodes = b.nodes();
+        if (nodes.empty() || nodes[0].leaf) continue;  // what the intersections left is small
+        ++checked;
+        std::vector<int> inSlots(nodes.size(), 0);
+        // Walk the wide tree from its root, which stands for binary node 0.
+        std::vector<std::pair<uint32_t, uint32_t>> todo{{0u, 0u}};  // wide, binary
+        size_t seen = 0;
+        while (!todo.empty()) {
+            const auto [w, bin] = todo.back();
+            todo.pop_back();
+            ++seen;
+            const BvhWideNode& wn = b.wides()[w];
+            for (int k = 0; k < kBvhWidth; ++k) {
+                if (wn.node[k] == kNoNode) {
+                    EXPECT_EQ(wn.wide[k], kNoWide);
+                    for (int a = 0; a < 3; ++a) EXPECT_GT(wn.lo[a][k], wn.hi[a][k]);
+                    continue;
+                }
+                const uint32_t id = wn.node[k];
+                ASSERT_LT(id, nodes.size());
+                ++inSlots[id];
+                // A descendant of `bin`: each expansion of a slot goes one level further, and
+                // there are at most kBvhWidth - 2 of them.
+                uint32_t up = b.parent(id);
+                for (int i = 0; i < kBvhWidth - 2 && up != bin && up != kNoNode; ++i)
+                    up = b.parent(up);
+                EXPECT_EQ(up, bin) << "seed " << seed << " slot node " << id;
+                for (int a = 0; a < 3; ++a) {
+                    EXPECT_LE(double(wn.lo[a][k]) + b.anchor()[a], nodes[id].lo[a])
+                        << "seed " << seed << " node " << id << " axis " << a;
+                    EXPECT_GE(double(wn.hi[a][k]) + b.anchor()[a], nodes[id].hi[a])
+                        << "seed " << seed << " node " << id << " axis " << a;
+                }
+                EXPECT_EQ(wn.wide[k] == kNoWide, bool(nodes[id].leaf));
+                if (wn.wide[k] != kNoWide) todo.push_back({wn.wide[k], id});
+            }
+        }
+        EXPECT_EQ(seen, b.wides().size());
+        for (uint32_t id = 0; id < nodes.size(); ++id)
+            if (nodes[id].leaf) {
+                EXPECT_EQ(inSlots[id], 1) << "seed " << seed << " leaf " << id;
+            }
+    }
+    EXPECT_GE(checked, 6);
+}
+
+// The float test of a wide node's four boxes meets every box the double test meets, on an
+// interval holding the double one: random rays, rays through node corners, edges and faces
+// (axis-parallel ones among them), from near and far, with tmin 0 and a secondary ray's.
+TEST(Bvh, WideBoxTestHoldsTheDoubleOne) {
+    size_t met = 0;
+    for (uint64_t seed = 70; seed <= 75; ++seed) {
+        test::RandomSceneOptions opt;
+        opt.primitives = 30;
+        opt.groups = 3;
+        opt.transforms = seed % 2 == 0;
+        if (seed % 3 == 0) opt.offset = Vec3(-3e5, 2e6, 1e4);
+        Scene scene = test::randomCsgScene(seed, opt);
+        auto accel = buildAccelerator(scene, bvhParams(1));
+        const Bvh& b = bvhOf(*accel);
+        std::vector<Ray> rays = test::randomRays(scene, seed, 300);
+        const std::vector<Ray> hard =
+            test::raysThroughPoints(nodePoints(b, 40, seed), scene.bounds, seed);
+        rays.insert(rays.end(), hard.begin(), hard.end());
+        for (const Ray& world : rays) {
+            const Ray r = b.frame().turned ? b.frame().toFrame(world) : world;
+            for (double tmin : {0.0, 1e-9 * scene.scale()}) {
+                auto check = [&](const auto& boxes) {
+                    for (uint32_t w = 0; w < b.wides().size(); ++w) {
+                        const BvhWideNode& wn = b.wides()[w];
+                        BvhEntry c[kBvhWidth];
+                        const int n =
+                            boxes.children({kNoNode, w, 0.0f, 0.0f}, floatDown(tmin), INFINITY, c);
+                        for (int k = 0; k < kBvhWidth; ++k) {
+                            if (wn.node[k] == kNoNode) continue;
+                            double t0, t1;
+                            if (!boxes.slab.clip(b.nodes()[wn.node[k]], tmin, kInf, t0, t1))
+                                continue;
+                            ++met;
+                            const BvhEntry* e = std::find_if(
+                                c, c + n, [&](const BvhEntry& x) { return x.node == wn.node[k]; });
+                            ASSERT_NE(e, c + n) << "seed " << seed << " node " << wn.node[k]
+                                                << " ray " << world.toString();
+                            EXPECT_LE(double(e->t0), t0);
+                            EXPECT_GE(double(e->t1), t1);
+                        }
+                    }
+                };
+                if (hasFlatAxis(r))
+                    check(WideBoxes<true>(b.nodes().data(), b.wides().data(), r, b.anchor()));
+                else
+                    check(WideBoxes<false>(b.nodes().data(), b.wides().data(), r, b.anchor()));
+            }
+        }
+    }
+    EXPECT_GT(met, 10000u);
+}
+
 // The observer sees the walk the render makes: the same hit and counts; every region event
-// names a node whose box holds the event's stretch; children events name the visited nodes.
+// names a node whose box holds the event's stretch (to the float test's rounding); children events
+// name the visited nodes.
 TEST(Bvh, ObservedWalkEqualsTheRender) {
     Scene scene = loadScene("builtin:drilled:4");
     auto accel = buildAccelerator(scene, bvhParams());
@@ -326,11 +440,14 @@ TEST(Bvh, ObservedWalkEqualsTheRender) {
             if (!g) continue;
             ASSERT_LT(g->region, b.nodes().size());
             if (std::isfinite(g->t0) && g->t0 <= g->t1) {
+                // Inner nodes' intervals are the float test's, widened by 2^-21 of t.
                 Box3 box = b.nodes()[g->region].box();
-                const Vec3 pad(1e-6 * scene.scale());
+                const Vec3 pad(1e-6 * scene.scale() + 2e-6 * g->t1 * glm::length(r.d));
                 box.lo -= pad;
                 box.hi += pad;
-                EXPECT_TRUE(box.contains(r.at(0.5 * (g->t0 + g->t1)))) << "node " << g->region;
+                EXPECT_TRUE(box.contains(r.at(0.5 * (g->t0 + g->t1))))
+                    << "node " << g->region << " t " << g->t0 << " " << g->t1 << " box "
+                    << b.nodes()[g->region].box().toString() << " ray " << r.toString();
             }
         }
     }

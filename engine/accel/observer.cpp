@@ -118,10 +118,11 @@ struct EventText {
     }
     std::string operator()(const walk::Children& e) const {
         const std::string node = "node " + std::to_string(e.node);
-        if (e.first == kNoNodeId) return node + ": the ray meets neither child's box";
-        std::string s = node + ": child " + std::to_string(e.first) + " at t = " + num(e.firstT);
-        if (e.second != kNoNodeId)
-            s += ", then child " + std::to_string(e.second) + " at t = " + num(e.secondT);
+        if (e.count == 0) return node + ": the ray meets no child's box";
+        std::string s = node + ":";
+        for (int i = 0; i < e.count; ++i)
+            s += (i ? ", then child " : " child ") + std::to_string(e.nodes[size_t(i)]) +
+                 " at t = " + num(e.t0s[size_t(i)]);
         return s;
     }
     std::string operator()(const walk::Culled& e) const {

@@ -67,12 +67,12 @@ struct NullObserver {
     void push(const Vec3& /*point*/, int /*axes*/) {}
     void indexStep(int /*axis*/, const uint32_t /*cell*/[3]) {}
     void rope(uint32_t /*from*/, int /*face*/, uint32_t /*to*/) {}
-    // BVH: an inner node's children the ray's interval meets, in the order they are visited
-    // (`second` kNoNode when one or none is met), with the t each box is entered at; a node
-    // left unvisited because its box begins beyond the hit found (`blocked`: a shadow ray's
-    // walk that knows it is blocked, and skips every box not holding the ray's start).
-    void nodeChildren(uint32_t /*node*/, uint32_t /*first*/, double /*t0First*/,
-                      uint32_t /*second*/, double /*t0Second*/) {}
+    // BVH: a wide node's children (at most four) whose boxes the ray's interval meets, in the
+    // order they are visited, with the t each box is entered at; a node left unvisited because
+    // its box begins beyond the hit found (`blocked`: a shadow ray's walk that knows it is
+    // blocked, and skips every box not holding the ray's start).
+    void nodeChildren(uint32_t /*node*/, const uint32_t* /*children*/, const double* /*t0s*/,
+                      int /*count*/) {}
     void nodeCulled(uint32_t /*node*/, double /*t0*/, double /*best*/, bool /*blocked*/) {}
     void walkRestart(const char* /*why*/) {}
     // Shadow rays and the light buffer: each stretch walked, none to walk, what blocked it.
@@ -164,14 +164,14 @@ struct Rope {
     uint32_t to = 0;
     bool operator==(const Rope&) const = default;
 };
-/// BVH: inner node `node`'s children met, `first` (entered at firstT) then `second` (at
-/// secondT); kNoNode where one or none is met.
+/// BVH: the children of wide node `node` (its binary node's descendants, down to four) whose
+/// boxes are met, nodes[0, count) entered at t0s[0, count), in the order walked.
 struct Children {
+    static constexpr int kMax = 4;  ///< the BVH's width (kBvhWidth)
     uint32_t node = 0;
-    uint32_t first = 0;
-    double firstT = 0.0;
-    uint32_t second = 0;
-    double secondT = 0.0;
+    int count = 0;
+    std::array<uint32_t, kMax> nodes{};
+    std::array<double, kMax> t0s{};
     bool operator==(const Children&) const = default;
 };
 /// BVH: node `node` not entered: its box begins at t0, beyond the hit at hitT; or, `blocked`, a
@@ -314,9 +314,11 @@ struct RecordingObserver {
         add(walk::IndexStep{axis, {cell[0], cell[1], cell[2]}});
     }
     void rope(uint32_t from, int face, uint32_t to) { add(walk::Rope{from, face, to}); }
-    void nodeChildren(uint32_t node, uint32_t first, double t0First, uint32_t second,
-                      double t0Second) {
-        add(walk::Children{node, first, t0First, second, t0Second});
+    void nodeChildren(uint32_t node, const uint32_t* children, const double* t0s, int count) {
+        walk::Children c{node, count, {}, {}};
+        for (int i = 0; i < count && i < walk::Children::kMax; ++i)
+            c.nodes[size_t(i)] = children[i], c.t0s[size_t(i)] = t0s[i];
+        add(std::move(c));
     }
     void nodeCulled(uint32_t node, double t0, double best, bool blocked) {
         add(walk::Culled{node, t0, best, blocked});

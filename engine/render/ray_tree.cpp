@@ -277,16 +277,20 @@ std::vector<StepReason> explainBvhSteps(const TracedRay& r, const StructureView&
         for (size_t i = steps[k] + 1; i < end; ++i) {
             if (const auto* c = ev[i].get<walk::Children>()) {
                 told = true;
-                if (c->first == kNoNode)
-                    s += "the ray meets neither child's box";
-                else if (c->second == kNoNode)
-                    s += "only child " + std::to_string(c->first) +
-                         "'s box is met (at t = " + num6(c->firstT) + ")";
-                else
-                    s += "both children's boxes are met; the nearer, " + std::to_string(c->first) +
-                         " (at t = " + num6(c->firstT) + "), first, then " +
-                         std::to_string(c->second) + " (at t = " + num6(c->secondT) +
-                         ") unless a hit comes before it";
+                if (c->count == 0) {
+                    s += "the ray meets none of its children's boxes";
+                } else if (c->count == 1) {
+                    s += "only child " + std::to_string(c->nodes[0]) +
+                         "'s box is met (at t = " + num6(c->t0s[0]) + ")";
+                } else {
+                    s += std::to_string(c->count) + " children's boxes are met; the nearest, " +
+                         std::to_string(c->nodes[0]) + " (at t = " + num6(c->t0s[0]) +
+                         "), first, then";
+                    for (int j = 1; j < c->count; ++j)
+                        s += (j > 1 ? ", " : " ") + std::to_string(c->nodes[size_t(j)]) +
+                             " (at t = " + num6(c->t0s[size_t(j)]) + ")";
+                    s += " unless a hit comes before them";
+                }
             } else if (const auto* u = ev[i].get<walk::Culled>()) {
                 (u->blocked ? unheld : culled)
                     .push_back(std::to_string(u->node) + " (its box begins at t = " + num6(u->t0) +
@@ -607,9 +611,19 @@ struct EventJson {
                 {"side", e.face % 2 ? "high" : "low"}};
     }
     nlohmann::json operator()(const walk::Children& e) const {
-        return {{"event", "children"},          {"node", e.node},
-                {"first", nodeJson(e.first)},   {"first_t", tJson(e.firstT)},
-                {"second", nodeJson(e.second)}, {"second_t", tJson(e.secondT)}};
+        // "first" and "second" as when the walk was binary; "children" holds them all.
+        nlohmann::json all = nlohmann::json::array();
+        for (int i = 0; i < e.count; ++i)
+            all.push_back({{"node", e.nodes[size_t(i)]}, {"t", tJson(e.t0s[size_t(i)])}});
+        auto at = [&e](int i) { return i < e.count ? e.nodes[size_t(i)] : kNoNode; };
+        auto tAt = [&e](int i) { return i < e.count ? e.t0s[size_t(i)] : kInf; };
+        return {{"event", "children"},
+                {"node", e.node},
+                {"first", nodeJson(at(0))},
+                {"first_t", tJson(tAt(0))},
+                {"second", nodeJson(at(1))},
+                {"second_t", tJson(tAt(1))},
+                {"children", all}};
     }
     nlohmann::json operator()(const walk::Culled& e) const {
         return {{"event", "culled"},

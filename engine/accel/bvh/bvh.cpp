@@ -233,6 +233,58 @@ struct BvhBuilder {
     }
     size_t listedTotal = 0, sharedSets = 0;
 
+    /// The wide nodes the walks read (bvh_boxes.h): from the root down, each inner node's
+    /// children, the inner one of largest area replaced by its own two children until there
+    /// are four (as Embree collapses its BVH2 into a BVH4), so that a wide node holds the
+    /// nodes most rays that enter it go on into.
+    void buildWide() {
+        if (out.nodes_.empty() || out.nodes_[0].leaf) return;
+        out.anchor_ = out.nodes_[0].box().center();
+        out.wides_.reserve(out.nodes_.size() / 2);
+        out.wides_.emplace_back();
+        fillWide(0, 0);
+    }
+    /// Wide node `w`, standing for inner binary node `bin`, and the wide nodes below it.
+    void fillWide(uint32_t w, uint32_t bin) {
+        const std::vector<BvhNode>& nodes = out.nodes_;
+        uint32_t slots[kBvhWidth] = {nodes[bin].first, nodes[bin].first + 1};
+        int n = 2;
+        while (n < kBvhWidth) {
+            int widest = -1;
+            double area = -1.0;
+            for (int k = 0; k < n; ++k)
+                if (!nodes[slots[k]].leaf && halfArea(nodes[slots[k]].box()) > area)
+                    widest = k, area = halfArea(nodes[slots[k]].box());
+            if (widest < 0) break;
+            const uint32_t first = nodes[slots[widest]].first;
+            slots[widest] = first;
+            slots[n++] = first + 1;
+        }
+        BvhWideNode wn;
+        for (int k = 0; k < kBvhWidth; ++k) {
+            wn.node[k] = kNoNode;
+            wn.wide[k] = kNoWide;
+            for (int a = 0; a < 3; ++a) wn.lo[a][k] = INFINITY, wn.hi[a][k] = -INFINITY;
+        }
+        for (int k = 0; k < n; ++k) {
+            const BvhNode& c = nodes[slots[k]];
+            wn.node[k] = slots[k];
+            // Outward: the float nearest below (above) the box's side less the anchor, then
+            // one float further, for the double subtraction's own rounding.
+            for (int a = 0; a < 3; ++a) {
+                wn.lo[a][k] = floatBelow(floatDown(c.lo[a] - out.anchor_[a]));
+                wn.hi[a][k] = floatAbove(floatUp(c.hi[a] - out.anchor_[a]));
+            }
+            if (!c.leaf) {
+                wn.wide[k] = uint32_t(out.wides_.size());
+                out.wides_.emplace_back();
+            }
+        }
+        out.wides_[w] = wn;
+        for (int k = 0; k < n; ++k)
+            if (wn.wide[k] != kNoWide) fillWide(wn.wide[k], wn.node[k]);
+    }
+
     /// The surface-area estimate of the built tree, in tests per ray that enters the root.
     void estimateCost() {
         const double rootArea = halfArea(out.nodes_[0].box());
@@ -285,6 +337,7 @@ Bvh Bvh::build(const Scene& scene, const BvhConfig& config, nlohmann::json& extr
         b.makeNode(0, uint32_t(b.ids.size()), 0, kNoNode);
         b.build(0, 0);
         b.fillLeaves();
+        b.buildWide();
         b.estimateCost();
     }
     extra["frame"] = {{"turned", fc.frame.turned}};
@@ -292,6 +345,7 @@ Bvh Bvh::build(const Scene& scene, const BvhConfig& config, nlohmann::json& extr
         extra["frame"]["axes"].push_back(
             {fc.frame.axes[a].x, fc.frame.axes[a].y, fc.frame.axes[a].z});
     extra["nodes"] = out.nodes_.size();
+    extra["wide_nodes"] = out.wides_.size();
     extra["leaves"] = b.leaves.size();
     extra["depth"] = out.depth_;
     extra["listed_primitives"] = b.listedTotal;

@@ -29,6 +29,9 @@ class BuildGuard;  // engine/accel/build_guard.h
 
 /// A node id meaning "no node" in the walk's events.
 inline constexpr uint32_t kNoNode = 0xffffffffu;
+/// The walks' stack: each wide node visited leaves at most kBvhWidth - 1 more entries waiting,
+/// and a wide node is at least one level below its parent.
+inline constexpr int kWalkStack = (kBvhWidth - 1) * kAutomaticBvhDepth + 2;
 
 class Bvh {
   public:
@@ -61,13 +64,19 @@ class Bvh {
     /// Regions are the nodes, inner and leaf: the ids the walk reports.
     size_t regionCount() const { return nodes_.size(); }
     size_t memoryBytes() const {
-        return nodes_.size() * sizeof(BvhNode) + primList_.size() * sizeof(uint32_t) +
-               parent_.size() * sizeof(uint32_t) + pool_.nodes.size() * sizeof(CsgNode);
+        return nodes_.size() * sizeof(BvhNode) + wides_.size() * sizeof(BvhWideNode) +
+               primList_.size() * sizeof(uint32_t) + parent_.size() * sizeof(uint32_t) +
+               pool_.nodes.size() * sizeof(CsgNode);
     }
     /// A union-only scene's leaves list only their own primitives, each primitive in one leaf.
     bool usesMailboxes() const { return !unionOnly_; }
 
     const std::vector<BvhNode>& nodes() const { return nodes_; }
+    /// The wide nodes the walks read (bvh_boxes.h): wides()[0] stands for the root, when it is
+    /// not a leaf.
+    const std::vector<BvhWideNode>& wides() const { return wides_; }
+    /// What the wide nodes' float boxes are relative to: the root box's centre.
+    const Vec3& anchor() const { return anchor_; }
     /// Node `id`'s parent; kNoNode for the root.
     uint32_t parent(uint32_t id) const { return parent_[id]; }
     /// Primitives listed by the leaves: leaf n's are primList()[n.first, n.first + n.count).
@@ -93,26 +102,21 @@ class Bvh {
     bool query(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                Hit& hit) const {
         if (nodes_.empty()) return false;
-        // An axis the ray runs parallel to is tested by the origin's place, not by a product
-        // with an infinite inverse (0 times infinity is NaN on a box face).
         // The boxes are the frame's (the world's unless the scene is turned): the walk reads
         // them with the ray in the frame, `fr` (the same t), the leaves test the world ray.
         Ray mapped;
         if (frame_.turned) mapped = frame_.toFrame(ray);
         const Ray& fr = frame_.turned ? mapped : ray;
-        const bool parallel = fr.d.x == 0.0 || fr.d.y == 0.0 || fr.d.z == 0.0;
-        if (unionOnly_) {
-            if (parallel)
-                return unionQuery<kAnyHit>(DoubleBoxes<true>{nodes_.data(), SlabRay(fr)}, ray, tmin,
-                                           tmax, ctx, obs, hit);
-            return unionQuery<kAnyHit>(DoubleBoxes<false>{nodes_.data(), SlabRay(fr)}, ray, tmin,
-                                       tmax, ctx, obs, hit);
+        // A ray with a flat axis (bvh_boxes.h) has that axis tested by the origin's place; the
+        // others never pay for the check.
+        if (hasFlatAxis(fr)) {
+            const WideBoxes<true> boxes(nodes_.data(), wides_.data(), fr, anchor_);
+            return unionOnly_ ? unionQuery<kAnyHit>(boxes, ray, tmin, tmax, ctx, obs, hit)
+                              : walk<kAnyHit>(boxes, ray, tmin, tmax, ctx, obs, hit);
         }
-        if (parallel)
-            return walk<kAnyHit>(DoubleBoxes<true>{nodes_.data(), SlabRay(fr)}, ray, tmin, tmax,
-                                 ctx, obs, hit);
-        return walk<kAnyHit>(DoubleBoxes<false>{nodes_.data(), SlabRay(fr)}, ray, tmin, tmax, ctx,
-                             obs, hit);
+        const WideBoxes<false> boxes(nodes_.data(), wides_.data(), fr, anchor_);
+        return unionOnly_ ? unionQuery<kAnyHit>(boxes, ray, tmin, tmax, ctx, obs, hit)
+                          : walk<kAnyHit>(boxes, ray, tmin, tmax, ctx, obs, hit);
     }
     /// A union-only scene's query: the first-start walk, and the walk in box-entry order when
     /// that one cannot decide.
@@ -158,14 +162,15 @@ class Bvh {
     template <class Boxes, class Obs>
     bool walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
                    double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const;
-    /// Inner entry `e`'s children the ray meets within [tmin, tmax], pushed far one first so
-    /// that the near one is walked next; told to the observer.
-    template <class Boxes, class Obs>
-    void pushChildren(const Boxes& boxes, const BvhEntry& e, double tmin, double tmax,
+    /// Inner entry `e`'s children the ray may meet within [tmin, tmax] (float bounds, rounded
+    /// outward), pushed far ones first so that the nearest is walked next (kNearFirst; else in
+    /// the node's order); told to the observer.
+    template <bool kNearFirst, class Boxes, class Obs>
+    void pushChildren(const Boxes& boxes, const BvhEntry& e, float tmin, float tmax,
                       BvhEntry* stack, int& sp, Obs& obs) const;
-    /// Tells the observer inner entry `e`'s children met (met[k]), the nearer first.
+    /// Tells the observer inner entry `e`'s children met: c[0, n), in the order walked.
     template <class Obs>
-    static void tellChildren(const BvhEntry& e, const BvhEntry c[2], const bool met[2], Obs& obs);
+    static void tellChildren(const BvhEntry& e, const BvhEntry* c, int n, Obs& obs);
     /// The leaf's visible hit inside [t0, t1] (t > tmin).
     template <class Obs>
     bool hitInLeafBox(const BvhNode& n, const Ray& ray, double tmin, double t0, double t1,
@@ -176,6 +181,8 @@ class Bvh {
     bool unionOnly_ = false;  ///< the scene's tree has only unions: leaves keep no tree
     int depth_ = 0;
     std::vector<BvhNode> nodes_;
+    std::vector<BvhWideNode> wides_;
+    Vec3 anchor_{0.0};
     std::vector<uint32_t> parent_;
     std::vector<uint32_t> primList_;
     CsgTree pool_;
@@ -234,52 +241,52 @@ template <class Obs>
     return b != nullptr;
 }
 
-template <class Boxes, class Obs>
+template <bool kNearFirst, class Boxes, class Obs>
 [[gnu::always_inline]] inline void Bvh::pushChildren(const Boxes& boxes, const BvhEntry& e,
-                                                     double tmin, double tmax, BvhEntry* stack,
+                                                     float tmin, float tmax, BvhEntry* stack,
                                                      int& sp, Obs& obs) const {
-    BvhEntry c[2];
-    bool met[2];
-    boxes.children(e, tmin, tmax, c, met);
-    if constexpr (Obs::kActive) tellChildren(e, c, met, obs);
-    if (met[0] && met[1]) {
-        const bool leftFirst = c[0].t0 <= c[1].t0;
-        stack[sp++] = c[leftFirst ? 1 : 0];  // the far one waits
-        stack[sp++] = c[leftFirst ? 0 : 1];
-    } else if (met[0] || met[1]) {
-        stack[sp++] = c[met[0] ? 0 : 1];
+    BvhEntry* const c = stack + sp;
+    const int n = boxes.children(e, tmin, tmax, c);
+    // Far to near: the nearest on top. At most four, so an insertion sort in place.
+    for (int i = 1; kNearFirst && i < n; ++i) {
+        const BvhEntry x = c[i];
+        int j = i;
+        for (; j > 0 && c[j - 1].t0 < x.t0; --j) c[j] = c[j - 1];
+        c[j] = x;
     }
+    if constexpr (Obs::kActive) {
+        BvhEntry walked[kBvhWidth];  // the top of the stack first
+        for (int i = 0; i < n; ++i) walked[i] = c[n - 1 - i];
+        tellChildren(e, walked, n, obs);
+    }
+    sp += n;
 }
 
 template <class Obs>
-void Bvh::tellChildren(const BvhEntry& e, const BvhEntry c[2], const bool met[2], Obs& obs) {
-    if (met[0] && met[1]) {
-        const bool leftFirst = c[0].t0 <= c[1].t0;
-        const BvhEntry& nearE = c[leftFirst ? 0 : 1];
-        const BvhEntry& farE = c[leftFirst ? 1 : 0];
-        obs.nodeChildren(e.node, nearE.node, nearE.t0, farE.node, farE.t0);
-    } else if (met[0] || met[1]) {
-        const BvhEntry& only = c[met[0] ? 0 : 1];
-        obs.nodeChildren(e.node, only.node, only.t0, kNoNode, kInf);
-    } else {
-        obs.nodeChildren(e.node, kNoNode, kInf, kNoNode, kInf);
-    }
+void Bvh::tellChildren(const BvhEntry& e, const BvhEntry* c, int n, Obs& obs) {
+    uint32_t ids[kBvhWidth];
+    double t0s[kBvhWidth];
+    for (int i = 0; i < n; ++i) ids[i] = c[i].node, t0s[i] = c[i].t0;
+    obs.nodeChildren(e.node, ids, t0s, n);
 }
 
 template <bool kAnyHit, class Boxes, class Obs>
 int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
                         double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const {
-    BvhEntry stack[kAutomaticBvhDepth + 2];
+    BvhEntry stack[kWalkStack];
     int sp = 0;
     stack[sp++] = root;
     // The first start after tmin so far. The ray begins outside every primitive as long as no
     // span holds tmin; a primitive whose box holds the ray's start is in a leaf entered at
-    // tmin, never culled, so a span holding tmin is always met.
+    // tmin (the float interval begins no later), never culled, so a span holding tmin is
+    // always met.
     Boundary first{tmax};
     bool found = false, tie = false;
     // Nodes whose box begins beyond `reach` are culled: the nearest start found; with kAnyHit,
     // tmin once a start is found (only the boxes holding the ray's start are left to walk).
     double reach = tmax;
+    const float tminF = floatDown(tmin);
+    float reachF = floatUp(reach);  // for the float box tests
     while (sp > 0) {
         const BvhEntry e = stack[--sp];
         if (e.t0 > reach) {
@@ -287,13 +294,15 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
             continue;
         }
         ++ctx.counters.regionVisits;
-        obs.region(e.node, e.t0, std::min(e.t1, first.t));
+        obs.region(e.node, e.t0, std::min(double(e.t1), first.t));
         if (!e.leaf()) {
-            pushChildren(boxes, e, tmin, reach, stack, sp, obs);
+            // A shadow ray's walk ends at any start: the order only costs.
+            pushChildren<!kAnyHit>(boxes, e, tminF, reachF, stack, sp, obs);
             continue;
         }
-        const uint32_t* const prims = primList_.data() + e.first;
-        for (uint32_t i = 0; i < e.count; ++i) {
+        const BvhNode& n = nodes_[e.node];
+        const uint32_t* const prims = primList_.data() + n.first;
+        for (uint32_t i = 0; i < n.count; ++i) {
             Span local[2];
             const int k = scene_->primSpans(prims[i], ray, local, ctx.precision);
             ++ctx.counters.primTests;
@@ -308,6 +317,7 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
                     found = true;
                     tie = false;
                     reach = kAnyHit ? tmin : first.t;
+                    reachF = floatUp(reach);
                 } else if (found && sp2.in.t == first.t) {
                     tie = !kAnyHit;
                 }
@@ -327,13 +337,15 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
 template <class Boxes, class Obs>
 bool Bvh::walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
                     double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const {
-    // A min-heap by entry t, one per thread, reused from ray to ray.
+    // A min-heap by entry t, one per thread, reused from ray to ray. The float intervals begin
+    // no later than the double ones, so a node is still taken before any span in it starts.
     auto later = [](const BvhEntry& a, const BvhEntry& b) { return a.t0 > b.t0; };
     thread_local std::vector<BvhEntry> heap;
     heap.assign(1, root);
     SpanList& spans = ctx.leafSpans;  // the spans met so far that end after tmin
     spans.clear();
     double best = tmax;  // the union's first boundary after tmin among the spans known
+    const float tminF = floatDown(tmin), tmaxF = floatUp(tmax);  // for the float box tests
     bool found = false;
     while (!heap.empty()) {
         std::pop_heap(heap.begin(), heap.end(), later);
@@ -344,22 +356,25 @@ bool Bvh::walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, do
             break;
         }
         ++ctx.counters.regionVisits;
-        obs.region(e.node, e.t0, std::min(e.t1, best));
+        obs.region(e.node, e.t0, std::min(double(e.t1), best));
         if (!e.leaf()) {
-            BvhEntry c[2];
-            bool met[2];
-            boxes.children(e, tmin, tmax, c, met);
-            for (int k = 0; k < 2; ++k)
-                if (met[k]) {
-                    heap.push_back(c[k]);
-                    std::push_heap(heap.begin(), heap.end(), later);
-                }
-            if constexpr (Obs::kActive) tellChildren(e, c, met, obs);
+            BvhEntry c[kBvhWidth];
+            const int n = boxes.children(e, tminF, tmaxF, c);
+            for (int k = 0; k < n; ++k) {
+                heap.push_back(c[k]);
+                std::push_heap(heap.begin(), heap.end(), later);
+            }
+            if constexpr (Obs::kActive) {
+                std::sort(c, c + n,
+                          [](const BvhEntry& a, const BvhEntry& b) { return a.t0 < b.t0; });
+                tellChildren(e, c, n, obs);
+            }
             continue;
         }
-        const uint32_t* const prims = primList_.data() + e.first;
+        const BvhNode& node = nodes_[e.node];
+        const uint32_t* const prims = primList_.data() + node.first;
         bool added = false;
-        for (uint32_t i = 0; i < e.count; ++i) {
+        for (uint32_t i = 0; i < node.count; ++i) {
             Span local[2];
             const int k = scene_->primSpans(prims[i], ray, local, ctx.precision);
             ++ctx.counters.primTests;
@@ -388,10 +403,12 @@ bool Bvh::walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, do
 template <bool kAnyHit, class Boxes, class Obs>
 bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, TraceContext& ctx,
                Obs& obs, Hit& hit) const {
-    // Push the far child, go on with the near one: at most one entry a level waits.
-    BvhEntry stack[kAutomaticBvhDepth + 2];
+    // Push the far children, go on with the nearest.
+    BvhEntry stack[kWalkStack];
     int sp = 0;
     double best = tmax;  // the leaves' windows end at the nearest hit found so far
+    const float tminF = floatDown(tmin);
+    float bestF = floatUp(best);  // for the float box tests
     bool found = false;
     if (!boxes.root(tmin, tmax, stack[sp++])) return false;
     while (sp > 0) {
@@ -400,21 +417,32 @@ bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, Tra
             if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, best, false);
             continue;
         }
-        const double t1 = std::min(e.t1, best);
-        ++ctx.counters.regionVisits;
-        obs.region(e.node, e.t0, t1);
         if (e.leaf()) {
+            // A leaf's window is its double box's, exactly: its tree agrees with the scene's
+            // only inside that box. A box only the float test meets is passed over.
+            const BvhNode& n = nodes_[e.node];
+            double t0, t1;
+            if (!boxes.slab.clip(n, tmin, kInf, t0, t1)) continue;
+            if (t0 > best) {
+                if constexpr (Obs::kActive) obs.nodeCulled(e.node, t0, best, false);
+                continue;
+            }
+            t1 = std::min(t1, best);
+            ++ctx.counters.regionVisits;
+            obs.region(e.node, t0, t1);
             Hit h;
-            if (hitInLeafBox(nodes_[e.node], ray, tmin, e.t0, t1, ctx, obs, h) &&
-                (!found || h.t < best)) {
+            if (hitInLeafBox(n, ray, tmin, t0, t1, ctx, obs, h) && (!found || h.t < best)) {
                 hit = h;
                 best = h.t;
+                bestF = floatUp(best);
                 found = true;
                 if constexpr (kAnyHit) return true;
             }
             continue;
         }
-        pushChildren(boxes, e, tmin, best, stack, sp, obs);
+        ++ctx.counters.regionVisits;
+        obs.region(e.node, e.t0, std::min(double(e.t1), best));
+        pushChildren<!kAnyHit>(boxes, e, tminF, bestF, stack, sp, obs);
     }
     return found;
 }

@@ -1,8 +1,16 @@
-// How the BVH's walks read node boxes: a reader hands them entries (a node, what it holds, the
-// ray's interval in its box), so each walk is written once for every way of testing boxes (the
-// ray parallel to an axis or not).
+// How the BVH's walks read node boxes. The binary nodes (BvhNode, in double) are the structure
+// every tool sees; the walks read 4-wide nodes (BvhWideNode) collapsed from them, whose four
+// children's boxes are tested at once with SSE in float, rounded outward so that no box the
+// double test meets is missed (docs/bvh.md, "Walk"). A reader hands the walks entries (a node,
+// and the ray's interval in its box), so each walk is written once.
 #pragma once
 
+#include <emmintrin.h>
+
+#include <bit>
+#include <cfloat>
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "engine/geometry/geometry.h"
@@ -23,14 +31,29 @@ struct alignas(64) BvhNode {
 };
 static_assert(sizeof(BvhNode) == 64);
 
-/// A node as a walk holds it: its id, what it holds, and the ray's interval in its box.
+/// How many children a wide node has at most.
+inline constexpr int kBvhWidth = 4;
+/// A slot of a wide node that holds no wide node (a leaf, or no child).
+inline constexpr uint32_t kNoWide = 0xffffffffu;
+
+/// A wide node, in two cache lines: an inner binary node with its descendants down to four
+/// nodes (its children, or their children), whose boxes are stored axis by axis (SoA) so that
+/// one SSE instruction works on all four. The boxes are the binary nodes' boxes less the
+/// BVH's anchor, rounded outward to float; an unused slot has an empty box (lo +inf, hi -inf).
+struct alignas(64) BvhWideNode {
+    float lo[3][kBvhWidth], hi[3][kBvhWidth];
+    uint32_t node[kBvhWidth];  ///< each slot's binary node id (kNoNode-like 0xffffffff: unused)
+    uint32_t wide[kBvhWidth];  ///< an inner slot's wide node; kNoWide for a leaf or unused slot
+};
+static_assert(sizeof(BvhWideNode) == 128);
+
+/// A node as a walk holds it: its binary id, its wide node (kNoWide for a leaf), and the ray's
+/// interval in its box, rounded outward to float (the float test's, which holds the double one).
 struct BvhEntry {
-    uint32_t node;   ///< its id (nodes(), the observer's region)
-    uint32_t first;  ///< leaf: its primList offset; inner: where the reader finds its children
-    uint32_t count;  ///< leaf: its primitives; inner: kInner
-    double t0, t1;
-    static constexpr uint32_t kInner = 0xffffffffu;
-    bool leaf() const { return count != kInner; }
+    uint32_t node;  ///< its id (nodes(), the observer's region)
+    uint32_t wide;  ///< inner: its wide node; leaf: kNoWide
+    float t0, t1;
+    bool leaf() const { return wide == kNoWide; }
 };
 
 /// The ray as the double box tests read it: its origin, and its inverse direction (0 along an
@@ -43,55 +66,146 @@ struct SlabRay {
             inv[a] = r.d[a] == 0.0 ? 0.0 : 1.0 / r.d[a];
         }
     }
-};
-
-/// Reads the double-precision nodes. kParallel: some axis of the ray has a zero direction,
-/// tested by the origin's place rather than by a product with an infinite inverse (0 times
-/// infinity is NaN on a box face).
-template <bool kParallel>
-struct DoubleBoxes {
-    const BvhNode* nodes;
-    SlabRay slab;
-
-    /// The ray's interval in node `n`'s box, within [tmin, tmax]: false when empty.
-    [[gnu::always_inline]] bool clip(const BvhNode& n, double tmin, double tmax, double& t0,
-                                     double& t1) const {
+    /// The ray's interval in `n`'s box within [tmin, tmax], in double: false when empty. An
+    /// axis the ray is parallel to is tested by the origin's place (0 times infinity is NaN on
+    /// a box face).
+    bool clip(const BvhNode& n, double tmin, double tmax, double& t0, double& t1) const {
         t0 = tmin;
         t1 = tmax;
         for (int a = 0; a < 3; ++a) {
-            if constexpr (kParallel) {
-                if (slab.inv[a] == 0.0) {  // parallel: inside the slab or not at all
-                    if (slab.o[a] < n.lo[a] || slab.o[a] > n.hi[a]) return false;
-                    continue;
-                }
+            if (inv[a] == 0.0) {
+                if (o[a] < n.lo[a] || o[a] > n.hi[a]) return false;
+                continue;
             }
-            const double ta = (n.lo[a] - slab.o[a]) * slab.inv[a],
-                         tb = (n.hi[a] - slab.o[a]) * slab.inv[a];
+            const double ta = (n.lo[a] - o[a]) * inv[a], tb = (n.hi[a] - o[a]) * inv[a];
             const double near = ta < tb ? ta : tb, far = ta < tb ? tb : ta;
             t0 = near > t0 ? near : t0;
             t1 = far < t1 ? far : t1;
         }
         return t0 <= t1;
     }
-    [[gnu::always_inline]] BvhEntry entry(uint32_t id, double t0, double t1) const {
-        const BvhNode& n = nodes[id];
-        return {id, n.first, n.leaf ? n.count : BvhEntry::kInner, t0, t1};
+};
+
+/// The next float above `f` (f itself for +inf and NaN), without a call into libm.
+inline float floatAbove(float f) {
+    if (!(f < INFINITY)) return f;
+    if (f == 0.0f) return FLT_TRUE_MIN;
+    const uint32_t u = std::bit_cast<uint32_t>(f);
+    return std::bit_cast<float>(f > 0.0f ? u + 1 : u - 1);
+}
+/// The next float below `f` (f itself for -inf and NaN).
+inline float floatBelow(float f) { return -floatAbove(-f); }
+/// The largest float at most `x`.
+inline float floatDown(double x) {
+    const float f = float(x);
+    return double(f) > x ? floatBelow(f) : f;
+}
+/// The smallest float at least `x`.
+inline float floatUp(double x) {
+    const float f = float(x);
+    return double(f) < x ? floatAbove(f) : f;
+}
+
+/// Whether the ray's direction along axis `a` is too small for its inverse to fit a float
+/// (zero, or below 2^-126): the float walk tests that axis by the origin's place.
+inline bool flatAxis(const Ray& r, int a) { return !(std::abs(r.d[a]) >= 0x1p-126); }
+/// Whether some axis of the ray is flatAxis().
+inline bool hasFlatAxis(const Ray& r) { return flatAxis(r, 0) || flatAxis(r, 1) || flatAxis(r, 2); }
+
+/// Reads the wide nodes with the ray in float. Each child's interval is computed from the near
+/// and far face along each axis (chosen once per ray by the direction's sign), with an origin
+/// moved to the side that makes the near t smaller and the far t larger; the float
+/// subtraction, product and inverse add a relative error of at most 3 ulps, covered by
+/// widening the interval by kSlack of its ends. kParallel: some axis is flatAxis(); it is
+/// tested by the origin's place, which would miss only a box the ray enters beyond t = 2^126
+/// times the box's distance along that axis.
+template <bool kParallel>
+struct WideBoxes {
+    const BvhNode* nodes;
+    const BvhWideNode* wides;
+    SlabRay slab;           ///< the ray in double, for the root's box
+    __m128 oNear[3];        ///< per axis, the origin less the anchor for the near face's t
+    __m128 oFar[3];         ///< and for the far face's
+    __m128 inv[3];          ///< the inverse direction (0 along a parallel axis)
+    int nearOff[3];         ///< byte offset in a BvhWideNode of each axis's near face's floats
+    int farOff[3];          ///< of the far face's
+    bool parallel[3] = {};  ///< the axes tested by the origin's place
+
+    /// Relative widening of an interval's ends: 8 ulps, for the 3 that the arithmetic may lose.
+    static constexpr float kSlack = 0x1p-21f;
+
+    /// `anchor`: what the wide nodes' boxes are relative to.
+    [[gnu::always_inline]] WideBoxes(const BvhNode* n, const BvhWideNode* w, const Ray& r,
+                                     const Vec3& anchor)
+        : nodes(n), wides(w), slab(r) {
+        for (int a = 0; a < 3; ++a) {
+            // The origin less the anchor, moved by 2^-22 of itself either way (and a hair, for
+            // 0) before rounding to the nearest float: the rounding moves it back by at most
+            // 2^-24 of it, the subtraction's own by far less, so the true origin lies between.
+            const double rel = r.o[a] - anchor[a], pad = std::abs(rel) * 0x1p-22 + 1e-30;
+            const float up = float(rel + pad), down = float(rel - pad);
+            const bool flat = flatAxis(r, a);
+            parallel[a] = flat;
+            const bool neg = !flat && r.d[a] < 0.0;
+            // Near face: lo when the ray goes up the axis (a larger origin makes its t smaller),
+            // hi when it goes down (a smaller origin does). The far face the other way round.
+            oNear[a] = _mm_set1_ps(neg ? down : up);
+            oFar[a] = _mm_set1_ps(neg ? up : down);
+            // The inverse rounds to float with 1 ulp of relative error, part of the 3 covered.
+            inv[a] = _mm_set1_ps(flat ? 0.0f : float(1.0 / r.d[a]));
+            const int lo = int(offsetof(BvhWideNode, lo)) + a * 16,
+                      hi = int(offsetof(BvhWideNode, hi)) + a * 16;
+            nearOff[a] = neg ? hi : lo;
+            farOff[a] = neg ? lo : hi;
+        }
     }
+
     /// The root's entry when the ray meets its box within [tmin, tmax].
     bool root(double tmin, double tmax, BvhEntry& e) const {
         double t0, t1;
-        if (!clip(nodes[0], tmin, tmax, t0, t1)) return false;
-        e = entry(0, t0, t1);
+        if (!slab.clip(nodes[0], tmin, tmax, t0, t1)) return false;
+        e = {0, nodes[0].leaf ? kNoWide : 0u, floatDown(t0), floatUp(t1)};
         return true;
     }
-    /// Inner entry `e`'s two children, met[k] when the ray meets child k's box in [tmin, tmax].
-    [[gnu::always_inline]] void children(const BvhEntry& e, double tmin, double tmax, BvhEntry c[2],
-                                         bool met[2]) const {
-        for (uint32_t k = 0; k < 2; ++k) {
-            double t0, t1;
-            met[k] = clip(nodes[e.first + k], tmin, tmax, t0, t1);
-            if (met[k]) c[k] = entry(e.first + k, t0, t1);
+
+    /// Inner entry `e`'s children that the ray may meet within [tmin, tmax] (every one that
+    /// the double test meets, and perhaps a few more), in slot order; returns how many. The
+    /// walks round their bounds to float once (floatDown(tmin), floatUp(tmax)), not per node.
+    [[gnu::always_inline]] int children(const BvhEntry& e, float tmin, float tmax,
+                                        BvhEntry c[kBvhWidth]) const {
+        const BvhWideNode& w = wides[e.wide];
+        const char* base = reinterpret_cast<const char*>(&w);
+        __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
+        __m128 outside = _mm_setzero_ps();
+        for (int a = 0; a < 3; ++a) {
+            const __m128 fn = _mm_load_ps(reinterpret_cast<const float*>(base + nearOff[a]));
+            const __m128 ff = _mm_load_ps(reinterpret_cast<const float*>(base + farOff[a]));
+            if constexpr (kParallel) {
+                if (parallel[a]) {  // the origin outside the slab: lo > origin or hi < origin
+                    outside = _mm_or_ps(
+                        outside, _mm_or_ps(_mm_cmpgt_ps(fn, oNear[a]), _mm_cmplt_ps(ff, oFar[a])));
+                    continue;
+                }
+            }
+            t0 = _mm_max_ps(t0, _mm_mul_ps(_mm_sub_ps(fn, oNear[a]), inv[a]));
+            t1 = _mm_min_ps(t1, _mm_mul_ps(_mm_sub_ps(ff, oFar[a]), inv[a]));
         }
+        const __m128 sign = _mm_set1_ps(-0.0f), slack = _mm_set1_ps(kSlack);
+        t0 = _mm_sub_ps(t0, _mm_mul_ps(_mm_andnot_ps(sign, t0), slack));
+        t1 = _mm_add_ps(t1, _mm_mul_ps(_mm_andnot_ps(sign, t1), slack));
+        int mask = _mm_movemask_ps(_mm_cmple_ps(t0, t1));  // NaN (an empty slot): not met
+        if constexpr (kParallel) mask &= ~_mm_movemask_ps(outside);
+        if (!mask) return 0;
+        alignas(16) float a0[kBvhWidth], a1[kBvhWidth];
+        _mm_store_ps(a0, t0);
+        _mm_store_ps(a1, t1);
+        int n = 0;
+        do {
+            const int k = __builtin_ctz(unsigned(mask));
+            mask &= mask - 1;
+            c[n++] = {w.node[k], w.wide[k], a0[k], a1[k]};
+        } while (mask);
+        return n;
     }
 };
 
