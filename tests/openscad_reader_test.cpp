@@ -508,6 +508,7 @@ TEST(OpenScadTwist, EveryHitLiesWithinTheStatedBoundOfTheExactTwistedSurface) {
     EXPECT_EQ(n.twistSubSlices, 16);
     const double dA = glm::radians(twist) / 128.0, w = std::hypot(a, b);
     EXPECT_NEAR(n.twistError, w * dA * dA / 8.0 + w * dA / 2.0, 1e-9);
+    EXPECT_EQ(s.modelError, n.twistError) << "the bound the scene carries to --stats";
     BuildParams bp;
     bp.scheme = SchemeKind::Brute;
     auto brute = buildAccelerator(s, bp);

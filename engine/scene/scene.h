@@ -48,6 +48,9 @@ struct Scene {
     Camera camera;
     Vec3 background{0.0};
     int width = 512, height = 512;  ///< default image size
+    /// The largest distance (model units) by which the solids read stray from the surfaces the
+    /// file describes: a twisted extrusion's slices (OpenScadCounts::twistError); 0: exact.
+    double modelError = 0.0;
 
     // Filled by prepare():
     std::vector<Box3> minBox;  ///< CSG-minimized box per primitive (empty: dropped)

@@ -31,6 +31,8 @@ echo "$out" | grep -q -- "--memory-budget" || fail "message does not name the op
 "$LANCER" render "$SRC/assets/openscad/screws.csg" --width 48 --height 48 -o "$tmp/s.png" \
     --stats "$tmp/s.json" >/dev/null 2>"$tmp/log" || { cat "$tmp/log"; fail "example020 refused at the defaults"; }
 grep -q '"auto_level_drop": [1-9]' "$tmp/s.json" || fail "example020 built at the full automatic depth?"
+# Its twisted extrusions' slices stray from the exact surface by the bound the reader states.
+grep -Eq '"model_error": [0-9.e-]*[1-9]' "$tmp/s.json" || fail "example020: no twist bound in --stats"
 "$LANCER" render "$SRC/assets/openscad/screws.csg" --scheme brute --width 48 --height 48 -o "$tmp/sb.png" -q
 cmp -s "$tmp/s.png" "$tmp/sb.png" || fail "example020: the regular image differs from brute force's"
 out=$("$LANCER" render "$SRC/assets/openscad/screws.csg" --max-level 30 --max-objects 4 --width 8 --height 8 \
@@ -44,6 +46,7 @@ for key in '"scheme": "regular"' '"full_table_bytes"' '"directory": "sub-tables"
   grep -q "$key" "$tmp/s.json" || fail "stats lack $key"
 done
 grep -q '"walk_errors": 0' "$tmp/s.json" || fail "walk errors in a default render"
+grep -Eq '"model_error": 0(\.0)?[,}]' "$tmp/s.json" || fail "builtin:default is exact: model_error must be 0"
 
 "$LANCER" trace builtin:default --scheme regular --width 64 --height 64 --pixel 32 32 >"$tmp/t.txt" 2>&1 \
   || { cat "$tmp/t.txt"; fail "trace failed"; }
