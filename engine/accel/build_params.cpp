@@ -49,15 +49,24 @@ int automaticMaxLevel(size_t primitives) {
     return std::clamp(int(std::lround(16.0 + 0.65 * std::log2(n))), 8, 48);
 }
 
+namespace {
+
+/// The automatic base level, lowered as the build asked (RegularConfig::autoLevelDrop).
+int droppedBaseLevel(const RegularConfig& config, size_t primitives) {
+    return std::max(automaticMaxLevel(primitives) - config.autoLevelDrop, 1);
+}
+
+}  // namespace
+
 int effectiveMaxLevel(const RegularConfig& config, size_t primitives) {
     if (config.maxLevel > 0) return config.maxLevel;
-    const int base = std::max(automaticMaxLevel(primitives) - config.autoLevelDrop, 1);
+    const int base = droppedBaseLevel(config, primitives);
     return config.usesCostStop() ? std::min(base + kGainDepth, 48) : base;
 }
 
 int gainLevel(const RegularConfig& config, size_t primitives) {
     if (!config.usesCostStop()) return std::numeric_limits<int>::max();
-    return std::max(automaticMaxLevel(primitives) - config.autoLevelDrop, 1);
+    return droppedBaseLevel(config, primitives);
 }
 
 std::string maxObjectsText(int maxObjects) {

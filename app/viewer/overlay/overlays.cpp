@@ -68,7 +68,6 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
         // overlays stayed on screen. Region ids of the old one mean nothing in the new one.
         structure_ = structure;
         view_ = std::make_shared<const StructureView>(*structure->scene, *structure->accel);
-        built_ = false;
         if (selection_ && !select(selection_->region)) selection_.reset();
         if (hasPendingSelect_) {
             hasPendingSelect_ = false;
@@ -91,11 +90,11 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
     // BVH nodes (over 100,000) took 68 ms of every frame (2026-12-06, scripts/frame-times): the
     // batches are in world space, so those of an earlier view are drawn right, only fewer.
     const bool viewMoved = geometry_.cameraDependent && !sameCamera(builtCamera_, view);
-    const bool stale = !built_ || builtView_ != view_.get() || builtOptions_ != options ||
+    const bool stale = builtView_ != view_.get() || builtOptions_ != options ||
                        builtWidth_ != width || builtHeight_ != height || costs != builtCosts_ ||
                        (viewMoved && !moving);
     if (!stale) return;
-    BuildInputs in{view_, view, width, height, options, costs};
+    BuildInputs in{structure_, view_, view, width, height, options, costs};
     if (!background_) {
         const auto t0 = std::chrono::steady_clock::now();
         OverlayGeometry g = build(in);
@@ -145,12 +144,11 @@ void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms) 
     builtCamera_ = in.camera;
     builtWidth_ = in.width;
     builtHeight_ = in.height;
-    built_ = true;
     ++rebuilds_;
 }
 
-void Overlays::drawLayerPart(const Camera& view, int width, int height, size_t first,
-                             size_t count) {
+void Overlays::drawLayerRange(const Camera& view, int width, int height, size_t first, size_t count,
+                              bool longestFirst) {
     if (!view_ || width <= 0 || height <= 0 || !options.any() || count == 0) return;
     const auto [nearDepth, farDepth] = clipDepths(*view_, view);
     const glm::mat4 toClip = gl::worldToClip(view, width, height, nearDepth, farDepth);
@@ -159,15 +157,17 @@ void Overlays::drawLayerPart(const Camera& view, int width, int height, size_t f
     gl::DrawOptions fill;
     fill.opacity = look.fillOpacity;
     fill.lines = false;
-    fill.firstTriangle = first > SIZE_MAX / 2 ? SIZE_MAX : 2 * first;  // a zone is two triangles
-    fill.triangleLimit = count > SIZE_MAX / 2 ? SIZE_MAX : 2 * count;
+    if (longestFirst) {  // a zone is two triangles
+        fill.firstTriangle = first > SIZE_MAX / 2 ? SIZE_MAX : 2 * first;
+        fill.triangleLimit = count > SIZE_MAX / 2 ? SIZE_MAX : 2 * count;
+    }
     renderer_->draw(*fills_, toClip, fill);
     gl::DrawOptions wire;
     wire.opacity = look.lineOpacity;
     wire.triangles = false;
     wire.firstLine = first;
     wire.lineLimit = count;
-    renderer_->draw(*wiresLongestFirst_, toClip, wire);
+    renderer_->draw(longestFirst ? *wiresLongestFirst_ : *wires_, toClip, wire);
     gl::DrawOptions cuts = wire;  // in cut order: shallow first, up to the replayed cut
     const size_t replayed =
         look.replayCuts >= 0 ? size_t(look.replayCuts) * geometry_.linesPerCut : SIZE_MAX;
@@ -181,30 +181,8 @@ size_t Overlays::layerLines() const {
 }
 
 void Overlays::drawLayers(const Camera& view, int width, int height, size_t lines) {
-    if (!view_ || width <= 0 || height <= 0 || !options.any()) return;
-    const auto [nearDepth, farDepth] = clipDepths(*view_, view);
-    const glm::mat4 toClip = gl::worldToClip(view, width, height, nearDepth, farDepth);
-    glViewport(0, 0, width, height);
     const bool capped = lines < geometry_.wires.lineCount() || lines < geometry_.cuts.lineCount();
-    gl::DrawOptions fill;
-    fill.opacity = look.fillOpacity;
-    fill.lines = false;
-    if (capped) fill.triangleLimit = 2 * lines;  // a zone is two triangles
-    renderer_->draw(*fills_, toClip, fill);
-    gl::DrawOptions wire;
-    wire.opacity = look.lineOpacity;
-    wire.triangles = false;
-    if (capped) {
-        wire.lineLimit = lines;
-        renderer_->draw(*wiresLongestFirst_, toClip, wire);
-    } else {
-        renderer_->draw(*wires_, toClip, wire);
-    }
-    gl::DrawOptions cuts = wire;
-    cuts.lineLimit =
-        look.replayCuts >= 0 ? size_t(look.replayCuts) * geometry_.linesPerCut : SIZE_MAX;
-    cuts.lineLimit = std::min(cuts.lineLimit, lines);  // the cuts are in cut order: shallow first
-    renderer_->draw(*cuts_, toClip, cuts);
+    drawLayerRange(view, width, height, 0, lines, capped);
 }
 
 void Overlays::drawSelection(const Camera& view, int width, int height, int x0, int y0) {
@@ -275,7 +253,7 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
     } else if (inParts) {  // parts until the frame's share is spent (GL finished: timed)
         do {
             const size_t part = std::min(std::max<size_t>(look.restLines, 1), total - layerDrawn_);
-            drawLayerPart(view, width, height, layerDrawn_, part);
+            drawLayerRange(view, width, height, layerDrawn_, part, true);
             layerDrawn_ += part;
             glFinish();
         } while (layerDrawn_ < total &&

@@ -81,10 +81,6 @@ class Overlays {
     }
     /// The layers with at most `lines` wireframe lines (the longest), cut lines and fills.
     void drawLayers(const Camera& view, int width, int height, size_t lines);
-    /// The layers' part [first, first + count) (OverlayGeometry::wiresLongestFirst's lines,
-    /// the cut lines in cut order and the zones' fills with the same indices): the parts
-    /// [0, a) then [a, b) draw what drawLayers(view, width, height, b) draws.
-    void drawLayerPart(const Camera& view, int width, int height, size_t first, size_t count);
     /// The selection's highlight alone (a few lines and faces: cheap to draw every frame), in
     /// a width x height viewport whose lower-left corner is framebuffer pixel (x0, y0) (GL's
     /// rows: the image viewport).
@@ -165,8 +161,16 @@ class Overlays {
     void leafColorCombo(const char* label);
     void costLine();
 
+    /// The layers' lines [first, first + count): `longestFirst`, of
+    /// OverlayGeometry::wiresLongestFirst, with the cut lines in cut order and the zones' fills
+    /// of the same indices (the parts [0, a) then [a, b) draw what [0, b) draws); otherwise the
+    /// wireframe in its own order and every fill.
+    void drawLayerRange(const Camera& view, int width, int height, size_t first, size_t count,
+                        bool longestFirst);
+
     /// What a build of the batches reads: taken whole, so a worker reads nothing that changes.
     struct BuildInputs {
+        std::shared_ptr<const SceneBuild> structure;  ///< what `view` reads, kept alive
         std::shared_ptr<const StructureView> view;
         Camera camera;
         int width = 0, height = 0;
@@ -188,8 +192,8 @@ class Overlays {
     std::shared_ptr<const ImageCosts> builtCosts_;  ///< the counts used (null: none)
     Camera builtCamera_;
     int builtWidth_ = 0, builtHeight_ = 0;
-    bool built_ = false;
-    const StructureView* builtView_ = nullptr;  ///< the structure's description they show
+    /// The structure's description they show (null: none built yet).
+    const StructureView* builtView_ = nullptr;
     uint64_t rebuilds_ = 0;
     double lastBuildMs_ = 0.0;
     // The layers' texture and what it was drawn for.
