@@ -1,11 +1,11 @@
 #version 330 core
-// The rendered image, or one of its per-pixel counters through the heat colour map.
+// One of the image's per-pixel counters through the heat colour map (the colour image is
+// composited on the CPU: app/viewer/image_view.cpp).
 in vec2 uv;
 out vec4 fragColor;
-uniform sampler2D colorTex;  // the image as 8-bit RGBA, as the PNG writer quantises it
 uniform sampler2D heatTex;   // one counter per pixel
-// 0: colour, 1: heat map, 2: heat map on a log scale, 3: a signed difference (old - new) on
-// the diverging map, 4: the same on a log scale
+// 0: heat map, 1: heat map on a log scale, 2: a signed difference (old - new) on the diverging
+// map, 3: the same on a log scale
 uniform int mode;
 uniform float scale;         // counter value shown at the top of the colour map
 uniform vec3 stops[8];       // colour map, evenly spaced (app/viewer/colormap.cpp)
@@ -30,10 +30,8 @@ void main() {
     vec2 t = vec2(uv.x, 1.0 - uv.y);  // image row 0 is the top row
     vec3 c;
     if (mode == 0)
-        c = clamp(texture(colorTex, t).rgb, 0.0, 1.0);
-    else if (mode == 1)
         c = colormap(texture(heatTex, t).r / scale);
-    else if (mode == 2)  // as heatValue() in app/viewer/colormap.cpp
+    else if (mode == 1)  // as heatValue() in app/viewer/colormap.cpp
         c = colormap(log(1.0 + texture(heatTex, t).r) / log(1.0 + scale));
     else {
         float d = texture(heatTex, t).r;
@@ -41,7 +39,7 @@ void main() {
             // A pixel with nothing to compare yet: grey stripes, unlike any value of the map.
             float band = mod(floor((gl_FragCoord.x + gl_FragCoord.y) / 6.0), 2.0);
             c = vec3(0.16 + 0.08 * band);
-        } else if (mode == 3) {  // as diffValue() in app/viewer/colormap.cpp
+        } else if (mode == 2) {  // as diffValue() in app/viewer/colormap.cpp
             c = diverging(d / scale);
         } else {
             c = diverging(sign(d) * log(1.0 + abs(d)) / log(1.0 + scale));

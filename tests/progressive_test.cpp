@@ -6,6 +6,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 
 #include "engine/scene/loader.h"
@@ -77,6 +79,77 @@ std::vector<int> followJob(ProgressiveRenderer& pr, uint64_t job, const Image& d
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     return seenStrides;
+}
+
+TEST(Progressive, AFinerPassOfTheViewOnScreenComesInPartsTheFirstPassOfAViewWhole) {
+    auto scene = std::make_shared<const Scene>(loadScene("builtin:default"));
+    std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
+    RenderOptions opt;
+    opt.width = 64;
+    opt.height = 40;
+    Image direct(opt.width, opt.height);
+    render(*scene, *accel, opt, direct);
+    // The worker waits after each band until the test has taken it: the bands come one by one.
+    std::mutex m;
+    std::condition_variable cv;
+    int bands = 0, released = 0;
+    ProgressiveRenderer pr({8, 4, 1});
+    pr.setOnPass([&] {
+        std::unique_lock lock(m);
+        ++bands;
+        cv.notify_all();
+        cv.wait(lock, [&] { return released >= bands; });
+    });
+    auto waitBands = [&](int n) {
+        std::unique_lock lock(m);
+        return cv.wait_for(lock, std::chrono::seconds(30), [&] { return bands >= n; });
+    };
+    auto release = [&](int n) {
+        std::lock_guard lock(m);
+        released = n;
+        cv.notify_all();
+    };
+    // Row y of `shown` shows the pass of `stride`: the corner pixel of its block.
+    auto rowShows = [&](const Image& shown, int y, int stride) {
+        for (int x = 0; x < opt.width; ++x)
+            if (shown.color[shown.index(x, y)] !=
+                direct.color[direct.index(x - x % stride, y - y % stride)])
+                return false;
+        return true;
+    };
+    constexpr int kMax = 5;
+    pr.start({scene, accel, opt});
+    Image shown;
+    uint64_t version = 0;
+    ProgressiveRenderer::Shown what;
+    ASSERT_TRUE(waitBands(1));
+    // The first pass of the view: whole, whatever the limit.
+    ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+    EXPECT_EQ(what.stride, 8);
+    EXPECT_FALSE(what.behind);
+    EXPECT_EQ(what.changedEnd - what.changedBegin, opt.height);
+    release(1);
+    ASSERT_TRUE(waitBands(2));  // the pass of stride 4, whole: in parts of kMax rows
+    int parts = 0, next = 0;
+    for (bool behind = true; behind && parts < 100; ++parts) {
+        ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+        EXPECT_EQ(what.stride, 4);
+        EXPECT_EQ(what.changedBegin, next);
+        EXPECT_LE(what.changedEnd - what.changedBegin, kMax);
+        EXPECT_EQ(what.rows, what.changedEnd);
+        next = what.changedEnd;
+        for (int y = 0; y < opt.height; ++y)
+            ASSERT_TRUE(rowShows(shown, y, y < next ? 4 : 8)) << "row " << y << ", part " << parts;
+        behind = what.behind;
+    }
+    EXPECT_EQ(parts, (opt.height + kMax - 1) / kMax);
+    EXPECT_EQ(next, opt.height);
+    EXPECT_FALSE(pr.snapshot(version, shown, &what, kMax)) << "caught up: nothing new";
+    release(1000);
+    ASSERT_TRUE(waitFor([&] { return pr.finished(); }, 30.0 * test::kInstrumented));
+    while (pr.snapshot(version, shown, &what, kMax))
+        EXPECT_LE(what.changedEnd - what.changedBegin, kMax);
+    EXPECT_EQ(shown.color, direct.color);
 }
 
 TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {

@@ -29,17 +29,14 @@ ImageView::ImageView() {
     locStops_ = program_->uniform("stops");
     locStopCount_ = program_->uniform("stopCount");
     locDivStops_ = program_->uniform("divStops");
-    locColor_ = program_->uniform("colorTex");
     locHeat_ = program_->uniform("heatTex");
     locOverlay_ = program_->uniform("overlayTex");
     locHasOverlay_ = program_->uniform("hasOverlay");
     glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even an empty one
-    GLuint tex[3];
-    glGenTextures(3, tex);
-    colorTex_ = tex[0];
-    heatTex_ = tex[1];
-    shadedTex_ = tex[2];
-    setupTexture(colorTex_);
+    GLuint tex[2];
+    glGenTextures(2, tex);
+    heatTex_ = tex[0];
+    shadedTex_ = tex[1];
     setupTexture(heatTex_);
     setupTexture(shadedTex_);
     glBindTexture(GL_TEXTURE_2D, 0);
@@ -47,8 +44,8 @@ ImageView::ImageView() {
 }
 
 ImageView::~ImageView() {
-    GLuint tex[3] = {colorTex_, heatTex_, shadedTex_};
-    glDeleteTextures(3, tex);
+    GLuint tex[2] = {heatTex_, shadedTex_};
+    glDeleteTextures(2, tex);
     glDeleteFramebuffers(1, &fbo_);
     glDeleteVertexArrays(1, &vao_);
 }
@@ -65,10 +62,7 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
     height_ = img.height;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    if (resized) {  // storage for every texture at the new size, the FBO on the shaded one
-        glBindTexture(GL_TEXTURE_2D, colorTex_);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                     nullptr);
+    if (resized) {  // storage for both textures at the new size, the FBO on the shaded one
         glBindTexture(GL_TEXTURE_2D, heatTex_);
         glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, width_, height_, 0, GL_RED, GL_FLOAT, nullptr);
         glBindTexture(GL_TEXTURE_2D, shadedTex_);
@@ -77,30 +71,15 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, shadedTex_, 0);
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        colorRgba_.assign(size_t(width_) * size_t(height_) * 4, 0);
     }
     if (rows > 0) {
         // 8 bits per channel, quantised as the PNG writer does: the screen shows what `render`
-        // saves.
-        if (mode == ViewMode::Color && !resized && shadedValid_ && shadedMode_ == ViewMode::Color &&
-            overlayTex_ == 0) {
-            // The colour shader only copies: the rows go straight into the shaded texture,
-            // bottom row first as the FBO holds them, and need no shading (under llvmpipe,
-            // shading a whole 1280x720 image took 7 ms of the UI thread). colorTex_ is left
-            // behind: a change of mode or size uploads the whole image, through it.
-            std::vector<uint8_t> flipped(size_t(width_) * size_t(rows) * 4);
-            img.rgba8Into(flipped.data(), rowBegin, rowEnd, true);
-            glBindTexture(GL_TEXTURE_2D, shadedTex_);
-            glTexSubImage2D(GL_TEXTURE_2D, 0, 0, height_ - rowEnd, width_, rows, GL_RGBA,
-                            GL_UNSIGNED_BYTE, flipped.data());
-            glBindTexture(GL_TEXTURE_2D, 0);
-            return;
-        }
-        // Texture row y is image row y, as in the first upload.
-        std::vector<uint8_t> rgba = img.rgba8(rowBegin, rowEnd);
-        glBindTexture(GL_TEXTURE_2D, colorTex_);
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, rowBegin, width_, rows, GL_RGBA, GL_UNSIGNED_BYTE,
-                        rgba.data());
+        // saves. Kept in every mode, so a change to the colour image needs no upload.
+        img.rgba8Into(colorRgba_.data() + size_t(rowBegin) * size_t(width_) * 4, rowBegin, rowEnd,
+                      false);
         if (mode != ViewMode::Color) {
+            // Texture row y is image row y; the shader flips.
             std::vector<float> own;
             if (!heat) own = heatChannel(img, mode, rowBegin, rowEnd);
             const std::vector<float>& values = heat ? *heat : own;
@@ -125,6 +104,60 @@ void ImageView::setOverlay(unsigned texture, uint64_t version) {
     overlayTex_ = texture;
     overlayVersion_ = version;
     shadedValid_ = false;
+    // The colour image is composited on the CPU (compose()): the layer's pixels are read back
+    // once per version, not once per pass.
+    overlayRgba_.clear();
+    overlayWidth_ = overlayHeight_ = 0;
+    if (texture == 0) return;
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &overlayWidth_);
+    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &overlayHeight_);
+    overlayRgba_.resize(size_t(std::max(overlayWidth_, 0)) * size_t(std::max(overlayHeight_, 0)) *
+                        4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    if (!overlayRgba_.empty())
+        glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_UNSIGNED_BYTE, overlayRgba_.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
+}
+
+void ImageView::compose(int rowBegin, int rowEnd) const {
+    // Image row r is FBO row height - 1 - r: rows [b, e) are FBO rows [h - e, h - b), written
+    // bottom row first. The layer is premultiplied: out = image (1 - a) + layer, rounded as the
+    // shader's 8-bit target rounds; a layer of another size is sampled at the nearest texel, as
+    // the heat maps' shader samples it.
+    const int rows = rowEnd - rowBegin;
+    if (rows <= 0) return;
+    const size_t w = size_t(width_);
+    composed_.resize(w * size_t(rows) * 4);
+    const bool layer = !overlayRgba_.empty();
+    std::vector<size_t> column;
+    if (layer)
+        for (size_t x = 0; x < w; ++x)
+            column.push_back(4 * ((2 * x + 1) * size_t(overlayWidth_) / (2 * w)));
+    for (int r = rowBegin; r < rowEnd; ++r) {
+        const uint8_t* c = colorRgba_.data() + size_t(r) * w * 4;
+        uint8_t* o = composed_.data() + size_t(rowEnd - 1 - r) * w * 4;
+        if (!layer) {
+            std::copy_n(c, w * 4, o);
+            continue;
+        }
+        const int fboRow = height_ - 1 - r;
+        const size_t ly = size_t(2 * fboRow + 1) * size_t(overlayHeight_) / size_t(2 * height_);
+        const uint8_t* l = overlayRgba_.data() + ly * size_t(overlayWidth_) * 4;
+        for (size_t x = 0; x < w; ++x, c += 4, o += 4) {
+            const uint8_t* p = l + column[x];
+            const unsigned keep = 255u - p[3];
+            for (int k = 0; k < 3; ++k)
+                o[k] = uint8_t(std::min((unsigned(c[k]) * keep + 127u) / 255u + p[k], 255u));
+            o[3] = 255;
+        }
+    }
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glBindTexture(GL_TEXTURE_2D, shadedTex_);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, height_ - rowEnd, width_, rows, GL_RGBA, GL_UNSIGNED_BYTE,
+                    composed_.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
 }
 
 std::vector<PixelRect> uncovered(int width, int height, const std::vector<PixelRect>& covered) {
@@ -203,6 +236,20 @@ PixelRect ImageView::viewport(int fbWidth, int fbHeight) const {
 
 void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging, int rowBegin,
                       int rowEnd) const {
+    if (mode == ViewMode::Color)
+        compose(rowBegin, rowEnd);
+    else
+        shadeHeat(scale, logScale, diverging, rowBegin, rowEnd);
+    dirty_.clear();
+    shadedValid_ = true;
+    shadedMode_ = mode;
+    shadedScale_ = scale;
+    shadedLog_ = logScale;
+    shadedDiverging_ = diverging;
+}
+
+void ImageView::shadeHeat(float scale, bool logScale, bool diverging, int rowBegin,
+                          int rowEnd) const {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, width_, height_);
     glDisable(GL_BLEND);
@@ -212,17 +259,14 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
     glEnable(GL_SCISSOR_TEST);
     glScissor(0, height_ - rowEnd, width_, rowEnd - rowBegin);
     glUseProgram(program_->id());
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, colorTex_);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, heatTex_);
-    glUniform1i(locColor_, 0);
     glUniform1i(locHeat_, 1);
     glActiveTexture(GL_TEXTURE2);
     glBindTexture(GL_TEXTURE_2D, overlayTex_);
     glUniform1i(locOverlay_, 2);
     glUniform1i(locHasOverlay_, overlayTex_ != 0);
-    glUniform1i(locMode_, mode == ViewMode::Color ? 0 : (diverging ? 3 : 1) + (logScale ? 1 : 0));
+    glUniform1i(locMode_, (diverging ? 2 : 0) + (logScale ? 1 : 0));
     glUniform1f(locScale_, scale);
     const auto& stops = colormapStops();
     glUniform3fv(locStops_, GLsizei(stops.size()), &stops[0].x);
@@ -237,16 +281,9 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, 0);
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, 0);
     glUseProgram(0);
     glDisable(GL_SCISSOR_TEST);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    dirty_.clear();
-    shadedValid_ = true;
-    shadedMode_ = mode;
-    shadedScale_ = scale;
-    shadedLog_ = logScale;
-    shadedDiverging_ = diverging;
 }
 
 std::vector<uint8_t> readFramebuffer(int width, int height) {

@@ -117,7 +117,9 @@ PixelRect toPixels(const Rect& r, glm::vec2 scale) {
 
 void ViewerApp::frame(int fbWidth, int fbHeight) {
     // 1. Poll: the structure and the image the workers finished since the last frame.
+    phases_.begin();
     state_.poll();
+    phases_.mark("poll");
 
     // 2. Input: the camera's mouse and keys (unless ImGui wants them).
     ImGui_ImplOpenGL3_NewFrame();
@@ -140,9 +142,11 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     overlays_->setCosts(state_.costs());
     overlays_->update(state_.sceneBuild(), state_.camera(), imageW, imageH, cameraMoving());
     inspector_->setShown(s.showInspector);
+    phases_.mark("overlays");
     inspector_->update(state_.sceneBuild(),
                        {state_.camera(), std::max(state_.width(), 1), std::max(state_.height(), 1)},
                        fbWidth, fbHeight, selectedRegion());
+    phases_.mark("inspector");
     // The inspector's half of the window moves the inspector's camera, and a click there picks.
     std::optional<int64_t> picked;
     if (inspector_->handleMouse(fbWidth, fbHeight, picked)) {
@@ -183,6 +187,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     else
         overlays_->setEvaluatedNodes(-1, nullptr, {});
 
+    phases_.mark("input and playback");
     // 3. Panels: each reads and acts on the state (panels/), where the layout puts it. A panel
     // showing a texture of its own drawing calls panels_.invalidate(its window's ID) whenever
     // that texture's pixels change.
@@ -213,13 +218,16 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     state_.startWork(imageW, imageH);
     overlays_->setCosts(state_.costs());
     ImGui::Render();
+    phases_.mark("panels");
 
     // 4. Image: the traced image or a heat map, the size of its viewport, copied there only
     // around the opaque popups or menus drawn over it in step 6. What no view fills (the gaps
     // between panels, under the menu bar) is cleared, the image viewport only while there is
     // no image: one full-window fill less per frame, which software GL feels.
     if (RowRange rows; state_.takeUpload(rows)) uploadImage(rows.begin, rows.end);
+    phases_.mark("upload");
     prepareOverlays(imageW, imageH);
+    phases_.mark("overlays");
     glViewport(0, 0, fbWidth, fbHeight);
     glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
     std::vector<PixelRect> views;
@@ -238,6 +246,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     view_->setViewport(area);
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale,
                 state_.heatDiverging());
+    phases_.mark("image");
 
     // 4b. The 3D inspector beside the image (the image is not copied under it), with the
     // ray played drawn into its picture.
@@ -255,6 +264,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         }
     }
     inspector_->draw(fbWidth, fbHeight);
+    phases_.mark("inspector");
 
     // 5. Overlays: their layers were composited into the image when it was shaded
     // (prepareOverlays); the selection's highlight is drawn over the image, under the panels
@@ -283,8 +293,10 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         glViewport(0, 0, fbWidth, fbHeight);
     }
 
+    phases_.mark("overlays");
     // 6. Panel layer: ImGui's panels, each rasterized again only when it changed.
     panels_.render();
+    phases_.mark("panel layer");
 
     PanelNotes& notes = state_.notes();
     if (!notes.pendingScreenshot.empty()) {
@@ -358,9 +370,6 @@ void ViewerApp::prepareOverlays(int fbWidth, int fbHeight) {
     // a quarter of a second. They are drawn whole when the drag ends.
     const bool dragging = cameraMoving() && overlays_->layerStale(camera, fbWidth, fbHeight);
     const unsigned layer = overlays_->layerTexture(camera, fbWidth, fbHeight, dragging);
-    if (layer != 0 && !overlayShown_ && view_->width() > 0)
-        uploadImage(0, -1);  // colour bands bypass colorTex
-    overlayShown_ = layer != 0;
     view_->setOverlay(layer, overlays_->layerVersion());
     if (logTimings_)
         logOverlayTiming(std::chrono::duration<double, std::milli>(Clock::now() - start).count(),

@@ -20,6 +20,7 @@
 #include "app/viewer/panels/panels.h"
 #include "app/viewer/panels/tree_panel.h"
 #include "app/viewer/playback/ray_player.h"
+#include "app/viewer/timing/frame_times.h"
 #include "app/viewer/viewer_state.h"
 
 namespace lancer::viewer {
@@ -142,6 +143,8 @@ class ViewerApp {
     const PanelLayout& layout() const { return layout_; }
     /// The colour keys the last frame drew over the image viewport's corner, and where.
     const KeyReport& keys() const { return keys_; }
+    /// Where the last frame()'s UI CPU time went, by step (--log-timings' slow frames).
+    const FramePhases& phases() const { return phases_; }
 
   private:
     /// Upload rows [rowBegin, rowEnd) (-1: to the last) of the image on screen, with the heat
@@ -168,7 +171,6 @@ class ViewerApp {
     std::unique_ptr<ImageView> view_;
     std::unique_ptr<overlay::Overlays> overlays_;
     bool logTimings_ = false;
-    bool overlayShown_ = false;   ///< the image view composites the overlays' layer
     bool cameraTurning_ = false;  ///< setCameraTurning: a scripted turn moves the camera
     struct OverlayStat {
         double ms = 0.0;
@@ -180,6 +182,7 @@ class ViewerApp {
     TreeBrowser tree_;
     std::unique_ptr<gl::BatchRenderer> rayRenderer_;
     Clock::time_point lastFrame_ = Clock::now();
+    FramePhases phases_;  ///< the last frame's CPU time by step
     /// The region the playback selected last (-1: none), so a click elsewhere is not undone.
     int64_t playedRegion_ = -1;
     gl::Batch inspectorRay_;     ///< the lines last handed to the inspector

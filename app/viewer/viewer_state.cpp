@@ -254,7 +254,7 @@ void ViewerState::pollBuilder() {
         } else if (sceneBuild_) {
             // The image on screen is the old structure's: A, if it is complete (the last band
             // may still wait in the renderer: take it first).
-            takeSnapshot();
+            takeSnapshot(true);
             const bool complete = shownComplete_ && shownJob_ == startedJob_ && !renderDirty_;
             diff_.rebuilt(shown_, complete, jobKey_, jobParams_,
                           complete ? renderer_.passes() : std::vector<PassRecord>{});
@@ -298,9 +298,15 @@ void ViewerState::pollBuilder() {
     }
 }
 
-bool ViewerState::takeSnapshot() {
+bool ViewerState::takeSnapshot(bool whole) {
     ProgressiveRenderer::Shown what;
-    if (!renderer_.snapshot(shownVersion_, shown_, &what)) return false;
+    // A finer pass of the view on screen comes in parts: a whole 1280x720 image (32 bytes a
+    // pixel) took 13-17 ms of the UI thread to copy, and its conversion and upload as much
+    // again. The first pass of a new view comes whole, never mixed with the old view.
+    const int maxRows =
+        whole || shown_.width <= 0 ? 0 : std::max(1, kSnapshotPixels / shown_.width);
+    if (!renderer_.snapshot(shownVersion_, shown_, &what, maxRows)) return false;
+    snapshotBehind_ = what.behind;
     uploadDue_ = true;
     changed_.add(what.changedBegin, what.changedEnd < 0 ? shown_.height : what.changedEnd);
     shownJob_ = what.job;
@@ -420,12 +426,13 @@ void ViewerState::updateCosts() {
 }
 
 bool ViewerState::settledSince() const {
-    return builtBefore_ && !builder_.busy() && !costsDue_ &&
+    return builtBefore_ && !builder_.busy() && !costsDue_ && !snapshotBehind_ &&
            (!sceneBuild_ || (!renderDirty_ && finishedBefore_ && renderer_.finished()));
 }
 
 bool ViewerState::eager(bool settled) const {
-    if (builder_.busy() || builder_.ready() || renderDirty_ || shownJob_ != renderer_.job())
+    if (builder_.busy() || builder_.ready() || renderDirty_ || shownJob_ != renderer_.job() ||
+        snapshotBehind_)
         return true;
     const ProgressiveRenderer::Shown next = renderer_.latest();
     return next.stride != shownStride_ || (renderer_.finished() && !settled);

@@ -61,6 +61,10 @@ struct SpeedupResult {
     bench::Speedup speedup;  ///< both renders, as `lancer bench` measures them
 };
 
+/// The pixels of a finer pass that one frame takes from the renderer at most (a third of a
+/// 1280x720 image): the rest comes in the next frames (ViewerState::takeSnapshot).
+inline constexpr int kSnapshotPixels = 1280 * 720 / 3;
+
 class ViewerState {
   public:
     using Clock = std::chrono::steady_clock;
@@ -198,8 +202,9 @@ class ViewerState {
     };
 
     void pollBuilder();
-    /// Take the renderer's newest image, if any (true then).
-    bool takeSnapshot();
+    /// Take the renderer's newest image, if any (true then): at most kSnapshotPixels' worth of
+    /// rows of a finer pass of the view on screen a frame, unless `whole`.
+    bool takeSnapshot(bool whole = false);
     void restartRender(const char* why);
     void updateAutoScale();
     /// After the snapshot: the A/B's status and totals, and a whole upload when what the heat
@@ -223,9 +228,10 @@ class ViewerState {
     // The image on screen.
     Image shown_;
     uint64_t shownVersion_ = 0;
-    uint64_t shownJob_ = 0;  ///< the render job the image on screen comes from
-    int shownStride_ = 0;    ///< and the pass it shows (some of its rows, at least)
-    RowRange changed_;       ///< rows not uploaded yet
+    uint64_t shownJob_ = 0;        ///< the render job the image on screen comes from
+    int shownStride_ = 0;          ///< and the pass it shows (some of its rows, at least)
+    RowRange changed_;             ///< rows not uploaded yet
+    bool snapshotBehind_ = false;  ///< the last snapshot left rows of its pass to the next
     bool uploadDue_ = false;
     int jobWidth_ = 0, jobHeight_ = 0;
     bool renderDirty_ = false, cameraMovedForBuild_ = false;

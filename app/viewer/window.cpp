@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -330,8 +331,17 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
             const double workMs =
                 std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
             statWorkMs += workMs;
-            if (app.sceneBuild())
-                (turnDue ? turningFrames : stillFrames).add(workMs, threadCpuMs() - frameCpuStart);
+            if (app.sceneBuild()) {
+                const double cpuMs = threadCpuMs() - frameCpuStart;
+                (turnDue ? turningFrames : stillFrames).add(workMs, cpuMs);
+                // A frame over budget says where its time went.
+                if (v.logTimings && cpuMs > kFrameBudgetMs)
+                    std::fprintf(stderr,
+                                 "timing: slow frame %d (%s): %.1f ms, %.1f ms of UI CPU: %s, "
+                                 "swap and rest %.1f\n",
+                                 frames, turnDue ? "turning" : "still", workMs, cpuMs,
+                                 app.phases().summary().c_str(), cpuMs - app.phases().totalMs());
+            }
             ++statFrames;
             if (v.logTimings && Clock::now() - statStart > std::chrono::seconds(2)) {
                 double secs = std::chrono::duration<double>(Clock::now() - statStart).count();

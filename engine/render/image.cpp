@@ -43,19 +43,23 @@ std::vector<uint8_t> Image::rgba8(int rowBegin, int rowEnd) const {
     return out;
 }
 
+static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "rgba8Into reads a row as floats");
+
 void Image::rgba8Into(uint8_t* out, int rowBegin, int rowEnd, bool bottomUp) const {
     size_t first, last;
     pixelRange(rowBegin, rowEnd, first, last);
     const size_t w = size_t(width), rows = w ? (last - first) / w : 0;
     for (size_t r = 0; r < rows; ++r) {
-        const glm::vec3* src = color.data() + first + r * w;
+        // The row's floats in one run, so the loop vectorises (a viewer converts a 1280x720
+        // image per pass).
+        const float* src = &color[first + r * w].x;
         uint8_t* o = out + 4 * w * (bottomUp ? rows - 1 - r : r);
-        for (size_t x = 0; x < w; ++x, o += 4) {
-            for (int c = 0; c < 3; ++c) {
-                const float v = std::min(std::max(src[x][c], 0.0f), 1.0f);
-                o[c] = uint8_t(v * 255.0f + 0.5f);
+        for (size_t x = 0; x < w; ++x) {
+            for (size_t c = 0; c < 3; ++c) {
+                const float v = std::min(std::max(src[3 * x + c], 0.0f), 1.0f);
+                o[4 * x + c] = uint8_t(v * 255.0f + 0.5f);
             }
-            o[3] = 255;
+            o[4 * x + 3] = 255;
         }
     }
 }

@@ -86,18 +86,28 @@ void ProgressiveRenderer::cancel() {
     cancel_ = true;
 }
 
-bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown) {
+bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown, int maxRows) {
     std::lock_guard lock(mutex_);
     if (version == displayVersion_) return false;
     // Only the rows written since the last snapshot, unless `out` is new or of another size.
     Shown s = displayShown_;
     const bool whole = out.width != display_.width || out.height != display_.height;
-    copyRows(display_, out, changed_.begin, changed_.end);  // whole when the size differs
+    int end = changed_.end;
+    if (!whole && maxRows > 0 && s.job == snapshotJob_ && end - changed_.begin > maxRows)
+        end = changed_.begin + maxRows;
+    copyRows(display_, out, changed_.begin, end);  // whole when the size differs
     s.changedBegin = whole ? 0 : changed_.begin;
-    s.changedEnd = whole ? display_.height : changed_.end;
-    changed_.clear();
+    s.changedEnd = whole ? display_.height : end;
+    snapshotJob_ = s.job;
+    if (!whole && end < changed_.end) {
+        changed_.begin = end;
+        s.rows = std::min(s.rows, end);  // the pass's rows that `out` holds
+        s.behind = true;
+    } else {
+        changed_.clear();
+        version = displayVersion_;
+    }
     if (shown) *shown = s;
-    version = displayVersion_;
     return true;
 }
 

@@ -75,13 +75,16 @@ class ProgressiveRenderer {
 
     /// What a snapshot shows: rows [0, rows) the pass of `stride`, the rows below it the pass
     /// before, of `previousStride` (0: none); rows [changedBegin, changedEnd) are the ones this
-    /// snapshot wrote; `job` is the number of the job it comes from (see job()).
+    /// snapshot wrote; `job` is the number of the job it comes from (see job()). `behind`: a
+    /// snapshot limited to `maxRows` left changed rows below changedEnd to the next one (they
+    /// still hold what earlier snapshots copied, so previousStride may not name them).
     struct Shown {
         int stride = 0;
         int rows = 0;
         int previousStride = 0;
         int changedBegin = 0, changedEnd = 0;
         uint64_t job = 0;
+        bool behind = false;
     };
     /// The number of the last job started (1 for the first; 0: none yet). A caller whose last
     /// snapshot has another number has not yet seen anything of the current job.
@@ -90,8 +93,11 @@ class ProgressiveRenderer {
     /// image, update `version` and return true; `shown` (if given) tells what the image holds
     /// and which rows changed. Only the rows written since the last snapshot are copied, so
     /// `out` must be the image the previous snapshots were taken into (any other is made a
-    /// whole copy when its size differs; keep one `out` per caller).
-    bool snapshot(uint64_t& version, Image& out, Shown* shown = nullptr);
+    /// whole copy when its size differs; keep one `out` per caller). `maxRows` > 0 copies at
+    /// most that many of them when `out` already shows this job (a finer pass of the same view:
+    /// never a mix of two views): the next snapshot copies the next ones, and `version` is
+    /// updated only by the snapshot that catches up.
+    bool snapshot(uint64_t& version, Image& out, Shown* shown = nullptr, int maxRows = 0);
     /// What a snapshot taken now would show (its changed rows left at 0): a caller that has
     /// shown another job or stride is behind by a pass.
     Shown latest() const;
@@ -119,8 +125,9 @@ class ProgressiveRenderer {
     std::atomic<bool> cancel_{false};
     std::atomic<size_t> progressDone_{0};
     std::atomic<size_t> progressTotal_{0};
-    Image display_;     ///< what snapshot() copies from: the passes' blocks, band by band
-    RowRange changed_;  ///< rows of display_ written since the last snapshot
+    Image display_;             ///< what snapshot() copies from: the passes' blocks, band by band
+    RowRange changed_;          ///< rows of display_ written since the last snapshot
+    uint64_t snapshotJob_ = 0;  ///< the job the last snapshot came from
     uint64_t displayVersion_ = 0;
     Shown displayShown_;
     Image work_;  ///< the worker's lattice buffer, kept between jobs of the same size

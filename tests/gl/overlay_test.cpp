@@ -642,6 +642,31 @@ TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShow
     for (size_t i = 0; i < direct.size(); i += 4)
         overlaid += std::abs(int(composited[i + 2]) - int(std::lround(0.4f * 255.0f))) > 8;
     EXPECT_GT(overlaid, size_t(kW));
+    // Rows uploaded while the layer is shown (a pass's band) show their new colour under the
+    // same layer, and the other rows stay as they were.
+    const int b0 = kH / 4, b1 = kH / 2;
+    for (int y = b0; y < b1; ++y)
+        for (int x = 0; x < kW; ++x) img.color[img.index(x, y)] = glm::vec3(0.6f, 0.1f, 0.1f);
+    view.upload(img, ViewMode::Color, b0, b1);
+    gl.clear(0, 0, 0);
+    view.draw(kW, kH, ViewMode::Color, 1.0f);
+    const std::vector<uint8_t> banded = gl.read();
+    size_t newColour = 0, layerKept = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            const size_t i = (size_t(y) * kW + size_t(x)) * 4;
+            const bool plain = std::abs(int(composited[i + 2]) - 102) <= 1 &&
+                               std::abs(int(composited[i]) - 51) <= 1;
+            if (y < b0 || y >= b1) {
+                ASSERT_EQ(banded[i], composited[i]) << x << "," << y << ": outside the band";
+            } else if (plain) {
+                newColour += std::abs(int(banded[i]) - 153) <= 1 && banded[i + 2] <= 26;
+            } else {
+                layerKept += banded[i] != 153 || banded[i + 2] > 26;
+            }
+        }
+    EXPECT_GT(newColour, size_t(kW));
+    EXPECT_GT(layerKept, 0u) << "the layer's lines in the band are still drawn over it";
     // A change of look draws the texture again; turning the layer off restores the image.
     ov.look.fillOpacity = 0.8f;
     ov.layerTexture(cam, kW, kH);
@@ -649,7 +674,10 @@ TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShow
     view.setOverlay(0, 0);
     view.draw(kW, kH, ViewMode::Color, 1.0f);
     const std::vector<uint8_t> plain = gl.read();
-    for (size_t i = 0; i < plain.size(); i += 4) ASSERT_NEAR(plain[i + 2], 102, 1);
+    for (size_t i = 0; i < plain.size(); i += 4) {
+        const int y = int(i / 4) / kW;
+        ASSERT_NEAR(plain[i + 2], y >= b0 && y < b1 ? 26 : 102, 1);
+    }
 }
 
 TEST(Overlays, WhileTheCameraMovesTheLayerHoldsTheLongestLinesAndAllOnceItRests) {

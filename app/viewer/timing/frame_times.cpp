@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <string_view>
 
 namespace lancer::viewer {
 
@@ -36,6 +37,32 @@ std::string FrameTimes::summary(const std::string& name) const {
                   over(kFrameBudgetMs), kFrameBudgetMs, cpuPercentile(50), cpuPercentile(95),
                   cpuPercentile(100));
     return name + ": " + line;
+}
+
+double FramePhases::totalMs() const {
+    double sum = 0.0;
+    for (const Phase& p : phases_) sum += p.ms;
+    return sum;
+}
+
+std::string FramePhases::summary() const {
+    std::vector<Phase> merged;
+    for (const Phase& p : phases_) {
+        auto same = std::find_if(merged.begin(), merged.end(), [&](const Phase& m) {
+            return std::string_view(m.name) == p.name;
+        });
+        if (same != merged.end())
+            same->ms += p.ms;
+        else
+            merged.push_back(p);
+    }
+    std::string out;
+    char ms[32];
+    for (const Phase& p : merged) {
+        std::snprintf(ms, sizeof ms, " %.1f", p.ms);
+        out += (out.empty() ? "" : ", ") + std::string(p.name) + ms;
+    }
+    return out;
 }
 
 }  // namespace lancer::viewer

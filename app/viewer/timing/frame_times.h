@@ -45,4 +45,36 @@ class FrameTimes {
     std::vector<double> wall_, cpu_;
 };
 
+/// Where one frame's UI CPU time went: the frame is cut at named marks, each phase's CPU time
+/// being the time from the mark before it. --log-timings prints it for the frames over budget,
+/// so a slow frame says which step made it slow.
+class FramePhases {
+  public:
+    /// Start a frame: the phases are cleared, the clock read.
+    void begin() {
+        phases_.clear();
+        last_ = threadCpuMs();
+    }
+    /// The phase `name` (a string literal) ends now.
+    void mark(const char* name) { markAt(name, threadCpuMs()); }
+    /// The phase `name` ends at CPU time `nowMs` (threadCpuMs(); tests give their own).
+    void markAt(const char* name, double nowMs) {
+        phases_.push_back({name, nowMs - last_});
+        last_ = nowMs;
+    }
+    /// The sum of the phases, in ms.
+    double totalMs() const;
+    /// "A 1.2, B 30.4, C 0.1" (ms, in the order marked; a phase marked twice is summed at its
+    /// first place).
+    std::string summary() const;
+
+  private:
+    struct Phase {
+        const char* name;
+        double ms;
+    };
+    std::vector<Phase> phases_;
+    double last_ = 0.0;
+};
+
 }  // namespace lancer::viewer

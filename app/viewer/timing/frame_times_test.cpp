@@ -30,5 +30,21 @@ TEST(FrameTimes, SummaryCountsFramesOverBudget) {
               "6.0 ms, p95 6.0 ms, max 40.0 ms");
 }
 
+TEST(FramePhases, EachPhaseIsTheTimeSinceTheMarkBeforeAndRepeatsSum) {
+    FramePhases f;
+    f.begin();
+    const double t0 = threadCpuMs();
+    f.markAt("poll", t0 + 2.0);
+    f.markAt("upload", t0 + 32.5);
+    f.markAt("draw", t0 + 33.0);
+    f.markAt("upload", t0 + 34.0);        // a second upload in the frame joins the first
+    EXPECT_NEAR(f.totalMs(), 34.0, 0.5);  // from begin(), a moment before t0
+    const std::string s = f.summary();
+    EXPECT_EQ(s.substr(s.find(','), std::string::npos), ", upload 31.5, draw 0.5");
+    EXPECT_EQ(s.substr(0, 5), "poll ");
+    f.begin();
+    EXPECT_EQ(f.summary(), "");
+}
+
 }  // namespace
 }  // namespace lancer::viewer
