@@ -383,6 +383,28 @@ OverlayGeometry buildOverlayGeometry(const StructureView& sv, const Camera& view
     return g;
 }
 
+double DepthStrip::at(double z) const {
+    if (slabs.empty() || !(z > z0())) return 0.0;
+    if (!(z < z1())) return 1.0;
+    size_t k = 0;
+    while (k + 1 < slabs.size() && z > slabs[k].z1) ++k;
+    const Slab& s = slabs[k];
+    const double in = s.z1 > s.z0 ? std::clamp((z - s.z0) / (s.z1 - s.z0), 0.0, 1.0) : 0.0;
+    return (double(k) + in) / double(slabs.size());
+}
+
+DepthStrip depthStrip(const ZoneFrameView& fr, uint32_t zone, std::optional<double> depth,
+                      std::optional<uint32_t> region) {
+    DepthStrip strip;
+    if (zone >= fr.zoneCount()) return strip;
+    for (const SlabInfo& s : fr.slabs(zone)) {
+        if (region ? s.region == *region : depth && *depth >= s.z0 && *depth <= s.z1)
+            if (strip.current < 0) strip.current = int(strip.slabs.size());
+        strip.slabs.push_back({s.region, s.z0, s.z1, s.prims.size()});
+    }
+    return strip;
+}
+
 std::optional<PickResult> pick(const StructureView& sv, const Camera& view, int width, int height,
                                double x, double y, float depth, bool projective) {
     if (width <= 0 || height <= 0 || x < 0.0 || y < 0.0 || x > width || y > height)
@@ -405,6 +427,7 @@ std::optional<PickResult> pick(const StructureView& sv, const Camera& view, int 
             out.region = slabs[k].region;
             out.zone = z;
             out.frame = ZoneFrameKind::Projective;
+            if (hit) out.frameDepth = dz;
             return out;
         }
         const Ray rc = s->frame().ray(ray);

@@ -132,12 +132,42 @@ struct PickResult {
     uint32_t region = 0;
     int64_t zone = -1;  ///< irregular: the zone of `frame` under the pixel
     ZoneFrameKind frame = ZoneFrameKind::Camera;
+    /// Projective zones: the depth along the camera's axis (F) of the hit the region was
+    /// picked at (none on a miss: the region is the zone's first slab).
+    std::optional<double> frameDepth;
 };
 /// Pick at continuous image point (x, y) of a width x height image seen by `view`; `depth` is
 /// the primary hit distance along the unit ray there (+inf on a miss). Nothing when the pixel
 /// sees no region.
 std::optional<PickResult> pick(const StructureView& sv, const Camera& view, int width, int height,
                                double x, double y, float depth, bool projective = true);
+
+/// A zone's depth slabs laid along one line: the image's depth strip. A projective zone's slabs
+/// all project onto the zone's rectangle, so the image cannot show them otherwise; the strip
+/// shows where along the depth each begins and ends, and which one the cursor or the selection
+/// is in.
+struct DepthStrip {
+    /// One slab of the zone.
+    struct Slab {
+        uint32_t region = 0;        ///< its region id
+        double z0 = 0.0, z1 = 0.0;  ///< its depth range along F
+        size_t prims = 0;           ///< primitives listed
+    };
+    std::vector<Slab> slabs;  ///< by increasing depth, each beginning where the one before ends
+    int current = -1;         ///< the slab holding the depth or region asked for (-1: none)
+    /// The depth range of the slabs.
+    double z0() const { return slabs.empty() ? 0.0 : slabs.front().z0; }
+    double z1() const { return slabs.empty() ? 0.0 : slabs.back().z1; }
+    /// Where depth z falls along the bar, in [0, 1]: each slab takes an equal share, in depth
+    /// order, and z is placed linearly inside its slab. On a depth scale the slab reaching the
+    /// far plane (which lists a floor, say) takes most of the bar and the slabs near the
+    /// objects a few pixels.
+    double at(double z) const;
+};
+/// Zone `zone`'s slabs of frame `fr`, the current one being the slab of region `region` when
+/// given, else the one holding depth `depth` (the first of two that share it as a boundary).
+DepthStrip depthStrip(const ZoneFrameView& fr, uint32_t zone, std::optional<double> depth,
+                      std::optional<uint32_t> region = std::nullopt);
 
 /// The frame the irregular overlays draw: the projective one when asked and present.
 const ZoneFrameView* overlayFrame(const StructureView& sv, bool projective);

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "app/viewer/colormap.h"
 #include "app/viewer/gl.h"
 #include "app/viewer/gl/transforms.h"
 #include "engine/model/csg.h"
@@ -20,6 +21,38 @@ std::string boxText(const Box3& b) {
     std::snprintf(buf, sizeof buf, "[%.4g %.4g %.4g] .. [%.4g %.4g %.4g]", b.lo.x, b.lo.y, b.lo.z,
                   b.hi.x, b.hi.y, b.hi.z);
     return buf;
+}
+
+/// The depth strip (DepthStrip) as a bar the width of about 20 characters: each slab a segment
+/// in the colour its wire has in the image (by its index in the zone), the current one framed
+/// in white, `depth` (the hit's) marked by a white line, and the depth range written under it.
+void depthStripBar(const DepthStrip& s, std::optional<double> depth) {
+    if (s.slabs.empty()) return;
+    const float w = ImGui::GetFontSize() * 20.0f, h = ImGui::GetFontSize();
+    ImDrawList* dl = ImGui::GetWindowDrawList();
+    const ImVec2 p = ImGui::GetCursorScreenPos();
+    auto x = [&](double z) { return p.x + float(s.at(z)) * w; };
+    auto u32 = [](glm::vec3 c) {
+        return ImGui::ColorConvertFloat4ToU32(ImVec4(c.x, c.y, c.z, 1.0f));
+    };
+    const ImU32 white = IM_COL32(255, 255, 255, 255), edge = IM_COL32(20, 20, 20, 255);
+    for (size_t k = 0; k < s.slabs.size(); ++k) {
+        const float x0 = x(s.slabs[k].z0), x1 = std::max(x(s.slabs[k].z1), x0 + 1.0f);
+        dl->AddRectFilled({x0, p.y}, {x1, p.y + h}, u32(levelColor(int(k))));
+        if (k > 0) dl->AddLine({x0, p.y}, {x0, p.y + h}, edge);
+    }
+    if (s.current >= 0) {
+        const DepthStrip::Slab& c = s.slabs[size_t(s.current)];
+        dl->AddRect({x(c.z0), p.y}, {std::max(x(c.z1), x(c.z0) + 1.0f), p.y + h}, white, 0.0f, 0,
+                    2.0f);
+    }
+    if (depth) dl->AddLine({x(*depth), p.y - 3.0f}, {x(*depth), p.y + h + 3.0f}, white, 2.0f);
+    ImGui::Dummy({w, h + 3.0f});
+    ImGui::TextWrapped("depth %.4g to %.4g, one cell a slab", s.z0(), s.z1());
+    if (s.current >= 0)
+        ImGui::TextWrapped("slab %d of %zu: depth %.4g to %.4g, %zu primitives", s.current,
+                           s.slabs.size(), s.slabs[size_t(s.current)].z0,
+                           s.slabs[size_t(s.current)].z1, s.slabs[size_t(s.current)].prims);
 }
 
 bool sameCamera(const Camera& a, const Camera& b) {
@@ -295,9 +328,12 @@ void Overlays::tooltip(const Camera& view, int width, int height, double x, doub
         const ZoneFrameView* fr = view_->frame(p->frame);
         ImGui::Text("zone %lld (%s frame)", static_cast<long long>(p->zone),
                     p->frame == ZoneFrameKind::Projective ? "projective" : "camera");
-        if (fr)
+        if (fr) {
             ImGui::Text("%zu primitives, %zu slabs", fr->zonePrims(uint32_t(p->zone)).size(),
                         fr->slabs(uint32_t(p->zone)).size());
+            depthStripBar(depthStrip(*fr, uint32_t(p->zone), p->frameDepth, p->region),
+                          p->frameDepth);
+        }
     }
     ImGui::Text("%s %u: %zu primitives", regionKindName(r.kind), r.id, r.prims.size());
     if (r.level >= 0) ImGui::Text("level %d", r.level);
@@ -486,7 +522,11 @@ void Overlays::selectionPanel(bool* open) {
     const Scene& scene = view_->scene();
     ImGui::Text("%s %u", regionKindName(r.kind), r.id);
     if (r.level >= 0) ImGui::Text("level %d", r.level);
-    if (r.zone >= 0) ImGui::Text("zone %lld, slab %u", static_cast<long long>(r.zone), r.slab);
+    if (r.zone >= 0) {
+        ImGui::Text("zone %lld, slab %u", static_cast<long long>(r.zone), r.slab);
+        if (const ZoneFrameView* fr = view_->frame(selection_->frame))
+            depthStripBar(depthStrip(*fr, uint32_t(r.zone), std::nullopt, r.id), std::nullopt);
+    }
     ImGui::TextWrapped("box (%s frame): %s",
                        r.kind == RegionKind::Leaf
                            ? (view_->regular()->frame().turned ? "grid" : "world")
