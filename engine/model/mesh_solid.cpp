@@ -5,6 +5,7 @@
 #include <cstring>
 #include <map>
 #include <numeric>
+#include <tuple>
 #include <unordered_map>
 
 #include "engine/util/hash.h"
@@ -24,13 +25,15 @@ double orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
     return glm::dot(glm::cross(b - a, c - a), d - a);
 }
 
-/// The segment pq crosses the triangle abc strictly (through its interior, not at an edge or
-/// an end), in the signs of double orientation tests.
+/// The segment pq crosses the plane of triangle abc strictly (not at an end) at a point of the
+/// closed triangle, in the signs of double orientation tests.
 bool segmentCrosses(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
     const double sp = orient(a, b, c, p), sq = orient(a, b, c, q);
     if (!((sp > 0.0 && sq < 0.0) || (sp < 0.0 && sq > 0.0))) return false;
+    // Through the closed triangle: a segment that pierces the surface on an edge between two
+    // triangles (a box's face diagonal) crosses it too.
     const double s1 = orient(p, q, a, b), s2 = orient(p, q, b, c), s3 = orient(p, q, c, a);
-    return (s1 > 0.0 && s2 > 0.0 && s3 > 0.0) || (s1 < 0.0 && s2 < 0.0 && s3 < 0.0);
+    return (s1 >= 0.0 && s2 >= 0.0 && s3 >= 0.0) || (s1 <= 0.0 && s2 <= 0.0 && s3 <= 0.0);
 }
 
 /// A ray's crossings with the mesh's triangles, or -1 when it meets an edge or a corner within
@@ -229,7 +232,11 @@ int side(const glm::dvec4& pl, const Vec3& p, double eps) {
     return d > eps ? 1 : d < -eps ? -1 : 0;
 }
 
-Vec3 crossing(const glm::dvec4& pl, const Vec3& a, const Vec3& b) {
+Vec3 crossing(const glm::dvec4& pl, const Vec3& a0, const Vec3& b0) {
+    // From the lesser end, so that the two faces on an edge, which walk it in opposite
+    // directions, compute the same point to the bit.
+    const bool swap = std::tie(b0.x, b0.y, b0.z) < std::tie(a0.x, a0.y, a0.z);
+    const Vec3 &a = swap ? b0 : a0, &b = swap ? a0 : b0;
     const double da = glm::dot(Vec3(pl), a) - pl.w, db = glm::dot(Vec3(pl), b) - pl.w;
     return a + (da / (da - db)) * (b - a);
 }
@@ -259,6 +266,15 @@ void splitPolygon(const std::vector<Vec3>& in, const glm::dvec4& pl, double eps,
 /// The convex polygon through `pts` (points on the plane `pl`), counter-clockwise about its
 /// normal; fewer than three points when they span no area.
 std::vector<Vec3> capPolygon(std::vector<Vec3> pts, const glm::dvec4& pl, double eps) {
+    // Points within eps of one another are one (an edge's crossing, or a vertex on the plane,
+    // reached from each of its faces): the monotone chain needs distinct points.
+    std::vector<Vec3> distinct;
+    for (const Vec3& p : pts) {
+        bool seen = false;
+        for (const Vec3& q : distinct) seen = seen || glm::length(p - q) <= 4.0 * eps;
+        if (!seen) distinct.push_back(p);
+    }
+    pts = std::move(distinct);
     if (pts.size() < 3) return {};
     const Vec3 n(pl);
     const Vec3 u = glm::normalize(std::abs(n.x) < 0.6 ? glm::cross(n, Vec3(1, 0, 0))
@@ -355,6 +371,7 @@ class SolidBsp {
         }
         out_.triangles = root.frags.size();
         root.cell = boxCell(b.lo - Vec3(0.01 * size), b.hi + Vec3(0.01 * size));
+        for (const CellFace& f : root.cell) root.path.push_back(f.plane);
         std::vector<Work> stack;
         stack.push_back(std::move(root));
         while (!stack.empty()) {
@@ -368,6 +385,7 @@ class SolidBsp {
     struct Work {
         std::vector<Fragment> frags;
         Cell cell;
+        std::vector<glm::dvec4> path;  ///< the half-spaces whose intersection is the cell
     };
 
     static Cell boxCell(const Vec3& lo, const Vec3& hi) {
@@ -426,6 +444,10 @@ class SolidBsp {
         w.frags = {};
         splitCell(w.cell, pl, eps_, back.cell, front.cell);
         w.cell = {};
+        back.path = w.path;
+        back.path.push_back(pl);
+        front.path = std::move(w.path);
+        front.path.push_back(-pl);
         leafOrPush(std::move(back), facePlane ? 1 : 0, stack);
         leafOrPush(std::move(front), facePlane ? -1 : 0, stack);
     }
@@ -439,10 +461,20 @@ class SolidBsp {
         }
         if (known == 0) known = parityInside(mesh_, cellCentre(w.cell), Vec3(0.0)) ? 1 : -1;
         if (known < 0) return;
+        // The cell is the intersection of its path's half-spaces: every one that a vertex of
+        // the cell lies on (within eps) bounds it, the others are redundant. The faces' own
+        // planes would do as well in exact arithmetic, but a face thinner than eps is dropped
+        // by the clipping, and the piece without its plane would reach beyond the cell.
         Polytope p;
-        for (const CellFace& f : w.cell) {
-            p.planes.push_back(f.plane);
+        for (const CellFace& f : w.cell)
             for (const Vec3& v : f.v) p.bounds.expand(v);
+        for (const glm::dvec4& pl : w.path) {
+            double most = -kInf;
+            for (const CellFace& f : w.cell)
+                for (const Vec3& v : f.v) most = std::max(most, glm::dot(Vec3(pl), v) - pl.w);
+            if (most >= -4.0 * eps_ &&
+                std::find(p.planes.begin(), p.planes.end(), pl) == p.planes.end())
+                p.planes.push_back(pl);
         }
         if (p.planes.size() > 255)
             throw MeshError("a convex piece has " + std::to_string(p.planes.size()) +
