@@ -179,8 +179,12 @@ bool isMeshFile(const std::string& path) {
 }
 
 TriangleMesh readMeshFile(const std::string& path, size_t maxTriangles) {
-    const SourceText src = SourceText::fromImportedFile(path, "a mesh");
-    return lowerExtension(path) == ".off" ? readOff(src, maxTriangles) : readStl(src, maxTriangles);
+    return readMeshText(SourceText::fromImportedFile(path, "a mesh"),
+                        lowerExtension(path) == ".off", maxTriangles);
+}
+
+TriangleMesh readMeshText(const SourceText& src, bool off, size_t maxTriangles) {
+    return off ? readOff(src, maxTriangles) : readStl(src, maxTriangles);
 }
 
 }  // namespace lancer

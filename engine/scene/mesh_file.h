@@ -5,6 +5,7 @@
 #include <string>
 
 #include "engine/model/mesh_solid.h"
+#include "engine/scene/source_text.h"
 
 namespace lancer {
 
@@ -15,5 +16,9 @@ bool isMeshFile(const std::string& path);
 /// At most `maxTriangles`; a file that cannot be read or parsed throws SceneError naming its
 /// path and line (binary STL: the facet).
 TriangleMesh readMeshFile(const std::string& path, size_t maxTriangles = MeshLimits{}.maxTriangles);
+
+/// readMeshFile's parse of text already read: OFF when `off`, else STL.
+TriangleMesh readMeshText(const SourceText& src, bool off,
+                          size_t maxTriangles = MeshLimits{}.maxTriangles);
 
 }  // namespace lancer
