@@ -243,13 +243,14 @@ TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
         "intersection, render, multmatrix, translate, rotate, scale, mirror, color, cube, sphere, "
         "cylinder, linear_extrude, rotate_extrude, square, circle, polygon, polyhedron, hull, "
         "text, import)");
-    // A non-convex polyhedron and a hull of spheres of two radii are refused by name.
+    // A self-intersecting polyhedron (two tetrahedra that overlap) and a hull of spheres of two
+    // radii are refused by name.
     expectCsgError(
-        "polyhedron(points = [[0, 0, 0], [4, 0, 0], [0, 4, 0], [1, 1, 3], [1, 1, 1]], "
-        "faces = [[0, 1, 3], [1, 2, 3], [2, 0, 3], [1, 0, 4], [2, 1, 4], [0, 2, 4]]);",
-        "mem.csg:1:1: polyhedron() is not convex (point 3 lies outside the plane of "
-        "face 3): Lancer models convex polyhedra exactly; a non-convex mesh is not "
-        "supported");
+        "polyhedron(points = [[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 0, 4], [1, 1, 1], [5, 1, 1], "
+        "[1, 5, 1], [1, 1, 5]], faces = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2], [4, 5, 6], "
+        "[4, 7, 5], [4, 6, 7], [5, 7, 6]]);",
+        "mem.csg:1:1: polyhedron() (its faces cut into triangles) is self-intersecting: "
+        "triangles 3 and 4 cross");
     expectCsgError("hull() { sphere(r = 1); translate([3, 0, 0]) sphere(r = 2); }",
                    "mem.csg:1:46: hull() of spheres of different radii (1 and 2) is not "
                    "supported: Lancer takes the exact hull of spheres of one radius");
@@ -666,8 +667,10 @@ TEST(OpenScadDxf, FilesAreFoundBesideTheCsgAndBadOnesAreNamed) {
     expectCsgError("linear_extrude(height = 1) { import(file = \"" + zero + "\"); }",
                    "mem.csg:1:44: import(): " + zero + ": not a regular file");
     expectCsgError("import(file = \"part.stl\");",
-                   "mem.csg:1:1: import() of 'part.stl': Lancer imports DXF drawings (inside an "
-                   "extrusion); STL, OFF and other meshes are not supported");
+                   "mem.csg:1:15: import(): part.stl: no such file");
+    expectCsgError("import(file = \"part.3mf\");",
+                   "mem.csg:1:1: import() of 'part.3mf': Lancer imports STL and OFF meshes and "
+                   "DXF drawings (inside an extrusion); other formats are not supported");
 }
 
 TEST(OpenScadOffset, RoundOffsetEqualsItsMinkowskiTwin) {

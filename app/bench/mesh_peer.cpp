@@ -11,21 +11,13 @@
 #include "app/bench/bench_rows.h"
 #include "app/bench/machine.h"
 #include "app/bench/scad_export.h"
+#include "engine/scene/mesh_file.h"
 
 namespace lancer::bench {
 
 namespace {
 
 namespace fs = std::filesystem;
-
-/// Binary STL: an 80-byte header, a triangle count, then 50 bytes a triangle. Told from ASCII
-/// by its size, which matches the count exactly (an ASCII file may begin with "solid" too).
-bool isBinaryStl(const std::string& bytes) {
-    if (bytes.size() < 84) return false;
-    uint32_t n = 0;
-    std::memcpy(&n, bytes.data() + 80, 4);
-    return bytes.size() == 84 + 50 * uint64_t(n);
-}
 
 void addTriangle(Scene& s, const Vec3& a, const Vec3& b, const Vec3& c) {
     Triangle t;
@@ -87,7 +79,7 @@ MeshRun MeshPeer::mesh(int fn, double timeoutSeconds) const {
 }
 
 Scene readStl(const std::string& path, const Scene& like) {
-    const std::string bytes = readWholeFile(path);
+    const TriangleMesh m = readMeshFile(path);
     Scene s;
     s.name = path;
     s.materials = like.materials;
@@ -96,34 +88,8 @@ Scene readStl(const std::string& path, const Scene& like) {
     s.background = like.background;
     s.width = like.width;
     s.height = like.height;
-    if (isBinaryStl(bytes)) {
-        uint32_t n = 0;
-        std::memcpy(&n, bytes.data() + 80, 4);
-        for (uint32_t i = 0; i < n; ++i) {
-            float v[9];
-            std::memcpy(v, bytes.data() + 84 + 50 * size_t(i) + 12, sizeof v);
-            addTriangle(s, Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5]), Vec3(v[6], v[7], v[8]));
-        }
-    } else {
-        std::istringstream in(bytes);
-        std::string line, word;
-        Vec3 p[3];
-        int k = 0, lineNo = 0;
-        while (std::getline(in, line)) {
-            ++lineNo;
-            std::istringstream ls(line);
-            if (!(ls >> word) || word != "vertex") continue;
-            Vec3& v = p[k];
-            if (!(ls >> v.x >> v.y >> v.z))
-                throw SceneError(path + ":" + std::to_string(lineNo) +
-                                 ": a vertex needs three numbers");
-            if (++k == 3) {
-                addTriangle(s, p[0], p[1], p[2]);
-                k = 0;
-            }
-        }
-        if (k != 0) throw SceneError(path + ": the last facet has fewer than three vertices");
-    }
+    for (const auto& t : m.triangles)
+        addTriangle(s, m.points[t[0]], m.points[t[1]], m.points[t[2]]);
     if (s.prims.empty()) throw SceneError(path + ": no triangles");
     std::vector<int> leaves;
     leaves.reserve(s.prims.size());

@@ -27,6 +27,8 @@ struct OpenScadCounts {
     int leftOut2D = 0;        ///< 2D nodes beside solids, not part of the solid model (as OpenSCAD)
     int dxfImports = 0;       ///< import() nodes of DXF drawings read
     int dxfOpenChains = 0;    ///< open paths among them, closed by their ends (as OpenSCAD)
+    int meshes = 0;           ///< closed meshes (non-convex polyhedra, STL/OFF imports) modelled
+    int meshPieces = 0;       ///< the convex pieces they were cut into (mesh_solid.h)
     int twistedExtrudes = 0;  ///< linear_extrude nodes with a twist, cut into slices
     int twistSlices = 0;      ///< OpenSCAD's slices for them, summed
     int twistSubSlices = 0;   ///< the most parts a slice of theirs is cut into

@@ -35,6 +35,17 @@ SourceText SourceText::fromFile(const std::string& path) {
     return SourceText(path, ss.str());
 }
 
+SourceText SourceText::fromImportedFile(const std::string& path, const std::string& what) {
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+        throw SceneError(path + ": not a regular file");
+    constexpr uintmax_t kMaxBytes = uintmax_t(256) << 20;
+    if (const uintmax_t size = std::filesystem::file_size(path, ec); !ec && size > kMaxBytes)
+        throw SceneError(path + ": " + std::to_string(size >> 20) +
+                         " MiB is over the 256 MiB Lancer reads of " + what);
+    return fromFile(path);
+}
+
 void SourceText::lineColumn(size_t pos, int& line, int& col) const {
     pos = std::min(pos, text_.size());
     auto it = std::upper_bound(lineStarts_.begin(), lineStarts_.end(), pos);

@@ -15,6 +15,9 @@ class SourceText {
     SourceText(std::string path, std::string text);
     /// Read a whole file; throws SceneError naming the path when it cannot be read.
     static SourceText fromFile(const std::string& path);
+    /// fromFile for a file a scene imports: only a regular file (a device or a pipe could be
+    /// read for ever) of at most 256 MiB; `what` names it in the message ("a DXF drawing").
+    static SourceText fromImportedFile(const std::string& path, const std::string& what);
     const std::string& path() const { return path_; }
     const std::string& text() const { return text_; }
     /// 1-based line and column of byte offset `pos`.

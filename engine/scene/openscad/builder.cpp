@@ -8,6 +8,7 @@
 #include <optional>
 #include <tuple>
 
+#include "engine/scene/mesh_file.h"
 #include "engine/scene/openscad/colors.h"
 #include "engine/scene/openscad/dxf.h"
 #include "engine/scene/openscad/hull3d.h"
@@ -204,10 +205,11 @@ class Builder {
         if (k == "hull") return hullNode(n, xf, mat);
         if (k == "linear_extrude") return linearExtrude(n, xf, mat);
         if (k == "rotate_extrude") return rotateExtrude(n, xf, mat);
+        if (k == "import" && isMeshFile(importFile(n))) return importMesh(n, xf, mat);
         if (k == "import" && !importsDxf(n))
             src_.fail(n.pos, "import() of '" + importFile(n) +
-                                 "': Lancer imports DXF drawings (inside an extrusion); STL, "
-                                 "OFF and other meshes are not supported");
+                                 "': Lancer imports STL and OFF meshes and DXF drawings (inside "
+                                 "an extrusion); other formats are not supported");
         if (is2DNode(k) || k == "import") {
             // As OpenSCAD's render: a 2D object beside solids is not part of the solid model.
             if (!first2D_) first2D_ = &n;
@@ -336,6 +338,42 @@ class Builder {
         std::string e = std::filesystem::path(importFile(n)).extension().string();
         for (char& c : e) c = char(std::tolower(static_cast<unsigned char>(c)));
         return e == ".dxf";
+    }
+
+    /// import() of an STL or OFF mesh, found beside the .csg: a closed mesh as a solid.
+    Built importMesh(const Node& n, const Transform& xf, int mat) {
+        Args a(src_, n, {"file", "layer", "convexity", "origin", "scale"},
+               {"timestamp", "center", "dpi", "id", "width", "height"});
+        if (!n.children.empty()) src_.fail(n.children.front().pos, "import() takes no children");
+        const Value* f = a.get("file");
+        std::filesystem::path path(f->str);
+        if (path.is_relative()) path = std::filesystem::path(src_.path()).parent_path() / path;
+        TriangleMesh m;
+        try {
+            m = readMeshFile(path.string());
+        } catch (const SceneError& e) {
+            src_.fail(f->pos, std::string("import(): ") + e.what());
+        }
+        return meshNode(std::move(m), xf, mat, n.pos, "import() of '" + f->str + "'");
+    }
+
+    /// A closed mesh as the union of its convex pieces (mesh_solid.h), each placed by `xf`.
+    Built meshNode(TriangleMesh m, const Transform& xf, int mat, size_t pos,
+                   const std::string& what) {
+        MeshSolid solid;
+        try {
+            solid = meshSolid(std::move(m));
+        } catch (const MeshError& e) {
+            src_.fail(pos, what + " is " + e.what());
+        }
+        if (solid.pieces.empty()) return emptyPrimitive();
+        ++counts_.meshes;
+        counts_.meshPieces += int(solid.pieces.size());
+        std::vector<int> items;
+        items.reserve(solid.pieces.size());
+        for (Polytope& p : solid.pieces)
+            items.push_back(place(std::move(p), xf, mat, pos, what).node);
+        return Built::of(scene_.tree.balanced(Op::Union, items));
     }
 
     /// import() of a DXF file: the closed outlines of its layer (dxf.cpp), read as OpenSCAD
@@ -1282,9 +1320,9 @@ class Builder {
         }
     }
 
-    /// polyhedron() as the convex polytope of its face planes. A mesh that is not closed (an
-    /// edge not shared by exactly two faces), has a face that is not flat, or is not convex is
-    /// refused: parity spans of a general mesh do not fit a primitive's two spans.
+    /// polyhedron() as the convex polytope of its face planes when it is convex and its faces
+    /// flat; otherwise as a closed mesh (meshNode: its faces cut into triangles, the solid cut
+    /// into convex pieces). An open mesh (an edge not shared by exactly two faces) is refused.
     Built polyhedron(const Node& n, const Transform& xf, int mat) {
         std::vector<Vec3> pts;
         std::vector<std::vector<int>> faces;
@@ -1326,17 +1364,11 @@ class Builder {
             nn /= len;
             double w = glm::dot(nn, c / double(f.size()));
             if (glm::dot(nn, centre) > w) nn = -nn, w = -w;
-            for (int i : f)
-                if (std::abs(glm::dot(nn, pts[size_t(i)]) - w) > tol)
-                    src_.fail(facesPos, "face " + std::to_string(fi) +
-                                            " of polyhedron() is not flat (its points are not "
-                                            "in one plane)");
+            bool convex = true;
+            for (int i : f) convex = convex && std::abs(glm::dot(nn, pts[size_t(i)]) - w) <= tol;
             for (size_t i = 0; i < pts.size(); ++i)
-                if (glm::dot(nn, pts[i]) - w > tol)
-                    src_.fail(n.pos, "polyhedron() is not convex (point " + std::to_string(i) +
-                                         " lies outside the plane of face " + std::to_string(fi) +
-                                         "): Lancer models convex polyhedra exactly; a non-convex "
-                                         "mesh is not supported");
+                convex = convex && glm::dot(nn, pts[i]) - w <= tol;
+            if (!convex) return polyhedronMeshNode(pts, faces, xf, mat, n.pos);
             bool known = false;
             for (const glm::dvec4& q : pt.planes)
                 known = known || (glm::dot(Vec3(q), nn) > 1.0 - 1e-12 && std::abs(q.w - w) <= tol);
@@ -1350,6 +1382,20 @@ class Builder {
         pt.bounds = padded(box);
         ++counts_.polyhedra;
         return place(std::move(pt), xf, mat, n.pos, "polyhedron()");
+    }
+
+    /// A polyhedron that is not convex (or has a face that is not flat) as a closed mesh.
+    Built polyhedronMeshNode(const std::vector<Vec3>& pts,
+                             const std::vector<std::vector<int>>& faces, const Transform& xf,
+                             int mat, size_t pos) {
+        TriangleMesh m;
+        m.points = pts;
+        std::vector<uint32_t> loop;
+        for (const auto& f : faces) {
+            loop.assign(f.begin(), f.end());
+            m.addPolygon(loop);
+        }
+        return meshNode(std::move(m), xf, mat, pos, "polyhedron() (its faces cut into triangles)");
     }
 
     /// A computed box grown by a hair, so that a solid bounded by exact planes stays inside.

@@ -307,15 +307,7 @@ class Reader {
 
 DxfOutlines readDxf(const std::string& path, const std::string& layer, const Vec2& origin,
                     double scale, const Fragments& frag) {
-    // A device or a pipe could be read for ever: only a regular file, of a bounded size.
-    std::error_code ec;
-    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-        throw SceneError(path + ": not a regular file");
-    constexpr uintmax_t kMaxBytes = uintmax_t(256) << 20;
-    if (const uintmax_t size = std::filesystem::file_size(path, ec); !ec && size > kMaxBytes)
-        throw SceneError(path + ": " + std::to_string(size >> 20) +
-                         " MiB is over the 256 MiB Lancer reads of a DXF drawing");
-    const SourceText src = SourceText::fromFile(path);
+    const SourceText src = SourceText::fromImportedFile(path, "a DXF drawing");
     const std::vector<Group> gs = groups(src);
     Reader r(src, layer, origin, scale, frag);
     r.read(gs);

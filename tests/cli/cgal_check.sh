@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# scripts/cgal-check --quick: three OpenSCAD examples (one imports an STL) meshed by CGAL and
+# rendered by Lancer, exact and as the imported mesh, their depths within the tessellation's
+# error; every row must pass. Skipped (exit 0 with a note) when openscad is not installed.
+set -u
+LANCER="$1"; SRC="$2"
+command -v openscad >/dev/null || { echo "SKIP: no openscad"; exit 0; }
+tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
+"$SRC/scripts/cgal-check" --quick --lancer "$LANCER" --out "$tmp/out" >"$tmp/table" 2>&1
+rc=$?
+cat "$tmp/table"
+[ "$rc" -eq 0 ] || { echo "FAIL: cgal-check exited $rc"; exit 1; }
+[ "$(grep -c '| pass |$' "$tmp/table")" -eq 3 ] || { echo "FAIL: not three passing rows"; exit 1; }
