@@ -11,6 +11,7 @@ LANCER_PACKAGES=(
   libgtest-dev libbenchmark-dev libembree-dev gnuplot-nox povray
   clang clang-format libclang-rt-14-dev
   libharfbuzz-dev libfreetype-dev libfontconfig-dev fonts-liberation
+  openscad
 )
 
 lancer_install_packages() {
