@@ -104,4 +104,71 @@ inline ::testing::AssertionResult sameLineCover(const gl::Batch& original, const
     return ::testing::AssertionSuccess();
 }
 
+/// Layers drawn over one another without overlap (gl::subtractCovered): every point of an axis
+/// line that some layer covers is drawn, in the colour of the first layer of `layers` (the
+/// highest precedence) that covers it, and in no other colour; no other point is drawn. Lines
+/// are told apart by position only; each layer's segments must lie along an axis.
+inline ::testing::AssertionResult drawnByPrecedence(const std::vector<gl::Batch>& layers,
+                                                    const gl::Batch& drawn) {
+    using Line = std::tuple<int, float, float>;
+    auto byLine = [](const LineCover& c, auto&& add) {
+        for (const auto& [key, ivs] : c.lines)
+            add(Line{std::get<0>(key), std::get<1>(key), std::get<2>(key)}, std::get<3>(key), ivs);
+    };
+    // Per line: each layer's intervals with its rank and colour; the drawing's by colour.
+    std::map<Line, std::vector<std::tuple<size_t, gl::Rgba8, Interval>>> ranked;
+    std::map<Line, std::map<gl::Rgba8, std::vector<Interval>>> drawnCover;
+    for (size_t l = 0; l < layers.size(); ++l) {
+        const LineCover c = lineCover(layers[l]);
+        if (!c.others.empty())
+            return ::testing::AssertionFailure() << "layer " << l << ": a segment along no axis";
+        byLine(c, [&](const Line& line, gl::Rgba8 col, const std::vector<Interval>& ivs) {
+            for (const Interval& iv : ivs) ranked[line].push_back({l, col, iv});
+        });
+    }
+    const LineCover d = lineCover(drawn);
+    if (!d.others.empty()) return ::testing::AssertionFailure() << "a drawn segment along no axis";
+    byLine(d, [&](const Line& line, gl::Rgba8 col, const std::vector<Interval>& ivs) {
+        auto& v = drawnCover[line][col];
+        v.insert(v.end(), ivs.begin(), ivs.end());
+    });
+    std::set<Line> lines;
+    for (const auto& kv : ranked) lines.insert(kv.first);
+    for (const auto& kv : drawnCover) lines.insert(kv.first);
+    for (const Line& line : lines) {
+        std::vector<double> ends;
+        for (const auto& [rank, col, iv] : ranked[line])
+            ends.insert(ends.end(), {iv.first, iv.second});
+        for (const auto& [col, ivs] : drawnCover[line])
+            for (const auto& [lo, hi] : ivs) ends.insert(ends.end(), {lo, hi});
+        std::sort(ends.begin(), ends.end());
+        ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+        // Midpoints only: at an end two layers may meet, either colour is right there.
+        for (size_t i = 0; i + 1 < ends.size(); ++i) {
+            const double t = 0.5 * (ends[i] + ends[i + 1]);
+            size_t best = SIZE_MAX;
+            for (const auto& [rank, col, iv] : ranked[line])
+                if (iv.first <= t && t <= iv.second) best = std::min(best, rank);
+            // The colours of the first layer covering t (neighbouring boxes of one layer may
+            // draw one edge in two colours).
+            std::set<gl::Rgba8> want;
+            for (const auto& [rank, col, iv] : ranked[line])
+                if (rank == best && iv.first <= t && t <= iv.second) want.insert(col);
+            for (const auto& [col, ivs] : drawnCover[line]) {
+                const bool on = covered(ivs, t);
+                if (on != (want.count(col) > 0))
+                    return ::testing::AssertionFailure()
+                           << "axis " << std::get<0>(line) << " line (" << std::get<1>(line) << ", "
+                           << std::get<2>(line) << ") point " << t << ": colour " << std::hex << col
+                           << std::dec << (on ? " drawn" : " missing");
+            }
+            for (gl::Rgba8 col : want)
+                if (!drawnCover[line].count(col))
+                    return ::testing::AssertionFailure()
+                           << "a point of a layer is not drawn at " << t;
+        }
+    }
+    return ::testing::AssertionSuccess();
+}
+
 }  // namespace lancer::viewer::testing

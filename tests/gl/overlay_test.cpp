@@ -84,12 +84,13 @@ gl::Batch leafEdges(const StructureView& sv, int lo = 0, int hi = 64) {
     return b;
 }
 
-/// The same for the directory grid's blocks of levels [lo, hi], coloured by kind.
-gl::Batch blockEdges(const StructureView& sv, int lo, int hi) {
+/// The same for the directory grid's blocks of levels [lo, hi], coloured by kind: the sub-tables
+/// or the single entries.
+gl::Batch blockEdges(const StructureView& sv, int lo, int hi, bool subTables) {
     const Box3 box = sv.worldBounds();
     gl::Batch b;
     for (const DirectoryBlock& blk : sv.directoryBlocks()) {
-        if (blk.level < lo || blk.level > hi) continue;
+        if (blk.level < lo || blk.level > hi || blk.subTable != subTables) continue;
         glm::vec3 a, z;
         for (int k = 0; k < 3; ++k) {
             const double cell = (box.hi[k] - box.lo[k]) / double(1u << sv.directoryLog2(k));
@@ -424,8 +425,10 @@ TEST(Overlays, TheLevelRangeSelectsLeavesAndGridBlocksByBspLevel) {
         ov.options.levelMin = ov.options.levelMax = level;
         ov.update(s, cam, kW, kH);
         EXPECT_EQ(ov.geometry().regionsTotal, count) << "level " << level;
-        EXPECT_TRUE(
-            viewer::testing::sameLineCover(blockEdges(sv, level, level), ov.geometry().wires))
+        // A sub-table's outline is drawn over the entries' edges it shares.
+        EXPECT_TRUE(viewer::testing::drawnByPrecedence(
+            {blockEdges(sv, level, level, true), blockEdges(sv, level, level, false)},
+            ov.geometry().wires))
             << "level " << level;
         depthDiffers |= perDepth[level] != count;
     }
@@ -438,6 +441,58 @@ TEST(Overlays, TheLevelRangeSelectsLeavesAndGridBlocksByBspLevel) {
         ov.update(s, cam, kW, kH);
         EXPECT_EQ(ov.geometry().regionsTotal, blocks.size());
     }
+}
+
+TEST(Overlays, LeavesAndGridTogetherDrawEachSharedEdgeOnceInTheColourThatSaysMore) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Regular);
+    const Camera& cam = s->scene->camera;
+    Overlays ov;
+    ov.options.grid = true;
+    ov.options.leaves = true;
+    ov.update(s, cam, kW, kH);
+    const StructureView& sv = *ov.view();
+    const gl::Batch subTables = blockEdges(sv, 0, 64, true), entries = blockEdges(sv, 0, 64, false);
+    const gl::Batch leaves = leafEdges(sv);
+    ASSERT_GT(entries.lineCount(), 0u);
+    // Sub-tables (none in this small table) over leaves over entries, every point of each
+    // drawn once.
+    EXPECT_TRUE(
+        viewer::testing::drawnByPrecedence({subTables, leaves, entries}, ov.geometry().wires));
+    // The table cuts some leaves: there the entries' lines still show.
+    const gl::Rgba8 entryColour = gl::rgba8(glm::vec3(0.55f, 0.65f, 0.8f));
+    size_t entryLines = 0;
+    for (size_t k = 0; k < ov.geometry().wires.lineCount(); ++k)
+        entryLines += ov.geometry().wires.lines[2 * k].color == entryColour;
+    EXPECT_GT(entryLines, 0u);
+    // Each layer alone draws its own edges whole.
+    ov.options.grid = false;
+    ov.update(s, cam, kW, kH);
+    EXPECT_TRUE(viewer::testing::sameLineCover(leaves, ov.geometry().wires));
+    // And drawn: a leaf edge shared with an entry shows the leaf's level colour, not the
+    // entry's grey-blue (the pixels of the whole layer at once).
+    ov.options.grid = true;
+    ov.update(s, cam, kW, kH);
+    gl.clear(0, 0, 0);
+    ov.drawLayers(cam, kW, kH);
+    const std::vector<uint8_t> both = gl.read();
+    ov.options.grid = false;
+    ov.update(s, cam, kW, kH);
+    gl.clear(0, 0, 0);
+    ov.drawLayers(cam, kW, kH);
+    const std::vector<uint8_t> alone = gl.read();
+    size_t leafPixels = 0, kept = 0;
+    for (size_t i = 0; i < alone.size(); i += 4) {
+        if (alone[i] == 0 && alone[i + 1] == 0 && alone[i + 2] == 0) continue;
+        ++leafPixels;
+        kept += both[i] == alone[i] && both[i + 1] == alone[i + 1] && both[i + 2] == alone[i + 2];
+    }
+    ASSERT_GT(leafPixels, size_t(kW));
+    // The leaf pixels keep their colour (a sub-table's outline would replace it with orange;
+    // this table has none), but where an entry's line crosses a leaf edge (2% of them here).
+    // Before, the entries drawn over the leaves took every one (the same count, 2026-12-06).
+    EXPECT_GE(kept, leafPixels * 19 / 20);
 }
 
 TEST(Overlays, ARebuildAtAnotherMaxLevelChangesTheDrawnLeavesAndOnlyThen) {

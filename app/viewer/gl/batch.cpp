@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <glm/gtc/type_ptr.hpp>
+#include <map>
 #include <tuple>
 
 #include "app/viewer/gl.h"
@@ -172,6 +173,76 @@ Batch mergeCollinearLines(const Batch& in) {
         a[r.axis] = r.lo;
         b[r.axis] = r.hi;
         out.line(a, b, r.color);
+    }
+    return out;
+}
+
+Batch subtractCovered(const Batch& in, const Batch& cover) {
+    // The cover's segments along each axis line (axis, the two other coordinates), as sorted,
+    // joined intervals; each of `in`'s segments keeps the gaps between them.
+    using Line = std::tuple<int, float, float>;
+    auto along = [](const BatchVertex& a, const BatchVertex& b, Line& line, float& lo, float& hi) {
+        int axis = -1, differing = 0;
+        for (int c = 0; c < 3; ++c) {
+            if (!std::isfinite(a.position[c]) || !std::isfinite(b.position[c])) return false;
+            if (a.position[c] != b.position[c]) axis = c, ++differing;
+        }
+        if (differing != 1) return false;
+        const int c1 = (axis + 1) % 3, c2 = (axis + 2) % 3;
+        line = {axis, a.position[std::min(c1, c2)], a.position[std::max(c1, c2)]};
+        lo = std::min(a.position[axis], b.position[axis]);
+        hi = std::max(a.position[axis], b.position[axis]);
+        return true;
+    };
+    std::map<Line, std::vector<std::pair<float, float>>> covered;
+    for (size_t k = 0; k < cover.lineCount(); ++k) {
+        Line line;
+        float lo, hi;
+        if (along(cover.lines[2 * k], cover.lines[2 * k + 1], line, lo, hi))
+            covered[line].push_back({lo, hi});
+    }
+    for (auto& [line, ivs] : covered) {
+        std::sort(ivs.begin(), ivs.end());
+        std::vector<std::pair<float, float>> joined;
+        for (const auto& iv : ivs)
+            if (!joined.empty() && iv.first <= joined.back().second)
+                joined.back().second = std::max(joined.back().second, iv.second);
+            else
+                joined.push_back(iv);
+        ivs = std::move(joined);
+    }
+    Batch out;
+    out.triangles = in.triangles;
+    for (size_t k = 0; k < in.lineCount(); ++k) {
+        const BatchVertex &a = in.lines[2 * k], &b = in.lines[2 * k + 1];
+        Line line;
+        float lo, hi;
+        const auto it = along(a, b, line, lo, hi) ? covered.find(line) : covered.end();
+        if (it == covered.end()) {
+            out.lines.push_back(a);
+            out.lines.push_back(b);
+            continue;
+        }
+        const int axis = std::get<0>(line);
+        auto piece = [&](float p, float q) {
+            if (!(p < q)) return;
+            const bool forward = a.position[axis] <= b.position[axis];
+            BatchVertex u = forward ? a : b, v = forward ? b : a;  // u at the low end
+            u.position[axis] = p;
+            v.position[axis] = q;
+            out.lines.push_back(u);
+            out.lines.push_back(v);
+        };
+        // The gaps of [lo, hi] between the covering intervals.
+        float from = lo;
+        for (const auto& [c0, c1] : it->second) {
+            if (c1 <= from) continue;
+            if (c0 >= hi) break;
+            piece(from, std::min(c0, hi));
+            from = std::max(from, c1);
+            if (from >= hi) break;
+        }
+        piece(from, hi);
     }
     return out;
 }

@@ -73,6 +73,11 @@ class Batch {
 /// the same pixels. The triangles are kept; a segment takes the place of the last one it
 /// replaces, so where lines of two colours overlap, which one lands on top may change.
 Batch mergeCollinearLines(const Batch& batch);
+/// The lines of `lines` without the parts that a segment of `cover` lies on (of any colour):
+/// where two layers draw the same edge, the one whose colour says more is drawn alone. Only
+/// segments along a world axis are cut (as mergeCollinearLines joins them); the others, and
+/// the triangles, are kept as they are. Order is kept, a cut segment's pieces in its place.
+Batch subtractCovered(const Batch& lines, const Batch& cover);
 
 /// How a batch is drawn.
 struct DrawOptions {

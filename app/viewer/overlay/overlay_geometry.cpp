@@ -250,6 +250,7 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
         }
         g.regionsDrawn += picked.size();
     }
+    gl::Batch subTables, entries;
     if (o.grid) {
         const std::vector<DirectoryBlock> blocks = sv.directoryBlocks();
         for (const DirectoryBlock& blk : blocks) {
@@ -263,14 +264,31 @@ void regularLayers(const StructureView& sv, const gl::ImageProjector& proj, int 
                                                  : glm::vec3(0.55f, 0.65f, 0.8f);
             if (o.gridColor == GridColor::Level) g.noteLevel(blk.level);
             if (o.gridColor == GridColor::TableDepth) g.noteLevel(blk.depth);
-            g.wires.box(toF(sv.gridCorners(blk.lo, blk.hi)), gl::rgba8(col));
+            (blk.subTable ? subTables : entries)
+                .box(toF(sv.gridCorners(blk.lo, blk.hi)), gl::rgba8(col));
             ++g.regionsDrawn;
         }
     }
     // Neighbouring boxes share faces, so most edges lie on others of the same colour: joined
     // once per structure and options, they make far fewer and shorter lines for each redraw of
     // the layer after a camera change, whose cost under llvmpipe is the lines'.
-    g.wires = gl::mergeCollinearLines(g.wires);
+    gl::Batch leaves = gl::mergeCollinearLines(g.wires);
+    if (!o.grid) {
+        g.wires = std::move(leaves);
+        return;
+    }
+    // Where layers share an edge, one colour is drawn: a sub-table's outline over the leaves'
+    // and the entries', a leaf's over an entry's. Drawn over one another, the pale entries
+    // (most of the grid's lines lie on leaf faces) hid the leaves' level colours; now an entry
+    // line shows only where the table cuts a leaf.
+    subTables = gl::mergeCollinearLines(subTables);
+    gl::Batch under = leaves;
+    under.lines.insert(under.lines.end(), subTables.lines.begin(), subTables.lines.end());
+    entries = gl::subtractCovered(gl::mergeCollinearLines(entries), under);
+    leaves = gl::subtractCovered(leaves, subTables);
+    g.wires = std::move(leaves);
+    for (const gl::Batch* b : {&entries, &subTables})
+        g.wires.lines.insert(g.wires.lines.end(), b->lines.begin(), b->lines.end());
 }
 
 /// The BVH's node boxes ("leaves" layer): every node whose depth lies in the level range, the
