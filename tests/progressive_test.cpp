@@ -81,7 +81,7 @@ std::vector<int> followJob(ProgressiveRenderer& pr, uint64_t job, const Image& d
     return seenStrides;
 }
 
-TEST(Progressive, AFinerPassOfTheViewOnScreenComesInPartsTheFirstPassOfAViewWhole) {
+TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
     auto scene = std::make_shared<const Scene>(loadScene("builtin:default"));
     std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
     RenderOptions opt;
@@ -123,7 +123,7 @@ TEST(Progressive, AFinerPassOfTheViewOnScreenComesInPartsTheFirstPassOfAViewWhol
     uint64_t version = 0;
     ProgressiveRenderer::Shown what;
     ASSERT_TRUE(waitBands(1));
-    // The first pass of the view: whole, whatever the limit.
+    // Into an image of another size (a new one): whole, whatever the limit.
     ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
     EXPECT_EQ(what.stride, 8);
     EXPECT_FALSE(what.behind);
@@ -150,6 +150,34 @@ TEST(Progressive, AFinerPassOfTheViewOnScreenComesInPartsTheFirstPassOfAViewWhol
     while (pr.snapshot(version, shown, &what, kMax))
         EXPECT_LE(what.changedEnd - what.changedBegin, kMax);
     EXPECT_EQ(shown.color, direct.color);
+    // A new view into the same image: its first pass comes in parts too, the rows below the
+    // part still the old view's, until the snapshot catches up.
+    RenderOptions moved = opt;
+    Camera cam = scene->camera;
+    cam.from += 0.3 * (cam.at - cam.from);
+    moved.camera = cam;
+    Image direct2(opt.width, opt.height);
+    render(*scene, *accel, moved, direct2);
+    int before = 0;
+    {
+        std::lock_guard lock(m);
+        before = bands;
+    }
+    release(before);  // the worker waits after the new job's first band
+    pr.start({scene, accel, moved});
+    ASSERT_TRUE(waitBands(before + 1));
+    ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+    EXPECT_EQ(what.job, 2u);
+    EXPECT_EQ(what.stride, 8);
+    EXPECT_TRUE(what.behind);
+    EXPECT_EQ(what.changedEnd, kMax);
+    for (int y = 0; y < opt.height; ++y)
+        for (int x = 0; x < opt.width; ++x) {
+            const Vec3 want = y < kMax ? direct2.color[direct2.index(x - x % 8, y - y % 8)]
+                                       : direct.color[direct.index(x, y)];
+            ASSERT_EQ(shown.color[shown.index(x, y)], glm::vec3(want)) << x << "," << y;
+        }
+    release(1000);
 }
 
 TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {

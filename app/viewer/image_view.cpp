@@ -201,9 +201,12 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     if (width_ == 0) return;
     scale = scale > 0.0f ? scale : 1.0f;
     diverging = diverging && mode != ViewMode::Color;
-    if (!shadedValid_ || mode != shadedMode_ ||
-        (mode != ViewMode::Color &&
-         (scale != shadedScale_ || logScale != shadedLog_ || diverging != shadedDiverging_)))
+    const bool held = hold_ && shadedWidth_ == width_ && shadedHeight_ == height_;
+    if (held) {
+        // As shaded before (setHold).
+    } else if (!shadedValid_ || mode != shadedMode_ ||
+               (mode != ViewMode::Color &&
+                (scale != shadedScale_ || logScale != shadedLog_ || diverging != shadedDiverging_)))
         shade(mode, scale, logScale, diverging, 0, height_);
     else if (!dirty_.empty())
         shade(mode, scale, logScale, diverging, dirty_.begin, dirty_.end);
@@ -242,6 +245,8 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
         shadeHeat(scale, logScale, diverging, rowBegin, rowEnd);
     dirty_.clear();
     shadedValid_ = true;
+    shadedWidth_ = width_;
+    shadedHeight_ = height_;
     shadedMode_ = mode;
     shadedScale_ = scale;
     shadedLog_ = logScale;

@@ -63,6 +63,10 @@ class ImageView {
     /// llvmpipe shaded a 1280x720 image in 37-41 ms of the UI thread, each pass that arrived
     /// with an overlay shown.
     void setOverlay(unsigned texture, uint64_t version);
+    /// While held, draw() shows what it showed before and shades nothing: uploads go on, and
+    /// the rows they changed are shaded once the hold ends (a new view's image coming in parts
+    /// is never shown half). A hold does not keep an image of another size.
+    void setHold(bool hold) { hold_ = hold; }
     /// Size of the uploaded image (0 x 0 before the first upload).
     int width() const { return width_; }
     int height() const { return height_; }
@@ -94,6 +98,8 @@ class ImageView {
     /// pass each time).
     mutable RowRange dirty_;
     int width_ = 0, height_ = 0;
+    mutable int shadedWidth_ = 0, shadedHeight_ = 0;  ///< the size the FBO was last shaded at
+    bool hold_ = false;
     PixelRect viewport_;
     unsigned overlayTex_ = 0;
     uint64_t overlayVersion_ = 0;

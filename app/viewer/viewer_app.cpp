@@ -244,6 +244,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         if (r.x0 < area.x1 && area.x0 < r.x1 && r.y0 < area.y1 && area.y0 < r.y1)
             covered.push_back(r);
     view_->setViewport(area);
+    view_->setHold(state_.holdImage());
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale,
                 state_.heatDiverging());
     phases_.mark("image");

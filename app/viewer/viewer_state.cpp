@@ -300,13 +300,22 @@ void ViewerState::pollBuilder() {
 
 bool ViewerState::takeSnapshot(bool whole) {
     ProgressiveRenderer::Shown what;
-    // A finer pass of the view on screen comes in parts: a whole 1280x720 image (32 bytes a
-    // pixel) took 13-17 ms of the UI thread to copy, and its conversion and upload as much
-    // again. The first pass of a new view comes whole, never mixed with the old view.
+    // A pass comes in parts: a whole 1280x720 image (32 bytes a pixel) took 13-17 ms of the UI
+    // thread to copy, and its conversion and upload as much again. A new view's rows are held
+    // off the screen (holdImage) until the last part is in, never mixed with the old view's;
+    // after kHoldFrames frames of holding the rest comes whole, so that a drag, whose every
+    // frame may bring a new view, still shows one.
+    const bool hurry = holdFrames_ >= kHoldFrames;
     const int maxRows =
-        whole || shown_.width <= 0 ? 0 : std::max(1, kSnapshotPixels / shown_.width);
-    if (!renderer_.snapshot(shownVersion_, shown_, &what, maxRows)) return false;
+        whole || hurry || shown_.width <= 0 ? 0 : std::max(1, kSnapshotPixels / shown_.width);
+    if (!renderer_.snapshot(shownVersion_, shown_, &what, maxRows)) {
+        if (holding_) ++holdFrames_;
+        return false;
+    }
     snapshotBehind_ = what.behind;
+    holding_ = what.behind && (holding_ || what.job != screenJob_);
+    holdFrames_ = holding_ ? holdFrames_ + 1 : 0;
+    if (!what.behind) screenJob_ = what.job;
     uploadDue_ = true;
     changed_.add(what.changedBegin, what.changedEnd < 0 ? shown_.height : what.changedEnd);
     shownJob_ = what.job;

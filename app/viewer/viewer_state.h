@@ -64,6 +64,8 @@ struct SpeedupResult {
 /// The pixels of a finer pass that one frame takes from the renderer at most (a third of a
 /// 1280x720 image): the rest comes in the next frames (ViewerState::takeSnapshot).
 inline constexpr int kSnapshotPixels = 1280 * 720 / 3;
+/// The frames a new view's image may be held off the screen before its rest comes whole.
+inline constexpr int kHoldFrames = 2;
 
 class ViewerState {
   public:
@@ -107,6 +109,9 @@ class ViewerState {
     const Camera& home() const { return home_; }
     /// The image on screen (the last snapshot taken).
     const Image& shown() const { return shown_; }
+    /// A new view's image is coming in parts (takeSnapshot): the screen keeps the previous
+    /// view's until the last part is in, so two views never share it.
+    bool holdImage() const { return holding_; }
     /// The shown image has every row at full resolution: its counters are the render's.
     bool shownComplete() const { return shownComplete_; }
     /// The render job the shown image comes from (a new one for each change).
@@ -203,7 +208,7 @@ class ViewerState {
 
     void pollBuilder();
     /// Take the renderer's newest image, if any (true then): at most kSnapshotPixels' worth of
-    /// rows of a finer pass of the view on screen a frame, unless `whole`.
+    /// rows a frame, unless `whole` (a new view's held off the screen until complete).
     bool takeSnapshot(bool whole = false);
     void restartRender(const char* why);
     void updateAutoScale();
@@ -232,6 +237,9 @@ class ViewerState {
     int shownStride_ = 0;          ///< and the pass it shows (some of its rows, at least)
     RowRange changed_;             ///< rows not uploaded yet
     bool snapshotBehind_ = false;  ///< the last snapshot left rows of its pass to the next
+    uint64_t screenJob_ = 0;       ///< the job whose rows the screen may show (caught up with)
+    bool holding_ = false;         ///< a new job's rows are coming in parts: holdImage()
+    int holdFrames_ = 0;           ///< snapshots (frames) it has been held
     bool uploadDue_ = false;
     int jobWidth_ = 0, jobHeight_ = 0;
     bool renderDirty_ = false, cameraMovedForBuild_ = false;

@@ -93,12 +93,10 @@ bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown, 
     Shown s = displayShown_;
     const bool whole = out.width != display_.width || out.height != display_.height;
     int end = changed_.end;
-    if (!whole && maxRows > 0 && s.job == snapshotJob_ && end - changed_.begin > maxRows)
-        end = changed_.begin + maxRows;
+    if (!whole && maxRows > 0 && end - changed_.begin > maxRows) end = changed_.begin + maxRows;
     copyRows(display_, out, changed_.begin, end);  // whole when the size differs
     s.changedBegin = whole ? 0 : changed_.begin;
     s.changedEnd = whole ? display_.height : end;
-    snapshotJob_ = s.job;
     if (!whole && end < changed_.end) {
         changed_.begin = end;
         s.rows = std::min(s.rows, end);  // the pass's rows that `out` holds

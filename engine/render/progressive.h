@@ -94,9 +94,10 @@ class ProgressiveRenderer {
     /// and which rows changed. Only the rows written since the last snapshot are copied, so
     /// `out` must be the image the previous snapshots were taken into (any other is made a
     /// whole copy when its size differs; keep one `out` per caller). `maxRows` > 0 copies at
-    /// most that many of them when `out` already shows this job (a finer pass of the same view:
-    /// never a mix of two views): the next snapshot copies the next ones, and `version` is
-    /// updated only by the snapshot that catches up.
+    /// most that many of them: the next snapshot copies the next ones, and `version` is updated
+    /// only by the snapshot that catches up (Shown::behind false). The rows of a new job's
+    /// first snapshots then lie beside the previous job's: a caller that must not show two
+    /// views at once waits for the catch-up.
     bool snapshot(uint64_t& version, Image& out, Shown* shown = nullptr, int maxRows = 0);
     /// What a snapshot taken now would show (its changed rows left at 0): a caller that has
     /// shown another job or stride is behind by a pass.
@@ -125,9 +126,8 @@ class ProgressiveRenderer {
     std::atomic<bool> cancel_{false};
     std::atomic<size_t> progressDone_{0};
     std::atomic<size_t> progressTotal_{0};
-    Image display_;             ///< what snapshot() copies from: the passes' blocks, band by band
-    RowRange changed_;          ///< rows of display_ written since the last snapshot
-    uint64_t snapshotJob_ = 0;  ///< the job the last snapshot came from
+    Image display_;     ///< what snapshot() copies from: the passes' blocks, band by band
+    RowRange changed_;  ///< rows of display_ written since the last snapshot
     uint64_t displayVersion_ = 0;
     Shown displayShown_;
     Image work_;  ///< the worker's lattice buffer, kept between jobs of the same size

@@ -130,6 +130,40 @@ TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnly) {
     }
 }
 
+TEST(ViewerGl, WhileHeldTheViewShowsTheImageBeforeAndTheRowsUploadedComeAtTheRelease) {
+    const int w = 120, h = 80;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    Image a(w, h), b(w, h);
+    for (size_t i = 0; i < a.color.size(); ++i) {
+        a.color[i] = glm::vec3(0.2f, 0.4f, 0.6f);
+        b.color[i] = glm::vec3(0.9f, 0.1f, 0.3f);
+    }
+    ImageView view;
+    view.upload(a, ViewMode::Color);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    // A new view comes in two parts: neither shows until the hold ends.
+    view.setHold(true);
+    view.upload(b, ViewMode::Color, 0, 40);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    std::vector<uint8_t> shown = gl.read();
+    for (int y : {0, 39, 40, 79})
+        ASSERT_LE(maxDiff(&shown[4 * a.index(7, y)], a.color[0]), 1) << "held: row " << y;
+    view.upload(b, ViewMode::Color, 40, 80);
+    view.setHold(false);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    shown = gl.read();
+    for (int y : {0, 39, 40, 79})
+        ASSERT_LE(maxDiff(&shown[4 * a.index(7, y)], b.color[0]), 1) << "released: row " << y;
+    // A hold does not keep an image of another size: the new size is shown at once.
+    Image c(w / 2, h / 2);
+    for (glm::vec3& col : c.color) col = glm::vec3(0.0f, 1.0f, 0.0f);
+    view.setHold(true);
+    view.upload(c, ViewMode::Color);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    EXPECT_LE(maxDiff(&gl.read()[4 * a.index(w / 2, h / 2)], c.color[0]), 1);
+}
+
 TEST(ViewerGl, PanelsFromTheirTexturesMatchImGuisOwnDrawingAndRedrawOnlyWhenChanged) {
     const int w = 420, h = 300;
     OffscreenGl gl(w, h);
