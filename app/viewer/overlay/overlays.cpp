@@ -108,10 +108,10 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
         }
     }
     if (!view_) return;
-    if (job_.valid()) {  // a build under way: the batches on screen stay until it is done
-        if (job_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
-        OverlayGeometry g = job_.get();
-        take(std::move(g), jobInputs_,
+    if (job_.pending()) {  // a build under way: the batches on screen stay until it is done
+        std::optional<OverlayGeometry> g = job_.poll();
+        if (!g) return;
+        take(std::move(*g), jobInputs_,
              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - jobStart_)
                  .count());
     }
@@ -137,20 +137,10 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
         return;
     }
     // On the worker: balls4's slabs (1.2 M lines) took the UI thread 0.83 s a structure
-    // (2026-12-06, scripts/frame-times). The worker before it has set its result: joined at once.
-    if (worker_.joinable()) worker_.join();
-    std::promise<OverlayGeometry> done;
-    job_ = done.get_future();
+    // (2026-12-06, scripts/frame-times).
     jobInputs_ = in;
     jobStart_ = std::chrono::steady_clock::now();
-    worker_ = std::jthread([done = std::move(done), in, wake = wake_]() mutable {
-        try {
-            done.set_value(build(in));
-        } catch (...) {  // rethrown by update(), as when it builds them itself
-            done.set_exception(std::current_exception());
-        }
-        if (wake) wake();
-    });
+    job_.start([in] { return build(in); }, wake_);
 }
 
 void Overlays::buildInBackground(std::function<void()> wake) {

@@ -6,12 +6,11 @@
 
 #include <cstdint>
 #include <functional>
-#include <future>
 #include <memory>
 #include <optional>
 #include <string>
-#include <thread>
 
+#include "app/viewer/background_job.h"
 #include "app/viewer/gl/batch.h"
 #include "app/viewer/image_costs.h"
 #include "app/viewer/overlay/overlay_geometry.h"
@@ -147,7 +146,7 @@ class Overlays {
     /// previous ones are drawn). Otherwise (tests) update() builds them itself.
     void buildInBackground(std::function<void()> wake);
     /// A build of the batches is under way on the worker.
-    bool building() const { return job_.valid(); }
+    bool building() const { return job_.pending(); }
     /// The cached geometry (what the last update built).
     const OverlayGeometry& geometry() const { return geometry_; }
     /// Times the batches were rebuilt (tests: a change rebuilds, nothing else does).
@@ -215,10 +214,9 @@ class Overlays {
     // buildInBackground(): the build under way, what it reads and when it began.
     bool background_ = false;
     std::function<void()> wake_;
-    std::future<OverlayGeometry> job_;
     BuildInputs jobInputs_;
     std::chrono::steady_clock::time_point jobStart_;
-    std::jthread worker_;  ///< last: joined before the rest is destroyed
+    BackgroundJob<OverlayGeometry> job_;  ///< last: its worker joined before the rest is destroyed
 };
 
 /// The names --show accepts (DESIGN.md section 6), and which of them the overlays draw.
