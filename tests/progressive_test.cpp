@@ -81,6 +81,18 @@ std::vector<int> followJob(ProgressiveRenderer& pr, uint64_t job, const Image& d
     return seenStrides;
 }
 
+/// `opt` with the camera moved 30% of the way to its target, and its render into `direct`.
+RenderOptions movedView(const Scene& scene, const Accelerator& accel, const RenderOptions& opt,
+                        Image& direct) {
+    RenderOptions moved = opt;
+    Camera cam = scene.camera;
+    cam.from += 0.3 * (cam.at - cam.from);
+    moved.camera = cam;
+    direct = Image(opt.width, opt.height);
+    render(scene, accel, moved, direct);
+    return moved;
+}
+
 TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
     auto scene = std::make_shared<const Scene>(loadScene("builtin:default"));
     std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
@@ -152,12 +164,8 @@ TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
     EXPECT_EQ(shown.color, direct.color);
     // A new view into the same image: its first pass comes in parts too, the rows below the
     // part still the old view's, until the snapshot catches up.
-    RenderOptions moved = opt;
-    Camera cam = scene->camera;
-    cam.from += 0.3 * (cam.at - cam.from);
-    moved.camera = cam;
-    Image direct2(opt.width, opt.height);
-    render(*scene, *accel, moved, direct2);
+    Image direct2;
+    const RenderOptions moved = movedView(*scene, *accel, opt, direct2);
     int before = 0;
     {
         std::lock_guard lock(m);
@@ -220,12 +228,8 @@ TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
     // A second job of the same size, another view, into the same image: every snapshot is
     // checked as above (an earlier attempt to hand the display over instead of copying it
     // showed stale rows here), and the end is the direct render.
-    RenderOptions moved = opt;
-    Camera cam = scene->camera;
-    cam.from += 0.3 * (cam.at - cam.from);
-    moved.camera = cam;
-    Image direct2(opt.width, opt.height);
-    render(*scene, *accel, moved, direct2);
+    Image direct2;
+    const RenderOptions moved = movedView(*scene, *accel, opt, direct2);
     ASSERT_NE(direct2.color, direct.color);
     pr.start({scene, accel, moved});
     seenStrides = followJob(pr, 2, direct2, shown, version);

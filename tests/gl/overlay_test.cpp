@@ -446,11 +446,10 @@ TEST(Overlays, TheLevelRangeSelectsLeavesAndGridBlocksByBspLevel) {
 TEST(Overlays, LeavesAndGridTogetherDrawEachSharedEdgeOnceInTheColourThatSaysMore) {
     OffscreenGl gl(kW, kH);
     ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
-    auto s = twoBoxes(SchemeKind::Regular);
-    const Camera& cam = s->scene->camera;
     Overlays ov;
-    ov.options.grid = true;
-    ov.options.leaves = true;
+    ov.options.grid = ov.options.leaves = true;
+    const auto s = twoBoxes(SchemeKind::Regular);
+    const Camera& cam = s->scene->camera;
     ov.update(s, cam, kW, kH);
     const StructureView& sv = *ov.view();
     const gl::Batch subTables = blockEdges(sv, 0, 64, true), entries = blockEdges(sv, 0, 64, false);

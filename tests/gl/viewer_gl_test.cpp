@@ -92,10 +92,8 @@ TEST(ViewerGl, ImageQuadCarriesTheTracedImageAndHeatMapsItsCounters) {
     EXPECT_LE(worst, 2);
 }
 
-TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnly) {
-    const int w = 120, h = 80;
-    OffscreenGl gl(w, h);
-    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+/// Two w x h images of one colour each, a blue-grey with 1 test a pixel and a red with 7.
+std::pair<Image, Image> twoPlainImages(int w, int h) {
     Image a(w, h), b(w, h);
     for (size_t i = 0; i < a.color.size(); ++i) {
         a.color[i] = glm::vec3(0.2f, 0.4f, 0.6f);
@@ -103,6 +101,14 @@ TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnly) {
         a.primTests[i] = 1;
         b.primTests[i] = 7;
     }
+    return {a, b};
+}
+
+TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnlyAndAHoldDefersThem) {
+    const int w = 120, h = 80;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    const auto [a, b] = twoPlainImages(w, h);
     ImageView view;
     view.upload(a, ViewMode::Color);
     view.draw(w, h, ViewMode::Color, 1.0f);  // shades every row
@@ -128,25 +134,14 @@ TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnly) {
         const float v = (y >= rowBegin && y < rowEnd ? 7.0f : 1.0f) / 8.0f;
         ASSERT_LE(maxDiff(&hot[4 * a.index(0, y)], colormap(v)), 2) << "row " << y;
     }
-}
-
-TEST(ViewerGl, WhileHeldTheViewShowsTheImageBeforeAndTheRowsUploadedComeAtTheRelease) {
-    const int w = 120, h = 80;
-    OffscreenGl gl(w, h);
-    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
-    Image a(w, h), b(w, h);
-    for (size_t i = 0; i < a.color.size(); ++i) {
-        a.color[i] = glm::vec3(0.2f, 0.4f, 0.6f);
-        b.color[i] = glm::vec3(0.9f, 0.1f, 0.3f);
-    }
-    ImageView view;
     view.upload(a, ViewMode::Color);
     view.draw(w, h, ViewMode::Color, 1.0f);
-    // A new view comes in two parts: neither shows until the hold ends.
+    // While held (ImageView::setHold) the view shows the image before; a new view comes in
+    // two parts, neither shown until the hold ends.
     view.setHold(true);
     view.upload(b, ViewMode::Color, 0, 40);
     view.draw(w, h, ViewMode::Color, 1.0f);
-    std::vector<uint8_t> shown = gl.read();
+    shown = gl.read();
     for (int y : {0, 39, 40, 79})
         ASSERT_LE(maxDiff(&shown[4 * a.index(7, y)], a.color[0]), 1) << "held: row " << y;
     view.upload(b, ViewMode::Color, 40, 80);
