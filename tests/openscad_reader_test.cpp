@@ -539,6 +539,49 @@ TEST(OpenScadTwist, EveryHitLiesWithinTheStatedBoundOfTheExactTwistedSurface) {
     EXPECT_GT(worst, n.twistError / 4.0);
 }
 
+TEST(OpenScadTwist, OpenScadsOwnMeshLiesWithinTheStatedBoundOfTheExactTwistedSurface) {
+    // OpenSCAD meshes the same twist as 8 slices whose wall quads (an edge at one end, the same
+    // edge turned pi/16 at the other) are cut into two triangles: scripts/cgal-check adds how
+    // far they stray (openscad_mesh_error) to its tolerance. Bound: rho (pi/16)^2 / 8 for the
+    // corners' arcs plus the longest edge (20) times pi/16 / 4 for the cut quads.
+    OpenScadCounts n;
+    const double twist = 90.0, h = 20.0, a = 10.0, b = 5.0;
+    const Scene s = csgText(
+        "linear_extrude(height = 20, twist = 90, $fn = 0, $fa = 12, $fs = 2) { square(size = "
+        "[20, 10], center = true); }",
+        &n);
+    const double d = glm::radians(twist) / 8.0, rho = std::hypot(a, b);
+    // (times 1 + 1e-9: the transform's stretch is rounded up)
+    EXPECT_NEAR(n.openScadTwistMeshError, rho * d * d / 8.0 + 20.0 * d / 4.0, 1e-8);
+    EXPECT_EQ(s.openScadMeshError, n.openScadTwistMeshError) << "the bound --stats reports";
+    const glm::dvec2 corner[4] = {{-a, -b}, {a, -b}, {a, b}, {-a, b}};
+    auto at = [&](int c, int slice) {  // corner c of the section at the slice's bottom
+        const double th = -glm::radians(twist) * slice / 8.0;
+        const glm::dvec2 q = glm::dvec2(std::cos(th) * corner[c].x - std::sin(th) * corner[c].y,
+                                        std::sin(th) * corner[c].x + std::cos(th) * corner[c].y);
+        return Vec3(q, h * slice / 8.0);
+    };
+    double worst = 0.0;
+    // Both cuts of every quad (whichever diagonal OpenSCAD takes), sampled on a grid.
+    for (int k = 0; k < 8; ++k)
+        for (int c = 0; c < 4; ++c) {
+            const Vec3 p0 = at(c, k), p1 = at((c + 1) % 4, k), q0 = at(c, k + 1),
+                       q1 = at((c + 1) % 4, k + 1);
+            const Vec3 tris[4][3] = {{p0, p1, q1}, {p0, q1, q0}, {p0, p1, q0}, {p1, q1, q0}};
+            for (const auto& t : tris)
+                for (int i = 0; i <= 20; ++i)
+                    for (int j = 0; i + j <= 20; ++j) {
+                        const Vec3 p =
+                            t[0] + (t[1] - t[0]) * (i / 20.0) + (t[2] - t[0]) * (j / 20.0);
+                        const double dist = twistedOutlineDistance(p, a, b, twist, h);
+                        worst = std::max(worst, dist);
+                        EXPECT_LE(dist, n.openScadTwistMeshError + 1e-9);
+                    }
+        }
+    // Not vacuous: OpenSCAD's triangles stray by most of it (0.98 of 1.04).
+    EXPECT_GT(worst, n.openScadTwistMeshError / 2.0);
+}
+
 TEST(OpenScadTwist, SchemesAgreeWithBruteForce) {
     // A twisted L (two convex pieces), a twisted scaled square minus a twisted round hole on
     // the axis (exact), turned: every scheme, ray for ray.
