@@ -1026,29 +1026,35 @@ class Builder {
             p0[i] = Vec3(a0 * base[i], z0);
             p1[i] = Vec3(a1 * base[i], z1);
         }
-        Vec3 centre(0.0);
-        for (size_t i = 0; i < m; ++i) centre += p0[i] + p1[i];
-        centre /= double(2 * m);
+        // The piece's winding gives each edge its outward side. Neither end's centre does: a
+        // sliver piece (example009's fan cut into trapezoids) has its centre within rounding of
+        // its long edges, and a side taken the wrong way left the hull without that face,
+        // reaching far outside its corners' box (the schemes, which clip by it, then missed
+        // what brute force hit).
+        double area2 = 0.0;
+        for (size_t i = 0; i < m; ++i) {
+            const Vec2 &u = base[i], &v = base[(i + 1) % m];
+            area2 += u.x * v.y - u.y * v.x;
+        }
+        if (!(area2 != 0.0)) return Built::empty();    // no area, no volume
+        const double turn = area2 > 0.0 ? 1.0 : -1.0;  // counter-clockwise: outward is right
         Polytope pt;
         auto sides = [&](const std::vector<Vec3>& ring, const std::vector<Vec3>& other) {
-            // The edge's outward side is away from its own end's centre: the centre of both
-            // ends may lie outside a thin piece that moves more than its width over the slice.
-            Vec2 mid(0.0);
-            for (const Vec3& q : ring) mid += Vec2(q);
-            mid /= double(m);
             for (size_t i = 0; i < m; ++i) {
                 const Vec3 &p = ring[i], &q = ring[(i + 1) % m];
                 const Vec2 e(q.x - p.x, q.y - p.y);
                 if (e == Vec2(0.0)) continue;  // a zero scale collapses the end
-                // The edge's outward normal in the end's plane (either winding), then the other
-                // end's farthest corner that way.
-                Vec2 out(e.y, -e.x);
-                if (glm::dot(out, mid - Vec2(p)) > 0.0) out = -out;
+                // The edge's outward normal in the end's plane (the ends keep the piece's
+                // winding: a turn and a positive scale), then the other end's farthest corner
+                // that way: the hull's face through the edge passes through it.
+                const Vec2 out = turn * Vec2(e.y, -e.x);
                 size_t best = 0;
                 for (size_t k = 1; k < m; ++k)
                     if (glm::dot(out, Vec2(other[k])) > glm::dot(out, Vec2(other[best]))) best = k;
                 Vec3 nn = glm::cross(q - p, other[best] - p);
-                if (glm::dot(nn, centre - p) > 0.0) nn = -nn;
+                // The face's normal is square to the edge, so its horizontal part lies along
+                // `out` (never zero: the corner is at the other end's height).
+                if (glm::dot(Vec2(nn), out) < 0.0) nn = -nn;
                 const double len = glm::length(nn);
                 if (!(len > 0.0)) continue;
                 nn /= len;
