@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -36,6 +37,10 @@ const char* kDictionary[] = {
     "CIRCLE", "LWPOLYLINE", "POLYLINE", "VERTEX", "INSERT", "BLOCK", "ENDBLK", "SECTION", "ENDSEC"};
 
 bool run(const std::string& input, const std::string& what) {
+    // LANCER_FUZZ_LAST=FILE keeps each input there before it runs: after a crash, the input that
+    // crashed (libFuzzer writes its own crash-* files; this driver has no other record).
+    static const char* last = std::getenv("LANCER_FUZZ_LAST");
+    if (last) std::ofstream(last, std::ios::binary) << input;
     auto start = std::chrono::steady_clock::now();
     LLVMFuzzerTestOneInput(reinterpret_cast<const uint8_t*>(input.data()), input.size());
     double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
