@@ -495,13 +495,18 @@ TEST(OpenScadTwist, SlicesFollowOpenScadsRule) {
     EXPECT_EQ(t.twistSlices, 5);
 }
 
+/// A 20 x 10 rectangle twisted by 90 degrees over a height of 20 (OpenSCAD's 8 slices).
+Scene twistedRectangle(OpenScadCounts* n) {
+    return csgText(
+        "linear_extrude(height = 20, twist = 90, $fn = 0, $fa = 12, $fs = 2) { square(size = "
+        "[20, 10], center = true); }",
+        n);
+}
+
 TEST(OpenScadTwist, EveryHitLiesWithinTheStatedBoundOfTheExactTwistedSurface) {
     OpenScadCounts n;
     const double twist = 90.0, h = 20.0, a = 10.0, b = 5.0;
-    const Scene s = csgText(
-        "linear_extrude(height = 20, twist = 90, $fn = 0, $fa = 12, $fs = 2) { square(size = "
-        "[20, 10], center = true); }",
-        &n);
+    const Scene s = twistedRectangle(&n);
     // OpenSCAD's 8 slices, each cut into 16 (the hull's first-order error, 1.1 at pi/16 a
     // slice, is over 0.2% of the radius); the bound for a turn of pi/128 of the piece centred
     // on the axis, its corners 11.18 from it: 11.18 (pi/128)^2 / 8 + 11.18 (pi/128) / 2.
@@ -546,10 +551,7 @@ TEST(OpenScadTwist, OpenScadsOwnMeshLiesWithinTheStatedBoundOfTheExactTwistedSur
     // corners' arcs plus the longest edge (20) times pi/16 / 4 for the cut quads.
     OpenScadCounts n;
     const double twist = 90.0, h = 20.0, a = 10.0, b = 5.0;
-    const Scene s = csgText(
-        "linear_extrude(height = 20, twist = 90, $fn = 0, $fa = 12, $fs = 2) { square(size = "
-        "[20, 10], center = true); }",
-        &n);
+    const Scene s = twistedRectangle(&n);
     const double d = glm::radians(twist) / 8.0, rho = std::hypot(a, b);
     // (times 1 + 1e-9: the transform's stretch is rounded up)
     EXPECT_NEAR(n.openScadTwistMeshError, rho * d * d / 8.0 + 20.0 * d / 4.0, 1e-8);

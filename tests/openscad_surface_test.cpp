@@ -36,14 +36,8 @@ Scene csgFile(const std::string& text, OpenScadCounts* counts = nullptr) {
 
 /// The nearest hit of brute force along the ray, or NaN.
 double depth(const Scene& s, const Ray& r) {
-    BuildParams bp;
-    bp.scheme = SchemeKind::Brute;
-    auto brute = buildAccelerator(s, bp);
-    TraceContext ctx(s.prims.size(), s.tree.depth());
-    NullObserver obs;
     Hit hit;
-    ctx.beginRay();
-    return brute->intersect(r, 0.0, kInf, ctx, obs, hit) ? hit.t : std::nan("");
+    return test::bruteHit(s, r, hit) ? hit.t : std::nan("");
 }
 
 /// The top's height at (x, y) as OpenSCAD's mesh has it (grid at integers, not centred): the
