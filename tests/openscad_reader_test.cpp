@@ -242,7 +242,7 @@ TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
         "mem.csg:2:2: the node 'minkowski' is not supported (supported: group, union, difference, "
         "intersection, render, multmatrix, translate, rotate, scale, mirror, color, cube, sphere, "
         "cylinder, linear_extrude, rotate_extrude, square, circle, polygon, polyhedron, hull, "
-        "text, import)");
+        "text, import, surface)");
     // A self-intersecting polyhedron (two tetrahedra that overlap) and a hull of spheres of two
     // radii are refused by name.
     expectCsgError(
