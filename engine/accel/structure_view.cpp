@@ -21,6 +21,8 @@ template <class... Ts>
 struct Overloaded : Ts... {
     using Ts::operator()...;
 };
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;  // clang 14 lacks C++20 aggregate deduction
 
 int64_t ropeNeighbour(uint32_t rope) {
     if (rope == kBorder) return kNoNeighbour;

@@ -34,6 +34,7 @@ nlohmann::json statsJson(const Scene& scene, const Accelerator& accel, const Ren
     j["live_primitives"] = scene.livePrimitives().size();
     j["dropped_primitives"] = scene.droppedPrims;
     j["model_error"] = scene.modelError;
+    j["openscad_mesh_error"] = scene.openScadMeshError;
     double rays = c.rays ? double(c.rays) : 1.0;
     j["prim_tests_per_ray"] = double(c.primTests) / rays;
     j["region_visits_per_ray"] = double(c.regionVisits) / rays;

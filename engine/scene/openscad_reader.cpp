@@ -25,6 +25,7 @@ Scene readOpenScad(const SourceText& src, const SourceText* camera, OpenScadCoun
     OpenScadCounts counts;
     openscad::buildModel(src, top, scene, counts);
     scene.modelError = counts.twistError;
+    scene.openScadMeshError = counts.openScadTwistMeshError;
     scene.prepare();
     // OpenSCAD's default view ($vpr = [55, 0, 25]): the eye at azimuth -65 degrees from +x,
     // 35 degrees above the ground plane, z up.

@@ -29,12 +29,17 @@ struct OpenScadCounts {
     int dxfOpenChains = 0;    ///< open paths among them, closed by their ends (as OpenSCAD)
     int meshes = 0;           ///< closed meshes (non-convex polyhedra, STL/OFF imports) modelled
     int meshPieces = 0;       ///< the convex pieces they were cut into (mesh_solid.h)
+    int surfaces = 0;         ///< surface() heightmaps modelled (as closed meshes)
     int twistedExtrudes = 0;  ///< linear_extrude nodes with a twist, cut into slices
     int twistSlices = 0;      ///< OpenSCAD's slices for them, summed
     int twistSubSlices = 0;   ///< the most parts a slice of theirs is cut into
     /// The largest distance (model units) between a twisted extrusion's exact surface and its
     /// slices' walls, over all of them; 0 when nothing is twisted.
     double twistError = 0.0;
+    /// The largest distance (model units) between a twisted extrusion's exact surface and
+    /// OpenSCAD's own mesh of it (its walls triangulated between OpenSCAD's slices, circles as
+    /// their polygons), beyond the facets' sagitta; for comparisons with that mesh.
+    double openScadTwistMeshError = 0.0;
 };
 
 /// Nodes the reader models exactly; every other node is refused naming the node and position.

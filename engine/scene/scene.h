@@ -51,6 +51,9 @@ struct Scene {
     /// The largest distance (model units) by which the solids read stray from the surfaces the
     /// file describes: a twisted extrusion's slices (OpenScadCounts::twistError); 0: exact.
     double modelError = 0.0;
+    /// How far OpenSCAD's own mesh of a .csg strays from the surfaces it describes beyond its
+    /// circles' facets (OpenScadCounts::openScadTwistMeshError); 0 for other formats.
+    double openScadMeshError = 0.0;
 
     // Filled by prepare():
     std::vector<Box3> minBox;  ///< CSG-minimized box per primitive (empty: dropped)

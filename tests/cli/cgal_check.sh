@@ -7,7 +7,7 @@ set -u
 LANCER="$1"; SRC="$2"
 command -v openscad >/dev/null || { echo "SKIP: no openscad"; exit 77; }
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
-"$SRC/scripts/cgal-check" --quick --lancer "$LANCER" --out "$tmp/out" >"$tmp/table" 2>&1
+"$SRC/scripts/cgal-check" --quick --lancer "$LANCER" --out "$tmp/out" --cache "" >"$tmp/table" 2>&1
 rc=$?
 cat "$tmp/table"
 [ "$rc" -eq 0 ] || { echo "FAIL: cgal-check exited $rc"; exit 1; }

@@ -23,7 +23,7 @@ check arity.csg 'sphere(1, 2);' 'arity.csg:1:11: sphere() takes at most 1 positi
 check word.csg 'sphere(r = "big");' "word.csg:1:12: expected a number for 'r' of sphere()"
 check inf.csg 'cube(size = [1, -inf, 1]);' "inf.csg:1:18: expected a finite number, got '-inf'"
 check negative.csg 'cylinder(h = 1, r1 = 1, r2 = -2);' "negative.csg:1:30: 'r2' must not be negative"
-check minkowski.csg 'group() {\n\tminkowski() {\n\t\tcube();\n\t}\n}\n' "minkowski.csg:2:2: the node 'minkowski' is not supported (supported: group, union, difference, intersection, render, multmatrix, translate, rotate, scale, mirror, color, cube, sphere, cylinder, linear_extrude, rotate_extrude, square, circle, polygon, polyhedron, hull, text, import)"
+check minkowski.csg 'group() {\n\tminkowski() {\n\t\tcube();\n\t}\n}\n' "minkowski.csg:2:2: the node 'minkowski' is not supported (supported: group, union, difference, intersection, render, multmatrix, translate, rotate, scale, mirror, color, cube, sphere, cylinder, linear_extrude, rotate_extrude, square, circle, polygon, polyhedron, hull, text, import, surface)"
 deep=$(printf 'group() %.0s' $(seq 1 3000))
 check deep.csg "${deep}cube();" 'deep.csg:1:4009: nesting deeper than 500 levels is refused'
 # A bad sidecar camera is named too.

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -19,67 +20,27 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 namespace {
 
 // Tokens of both formats, so mutations reach deeper than random bytes would.
-const char* kDictionary[] = {" ",
-                             "\n",
-                             "\t",
-                             "0",
-                             "-1",
-                             "1e308",
-                             "1e999",
-                             "nan",
-                             "inf",
-                             "-inf",
-                             "0.5",
-                             "99999999999",
-                             "#",
-                             "v\n",
-                             "from",
-                             "at",
-                             "up",
-                             "angle",
-                             "hither",
-                             "resolution",
-                             "b",
-                             "l",
-                             "f",
-                             "s",
-                             "p",
-                             "pp",
-                             "c",
-                             "{",
-                             "}",
-                             "(",
-                             ")",
-                             "[",
-                             "]",
-                             ",",
-                             ";",
-                             "=",
-                             "%",
-                             "*",
-                             "!",
-                             "\"",
-                             "//",
-                             "/*",
-                             "*/",
-                             "group()",
-                             "union()",
-                             "difference()",
-                             "intersection()",
-                             "render()",
-                             "color(\"red\")",
-                             "multmatrix([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])",
-                             "cube(1);",
-                             "sphere(r = 1);",
-                             "cylinder(h = 1, r1 = 1, r2 = 0);",
-                             "center = true",
-                             "$fn = 0",
-                             "undef",
-                             "hull()",
-                             "[[",
-                             "]]"};
+const char* kDictionary[] = {
+    " ", "\n", "\t", "0", "-1", "1e308", "1e999", "nan", "inf", "-inf", "0.5", "99999999999", "#",
+    "v\n", "from", "at", "up", "angle", "hither", "resolution", "b", "l", "f", "s", "p", "pp", "c",
+    "{", "}", "(", ")", "[", "]", ",", ";", "=", "%", "*", "!", "\"", "//", "/*", "*/", "group()",
+    "union()", "difference()", "intersection()", "render()", "color(\"red\")",
+    "multmatrix([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])", "cube(1);",
+    "sphere(r = 1);", "cylinder(h = 1, r1 = 1, r2 = 0);", "center = true", "$fn = 0", "undef",
+    "hull()", "[[", "]]",
+    // OpenSCAD's 2D nodes and extrusions (the pipeline's .csg inputs)
+    "linear_extrude(height = 1, twist = 90, slices = 2)", "rotate_extrude(angle = 180)",
+    "circle(r = 1);", "square(size = [2, 1], center = true);",
+    "polygon(points = [[0, 0], [1, 0], [0, 1]]);", "offset(r = 0.5)",
+    // DXF group codes and entities
+    "\n0\n", "\n8\n", "\n10\n", "\n20\n", "\n40\n", "\n42\n", "\n50\n", "\n70\n", "LINE", "ARC",
+    "CIRCLE", "LWPOLYLINE", "POLYLINE", "VERTEX", "INSERT", "BLOCK", "ENDBLK", "SECTION", "ENDSEC"};
 
 bool run(const std::string& input, const std::string& what) {
+    // LANCER_FUZZ_LAST=FILE keeps each input there before it runs: after a crash, the input that
+    // crashed (libFuzzer writes its own crash-* files; this driver has no other record).
+    static const char* last = std::getenv("LANCER_FUZZ_LAST");
+    if (last) std::ofstream(last, std::ios::binary) << input;
     auto start = std::chrono::steady_clock::now();
     LLVMFuzzerTestOneInput(reinterpret_cast<const uint8_t*>(input.data()), input.size());
     double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -296,6 +296,16 @@ RecordingObserver recordWalk(const Accelerator& accel, const Ray& ray, TraceCont
     return obs;
 }
 
+bool bruteHit(const Scene& scene, const Ray& ray, Hit& hit) {
+    BuildParams bp;
+    bp.scheme = SchemeKind::Brute;
+    auto brute = buildAccelerator(scene, bp);
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    NullObserver obs;
+    ctx.beginRay();
+    return brute->intersect(ray, 0.0, kInf, ctx, obs, hit);
+}
+
 std::vector<Ray> pixelRays(const Scene& scene, int w, int h) {
     std::vector<Ray> rays;
     rays.reserve(size_t(w) * size_t(h));

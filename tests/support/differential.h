@@ -75,6 +75,9 @@ RayCounters traceCounters(const Scene& scene, const Accelerator& accel,
 /// One ray's walk through `accel` with t in (0, inf), as an observer records it (a new ray id).
 RecordingObserver recordWalk(const Accelerator& accel, const Ray& ray, TraceContext& ctx);
 
+/// Brute force's nearest hit along `ray` with t in (0, inf); false when it misses.
+bool bruteHit(const Scene& scene, const Ray& ray, Hit& hit);
+
 /// Primary rays of every pixel of a w x h image of the scene's camera.
 std::vector<Ray> pixelRays(const Scene& scene, int w, int h);
 

@@ -67,6 +67,14 @@ struct BvhBuilder {
     /// Where ids[b, e) splits: the binned surface-area split of least estimated cost over the
     /// three axes; returns the first index of the right side, or b when no split is better
     /// than a leaf (with the cost stop) or when the centres cannot be told apart.
+    /// The bin of a centre at `f` bins from the low end, within [0, kBins): a model near the
+    /// doubles' limit (a part moved by 1e308) makes f infinite or NaN, whose conversion to int
+    /// was undefined and indexed far outside the bins (a crash found by fuzz_pipeline).
+    static int binOf(double f) {
+        if (!(f >= 0.0)) return 0;
+        return f < double(kBins) ? int(f) : kBins - 1;
+    }
+
     uint32_t split(uint32_t node, uint32_t b, uint32_t e) {
         const uint32_t count = e - b;
         Box3 cb;
@@ -82,7 +90,7 @@ struct BvhBuilder {
             uint32_t binCount[kBins] = {};
             for (uint32_t i = b; i < e; ++i) {
                 const uint32_t p = ids[i];
-                const int k = std::min(kBins - 1, int((centres[p][a] - lo) * scale));
+                const int k = binOf((centres[p][a] - lo) * scale);
                 binBox[k].expand(boxes[p]);
                 ++binCount[k];
             }
@@ -115,7 +123,7 @@ struct BvhBuilder {
         }
         const double lo = cb.lo[bestAxis], scale = kBins / (cb.hi[bestAxis] - lo);
         const auto mid = std::partition(ids.begin() + b, ids.begin() + e, [&](uint32_t p) {
-            return std::min(kBins - 1, int((centres[p][bestAxis] - lo) * scale)) < bestBin;
+            return binOf((centres[p][bestAxis] - lo) * scale) < bestBin;
         });
         return uint32_t(mid - ids.begin());
     }

@@ -9,11 +9,19 @@ namespace {
 
 /// The rotation nearest the linear part `m` of a transform by Gram-Schmidt on its first two
 /// columns: exact for a rotation times a scale along the local axes (OpenSCAD's
-/// multmatrix(rotate) of a scaled cube). False for a degenerate map.
+/// multmatrix(rotate) of a scaled cube). False for a degenerate map, and for a sheared one
+/// (columns more than 1e-3 from square): it has no axes of its own, and boxes along the
+/// nearest rotation's axes hug a sheared primitive so tightly that its hits, computed through
+/// the ill-conditioned map, fell outside them (a cone sheared by 9999: the BVH missed a hit
+/// brute force found; tests/fuzz/corpus/pipeline/sheared-cone.csg).
 bool orthonormalize(const Mat3& m, Mat3& out) {
     const Vec3 c0 = m[0], c1 = m[1];
     const double n0 = glm::length(c0), l1 = glm::length(c1);
     if (!(n0 > 0.0) || !std::isfinite(n0) || !(l1 > 0.0) || !std::isfinite(l1)) return false;
+    for (int i = 0; i < 3; ++i)
+        for (int j = i + 1; j < 3; ++j)
+            if (!(std::abs(glm::dot(m[i], m[j])) <= 1e-3 * glm::length(m[i]) * glm::length(m[j])))
+                return false;
     const Vec3 u0 = c0 / n0;
     const Vec3 v1 = c1 - glm::dot(c1, u0) * u0;
     const double n1 = glm::length(v1);

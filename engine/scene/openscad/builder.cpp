@@ -13,6 +13,7 @@
 #include "engine/scene/openscad/dxf.h"
 #include "engine/scene/openscad/hull3d.h"
 #include "engine/scene/openscad/region2d.h"
+#include "engine/scene/openscad/surface.h"
 #include "engine/scene/openscad/text2d.h"
 
 namespace lancer::openscad {
@@ -206,6 +207,7 @@ class Builder {
         if (k == "linear_extrude") return linearExtrude(n, xf, mat);
         if (k == "rotate_extrude") return rotateExtrude(n, xf, mat);
         if (k == "import" && isMeshFile(importFile(n))) return importMesh(n, xf, mat);
+        if (k == "surface") return surface(n, xf, mat);
         if (k == "import" && !importsDxf(n))
             src_.fail(n.pos, "import() of '" + importFile(n) +
                                  "': Lancer imports STL and OFF meshes and DXF drawings (inside "
@@ -236,6 +238,9 @@ class Builder {
         glm::dmat3 disk{1.0};  ///< 2D affine (homogeneous) of the unit disk
         int a = -1, b = -1;
         size_t pos = 0;  ///< the node that made it
+        /// A piece: the longest edge of the outlines it was cut from (its own edges may be
+        /// parts of them); 0: its own edges are the outline's.
+        double outlineEdge = 0.0;
     };
 
     int region(Region r) {
@@ -355,6 +360,30 @@ class Builder {
             src_.fail(f->pos, std::string("import(): ") + e.what());
         }
         return meshNode(std::move(m), xf, mat, n.pos, "import() of '" + f->str + "'");
+    }
+
+    /// surface() of a heightmap (.dat or PNG) found beside the .csg: OpenSCAD's closed mesh of
+    /// it (surface.h) as a solid; `convexity` is read and ignored.
+    Built surface(const Node& n, const Transform& xf, int mat) {
+        Args a(src_, n, {"file", "center", "invert", "convexity"}, {"timestamp"});
+        if (!n.children.empty()) src_.fail(n.children.front().pos, "surface() takes no children");
+        const Value* f = a.get("file");
+        if (!f || f->kind != Value::Kind::String)
+            src_.fail(n.pos, "surface() needs a 'file' string");
+        const bool center = a.boolean("center", false), invert = a.boolean("invert", false);
+        a.number("convexity");
+        std::filesystem::path path(f->str);
+        if (path.is_relative()) path = std::filesystem::path(src_.path()).parent_path() / path;
+        TriangleMesh m;
+        try {
+            m = heightMapMesh(
+                readHeightMap(SourceText::fromImportedFile(path.string(), "a heightmap"), invert),
+                center);
+        } catch (const SceneError& e) {
+            src_.fail(f->pos, std::string("surface(): ") + e.what());
+        }
+        ++counts_.surfaces;
+        return meshNode(std::move(m), xf, mat, n.pos, "surface() of '" + f->str + "'");
     }
 
     /// A closed mesh as the union of its convex pieces (mesh_solid.h), each placed by `xf`.
@@ -566,10 +595,14 @@ class Builder {
     Built pieces(const std::vector<std::vector<Vec2>>& paths, size_t pos) {
         std::vector<ConvexPiece> ps = convexPieces(paths);
         if (ps.empty()) return emptyPrimitive();
+        double edge = 0.0;
+        for (const auto& q : paths)
+            for (size_t i = 0; i < q.size(); ++i)
+                edge = std::max(edge, glm::length(q[(i + 1) % q.size()] - q[i]));
         std::vector<int> items;
         for (ConvexPiece& p : ps)
             items.push_back(
-                region({Region::Kind::Piece, std::move(p), glm::dmat3(1.0), -1, -1, pos}));
+                region({Region::Kind::Piece, std::move(p), glm::dmat3(1.0), -1, -1, pos, edge}));
         return Built::of(regionOp(Region::Kind::Union, items, pos));
     }
 
@@ -885,6 +918,29 @@ class Builder {
         return int(std::clamp(std::ceil(first / (0.002 * rho)), 1.0, double(kMaxTwistSubSlices)));
     }
 
+    /// Records how far OpenSCAD's own mesh of a twisted extrusion strays from the exact
+    /// surface (OpenScadCounts::openScadTwistMeshError), for a piece or circle whose corners lie
+    /// within `rho` of the axis and whose outline edges (OpenSCAD's wall quads) are at most
+    /// `longest` long. Per OpenSCAD slice (turn D, scale from s0 to s1, S the larger, dS the
+    /// change): a wall point's exact path is a curve S(t) R(t D) x, which strays from the chord
+    /// between the slice's ends by |x| (S D^2 / 8 + dS D / 4) (its second derivative over 8);
+    /// the quad between the ends is cut into two triangles, which stray from the bilinear
+    /// surface by a quarter of |(S1 R1 - S0 R0) e| <= |e| (S D + dS). Then stretched by xf.
+    void noteOpenScadTwistMesh(const TwistedExtrusion& tw, double rho, double longest) {
+        const double d = std::abs(tw.twist) / tw.slices;
+        for (int j = 0; j < tw.slices; ++j) {
+            const double t0 = double(j) / tw.slices, t1 = double(j + 1) / tw.slices;
+            const Vec2 s0 = Vec2(1.0) - (Vec2(1.0) - tw.scale) * t0;
+            const Vec2 s1 = Vec2(1.0) - (Vec2(1.0) - tw.scale) * t1;
+            const double smax = std::max({s0.x, s0.y, s1.x, s1.y});
+            const double dS = std::max(std::abs(s1.x - s0.x), std::abs(s1.y - s0.y));
+            const double e =
+                rho * (smax * d * d / 8.0 + dS * d / 4.0) + longest * (smax * d + dS) / 4.0;
+            counts_.openScadTwistMeshError = std::max(counts_.openScadTwistMeshError, tw.norm * e);
+            if (tw.scale.x == tw.scale.y && tw.scale.x == 1.0) break;  // every slice alike
+        }
+    }
+
     /// The twisted extrusion of the region's node: as extrudeRegion, the booleans of the 2D
     /// node become booleans of the twisted leaves (each height's section is the region under
     /// one linear map, which commutes with them).
@@ -909,9 +965,18 @@ class Builder {
                                      ") that is off the twist axis, not round or scaled "
                                      "unevenly: its wall is a helical sweep, which Lancer "
                                      "does not trace");
+            // OpenSCAD twists the circle's polygon: its walls are chords of n fragments.
+            const double radius = std::sqrt(glm::dot(u, u));
+            const double frags = openscad::fragmentsFromR(
+                radius, special(n, "$fn", 0.0), special(n, "$fa", 12.0), special(n, "$fs", 2.0));
+            noteOpenScadTwistMesh(tw, radius, 2.0 * radius * std::sin(M_PI / std::max(frags, 3.0)));
             return extrudeRegion(id, n, tw.xf, tw.mat, tw.h, (tw.scale - 1.0) / tw.h);
         }
         const std::vector<Vec2>& base = r.piece.vertices;
+        double longest = r.outlineEdge;
+        for (size_t i = 0; i < base.size(); ++i)
+            longest = std::max(longest, glm::length(base[(i + 1) % base.size()] - base[i]));
+        noteOpenScadTwistMesh(tw, std::sqrt(regionMaxR2(id)), longest);
         if (2 * base.size() + 2 > 255)
             src_.fail(n.pos, "linear_extrude with twist of a convex piece of " +
                                  std::to_string(base.size()) + " corners (of the 2D node at " +
@@ -961,29 +1026,35 @@ class Builder {
             p0[i] = Vec3(a0 * base[i], z0);
             p1[i] = Vec3(a1 * base[i], z1);
         }
-        Vec3 centre(0.0);
-        for (size_t i = 0; i < m; ++i) centre += p0[i] + p1[i];
-        centre /= double(2 * m);
+        // The piece's winding gives each edge its outward side. Neither end's centre does: a
+        // sliver piece (example009's fan cut into trapezoids) has its centre within rounding of
+        // its long edges, and a side taken the wrong way left the hull without that face,
+        // reaching far outside its corners' box (the schemes, which clip by it, then missed
+        // what brute force hit).
+        double area2 = 0.0;
+        for (size_t i = 0; i < m; ++i) {
+            const Vec2 &u = base[i], &v = base[(i + 1) % m];
+            area2 += u.x * v.y - u.y * v.x;
+        }
+        if (!(area2 != 0.0)) return Built::empty();    // no area, no volume
+        const double turn = area2 > 0.0 ? 1.0 : -1.0;  // counter-clockwise: outward is right
         Polytope pt;
         auto sides = [&](const std::vector<Vec3>& ring, const std::vector<Vec3>& other) {
-            // The edge's outward side is away from its own end's centre: the centre of both
-            // ends may lie outside a thin piece that moves more than its width over the slice.
-            Vec2 mid(0.0);
-            for (const Vec3& q : ring) mid += Vec2(q);
-            mid /= double(m);
             for (size_t i = 0; i < m; ++i) {
                 const Vec3 &p = ring[i], &q = ring[(i + 1) % m];
                 const Vec2 e(q.x - p.x, q.y - p.y);
                 if (e == Vec2(0.0)) continue;  // a zero scale collapses the end
-                // The edge's outward normal in the end's plane (either winding), then the other
-                // end's farthest corner that way.
-                Vec2 out(e.y, -e.x);
-                if (glm::dot(out, mid - Vec2(p)) > 0.0) out = -out;
+                // The edge's outward normal in the end's plane (the ends keep the piece's
+                // winding: a turn and a positive scale), then the other end's farthest corner
+                // that way: the hull's face through the edge passes through it.
+                const Vec2 out = turn * Vec2(e.y, -e.x);
                 size_t best = 0;
                 for (size_t k = 1; k < m; ++k)
                     if (glm::dot(out, Vec2(other[k])) > glm::dot(out, Vec2(other[best]))) best = k;
                 Vec3 nn = glm::cross(q - p, other[best] - p);
-                if (glm::dot(nn, centre - p) > 0.0) nn = -nn;
+                // The face's normal is square to the edge, so its horizontal part lies along
+                // `out` (never zero: the corner is at the other end's height).
+                if (glm::dot(Vec2(nn), out) < 0.0) nn = -nn;
                 const double len = glm::length(nn);
                 if (!(len > 0.0)) continue;
                 nn /= len;
@@ -1896,7 +1967,7 @@ const std::vector<std::string>& openScadSupportedNodes() {
         "group",     "union",      "difference",     "intersection",   "render", "multmatrix",
         "translate", "rotate",     "scale",          "mirror",         "color",  "cube",
         "sphere",    "cylinder",   "linear_extrude", "rotate_extrude", "square", "circle",
-        "polygon",   "polyhedron", "hull",           "text",           "import"};
+        "polygon",   "polyhedron", "hull",           "text",           "import", "surface"};
     return nodes;
 }
 

@@ -307,7 +307,12 @@ class Reader {
 
 DxfOutlines readDxf(const std::string& path, const std::string& layer, const Vec2& origin,
                     double scale, const Fragments& frag) {
-    const SourceText src = SourceText::fromImportedFile(path, "a DXF drawing");
+    return readDxfText(SourceText::fromImportedFile(path, "a DXF drawing"), layer, origin, scale,
+                       frag);
+}
+
+DxfOutlines readDxfText(const SourceText& src, const std::string& layer, const Vec2& origin,
+                        double scale, const Fragments& frag) {
     const std::vector<Group> gs = groups(src);
     Reader r(src, layer, origin, scale, frag);
     r.read(gs);

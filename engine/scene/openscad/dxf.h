@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "engine/scene/openscad/region2d.h"
+#include "engine/scene/source_text.h"
 
 namespace lancer::openscad {
 
@@ -31,5 +32,9 @@ struct DxfOutlines {
 /// naming its path and line.
 DxfOutlines readDxf(const std::string& path, const std::string& layer, const Vec2& origin,
                     double scale, const Fragments& frag);
+
+/// readDxf of a drawing already read (`src`'s path names it in messages).
+DxfOutlines readDxfText(const SourceText& src, const std::string& layer, const Vec2& origin,
+                        double scale, const Fragments& frag);
 
 }  // namespace lancer::openscad
