@@ -7,6 +7,7 @@
 # SOURCE_DIR
 set -euo pipefail
 lancer=$1
+xvfb_run="$(dirname "$0")/xvfb_run"  # xvfb-run -a, its auth file cleaned up by us
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
@@ -20,7 +21,7 @@ if ! command -v xvfb-run >/dev/null; then
   exit 1
 fi
 # --width and --height are the image viewport's: the window (panels beside it) fits the screen.
-run() { timeout 240 xvfb-run -a -s "-screen 0 1920x1080x24" "$lancer" view builtin:default \
+run() { timeout 240 "$xvfb_run" -s "-screen 0 1920x1080x24" "$lancer" view builtin:default \
   --width 640 --height 400 --frames 3 --ini none "$@"; }
 fails "--show" run --show rays
 fails "--pick" run --pick 5000 10

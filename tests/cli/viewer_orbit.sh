@@ -6,6 +6,7 @@
 # Usage: viewer_orbit.sh LANCER SOURCE_DIR
 set -euo pipefail
 lancer=$1
+xvfb_run="$(dirname "$0")/xvfb_run"  # xvfb-run -a, its auth file cleaned up by us
 src=$2
 if ! command -v xvfb-run >/dev/null; then
   echo "xvfb-run is not installed (apt-get install xvfb)" >&2
@@ -15,7 +16,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 viewport() { sed -n 's/.*image \([0-9]*\)x\([0-9]*\) at \([0-9]*\),\([0-9]*\)$/\3 \4/p' "$1"; }
 view() {  # FRAMES NAME: turn 90 degrees in each of FRAMES frames, screenshot NAME.png
-  timeout 240 xvfb-run -a -s "-screen 0 1920x1080x24" "$lancer" view builtin:default \
+  timeout 240 "$xvfb_run" -s "-screen 0 1920x1080x24" "$lancer" view builtin:default \
     --frames "$1" --orbit 90 --log-timings --screenshot "$tmp/$2.png" \
     --width 480 --height 360 --ini none >"$tmp/$2.txt" 2>"$tmp/$2.err"
 }

@@ -5,6 +5,7 @@
 # Usage: viewer_refusal_cli.sh LANCER SOURCE_DIR
 set -euo pipefail
 lancer=$1
+xvfb_run="$(dirname "$0")/xvfb_run"  # xvfb-run -a, its auth file cleaned up by us
 src=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -16,7 +17,7 @@ if ! command -v xvfb-run >/dev/null; then
 fi
 # -noreset: Xvfb signals xvfb-run again when its last client leaves, which can fail
 # xvfb-run's clean-up (status 5) when the viewer exits at once.
-run() { timeout 240 xvfb-run -a -s "-screen 0 1920x1080x24 -noreset" "$lancer" view "$@" --width 320 \
+run() { timeout 240 "$xvfb_run" -s "-screen 0 1920x1080x24 -noreset" "$lancer" view "$@" --width 320 \
   --height 200 --frames 3 --ini none --screenshot "$tmp/shot.png"; }
 fails "the structure was refused: --max-level 48 --max-objects 1" \
   run "$src/assets/spd/balls4.nff" --max-level 48 --max-objects 1 --no-cost-stop
