@@ -291,6 +291,46 @@ TEST(Bvh, LeavesListEveryPrimitiveMeetingTheirBox) {
 
 // The knobs change the structure as a user expects: more leaves at max-objects 1 than at 8
 // without the cost stop, a shallower tree under a lower max-level.
+// A union-only scene's entries are primList's primitives in its order, each leaf's last one
+// marked (the walks stop there), with the scene's packed sphere or none: on the sphereflake (a
+// floor polygon among spheres), the rings (open cylinders among spheres) at several leaf sizes.
+TEST(Bvh, UnionEntriesAreTheLeavesPrimitives) {
+    for (const char* spec : {"builtin:balls:3", "builtin:rings:3"}) {
+        for (int maxObjects : {-1, 1, 5}) {
+            Scene scene = loadScene(spec);
+            ASSERT_TRUE(scene.tree.unionOnly());
+            auto accel = buildAccelerator(scene, bvhParams(maxObjects));
+            const Bvh& b = bvhOf(*accel);
+            const std::vector<BvhUnionEntry>& x = b.unionEntries();
+            ASSERT_EQ(x.size(), b.primList().size());
+            std::vector<char> ends(x.size(), 0);
+            size_t spheres = 0, others = 0;
+            for (const BvhNode& n : b.nodes()) {
+                if (!n.leaf) continue;
+                ASSERT_GT(n.count, 0u);
+                ends[n.first + n.count - 1] = 1;
+            }
+            for (size_t i = 0; i < x.size(); ++i) {
+                const uint32_t p = b.primList()[i];
+                EXPECT_EQ(x[i].prim, p) << spec << " entry " << i;
+                EXPECT_EQ(x[i].last, uint32_t(ends[i])) << spec << " entry " << i;
+                const bool packed = scene.packedSpheres[p].r >= 0.0;
+                EXPECT_EQ(x[i].r >= 0.0, packed) << spec << " entry " << i;
+                if (packed) {
+                    EXPECT_EQ(x[i].c, scene.packedSpheres[p].c);
+                    EXPECT_EQ(x[i].r, scene.packedSpheres[p].r);
+                }
+                ++(packed ? spheres : others);
+            }
+            EXPECT_GT(spheres, 0u) << spec;
+            EXPECT_GT(others, 0u) << spec;
+        }
+    }
+    // A CSG scene's leaves read their binary node: no entries.
+    Scene csg = loadScene("builtin:drilled:3");
+    EXPECT_TRUE(bvhOf(*buildAccelerator(csg, bvhParams())).unionEntries().empty());
+}
+
 TEST(Bvh, KnobsChangeTheStructure) {
     Scene scene = loadScene("builtin:lattice:4");
     auto fine = buildAccelerator(scene, bvhParams(1, false));
@@ -356,8 +396,12 @@ TEST(Bvh, WideNodesHoldTheirChildrensBoxes) {
                     EXPECT_GE(double(wn.hi[a][k]) + b.anchor()[a], nodes[id].hi[a])
                         << "seed " << seed << " node " << id << " axis " << a;
                 }
-                EXPECT_EQ(wn.wide[k] == kNoWide, bool(nodes[id].leaf));
-                if (wn.wide[k] != kNoWide) todo.push_back({wn.wide[k], id});
+                // A leaf's slot names its first entry, which the union-only walks read.
+                EXPECT_EQ(bool(wn.wide[k] & kWideLeaf), bool(nodes[id].leaf));
+                if (nodes[id].leaf) {
+                    EXPECT_EQ(wn.wide[k] & ~kWideLeaf, nodes[id].first);
+                }
+                if (!(wn.wide[k] & kWideLeaf)) todo.push_back({wn.wide[k], id});
             }
         }
         EXPECT_EQ(seen, b.wides().size());

@@ -195,6 +195,7 @@ struct BvhBuilder {
             out.primList_ = ids;
             listedTotal = ids.size();
             sharedSets = leaves.size();
+            fillUnionEntries();
             return;
         }
         std::vector<std::vector<uint32_t>> lists(leaves.size());
@@ -232,6 +233,20 @@ struct BvhBuilder {
         sharedSets = pool.size();
     }
     size_t listedTotal = 0, sharedSets = 0;
+
+    /// A union-only scene's entries (Bvh::unionEntries): primList's primitives with their
+    /// spheres, each leaf's last one marked.
+    void fillUnionEntries() {
+        const std::vector<PackedSphere>& packed = scene.packedSpheres;
+        std::vector<BvhUnionEntry>& x = out.unionEntries_;
+        x.resize(out.primList_.size());
+        for (size_t i = 0; i < x.size(); ++i) {
+            const uint32_t p = out.primList_[i];
+            const bool sphere = p < packed.size() && packed[p].r >= 0.0;
+            x[i] = {sphere ? packed[p].c : Vec3(0.0), sphere ? packed[p].r : -1.0, p, 0};
+        }
+        for (uint32_t leaf : leaves) x[end[leaf] - 1].last = 1;
+    }
 
     /// The wide nodes the walks read (bvh_boxes.h): from the root down, each inner node's
     /// children, the inner one of largest area replaced by its own two children until there
@@ -275,14 +290,16 @@ struct BvhBuilder {
                 wn.lo[a][k] = floatBelow(floatDown(c.lo[a] - out.anchor_[a]));
                 wn.hi[a][k] = floatAbove(floatUp(c.hi[a] - out.anchor_[a]));
             }
-            if (!c.leaf) {
+            if (c.leaf) {
+                wn.wide[k] = kWideLeaf | c.first;
+            } else {
                 wn.wide[k] = uint32_t(out.wides_.size());
                 out.wides_.emplace_back();
             }
         }
         out.wides_[w] = wn;
         for (int k = 0; k < n; ++k)
-            if (wn.wide[k] != kNoWide) fillWide(wn.wide[k], wn.node[k]);
+            if (!(wn.wide[k] & kWideLeaf)) fillWide(wn.wide[k], wn.node[k]);
     }
 
     /// The surface-area estimate of the built tree, in tests per ray that enters the root.
@@ -337,6 +354,9 @@ Bvh Bvh::build(const Scene& scene, const BvhConfig& config, nlohmann::json& extr
         b.makeNode(0, uint32_t(b.ids.size()), 0, kNoNode);
         b.build(0, 0);
         b.fillLeaves();
+        // A wide node's leaf slot holds the leaf's first entry in 31 bits (kWideLeaf).
+        if (out.primList_.size() >= kWideLeaf)
+            throw std::invalid_argument("the BVH's leaves list more than 2^31 primitives");
         b.buildWide();
         b.estimateCost();
     }

@@ -33,6 +33,17 @@ inline constexpr uint32_t kNoNode = 0xffffffffu;
 /// and a wide node is at least one level below its parent.
 inline constexpr int kWalkStack = (kBvhWidth - 1) * kAutomaticBvhDepth + 2;
 
+/// A union-only scene's primitive as the walks test it, listed as Bvh::primList() lists it (so
+/// a leaf's are one contiguous read): a sphere's centre and radius, as Scene::packedSpheres holds
+/// them (the same test, the same bits), r < 0 for any other primitive (tested by the scene).
+struct BvhUnionEntry {
+    Vec3 c{0.0};
+    double r = -1.0;
+    uint32_t prim = 0;  ///< its id: the hit's, the observer's
+    uint32_t last = 0;  ///< 1: the last of its leaf's
+};
+static_assert(sizeof(BvhUnionEntry) == 40);
+
 class Bvh {
   public:
     static constexpr SchemeKind kKind = SchemeKind::Bvh;  ///< its row of kSchemeTable
@@ -66,7 +77,7 @@ class Bvh {
     size_t memoryBytes() const {
         return nodes_.size() * sizeof(BvhNode) + wides_.size() * sizeof(BvhWideNode) +
                primList_.size() * sizeof(uint32_t) + parent_.size() * sizeof(uint32_t) +
-               pool_.nodes.size() * sizeof(CsgNode);
+               unionEntries_.size() * sizeof(BvhUnionEntry) + pool_.nodes.size() * sizeof(CsgNode);
     }
     /// A union-only scene's leaves list only their own primitives, each primitive in one leaf.
     bool usesMailboxes() const { return !unionOnly_; }
@@ -81,6 +92,9 @@ class Bvh {
     uint32_t parent(uint32_t id) const { return parent_[id]; }
     /// Primitives listed by the leaves: leaf n's are primList()[n.first, n.first + n.count).
     const std::vector<uint32_t>& primList() const { return primList_; }
+    /// A union-only scene's primitives as primList() lists them, with their spheres (each
+    /// leaf's last marked): what its walks read; empty for other scenes.
+    const std::vector<BvhUnionEntry>& unionEntries() const { return unionEntries_; }
     /// The leaves' restricted trees (empty for a union-only scene: its leaves merge their
     /// primitives' spans).
     const CsgTree& treePool() const { return pool_; }
@@ -171,6 +185,18 @@ class Bvh {
     /// Tells the observer inner entry `e`'s children met: c[0, n), in the order walked.
     template <class Obs>
     static void tellChildren(const BvhEntry& e, const BvhEntry* c, int n, Obs& obs);
+    /// The spans along `ray` of a union-only scene's entry `x`, into `out` (how many), counted
+    /// and told to the observer: a sphere tested from the entry, anything else by the scene.
+    template <class Obs>
+    int unionSpans(const BvhUnionEntry& x, const Ray& ray, TraceContext& ctx, Obs& obs,
+                   Span* out) const {
+        const int k = x.r >= 0.0 && ctx.precision == Precision::Double
+                          ? sphereSpans(x.c, x.r, ray, x.prim, out)
+                          : scene_->primSpans(x.prim, ray, out, ctx.precision);
+        ++ctx.counters.primTests;
+        obs.primTest(x.prim, out, k);
+        return k;
+    }
     /// The leaf's visible hit inside [t0, t1] (t > tmin).
     template <class Obs>
     bool hitInLeafBox(const BvhNode& n, const Ray& ray, double tmin, double t0, double t1,
@@ -185,6 +211,7 @@ class Bvh {
     Vec3 anchor_{0.0};
     std::vector<uint32_t> parent_;
     std::vector<uint32_t> primList_;
+    std::vector<BvhUnionEntry> unionEntries_;
     CsgTree pool_;
 
     friend struct BvhBuilder;
@@ -300,13 +327,10 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
             pushChildren<!kAnyHit>(boxes, e, tminF, reachF, stack, sp, obs);
             continue;
         }
-        const BvhNode& n = nodes_[e.node];
-        const uint32_t* const prims = primList_.data() + n.first;
-        for (uint32_t i = 0; i < n.count; ++i) {
+        // The leaf's entries, read from its slot without its binary node.
+        for (const BvhUnionEntry* x = unionEntries_.data() + e.first();; ++x) {
             Span local[2];
-            const int k = scene_->primSpans(prims[i], ray, local, ctx.precision);
-            ++ctx.counters.primTests;
-            obs.primTest(prims[i], local, k);
+            const int k = unionSpans(*x, ray, ctx, obs, local);
             for (int j = 0; j < k; ++j) {
                 const Span& sp2 = local[j];
                 if (!(sp2.out.t > tmin)) continue;
@@ -322,6 +346,7 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
                     tie = !kAnyHit;
                 }
             }
+            if (x->last) break;
         }
         if constexpr (Obs::kActive) {
             ctx.result.clear();
@@ -371,19 +396,16 @@ bool Bvh::walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, do
             }
             continue;
         }
-        const BvhNode& node = nodes_[e.node];
-        const uint32_t* const prims = primList_.data() + node.first;
         bool added = false;
-        for (uint32_t i = 0; i < node.count; ++i) {
+        for (const BvhUnionEntry* x = unionEntries_.data() + e.first();; ++x) {
             Span local[2];
-            const int k = scene_->primSpans(prims[i], ray, local, ctx.precision);
-            ++ctx.counters.primTests;
-            obs.primTest(prims[i], local, k);
+            const int k = unionSpans(*x, ray, ctx, obs, local);
             for (int j = 0; j < k; ++j)
                 if (local[j].out.t > tmin && local[j].in.t <= tmax) {
                     spans.push_back(local[j]);
                     added = true;
                 }
+            if (x->last) break;
         }
         if (added) {
             flatUnion(spans, ctx.result);  // sorts `spans` in place

@@ -33,8 +33,12 @@ static_assert(sizeof(BvhNode) == 64);
 
 /// How many children a wide node has at most.
 inline constexpr int kBvhWidth = 4;
-/// A slot of a wide node that holds no wide node (a leaf, or no child).
+/// A wide node's slot that holds no child.
 inline constexpr uint32_t kNoWide = 0xffffffffu;
+/// The bit of a wide node's `wide` slot that marks a leaf; the other bits are the leaf's first
+/// entry in Bvh::primList() (and in Bvh::unionEntries()), so that a walk reaches a union-only
+/// leaf's primitives without reading its binary node.
+inline constexpr uint32_t kWideLeaf = 0x80000000u;
 
 /// A wide node, in two cache lines: an inner binary node with its descendants down to four
 /// nodes (its children, or their children), whose boxes are stored axis by axis (SoA) so that
@@ -43,17 +47,21 @@ inline constexpr uint32_t kNoWide = 0xffffffffu;
 struct alignas(64) BvhWideNode {
     float lo[3][kBvhWidth], hi[3][kBvhWidth];
     uint32_t node[kBvhWidth];  ///< each slot's binary node id (kNoNode-like 0xffffffff: unused)
-    uint32_t wide[kBvhWidth];  ///< an inner slot's wide node; kNoWide for a leaf or unused slot
+    /// An inner slot's wide node; a leaf's: kWideLeaf | its first entry; kNoWide: unused.
+    uint32_t wide[kBvhWidth];
 };
 static_assert(sizeof(BvhWideNode) == 128);
 
-/// A node as a walk holds it: its binary id, its wide node (kNoWide for a leaf), and the ray's
-/// interval in its box, rounded outward to float (the float test's, which holds the double one).
+/// A node as a walk holds it: its binary id, its wide node (a leaf: kWideLeaf and its first
+/// entry), and the ray's interval in its box, rounded outward to float (the float test's, which
+/// holds the double one).
 struct BvhEntry {
     uint32_t node;  ///< its id (nodes(), the observer's region)
-    uint32_t wide;  ///< inner: its wide node; leaf: kNoWide
+    uint32_t wide;  ///< inner: its wide node; leaf: kWideLeaf | its first entry
     float t0, t1;
-    bool leaf() const { return wide == kNoWide; }
+    bool leaf() const { return wide & kWideLeaf; }
+    /// A leaf's first entry in Bvh::primList().
+    uint32_t first() const { return wide & ~kWideLeaf; }
 };
 
 /// The ray as the double box tests read it: its origin, and its inverse direction (0 along an
@@ -164,7 +172,7 @@ struct WideBoxes {
     bool root(double tmin, double tmax, BvhEntry& e) const {
         double t0, t1;
         if (!slab.clip(nodes[0], tmin, tmax, t0, t1)) return false;
-        e = {0, nodes[0].leaf ? kNoWide : 0u, floatDown(t0), floatUp(t1)};
+        e = {0, nodes[0].leaf ? kWideLeaf | nodes[0].first : 0u, floatDown(t0), floatUp(t1)};
         return true;
     }
 
