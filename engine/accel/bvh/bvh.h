@@ -13,6 +13,7 @@
 // the mailboxes spare a primitive listed by several leaves a second test.
 #pragma once
 
+#include <cassert>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -57,7 +58,7 @@ class Bvh {
     static Bvh build(const Scene& scene, const BvhConfig& config, nlohmann::json& extra,
                      BuildGuard* guard = nullptr);
 
-    /// Nearest visible hit with t in (tmin, tmax], the nodes visited front to back.
+    /// Nearest visible hit with t in (tmin, tmax] (tmin >= 0), the nodes visited front to back.
     template <class Obs>
     bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                    Hit& hit) const {
@@ -115,6 +116,7 @@ class Bvh {
     template <bool kAnyHit, class Obs>
     bool query(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                Hit& hit) const {
+        assert(tmin >= 0.0);  // the float box tests widen their intervals for t >= 0
         if (nodes_.empty()) return false;
         // The boxes are the frame's (the world's unless the scene is turned): the walk reads
         // them with the ray in the frame, `fr` (the same t), the leaves test the world ray.
@@ -313,10 +315,13 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
     // tmin once a start is found (only the boxes holding the ray's start are left to walk).
     double reach = tmax;
     const float tminF = floatDown(tmin);
-    float reachF = floatUp(reach);  // for the float box tests
+    // For the float box tests, and to cull: a node entered after reachF is entered after reach
+    // (the few in between are walked for nothing, never culled wrongly).
+    float reachF = floatUp(reach);
+    Span local[2];  // a primitive's spans (out of the loop: Span's members are initialised)
     while (sp > 0) {
         const BvhEntry e = stack[--sp];
-        if (e.t0 > reach) {
+        if (e.t0 > reachF) {
             if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, first.t, kAnyHit && found);
             continue;
         }
@@ -329,7 +334,6 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
         }
         // The leaf's entries, read from its slot without its binary node.
         for (const BvhUnionEntry* x = unionEntries_.data() + e.first();; ++x) {
-            Span local[2];
             const int k = unionSpans(*x, ray, ctx, obs, local);
             for (int j = 0; j < k; ++j) {
                 const Span& sp2 = local[j];
@@ -430,12 +434,12 @@ bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, Tra
     int sp = 0;
     double best = tmax;  // the leaves' windows end at the nearest hit found so far
     const float tminF = floatDown(tmin);
-    float bestF = floatUp(best);  // for the float box tests
+    float bestF = floatUp(best);  // for the float box tests and the culling
     bool found = false;
     if (!boxes.root(tmin, tmax, stack[sp++])) return false;
     while (sp > 0) {
         const BvhEntry e = stack[--sp];
-        if (e.t0 > best) {  // its box begins beyond the hit: nothing nearer in it
+        if (e.t0 > bestF) {  // its box begins beyond the hit: nothing nearer in it
             if constexpr (Obs::kActive) obs.nodeCulled(e.node, e.t0, best, false);
             continue;
         }

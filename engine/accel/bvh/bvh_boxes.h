@@ -179,6 +179,7 @@ struct WideBoxes {
     /// Inner entry `e`'s children that the ray may meet within [tmin, tmax] (every one that
     /// the double test meets, and perhaps a few more), in slot order; returns how many. The
     /// walks round their bounds to float once (floatDown(tmin), floatUp(tmax)), not per node.
+    /// tmin >= 0, as every walk's.
     [[gnu::always_inline]] int children(const BvhEntry& e, float tmin, float tmax,
                                         BvhEntry c[kBvhWidth]) const {
         const BvhWideNode& w = wides[e.wide];
@@ -198,9 +199,11 @@ struct WideBoxes {
             t0 = _mm_max_ps(t0, _mm_mul_ps(_mm_sub_ps(fn, oNear[a]), inv[a]));
             t1 = _mm_min_ps(t1, _mm_mul_ps(_mm_sub_ps(ff, oFar[a]), inv[a]));
         }
-        const __m128 sign = _mm_set1_ps(-0.0f), slack = _mm_set1_ps(kSlack);
-        t0 = _mm_sub_ps(t0, _mm_mul_ps(_mm_andnot_ps(sign, t0), slack));
-        t1 = _mm_add_ps(t1, _mm_mul_ps(_mm_andnot_ps(sign, t1), slack));
+        // t0 >= tmin >= 0, so widening it is a product; a negative t1 is a box that the
+        // double test misses too (its t0 >= tmin >= 0; the rounding never turns a sign).
+        // Each product rounds by half an ulp, far within the slack.
+        t0 = _mm_mul_ps(t0, _mm_set1_ps(1.0f - kSlack));
+        t1 = _mm_mul_ps(t1, _mm_set1_ps(1.0f + kSlack));
         int mask = _mm_movemask_ps(_mm_cmple_ps(t0, t1));  // NaN (an empty slot): not met
         if constexpr (kParallel) mask &= ~_mm_movemask_ps(outside);
         if (!mask) return 0;
