@@ -367,6 +367,14 @@ TEST(Bvh, WideNodesHoldTheirChildrensBoxes) {
         if (nodes.empty() || nodes[0].leaf) continue;  // what the intersections left is small
         ++checked;
         std::vector<int> inSlots(nodes.size(), 0);
+        // The walks start at the root, slot 0 of top(), the others unused.
+        EXPECT_EQ(b.top().node[0], 0u);
+        EXPECT_EQ(b.top().wide[0], 0u);
+        for (int k = 1; k < kBvhWidth; ++k) EXPECT_EQ(b.top().node[k], kNoNode);
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_LE(double(b.top().lo[a][0]) + b.anchor()[a], nodes[0].lo[a]);
+            EXPECT_GE(double(b.top().hi[a][0]) + b.anchor()[a], nodes[0].hi[a]);
+        }
         // Walk the wide tree from its root, which stands for binary node 0.
         std::vector<std::pair<uint32_t, uint32_t>> todo{{0u, 0u}};  // wide, binary
         size_t seen = 0;
@@ -434,17 +442,20 @@ TEST(Bvh, WideBoxTestHoldsTheDoubleOne) {
         for (const Ray& world : rays) {
             const Ray r = b.frame().turned ? b.frame().toFrame(world) : world;
             for (double tmin : {0.0, 1e-9 * scene.scale()}) {
+                const SlabRay slab(r);
                 auto check = [&](const auto& boxes) {
-                    for (uint32_t w = 0; w < b.wides().size(); ++w) {
-                        const BvhWideNode& wn = b.wides()[w];
+                    // The wide nodes, and the root's one slot (w == wides().size()).
+                    for (uint32_t w = 0; w <= b.wides().size(); ++w) {
+                        const bool top = w == b.wides().size();
+                        const BvhWideNode& wn = top ? b.top() : b.wides()[w];
                         BvhEntry c[kBvhWidth];
-                        const int n =
-                            boxes.children({kNoNode, w, 0.0f, 0.0f}, floatDown(tmin), INFINITY, c);
+                        const __m128 lo = _mm_set1_ps(floatDown(tmin)), hi = _mm_set1_ps(INFINITY);
+                        const int n = top ? boxes.root(lo, hi, c[0])
+                                          : boxes.children({kNoNode, w, 0.0f, 0.0f}, lo, hi, c);
                         for (int k = 0; k < kBvhWidth; ++k) {
                             if (wn.node[k] == kNoNode) continue;
                             double t0, t1;
-                            if (!boxes.slab.clip(b.nodes()[wn.node[k]], tmin, kInf, t0, t1))
-                                continue;
+                            if (!slab.clip(b.nodes()[wn.node[k]], tmin, kInf, t0, t1)) continue;
                             ++met;
                             const BvhEntry* e = std::find_if(
                                 c, c + n, [&](const BvhEntry& x) { return x.node == wn.node[k]; });
@@ -456,9 +467,9 @@ TEST(Bvh, WideBoxTestHoldsTheDoubleOne) {
                     }
                 };
                 if (hasFlatAxis(r))
-                    check(WideBoxes<true>(b.nodes().data(), b.wides().data(), r, b.anchor()));
+                    check(WideBoxes<true>(&b.top(), b.wides().data(), r, b.anchor()));
                 else
-                    check(WideBoxes<false>(b.nodes().data(), b.wides().data(), r, b.anchor()));
+                    check(WideBoxes<false>(&b.top(), b.wides().data(), r, b.anchor()));
             }
         }
     }

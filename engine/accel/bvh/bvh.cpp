@@ -251,13 +251,32 @@ struct BvhBuilder {
     /// The wide nodes the walks read (bvh_boxes.h): from the root down, each inner node's
     /// children, the inner one of largest area replaced by its own two children until there
     /// are four (as Embree collapses its BVH2 into a BVH4), so that a wide node holds the
-    /// nodes most rays that enter it go on into.
+    /// nodes most rays that enter it go on into. The root itself is the one slot of Bvh::top_.
     void buildWide() {
-        if (out.nodes_.empty() || out.nodes_[0].leaf) return;
+        if (out.nodes_.empty()) return;
         out.anchor_ = out.nodes_[0].box().center();
-        out.wides_.reserve(out.nodes_.size() / 2);
-        out.wides_.emplace_back();
-        fillWide(0, 0);
+        if (!out.nodes_[0].leaf) out.wides_.reserve(out.nodes_.size() / 2);
+        out.top_ = BvhWideNode::empty();
+        setSlot(out.top_, 0, 0);
+        if (!out.nodes_[0].leaf) fillWide(0, 0);
+    }
+    /// Slot k of `wn` holds binary node `id`: its box less the anchor, rounded outward, and its
+    /// wide node (made here, filled by fillWide) or, for a leaf, its first entry.
+    void setSlot(BvhWideNode& wn, int k, uint32_t id) {
+        const BvhNode& c = out.nodes_[id];
+        wn.node[k] = id;
+        // Outward: the float nearest below (above) the box's side less the anchor, then one
+        // float further, for the double subtraction's own rounding.
+        for (int a = 0; a < 3; ++a) {
+            wn.lo[a][k] = floatBelow(floatDown(c.lo[a] - out.anchor_[a]));
+            wn.hi[a][k] = floatAbove(floatUp(c.hi[a] - out.anchor_[a]));
+        }
+        if (c.leaf) {
+            wn.wide[k] = kWideLeaf | c.first;
+        } else {
+            wn.wide[k] = uint32_t(out.wides_.size());
+            out.wides_.emplace_back();
+        }
     }
     /// Wide node `w`, standing for inner binary node `bin`, and the wide nodes below it.
     void fillWide(uint32_t w, uint32_t bin) {
@@ -275,28 +294,8 @@ struct BvhBuilder {
             slots[widest] = first;
             slots[n++] = first + 1;
         }
-        BvhWideNode wn;
-        for (int k = 0; k < kBvhWidth; ++k) {
-            wn.node[k] = kNoNode;
-            wn.wide[k] = kNoWide;
-            for (int a = 0; a < 3; ++a) wn.lo[a][k] = INFINITY, wn.hi[a][k] = -INFINITY;
-        }
-        for (int k = 0; k < n; ++k) {
-            const BvhNode& c = nodes[slots[k]];
-            wn.node[k] = slots[k];
-            // Outward: the float nearest below (above) the box's side less the anchor, then
-            // one float further, for the double subtraction's own rounding.
-            for (int a = 0; a < 3; ++a) {
-                wn.lo[a][k] = floatBelow(floatDown(c.lo[a] - out.anchor_[a]));
-                wn.hi[a][k] = floatAbove(floatUp(c.hi[a] - out.anchor_[a]));
-            }
-            if (c.leaf) {
-                wn.wide[k] = kWideLeaf | c.first;
-            } else {
-                wn.wide[k] = uint32_t(out.wides_.size());
-                out.wides_.emplace_back();
-            }
-        }
+        BvhWideNode wn = BvhWideNode::empty();
+        for (int k = 0; k < n; ++k) setSlot(wn, k, slots[k]);
         out.wides_[w] = wn;
         for (int k = 0; k < n; ++k)
             if (!(wn.wide[k] & kWideLeaf)) fillWide(wn.wide[k], wn.node[k]);

@@ -87,6 +87,8 @@ class Bvh {
     /// The wide nodes the walks read (bvh_boxes.h): wides()[0] stands for the root, when it is
     /// not a leaf.
     const std::vector<BvhWideNode>& wides() const { return wides_; }
+    /// The wide node whose slot 0 is the root (the others unused), where the walks start.
+    const BvhWideNode& top() const { return top_; }
     /// What the wide nodes' float boxes are relative to: the root box's centre.
     const Vec3& anchor() const { return anchor_; }
     /// Node `id`'s parent; kNoNode for the root.
@@ -126,13 +128,13 @@ class Bvh {
         // A ray with a flat axis (bvh_boxes.h) has that axis tested by the origin's place; the
         // others never pay for the check.
         if (hasFlatAxis(fr)) {
-            const WideBoxes<true> boxes(nodes_.data(), wides_.data(), fr, anchor_);
+            const WideBoxes<true> boxes(&top_, wides_.data(), fr, anchor_);
             return unionOnly_ ? unionQuery<kAnyHit>(boxes, ray, tmin, tmax, ctx, obs, hit)
-                              : walk<kAnyHit>(boxes, ray, tmin, tmax, ctx, obs, hit);
+                              : walk<kAnyHit>(boxes, SlabRay(fr), ray, tmin, tmax, ctx, obs, hit);
         }
-        const WideBoxes<false> boxes(nodes_.data(), wides_.data(), fr, anchor_);
+        const WideBoxes<false> boxes(&top_, wides_.data(), fr, anchor_);
         return unionOnly_ ? unionQuery<kAnyHit>(boxes, ray, tmin, tmax, ctx, obs, hit)
-                          : walk<kAnyHit>(boxes, ray, tmin, tmax, ctx, obs, hit);
+                          : walk<kAnyHit>(boxes, SlabRay(fr), ray, tmin, tmax, ctx, obs, hit);
     }
     /// A union-only scene's query: the first-start walk, and the walk in box-entry order when
     /// that one cannot decide.
@@ -140,7 +142,8 @@ class Bvh {
     bool unionQuery(const Boxes& boxes, const Ray& ray, double tmin, double tmax, TraceContext& ctx,
                     Obs& obs, Hit& hit) const {
         BvhEntry root;
-        if (!boxes.root(tmin, tmax, root)) return false;
+        if (!boxes.root(_mm_set1_ps(floatDown(tmin)), _mm_set1_ps(floatUp(tmax)), root))
+            return false;
         const int r = walkFirstStart<kAnyHit>(boxes, root, ray, tmin, tmax, ctx, obs, hit);
         if (r >= 0) return r == 1;
         if constexpr (Obs::kActive)
@@ -153,11 +156,12 @@ class Bvh {
     // tests the leaves' primitives with the world ray `ray`.
     /// The walk of a scene with intersections or differences: leaves list every primitive
     /// meeting their box, with its restricted tree; front to back by a stack, each leaf's hit
-    /// inside its box, the nearest kept. Each leaf's hit is a boundary of the whole scene (its
-    /// tree agrees with the scene's inside its box), so with kAnyHit the first one ends it.
+    /// inside its box (`slab`: the ray in the frame, for the leaves' double boxes), the nearest
+    /// kept. Each leaf's hit is a boundary of the whole scene (its tree agrees with the scene's
+    /// inside its box), so with kAnyHit the first one ends it.
     template <bool kAnyHit, class Boxes, class Obs>
-    bool walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, TraceContext& ctx,
-              Obs& obs, Hit& hit) const;
+    bool walk(const Boxes& boxes, const SlabRay& slab, const Ray& ray, double tmin, double tmax,
+              TraceContext& ctx, Obs& obs, Hit& hit) const;
     /// A union-only scene's walk for a ray that begins outside every primitive, most rays: the
     /// union's first boundary is then the first start of a span after tmin, and the walk is a
     /// closest-hit walk (a stack, nodes beyond the nearest start culled). Returns 1 (hit), 0
@@ -182,7 +186,7 @@ class Bvh {
     /// outward), pushed far ones first so that the nearest is walked next (kNearFirst; else in
     /// the node's order); told to the observer.
     template <bool kNearFirst, class Boxes, class Obs>
-    void pushChildren(const Boxes& boxes, const BvhEntry& e, float tmin, float tmax,
+    void pushChildren(const Boxes& boxes, const BvhEntry& e, __m128 tmin, __m128 tmax,
                       BvhEntry* stack, int& sp, Obs& obs) const;
     /// Tells the observer inner entry `e`'s children met: c[0, n), in the order walked.
     template <class Obs>
@@ -210,6 +214,8 @@ class Bvh {
     int depth_ = 0;
     std::vector<BvhNode> nodes_;
     std::vector<BvhWideNode> wides_;
+    /// The root in a wide node's slot 0 (the other slots unused): the walks test it as any node.
+    BvhWideNode top_ = BvhWideNode::empty();
     Vec3 anchor_{0.0};
     std::vector<uint32_t> parent_;
     std::vector<uint32_t> primList_;
@@ -272,7 +278,7 @@ template <class Obs>
 
 template <bool kNearFirst, class Boxes, class Obs>
 [[gnu::always_inline]] inline void Bvh::pushChildren(const Boxes& boxes, const BvhEntry& e,
-                                                     float tmin, float tmax, BvhEntry* stack,
+                                                     __m128 tmin, __m128 tmax, BvhEntry* stack,
                                                      int& sp, Obs& obs) const {
     BvhEntry* const c = stack + sp;
     const int n = boxes.children(e, tmin, tmax, c);
@@ -314,10 +320,11 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
     // Nodes whose box begins beyond `reach` are culled: the nearest start found; with kAnyHit,
     // tmin once a start is found (only the boxes holding the ray's start are left to walk).
     double reach = tmax;
-    const float tminF = floatDown(tmin);
+    const __m128 tminV = _mm_set1_ps(floatDown(tmin));  // for the float box tests
     // For the float box tests, and to cull: a node entered after reachF is entered after reach
     // (the few in between are walked for nothing, never culled wrongly).
     float reachF = floatUp(reach);
+    __m128 reachV = _mm_set1_ps(reachF);
     Span local[2];  // a primitive's spans (out of the loop: Span's members are initialised)
     while (sp > 0) {
         const BvhEntry e = stack[--sp];
@@ -329,7 +336,7 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
         obs.region(e.node, e.t0, std::min(double(e.t1), first.t));
         if (!e.leaf()) {
             // A shadow ray's walk ends at any start: the order only costs.
-            pushChildren<!kAnyHit>(boxes, e, tminF, reachF, stack, sp, obs);
+            pushChildren<!kAnyHit>(boxes, e, tminV, reachV, stack, sp, obs);
             continue;
         }
         // The leaf's entries, read from its slot without its binary node.
@@ -346,6 +353,7 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
                     tie = false;
                     reach = kAnyHit ? tmin : first.t;
                     reachF = floatUp(reach);
+                    reachV = _mm_set1_ps(reachF);
                 } else if (found && sp2.in.t == first.t) {
                     tie = !kAnyHit;
                 }
@@ -427,16 +435,17 @@ bool Bvh::walkUnion(const Boxes& boxes, const BvhEntry& root, const Ray& ray, do
 }
 
 template <bool kAnyHit, class Boxes, class Obs>
-bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, TraceContext& ctx,
-               Obs& obs, Hit& hit) const {
+bool Bvh::walk(const Boxes& boxes, const SlabRay& slab, const Ray& ray, double tmin, double tmax,
+               TraceContext& ctx, Obs& obs, Hit& hit) const {
     // Push the far children, go on with the nearest.
     BvhEntry stack[kWalkStack];
     int sp = 0;
     double best = tmax;  // the leaves' windows end at the nearest hit found so far
-    const float tminF = floatDown(tmin);
-    float bestF = floatUp(best);  // for the float box tests and the culling
+    const __m128 tminV = _mm_set1_ps(floatDown(tmin));  // for the float box tests
+    float bestF = floatUp(best);                        // for the float box tests and the culling
+    __m128 bestV = _mm_set1_ps(bestF);
     bool found = false;
-    if (!boxes.root(tmin, tmax, stack[sp++])) return false;
+    if (!boxes.root(tminV, bestV, stack[sp++])) return false;
     while (sp > 0) {
         const BvhEntry e = stack[--sp];
         if (e.t0 > bestF) {  // its box begins beyond the hit: nothing nearer in it
@@ -448,7 +457,7 @@ bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, Tra
             // only inside that box. A box only the float test meets is passed over.
             const BvhNode& n = nodes_[e.node];
             double t0, t1;
-            if (!boxes.slab.clip(n, tmin, kInf, t0, t1)) continue;
+            if (!slab.clip(n, tmin, kInf, t0, t1)) continue;
             if (t0 > best) {
                 if constexpr (Obs::kActive) obs.nodeCulled(e.node, t0, best, false);
                 continue;
@@ -461,6 +470,7 @@ bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, Tra
                 hit = h;
                 best = h.t;
                 bestF = floatUp(best);
+                bestV = _mm_set1_ps(bestF);
                 found = true;
                 if constexpr (kAnyHit) return true;
             }
@@ -468,7 +478,7 @@ bool Bvh::walk(const Boxes& boxes, const Ray& ray, double tmin, double tmax, Tra
         }
         ++ctx.counters.regionVisits;
         obs.region(e.node, e.t0, std::min(double(e.t1), best));
-        pushChildren<!kAnyHit>(boxes, e, tminF, bestF, stack, sp, obs);
+        pushChildren<!kAnyHit>(boxes, e, tminV, bestV, stack, sp, obs);
     }
     return found;
 }

@@ -49,6 +49,16 @@ struct alignas(64) BvhWideNode {
     uint32_t node[kBvhWidth];  ///< each slot's binary node id (kNoNode-like 0xffffffff: unused)
     /// An inner slot's wide node; a leaf's: kWideLeaf | its first entry; kNoWide: unused.
     uint32_t wide[kBvhWidth];
+    /// A node whose four slots are unused.
+    static BvhWideNode empty() {
+        BvhWideNode w;
+        for (int k = 0; k < kBvhWidth; ++k) {
+            w.node[k] = 0xffffffffu;
+            w.wide[k] = kNoWide;
+            for (int a = 0; a < 3; ++a) w.lo[a][k] = INFINITY, w.hi[a][k] = -INFINITY;
+        }
+        return w;
+    }
 };
 static_assert(sizeof(BvhWideNode) == 128);
 
@@ -129,23 +139,24 @@ inline bool hasFlatAxis(const Ray& r) { return flatAxis(r, 0) || flatAxis(r, 1) 
 /// times the box's distance along that axis.
 template <bool kParallel>
 struct WideBoxes {
-    const BvhNode* nodes;
-    const BvhWideNode* wides;
-    SlabRay slab;           ///< the ray in double, for the root's box
-    __m128 oNear[3];        ///< per axis, the origin less the anchor for the near face's t
-    __m128 oFar[3];         ///< and for the far face's
-    __m128 inv[3];          ///< the inverse direction (0 along a parallel axis)
-    int nearOff[3];         ///< byte offset in a BvhWideNode of each axis's near face's floats
-    int farOff[3];          ///< of the far face's
-    bool parallel[3] = {};  ///< the axes tested by the origin's place
+    const BvhWideNode* top;      ///< a wide node whose one slot is the root
+    const BvhWideNode* wides;    ///< the wide nodes
+    __m128 oNear[3];             ///< per axis, the origin less the anchor for the near face's t
+    __m128 oFar[3];              ///< and for the far face's
+    __m128 inv[3];               ///< the inverse direction (0 along a parallel axis)
+    __m128 widenNear, widenFar;  ///< the factors that widen an interval's ends (kSlack)
+    int nearOff[3];              ///< byte offset in a BvhWideNode of each axis's near face's floats
+    int farOff[3];               ///< of the far face's
+    bool parallel[3] = {};       ///< the axes tested by the origin's place
 
     /// Relative widening of an interval's ends: 8 ulps, for the 3 that the arithmetic may lose.
     static constexpr float kSlack = 0x1p-21f;
 
-    /// `anchor`: what the wide nodes' boxes are relative to.
-    [[gnu::always_inline]] WideBoxes(const BvhNode* n, const BvhWideNode* w, const Ray& r,
+    /// `t`: the wide node standing for the root (its slot 0); `anchor`: what the wide nodes'
+    /// boxes are relative to.
+    [[gnu::always_inline]] WideBoxes(const BvhWideNode* t, const BvhWideNode* w, const Ray& r,
                                      const Vec3& anchor)
-        : nodes(n), wides(w), slab(r) {
+        : top(t), wides(w) {
         for (int a = 0; a < 3; ++a) {
             // The origin less the anchor, moved by 2^-22 of itself either way (and a hair, for
             // 0) before rounding to the nearest float: the rounding moves it back by at most
@@ -166,25 +177,36 @@ struct WideBoxes {
             nearOff[a] = neg ? hi : lo;
             farOff[a] = neg ? lo : hi;
         }
+        // Kept here, read by the products as memory operands, rather than made again per node.
+        widenNear = _mm_set1_ps(1.0f - kSlack);
+        widenFar = _mm_set1_ps(1.0f + kSlack);
     }
 
-    /// The root's entry when the ray meets its box within [tmin, tmax].
-    bool root(double tmin, double tmax, BvhEntry& e) const {
-        double t0, t1;
-        if (!slab.clip(nodes[0], tmin, tmax, t0, t1)) return false;
-        e = {0, nodes[0].leaf ? kWideLeaf | nodes[0].first : 0u, floatDown(t0), floatUp(t1)};
-        return true;
+    /// The root's entry when the ray may meet its box within [tmin, tmax] (the float test, as
+    /// for any node); returns 0 or 1.
+    [[gnu::always_inline]] int root(__m128 tmin, __m128 tmax, BvhEntry& e) const {
+        return meets(*top, tmin, tmax, &e);
     }
 
     /// Inner entry `e`'s children that the ray may meet within [tmin, tmax] (every one that
     /// the double test meets, and perhaps a few more), in slot order; returns how many. The
-    /// walks round their bounds to float once (floatDown(tmin), floatUp(tmax)), not per node.
-    /// tmin >= 0, as every walk's.
-    [[gnu::always_inline]] int children(const BvhEntry& e, float tmin, float tmax,
+    /// bounds come in each of the four lanes: the walks round them to float (floatDown(tmin),
+    /// floatUp(tmax)) and broadcast them once, not per node. tmin >= 0, as every walk's.
+    [[gnu::always_inline]] int children(const BvhEntry& e, __m128 tmin, __m128 tmax,
                                         BvhEntry c[kBvhWidth]) const {
-        const BvhWideNode& w = wides[e.wide];
+        return meets(wides[e.wide], tmin, tmax, c);
+    }
+    /// children() with the bounds as floats.
+    int children(const BvhEntry& e, float tmin, float tmax, BvhEntry c[kBvhWidth]) const {
+        return children(e, _mm_set1_ps(tmin), _mm_set1_ps(tmax), c);
+    }
+
+  private:
+    /// The slots of `w` the ray may meet within [tmin, tmax], in slot order, into `c`.
+    [[gnu::always_inline]] int meets(const BvhWideNode& w, __m128 tmin, __m128 tmax,
+                                     BvhEntry c[kBvhWidth]) const {
         const char* base = reinterpret_cast<const char*>(&w);
-        __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
+        __m128 t0 = tmin, t1 = tmax;
         __m128 outside = _mm_setzero_ps();
         for (int a = 0; a < 3; ++a) {
             const __m128 fn = _mm_load_ps(reinterpret_cast<const float*>(base + nearOff[a]));
@@ -202,8 +224,8 @@ struct WideBoxes {
         // t0 >= tmin >= 0, so widening it is a product; a negative t1 is a box that the
         // double test misses too (its t0 >= tmin >= 0; the rounding never turns a sign).
         // Each product rounds by half an ulp, far within the slack.
-        t0 = _mm_mul_ps(t0, _mm_set1_ps(1.0f - kSlack));
-        t1 = _mm_mul_ps(t1, _mm_set1_ps(1.0f + kSlack));
+        t0 = _mm_mul_ps(t0, widenNear);
+        t1 = _mm_mul_ps(t1, widenFar);
         int mask = _mm_movemask_ps(_mm_cmple_ps(t0, t1));  // NaN (an empty slot): not met
         if constexpr (kParallel) mask &= ~_mm_movemask_ps(outside);
         if (!mask) return 0;
