@@ -221,6 +221,36 @@ TEST(Bvh, OccludedAnswersAsTheNearestHit) {
     EXPECT_LT(blocked, rays);
 }
 
+// The render's union-only walks are made once per octant of the ray's direction (the faces'
+// offsets constants): each of the eight gives brute force's nearest hit and occlusion, on
+// rays through node corners, edges and faces and random ones, from tmin 0 and a secondary
+// ray's, on spheres with a floor polygon and on spheres with open cylinders.
+TEST(Bvh, UnionWalksOfEveryOctantAgreeWithBruteForce) {
+    for (const char* spec : {"builtin:balls:3", "builtin:rings:3"}) {
+        Scene scene = loadScene(spec);
+        ASSERT_TRUE(scene.tree.unionOnly());
+        for (int maxObjects : {-1, 3}) {
+            auto accel = buildAccelerator(scene, bvhParams(maxObjects));
+            const Bvh& b = bvhOf(*accel);
+            std::vector<Ray> rays = test::randomRays(scene, 11, 2000);
+            const std::vector<Ray> hard =
+                test::raysThroughPoints(nodePoints(b, 80, 12), scene.bounds, 13);
+            rays.insert(rays.end(), hard.begin(), hard.end());
+            size_t octants[8] = {};
+            for (const Ray& r : rays)
+                if (!hasFlatAxis(r))
+                    ++octants[WideBoxes<false>(&b.top(), b.wides().data(), r, b.anchor()).octant];
+            for (int k = 0; k < 8; ++k) EXPECT_GE(octants[k], 100u) << spec << " octant " << k;
+            const std::string what = std::string(spec) + " " + toString(bvhParams(maxObjects));
+            expectSame(scene, *accel, rays, what);
+            expectSame(scene, *accel, rays, what + " tmin", 1e-9 * scene.scale());
+            size_t blocked = 0;
+            EXPECT_EQ(occludedAsBrute(scene, *accel, rays, 0.0, what, blocked), 4 * rays.size());
+            EXPECT_GT(blocked, rays.size() / 4);
+        }
+    }
+}
+
 TEST(Bvh, MailboxesSpareRepeatedTestsOnly) {
     Scene scene = loadScene("builtin:lattice:4");
     BuildParams with = bvhParams(), without = bvhParams();

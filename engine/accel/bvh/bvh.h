@@ -13,10 +13,12 @@
 // the mailboxes spare a primitive listed by several leaves a second test.
 #pragma once
 
+#include <array>
 #include <cassert>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/accel/build_params.h"
@@ -144,7 +146,7 @@ class Bvh {
         BvhEntry root;
         if (!boxes.root(_mm_set1_ps(floatDown(tmin)), _mm_set1_ps(floatUp(tmax)), root))
             return false;
-        const int r = walkFirstStart<kAnyHit>(boxes, root, ray, tmin, tmax, ctx, obs, hit);
+        const int r = firstStart<kAnyHit>(boxes, root, ray, tmin, tmax, ctx, obs, hit);
         if (r >= 0) return r == 1;
         if constexpr (Obs::kActive)
             obs.walkRestart(
@@ -169,9 +171,28 @@ class Bvh {
     /// With kAnyHit, any start in (tmin, tmax] proves a boundary there once the ray is known to
     /// begin outside every primitive: from then on only the nodes whose box holds the ray's
     /// start (entered at tmin) are walked, to rule out a span holding tmin; ties do not matter.
-    template <bool kAnyHit, class Boxes, class Obs>
+    /// kOct: made for rays of that octant (WideBoxes::octant), -1 for any.
+    template <bool kAnyHit, int kOct, class Boxes, class Obs>
     int walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
                        double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const;
+    /// walkFirstStart, made for the ray's octant: the render's walks, whose node visits then
+    /// read the faces at constant offsets (balls:6's render: 5% fewer instructions); an observed
+    /// walk or a ray with a parallel axis takes the one for any.
+    template <bool kAnyHit, class Boxes, class Obs>
+    int firstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
+                   double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const {
+        if constexpr (!Boxes::kHasParallel && !Obs::kActive) {
+            using Walk = int (Bvh::*)(const Boxes&, const BvhEntry&, const Ray&, double, double,
+                                      TraceContext&, Obs&, Hit&) const;
+            static constexpr auto kWalks = []<int... k>(std::integer_sequence<int, k...>) {
+                return std::array<Walk, 8>{&Bvh::walkFirstStart<kAnyHit, k, Boxes, Obs>...};
+            }
+            (std::make_integer_sequence<int, 8>());
+            return (this->*kWalks[boxes.octant])(boxes, root, ray, tmin, tmax, ctx, obs, hit);
+        } else {
+            return walkFirstStart<kAnyHit, -1>(boxes, root, ray, tmin, tmax, ctx, obs, hit);
+        }
+    }
     /// The walk of a union-only scene: each primitive in one leaf only, leaves in order of the
     /// t their box is entered at (a heap), their primitives' spans merged as they come. When a
     /// node is entered at t, every span that starts before t is known (its primitive's box lies
@@ -185,7 +206,7 @@ class Bvh {
     /// Inner entry `e`'s children the ray may meet within [tmin, tmax] (float bounds, rounded
     /// outward), pushed far ones first so that the nearest is walked next (kNearFirst; else in
     /// the node's order); told to the observer.
-    template <bool kNearFirst, class Boxes, class Obs>
+    template <bool kNearFirst, int kOct, class Boxes, class Obs>
     void pushChildren(const Boxes& boxes, const BvhEntry& e, __m128 tmin, __m128 tmax,
                       BvhEntry* stack, int& sp, Obs& obs) const;
     /// Tells the observer inner entry `e`'s children met: c[0, n), in the order walked.
@@ -276,12 +297,12 @@ template <class Obs>
     return b != nullptr;
 }
 
-template <bool kNearFirst, class Boxes, class Obs>
+template <bool kNearFirst, int kOct, class Boxes, class Obs>
 [[gnu::always_inline]] inline void Bvh::pushChildren(const Boxes& boxes, const BvhEntry& e,
                                                      __m128 tmin, __m128 tmax, BvhEntry* stack,
                                                      int& sp, Obs& obs) const {
     BvhEntry* const c = stack + sp;
-    const int n = boxes.children(e, tmin, tmax, c);
+    const int n = boxes.template children<kOct>(e, tmin, tmax, c);
     // Far to near: the nearest on top. At most four, so an insertion sort in place.
     for (int i = 1; kNearFirst && i < n; ++i) {
         const BvhEntry x = c[i];
@@ -305,7 +326,7 @@ void Bvh::tellChildren(const BvhEntry& e, const BvhEntry* c, int n, Obs& obs) {
     obs.nodeChildren(e.node, ids, t0s, n);
 }
 
-template <bool kAnyHit, class Boxes, class Obs>
+template <bool kAnyHit, int kOct, class Boxes, class Obs>
 int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray, double tmin,
                         double tmax, TraceContext& ctx, Obs& obs, Hit& hit) const {
     BvhEntry stack[kWalkStack];
@@ -336,7 +357,7 @@ int Bvh::walkFirstStart(const Boxes& boxes, const BvhEntry& root, const Ray& ray
         obs.region(e.node, e.t0, std::min(double(e.t1), first.t));
         if (!e.leaf()) {
             // A shadow ray's walk ends at any start: the order only costs.
-            pushChildren<!kAnyHit>(boxes, e, tminV, reachV, stack, sp, obs);
+            pushChildren<!kAnyHit, kOct>(boxes, e, tminV, reachV, stack, sp, obs);
             continue;
         }
         // The leaf's entries, read from its slot without its binary node.
@@ -478,7 +499,7 @@ bool Bvh::walk(const Boxes& boxes, const SlabRay& slab, const Ray& ray, double t
         }
         ++ctx.counters.regionVisits;
         obs.region(e.node, e.t0, std::min(double(e.t1), best));
-        pushChildren<!kAnyHit>(boxes, e, tminV, bestV, stack, sp, obs);
+        pushChildren<!kAnyHit, -1>(boxes, e, tminV, bestV, stack, sp, obs);
     }
     return found;
 }

@@ -139,8 +139,9 @@ inline bool hasFlatAxis(const Ray& r) { return flatAxis(r, 0) || flatAxis(r, 1) 
 /// times the box's distance along that axis.
 template <bool kParallel>
 struct WideBoxes {
-    const BvhWideNode* top;      ///< a wide node whose one slot is the root
-    const BvhWideNode* wides;    ///< the wide nodes
+    static constexpr bool kHasParallel = kParallel;  ///< some axis is tested by the origin's place
+    const BvhWideNode* top;                          ///< a wide node whose one slot is the root
+    const BvhWideNode* wides;                        ///< the wide nodes
     __m128 oNear[3];             ///< per axis, the origin less the anchor for the near face's t
     __m128 oFar[3];              ///< and for the far face's
     __m128 inv[3];               ///< the inverse direction (0 along a parallel axis)
@@ -148,6 +149,9 @@ struct WideBoxes {
     int nearOff[3];              ///< byte offset in a BvhWideNode of each axis's near face's floats
     int farOff[3];               ///< of the far face's
     bool parallel[3] = {};       ///< the axes tested by the origin's place
+    /// Bit a set: the ray goes down axis a, whose near face is then hi (0 for a parallel axis):
+    /// the walks made for one octant (kOct) have the faces' offsets as constants.
+    int octant = 0;
 
     /// Relative widening of an interval's ends: 8 ulps, for the 3 that the arithmetic may lose.
     static constexpr float kSlack = 0x1p-21f;
@@ -172,10 +176,9 @@ struct WideBoxes {
             oFar[a] = _mm_set1_ps(neg ? up : down);
             // The inverse rounds to float with 1 ulp of relative error, part of the 3 covered.
             inv[a] = _mm_set1_ps(flat ? 0.0f : float(1.0 / r.d[a]));
-            const int lo = int(offsetof(BvhWideNode, lo)) + a * 16,
-                      hi = int(offsetof(BvhWideNode, hi)) + a * 16;
-            nearOff[a] = neg ? hi : lo;
-            farOff[a] = neg ? lo : hi;
+            nearOff[a] = neg ? hiOffset(a) : loOffset(a);
+            farOff[a] = neg ? loOffset(a) : hiOffset(a);
+            octant |= int(neg) << a;
         }
         // Kept here, read by the products as memory operands, rather than made again per node.
         widenNear = _mm_set1_ps(1.0f - kSlack);
@@ -185,16 +188,19 @@ struct WideBoxes {
     /// The root's entry when the ray may meet its box within [tmin, tmax] (the float test, as
     /// for any node); returns 0 or 1.
     [[gnu::always_inline]] int root(__m128 tmin, __m128 tmax, BvhEntry& e) const {
-        return meets(*top, tmin, tmax, &e);
+        return meets<-1>(*top, tmin, tmax, &e);
     }
 
     /// Inner entry `e`'s children that the ray may meet within [tmin, tmax] (every one that
     /// the double test meets, and perhaps a few more), in slot order; returns how many. The
     /// bounds come in each of the four lanes: the walks round them to float (floatDown(tmin),
     /// floatUp(tmax)) and broadcast them once, not per node. tmin >= 0, as every walk's.
+    /// kOct: the ray's octant when the caller is made for one (its faces' offsets constants;
+    /// not with kParallel), -1 for any.
+    template <int kOct = -1>
     [[gnu::always_inline]] int children(const BvhEntry& e, __m128 tmin, __m128 tmax,
                                         BvhEntry c[kBvhWidth]) const {
-        return meets(wides[e.wide], tmin, tmax, c);
+        return meets<kOct>(wides[e.wide], tmin, tmax, c);
     }
     /// children() with the bounds as floats.
     int children(const BvhEntry& e, float tmin, float tmax, BvhEntry c[kBvhWidth]) const {
@@ -202,15 +208,24 @@ struct WideBoxes {
     }
 
   private:
+    /// Byte offset in a BvhWideNode of axis a's lo floats, and of its hi ones.
+    static constexpr int loOffset(int a) { return int(offsetof(BvhWideNode, lo)) + a * 16; }
+    static constexpr int hiOffset(int a) { return int(offsetof(BvhWideNode, hi)) + a * 16; }
+
     /// The slots of `w` the ray may meet within [tmin, tmax], in slot order, into `c`.
+    template <int kOct>
     [[gnu::always_inline]] int meets(const BvhWideNode& w, __m128 tmin, __m128 tmax,
                                      BvhEntry c[kBvhWidth]) const {
+        static_assert(kOct < 0 || !kParallel, "a parallel axis has no octant");
         const char* base = reinterpret_cast<const char*>(&w);
         __m128 t0 = tmin, t1 = tmax;
         __m128 outside = _mm_setzero_ps();
         for (int a = 0; a < 3; ++a) {
-            const __m128 fn = _mm_load_ps(reinterpret_cast<const float*>(base + nearOff[a]));
-            const __m128 ff = _mm_load_ps(reinterpret_cast<const float*>(base + farOff[a]));
+            const bool down = kOct >> a & 1;
+            const int nOff = kOct < 0 ? nearOff[a] : down ? hiOffset(a) : loOffset(a);
+            const int fOff = kOct < 0 ? farOff[a] : down ? loOffset(a) : hiOffset(a);
+            const __m128 fn = _mm_load_ps(reinterpret_cast<const float*>(base + nOff));
+            const __m128 ff = _mm_load_ps(reinterpret_cast<const float*>(base + fOff));
             if constexpr (kParallel) {
                 if (parallel[a]) {  // the origin outside the slab: lo > origin or hi < origin
                     outside = _mm_or_ps(
