@@ -221,6 +221,36 @@ TEST(Bvh, OccludedAnswersAsTheNearestHit) {
     EXPECT_LT(blocked, rays);
 }
 
+// The render's union-only walks are made once per octant of the ray's direction (the faces'
+// offsets constants): each of the eight gives brute force's nearest hit and occlusion, on
+// rays through node corners, edges and faces and random ones, from tmin 0 and a secondary
+// ray's, on spheres with a floor polygon and on spheres with open cylinders.
+TEST(Bvh, UnionWalksOfEveryOctantAgreeWithBruteForce) {
+    for (const char* spec : {"builtin:balls:3", "builtin:rings:3"}) {
+        Scene scene = loadScene(spec);
+        ASSERT_TRUE(scene.tree.unionOnly());
+        for (int maxObjects : {-1, 3}) {
+            auto accel = buildAccelerator(scene, bvhParams(maxObjects));
+            const Bvh& b = bvhOf(*accel);
+            std::vector<Ray> rays = test::randomRays(scene, 11, 2000);
+            const std::vector<Ray> hard =
+                test::raysThroughPoints(nodePoints(b, 80, 12), scene.bounds, 13);
+            rays.insert(rays.end(), hard.begin(), hard.end());
+            size_t octants[8] = {};
+            for (const Ray& r : rays)
+                if (!hasFlatAxis(r))
+                    ++octants[WideBoxes<false>(&b.top(), b.wides().data(), r, b.anchor()).octant];
+            for (int k = 0; k < 8; ++k) EXPECT_GE(octants[k], 100u) << spec << " octant " << k;
+            const std::string what = std::string(spec) + " " + toString(bvhParams(maxObjects));
+            expectSame(scene, *accel, rays, what);
+            expectSame(scene, *accel, rays, what + " tmin", 1e-9 * scene.scale());
+            size_t blocked = 0;
+            EXPECT_EQ(occludedAsBrute(scene, *accel, rays, 0.0, what, blocked), 4 * rays.size());
+            EXPECT_GT(blocked, rays.size() / 4);
+        }
+    }
+}
+
 TEST(Bvh, MailboxesSpareRepeatedTestsOnly) {
     Scene scene = loadScene("builtin:lattice:4");
     BuildParams with = bvhParams(), without = bvhParams();
@@ -291,6 +321,46 @@ TEST(Bvh, LeavesListEveryPrimitiveMeetingTheirBox) {
 
 // The knobs change the structure as a user expects: more leaves at max-objects 1 than at 8
 // without the cost stop, a shallower tree under a lower max-level.
+// A union-only scene's entries are primList's primitives in its order, each leaf's last one
+// marked (the walks stop there), with the scene's packed sphere or none: on the sphereflake (a
+// floor polygon among spheres), the rings (open cylinders among spheres) at several leaf sizes.
+TEST(Bvh, UnionEntriesAreTheLeavesPrimitives) {
+    for (const char* spec : {"builtin:balls:3", "builtin:rings:3"}) {
+        for (int maxObjects : {-1, 1, 5}) {
+            Scene scene = loadScene(spec);
+            ASSERT_TRUE(scene.tree.unionOnly());
+            auto accel = buildAccelerator(scene, bvhParams(maxObjects));
+            const Bvh& b = bvhOf(*accel);
+            const std::vector<BvhUnionEntry>& x = b.unionEntries();
+            ASSERT_EQ(x.size(), b.primList().size());
+            std::vector<char> ends(x.size(), 0);
+            size_t spheres = 0, others = 0;
+            for (const BvhNode& n : b.nodes()) {
+                if (!n.leaf) continue;
+                ASSERT_GT(n.count, 0u);
+                ends[n.first + n.count - 1] = 1;
+            }
+            for (size_t i = 0; i < x.size(); ++i) {
+                const uint32_t p = b.primList()[i];
+                EXPECT_EQ(x[i].prim, p) << spec << " entry " << i;
+                EXPECT_EQ(x[i].last, uint32_t(ends[i])) << spec << " entry " << i;
+                const bool packed = scene.packedSpheres[p].r >= 0.0;
+                EXPECT_EQ(x[i].r >= 0.0, packed) << spec << " entry " << i;
+                if (packed) {
+                    EXPECT_EQ(x[i].c, scene.packedSpheres[p].c);
+                    EXPECT_EQ(x[i].r, scene.packedSpheres[p].r);
+                }
+                ++(packed ? spheres : others);
+            }
+            EXPECT_GT(spheres, 0u) << spec;
+            EXPECT_GT(others, 0u) << spec;
+        }
+    }
+    // A CSG scene's leaves read their binary node: no entries.
+    Scene csg = loadScene("builtin:drilled:3");
+    EXPECT_TRUE(bvhOf(*buildAccelerator(csg, bvhParams())).unionEntries().empty());
+}
+
 TEST(Bvh, KnobsChangeTheStructure) {
     Scene scene = loadScene("builtin:lattice:4");
     auto fine = buildAccelerator(scene, bvhParams(1, false));
@@ -327,6 +397,14 @@ TEST(Bvh, WideNodesHoldTheirChildrensBoxes) {
         if (nodes.empty() || nodes[0].leaf) continue;  // what the intersections left is small
         ++checked;
         std::vector<int> inSlots(nodes.size(), 0);
+        // The walks start at the root, slot 0 of top(), the others unused.
+        EXPECT_EQ(b.top().node[0], 0u);
+        EXPECT_EQ(b.top().wide[0], 0u);
+        for (int k = 1; k < kBvhWidth; ++k) EXPECT_EQ(b.top().node[k], kNoNode);
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_LE(double(b.top().lo[a][0]) + b.anchor()[a], nodes[0].lo[a]);
+            EXPECT_GE(double(b.top().hi[a][0]) + b.anchor()[a], nodes[0].hi[a]);
+        }
         // Walk the wide tree from its root, which stands for binary node 0.
         std::vector<std::pair<uint32_t, uint32_t>> todo{{0u, 0u}};  // wide, binary
         size_t seen = 0;
@@ -356,8 +434,12 @@ TEST(Bvh, WideNodesHoldTheirChildrensBoxes) {
                     EXPECT_GE(double(wn.hi[a][k]) + b.anchor()[a], nodes[id].hi[a])
                         << "seed " << seed << " node " << id << " axis " << a;
                 }
-                EXPECT_EQ(wn.wide[k] == kNoWide, bool(nodes[id].leaf));
-                if (wn.wide[k] != kNoWide) todo.push_back({wn.wide[k], id});
+                // A leaf's slot names its first entry, which the union-only walks read.
+                EXPECT_EQ(bool(wn.wide[k] & kWideLeaf), bool(nodes[id].leaf));
+                if (nodes[id].leaf) {
+                    EXPECT_EQ(wn.wide[k] & ~kWideLeaf, nodes[id].first);
+                }
+                if (!(wn.wide[k] & kWideLeaf)) todo.push_back({wn.wide[k], id});
             }
         }
         EXPECT_EQ(seen, b.wides().size());
@@ -390,17 +472,20 @@ TEST(Bvh, WideBoxTestHoldsTheDoubleOne) {
         for (const Ray& world : rays) {
             const Ray r = b.frame().turned ? b.frame().toFrame(world) : world;
             for (double tmin : {0.0, 1e-9 * scene.scale()}) {
+                const SlabRay slab(r);
                 auto check = [&](const auto& boxes) {
-                    for (uint32_t w = 0; w < b.wides().size(); ++w) {
-                        const BvhWideNode& wn = b.wides()[w];
+                    // The wide nodes, and the root's one slot (w == wides().size()).
+                    for (uint32_t w = 0; w <= b.wides().size(); ++w) {
+                        const bool top = w == b.wides().size();
+                        const BvhWideNode& wn = top ? b.top() : b.wides()[w];
                         BvhEntry c[kBvhWidth];
-                        const int n =
-                            boxes.children({kNoNode, w, 0.0f, 0.0f}, floatDown(tmin), INFINITY, c);
+                        const __m128 lo = _mm_set1_ps(floatDown(tmin)), hi = _mm_set1_ps(INFINITY);
+                        const int n = top ? boxes.root(lo, hi, c[0])
+                                          : boxes.children({kNoNode, w, 0.0f, 0.0f}, lo, hi, c);
                         for (int k = 0; k < kBvhWidth; ++k) {
                             if (wn.node[k] == kNoNode) continue;
                             double t0, t1;
-                            if (!boxes.slab.clip(b.nodes()[wn.node[k]], tmin, kInf, t0, t1))
-                                continue;
+                            if (!slab.clip(b.nodes()[wn.node[k]], tmin, kInf, t0, t1)) continue;
                             ++met;
                             const BvhEntry* e = std::find_if(
                                 c, c + n, [&](const BvhEntry& x) { return x.node == wn.node[k]; });
@@ -412,9 +497,9 @@ TEST(Bvh, WideBoxTestHoldsTheDoubleOne) {
                     }
                 };
                 if (hasFlatAxis(r))
-                    check(WideBoxes<true>(b.nodes().data(), b.wides().data(), r, b.anchor()));
+                    check(WideBoxes<true>(&b.top(), b.wides().data(), r, b.anchor()));
                 else
-                    check(WideBoxes<false>(b.nodes().data(), b.wides().data(), r, b.anchor()));
+                    check(WideBoxes<false>(&b.top(), b.wides().data(), r, b.anchor()));
             }
         }
     }

@@ -203,6 +203,7 @@ struct BvhBuilder {
             out.primList_ = ids;
             listedTotal = ids.size();
             sharedSets = leaves.size();
+            fillUnionEntries();
             return;
         }
         std::vector<std::vector<uint32_t>> lists(leaves.size());
@@ -241,16 +242,49 @@ struct BvhBuilder {
     }
     size_t listedTotal = 0, sharedSets = 0;
 
+    /// A union-only scene's entries (Bvh::unionEntries): primList's primitives with their
+    /// spheres, each leaf's last one marked.
+    void fillUnionEntries() {
+        const std::vector<PackedSphere>& packed = scene.packedSpheres;
+        std::vector<BvhUnionEntry>& x = out.unionEntries_;
+        x.resize(out.primList_.size());
+        for (size_t i = 0; i < x.size(); ++i) {
+            const uint32_t p = out.primList_[i];
+            const bool sphere = p < packed.size() && packed[p].r >= 0.0;
+            x[i] = {sphere ? packed[p].c : Vec3(0.0), sphere ? packed[p].r : -1.0, p, 0};
+        }
+        for (uint32_t leaf : leaves) x[end[leaf] - 1].last = 1;
+    }
+
     /// The wide nodes the walks read (bvh_boxes.h): from the root down, each inner node's
     /// children, the inner one of largest area replaced by its own two children until there
     /// are four (as Embree collapses its BVH2 into a BVH4), so that a wide node holds the
-    /// nodes most rays that enter it go on into.
+    /// nodes most rays that enter it go on into. The root itself is the one slot of Bvh::top_.
     void buildWide() {
-        if (out.nodes_.empty() || out.nodes_[0].leaf) return;
+        if (out.nodes_.empty()) return;
         out.anchor_ = out.nodes_[0].box().center();
-        out.wides_.reserve(out.nodes_.size() / 2);
-        out.wides_.emplace_back();
-        fillWide(0, 0);
+        if (!out.nodes_[0].leaf) out.wides_.reserve(out.nodes_.size() / 2);
+        out.top_ = BvhWideNode::empty();
+        setSlot(out.top_, 0, 0);
+        if (!out.nodes_[0].leaf) fillWide(0, 0);
+    }
+    /// Slot k of `wn` holds binary node `id`: its box less the anchor, rounded outward, and its
+    /// wide node (made here, filled by fillWide) or, for a leaf, its first entry.
+    void setSlot(BvhWideNode& wn, int k, uint32_t id) {
+        const BvhNode& c = out.nodes_[id];
+        wn.node[k] = id;
+        // Outward: the float nearest below (above) the box's side less the anchor, then one
+        // float further, for the double subtraction's own rounding.
+        for (int a = 0; a < 3; ++a) {
+            wn.lo[a][k] = floatBelow(floatDown(c.lo[a] - out.anchor_[a]));
+            wn.hi[a][k] = floatAbove(floatUp(c.hi[a] - out.anchor_[a]));
+        }
+        if (c.leaf) {
+            wn.wide[k] = kWideLeaf | c.first;
+        } else {
+            wn.wide[k] = uint32_t(out.wides_.size());
+            out.wides_.emplace_back();
+        }
     }
     /// Wide node `w`, standing for inner binary node `bin`, and the wide nodes below it.
     void fillWide(uint32_t w, uint32_t bin) {
@@ -268,29 +302,11 @@ struct BvhBuilder {
             slots[widest] = first;
             slots[n++] = first + 1;
         }
-        BvhWideNode wn;
-        for (int k = 0; k < kBvhWidth; ++k) {
-            wn.node[k] = kNoNode;
-            wn.wide[k] = kNoWide;
-            for (int a = 0; a < 3; ++a) wn.lo[a][k] = INFINITY, wn.hi[a][k] = -INFINITY;
-        }
-        for (int k = 0; k < n; ++k) {
-            const BvhNode& c = nodes[slots[k]];
-            wn.node[k] = slots[k];
-            // Outward: the float nearest below (above) the box's side less the anchor, then
-            // one float further, for the double subtraction's own rounding.
-            for (int a = 0; a < 3; ++a) {
-                wn.lo[a][k] = floatBelow(floatDown(c.lo[a] - out.anchor_[a]));
-                wn.hi[a][k] = floatAbove(floatUp(c.hi[a] - out.anchor_[a]));
-            }
-            if (!c.leaf) {
-                wn.wide[k] = uint32_t(out.wides_.size());
-                out.wides_.emplace_back();
-            }
-        }
+        BvhWideNode wn = BvhWideNode::empty();
+        for (int k = 0; k < n; ++k) setSlot(wn, k, slots[k]);
         out.wides_[w] = wn;
         for (int k = 0; k < n; ++k)
-            if (wn.wide[k] != kNoWide) fillWide(wn.wide[k], wn.node[k]);
+            if (!(wn.wide[k] & kWideLeaf)) fillWide(wn.wide[k], wn.node[k]);
     }
 
     /// The surface-area estimate of the built tree, in tests per ray that enters the root.
@@ -345,6 +361,9 @@ Bvh Bvh::build(const Scene& scene, const BvhConfig& config, nlohmann::json& extr
         b.makeNode(0, uint32_t(b.ids.size()), 0, kNoNode);
         b.build(0, 0);
         b.fillLeaves();
+        // A wide node's leaf slot holds the leaf's first entry in 31 bits (kWideLeaf).
+        if (out.primList_.size() >= kWideLeaf)
+            throw std::invalid_argument("the BVH's leaves list more than 2^31 primitives");
         b.buildWide();
         b.estimateCost();
     }

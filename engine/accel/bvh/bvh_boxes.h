@@ -33,8 +33,12 @@ static_assert(sizeof(BvhNode) == 64);
 
 /// How many children a wide node has at most.
 inline constexpr int kBvhWidth = 4;
-/// A slot of a wide node that holds no wide node (a leaf, or no child).
+/// A wide node's slot that holds no child.
 inline constexpr uint32_t kNoWide = 0xffffffffu;
+/// The bit of a wide node's `wide` slot that marks a leaf; the other bits are the leaf's first
+/// entry in Bvh::primList() (and in Bvh::unionEntries()), so that a walk reaches a union-only
+/// leaf's primitives without reading its binary node.
+inline constexpr uint32_t kWideLeaf = 0x80000000u;
 
 /// A wide node, in two cache lines: an inner binary node with its descendants down to four
 /// nodes (its children, or their children), whose boxes are stored axis by axis (SoA) so that
@@ -43,17 +47,31 @@ inline constexpr uint32_t kNoWide = 0xffffffffu;
 struct alignas(64) BvhWideNode {
     float lo[3][kBvhWidth], hi[3][kBvhWidth];
     uint32_t node[kBvhWidth];  ///< each slot's binary node id (kNoNode-like 0xffffffff: unused)
-    uint32_t wide[kBvhWidth];  ///< an inner slot's wide node; kNoWide for a leaf or unused slot
+    /// An inner slot's wide node; a leaf's: kWideLeaf | its first entry; kNoWide: unused.
+    uint32_t wide[kBvhWidth];
+    /// A node whose four slots are unused.
+    static BvhWideNode empty() {
+        BvhWideNode w;
+        for (int k = 0; k < kBvhWidth; ++k) {
+            w.node[k] = 0xffffffffu;
+            w.wide[k] = kNoWide;
+            for (int a = 0; a < 3; ++a) w.lo[a][k] = INFINITY, w.hi[a][k] = -INFINITY;
+        }
+        return w;
+    }
 };
 static_assert(sizeof(BvhWideNode) == 128);
 
-/// A node as a walk holds it: its binary id, its wide node (kNoWide for a leaf), and the ray's
-/// interval in its box, rounded outward to float (the float test's, which holds the double one).
+/// A node as a walk holds it: its binary id, its wide node (a leaf: kWideLeaf and its first
+/// entry), and the ray's interval in its box, rounded outward to float (the float test's, which
+/// holds the double one).
 struct BvhEntry {
     uint32_t node;  ///< its id (nodes(), the observer's region)
-    uint32_t wide;  ///< inner: its wide node; leaf: kNoWide
+    uint32_t wide;  ///< inner: its wide node; leaf: kWideLeaf | its first entry
     float t0, t1;
-    bool leaf() const { return wide == kNoWide; }
+    bool leaf() const { return wide & kWideLeaf; }
+    /// A leaf's first entry in Bvh::primList().
+    uint32_t first() const { return wide & ~kWideLeaf; }
 };
 
 /// The ray as the double box tests read it: its origin, and its inverse direction (0 along an
@@ -121,23 +139,28 @@ inline bool hasFlatAxis(const Ray& r) { return flatAxis(r, 0) || flatAxis(r, 1) 
 /// times the box's distance along that axis.
 template <bool kParallel>
 struct WideBoxes {
-    const BvhNode* nodes;
-    const BvhWideNode* wides;
-    SlabRay slab;           ///< the ray in double, for the root's box
-    __m128 oNear[3];        ///< per axis, the origin less the anchor for the near face's t
-    __m128 oFar[3];         ///< and for the far face's
-    __m128 inv[3];          ///< the inverse direction (0 along a parallel axis)
-    int nearOff[3];         ///< byte offset in a BvhWideNode of each axis's near face's floats
-    int farOff[3];          ///< of the far face's
-    bool parallel[3] = {};  ///< the axes tested by the origin's place
+    static constexpr bool kHasParallel = kParallel;  ///< some axis is tested by the origin's place
+    const BvhWideNode* top;                          ///< a wide node whose one slot is the root
+    const BvhWideNode* wides;                        ///< the wide nodes
+    __m128 oNear[3];             ///< per axis, the origin less the anchor for the near face's t
+    __m128 oFar[3];              ///< and for the far face's
+    __m128 inv[3];               ///< the inverse direction (0 along a parallel axis)
+    __m128 widenNear, widenFar;  ///< the factors that widen an interval's ends (kSlack)
+    int nearOff[3];              ///< byte offset in a BvhWideNode of each axis's near face's floats
+    int farOff[3];               ///< of the far face's
+    bool parallel[3] = {};       ///< the axes tested by the origin's place
+    /// Bit a set: the ray goes down axis a, whose near face is then hi (0 for a parallel axis):
+    /// the walks made for one octant (kOct) have the faces' offsets as constants.
+    int octant = 0;
 
     /// Relative widening of an interval's ends: 8 ulps, for the 3 that the arithmetic may lose.
     static constexpr float kSlack = 0x1p-21f;
 
-    /// `anchor`: what the wide nodes' boxes are relative to.
-    [[gnu::always_inline]] WideBoxes(const BvhNode* n, const BvhWideNode* w, const Ray& r,
+    /// `t`: the wide node standing for the root (its slot 0); `anchor`: what the wide nodes'
+    /// boxes are relative to.
+    [[gnu::always_inline]] WideBoxes(const BvhWideNode* t, const BvhWideNode* w, const Ray& r,
                                      const Vec3& anchor)
-        : nodes(n), wides(w), slab(r) {
+        : top(t), wides(w) {
         for (int a = 0; a < 3; ++a) {
             // The origin less the anchor, moved by 2^-22 of itself either way (and a hair, for
             // 0) before rounding to the nearest float: the rounding moves it back by at most
@@ -153,33 +176,56 @@ struct WideBoxes {
             oFar[a] = _mm_set1_ps(neg ? up : down);
             // The inverse rounds to float with 1 ulp of relative error, part of the 3 covered.
             inv[a] = _mm_set1_ps(flat ? 0.0f : float(1.0 / r.d[a]));
-            const int lo = int(offsetof(BvhWideNode, lo)) + a * 16,
-                      hi = int(offsetof(BvhWideNode, hi)) + a * 16;
-            nearOff[a] = neg ? hi : lo;
-            farOff[a] = neg ? lo : hi;
+            nearOff[a] = neg ? hiOffset(a) : loOffset(a);
+            farOff[a] = neg ? loOffset(a) : hiOffset(a);
+            octant |= int(neg) << a;
         }
+        // Kept here, read by the products as memory operands, rather than made again per node.
+        widenNear = _mm_set1_ps(1.0f - kSlack);
+        widenFar = _mm_set1_ps(1.0f + kSlack);
     }
 
-    /// The root's entry when the ray meets its box within [tmin, tmax].
-    bool root(double tmin, double tmax, BvhEntry& e) const {
-        double t0, t1;
-        if (!slab.clip(nodes[0], tmin, tmax, t0, t1)) return false;
-        e = {0, nodes[0].leaf ? kNoWide : 0u, floatDown(t0), floatUp(t1)};
-        return true;
+    /// The root's entry when the ray may meet its box within [tmin, tmax] (the float test, as
+    /// for any node); returns 0 or 1.
+    [[gnu::always_inline]] int root(__m128 tmin, __m128 tmax, BvhEntry& e) const {
+        return meets<-1>(*top, tmin, tmax, &e);
     }
 
     /// Inner entry `e`'s children that the ray may meet within [tmin, tmax] (every one that
     /// the double test meets, and perhaps a few more), in slot order; returns how many. The
-    /// walks round their bounds to float once (floatDown(tmin), floatUp(tmax)), not per node.
-    [[gnu::always_inline]] int children(const BvhEntry& e, float tmin, float tmax,
+    /// bounds come in each of the four lanes: the walks round them to float (floatDown(tmin),
+    /// floatUp(tmax)) and broadcast them once, not per node. tmin >= 0, as every walk's.
+    /// kOct: the ray's octant when the caller is made for one (its faces' offsets constants;
+    /// not with kParallel), -1 for any.
+    template <int kOct = -1>
+    [[gnu::always_inline]] int children(const BvhEntry& e, __m128 tmin, __m128 tmax,
                                         BvhEntry c[kBvhWidth]) const {
-        const BvhWideNode& w = wides[e.wide];
+        return meets<kOct>(wides[e.wide], tmin, tmax, c);
+    }
+    /// children() with the bounds as floats.
+    int children(const BvhEntry& e, float tmin, float tmax, BvhEntry c[kBvhWidth]) const {
+        return children(e, _mm_set1_ps(tmin), _mm_set1_ps(tmax), c);
+    }
+
+  private:
+    /// Byte offset in a BvhWideNode of axis a's lo floats, and of its hi ones.
+    static constexpr int loOffset(int a) { return int(offsetof(BvhWideNode, lo)) + a * 16; }
+    static constexpr int hiOffset(int a) { return int(offsetof(BvhWideNode, hi)) + a * 16; }
+
+    /// The slots of `w` the ray may meet within [tmin, tmax], in slot order, into `c`.
+    template <int kOct>
+    [[gnu::always_inline]] int meets(const BvhWideNode& w, __m128 tmin, __m128 tmax,
+                                     BvhEntry c[kBvhWidth]) const {
+        static_assert(kOct < 0 || !kParallel, "a parallel axis has no octant");
         const char* base = reinterpret_cast<const char*>(&w);
-        __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
+        __m128 t0 = tmin, t1 = tmax;
         __m128 outside = _mm_setzero_ps();
         for (int a = 0; a < 3; ++a) {
-            const __m128 fn = _mm_load_ps(reinterpret_cast<const float*>(base + nearOff[a]));
-            const __m128 ff = _mm_load_ps(reinterpret_cast<const float*>(base + farOff[a]));
+            const bool down = kOct >> a & 1;
+            const int nOff = kOct < 0 ? nearOff[a] : down ? hiOffset(a) : loOffset(a);
+            const int fOff = kOct < 0 ? farOff[a] : down ? loOffset(a) : hiOffset(a);
+            const __m128 fn = _mm_load_ps(reinterpret_cast<const float*>(base + nOff));
+            const __m128 ff = _mm_load_ps(reinterpret_cast<const float*>(base + fOff));
             if constexpr (kParallel) {
                 if (parallel[a]) {  // the origin outside the slab: lo > origin or hi < origin
                     outside = _mm_or_ps(
@@ -190,9 +236,11 @@ struct WideBoxes {
             t0 = _mm_max_ps(t0, _mm_mul_ps(_mm_sub_ps(fn, oNear[a]), inv[a]));
             t1 = _mm_min_ps(t1, _mm_mul_ps(_mm_sub_ps(ff, oFar[a]), inv[a]));
         }
-        const __m128 sign = _mm_set1_ps(-0.0f), slack = _mm_set1_ps(kSlack);
-        t0 = _mm_sub_ps(t0, _mm_mul_ps(_mm_andnot_ps(sign, t0), slack));
-        t1 = _mm_add_ps(t1, _mm_mul_ps(_mm_andnot_ps(sign, t1), slack));
+        // t0 >= tmin >= 0, so widening it is a product; a negative t1 is a box that the
+        // double test misses too (its t0 >= tmin >= 0; the rounding never turns a sign).
+        // Each product rounds by half an ulp, far within the slack.
+        t0 = _mm_mul_ps(t0, widenNear);
+        t1 = _mm_mul_ps(t1, widenFar);
         int mask = _mm_movemask_ps(_mm_cmple_ps(t0, t1));  // NaN (an empty slot): not met
         if constexpr (kParallel) mask &= ~_mm_movemask_ps(outside);
         if (!mask) return 0;
