@@ -12,14 +12,14 @@
 namespace lancer {
 namespace {
 
-struct Case {
+struct CostCase {
     const char* scene;
     SchemeKind scheme;
     int bounces;
 };
 
-std::vector<Case> cases() {
-    std::vector<Case> out;
+std::vector<CostCase> costCases() {
+    std::vector<CostCase> out;
     for (const char* scene : {"builtin:default", "builtin:balls:1", "builtin:drilled:2"})
         for (SchemeKind s :
              {SchemeKind::Brute, SchemeKind::Regular, SchemeKind::Irregular, SchemeKind::Bvh})
@@ -42,7 +42,7 @@ RenderOptions options(int w, int h, int bounces) {
 // a render that casts no other ray (no shadows, no bounces).
 TEST(RegionCosts, TotalsEqualTheRendersCounters) {
     const int w = 64, h = 40;
-    for (const Case& c : cases()) {
+    for (const CostCase& c : costCases()) {
         SCOPED_TRACE(std::string(c.scene) + " " + schemeName(c.scheme) + " bounces " +
                      std::to_string(c.bounces));
         Scene scene = loadScene(c.scene);
@@ -76,7 +76,7 @@ TEST(RegionCosts, TotalsEqualTheRendersCounters) {
 // tracePixel() records it (the walk `lancer trace` and the viewer's playback show).
 TEST(RegionCosts, EachRegionsCountsAreItsRecordedEvents) {
     const int w = 18, h = 12;
-    for (const Case& c : cases()) {
+    for (const CostCase& c : costCases()) {
         if (c.bounces == 0) continue;
         SCOPED_TRACE(std::string(c.scene) + " " + schemeName(c.scheme));
         Scene scene = loadScene(c.scene);
