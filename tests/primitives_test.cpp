@@ -6,19 +6,13 @@
 #include "engine/scene/builtin_scenes.h"
 #include "engine/scene/scene.h"
 #include "tests/support/differential.h"
+#include "tests/support/shape_spans.h"
 
 namespace lancer {
 namespace {
 
-struct Result {
-    int n;
-    Span s[2];
-};
-Result spans(const Shape& shape, const Ray& r) {
-    Result res;
-    res.n = shapeSpans(shape, r, 7, res.s);
-    return res;
-}
+using Result = test::ShapeSpans;
+Result spans(const Shape& shape, const Ray& r) { return test::spansOf(shape, r); }
 Result spans(const Primitive& p, const Ray& r) {
     Result res;
     res.n = p.spans(r, 7, res.s);

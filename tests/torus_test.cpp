@@ -12,6 +12,7 @@
 #include "engine/model/quartic.h"
 #include "engine/scene/scene.h"
 #include "tests/support/differential.h"
+#include "tests/support/shape_spans.h"
 
 namespace lancer {
 namespace {
@@ -64,15 +65,8 @@ TEST(Quartic, CloseRootsAreSeparatedAndDoubleRootsDoNotCross) {
     EXPECT_DOUBLE_EQ(r[3], 1.0);
 }
 
-struct Result {
-    int n = 0;
-    Span s[2];
-};
-Result spans(const Torus& t, const Ray& r) {
-    Result res;
-    res.n = shapeSpans(t, r, 5, res.s);
-    return res;
-}
+using Result = test::ShapeSpans;
+Result spans(const Torus& t, const Ray& r) { return test::spansOf(t, r, 5); }
 
 /// Signed distance from p to the surface of the torus (R, r) about z.
 double distance(const Torus& t, const Vec3& p) {

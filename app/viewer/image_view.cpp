@@ -201,14 +201,15 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     if (width_ == 0) return;
     scale = scale > 0.0f ? scale : 1.0f;
     diverging = diverging && mode != ViewMode::Color;
+    // Held (setHold): drawn as shaded before.
     const bool held = hold_ && shadedWidth_ == width_ && shadedHeight_ == height_;
-    if (held) {
-        // As shaded before (setHold).
-    } else if (!shadedValid_ || mode != shadedMode_ ||
-               (mode != ViewMode::Color &&
-                (scale != shadedScale_ || logScale != shadedLog_ || diverging != shadedDiverging_)))
+    const bool whole =
+        !shadedValid_ || mode != shadedMode_ ||
+        (mode != ViewMode::Color &&
+         (scale != shadedScale_ || logScale != shadedLog_ || diverging != shadedDiverging_));
+    if (!held && whole)
         shade(mode, scale, logScale, diverging, 0, height_);
-    else if (!dirty_.empty())
+    else if (!held && !dirty_.empty())
         shade(mode, scale, logScale, diverging, dirty_.begin, dirty_.end);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);

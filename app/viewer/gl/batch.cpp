@@ -95,6 +95,34 @@ void Batch::clear() {
     triangles.clear();
 }
 
+namespace {
+
+/// A segment along a coordinate axis: the axis, the two other coordinates (in axis order) and
+/// its interval on the axis.
+struct AxisSegment {
+    int axis;
+    float u, v;
+    float lo, hi;
+};
+
+/// Segment (a, b) as an AxisSegment: false unless exactly one coordinate differs and every
+/// coordinate is finite (NaN differs: such a segment is no axis segment).
+bool alongAxis(const BatchVertex& a, const BatchVertex& b, AxisSegment& out) {
+    int axis = -1, differing = 0;
+    for (int c = 0; c < 3; ++c) {
+        if (!std::isfinite(a.position[c]) || !std::isfinite(b.position[c])) return false;
+        if (a.position[c] != b.position[c]) axis = c, ++differing;
+    }
+    if (differing != 1) return false;
+    const int c1 = (axis + 1) % 3, c2 = (axis + 2) % 3;
+    out = {axis, a.position[std::min(c1, c2)], a.position[std::max(c1, c2)],
+           std::min(a.position[axis], b.position[axis]),
+           std::max(a.position[axis], b.position[axis])};
+    return true;
+}
+
+}  // namespace
+
 Batch mergeCollinearLines(const Batch& in) {
     // One record per segment along an axis: its line (axis, the two other coordinates, the
     // colour) and its interval on it; sorted by line then start, runs that overlap or touch are
@@ -113,24 +141,12 @@ Batch mergeCollinearLines(const Batch& in) {
     for (size_t k = 0; k < n; ++k) {
         const BatchVertex& a = in.lines[2 * k];
         const BatchVertex& b = in.lines[2 * k + 1];
-        int axis = -1, differing = 0;
-        for (int c = 0; c < 3; ++c)
-            if (a.position[c] != b.position[c]) {  // NaN differs: such a segment is kept
-                axis = c;
-                ++differing;
-            }
-        bool finite = true;
-        for (int c = 0; c < 3; ++c)
-            finite = finite && std::isfinite(a.position[c]) && std::isfinite(b.position[c]);
-        if (differing != 1 || a.color != b.color || !finite) {
+        AxisSegment g;
+        if (!alongAxis(a, b, g) || a.color != b.color) {  // such a segment is kept
             kept.push_back(k);
             continue;
         }
-        const int c1 = (axis + 1) % 3, c2 = (axis + 2) % 3;
-        const int ua = std::min(c1, c2), va = std::max(c1, c2);
-        pieces.push_back({axis, a.position[ua], a.position[va], a.color,
-                          std::min(a.position[axis], b.position[axis]),
-                          std::max(a.position[axis], b.position[axis]), k});
+        pieces.push_back({g.axis, g.u, g.v, a.color, g.lo, g.hi, k});
     }
     auto lineKey = [](const Piece& p) { return std::tuple(p.axis, p.u, p.v, p.color); };
     std::sort(pieces.begin(), pieces.end(), [&](const Piece& a, const Piece& b) {
@@ -181,26 +197,10 @@ Batch subtractCovered(const Batch& in, const Batch& cover) {
     // The cover's segments along each axis line (axis, the two other coordinates), as sorted,
     // joined intervals; each of `in`'s segments keeps the gaps between them.
     using Line = std::tuple<int, float, float>;
-    auto along = [](const BatchVertex& a, const BatchVertex& b, Line& line, float& lo, float& hi) {
-        int axis = -1, differing = 0;
-        for (int c = 0; c < 3; ++c) {
-            if (!std::isfinite(a.position[c]) || !std::isfinite(b.position[c])) return false;
-            if (a.position[c] != b.position[c]) axis = c, ++differing;
-        }
-        if (differing != 1) return false;
-        const int c1 = (axis + 1) % 3, c2 = (axis + 2) % 3;
-        line = {axis, a.position[std::min(c1, c2)], a.position[std::max(c1, c2)]};
-        lo = std::min(a.position[axis], b.position[axis]);
-        hi = std::max(a.position[axis], b.position[axis]);
-        return true;
-    };
     std::map<Line, std::vector<std::pair<float, float>>> covered;
-    for (size_t k = 0; k < cover.lineCount(); ++k) {
-        Line line;
-        float lo, hi;
-        if (along(cover.lines[2 * k], cover.lines[2 * k + 1], line, lo, hi))
-            covered[line].push_back({lo, hi});
-    }
+    for (size_t k = 0; k < cover.lineCount(); ++k)
+        if (AxisSegment g; alongAxis(cover.lines[2 * k], cover.lines[2 * k + 1], g))
+            covered[{g.axis, g.u, g.v}].push_back({g.lo, g.hi});
     for (auto& [line, ivs] : covered) {
         std::sort(ivs.begin(), ivs.end());
         std::vector<std::pair<float, float>> joined;
@@ -215,15 +215,15 @@ Batch subtractCovered(const Batch& in, const Batch& cover) {
     out.triangles = in.triangles;
     for (size_t k = 0; k < in.lineCount(); ++k) {
         const BatchVertex &a = in.lines[2 * k], &b = in.lines[2 * k + 1];
-        Line line;
-        float lo, hi;
-        const auto it = along(a, b, line, lo, hi) ? covered.find(line) : covered.end();
+        AxisSegment g;
+        const auto it = alongAxis(a, b, g) ? covered.find(Line{g.axis, g.u, g.v}) : covered.end();
         if (it == covered.end()) {
             out.lines.push_back(a);
             out.lines.push_back(b);
             continue;
         }
-        const int axis = std::get<0>(line);
+        const int axis = g.axis;
+        const float lo = g.lo, hi = g.hi;
         auto piece = [&](float p, float q) {
             if (!(p < q)) return;
             const bool forward = a.position[axis] <= b.position[axis];
