@@ -97,6 +97,32 @@ TEST(Golden, DepthMatchesAnalyticValues) {
     EXPECT_TRUE(std::isinf(depthAt(0, 0)));
 }
 
+TEST(Render, PixelRaysAreCameraPrimaryRaysBitForBit) {
+    // The render's rays come from per-column and per-row terms: each must be the ray that
+    // Camera::primaryRay (trace, the viewer's picks, the structure overlays) gives.
+    for (Projection projection : {Projection::Perspective, Projection::Orthographic}) {
+        Camera cam;
+        cam.from = {1.3, -7.1, 2.9};
+        cam.at = {-0.4, 0.6, 0.2};
+        cam.up = {0.1, 0.2, 1.0};
+        cam.fov = 37.0;
+        cam.projection = projection;
+        cam.orthoHeight = 6.5;
+        for (auto [w, h] : {std::pair{97, 61}, std::pair{64, 200}}) {
+            const PrimaryRays rays(cam, w, h);
+            for (int y = 0; y < h; ++y) {
+                for (int x = 0; x < w; ++x) {
+                    const Ray a = rays.pixel(x, y), b = cam.primaryRay(x, y, w, h);
+                    for (int k = 0; k < 3; ++k) {
+                        ASSERT_EQ(a.o[k], b.o[k]) << x << " " << y;
+                        ASSERT_EQ(a.d[k], b.d[k]) << x << " " << y;
+                    }
+                }
+            }
+        }
+    }
+}
+
 TEST(Render, DepthPfmIsStandardBottomToTop) {
     Rendered r = renderScene("builtin:default", 40, 25, 0);
     std::string path = ::testing::TempDir() + "/depth.pfm";

@@ -93,8 +93,11 @@ class LightBuffer {
         const Map& m = maps_[point];
         const double rate = -m.s * dir[m.a];  // depth gained per unit of t
         if (m.fine.slots.empty() || !(rate > 0.0)) return 0.0;
-        const double u = dir[m.b] / rate, v = dir[m.c] / rate;
-        return std::max(0.0, (m.bin(u, v)[0].near - hair_) / rate);
+        // One division, not three: the products stray from the quotients by an ulp or two,
+        // which the bins' pad and hair_ (far above rounding) cover.
+        const double per = 1.0 / rate;
+        const double u = dir[m.b] * per, v = dir[m.c] * per;
+        return std::max(0.0, (m.bin(u, v)[0].near - hair_) * per);
     }
 
     bool empty() const { return maps_.empty(); }

@@ -97,7 +97,9 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                     uint64_t t0 = ticks();
                     for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
                         if (!pass.contains(x, y)) continue;
-                        RayCounters before = ctx.counters;
+                        // Only the two counters the image keeps, not the whole struct.
+                        const uint64_t testsBefore = ctx.counters.primTests;
+                        const uint64_t visitsBefore = ctx.counters.regionVisits;
                         Hit hit;
                         Vec3 c = tracer.pixel(primary, eye, x, y, ctx, obs, hit);
                         size_t i = img.index(x, y);
@@ -105,9 +107,8 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                         img.depth[i] =
                             hit.valid() ? float(hit.t) : std::numeric_limits<float>::infinity();
                         img.hitPrim[i] = hit.prim;
-                        RayCounters d = ctx.counters - before;
-                        img.primTests[i] = uint32_t(d.primTests);
-                        img.regionVisits[i] = uint32_t(d.regionVisits);
+                        img.primTests[i] = uint32_t(ctx.counters.primTests - testsBefore);
+                        img.regionVisits[i] = uint32_t(ctx.counters.regionVisits - visitsBefore);
                         const uint64_t t1 = ticks();
                         img.timeUs[i] = float(t1 - t0);
                         t0 = t1;

@@ -41,6 +41,10 @@ class Tracer {
     bool nearest(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                  Hit& hit) const {
         ctx.beginRay();
+        // An empty interval holds no hit in any scheme: the primary rays the eye buffer sends
+        // from +inf (no box in their direction), most pixels of a small object's image, skip
+        // the scheme's clip and frame mapping.
+        if (!(tmin < tmax)) return false;
         return accel_.intersect(ray, tmin, tmax, ctx, obs, hit);
     }
 
@@ -78,7 +82,7 @@ class Tracer {
     template <class Obs>
     Vec3 pixel(const PrimaryRays& primary, const LightBuffer& eye, int x, int y, TraceContext& ctx,
                Obs& obs, Hit& hit) const {
-        const Ray ray = primary(x, y);
+        const Ray ray = primary.pixel(x, y);
         ++ctx.counters.primaryRays;
         double near = eye.nearFrom(ray.d, 0);
         // A float test may put a hit on the nearest box's face a little before it.

@@ -11,20 +11,34 @@ void Camera::basis(Vec3& f, Vec3& r, Vec3& u) const {
     u = glm::cross(r, f);
 }
 
+namespace {
+
+// Offsets of a pixel centre on the image plane, in units of the half height.
+double offsetX(double x, double w, double h) { return ((x + 0.5) / w * 2.0 - 1.0) * w / h; }
+double offsetY(double y, double h) { return 1.0 - (y + 0.5) / h * 2.0; }
+
+}  // namespace
+
 Ray Camera::primaryRay(double x, double y, int w, int h) const {
-    return PrimaryRays(*this, w, h)(x, y);
+    return PrimaryRays(*this, 0, 0, w, h)(x, y);
 }
 
-PrimaryRays::PrimaryRays(const Camera& cam, int w, int h)
+PrimaryRays::PrimaryRays(const Camera& cam, int w, int h) : PrimaryRays(cam, w, h, w, h) {}
+
+PrimaryRays::PrimaryRays(const Camera& cam, int columns, int rows, int w, int h)
     : from_(cam.from), w_(w), h_(h), ortho_(cam.projection == Projection::Orthographic) {
     cam.basis(f_, r_, u_);
     half_ = ortho_ ? 0.5 * cam.orthoHeight : std::tan(glm::radians(cam.fov) * 0.5);
+    const Vec3 base = ortho_ ? from_ : f_;
+    column_.resize(size_t(std::max(columns, 0)));
+    row_.resize(size_t(std::max(rows, 0)));
+    for (size_t x = 0; x < column_.size(); ++x)
+        column_[x] = base + (offsetX(double(x), w_, h_) * half_) * r_;
+    for (size_t y = 0; y < row_.size(); ++y) row_[y] = (offsetY(double(y), h_) * half_) * u_;
 }
 
 Ray PrimaryRays::operator()(double x, double y) const {
-    // Offsets of the pixel centre on the image plane, in units of the half height.
-    double sx = ((x + 0.5) / w_ * 2.0 - 1.0) * w_ / h_;
-    double sy = 1.0 - (y + 0.5) / h_ * 2.0;
+    const double sx = offsetX(x, w_, h_), sy = offsetY(y, h_);
     if (ortho_) return {from_ + (sx * half_) * r_ + (sy * half_) * u_, f_};
     return {from_, glm::normalize(f_ + (sx * half_) * r_ + (sy * half_) * u_)};
 }
