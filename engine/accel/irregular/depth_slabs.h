@@ -44,13 +44,14 @@ inline constexpr size_t mergedRefBytes(bool unionOnly) {
     return unionOnly ? kUnionOnlyRefBytes : kMergedRefBytes;
 }
 
-/// Cut every zone of `bsp` along depth inside [zlo, zhi]; box[p] is primitive p's camera box.
+/// Cut every zone of `bsp` along depth inside [zlo, zhi]; depth[i] is the depth range of the
+/// zone reference bsp.zonePrims[i] (its primitive's camera box's, or narrower: narrowZones).
 /// A zone whose slabs would take the structure past `maxBytes` bytes or `maxRegions` regions
 /// (0: no limit) keeps every fourth cut (then every sixteenth, ..) until they fit, or is one slab
 /// holding all its primitives: its slabs merge. `guard` (may be null)
 /// is polled for cancellation.
-DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
-                           double zlo, double zhi, BuildGuard* guard = nullptr, size_t maxBytes = 0,
-                           size_t maxRegions = 0);
+DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
+                           const std::vector<glm::dvec2>& depth, double zlo, double zhi,
+                           BuildGuard* guard = nullptr, size_t maxBytes = 0, size_t maxRegions = 0);
 
 }  // namespace lancer
