@@ -8,10 +8,12 @@
 
 namespace lancer {
 
-DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
-                           double zlo, double zhi, BuildGuard* guard, size_t maxBytes,
-                           size_t maxRegions) {
+DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
+                           const std::vector<glm::dvec2>& depth, double zlo, double zhi,
+                           BuildGuard* guard, size_t maxBytes, size_t maxRegions) {
     DepthSlabs out;
+    // The depth range of the zone reference at p (a pointer into bsp.zonePrims).
+    auto range = [&](const uint32_t* p) { return depth[size_t(p - bsp.zonePrims.data())]; };
     // A union-only scene's region is the union of its primitives: the walk merges their spans
     // (hitInLeaf), so no tree is made, and each reference costs its list entries alone.
     out.unionOnly = scene.tree.unionOnly();
@@ -44,8 +46,8 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
     auto zoneCuts = [&](const uint32_t* first, const uint32_t* last) {
         cuts = {zlo, zhi};
         for (const uint32_t* p = first; p != last; ++p) {
-            cuts.push_back(std::clamp(box[*p].lo.z, zlo, zhi));
-            cuts.push_back(std::clamp(box[*p].hi.z, zlo, zhi));
+            cuts.push_back(std::clamp(range(p).x, zlo, zhi));
+            cuts.push_back(std::clamp(range(p).y, zlo, zhi));
         }
         std::sort(cuts.begin(), cuts.end());
         cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
@@ -64,7 +66,7 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
                 auto at = [&](double v) {
                     return std::lower_bound(cuts.begin(), cuts.end(), std::clamp(v, zlo, zhi));
                 };
-                refs += size_t(at(box[*p].hi.z) - at(box[*p].lo.z));
+                refs += size_t(at(range(p).y) - at(range(p).x));
             }
             const size_t slabs = first == last ? 1 : cuts.size() - 1;
             allSlabs += slabs;
@@ -105,8 +107,8 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::
             slabFirst.assign(n + 1, 0);
             span.clear();
             for (const uint32_t* p = first; p != last; ++p) {
-                const double lo = std::clamp(box[*p].lo.z, zlo, zhi);
-                const double hi = std::clamp(box[*p].hi.z, zlo, zhi);
+                const double lo = std::clamp(range(p).x, zlo, zhi);
+                const double hi = std::clamp(range(p).y, zlo, zhi);
                 size_t a = size_t(std::upper_bound(cuts.begin(), cuts.end(), lo) - cuts.begin());
                 a = std::min(a == 0 ? 0 : a - 1, n - 1);
                 const size_t b = std::min(

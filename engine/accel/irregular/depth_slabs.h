@@ -1,9 +1,10 @@
 // The irregular scheme's 3D step: each zone of the screen BSP cut along depth at the zmin/zmax
-// of the boxes over it. Each slab is a region with the primitives whose box overlaps its
-// interior and their restricted tree; equal primitive sets share one tree in the pool. Boxes
-// that only touch a slab are left out: with the padding of irregular.cpp their primitives have
-// no hit there, and a closed overlap would add each box to the slabs on both sides of its own
-// zmin and zmax.
+// of the boxes over it (in a turned scene, the depths each primitive's boxes take over that zone:
+// narrowZones, turned_hulls.h). Each slab is a region with the primitives whose depth range
+// overlaps its interior and their restricted tree; equal primitive sets share one tree in the
+// pool. Ranges that only touch a slab are left out: with the padding of irregular.cpp their
+// primitives have no hit there, and a closed overlap would add each box to the slabs on both
+// sides of its own zmin and zmax.
 #pragma once
 
 #include <vector>
@@ -44,13 +45,14 @@ inline constexpr size_t mergedRefBytes(bool unionOnly) {
     return unionOnly ? kUnionOnlyRefBytes : kMergedRefBytes;
 }
 
-/// Cut every zone of `bsp` along depth inside [zlo, zhi]; box[p] is primitive p's camera box.
+/// Cut every zone of `bsp` along depth inside [zlo, zhi]; depth[i] is the depth range of the
+/// zone reference bsp.zonePrims[i] (its primitive's camera box's, or narrower: narrowZones).
 /// A zone whose slabs would take the structure past `maxBytes` bytes or `maxRegions` regions
 /// (0: no limit) keeps every fourth cut (then every sixteenth, ..) until they fit, or is one slab
 /// holding all its primitives: its slabs merge. `guard` (may be null)
 /// is polled for cancellation.
-DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp, const std::vector<Box3>& box,
-                           double zlo, double zhi, BuildGuard* guard = nullptr, size_t maxBytes = 0,
-                           size_t maxRegions = 0);
+DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
+                           const std::vector<glm::dvec2>& depth, double zlo, double zhi,
+                           BuildGuard* guard = nullptr, size_t maxBytes = 0, size_t maxRegions = 0);
 
 }  // namespace lancer

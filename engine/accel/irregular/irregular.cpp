@@ -10,6 +10,7 @@
 #include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/corner_pointers.h"
 #include "engine/accel/irregular/depth_slabs.h"
+#include "engine/accel/irregular/turned_hulls.h"
 #include "engine/accel/regular/grid_frame.h"
 #include "engine/util/format.h"
 #include "engine/util/task_fence.h"
@@ -122,6 +123,12 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     sp.zoneBytes = kMergedZoneBytes;
     sp.refBytes = mergedRefBytes(scene.tree.unionOnly());
     sp.guard = &guard;
+    // Turned scenes: zones list what the turned boxes' outlines meet, slabs cut at the depths
+    // the boxes take over each zone (turned_hulls.h).
+    const TurnedHulls hulls = TurnedHulls::make(scene, s.frame_, turned, live, eps);
+    if (!hulls.empty()) sp.hulls = &hulls;
+    sp.column = ZoneColumn::Parallel;
+    sp.hullPad = eps;
 
     // The two frames' structures are independent (each within its half of the budget): the
     // projective zones are built as a task beside the camera frame's, which halves the build's
@@ -149,7 +156,9 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
         // 3D step.
         guard.poll();
         auto t1 = Clock::now();
-        slabs = buildDepthSlabs(scene, s.bsp_, box, s.bounds_.lo.z, s.bounds_.hi.z, &guard,
+        const std::vector<glm::dvec2> depth = narrowZones(s.bsp_, hulls, ZoneColumn::Parallel, box,
+                                                          s.bounds_.lo.z, s.bounds_.hi.z, eps);
+        slabs = buildDepthSlabs(scene, s.bsp_, depth, s.bounds_.lo.z, s.bounds_.hi.z, &guard,
                                 slabBytes, maxRegions);
         if (slabs.regions.size() > kMaxRegions)
             throw std::invalid_argument(

@@ -6,6 +6,7 @@
 
 #include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/depth_slabs.h"
+#include "engine/accel/irregular/turned_hulls.h"
 #include "engine/model/restriction.h"
 
 namespace lancer {
@@ -71,9 +72,15 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     s.hi_ = hi;
     s.zNear_ = zNear;
     s.zFar_ = zFar;
-    s.bsp_ = ScreenBsp::build(pbox, inside, lo, hi, sp);
+    ScreenBspParams eyeParams = sp;
+    eyeParams.column = ZoneColumn::FromEye;
+    s.bsp_ = ScreenBsp::build(pbox, inside, lo, hi, eyeParams);
+    const std::vector<glm::dvec2> depth =
+        sp.hulls
+            ? narrowZones(s.bsp_, *sp.hulls, ZoneColumn::FromEye, pbox, zNear, zFar, sp.hullPad)
+            : narrowZones(s.bsp_, TurnedHulls{}, ZoneColumn::FromEye, pbox, zNear, zFar, 0.0);
     DepthSlabs slabs =
-        buildDepthSlabs(scene, s.bsp_, pbox, zNear, zFar, sp.guard, maxSlabBytes, maxRegions);
+        buildDepthSlabs(scene, s.bsp_, depth, zNear, zFar, sp.guard, maxSlabBytes, maxRegions);
     s.zones_ = s.bsp_.zoneCount();
     s.zoneFirst_ = std::move(slabs.zoneFirstRegion);
     s.slabLo_.reserve(slabs.regions.size());

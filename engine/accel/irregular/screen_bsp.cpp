@@ -7,6 +7,7 @@
 
 #include "engine/accel/accelerator.h"
 #include "engine/accel/build_guard.h"
+#include "engine/accel/irregular/turned_hulls.h"
 
 namespace lancer {
 
@@ -281,6 +282,12 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
                (bsp.zoneLo.size() + queue.size()) * params.zoneBytes +
                (bsp.zonePrims.size() + waitingRefs) * params.refBytes;
     };
+    // Primitive p belongs to the cell [lo, hi]: its rectangle's interior meets the cell's and,
+    // in a turned scene, its turned box's outline meets the cell.
+    auto meets = [&](uint32_t p, glm::dvec2 lo, glm::dvec2 hi) {
+        return overlapsOpen(rect[p], lo, hi) &&
+               (!params.hulls || params.hulls->touches(p, params.column, lo, hi));
+    };
     // The cell becomes a zone: its rectangle and its primitives.
     auto makeZone = [&](const Cell& cell) {
         int32_t& slot = cell.parent < 0 ? bsp.root : bsp.nodes[cell.parent].child[cell.side];
@@ -310,8 +317,8 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         size_t nBelow = 0, nAbove = 0, polled = 0;
         for (uint32_t p : cell.prims) {
             if (params.guard && (++polled & 32767) == 0) params.guard->poll();
-            nBelow += overlapsOpen(rect[p], cell.lo, bHi);
-            nAbove += overlapsOpen(rect[p], aLo, cell.hi);
+            nBelow += meets(p, cell.lo, bHi);
+            nAbove += meets(p, aLo, cell.hi);
         }
         // A ray through the cell (the area of a side is its share of the rays) tests its
         // rectangles; split, it crosses one more zone and tests one side's. The gain is the
@@ -392,8 +399,8 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         above.prims.reserve(cell.primsAbove);
         for (uint32_t p : cell.prims) {
             if (params.guard && (++polled & 32767) == 0) params.guard->poll();
-            if (overlapsOpen(rect[p], below.lo, below.hi)) below.prims.push_back(p);
-            if (overlapsOpen(rect[p], above.lo, above.hi)) above.prims.push_back(p);
+            if (meets(p, below.lo, below.hi)) below.prims.push_back(p);
+            if (meets(p, above.lo, above.hi)) above.prims.push_back(p);
         }
         int32_t node = int32_t(bsp.nodes.size());
         (cell.parent < 0 ? bsp.root : bsp.nodes[cell.parent].child[cell.side]) = node;

@@ -1,0 +1,229 @@
+#include "engine/accel/irregular/turned_hulls.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "engine/accel/irregular/screen_bsp.h"
+
+namespace lancer {
+
+namespace {
+
+/// A convex polygon being clipped: a quad cut by at most 15 planes has at most 19 vertices.
+struct Poly {
+    std::array<Vec3, 24> v;
+    int n = 0;
+};
+
+/// Keeps the part of `in` where n . x <= d (Sutherland-Hodgman).
+void clip(const Poly& in, const Vec3& n, double d, Poly& out) {
+    out.n = 0;
+    for (int i = 0; i < in.n; ++i) {
+        const Vec3& a = in.v[i];
+        const Vec3& b = in.v[(i + 1) % in.n];
+        const double da = glm::dot(n, a) - d, db = glm::dot(n, b) - d;
+        if (da <= 0.0) out.v[out.n++] = a;
+        if ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
+            const double s = da / (da - db);
+            out.v[out.n++] = a + s * (b - a);
+        }
+    }
+}
+
+/// The convex hull of `pts`, counterclockwise (Andrew's monotone chain).
+std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> pts) {
+    std::sort(pts.begin(), pts.end(),
+              [](glm::dvec2 a, glm::dvec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    if (pts.size() < 3) return pts;
+    auto cross = [](glm::dvec2 o, glm::dvec2 a, glm::dvec2 b) {
+        return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+    };
+    std::vector<glm::dvec2> h(2 * pts.size());
+    size_t k = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {
+        while (k >= 2 && cross(h[k - 2], h[k - 1], pts[i]) <= 0.0) --k;
+        h[k++] = pts[i];
+    }
+    for (size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
+        while (k >= t && cross(h[k - 2], h[k - 1], pts[i - 1]) <= 0.0) --k;
+        h[k++] = pts[i - 1];
+    }
+    h.resize(k - 1);
+    return h;
+}
+
+}  // namespace
+
+TurnedHulls TurnedHulls::make(const Scene& scene, const CameraFrame& frame,
+                              const FrameChoice& turned, const std::vector<uint32_t>& live,
+                              double pad) {
+    TurnedHulls h;
+    if (!turned.frame.turned) return h;
+    // A box along the world-frame axes `axes` (columns) in the camera frame: a rotation keeps it
+    // a box, its planes along the camera images of those axes, offset by the eye's position.
+    auto solid = [&](const Box3& b, const Mat3& axes) {
+        Solid s;
+        const Box3 w{b.lo - Vec3(pad), b.hi + Vec3(pad)};
+        for (int a = 0; a < 3; ++a) {
+            s.axis[a] = frame.vector(axes[a]);
+            const double o = glm::dot(axes[a], frame.origin);
+            s.lo[a] = w.lo[a] - o;
+            s.hi[a] = w.hi[a] - o;
+        }
+        for (int c = 0; c < 8; ++c) s.corner[c] = frame.point(axes * boxCorner(w, c));
+        return s;
+    };
+    h.index_.assign(scene.prims.size(), -1);
+    for (uint32_t p : live) {
+        const Box3& fb = turned.boxes[p];
+        if (fb.isEmpty() || scene.minBox[p].isEmpty()) continue;
+        Hull hull;
+        hull.turned = solid(fb, turned.frame.axes);
+        hull.world = solid(scene.minBox[p], Mat3(1.0));
+        std::vector<glm::dvec2> flat, eye;
+        bool front = true;
+        for (const Vec3& c : hull.turned.corner) {
+            flat.push_back({c.x, c.y});
+            front = front && c.z > 0.0;
+            if (front) eye.push_back({c.x / c.z, c.y / c.z});
+        }
+        hull.outline[0] = convexHull(flat);
+        if (front) hull.outline[1] = convexHull(eye);
+        h.index_[p] = int32_t(h.hulls_.size());
+        h.hulls_.push_back(std::move(hull));
+    }
+    return h;
+}
+
+bool TurnedHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi) const {
+    if (index_.empty() || index_[p] < 0) return true;
+    const std::vector<glm::dvec2>& o = hulls_[index_[p]].outline[int(column)];
+    if (o.size() < 3) return true;
+    // Separating axes of two convex polygons: the rectangle's (its bound against the outline's)
+    // and each outline edge's outward normal, the rectangle's nearest corner beyond it.
+    glm::dvec2 olo(kInf), ohi(-kInf);
+    for (glm::dvec2 q : o) {
+        olo = glm::min(olo, q);
+        ohi = glm::max(ohi, q);
+    }
+    if (olo.x > hi.x || ohi.x < lo.x || olo.y > hi.y || ohi.y < lo.y) return false;
+    for (size_t i = 0; i < o.size(); ++i) {
+        const glm::dvec2 a = o[i], b = o[(i + 1) % o.size()];
+        const glm::dvec2 n{b.y - a.y, a.x - b.x};  // outward for a counterclockwise polygon
+        const glm::dvec2 c{n.x > 0.0 ? lo.x : hi.x, n.y > 0.0 ? lo.y : hi.y};
+        if (glm::dot(n, c - a) > 0.0) return false;
+    }
+    return true;
+}
+
+glm::dvec2 TurnedHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi,
+                                double zNear, glm::dvec2 whole) const {
+    if (index_.empty() || index_[p] < 0) return whole;
+    const Hull& h = hulls_[index_[p]];
+    // The column's planes n . x <= d: the rectangle swept along z, or the rays from the eye
+    // through it (u0 <= x / z <= u1 .. for z > 0) and z >= zNear.
+    std::array<Vec3, 5> cn;
+    std::array<double, 5> cd;
+    int planes = 4;
+    if (column == ZoneColumn::Parallel) {
+        cn = {Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, -1, 0), Vec3(0, 1, 0), Vec3(0)};
+        cd = {-lo.x, hi.x, -lo.y, hi.y, 0.0};
+    } else {
+        cn = {Vec3(-1, 0, lo.x), Vec3(1, 0, -hi.x), Vec3(0, -1, lo.y), Vec3(0, 1, -hi.y),
+              Vec3(0, 0, -1)};
+        cd = {0.0, 0.0, 0.0, 0.0, -zNear};
+        planes = 5;
+    }
+    // The extremes in depth of the solid (both boxes and the column) lie on a face of one of
+    // the boxes: the column is unbounded in depth (beyond zNear, handled below), so its sides
+    // alone hold no extreme. Each face is clipped by the other box and the column.
+    glm::dvec2 range(kInf, -kInf);
+    const Solid* solids[2] = {&h.turned, &h.world};
+    Poly a, b;
+    for (int s = 0; s < 2; ++s) {
+        const Solid& me = *solids[s];
+        const Solid& other = *solids[1 - s];
+        for (int axis = 0; axis < 3; ++axis) {
+            const int u = 1 << ((axis + 1) % 3), v = 1 << ((axis + 2) % 3);
+            for (int side = 0; side < 2; ++side) {
+                const int base = side << axis;
+                a.n = 4;
+                a.v[0] = me.corner[base];
+                a.v[1] = me.corner[base | u];
+                a.v[2] = me.corner[base | u | v];
+                a.v[3] = me.corner[base | v];
+                Poly* in = &a;
+                Poly* out = &b;
+                for (int k = 0; k < 3 && in->n; ++k) {
+                    clip(*in, other.axis[k], other.hi[k], *out);
+                    std::swap(in, out);
+                    if (!in->n) break;
+                    clip(*in, -other.axis[k], -other.lo[k], *out);
+                    std::swap(in, out);
+                }
+                for (int k = 0; k < planes && in->n; ++k) {
+                    clip(*in, cn[k], cd[k], *out);
+                    std::swap(in, out);
+                }
+                for (int i = 0; i < in->n; ++i) {
+                    range.x = std::min(range.x, in->v[i].z);
+                    range.y = std::max(range.y, in->v[i].z);
+                }
+            }
+        }
+    }
+    // From the eye, the plane z = zNear closes the column: where the boxes reach in front of
+    // it, the solid's nearest points may lie on that plane, inside both boxes.
+    if (column == ZoneColumn::FromEye && range.x <= range.y) {
+        for (const Solid* s : solids)
+            for (const Vec3& c : s->corner)
+                if (c.z < zNear) range.x = zNear;
+    }
+    return {std::max(range.x, whole.x), std::min(range.y, whole.y)};
+}
+
+std::vector<glm::dvec2> narrowZones(ScreenBsp& bsp, const TurnedHulls& hulls, ZoneColumn column,
+                                    const std::vector<Box3>& box, double zlo, double zhi,
+                                    double pad) {
+    std::vector<glm::dvec2> depth;
+    depth.reserve(bsp.zonePrims.size());
+    auto whole = [&](uint32_t p) {
+        return glm::dvec2(std::clamp(box[p].lo.z, zlo, zhi), std::clamp(box[p].hi.z, zlo, zhi));
+    };
+    if (hulls.empty()) {
+        for (uint32_t p : bsp.zonePrims) depth.push_back(whole(p));
+        return depth;
+    }
+    size_t kept = 0;
+    uint32_t first = 0;
+    for (size_t z = 0; z < bsp.zoneCount(); ++z) {
+        // The column widened beyond the rounding of where a ray's point falls: the padding in
+        // the camera frame, a billionth of the coordinate from the eye.
+        glm::dvec2 lo = bsp.zoneLo[z], hi = bsp.zoneHi[z];
+        for (int k = 0; k < 2; ++k) {
+            const double wl =
+                column == ZoneColumn::Parallel ? pad : 1e-9 * std::max(1.0, std::abs(lo[k]));
+            const double wh =
+                column == ZoneColumn::Parallel ? pad : 1e-9 * std::max(1.0, std::abs(hi[k]));
+            lo[k] -= wl;
+            hi[k] += wh;
+        }
+        const uint32_t end = bsp.zoneFirst[z + 1];
+        for (uint32_t i = first; i < end; ++i) {
+            const uint32_t p = bsp.zonePrims[i];
+            glm::dvec2 d = hulls.depthIn(p, column, lo, hi, zlo, whole(p));
+            if (!(d.x <= d.y)) continue;  // the hull misses the zone's column
+            d = {std::clamp(d.x - pad, zlo, zhi), std::clamp(d.y + pad, zlo, zhi)};
+            // Never wider than the box: the hull is within it, the padding is not.
+            d = {std::max(d.x, whole(p).x), std::min(d.y, whole(p).y)};
+            bsp.zonePrims[kept++] = p;
+            depth.push_back(d);
+        }
+        first = end;
+        bsp.zoneFirst[z + 1] = uint32_t(kept);
+    }
+    bsp.zonePrims.resize(kept);
+    return depth;
+}
+
+}  // namespace lancer

@@ -1,0 +1,73 @@
+// The irregular scheme's bounds of primitives in a scene turned off the world's axes (docs/
+// irregular.md, "Turned scenes"). A bar of a turned Menger sponge along a diagonal of the view
+// projects to a thin slanted strip, but its camera-frame box covers the strip's whole screen
+// rectangle and its whole depth range: every zone under that rectangle listed the bar through
+// every slab. Here each primitive keeps its two boxes as the convex solids they are in the camera
+// frame (its minimized box along the turn's own axes, and its minimized world box), and a zone
+// asks them two things: does the turned box's outline on the screen meet the zone (the screen
+// BSP's lists), and what depth range do the two boxes together take over the zone's footprint
+// (the depth slabs' cuts). The zones stay screen rectangles and the slabs depth intervals: only
+// what each lists gets tighter.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "engine/accel/irregular/camera_frame.h"
+#include "engine/accel/regular/grid_frame.h"
+
+namespace lancer {
+
+struct ScreenBsp;  // screen_bsp.h
+
+/// The rays a screen zone stands for: its rectangle swept along depth in the camera frame
+/// (`Parallel`, the camera-frame structure), or the rays from the eye through it, a rectangle
+/// of (u, v) = (x/z, y/z) (`FromEye`, the projective zones).
+enum class ZoneColumn : uint8_t { Parallel, FromEye };
+
+class TurnedHulls {
+  public:
+    /// The hulls of the primitives `live` when `turned` chose a turned frame (chooseGridFrame),
+    /// each box widened by `pad` on every side; empty otherwise (nothing changes then).
+    static TurnedHulls make(const Scene& scene, const CameraFrame& frame, const FrameChoice& turned,
+                            const std::vector<uint32_t>& live, double pad);
+
+    /// No primitive has a hull: the zones keep their rectangles' lists.
+    bool empty() const { return hulls_.empty(); }
+    /// Primitive p's turned box, seen along `column`, meets the screen rectangle [lo, hi] (a
+    /// primitive without a hull always does; so does one reaching behind the eye, `FromEye`).
+    bool touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi) const;
+    /// The depth range of primitive p's two boxes together within the column over [lo, hi],
+    /// at z >= zNear for `FromEye` (lo > hi: they miss it); `whole` (its camera-frame box's
+    /// depth range) for a primitive without a hull.
+    glm::dvec2 depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi, double zNear,
+                       glm::dvec2 whole) const;
+
+  private:
+    /// A box of the camera frame along axes of its own: its eight corners (bit 0 the high
+    /// side of the first axis, ..) and its planes, axis[a] . x between lo[a] and hi[a].
+    struct Solid {
+        std::array<Vec3, 8> corner;
+        std::array<Vec3, 3> axis;
+        Vec3 lo, hi;
+    };
+    struct Hull {
+        Solid turned, world;
+        /// The turned box's outline, a convex polygon counterclockwise, along each column
+        /// (`FromEye`: none when a corner is not in front of the eye).
+        std::vector<glm::dvec2> outline[2];
+    };
+    std::vector<int32_t> index_;  ///< per primitive: its hull, or -1
+    std::vector<Hull> hulls_;
+};
+
+/// Narrows the zones of `bsp` to what the hulls hold: drops from each zone the primitives whose
+/// hull misses its column, and gives each remaining reference (bsp.zonePrims' order) its depth
+/// range there, padded by `pad` and within the primitive's `box` depths clamped to [zlo, zhi].
+/// Empty hulls: every reference keeps its box's depths.
+std::vector<glm::dvec2> narrowZones(ScreenBsp& bsp, const TurnedHulls& hulls, ZoneColumn column,
+                                    const std::vector<Box3>& box, double zlo, double zhi,
+                                    double pad);
+
+}  // namespace lancer
