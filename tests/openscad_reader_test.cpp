@@ -795,8 +795,24 @@ TEST(OpenScadOffset, UnsupportedOffsetsAreRefusedByName) {
     expectCsgError(ex + "offset(r = -1) { square(2); circle(1); } }",
                    "mem.csg:1:30: offset(r < 0) is supported of one square, polygon or circle "
                    "only (its child made at mem.csg:1:58 is another shape or a boolean)");
-    expectCsgError(ex + "offset(delta = 1, chamfer = false) square(2); }",
-                   "mem.csg:1:45: offset(delta = ...) is not supported (only r > 0)");
+    expectCsgError(ex + "offset(delta = -1) { square(2); translate([5, 0]) square(2); } }",
+                   "mem.csg:1:30: offset(delta < 0) is supported of one square, polygon, glyph "
+                   "or DXF drawing only (the shapes made at mem.csg:1:80 and mem.csg:1:51)");
+    expectCsgError(ex + "offset(delta = 1) { square(2); translate([1, 1]) square(2); } }",
+                   "mem.csg:1:30: offset(delta) of outlines that cross or touch (of the shapes "
+                   "made at mem.csg:1:79, ...) is not supported: their region's outline is not "
+                   "their paths");
+    expectCsgError(ex + "offset(delta = 1) { square(4); translate([1, 1]) square(1); } }",
+                   "mem.csg:1:30: offset(delta) of the shape made at mem.csg:1:79, which lies "
+                   "inside the shape made at mem.csg:1:50, is not supported: their union's "
+                   "outline is not theirs");
+    expectCsgError(ex + "offset(delta = 1) { square(2); translate([5, 0]) circle(1); } }",
+                   "mem.csg:1:30: offset(delta) of a circle (at mem.csg:1:79) beside other "
+                   "shapes is not supported (only of one circle)");
+    expectCsgError(ex + "offset(delta = 1) offset(r = 1) square(2); }",
+                   "mem.csg:1:30: offset(delta) of the shape made at mem.csg:1:48 (a boolean or "
+                   "an offset) is not supported: Lancer offsets by delta squares, polygons, "
+                   "text, DXF drawings and circles");
     expectCsgError(ex + "offset(r = 1) difference() { square(2); circle(1); } }",
                    "mem.csg:1:30: offset() of an intersection or difference (made at "
                    "mem.csg:1:44) is not supported (only of unions)");
@@ -805,13 +821,77 @@ TEST(OpenScadOffset, UnsupportedOffsetsAreRefusedByName) {
                    "non-uniform scale) is not supported");
 }
 
+TEST(OpenScadOffset, DeltaOffsetsEqualTheirPolygonTwins) {
+    const std::string ex = "linear_extrude(height = 3) { ";
+    // A square grown by delta is the larger square (mitred corners), both ways round.
+    expectSameSolid(ex + "offset(delta = 1, chamfer = false) { square(size = [2, 4]); } }",
+                    "translate([-1, -1, 0]) cube(size = [4, 6, 3]);");
+    expectSameSolid(ex + "offset(delta = 1) { mirror([1, 0]) square(size = [2, 4]); } }",
+                    "translate([-3, -1, 0]) cube(size = [4, 6, 3]);");
+    // Chamfered, each corner is cut square to its bisector at distance 1: along the moved
+    // edges by tan(22.5 degrees) = sqrt(2) - 1 past the corner.
+    const double t = std::sqrt(2.0) - 1.0;
+    auto pt = [](double x, double y) {
+        char buf[80];
+        std::snprintf(buf, sizeof buf, "[%.17g, %.17g]", x, y);
+        return std::string(buf);
+    };
+    expectSameSolid(ex + "offset(delta = 1, chamfer = true) { square(size = [2, 2]); } }",
+                    ex + "polygon(points = [" + pt(-t, -1) + ", " + pt(2 + t, -1) + ", " +
+                        pt(3, -t) + ", " + pt(3, 2 + t) + ", " + pt(2 + t, 3) + ", " + pt(-t, 3) +
+                        ", " + pt(-1, 2 + t) + ", " + pt(-1, -t) + "]); }");
+    // A triangle's mitre reaches d / sin(half its angle) out: the right isosceles triangle
+    // (0,0), (2,0), (0,2) grown by 1 is the triangle of the three moved lines, x >= -1,
+    // y >= -1, x + y <= 2 + sqrt(2).
+    const double s2 = 2.0 + std::sqrt(2.0);
+    expectSameSolid(ex + "offset(delta = 1) { polygon(points = [[0, 0], [2, 0], [0, 2]]); } }",
+                    ex + "polygon(points = [" + pt(-1, -1) + ", " + pt(s2 + 1, -1) + ", " +
+                        pt(-1, s2 + 1) + "]); }");
+    // Shrunk, an L keeps its mitred reflex corner: the L of arms 1 wide inside the 4 x 4 L
+    // of arms 2 wide.
+    expectSameSolid(ex + "offset(delta = -0.5) { polygon(points = [[0, 0], [4, 0], [4, 2], "
+                         "[2, 2], [2, 4], [0, 4]]); } }",
+                    ex + "polygon(points = [[0.5, 0.5], [3.5, 0.5], [3.5, 1.5], [1.5, 1.5], "
+                         "[1.5, 3.5], [0.5, 3.5]]); }",
+                    false);
+    // A hole grows inward as the outline grows outward: a frame 4 wide with a 2 wide hole,
+    // grown by 0.5, is the frame 5 wide with a 1 wide hole; shrunk, 3 wide around 3 wide.
+    const std::string frame =
+        "polygon(points = [[0, 0], [4, 0], [4, 4], [0, 4], [1, 1], [3, 1], [3, 3], [1, 3]], "
+        "paths = [[0, 1, 2, 3], [4, 5, 6, 7]]); } }";
+    expectSameSolid(ex + "offset(delta = 0.5) { " + frame,
+                    "difference() { translate([-0.5, -0.5, 0]) cube(size = [5, 5, 3]); "
+                    "translate([1.5, 1.5, -1]) cube(size = [1, 1, 5]); }");
+    expectSameSolid(ex + "offset(delta = -0.25) { " + frame,
+                    "difference() { translate([0.25, 0.25, 0]) cube(size = [3.5, 3.5, 3]); "
+                    "translate([0.75, 0.75, -1]) cube(size = [2.5, 2.5, 5]); }",
+                    false);
+    // Two apart grow each; a circle, which has no corner, grows or shrinks round.
+    const Scene two = csgText(ex +
+                              "offset(delta = 1) { square(2); translate([10, 0]) "
+                              "square(2); } }");
+    EXPECT_NEAR(two.bounds.lo.x, -1.0, 1e-6);
+    EXPECT_NEAR(two.bounds.hi.x, 13.0, 1e-6);
+    expectSameSolid(ex + "offset(delta = -0.5, chamfer = true) { circle(r = 1.5); } }",
+                    "cylinder(h = 3, r = 1);");
+    // Shrunk past its width, a shape is gone.
+    expectSameSolid("cube(1); " + ex + "offset(delta = -1.5) { square(2); } }", "cube(1);", false);
+}
+
 TEST(OpenScadOffset, SchemesAgreeWithBruteForce) {
     const Scene s = csgText(
         "difference() { linear_extrude(height = 2, center = true) { offset(r = 0.4) { "
         "polygon(points = [[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); circle(r = 0.5); } } "
         "translate([1.5, 1, 0]) sphere(r = 0.8); }\n"
         "translate([0, 4, 0]) linear_extrude(height = 1) { offset(r = -0.3) { polygon(points = "
-        "[[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); } }");
+        "[[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); } }\n"
+        "translate([5, 0, 0]) linear_extrude(height = 1.5, twist = 30) { offset(delta = 0.3) "
+        "{ polygon(points = [[0, 0], [3, 0], [3, 2], [1.5, 0.5], [0, 2]]); } }\n"
+        "translate([5, 4, 0]) difference() { linear_extrude(height = 1) { offset(delta = "
+        "0.4, chamfer = true) { polygon(points = [[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2], "
+        "[0.5, 0.5], [1, 0.5], [0.75, 0.8]], paths = [[0, 1, 2, 3, 4], [5, 6, 7]]); } } "
+        "translate([0, 4, 0]) linear_extrude(height = 1) offset(delta = -0.3) polygon(points = "
+        "[[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); }");
     const std::vector<Ray> rays = test::randomRays(s, 7, 3000);
     test::expectEverySchemeSame(s, rays);
 }

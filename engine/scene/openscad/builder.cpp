@@ -456,15 +456,19 @@ class Builder {
 
     /// offset(r > 0): the Minkowski sum of the child with a disk of radius r, exact. The sum
     /// distributes over union, and a convex piece's sum is the piece, a rectangle outward of each
-    /// edge and a disk at each vertex; a disk's sum is the disk of radius + r. Negative r, delta
-    /// and children made by intersection or difference are refused by name.
+    /// edge and a disk at each vertex; a disk's sum is the disk of radius + r. r < 0 erodes
+    /// (erode), delta moves the outline (offsetDelta); children made by intersection or
+    /// difference are refused by name.
     Built offsetNode(const Node& n, const glm::dmat3& af, const Node& extrude) {
         Args a(src_, n, {}, {"r", "delta", "chamfer"});
-        if (a.get("delta") && !a.get("r"))
-            src_.fail(a.get("delta")->pos, "offset(delta = ...) is not supported (only r > 0)");
+        // As OpenSCAD: r when given (round corners), else delta (mitred or chamfered).
+        const bool byDelta = !a.get("r") && a.get("delta");
+        const char* which = byDelta ? "delta" : "r";
+        const bool chamfer = a.boolean("chamfer", false);
         double r = 0.0;
-        if (auto v = a.number("r")) r = *v;
-        if (!std::isfinite(r)) src_.fail(a.get("r")->pos, "offset(r) must be finite");
+        if (auto v = a.number(which)) r = *v;
+        if (!std::isfinite(r))
+            src_.fail(a.get(which)->pos, std::string("offset(") + which + ") must be finite");
         // The radius in the parent frame: af must be a similarity for the disk to stay a disk.
         Vec2 ex(af[0][0], af[0][1]), ey(af[1][0], af[1][1]);
         double sx = glm::length(ex), sy = glm::length(ey);
@@ -474,10 +478,92 @@ class Builder {
         double rr = r * sx;
         Built b = regionUnion(n.children, af, extrude);
         if (b.kind != Built::Kind::Node || rr == 0.0) return b;
+        if (byDelta) return offsetDelta(b.node, rr, chamfer, n.pos);
         if (rr < 0.0) return erode(b.node, -rr, n.pos);
         std::vector<int> items;
         grow(b.node, rr, n.pos, items);
         return Built::of(regionOp(Region::Kind::Union, items, n.pos));
+    }
+
+    /// offset(delta = d): the region's outline moved out by d (in by -d), mitred or chamfered
+    /// at its corners as Clipper does (offsetAdditions), exactly. A circle, which has no corner,
+    /// becomes the circle of radius + d. The outline must be the children's paths: squares,
+    /// polygons, text and DXF drawings whose outlines neither cross nor touch (nor, for d > 0,
+    /// lie inside another child's, where the union's outline would not be theirs; for d < 0,
+    /// of one child, as a negative r). Anything else is refused by name.
+    Built offsetDelta(int id, double d, bool chamfer, size_t pos) {
+        std::vector<int> disks, shapes, stack{id};
+        while (!stack.empty()) {
+            const int i = stack.back();
+            stack.pop_back();
+            const Region& g = regions_[size_t(i)];
+            if (outlines_.count(i)) {
+                shapes.push_back(i);
+            } else if (g.kind == Region::Kind::Disk) {
+                disks.push_back(i);
+            } else if (g.kind == Region::Kind::Union) {
+                stack.push_back(g.a);
+                stack.push_back(g.b);
+            } else {
+                src_.fail(pos, "offset(delta) of the shape made at " + src_.where(g.pos) +
+                                   " (a boolean or an offset) is not supported: Lancer offsets "
+                                   "by delta squares, polygons, text, DXF drawings and circles");
+            }
+        }
+        if (!disks.empty()) {
+            if (disks.size() + shapes.size() > 1)
+                src_.fail(pos, "offset(delta) of a circle (at " +
+                                   src_.where(regions_[size_t(disks[0])].pos) +
+                                   ") beside other shapes is not supported (only of one circle)");
+            const int c = offsetCircle(regions_[size_t(disks[0])], d, pos);
+            return c < 0 ? Built::empty() : Built::of(c);
+        }
+        if (d < 0.0 && shapes.size() > 1)
+            src_.fail(pos,
+                      "offset(delta < 0) is supported of one square, polygon, glyph or DXF "
+                      "drawing only (the shapes made at " +
+                          src_.where(regions_[size_t(shapes[0])].pos) + " and " +
+                          src_.where(regions_[size_t(shapes[1])].pos) + ")");
+        std::vector<std::vector<Vec2>> paths;
+        std::vector<size_t> owner;
+        for (size_t k = 0; k < shapes.size(); ++k)
+            for (const auto& q : outlines_.at(shapes[k])) {
+                paths.push_back(q);
+                owner.push_back(k);
+            }
+        std::vector<Outline> outs;
+        if (!regionOutlines(paths, outs))
+            src_.fail(pos, "offset(delta) of outlines that cross or touch (of the shape" +
+                               std::string(shapes.size() > 1 ? "s" : "") + " made at " +
+                               src_.where(regions_[size_t(shapes[0])].pos) +
+                               (shapes.size() > 1 ? ", ..." : "") +
+                               ") is not supported: their region's outline is not their paths");
+        std::vector<std::vector<Vec2>> loops;
+        for (const Outline& o : outs) {
+            const size_t k = owner[size_t(o.source)];
+            if (o.parent >= 0 && owner[size_t(outs[size_t(o.parent)].source)] != k)
+                src_.fail(
+                    pos,
+                    "offset(delta) of the shape made at " +
+                        src_.where(regions_[size_t(shapes[k])].pos) +
+                        ", which lies inside the shape made at " +
+                        src_.where(
+                            regions_[size_t(shapes[owner[size_t(outs[size_t(o.parent)].source)]])]
+                                .pos) +
+                        ", is not supported: their union's outline is not theirs");
+            loops.push_back(o.points);
+            // Shrinking grows the complement: the outline the other way round.
+            if (d < 0.0) std::reverse(loops.back().begin(), loops.back().end());
+        }
+        std::vector<int> items;
+        for (const auto& poly : offsetAdditions(loops, std::abs(d), chamfer))
+            for (ConvexPiece& c : convexPieces({poly}))
+                items.push_back(
+                    region({Region::Kind::Piece, std::move(c), glm::dmat3(1.0), -1, -1, pos}));
+        if (items.empty()) return Built::of(id);
+        const int added = regionOp(Region::Kind::Union, items, pos);
+        return Built::of(d > 0.0 ? regionOp(Region::Kind::Union, {id, added}, pos)
+                                 : regionOp(Region::Kind::Difference, {id, added}, pos));
     }
 
     /// The circle `disk` (a Disk region) offset by `r` (either sign) as a new Disk region; -1
@@ -603,7 +689,9 @@ class Builder {
         for (ConvexPiece& p : ps)
             items.push_back(
                 region({Region::Kind::Piece, std::move(p), glm::dmat3(1.0), -1, -1, pos, edge}));
-        return Built::of(regionOp(Region::Kind::Union, items, pos));
+        const int id = regionOp(Region::Kind::Union, items, pos);
+        outlines_[id] = paths;
+        return Built::of(id);
     }
 
     Vec2 vec2(const Args& a, const Value& v, const std::string& what) {
@@ -1947,6 +2035,9 @@ class Builder {
     OpenScadCounts& counts_;
     std::map<std::tuple<double, double, double>, int> materialOf_;
     std::vector<Region> regions_;
+    /// The paths (even-odd) of the regions that pieces() made, by region: their outlines, for
+    /// offset(delta).
+    std::map<int, std::vector<std::vector<Vec2>>> outlines_;
     const Node* first2D_ = nullptr;  ///< the first 2D node met among solids
 };
 
