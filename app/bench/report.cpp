@@ -237,7 +237,7 @@ int runBench(const BenchOptions& opt) {
         const bool meshAxis = !opt.schemesOnly && withBrute && listed(opt.meshScenes, spec);
         Scene scene;
         try {
-            scene = loadScene(spec);
+            scene = loadScene(spec, opt.read);
         } catch (const std::exception& e) {
             std::cerr << "error: " << e.what() << "\n";
             return 2;

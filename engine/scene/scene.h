@@ -34,6 +34,17 @@ struct SceneError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+/// How a reader models OpenSCAD's round primitives.
+enum class Facets : uint8_t {
+    Exact,     ///< the true circle, sphere, cylinder and cone (the default)
+    OpenScad,  ///< OpenSCAD's polygons and polyhedra of them, by $fn, $fa, $fs
+};
+
+/// Options of the scene readers (`--facets`).
+struct ReadOptions {
+    Facets facets = Facets::Exact;  ///< circles, spheres, cylinders and cones of .csg files
+};
+
 struct PackedSphere {
     Vec3 c{0.0};
     double r = -1.0;

@@ -11,6 +11,7 @@
 #include "engine/scene/mesh_file.h"
 #include "engine/scene/openscad/colors.h"
 #include "engine/scene/openscad/dxf.h"
+#include "engine/scene/openscad/facets.h"
 #include "engine/scene/openscad/hull3d.h"
 #include "engine/scene/openscad/region2d.h"
 #include "engine/scene/openscad/surface.h"
@@ -112,8 +113,8 @@ class Args {
 
 class Builder {
   public:
-    Builder(const SourceText& src, Scene& scene, OpenScadCounts& counts)
-        : src_(src), scene_(scene), counts_(counts) {}
+    Builder(const SourceText& src, Scene& scene, OpenScadCounts& counts, const ReadOptions& options)
+        : src_(src), scene_(scene), counts_(counts), facets_(options.facets == Facets::OpenScad) {}
 
     /// The whole model: the children of the file's top level, or the first `!` subtree.
     int model(const std::vector<Node>& top) {
@@ -241,6 +242,8 @@ class Builder {
         /// A piece: the longest edge of the outlines it was cut from (its own edges may be
         /// parts of them); 0: its own edges are the outline's.
         double outlineEdge = 0.0;
+        /// A disk: OpenSCAD's fragments of its circle (for hull()); 0: by the default rule.
+        int fragments = 0;
     };
 
     int region(Region r) {
@@ -317,6 +320,7 @@ class Builder {
             return shape2(n, af);
         }
         if (k == "offset") return offsetNode(n, af, extrude);
+        if (k == "hull") return hull2(n, af, extrude);
         if (k == "import") return importDxf(n, af);
         if (is2DNode(k))
             src_.fail(n.pos, "the 2D node '" + k +
@@ -327,6 +331,63 @@ class Builder {
             src_.fail(n.pos, "the 3D node '" + k + "' is inside " + extrude.name + "() at " +
                                  src_.where(extrude.pos) + ", which extrudes 2D children only");
         refuse(n);
+    }
+
+    // ---- hull() in 2D ----
+
+    /// hull() of 2D children: the convex hull of their corners, a circle's by OpenSCAD's polygon
+    /// of it at its $fn, $fa, $fs (its sagitta joins the profile's error); one convex piece.
+    /// Booleans among the children are refused by name (their outline is not their parts').
+    Built hull2(const Node& n, const glm::dmat3& af, const Node& extrude) {
+        Args(src_, n, {}, {});
+        ++counts_.operators;
+        Built b = regionUnion(n.children, af, extrude);
+        if (b.kind != Built::Kind::Node) return b;
+        std::vector<Vec2> pts;
+        std::vector<int> stack{b.node};
+        while (!stack.empty()) {
+            const Region& g = regions_[size_t(stack.back())];
+            stack.pop_back();
+            if (g.kind == Region::Kind::Union) {
+                stack.push_back(g.a);
+                stack.push_back(g.b);
+            } else if (g.kind == Region::Kind::Piece) {
+                pts.insert(pts.end(), g.piece.vertices.begin(), g.piece.vertices.end());
+            } else if (g.kind == Region::Kind::Disk) {
+                const int k =
+                    g.fragments > 0 ? g.fragments : FragmentRule{}.fragments(planeStretch(g.disk));
+                for (const Vec2& p : circlePolygon(1.0, k))
+                    pts.push_back(Vec2(g.disk * glm::dvec3(p, 1.0)));
+                profileSagitta_ = std::max(profileSagitta_, sagitta(1.0, k) * planeStretch(g.disk));
+                ++counts_.facetedShapes;
+            } else {
+                src_.fail(g.pos, "a 2D boolean inside hull() at " + src_.where(n.pos) +
+                                     " is not supported: Lancer takes the hull of squares, "
+                                     "circles, polygons, text and their unions and transforms");
+            }
+        }
+        // Andrew's monotone chain.
+        std::sort(pts.begin(), pts.end(), [](const Vec2& p, const Vec2& q) {
+            return p.x < q.x || (p.x == q.x && p.y < q.y);
+        });
+        pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+        if (pts.size() < 3) return emptyPrimitive();
+        std::vector<Vec2> ring;
+        for (int pass = 0; pass < 2; ++pass) {
+            const size_t base = ring.size();
+            for (const Vec2& p : pts) {
+                while (ring.size() >= base + 2) {
+                    const Vec2 u = ring.back() - ring[ring.size() - 2], v = p - ring.back();
+                    if (u.x * v.y - u.y * v.x > 0.0) break;
+                    ring.pop_back();
+                }
+                ring.push_back(p);
+            }
+            ring.pop_back();
+            std::reverse(pts.begin(), pts.end());
+        }
+        ++counts_.hulls;
+        return pieces({ring}, n.pos);
     }
 
     // ---- import() of DXF drawings ----
@@ -729,9 +790,26 @@ class Builder {
                 r = nonNegative(a, "r", *rr);
             if (r == 0.0) return emptyPrimitive();
             ++counts_.circles;
+            if (facets_) {
+                // OpenSCAD's polygon of the circle; its sagitta, stretched by the plane map, is
+                // the profile's error until the extrusion's transform is known.
+                const int k = fragmentRule(n).fragments(r);
+                std::vector<Vec2> poly = circlePolygon(r, k);
+                for (Vec2& p : poly) p = apply(p);
+                ++counts_.facetedShapes;
+                profileSagitta_ = std::max(profileSagitta_, sagitta(r, k) * planeStretch(af));
+                return pieces({poly}, n.pos);
+            }
             glm::dmat3 s(1.0);
             s[0][0] = s[1][1] = r;
-            return Built::of(region({Region::Kind::Disk, {}, af * s, -1, -1, n.pos}));
+            return Built::of(region({Region::Kind::Disk,
+                                     {},
+                                     af * s,
+                                     -1,
+                                     -1,
+                                     n.pos,
+                                     0.0,
+                                     fragmentRule(n).fragments(r)}));
         }
         Args a(src_, n, {"points", "paths", "convexity"}, {});
         const Value* pts = a.get("points");
@@ -822,6 +900,7 @@ class Builder {
         }
         bool center = a.boolean("center", false);
         Built r = regionUnion(n.children, glm::dmat3(1.0), n);
+        noteProfileFacets(xf, std::max({1.0, scale.x, scale.y}));
         if (r.kind != Built::Kind::Node) return r;
         if (!(h > 0.0)) return emptyPrimitive();  // OpenSCAD makes nothing of it
         ++counts_.linearExtrudes;
@@ -1284,6 +1363,7 @@ class Builder {
                 "rotate_extrude(file = ...) imports a DXF drawing, which Lancer does not read");
         double angle = std::clamp(a.number("angle").value_or(360.0), -360.0, 360.0);
         Built r = regionUnion(n.children, glm::dmat3(1.0), n);
+        noteProfileFacets(xf, 1.0);
         if (r.kind != Built::Kind::Node) return r;
         if (angle == 0.0) return emptyPrimitive();
         Box3 box = regionBox(r.node);
@@ -1572,12 +1652,18 @@ class Builder {
         std::vector<Vec3> centres;
         std::vector<double> radii;
         std::vector<size_t> ballPos;
+        bool ellipsoid = false;  ///< a sphere under a transform that is not a similarity
+        /// OpenSCAD's facets of the curved children (spheres, cylinders, cones), and how far the
+        /// farthest strays inside its exact surface (in the hull's frame).
+        std::vector<Vec3> facetPoints;
+        double facetError = 0.0;
+        int curved = 0;  ///< cylinders and cones
     };
 
     [[noreturn]] void refuseInHull(const Node& n, const Node& hull) {
         src_.fail(n.pos, "'" + n.name + "' inside hull() at " + src_.where(hull.pos) +
-                             " is not supported: Lancer takes the exact hull of cubes, polyhedra "
-                             "and spheres of one radius (and their groups and transforms)");
+                             " is not supported: Lancer takes the hull of cubes, polyhedra, "
+                             "spheres and cylinders (and their groups and transforms)");
     }
 
     void gatherHull(const Node& n, const Transform& t, const Node& hull, HullInput& in) {
@@ -1611,12 +1697,32 @@ class Builder {
             for (const Vec3& p : pts) in.points.push_back(t.point(p));
             return;
         }
-        if (k == "cube" || k == "sphere") {
+        if (k == "cube" || k == "sphere" || k == "cylinder") {
             if (!n.children.empty()) src_.fail(n.children.front().pos, k + "() takes no children");
             Transform local;
             std::optional<Shape> s = primitiveShape(n, local);
             if (!s) return;
             const Transform tl = t * local;
+            if (!std::holds_alternative<Block>(*s)) {
+                // OpenSCAD's facets of it, should the hull not be the exact one of equal balls.
+                const FragmentRule rule = fragmentRule(n);
+                std::vector<Vec3> f;
+                double err = 0.0;
+                if (const Sphere* sp = std::get_if<Sphere>(&*s)) {
+                    const int k2 = rule.fragments(sp->r);
+                    f = spherePoints(sp->r, k2);
+                    err = sphereFacetError(sp->r, k2);
+                } else {
+                    const Cone& c = std::get<Cone>(*s);
+                    const int k2 = rule.fragments(std::max(c.r1, c.r2));
+                    f = cylinderPoints(c.r1, c.r2, c.h, k2);
+                    err = sagitta(std::max(c.r1, c.r2), k2);
+                    ++in.curved;
+                }
+                for (const Vec3& p : f) in.facetPoints.push_back(tl.point(p));
+                in.facetError = std::max(in.facetError, err * stretch(tl));
+                if (std::holds_alternative<Cone>(*s)) return;
+            }
             if (const Block* b = std::get_if<Block>(&*s)) {
                 for (int c = 0; c < 8; ++c)
                     in.points.push_back(
@@ -1632,8 +1738,7 @@ class Builder {
             if (std::abs(glm::dot(c0, c1)) > e || std::abs(glm::dot(c0, c2)) > e ||
                 std::abs(glm::dot(c1, c2)) > e || std::abs(glm::dot(c1, c1) - l * l) > e ||
                 std::abs(glm::dot(c2, c2) - l * l) > e)
-                src_.fail(n.pos, "a sphere scaled unevenly (an ellipsoid) inside hull() at " +
-                                     src_.where(hull.pos) + " is not supported");
+                in.ellipsoid = true;
             in.centres.push_back(tl.point(sp.c));
             in.radii.push_back(sp.r * l);
             in.ballPos.push_back(n.pos);
@@ -1644,29 +1749,30 @@ class Builder {
 
     /// hull(): of corner points, the convex polytope of their hull; of balls of one radius r,
     /// the hull of their centres grown by r, exactly the union of that hull, a slab over each
-    /// face, a cylinder along each edge and a ball at each vertex.
+    /// face, a cylinder along each edge and a ball at each vertex. Of anything else curved
+    /// (spheres of different radii, ellipsoids, cylinders, cones, round children beside
+    /// corners; and every round child with --facets openscad), the polytope of the corners and
+    /// OpenSCAD's facets of the curved children at their $fn, $fa, $fs, as OpenSCAD takes it;
+    /// its error is the facets' (OpenScadCounts::facetError).
     Built hullNode(const Node& n, const Transform& xf, int mat) {
         Args(src_, n, {}, {});
         ++counts_.operators;
         HullInput in;
         for (const Node& c : n.children) gatherHull(c, Transform(), n, in);
-        if (!in.points.empty() && !in.centres.empty())
-            src_.fail(n.pos,
-                      "hull() of spheres together with cubes or polyhedra is not "
-                      "supported (its surface has patches of neither)");
+        bool exactBalls =
+            !in.centres.empty() && in.points.empty() && !in.curved && !in.ellipsoid && !facets_;
+        for (size_t i = 1; exactBalls && i < in.radii.size(); ++i)
+            exactBalls = std::abs(in.radii[i] - in.radii[0]) <= 1e-12 * in.radii[0];
+        if (!exactBalls && !in.facetPoints.empty()) {
+            in.points.insert(in.points.end(), in.facetPoints.begin(), in.facetPoints.end());
+            in.centres.clear();
+            counts_.facetError = std::max(counts_.facetError, in.facetError * stretch(xf));
+            counts_.facetedShapes += 1;
+        }
         const bool balls = !in.centres.empty();
         std::vector<Vec3>& pts = balls ? in.centres : in.points;
         if (pts.empty()) return Built::empty();
-        double r = 0.0;
-        if (balls) {
-            r = in.radii[0];
-            for (size_t i = 1; i < in.radii.size(); ++i)
-                if (std::abs(in.radii[i] - r) > 1e-12 * r)
-                    src_.fail(in.ballPos[i], "hull() of spheres of different radii (" +
-                                                 twistText(r) + " and " + twistText(in.radii[i]) +
-                                                 ") is not supported: Lancer takes the exact hull "
-                                                 "of spheres of one radius");
-        }
+        const double r = balls ? in.radii[0] : 0.0;
         {
             std::sort(pts.begin(), pts.end(), [](const Vec3& a, const Vec3& b) {
                 return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
@@ -1688,6 +1794,19 @@ class Builder {
             ++counts_.polytopes;
             items.push_back(place(std::move(pt), xf, mat, n.pos, "hull()").node);
         };
+        if (h.dim == 3 && h.planes.size() > 255 && !balls) {
+            // Over a polytope's planes (a hull of facets): the hull as a closed mesh, cut into
+            // convex pieces.
+            TriangleMesh m;
+            m.points = h.vertices;
+            std::vector<uint32_t> loop;
+            for (const auto& f : h.faces) {
+                loop.assign(f.begin(), f.end());
+                m.addPolygon(loop);
+            }
+            return meshNode(std::move(m), xf, mat, n.pos,
+                            "hull() (of " + std::to_string(h.faces.size()) + " faces)");
+        }
         if (h.dim == 3 && h.planes.size() > 255)
             src_.fail(n.pos,
                       "hull() has more than 255 faces, which Lancer's polytope does not "
@@ -1882,12 +2001,121 @@ class Builder {
         Transform local;
         std::optional<Shape> shape = primitiveShape(n, local);
         if (!shape) return emptyPrimitive();
+        if (facets_ && !std::holds_alternative<Block>(*shape))
+            return facetedPrimitive(n, *shape, xf * local, mat);
         Primitive p = makePrimitive(std::move(*shape), xf * local, mat);
         if (!p.worldBox.isBounded())
             src_.fail(n.pos, n.name + "() is too large: its bounds overflow a double");
         p.origin = src_.where(n.pos);
         scene_.prims.push_back(std::move(p));
         return Built::of(scene_.tree.leaf(uint32_t(scene_.prims.size() - 1)));
+    }
+
+    // ---- OpenSCAD's facets (--facets openscad) ----
+
+    /// The node's $fn, $fa, $fs (OpenSCAD's defaults when absent), checked as OpenSCAD needs
+    /// them to count fragments.
+    FragmentRule fragmentRule(const Node& n) const {
+        FragmentRule f{special(n, "$fn", 0.0), special(n, "$fa", 12.0), special(n, "$fs", 2.0)};
+        if (!(f.fa > 0.0 && f.fs > 0.0))
+            src_.fail(n.pos, n.name + "() needs $fa > 0 and $fs > 0 to count its facets");
+        if (f.fn > double(kMaxFragments))
+            src_.fail(n.pos, n.name + "() with $fn = " + twistText(f.fn) +
+                                 ": Lancer makes at most " + std::to_string(kMaxFragments) +
+                                 " facets of a circle");
+        return f;
+    }
+
+    /// The most a 2D affine map stretches a length.
+    static double planeStretch(const glm::dmat3& af) {
+        Transform t;
+        t.m = Mat4(1.0);
+        t.m[0] = {af[0][0], af[0][1], 0.0, 0.0};
+        t.m[1] = {af[1][0], af[1][1], 0.0, 0.0};
+        return stretch(t);
+    }
+
+    /// Folds the faceted circles of a profile just read into the model's facet error, in model
+    /// units: stretched by the extrusion's transform and its largest scale `grow`.
+    void noteProfileFacets(const Transform& xf, double grow) {
+        counts_.facetError = std::max(counts_.facetError, profileSagitta_ * stretch(xf) * grow);
+        profileSagitta_ = 0.0;
+    }
+
+    /// One band of a faceted solid of revolution about z: the `n`-gon of radius r0 at z0 below
+    /// the one of radius r1 at z1 (their corners at the same angles; a radius of 0 is an apex),
+    /// as OpenSCAD's polyhedron has it: a convex polytope of its n side planes and two caps, cut
+    /// into sectors by planes through the axis when that is over the 255 planes of a polytope.
+    /// Returns the smallest distance of a side plane from the origin.
+    double facetBand(double r0, double z0, double r1, double z1, int n, const Transform& xf,
+                     int mat, size_t pos, const std::string& what, std::vector<int>& items) {
+        const std::vector<Vec2> lo = circlePolygon(r0, n), hi = circlePolygon(r1, n);
+        std::vector<glm::dvec4> sides(static_cast<size_t>(n));
+        double nearest = kInf;
+        for (int j = 0; j < n; ++j) {
+            const int k = (j + 1) % n;
+            const Vec3 p0(lo[size_t(j)], z0), p1(lo[size_t(k)], z0), q0(hi[size_t(j)], z1),
+                q1(hi[size_t(k)], z1);
+            // The plane through the wider ring's edge and the other ring's corner.
+            Vec3 nn = r0 >= r1 ? glm::cross(p1 - p0, q0 - p0) : glm::cross(q1 - q0, p0 - q0);
+            const Vec2 mid = lo[size_t(j)] + lo[size_t(k)] + hi[size_t(j)] + hi[size_t(k)];
+            if (glm::dot(Vec2(nn), mid) < 0.0) nn = -nn;
+            nn = glm::normalize(nn);
+            sides[size_t(j)] = glm::dvec4(nn, glm::dot(nn, r0 >= r1 ? p0 : q0));
+            nearest = std::min(nearest, sides[size_t(j)].w);
+        }
+        const int sectors = n + 2 <= 255 ? 1 : std::max(3, (n + 249) / 250);
+        for (int s = 0; s < sectors; ++s) {
+            const int j0 = int(int64_t(s) * n / sectors), j1 = int(int64_t(s + 1) * n / sectors);
+            Polytope pt;
+            Box3 box;
+            for (int j = j0; j < j1; ++j) pt.planes.push_back(sides[size_t(j)]);
+            for (int j = j0; j <= j1; ++j) {
+                box.expand(Vec3(lo[size_t(j % n)], z0));
+                box.expand(Vec3(hi[size_t(j % n)], z1));
+            }
+            if (sectors > 1) {
+                // Through the axis at the sector's first and last corner (shared planes are
+                // negated exactly, so neighbouring sectors meet to the bit).
+                const double a0 = 360.0 * j0 / n, a1 = 360.0 * (j1 % n) / n;
+                pt.planes.push_back({sinDegrees(a0), -cosDegrees(a0), 0.0, 0.0});
+                pt.planes.push_back({-sinDegrees(a1), cosDegrees(a1), 0.0, 0.0});
+                box.expand(Vec3(0.0, 0.0, z0));
+                box.expand(Vec3(0.0, 0.0, z1));
+            }
+            pt.planes.push_back({0.0, 0.0, -1.0, -z0});
+            pt.planes.push_back({0.0, 0.0, 1.0, z1});
+            pt.bounds = padded(box);
+            ++counts_.polytopes;
+            items.push_back(place(std::move(pt), xf, mat, pos, what).node);
+        }
+        return nearest;
+    }
+
+    /// sphere() or cylinder() as OpenSCAD's polyhedron of it (facetBand per band between two
+    /// rings), its sagitta recorded in OpenScadCounts::facetError.
+    Built facetedPrimitive(const Node& n, const Shape& shape, const Transform& xf, int mat) {
+        const FragmentRule rule = fragmentRule(n);
+        std::vector<int> items;
+        double error = 0.0;
+        const std::string what = n.name + "()";
+        if (const Sphere* s = std::get_if<Sphere>(&shape)) {
+            const SphereRings rings = sphereRings(s->r, rule.fragments(s->r));
+            double nearest = rings.z.front();  // the caps
+            for (size_t i = 0; i + 1 < rings.z.size(); ++i)
+                nearest = std::min(nearest,
+                                   facetBand(rings.radius[i + 1], rings.z[i + 1], rings.radius[i],
+                                             rings.z[i], rings.n, xf, mat, n.pos, what, items));
+            error = s->r - nearest;  // every corner lies on the sphere
+        } else {
+            const Cone& c = std::get<Cone>(shape);
+            const int k = rule.fragments(std::max(c.r1, c.r2));
+            facetBand(c.r1, 0.0, c.r2, c.h, k, xf, mat, n.pos, what, items);
+            error = sagitta(std::max(c.r1, c.r2), k);
+        }
+        ++counts_.facetedShapes;
+        counts_.facetError = std::max(counts_.facetError, error * stretch(xf));
+        return Built::of(scene_.tree.balanced(Op::Union, items));
     }
 
     /// cube(), sphere() or cylinder() as a shape placed by `local` in the node's frame; nothing
@@ -2033,6 +2261,9 @@ class Builder {
     const SourceText& src_;
     Scene& scene_;
     OpenScadCounts& counts_;
+    const bool facets_;  ///< --facets openscad: round shapes as OpenSCAD's polygons and polyhedra
+    /// The largest sagitta of the faceted circles of the profile being read (2D units).
+    double profileSagitta_ = 0.0;
     std::map<std::tuple<double, double, double>, int> materialOf_;
     std::vector<Region> regions_;
     /// The paths (even-odd) of the regions that pieces() made, by region: their outlines, for
@@ -2044,9 +2275,9 @@ class Builder {
 }  // namespace
 
 void buildModel(const SourceText& src, const std::vector<Node>& top, Scene& scene,
-                OpenScadCounts& counts) {
+                OpenScadCounts& counts, const ReadOptions& options) {
     scene.materials[0].color = hexColor(kDefaultColor);
-    scene.tree.root = Builder(src, scene, counts).model(top);
+    scene.tree.root = Builder(src, scene, counts, options).model(top);
 }
 
 }  // namespace lancer::openscad
