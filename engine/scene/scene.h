@@ -43,6 +43,9 @@ enum class Facets : uint8_t {
 /// Options of the scene readers (`--facets`).
 struct ReadOptions {
     Facets facets = Facets::Exact;  ///< circles, spheres, cylinders and cones of .csg files
+    /// The parts each of OpenSCAD's slices of a twisted extrusion is cut into (1 to 16; the
+    /// bench's speed-against-error knob); 0: as many as the reader's error target asks.
+    int twistParts = 0;
 };
 
 struct PackedSphere {

@@ -114,7 +114,11 @@ class Args {
 class Builder {
   public:
     Builder(const SourceText& src, Scene& scene, OpenScadCounts& counts, const ReadOptions& options)
-        : src_(src), scene_(scene), counts_(counts), facets_(options.facets == Facets::OpenScad) {}
+        : src_(src),
+          scene_(scene),
+          counts_(counts),
+          facets_(options.facets == Facets::OpenScad),
+          twistParts_(options.twistParts) {}
 
     /// The whole model: the children of the file's top level, or the first `!` subtree.
     int model(const std::vector<Node>& top) {
@@ -922,8 +926,11 @@ class Builder {
                                      " convex pieces is over the " +
                                      std::to_string(kMaxTwistPolytopes) +
                                      " polytopes Lancer makes of a twisted extrusion");
-            tw.sub = std::min(twistSubSlices(r.node, tw, std::sqrt(regionMaxR2(r.node))),
-                              std::max(1, int(double(kMaxTwistPolytopes) / (slices * pieces))));
+            const int parts = twistParts_ > 0
+                                  ? std::min(twistParts_, kMaxTwistSubSlices)
+                                  : twistSubSlices(r.node, tw, std::sqrt(regionMaxR2(r.node)));
+            tw.sub =
+                std::min(parts, std::max(1, int(double(kMaxTwistPolytopes) / (slices * pieces))));
             counts_.twistSubSlices = std::max(counts_.twistSubSlices, tw.sub);
             return twistRegion(r.node, n, tw);
         }
@@ -1794,19 +1801,7 @@ class Builder {
             ++counts_.polytopes;
             items.push_back(place(std::move(pt), xf, mat, n.pos, "hull()").node);
         };
-        if (h.dim == 3 && h.planes.size() > 255 && !balls) {
-            // Over a polytope's planes (a hull of facets): the hull as a closed mesh, cut into
-            // convex pieces.
-            TriangleMesh m;
-            m.points = h.vertices;
-            std::vector<uint32_t> loop;
-            for (const auto& f : h.faces) {
-                loop.assign(f.begin(), f.end());
-                m.addPolygon(loop);
-            }
-            return meshNode(std::move(m), xf, mat, n.pos,
-                            "hull() (of " + std::to_string(h.faces.size()) + " faces)");
-        }
+        if (h.dim == 3 && h.planes.size() > 255 && !balls) return wedgedHull(h, xf, mat, n.pos);
         if (h.dim == 3 && h.planes.size() > 255)
             src_.fail(n.pos,
                       "hull() has more than 255 faces, which Lancer's polytope does not "
@@ -1847,6 +1842,82 @@ class Builder {
             items.push_back(place(Sphere{v, r}, xf, mat, n.pos, "hull()").node);
         }
         return Built::of(scene_.tree.balanced(Op::Union, items));
+    }
+
+    /// A convex hull of more faces than a polytope holds (a hull of facets), cut into wedges
+    /// about the vertical line through its vertices' mean: each wedge the polytope of its two
+    /// planes through the line and of the hull's faces that may meet it (a face with a vertex
+    /// on the inner side of each wedge plane; every face that meets the wedge has), which bound
+    /// the hull within the wedge exactly. Neighbouring wedges share a plane negated to the bit.
+    Built wedgedHull(const ConvexHull3& h, const Transform& xf, int mat, size_t pos) {
+        Vec3 c(0.0);
+        for (const Vec3& v : h.vertices) c += v;
+        c /= double(h.vertices.size());
+        // How far the line through c runs inside the hull (the wedges' common edge).
+        double t0 = -kInf, t1 = kInf;
+        for (const glm::dvec4& q : h.planes) {
+            const double room = q.w - glm::dot(Vec3(q), c);
+            if (q.z > 0.0) t1 = std::min(t1, room / q.z);
+            if (q.z < 0.0) t0 = std::max(t0, room / q.z);
+        }
+        for (int wedges = std::max(3, int(h.planes.size() / 200) + 1);; wedges *= 2) {
+            std::vector<Polytope> parts;
+            // Each side's outward normal, the wedge s between sides s and s + 1 (the last side
+            // the first one negated).
+            std::vector<Vec3> side(static_cast<size_t>(wedges));
+            for (int s = 0; s < wedges; ++s) {
+                const double a = 2.0 * M_PI * s / wedges;
+                side[size_t(s)] = Vec3(std::sin(a), -std::cos(a), 0.0);
+            }
+            auto inside = [&](const Vec3& p, const Vec3& nn) {
+                return glm::dot(nn, p - c) <= 1e-9 * glm::length(p - c);
+            };
+            bool fits = true;
+            for (int s = 0; s < wedges && fits; ++s) {
+                const Vec3 n0 = side[size_t(s)], n1 = -side[size_t((s + 1) % wedges)];
+                Polytope pt;
+                for (size_t f = 0; f < h.faces.size(); ++f) {
+                    bool in0 = false, in1 = false;
+                    for (int v : h.faces[f]) {
+                        in0 = in0 || inside(h.vertices[size_t(v)], n0);
+                        in1 = in1 || inside(h.vertices[size_t(v)], n1);
+                    }
+                    if (in0 && in1) pt.planes.push_back(h.planes[f]);
+                }
+                pt.planes.push_back(glm::dvec4(n0, glm::dot(n0, c)));
+                pt.planes.push_back(glm::dvec4(n1, glm::dot(n1, c)));
+                if (pt.planes.size() > 255) {
+                    fits = false;
+                    break;
+                }
+                // Its corners: hull vertices inside it, hull edges crossing its sides, and the
+                // ends of its edge on the line.
+                Box3 box;
+                box.expand(c + Vec3(0.0, 0.0, t0));
+                box.expand(c + Vec3(0.0, 0.0, t1));
+                for (const Vec3& v : h.vertices)
+                    if (inside(v, n0) && inside(v, n1)) box.expand(v);
+                for (const auto& [i, j] : h.edges) {
+                    const Vec3 &u = h.vertices[size_t(i)], &v = h.vertices[size_t(j)];
+                    for (int k = 0; k < 2; ++k) {
+                        const Vec3& nk = k ? n1 : n0;
+                        const double du = glm::dot(nk, u - c), dv = glm::dot(nk, v - c);
+                        if ((du < 0.0) == (dv < 0.0)) continue;
+                        const Vec3 p = u + (v - u) * (du / (du - dv));
+                        if (inside(p, k ? n0 : n1)) box.expand(p);
+                    }
+                }
+                pt.bounds = padded(box);
+                parts.push_back(std::move(pt));
+            }
+            if (!fits) continue;
+            std::vector<int> items;
+            for (Polytope& pt : parts) {
+                ++counts_.polytopes;
+                items.push_back(place(std::move(pt), xf, mat, pos, "hull()").node);
+            }
+            return Built::of(scene_.tree.balanced(Op::Union, items));
+        }
     }
 
     [[noreturn]] void refuse(const Node& n) {
@@ -2262,6 +2333,7 @@ class Builder {
     Scene& scene_;
     OpenScadCounts& counts_;
     const bool facets_;  ///< --facets openscad: round shapes as OpenSCAD's polygons and polyhedra
+    const int twistParts_;  ///< ReadOptions::twistParts
     /// The largest sagitta of the faceted circles of the profile being read (2D units).
     double profileSagitta_ = 0.0;
     std::map<std::tuple<double, double, double>, int> materialOf_;
