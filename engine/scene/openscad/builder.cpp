@@ -55,7 +55,7 @@ class Args {
                                         " positional argument" + (pos.size() == 1 ? "" : "s"));
                 name = pos[next++];
             } else if (name[0] == '$') {
-                continue;  // $fn, $fa, $fs: tessellation settings; Lancer traces the exact solid
+                continue;  // $fn, $fa, $fs: read by special() where they count facets
             } else {
                 bool known = false;
                 for (const char* k : all) known = known || name == k;
