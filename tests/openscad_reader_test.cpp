@@ -255,6 +255,9 @@ TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
                    "mem.csg:1:25: 'linear_extrude' inside hull() at mem.csg:1:1 is not "
                    "supported: Lancer takes the hull of cubes, polyhedra, spheres and "
                    "cylinders (and their groups and transforms)");
+    expectCsgError("hull() { sphere(r = 1, $fn = 200); sphere(r = 2, $fn = 200); }",
+                   "mem.csg:1:36: hull() at mem.csg:1:1 of more than 20000 points (its curved "
+                   "children's facets) is not supported");
     expectCsgError("linear_extrude(height = 1) hull() { difference() { square(2); circle(1); } }",
                    "mem.csg:1:37: a 2D boolean inside hull() at mem.csg:1:28 is not supported: "
                    "Lancer takes the hull of squares, circles, polygons, text and their unions "
@@ -949,6 +952,7 @@ TEST(OpenScadFacets, FewFragmentsMakeTheirPolyhedronTwins) {
     EXPECT_EQ(std::get<Polytope>(ball.prims[0].shape).planes.size(), 32u);
     const Scene pent = facetedText("cylinder(h = 1, r = 1);", &n);
     EXPECT_EQ(std::get<Polytope>(pent.prims[0].shape).planes.size(), 7u);
+    EXPECT_THROW(facetedText("sphere(r = 1, $fn = 2000);"), SceneError);  // 2 million facets
     // Exact by default: the same model is one sphere.
     const Scene exact = csgText("sphere(r = 10, $fn = 0, $fa = 12, $fs = 2);", &n);
     ASSERT_EQ(exact.prims.size(), 1u);

@@ -1054,6 +1054,8 @@ class Builder {
     }
 
     static constexpr int kMaxTwistSlices = 10000;  ///< slices beyond this are refused
+    /// The most facets (fragments times rings) of one faceted sphere: $fn = 1414.
+    static constexpr double kMaxSphereFacets = 1e6;
     static constexpr int kMaxTwistSubSlices = 16;  ///< the most a slice is cut again
     /// The most polytopes one twisted extrusion makes (example020's spring: 20,480).
     static constexpr int kMaxTwistPolytopes = 200000;
@@ -1715,13 +1717,24 @@ class Builder {
                 const FragmentRule rule = fragmentRule(n);
                 std::vector<Vec3> f;
                 double err = 0.0;
-                if (const Sphere* sp = std::get_if<Sphere>(&*s)) {
-                    const int k2 = rule.fragments(sp->r);
+                const Sphere* round = std::get_if<Sphere>(&*s);
+                const Cone* cone = std::get_if<Cone>(&*s);
+                const int kf = rule.fragments(round ? round->r : std::max(cone->r1, cone->r2));
+                // Refused before the points are made: a sphere of n fragments has n (n + 1) / 2.
+                const double more = round ? double(kf) * double((kf + 1) / 2) : 2.0 * kf;
+                if (double(in.facetPoints.size() + in.points.size()) + more >
+                    double(kMaxHullPoints))
+                    src_.fail(n.pos, "hull() at " + src_.where(hull.pos) + " of more than " +
+                                         std::to_string(kMaxHullPoints) +
+                                         " points (its curved children's facets) is not "
+                                         "supported");
+                if (const Sphere* sp = round) {
+                    const int k2 = kf;
                     f = spherePoints(sp->r, k2);
                     err = sphereFacetError(sp->r, k2);
                 } else {
-                    const Cone& c = std::get<Cone>(*s);
-                    const int k2 = rule.fragments(std::max(c.r1, c.r2));
+                    const Cone& c = *cone;
+                    const int k2 = kf;
                     f = cylinderPoints(c.r1, c.r2, c.h, k2);
                     err = sagitta(std::max(c.r1, c.r2), k2);
                     ++in.curved;
@@ -2171,7 +2184,12 @@ class Builder {
         double error = 0.0;
         const std::string what = n.name + "()";
         if (const Sphere* s = std::get_if<Sphere>(&shape)) {
-            const SphereRings rings = sphereRings(s->r, rule.fragments(s->r));
+            const int k = rule.fragments(s->r);
+            if (double(k) * double((k + 1) / 2) > kMaxSphereFacets)
+                src_.fail(n.pos, "sphere() of " + std::to_string(k) +
+                                     " fragments: Lancer makes at most " +
+                                     twistText(kMaxSphereFacets) + " facets of a sphere");
+            const SphereRings rings = sphereRings(s->r, k);
             double nearest = rings.z.front();  // the caps
             for (size_t i = 0; i + 1 < rings.z.size(); ++i)
                 nearest = std::min(nearest,
