@@ -231,6 +231,15 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1.0, 86400.0))
         ->capture_default_str();
     benchCmd->add_flag("--quick", bopt.quick, "Fewer knob values (a smoke run)");
+    benchCmd
+        ->add_option_function<std::string>(
+            "--facets",
+            [&bopt](const std::string& v) {
+                bopt.read.facets = v == "openscad" ? Facets::OpenScad : Facets::Exact;
+            },
+            "Round shapes of .csg scenes: exact, or openscad (OpenSCAD's polygons and polyhedra "
+            "by $fn, $fa, $fs)")
+        ->transform(CLI::IsMember({"exact", "openscad"}));
     benchCmd->add_flag("--no-plots{false}", bopt.plots, "Write the CSV only");
     benchCmd->add_flag("--schemes-only", bopt.schemesOnly,
                        "Each scheme at its defaults, and the peer: the comparison table");

@@ -243,17 +243,25 @@ TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
         "intersection, render, multmatrix, translate, rotate, scale, mirror, color, cube, sphere, "
         "cylinder, linear_extrude, rotate_extrude, square, circle, polygon, polyhedron, hull, "
         "text, import, surface)");
-    // A self-intersecting polyhedron (two tetrahedra that overlap) and a hull of spheres of two
-    // radii are refused by name.
+    // A self-intersecting polyhedron (two tetrahedra that overlap) and a hull of an extrusion
+    // are refused by name.
     expectCsgError(
         "polyhedron(points = [[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 0, 4], [1, 1, 1], [5, 1, 1], "
         "[1, 5, 1], [1, 1, 5]], faces = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2], [4, 5, 6], "
         "[4, 7, 5], [4, 6, 7], [5, 7, 6]]);",
         "mem.csg:1:1: polyhedron() (its faces cut into triangles) is self-intersecting: "
         "triangles 3 and 4 cross");
-    expectCsgError("hull() { sphere(r = 1); translate([3, 0, 0]) sphere(r = 2); }",
-                   "mem.csg:1:46: hull() of spheres of different radii (1 and 2) is not "
-                   "supported: Lancer takes the exact hull of spheres of one radius");
+    expectCsgError("hull() { sphere(r = 1); linear_extrude(height = 2) square(1); }",
+                   "mem.csg:1:25: 'linear_extrude' inside hull() at mem.csg:1:1 is not "
+                   "supported: Lancer takes the hull of cubes, polyhedra, spheres and "
+                   "cylinders (and their groups and transforms)");
+    expectCsgError("hull() { sphere(r = 1, $fn = 200); sphere(r = 2, $fn = 200); }",
+                   "mem.csg:1:36: hull() at mem.csg:1:1 of more than 20000 points (its curved "
+                   "children's facets) is not supported");
+    expectCsgError("linear_extrude(height = 1) hull() { difference() { square(2); circle(1); } }",
+                   "mem.csg:1:37: a 2D boolean inside hull() at mem.csg:1:28 is not supported: "
+                   "Lancer takes the hull of squares, circles, polygons, text and their unions "
+                   "and transforms");
     // Twists Lancer cannot slice as OpenSCAD does, and a torus, are refused by name.
     expectCsgError(
         "linear_extrude(height = 10, twist = 90) { translate([3, 0]) circle(r = 1); }",
@@ -317,9 +325,11 @@ TEST(OpenScadReader, MalformedInputNamesFileLineAndColumn) {
 /// Two models have the same bounds (within a hair: a polytope's box is grown by one) and the
 /// same depth image from the first one's camera, pixel for pixel; they hit something.
 /// With `bounds` false only the images are compared (a difference keeps its first operand's box).
-void expectSameSolid(const std::string& model, const std::string& twin, bool bounds = true) {
+/// `options` read the model (the twin is read exactly).
+void expectSameSolid(const std::string& model, const std::string& twin, bool bounds = true,
+                     const ReadOptions& options = {}) {
     SCOPED_TRACE(model);
-    const Scene a = csgText(model);
+    const Scene a = readOpenScad(SourceText("mem.csg", model), nullptr, nullptr, options);
     Scene b = csgText(twin);
     for (int k = 0; k < 3 && bounds; ++k) {
         EXPECT_NEAR(a.bounds.lo[k], b.bounds.lo[k], 1e-6 * a.scale());
@@ -795,8 +805,24 @@ TEST(OpenScadOffset, UnsupportedOffsetsAreRefusedByName) {
     expectCsgError(ex + "offset(r = -1) { square(2); circle(1); } }",
                    "mem.csg:1:30: offset(r < 0) is supported of one square, polygon or circle "
                    "only (its child made at mem.csg:1:58 is another shape or a boolean)");
-    expectCsgError(ex + "offset(delta = 1, chamfer = false) square(2); }",
-                   "mem.csg:1:45: offset(delta = ...) is not supported (only r > 0)");
+    expectCsgError(ex + "offset(delta = -1) { square(2); translate([5, 0]) square(2); } }",
+                   "mem.csg:1:30: offset(delta < 0) is supported of one square, polygon, glyph "
+                   "or DXF drawing only (the shapes made at mem.csg:1:80 and mem.csg:1:51)");
+    expectCsgError(ex + "offset(delta = 1) { square(2); translate([1, 1]) square(2); } }",
+                   "mem.csg:1:30: offset(delta) of outlines that cross or touch (of the shapes "
+                   "made at mem.csg:1:79, ...) is not supported: their region's outline is not "
+                   "their paths");
+    expectCsgError(ex + "offset(delta = 1) { square(4); translate([1, 1]) square(1); } }",
+                   "mem.csg:1:30: offset(delta) of the shape made at mem.csg:1:79, which lies "
+                   "inside the shape made at mem.csg:1:50, is not supported: their union's "
+                   "outline is not theirs");
+    expectCsgError(ex + "offset(delta = 1) { square(2); translate([5, 0]) circle(1); } }",
+                   "mem.csg:1:30: offset(delta) of a circle (at mem.csg:1:79) beside other "
+                   "shapes is not supported (only of one circle)");
+    expectCsgError(ex + "offset(delta = 1) offset(r = 1) square(2); }",
+                   "mem.csg:1:30: offset(delta) of the shape made at mem.csg:1:48 (a boolean or "
+                   "an offset) is not supported: Lancer offsets by delta squares, polygons, "
+                   "text, DXF drawings and circles");
     expectCsgError(ex + "offset(r = 1) difference() { square(2); circle(1); } }",
                    "mem.csg:1:30: offset() of an intersection or difference (made at "
                    "mem.csg:1:44) is not supported (only of unions)");
@@ -805,14 +831,291 @@ TEST(OpenScadOffset, UnsupportedOffsetsAreRefusedByName) {
                    "non-uniform scale) is not supported");
 }
 
+TEST(OpenScadOffset, DeltaOffsetsEqualTheirPolygonTwins) {
+    const std::string ex = "linear_extrude(height = 3) { ";
+    // A square grown by delta is the larger square (mitred corners), both ways round.
+    expectSameSolid(ex + "offset(delta = 1, chamfer = false) { square(size = [2, 4]); } }",
+                    "translate([-1, -1, 0]) cube(size = [4, 6, 3]);");
+    expectSameSolid(ex + "offset(delta = 1) { mirror([1, 0]) square(size = [2, 4]); } }",
+                    "translate([-3, -1, 0]) cube(size = [4, 6, 3]);");
+    // Chamfered, each corner is cut square to its bisector at distance 1: along the moved
+    // edges by tan(22.5 degrees) = sqrt(2) - 1 past the corner.
+    const double t = std::sqrt(2.0) - 1.0;
+    auto pt = [](double x, double y) {
+        char buf[80];
+        std::snprintf(buf, sizeof buf, "[%.17g, %.17g]", x, y);
+        return std::string(buf);
+    };
+    expectSameSolid(ex + "offset(delta = 1, chamfer = true) { square(size = [2, 2]); } }",
+                    ex + "polygon(points = [" + pt(-t, -1) + ", " + pt(2 + t, -1) + ", " +
+                        pt(3, -t) + ", " + pt(3, 2 + t) + ", " + pt(2 + t, 3) + ", " + pt(-t, 3) +
+                        ", " + pt(-1, 2 + t) + ", " + pt(-1, -t) + "]); }");
+    // A triangle's mitre reaches d / sin(half its angle) out: the right isosceles triangle
+    // (0,0), (2,0), (0,2) grown by 1 is the triangle of the three moved lines, x >= -1,
+    // y >= -1, x + y <= 2 + sqrt(2).
+    const double s2 = 2.0 + std::sqrt(2.0);
+    expectSameSolid(ex + "offset(delta = 1) { polygon(points = [[0, 0], [2, 0], [0, 2]]); } }",
+                    ex + "polygon(points = [" + pt(-1, -1) + ", " + pt(s2 + 1, -1) + ", " +
+                        pt(-1, s2 + 1) + "]); }");
+    // Shrunk, an L keeps its mitred reflex corner: the L of arms 1 wide inside the 4 x 4 L
+    // of arms 2 wide.
+    expectSameSolid(ex + "offset(delta = -0.5) { polygon(points = [[0, 0], [4, 0], [4, 2], "
+                         "[2, 2], [2, 4], [0, 4]]); } }",
+                    ex + "polygon(points = [[0.5, 0.5], [3.5, 0.5], [3.5, 1.5], [1.5, 1.5], "
+                         "[1.5, 3.5], [0.5, 3.5]]); }",
+                    false);
+    // A hole grows inward as the outline grows outward: a frame 4 wide with a 2 wide hole,
+    // grown by 0.5, is the frame 5 wide with a 1 wide hole; shrunk, 3 wide around 3 wide.
+    const std::string frame =
+        "polygon(points = [[0, 0], [4, 0], [4, 4], [0, 4], [1, 1], [3, 1], [3, 3], [1, 3]], "
+        "paths = [[0, 1, 2, 3], [4, 5, 6, 7]]); } }";
+    expectSameSolid(ex + "offset(delta = 0.5) { " + frame,
+                    "difference() { translate([-0.5, -0.5, 0]) cube(size = [5, 5, 3]); "
+                    "translate([1.5, 1.5, -1]) cube(size = [1, 1, 5]); }");
+    expectSameSolid(ex + "offset(delta = -0.25) { " + frame,
+                    "difference() { translate([0.25, 0.25, 0]) cube(size = [3.5, 3.5, 3]); "
+                    "translate([0.75, 0.75, -1]) cube(size = [2.5, 2.5, 5]); }",
+                    false);
+    // Two apart grow each; a circle, which has no corner, grows or shrinks round.
+    const Scene two = csgText(ex +
+                              "offset(delta = 1) { square(2); translate([10, 0]) "
+                              "square(2); } }");
+    EXPECT_NEAR(two.bounds.lo.x, -1.0, 1e-6);
+    EXPECT_NEAR(two.bounds.hi.x, 13.0, 1e-6);
+    expectSameSolid(ex + "offset(delta = -0.5, chamfer = true) { circle(r = 1.5); } }",
+                    "cylinder(h = 3, r = 1);");
+    // Shrunk past its width, a shape is gone.
+    expectSameSolid("cube(1); " + ex + "offset(delta = -1.5) { square(2); } }", "cube(1);", false);
+}
+
 TEST(OpenScadOffset, SchemesAgreeWithBruteForce) {
     const Scene s = csgText(
         "difference() { linear_extrude(height = 2, center = true) { offset(r = 0.4) { "
         "polygon(points = [[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); circle(r = 0.5); } } "
         "translate([1.5, 1, 0]) sphere(r = 0.8); }\n"
         "translate([0, 4, 0]) linear_extrude(height = 1) { offset(r = -0.3) { polygon(points = "
-        "[[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); } }");
+        "[[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); } }\n"
+        "translate([5, 0, 0]) linear_extrude(height = 1.5, twist = 30) { offset(delta = 0.3) "
+        "{ polygon(points = [[0, 0], [3, 0], [3, 2], [1.5, 0.5], [0, 2]]); } }\n"
+        "translate([5, 4, 0]) difference() { linear_extrude(height = 1) { offset(delta = "
+        "0.4, chamfer = true) { polygon(points = [[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2], "
+        "[0.5, 0.5], [1, 0.5], [0.75, 0.8]], paths = [[0, 1, 2, 3, 4], [5, 6, 7]]); } } "
+        "translate([0, 4, 0]) linear_extrude(height = 1) offset(delta = -0.3) polygon(points = "
+        "[[0, 0], [3, 0], [3, 2], [1.5, 1], [0, 2]]); }");
     const std::vector<Ray> rays = test::randomRays(s, 7, 3000);
+    test::expectEverySchemeSame(s, rays);
+}
+
+// ---- --facets openscad ----
+
+Scene facetedText(const std::string& text, OpenScadCounts* counts = nullptr) {
+    ReadOptions o;
+    o.facets = Facets::OpenScad;
+    return readOpenScad(SourceText("mem.csg", text), nullptr, counts, o);
+}
+
+/// The faceted model of `model` and `twin` (read exactly) are the same solid.
+void expectFacetedTwin(const std::string& model, const std::string& twin) {
+    ReadOptions o;
+    o.facets = Facets::OpenScad;
+    expectSameSolid(model, twin, true, o);
+}
+
+TEST(OpenScadFacets, FewFragmentsMakeTheirPolyhedronTwins) {
+    // $fn = 4: the circle's square has corners at 0, 90, 180, 270 degrees, radius 1 (a unit
+    // square turned by 45 degrees, side sqrt(2)); the sphere's two rings lie at polar angles 45
+    // and 135 degrees (radius and height sqrt(1/2)): a box of side 1 and height sqrt(2).
+    const std::string turn =
+        "multmatrix([[0.70710678118654757, -0.70710678118654746, 0, 0], "
+        "[0.70710678118654746, 0.70710678118654757, 0, 0], [0, 0, 1, 0], "
+        "[0, 0, 0, 1]]) ";
+    expectFacetedTwin("sphere(r = 1, $fn = 4);",
+                      turn + "cube(size = [1, 1, 1.4142135623730951], center = true);");
+    expectFacetedTwin("cylinder(h = 2, r = 1, center = true, $fn = 4);",
+                      turn +
+                          "cube(size = [1.4142135623730951, 1.4142135623730951, 2], center = "
+                          "true);");
+    expectFacetedTwin("linear_extrude(height = 2) circle(r = 1, $fn = 4);",
+                      turn +
+                          "translate([-0.70710678118654757, -0.70710678118654757, 0]) "
+                          "cube(size = [1.4142135623730951, 1.4142135623730951, 2]);");
+    // A cone to an apex: the square pyramid.
+    expectFacetedTwin("cylinder(h = 1, r1 = 1, r2 = 0, $fn = 4);",
+                      "polyhedron(points = [[1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0], [0, 0, "
+                      "1]], faces = [[0, 3, 2, 1], [4, 0, 1], [4, 1, 2], [4, 2, 3], [4, 3, 0]]);");
+    // The default rule: r = 10 with $fa = 12, $fs = 2 is 30 fragments, r = 1 is 5.
+    OpenScadCounts n;
+    const Scene ball = facetedText("sphere(r = 10, $fn = 0, $fa = 12, $fs = 2);", &n);
+    EXPECT_EQ(n.polytopes, 14);  // 15 rings, 14 bands
+    EXPECT_EQ(n.facetedShapes, 1);
+    ASSERT_TRUE(std::holds_alternative<Polytope>(ball.prims[0].shape));
+    EXPECT_EQ(std::get<Polytope>(ball.prims[0].shape).planes.size(), 32u);
+    const Scene pent = facetedText("cylinder(h = 1, r = 1);", &n);
+    EXPECT_EQ(std::get<Polytope>(pent.prims[0].shape).planes.size(), 7u);
+    EXPECT_THROW(facetedText("sphere(r = 1, $fn = 2000);"), SceneError);  // 2 million facets
+    // Exact by default: the same model is one sphere.
+    const Scene exact = csgText("sphere(r = 10, $fn = 0, $fa = 12, $fs = 2);", &n);
+    ASSERT_EQ(exact.prims.size(), 1u);
+    EXPECT_TRUE(std::holds_alternative<Sphere>(exact.prims[0].shape));
+    EXPECT_EQ(exact.modelError, 0.0);
+}
+
+/// Where brute force's nearest hits of `count` random rays (seed `seed`) lie.
+std::vector<Vec3> bruteHits(const Scene& s, uint64_t seed, int count) {
+    auto brute = buildAccelerator(s, BuildParams{});
+    TraceContext ctx(s.prims.size(), s.tree.depth());
+    NullObserver obs;
+    std::vector<Vec3> out;
+    for (const Ray& ray : test::randomRays(s, seed, count)) {
+        ctx.beginRay();
+        Hit h;
+        if (brute->intersect(ray, 0.0, kInf, ctx, obs, h)) out.push_back(ray.at(h.t));
+    }
+    return out;
+}
+
+TEST(OpenScadFacets, HitsLieWithinTheStatedSagittaInsideTheExactSurface) {
+    // Every hit on a faceted sphere lies inside the sphere, by at most the stated error; on a
+    // faceted cylinder, inside its radius by at most the sagitta. $fn = 300 cuts each band
+    // into sectors (302 planes are over a polytope's 255).
+    for (const char* model : {"sphere(r = 2, $fn = 300);", "sphere(r = 2, $fn = 12);",
+                              "scale(3) sphere(r = 2, $fa = 12, $fs = 2);",
+                              "cylinder(h = 3, r = 2, center = true, $fn = 7);"}) {
+        SCOPED_TRACE(model);
+        OpenScadCounts n;
+        const Scene s = facetedText(model, &n);
+        const bool sphere = std::string(model).find("sphere") != std::string::npos;
+        const double scale = std::string(model).rfind("scale", 0) == 0 ? 3.0 : 1.0;
+        const double r = 2.0 * scale;
+        const double stated = s.modelError;
+        EXPECT_GT(stated, 0.0);
+        EXPECT_EQ(stated, n.facetError);
+        double worst = 0.0;
+        const std::vector<Vec3> hits = bruteHits(s, 11, 2000);
+        for (const Vec3& p : hits) {
+            const double inside = r - (sphere ? glm::length(p) : std::hypot(p.x, p.y));
+            if (!sphere && std::abs(p.z) > 1.5 - 1e-9) continue;  // on a cap: exact
+            EXPECT_GE(inside, -1e-9 * r);
+            worst = std::max(worst, inside);
+        }
+        EXPECT_GT(hits.size(), 500u);
+        EXPECT_LE(worst, stated * (1.0 + 1e-9));
+        EXPECT_GT(worst, 0.5 * stated);  // the bound is near what the facets do
+    }
+}
+
+TEST(OpenScadFacets, SchemesAgreeWithBruteForce) {
+    const Scene s = facetedText(
+        "difference() { sphere(r = 2, $fn = 20); cylinder(h = 5, r = 1, center = true, $fn = "
+        "9); }\n"
+        "translate([5, 0, 0]) cylinder(h = 3, r1 = 2, r2 = 0.5, $fn = 300);\n"
+        "translate([0, 5, 0]) rotate_extrude() translate([2, 0]) circle(r = 0.5, $fn = 8);\n"
+        "translate([5, 5, 0]) linear_extrude(height = 1, twist = 45) difference() { circle(r = "
+        "1.5, $fn = 16); square(1, center = true); }");
+    const std::vector<Ray> rays = test::randomRays(s, 13, 3000);
+    test::expectEverySchemeSame(s, rays);
+}
+
+// ---- hull() of curved children by their facets ----
+
+TEST(OpenScadHullFacets, CurvedChildrenMakeTheHullOfTheirFacets) {
+    // $fn = 4: a sphere's polyhedron is a box turned by 45 degrees (side r sqrt(2), height
+    // r sqrt(2)), a cylinder's a square prism, a circle's a square: the hull of their facets
+    // is the hull of those boxes' corners.
+    const std::string turn =
+        "multmatrix([[0.70710678118654757, -0.70710678118654746, 0, 0], "
+        "[0.70710678118654746, 0.70710678118654757, 0, 0], [0, 0, 1, 0], "
+        "[0, 0, 0, 1]]) ";
+    expectSameSolid(
+        "hull() { sphere(r = 1, $fn = 4); translate([4, 0, 0]) sphere(r = 2, $fn = "
+        "4); }",
+        "hull() { " + turn +
+            "cube(size = [1, 1, 1.4142135623730951], center = true); translate([4, "
+            "0, 0]) " +
+            turn + "cube(size = [2, 2, 2.8284271247461903], center = true); }");
+    expectSameSolid("hull() { cylinder(h = 1, r = 1, $fn = 4); translate([3, 0, 0]) cube(1); }",
+                    "hull() { " + turn +
+                        "translate([-0.70710678118654757, -0.70710678118654757, 0]) cube(size = "
+                        "[1.4142135623730951, 1.4142135623730951, 1]); translate([3, 0, 0]) "
+                        "cube(1); }");
+    // In 2D: two squares of circles and a point of a polygon.
+    expectSameSolid(
+        "linear_extrude(height = 1) hull() { circle(r = 1, $fn = 4); translate([3, "
+        "0]) circle(r = 1, $fn = 4); polygon(points = [[1.5, 3], [1.5, 2], [1, "
+        "2]]); }",
+        "linear_extrude(height = 1) polygon(points = [[-1, 0], [0, -1], [3, -1], "
+        "[4, 0], [1.5, 3]]);");
+    OpenScadCounts n;
+    const Scene s = csgText("hull() { sphere(r = 1, $fn = 4); cube(1); }", &n);
+    EXPECT_EQ(n.hulls, 1);
+    EXPECT_EQ(n.facetedShapes, 1);
+    EXPECT_NEAR(s.modelError, 0.5, 1e-8);  // the turned box's side faces lie 0.5 out
+    // Equal balls stay exact: no error; with --facets openscad, their facets' hull.
+    const Scene exact = csgText("hull() { sphere(1); translate([3, 0, 0]) sphere(1); }", &n);
+    EXPECT_EQ(exact.modelError, 0.0);
+    EXPECT_EQ(n.facetedShapes, 0);
+    ReadOptions o;
+    o.facets = Facets::OpenScad;
+    const Scene faceted =
+        readOpenScad(SourceText("mem.csg",
+                                "hull() { sphere(1, $fn = 4); translate([3, 0, 0]) sphere(1, $fn = "
+                                "4); }"),
+                     nullptr, &n, o);
+    EXPECT_EQ(n.polytopes, 1);
+    // A corner of the turned box at x = 3 + sqrt(1/2).
+    EXPECT_NEAR(faceted.bounds.hi.x, 3.0 + std::sqrt(0.5), 1e-6);
+}
+
+/// How far inside the exact hull of the balls (c0, r0) and (c1, r1) the point p lies (negative:
+/// outside): the hull is the union of the balls between them, linearly, and its inner parallel
+/// body at depth e their hull with radii less e.
+double depthInHullOfTwoBalls(const Vec3& p, const Vec3& c0, double r0, const Vec3& c1, double r1) {
+    auto f = [&](double t) { return glm::length(p - glm::mix(c0, c1, t)) - glm::mix(r0, r1, t); };
+    double lo = 0.0, hi = 1.0;  // f is convex in t: ternary search for its least value
+    for (int i = 0; i < 200; ++i) {
+        const double a = lo + (hi - lo) / 3.0, b = hi - (hi - lo) / 3.0;
+        (f(a) < f(b) ? hi : lo) = f(a) < f(b) ? b : a;
+    }
+    return -std::min({f(lo), f(0.0), f(1.0)});
+}
+
+TEST(OpenScadHullFacets, HitsLieInsideTheExactHullWithinTheStatedError) {
+    // Spheres of radii 1 and 2 at OpenSCAD's default facets (5 and 7 fragments), and finer.
+    for (const char* fn : {"", ", $fn = 24", ", $fn = 48"}) {
+        SCOPED_TRACE(fn);
+        OpenScadCounts n;
+        const Scene s = csgText(std::string("hull() { sphere(r = 1") + fn +
+                                    "); translate([4, 1, 0]) sphere(r = 2" + fn + "); }",
+                                &n);
+        const double stated = s.modelError;
+        EXPECT_GT(stated, 0.0);
+        double worst = 0.0;
+        const std::vector<Vec3> hits = bruteHits(s, 17, 2000);
+        for (const Vec3& p : hits) {
+            const double d = depthInHullOfTwoBalls(p, Vec3(0.0), 1.0, Vec3(4.0, 1.0, 0.0), 2.0);
+            EXPECT_GE(d, -1e-9);
+            worst = std::max(worst, d);
+        }
+        EXPECT_GT(hits.size(), 500u);
+        EXPECT_LE(worst, stated * (1.0 + 1e-9));
+        EXPECT_GT(worst, 0.3 * stated);
+    }
+}
+
+TEST(OpenScadHullFacets, SchemesAgreeWithBruteForce) {
+    // Past 255 faces ($fn = 40) the hull is cut into wedges about a vertical line.
+    OpenScadCounts n;
+    const Scene s = csgText(
+        "difference() { hull() { sphere(r = 1); translate([3, 0, 1]) sphere(r = 2); "
+        "translate([0, 3, 0]) cylinder(h = 2, r1 = 1, r2 = 0.2); } translate([1.5, 1, 0]) "
+        "cube(1.5, center = true); }\n"
+        "translate([0, -6, 0]) hull() { sphere(r = 1, $fn = 40); translate([3, 0, 0]) sphere(r "
+        "= 1.5, $fn = 40); }\n"
+        "translate([6, 0, 0]) linear_extrude(height = 1, twist = 30) hull() { circle(r = 1); "
+        "translate([2, 1]) circle(r = 0.5); }",
+        &n);
+    EXPECT_GT(n.polytopes, 3);
+    const std::vector<Ray> rays = test::randomRays(s, 19, 3000);
     test::expectEverySchemeSame(s, rays);
 }
 

@@ -35,6 +35,9 @@ struct BenchRow {
     std::string note;
     /// What the error columns hold when they are not the usual ones (a peer's silhouette).
     std::string errorNote;
+    /// The model's stated distance from the exact surface (`--stats` model_error) where a row
+    /// reads the scene its own way (the twist parts axis); negative: the scene's own.
+    double modelError = -1.0;
     bool inTable = false;  ///< a row of the comparison table (schemes.md)
     bool peer = false;     ///< another renderer (Embree, POV-Ray): no regions, tests or visits
 

@@ -22,6 +22,7 @@
 #include "engine/render/progressive.h"
 #include "engine/render/renderer.h"
 #include "engine/scene/loader.h"
+#include "engine/scene/openscad_reader.h"
 
 namespace lancer::bench {
 
@@ -135,7 +136,7 @@ const char* kHeader =
     "scene,scheme,knob,value,build_ms,memory_bytes,regions,render_ms,speedup,rays,prim_tests_per_"
     "ray,region_visits_per_ray,mailbox_hits,walk_errors,hit_diff_pixels,color_diff_pixels,max_"
     "depth_diff,repeats,build_ms_min,build_ms_max,render_ms_min,render_ms_max,speedup_min,speedup_"
-    "max,color_rmse,silhouette_diff_pixels,depth_rms,depth_p99,note\n";
+    "max,color_rmse,silhouette_diff_pixels,depth_rms,depth_p99,model_error,note\n";
 
 /// A CSV field: quoted when it holds a comma or a quote.
 std::string csvField(const std::string& s) {
@@ -150,7 +151,7 @@ void writeCsvRow(std::ostream& csv, const BenchRow& r) {
         << csvField(r.value) << ",";
     if (!r.measured()) {
         // Every figure empty, the reason last.
-        for (int i = 0; i < 24; ++i) csv << ",";
+        for (int i = 0; i < 25; ++i) csv << ",";
         csv << csvField(r.note) << "\n";
         return;
     }
@@ -179,7 +180,8 @@ void writeCsvRow(std::ostream& csv, const BenchRow& r) {
         << (r.compared && r.colorCompared ? num(r.error.colorRmse) : none) << ","
         << (r.compared ? std::to_string(r.error.silhouetteDiff) : none) << ","
         << (r.compared ? num(r.error.rmsDepthDiff) : none) << ","
-        << (r.compared ? num(r.error.p99DepthDiff) : none) << "," << csvField(r.csvNote()) << "\n";
+        << (r.compared ? num(r.error.p99DepthDiff) : none) << ","
+        << (r.modelError >= 0.0 ? num(r.modelError) : none) << "," << csvField(r.csvNote()) << "\n";
 }
 
 using Clock = std::chrono::steady_clock;
@@ -237,7 +239,7 @@ int runBench(const BenchOptions& opt) {
         const bool meshAxis = !opt.schemesOnly && withBrute && listed(opt.meshScenes, spec);
         Scene scene;
         try {
-            scene = loadScene(spec);
+            scene = loadScene(spec, opt.read);
         } catch (const std::exception& e) {
             std::cerr << "error: " << e.what() << "\n";
             return 2;
@@ -323,6 +325,37 @@ int runBench(const BenchOptions& opt) {
             r.shading.precision = c.shading.precision;
             schemeJob(row, c.build, r, bruteRow ? &ref : nullptr);
         }
+
+        // A twisted extrusion's slices as a knob: the scene read again with each slice of
+        // OpenSCAD's cut into 1 to 16 parts, rendered by the regular scheme against brute force
+        // on the scene as read by default; model_error is each reading's stated bound.
+        OpenScadCounts counts;
+        if (full && !opt.schemesOnly && bruteRow && wanted(SchemeKind::Regular) &&
+            spec.size() > 4 && spec.compare(spec.size() - 4, 4, ".csg") == 0) {
+            readOpenScadFile(spec, &counts, opt.read);  // read above: it reads again
+        }
+        if (counts.twistedExtrudes > 0)
+            for (int parts :
+                 opt.quick ? std::vector<int>{1, 4} : std::vector<int>{1, 2, 4, 8, 16}) {
+                BenchRow& row = newRow("regular", "twist parts", std::to_string(parts));
+                against.push_back({&row, bruteRow});
+                ReadOptions o = opt.read;
+                o.twistParts = parts;
+                auto variant = std::make_shared<Scene>(loadScene(spec, o));
+                row.modelError = variant->modelError;
+                BuildParams b;
+                b.scheme = SchemeKind::Regular;
+                jobs.push_back([variant, &row, b, r = ro, &ref, w, h, record](int round) {
+                    auto accel = buildAccelerator(*variant, b);
+                    Image img(w, h);
+                    const RenderStats s = render(*variant, *accel, r, img);
+                    record(row, accel->info(), s, round);
+                    if (round == 0) {
+                        row.error = compareImages(ref, img);
+                        row.compared = true;
+                    }
+                });
+            }
 
         // Against Embree, on union-only scenes, on primary and shadow rays (--bounces 0), with
         // every scheme of ours on the same workload.

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "engine/accel/build_params.h"
+#include "engine/scene/scene.h"
 
 namespace lancer::bench {
 
@@ -36,7 +37,9 @@ struct BenchOptions {
     std::vector<std::string> meshScenes{"builtin:lattice:2"};
     /// The $fn of each mesh; empty: 8, 16, 32, 64 (--quick: 8, 16).
     std::vector<int> meshFn;
-    double meshTimeout = 120.0;  ///< seconds an openscad run may take before it is stopped
+    double meshTimeout = 120.0;
+    ReadOptions read;  ///< --facets: how .csg scenes are read  ///< seconds an openscad run may
+                       ///< take before it is stopped
     /// The command line that started the run (for the page), argv[0] first.
     std::vector<std::string> commandLine;
 };

@@ -127,7 +127,7 @@ RenderOptions renderOptions(const CommonOptions& o, const Scene& scene) {
 }
 
 Scene loadSceneWithCamera(const CommonOptions& o) {
-    Scene scene = loadScene(o.scene);
+    Scene scene = loadScene(o.scene, o.knobs.read);
     if (!o.knobs.cameraPath.empty()) applyCameraFile(scene, o.knobs.cameraPath);
     return scene;
 }

@@ -352,6 +352,19 @@ std::vector<ParamDesc> makeTable() {
     d.set = [](K& k, double v) { k.shading.refractions = v != 0.0; };
     add(d);
 
+    d = {.flag = "--facets",
+         .metavar = "F",
+         .iniKey = nullptr,
+         .label = "facets",
+         .help =
+             "Round shapes of .csg files: exact (the true circle, sphere, cylinder, cone), or "
+             "openscad (OpenSCAD's polygons and polyhedra of them by $fn, $fa, $fs)",
+         .kind = ParamKind::Enum};
+    d.names = {"exact", "openscad"};
+    d.reach = ViewerReach::Startup;
+    d.get = [](const K& k) { return double(k.read.facets); };
+    d.set = [](K& k, double v) { k.read.facets = Facets(int(v)); };
+    add(d);
     d = {.flag = "--camera",
          .metavar = "FILE",
          .iniKey = nullptr,

@@ -11,6 +11,7 @@
 
 #include "engine/accel/build_params.h"
 #include "engine/render/tracer.h"
+#include "engine/scene/scene.h"
 
 namespace lancer::cli {
 
@@ -29,6 +30,7 @@ struct Knobs {
     /// Image size; 0: the scene's own (the other follows its aspect). The viewer's image viewport
     /// (the window opens around it with the panels).
     int width = 0, height = 0;
+    ReadOptions read;        ///< --facets: how .csg files' round shapes are read
     std::string cameraPath;  ///< --camera: a .camera.json replacing the scene's camera
     std::string statsPath;   ///< --stats: statistics as JSON
     std::string depthPath;   ///< --depth: primary hit distances as PFM

@@ -15,7 +15,7 @@ BuildResult buildStructure(const BuildRequest& r, std::stop_token stop) {
     if (!scene) {
         auto start = std::chrono::steady_clock::now();
         try {
-            Scene loaded = loadScene(r.spec);
+            Scene loaded = loadScene(r.spec, r.read);
             if (!r.cameraFile.empty()) applyCameraFile(loaded, r.cameraFile);
             scene = std::make_shared<const Scene>(std::move(loaded));
         } catch (const std::exception& e) {

@@ -34,6 +34,7 @@ struct BuildRequest {
     std::optional<Camera> camera;  ///< the view the structure is built for (irregular scheme)
     /// --camera: a .camera.json replacing the camera of the scene read (its home view).
     std::string cameraFile;
+    ReadOptions read;  ///< --facets: how the scene is read
 };
 
 struct BuildResult {

@@ -69,6 +69,7 @@ cli::Knobs knobsOf(const ViewerSettings& s) {
     k.width = s.windowWidth;
     k.height = s.windowHeight;
     k.cameraPath = s.cameraPath;
+    k.read = s.read;
     return k;
 }
 
@@ -79,6 +80,7 @@ void setKnobs(ViewerSettings& s, const cli::Knobs& k) {
     s.windowWidth = k.width;
     s.windowHeight = k.height;
     s.cameraPath = k.cameraPath;
+    s.read = k.read;
 }
 
 std::string settingsLines(const ViewerSettings& s) {

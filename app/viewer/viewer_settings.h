@@ -19,6 +19,8 @@ struct ViewerSettings {
     ShadingOptions shading;
     /// --camera FILE: replaces the camera of the first scene opened (not saved in the ini).
     std::string cameraPath;
+    /// --facets: how .csg files are read (not saved in the ini).
+    ReadOptions read;
     int threads = 0;  ///< render threads (0: all cores)
     int windowWidth = 1280, windowHeight = 720;
     /// The panel columns' widths as last dragged (0: automatic) and, with the inspector

@@ -177,6 +177,7 @@ void ViewerState::requestBuild(bool reloadScene, const char* why) {
     if (reloadScene || !sceneBuild_) {
         r.spec = s_.scene;
         r.cameraFile = s_.cameraPath;
+        r.read = s_.read;
     } else {
         r.spec = sceneBuild_->spec;
         r.loaded = sceneBuild_->scene;

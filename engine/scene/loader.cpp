@@ -24,13 +24,13 @@ void checkSceneFile(const std::string& spec) {
     if (std::string why = fileProblem(spec); !why.empty()) throw SceneError(spec + ": " + why);
 }
 
-Scene loadScene(const std::string& spec) {
+Scene loadScene(const std::string& spec, const ReadOptions& options) {
     if (std::optional<BuiltinSpec> builtin = parseBuiltinSpec(spec)) return makeBuiltin(*builtin);
     checkSceneFile(spec);
     std::string ext = extension(spec);
     if (ext == ".json") return readJsonScene(SourceText::fromFile(spec));
     if (ext == ".nff") return readNff(SourceText::fromFile(spec));
-    if (ext == ".csg") return readOpenScadFile(spec);
+    if (ext == ".csg") return readOpenScadFile(spec, nullptr, options);
     throw SceneError(spec + ": unknown scene format '" + ext +
                      "' (expected .json, .nff, .csg, or builtin:NAME[:SIZE])");
 }

@@ -7,8 +7,9 @@
 
 namespace lancer {
 
-/// Throws SceneError with the file, line and column of any problem.
-Scene loadScene(const std::string& spec);
+/// Throws SceneError with the file, line and column of any problem. `options` reach the readers
+/// that read them (.csg: --facets).
+Scene loadScene(const std::string& spec, const ReadOptions& options = {});
 /// Throws SceneError naming `spec` when it is a path that is missing ("no such file") or a
 /// directory; a built-in name passes (its own errors come when it is made).
 void checkSceneFile(const std::string& spec);

@@ -18,13 +18,14 @@ std::string openScadCameraPath(const std::string& csgPath) {
     return base + ".camera.json";
 }
 
-Scene readOpenScad(const SourceText& src, const SourceText* camera, OpenScadCounts* countsOut) {
+Scene readOpenScad(const SourceText& src, const SourceText* camera, OpenScadCounts* countsOut,
+                   const ReadOptions& options) {
     std::vector<openscad::Node> top = openscad::parse(src, openscad::tokenize(src));
     Scene scene;
     scene.name = src.path();
     OpenScadCounts counts;
-    openscad::buildModel(src, top, scene, counts);
-    scene.modelError = counts.twistError;
+    openscad::buildModel(src, top, scene, counts, options);
+    scene.modelError = std::max(counts.twistError, counts.facetError);
     scene.openScadMeshError = counts.openScadTwistMeshError;
     scene.prepare();
     // OpenSCAD's default view ($vpr = [55, 0, 25]): the eye at azimuth -65 degrees from +x,
@@ -45,15 +46,16 @@ Scene readOpenScad(const SourceText& src, const SourceText* camera, OpenScadCoun
     return scene;
 }
 
-Scene readOpenScadFile(const std::string& path, OpenScadCounts* counts) {
+Scene readOpenScadFile(const std::string& path, OpenScadCounts* counts,
+                       const ReadOptions& options) {
     SourceText src = SourceText::fromFile(path);
     std::string cam = openScadCameraPath(path);
     std::error_code ec;
     if (std::filesystem::exists(cam, ec)) {
         SourceText camSrc = SourceText::fromFile(cam);
-        return readOpenScad(src, &camSrc, counts);
+        return readOpenScad(src, &camSrc, counts, options);
     }
-    return readOpenScad(src, nullptr, counts);
+    return readOpenScad(src, nullptr, counts, options);
 }
 
 }  // namespace lancer

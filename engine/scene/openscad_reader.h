@@ -40,6 +40,11 @@ struct OpenScadCounts {
     /// OpenSCAD's own mesh of it (its walls triangulated between OpenSCAD's slices, circles as
     /// their polygons), beyond the facets' sagitta; for comparisons with that mesh.
     double openScadTwistMeshError = 0.0;
+    int facetedShapes = 0;  ///< circles, spheres, cylinders, cones built as OpenSCAD's facets
+    /// The largest sagitta (model units) of the facets of curved shapes modelled by them (with
+    /// --facets openscad, and hull() of curved children): how far they stray inside the exact
+    /// surface; 0 when none is.
+    double facetError = 0.0;
 };
 
 /// Nodes the reader models exactly; every other node is refused naming the node and position.
@@ -48,11 +53,14 @@ const std::vector<std::string>& openScadSupportedNodes();
 /// Read a .csg text. `camera` (optional) is the sidecar NAME.camera.json; without it the camera
 /// is framed on the bounds from OpenSCAD's default view direction, with the default light rig.
 /// Throws SceneError naming file, line and column.
+/// `options.facets` OpenScad builds circles, spheres, cylinders and cones as OpenSCAD's polygons
+/// and polyhedra (docs/scenes.md, "OpenSCAD's facets").
 Scene readOpenScad(const SourceText& src, const SourceText* camera = nullptr,
-                   OpenScadCounts* counts = nullptr);
+                   OpenScadCounts* counts = nullptr, const ReadOptions& options = {});
 
 /// Read `path` and, when it exists, its sidecar (path without ".csg" + ".camera.json").
-Scene readOpenScadFile(const std::string& path, OpenScadCounts* counts = nullptr);
+Scene readOpenScadFile(const std::string& path, OpenScadCounts* counts = nullptr,
+                       const ReadOptions& options = {});
 
 /// The sidecar path of a .csg path: "dir/NAME.csg" -> "dir/NAME.camera.json".
 std::string openScadCameraPath(const std::string& csgPath);

@@ -34,6 +34,20 @@ struct SceneError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+/// How a reader models OpenSCAD's round primitives.
+enum class Facets : uint8_t {
+    Exact,     ///< the true circle, sphere, cylinder and cone (the default)
+    OpenScad,  ///< OpenSCAD's polygons and polyhedra of them, by $fn, $fa, $fs
+};
+
+/// Options of the scene readers (`--facets`).
+struct ReadOptions {
+    Facets facets = Facets::Exact;  ///< circles, spheres, cylinders and cones of .csg files
+    /// The parts each of OpenSCAD's slices of a twisted extrusion is cut into (1 to 16; the
+    /// bench's speed-against-error knob); 0: as many as the reader's error target asks.
+    int twistParts = 0;
+};
+
 struct PackedSphere {
     Vec3 c{0.0};
     double r = -1.0;

@@ -27,6 +27,19 @@ if grep -q ',embree,peer (bounces 0),' "$csv"; then
   awk -F, '$3=="peer (bounces 0)" && $2!="embree" && $15 != 0 { exit 1 }' "$csv" \
     || fail "a scheme at --bounces 0 differs from brute force at --bounces 0"
 fi
+# A twisted extrusion's parts per slice as a knob: rows at 1 and 4 parts, the stated bound in
+# the model_error column about 4 times smaller at 4 parts (--facets reaches the bench too).
+"$LANCER" bench --quick --no-plots --no-mesh --schemes brute regular --facets openscad \
+  --scenes "$SRC/assets/openscad/twists.csg" --width 24 --height 16 --threads 2 --repeats 1 \
+  --out "$tmp/t" 2>"$tmp/log" || { cat "$tmp/log"; fail "bench of a twist exited non-zero"; }
+python3 - "$tmp/t/report.csv" <<'PY' || fail "twist parts rows"
+import csv, sys
+rows = [r for r in csv.DictReader(open(sys.argv[1])) if r["knob"] == "twist parts"]
+assert [r["value"] for r in rows] == ["1", "4"], rows
+e = [float(r["model_error"]) for r in rows]
+assert e[0] > 3.5 * e[1] > 0, e
+assert all(r["depth_p99"] != "" for r in rows), rows
+PY
 out=$("$LANCER" bench --quick --scenes builtin:nosuch --out "$tmp/c" 2>&1) && fail "unknown scene accepted"
 echo "$out" | grep -q "unknown built-in scene" || fail "bench error message: $out"
 echo ok

@@ -87,6 +87,21 @@ out=$("$LANCER" trace builtin:default --width 64 --height 40 --pixel 64 0 2>&1) 
 echo "$out" | grep -q -- "--pixel" || fail "outside pixel message: $out"
 
 # --help lists every common option.
+# --facets openscad: a sphere becomes OpenSCAD's polyhedron, its sagitta in model_error; exact
+# by default; a value that is not one is refused naming the option.
+echo 'sphere(r = 10, $fn = 0, $fa = 12, $fs = 2);' > "$tmp/ball.csg"
+"$LANCER" render "$tmp/ball.csg" -o "$tmp/f.png" --width 16 --height 16 --facets openscad \
+  --stats "$tmp/f.json" -q || fail "--facets openscad"
+"$LANCER" render "$tmp/ball.csg" -o "$tmp/e.png" --width 16 --height 16 --stats "$tmp/e.json" -q \
+  || fail "exact sphere"
+python3 - "$tmp/f.json" "$tmp/e.json" <<'PY' || fail "--facets stats"
+import json, sys
+f, e = (json.load(open(p)) for p in sys.argv[1:])
+assert f["primitives"] == 14 and 0.1 < f["model_error"] < 0.2, f
+assert e["primitives"] == 1 and e["model_error"] == 0, e
+PY
+out=$("$LANCER" render "$tmp/ball.csg" -o "$tmp/x.png" --facets round 2>&1) && fail "--facets round accepted"
+echo "$out" | grep -q -- "--facets" || fail "--facets error does not name the option: $out"
 help=$("$LANCER" render --help)
 for opt in --width --height --scheme --max-level --max-objects --step --delta --threads --bounces --stats --depth; do
   echo "$help" | grep -q -- "$opt" || fail "render --help lacks $opt"

@@ -11,6 +11,7 @@
 #include "engine/scene/mesh_file.h"
 #include "engine/scene/openscad/colors.h"
 #include "engine/scene/openscad/dxf.h"
+#include "engine/scene/openscad/facets.h"
 #include "engine/scene/openscad/hull3d.h"
 #include "engine/scene/openscad/region2d.h"
 #include "engine/scene/openscad/surface.h"
@@ -54,7 +55,7 @@ class Args {
                                         " positional argument" + (pos.size() == 1 ? "" : "s"));
                 name = pos[next++];
             } else if (name[0] == '$') {
-                continue;  // $fn, $fa, $fs: tessellation settings; Lancer traces the exact solid
+                continue;  // $fn, $fa, $fs: read by special() where they count facets
             } else {
                 bool known = false;
                 for (const char* k : all) known = known || name == k;
@@ -112,8 +113,12 @@ class Args {
 
 class Builder {
   public:
-    Builder(const SourceText& src, Scene& scene, OpenScadCounts& counts)
-        : src_(src), scene_(scene), counts_(counts) {}
+    Builder(const SourceText& src, Scene& scene, OpenScadCounts& counts, const ReadOptions& options)
+        : src_(src),
+          scene_(scene),
+          counts_(counts),
+          facets_(options.facets == Facets::OpenScad),
+          twistParts_(options.twistParts) {}
 
     /// The whole model: the children of the file's top level, or the first `!` subtree.
     int model(const std::vector<Node>& top) {
@@ -241,6 +246,8 @@ class Builder {
         /// A piece: the longest edge of the outlines it was cut from (its own edges may be
         /// parts of them); 0: its own edges are the outline's.
         double outlineEdge = 0.0;
+        /// A disk: OpenSCAD's fragments of its circle (for hull()); 0: by the default rule.
+        int fragments = 0;
     };
 
     int region(Region r) {
@@ -317,6 +324,7 @@ class Builder {
             return shape2(n, af);
         }
         if (k == "offset") return offsetNode(n, af, extrude);
+        if (k == "hull") return hull2(n, af, extrude);
         if (k == "import") return importDxf(n, af);
         if (is2DNode(k))
             src_.fail(n.pos, "the 2D node '" + k +
@@ -327,6 +335,63 @@ class Builder {
             src_.fail(n.pos, "the 3D node '" + k + "' is inside " + extrude.name + "() at " +
                                  src_.where(extrude.pos) + ", which extrudes 2D children only");
         refuse(n);
+    }
+
+    // ---- hull() in 2D ----
+
+    /// hull() of 2D children: the convex hull of their corners, a circle's by OpenSCAD's polygon
+    /// of it at its $fn, $fa, $fs (its sagitta joins the profile's error); one convex piece.
+    /// Booleans among the children are refused by name (their outline is not their parts').
+    Built hull2(const Node& n, const glm::dmat3& af, const Node& extrude) {
+        Args(src_, n, {}, {});
+        ++counts_.operators;
+        Built b = regionUnion(n.children, af, extrude);
+        if (b.kind != Built::Kind::Node) return b;
+        std::vector<Vec2> pts;
+        std::vector<int> stack{b.node};
+        while (!stack.empty()) {
+            const Region& g = regions_[size_t(stack.back())];
+            stack.pop_back();
+            if (g.kind == Region::Kind::Union) {
+                stack.push_back(g.a);
+                stack.push_back(g.b);
+            } else if (g.kind == Region::Kind::Piece) {
+                pts.insert(pts.end(), g.piece.vertices.begin(), g.piece.vertices.end());
+            } else if (g.kind == Region::Kind::Disk) {
+                const int k =
+                    g.fragments > 0 ? g.fragments : FragmentRule{}.fragments(planeStretch(g.disk));
+                for (const Vec2& p : circlePolygon(1.0, k))
+                    pts.push_back(Vec2(g.disk * glm::dvec3(p, 1.0)));
+                profileSagitta_ = std::max(profileSagitta_, sagitta(1.0, k) * planeStretch(g.disk));
+                ++counts_.facetedShapes;
+            } else {
+                src_.fail(g.pos, "a 2D boolean inside hull() at " + src_.where(n.pos) +
+                                     " is not supported: Lancer takes the hull of squares, "
+                                     "circles, polygons, text and their unions and transforms");
+            }
+        }
+        // Andrew's monotone chain.
+        std::sort(pts.begin(), pts.end(), [](const Vec2& p, const Vec2& q) {
+            return p.x < q.x || (p.x == q.x && p.y < q.y);
+        });
+        pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+        if (pts.size() < 3) return emptyPrimitive();
+        std::vector<Vec2> ring;
+        for (int pass = 0; pass < 2; ++pass) {
+            const size_t base = ring.size();
+            for (const Vec2& p : pts) {
+                while (ring.size() >= base + 2) {
+                    const Vec2 u = ring.back() - ring[ring.size() - 2], v = p - ring.back();
+                    if (u.x * v.y - u.y * v.x > 0.0) break;
+                    ring.pop_back();
+                }
+                ring.push_back(p);
+            }
+            ring.pop_back();
+            std::reverse(pts.begin(), pts.end());
+        }
+        ++counts_.hulls;
+        return pieces({ring}, n.pos);
     }
 
     // ---- import() of DXF drawings ----
@@ -456,15 +521,19 @@ class Builder {
 
     /// offset(r > 0): the Minkowski sum of the child with a disk of radius r, exact. The sum
     /// distributes over union, and a convex piece's sum is the piece, a rectangle outward of each
-    /// edge and a disk at each vertex; a disk's sum is the disk of radius + r. Negative r, delta
-    /// and children made by intersection or difference are refused by name.
+    /// edge and a disk at each vertex; a disk's sum is the disk of radius + r. r < 0 erodes
+    /// (erode), delta moves the outline (offsetDelta); children made by intersection or
+    /// difference are refused by name.
     Built offsetNode(const Node& n, const glm::dmat3& af, const Node& extrude) {
         Args a(src_, n, {}, {"r", "delta", "chamfer"});
-        if (a.get("delta") && !a.get("r"))
-            src_.fail(a.get("delta")->pos, "offset(delta = ...) is not supported (only r > 0)");
+        // As OpenSCAD: r when given (round corners), else delta (mitred or chamfered).
+        const bool byDelta = !a.get("r") && a.get("delta");
+        const char* which = byDelta ? "delta" : "r";
+        const bool chamfer = a.boolean("chamfer", false);
         double r = 0.0;
-        if (auto v = a.number("r")) r = *v;
-        if (!std::isfinite(r)) src_.fail(a.get("r")->pos, "offset(r) must be finite");
+        if (auto v = a.number(which)) r = *v;
+        if (!std::isfinite(r))
+            src_.fail(a.get(which)->pos, std::string("offset(") + which + ") must be finite");
         // The radius in the parent frame: af must be a similarity for the disk to stay a disk.
         Vec2 ex(af[0][0], af[0][1]), ey(af[1][0], af[1][1]);
         double sx = glm::length(ex), sy = glm::length(ey);
@@ -474,10 +543,92 @@ class Builder {
         double rr = r * sx;
         Built b = regionUnion(n.children, af, extrude);
         if (b.kind != Built::Kind::Node || rr == 0.0) return b;
+        if (byDelta) return offsetDelta(b.node, rr, chamfer, n.pos);
         if (rr < 0.0) return erode(b.node, -rr, n.pos);
         std::vector<int> items;
         grow(b.node, rr, n.pos, items);
         return Built::of(regionOp(Region::Kind::Union, items, n.pos));
+    }
+
+    /// offset(delta = d): the region's outline moved out by d (in by -d), mitred or chamfered
+    /// at its corners as Clipper does (offsetAdditions), exactly. A circle, which has no corner,
+    /// becomes the circle of radius + d. The outline must be the children's paths: squares,
+    /// polygons, text and DXF drawings whose outlines neither cross nor touch (nor, for d > 0,
+    /// lie inside another child's, where the union's outline would not be theirs; for d < 0,
+    /// of one child, as a negative r). Anything else is refused by name.
+    Built offsetDelta(int id, double d, bool chamfer, size_t pos) {
+        std::vector<int> disks, shapes, stack{id};
+        while (!stack.empty()) {
+            const int i = stack.back();
+            stack.pop_back();
+            const Region& g = regions_[size_t(i)];
+            if (outlines_.count(i)) {
+                shapes.push_back(i);
+            } else if (g.kind == Region::Kind::Disk) {
+                disks.push_back(i);
+            } else if (g.kind == Region::Kind::Union) {
+                stack.push_back(g.a);
+                stack.push_back(g.b);
+            } else {
+                src_.fail(pos, "offset(delta) of the shape made at " + src_.where(g.pos) +
+                                   " (a boolean or an offset) is not supported: Lancer offsets "
+                                   "by delta squares, polygons, text, DXF drawings and circles");
+            }
+        }
+        if (!disks.empty()) {
+            if (disks.size() + shapes.size() > 1)
+                src_.fail(pos, "offset(delta) of a circle (at " +
+                                   src_.where(regions_[size_t(disks[0])].pos) +
+                                   ") beside other shapes is not supported (only of one circle)");
+            const int c = offsetCircle(regions_[size_t(disks[0])], d, pos);
+            return c < 0 ? Built::empty() : Built::of(c);
+        }
+        if (d < 0.0 && shapes.size() > 1)
+            src_.fail(pos,
+                      "offset(delta < 0) is supported of one square, polygon, glyph or DXF "
+                      "drawing only (the shapes made at " +
+                          src_.where(regions_[size_t(shapes[0])].pos) + " and " +
+                          src_.where(regions_[size_t(shapes[1])].pos) + ")");
+        std::vector<std::vector<Vec2>> paths;
+        std::vector<size_t> owner;
+        for (size_t k = 0; k < shapes.size(); ++k)
+            for (const auto& q : outlines_.at(shapes[k])) {
+                paths.push_back(q);
+                owner.push_back(k);
+            }
+        std::vector<Outline> outs;
+        if (!regionOutlines(paths, outs))
+            src_.fail(pos, "offset(delta) of outlines that cross or touch (of the shape" +
+                               std::string(shapes.size() > 1 ? "s" : "") + " made at " +
+                               src_.where(regions_[size_t(shapes[0])].pos) +
+                               (shapes.size() > 1 ? ", ..." : "") +
+                               ") is not supported: their region's outline is not their paths");
+        std::vector<std::vector<Vec2>> loops;
+        for (const Outline& o : outs) {
+            const size_t k = owner[size_t(o.source)];
+            if (o.parent >= 0 && owner[size_t(outs[size_t(o.parent)].source)] != k)
+                src_.fail(
+                    pos,
+                    "offset(delta) of the shape made at " +
+                        src_.where(regions_[size_t(shapes[k])].pos) +
+                        ", which lies inside the shape made at " +
+                        src_.where(
+                            regions_[size_t(shapes[owner[size_t(outs[size_t(o.parent)].source)]])]
+                                .pos) +
+                        ", is not supported: their union's outline is not theirs");
+            loops.push_back(o.points);
+            // Shrinking grows the complement: the outline the other way round.
+            if (d < 0.0) std::reverse(loops.back().begin(), loops.back().end());
+        }
+        std::vector<int> items;
+        for (const auto& poly : offsetAdditions(loops, std::abs(d), chamfer))
+            for (ConvexPiece& c : convexPieces({poly}))
+                items.push_back(
+                    region({Region::Kind::Piece, std::move(c), glm::dmat3(1.0), -1, -1, pos}));
+        if (items.empty()) return Built::of(id);
+        const int added = regionOp(Region::Kind::Union, items, pos);
+        return Built::of(d > 0.0 ? regionOp(Region::Kind::Union, {id, added}, pos)
+                                 : regionOp(Region::Kind::Difference, {id, added}, pos));
     }
 
     /// The circle `disk` (a Disk region) offset by `r` (either sign) as a new Disk region; -1
@@ -603,7 +754,9 @@ class Builder {
         for (ConvexPiece& p : ps)
             items.push_back(
                 region({Region::Kind::Piece, std::move(p), glm::dmat3(1.0), -1, -1, pos, edge}));
-        return Built::of(regionOp(Region::Kind::Union, items, pos));
+        const int id = regionOp(Region::Kind::Union, items, pos);
+        outlines_[id] = paths;
+        return Built::of(id);
     }
 
     Vec2 vec2(const Args& a, const Value& v, const std::string& what) {
@@ -641,9 +794,26 @@ class Builder {
                 r = nonNegative(a, "r", *rr);
             if (r == 0.0) return emptyPrimitive();
             ++counts_.circles;
+            if (facets_) {
+                // OpenSCAD's polygon of the circle; its sagitta, stretched by the plane map, is
+                // the profile's error until the extrusion's transform is known.
+                const int k = fragmentRule(n).fragments(r);
+                std::vector<Vec2> poly = circlePolygon(r, k);
+                for (Vec2& p : poly) p = apply(p);
+                ++counts_.facetedShapes;
+                profileSagitta_ = std::max(profileSagitta_, sagitta(r, k) * planeStretch(af));
+                return pieces({poly}, n.pos);
+            }
             glm::dmat3 s(1.0);
             s[0][0] = s[1][1] = r;
-            return Built::of(region({Region::Kind::Disk, {}, af * s, -1, -1, n.pos}));
+            return Built::of(region({Region::Kind::Disk,
+                                     {},
+                                     af * s,
+                                     -1,
+                                     -1,
+                                     n.pos,
+                                     0.0,
+                                     fragmentRule(n).fragments(r)}));
         }
         Args a(src_, n, {"points", "paths", "convexity"}, {});
         const Value* pts = a.get("points");
@@ -734,6 +904,7 @@ class Builder {
         }
         bool center = a.boolean("center", false);
         Built r = regionUnion(n.children, glm::dmat3(1.0), n);
+        noteProfileFacets(xf, std::max({1.0, scale.x, scale.y}));
         if (r.kind != Built::Kind::Node) return r;
         if (!(h > 0.0)) return emptyPrimitive();  // OpenSCAD makes nothing of it
         ++counts_.linearExtrudes;
@@ -755,8 +926,11 @@ class Builder {
                                      " convex pieces is over the " +
                                      std::to_string(kMaxTwistPolytopes) +
                                      " polytopes Lancer makes of a twisted extrusion");
-            tw.sub = std::min(twistSubSlices(r.node, tw, std::sqrt(regionMaxR2(r.node))),
-                              std::max(1, int(double(kMaxTwistPolytopes) / (slices * pieces))));
+            const int parts = twistParts_ > 0
+                                  ? std::min(twistParts_, kMaxTwistSubSlices)
+                                  : twistSubSlices(r.node, tw, std::sqrt(regionMaxR2(r.node)));
+            tw.sub =
+                std::min(parts, std::max(1, int(double(kMaxTwistPolytopes) / (slices * pieces))));
             counts_.twistSubSlices = std::max(counts_.twistSubSlices, tw.sub);
             return twistRegion(r.node, n, tw);
         }
@@ -880,6 +1054,8 @@ class Builder {
     }
 
     static constexpr int kMaxTwistSlices = 10000;  ///< slices beyond this are refused
+    /// The most facets (fragments times rings) of one faceted sphere: $fn = 1414.
+    static constexpr double kMaxSphereFacets = 1e6;
     static constexpr int kMaxTwistSubSlices = 16;  ///< the most a slice is cut again
     /// The most polytopes one twisted extrusion makes (example020's spring: 20,480).
     static constexpr int kMaxTwistPolytopes = 200000;
@@ -1196,6 +1372,7 @@ class Builder {
                 "rotate_extrude(file = ...) imports a DXF drawing, which Lancer does not read");
         double angle = std::clamp(a.number("angle").value_or(360.0), -360.0, 360.0);
         Built r = regionUnion(n.children, glm::dmat3(1.0), n);
+        noteProfileFacets(xf, 1.0);
         if (r.kind != Built::Kind::Node) return r;
         if (angle == 0.0) return emptyPrimitive();
         Box3 box = regionBox(r.node);
@@ -1484,12 +1661,18 @@ class Builder {
         std::vector<Vec3> centres;
         std::vector<double> radii;
         std::vector<size_t> ballPos;
+        bool ellipsoid = false;  ///< a sphere under a transform that is not a similarity
+        /// OpenSCAD's facets of the curved children (spheres, cylinders, cones), and how far the
+        /// farthest strays inside its exact surface (in the hull's frame).
+        std::vector<Vec3> facetPoints;
+        double facetError = 0.0;
+        int curved = 0;  ///< cylinders and cones
     };
 
     [[noreturn]] void refuseInHull(const Node& n, const Node& hull) {
         src_.fail(n.pos, "'" + n.name + "' inside hull() at " + src_.where(hull.pos) +
-                             " is not supported: Lancer takes the exact hull of cubes, polyhedra "
-                             "and spheres of one radius (and their groups and transforms)");
+                             " is not supported: Lancer takes the hull of cubes, polyhedra, "
+                             "spheres and cylinders (and their groups and transforms)");
     }
 
     void gatherHull(const Node& n, const Transform& t, const Node& hull, HullInput& in) {
@@ -1523,12 +1706,43 @@ class Builder {
             for (const Vec3& p : pts) in.points.push_back(t.point(p));
             return;
         }
-        if (k == "cube" || k == "sphere") {
+        if (k == "cube" || k == "sphere" || k == "cylinder") {
             if (!n.children.empty()) src_.fail(n.children.front().pos, k + "() takes no children");
             Transform local;
             std::optional<Shape> s = primitiveShape(n, local);
             if (!s) return;
             const Transform tl = t * local;
+            if (!std::holds_alternative<Block>(*s)) {
+                // OpenSCAD's facets of it, should the hull not be the exact one of equal balls.
+                const FragmentRule rule = fragmentRule(n);
+                std::vector<Vec3> f;
+                double err = 0.0;
+                const Sphere* round = std::get_if<Sphere>(&*s);
+                const Cone* cone = std::get_if<Cone>(&*s);
+                const int kf = rule.fragments(round ? round->r : std::max(cone->r1, cone->r2));
+                // Refused before the points are made: a sphere of n fragments has n (n + 1) / 2.
+                const double more = round ? double(kf) * double((kf + 1) / 2) : 2.0 * kf;
+                if (double(in.facetPoints.size() + in.points.size()) + more >
+                    double(kMaxHullPoints))
+                    src_.fail(n.pos, "hull() at " + src_.where(hull.pos) + " of more than " +
+                                         std::to_string(kMaxHullPoints) +
+                                         " points (its curved children's facets) is not "
+                                         "supported");
+                if (const Sphere* sp = round) {
+                    const int k2 = kf;
+                    f = spherePoints(sp->r, k2);
+                    err = sphereFacetError(sp->r, k2);
+                } else {
+                    const Cone& c = *cone;
+                    const int k2 = kf;
+                    f = cylinderPoints(c.r1, c.r2, c.h, k2);
+                    err = sagitta(std::max(c.r1, c.r2), k2);
+                    ++in.curved;
+                }
+                for (const Vec3& p : f) in.facetPoints.push_back(tl.point(p));
+                in.facetError = std::max(in.facetError, err * stretch(tl));
+                if (std::holds_alternative<Cone>(*s)) return;
+            }
             if (const Block* b = std::get_if<Block>(&*s)) {
                 for (int c = 0; c < 8; ++c)
                     in.points.push_back(
@@ -1544,8 +1758,7 @@ class Builder {
             if (std::abs(glm::dot(c0, c1)) > e || std::abs(glm::dot(c0, c2)) > e ||
                 std::abs(glm::dot(c1, c2)) > e || std::abs(glm::dot(c1, c1) - l * l) > e ||
                 std::abs(glm::dot(c2, c2) - l * l) > e)
-                src_.fail(n.pos, "a sphere scaled unevenly (an ellipsoid) inside hull() at " +
-                                     src_.where(hull.pos) + " is not supported");
+                in.ellipsoid = true;
             in.centres.push_back(tl.point(sp.c));
             in.radii.push_back(sp.r * l);
             in.ballPos.push_back(n.pos);
@@ -1556,29 +1769,30 @@ class Builder {
 
     /// hull(): of corner points, the convex polytope of their hull; of balls of one radius r,
     /// the hull of their centres grown by r, exactly the union of that hull, a slab over each
-    /// face, a cylinder along each edge and a ball at each vertex.
+    /// face, a cylinder along each edge and a ball at each vertex. Of anything else curved
+    /// (spheres of different radii, ellipsoids, cylinders, cones, round children beside
+    /// corners; and every round child with --facets openscad), the polytope of the corners and
+    /// OpenSCAD's facets of the curved children at their $fn, $fa, $fs, as OpenSCAD takes it;
+    /// its error is the facets' (OpenScadCounts::facetError).
     Built hullNode(const Node& n, const Transform& xf, int mat) {
         Args(src_, n, {}, {});
         ++counts_.operators;
         HullInput in;
         for (const Node& c : n.children) gatherHull(c, Transform(), n, in);
-        if (!in.points.empty() && !in.centres.empty())
-            src_.fail(n.pos,
-                      "hull() of spheres together with cubes or polyhedra is not "
-                      "supported (its surface has patches of neither)");
+        bool exactBalls =
+            !in.centres.empty() && in.points.empty() && !in.curved && !in.ellipsoid && !facets_;
+        for (size_t i = 1; exactBalls && i < in.radii.size(); ++i)
+            exactBalls = std::abs(in.radii[i] - in.radii[0]) <= 1e-12 * in.radii[0];
+        if (!exactBalls && !in.facetPoints.empty()) {
+            in.points.insert(in.points.end(), in.facetPoints.begin(), in.facetPoints.end());
+            in.centres.clear();
+            counts_.facetError = std::max(counts_.facetError, in.facetError * stretch(xf));
+            counts_.facetedShapes += 1;
+        }
         const bool balls = !in.centres.empty();
         std::vector<Vec3>& pts = balls ? in.centres : in.points;
         if (pts.empty()) return Built::empty();
-        double r = 0.0;
-        if (balls) {
-            r = in.radii[0];
-            for (size_t i = 1; i < in.radii.size(); ++i)
-                if (std::abs(in.radii[i] - r) > 1e-12 * r)
-                    src_.fail(in.ballPos[i], "hull() of spheres of different radii (" +
-                                                 twistText(r) + " and " + twistText(in.radii[i]) +
-                                                 ") is not supported: Lancer takes the exact hull "
-                                                 "of spheres of one radius");
-        }
+        const double r = balls ? in.radii[0] : 0.0;
         {
             std::sort(pts.begin(), pts.end(), [](const Vec3& a, const Vec3& b) {
                 return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
@@ -1600,6 +1814,7 @@ class Builder {
             ++counts_.polytopes;
             items.push_back(place(std::move(pt), xf, mat, n.pos, "hull()").node);
         };
+        if (h.dim == 3 && h.planes.size() > 255 && !balls) return wedgedHull(h, xf, mat, n.pos);
         if (h.dim == 3 && h.planes.size() > 255)
             src_.fail(n.pos,
                       "hull() has more than 255 faces, which Lancer's polytope does not "
@@ -1640,6 +1855,82 @@ class Builder {
             items.push_back(place(Sphere{v, r}, xf, mat, n.pos, "hull()").node);
         }
         return Built::of(scene_.tree.balanced(Op::Union, items));
+    }
+
+    /// A convex hull of more faces than a polytope holds (a hull of facets), cut into wedges
+    /// about the vertical line through its vertices' mean: each wedge the polytope of its two
+    /// planes through the line and of the hull's faces that may meet it (a face with a vertex
+    /// on the inner side of each wedge plane; every face that meets the wedge has), which bound
+    /// the hull within the wedge exactly. Neighbouring wedges share a plane negated to the bit.
+    Built wedgedHull(const ConvexHull3& h, const Transform& xf, int mat, size_t pos) {
+        Vec3 c(0.0);
+        for (const Vec3& v : h.vertices) c += v;
+        c /= double(h.vertices.size());
+        // How far the line through c runs inside the hull (the wedges' common edge).
+        double t0 = -kInf, t1 = kInf;
+        for (const glm::dvec4& q : h.planes) {
+            const double room = q.w - glm::dot(Vec3(q), c);
+            if (q.z > 0.0) t1 = std::min(t1, room / q.z);
+            if (q.z < 0.0) t0 = std::max(t0, room / q.z);
+        }
+        for (int wedges = std::max(3, int(h.planes.size() / 200) + 1);; wedges *= 2) {
+            std::vector<Polytope> parts;
+            // Each side's outward normal, the wedge s between sides s and s + 1 (the last side
+            // the first one negated).
+            std::vector<Vec3> side(static_cast<size_t>(wedges));
+            for (int s = 0; s < wedges; ++s) {
+                const double a = 2.0 * M_PI * s / wedges;
+                side[size_t(s)] = Vec3(std::sin(a), -std::cos(a), 0.0);
+            }
+            auto inside = [&](const Vec3& p, const Vec3& nn) {
+                return glm::dot(nn, p - c) <= 1e-9 * glm::length(p - c);
+            };
+            bool fits = true;
+            for (int s = 0; s < wedges && fits; ++s) {
+                const Vec3 n0 = side[size_t(s)], n1 = -side[size_t((s + 1) % wedges)];
+                Polytope pt;
+                for (size_t f = 0; f < h.faces.size(); ++f) {
+                    bool in0 = false, in1 = false;
+                    for (int v : h.faces[f]) {
+                        in0 = in0 || inside(h.vertices[size_t(v)], n0);
+                        in1 = in1 || inside(h.vertices[size_t(v)], n1);
+                    }
+                    if (in0 && in1) pt.planes.push_back(h.planes[f]);
+                }
+                pt.planes.push_back(glm::dvec4(n0, glm::dot(n0, c)));
+                pt.planes.push_back(glm::dvec4(n1, glm::dot(n1, c)));
+                if (pt.planes.size() > 255) {
+                    fits = false;
+                    break;
+                }
+                // Its corners: hull vertices inside it, hull edges crossing its sides, and the
+                // ends of its edge on the line.
+                Box3 box;
+                box.expand(c + Vec3(0.0, 0.0, t0));
+                box.expand(c + Vec3(0.0, 0.0, t1));
+                for (const Vec3& v : h.vertices)
+                    if (inside(v, n0) && inside(v, n1)) box.expand(v);
+                for (const auto& [i, j] : h.edges) {
+                    const Vec3 &u = h.vertices[size_t(i)], &v = h.vertices[size_t(j)];
+                    for (int k = 0; k < 2; ++k) {
+                        const Vec3& nk = k ? n1 : n0;
+                        const double du = glm::dot(nk, u - c), dv = glm::dot(nk, v - c);
+                        if ((du < 0.0) == (dv < 0.0)) continue;
+                        const Vec3 p = u + (v - u) * (du / (du - dv));
+                        if (inside(p, k ? n0 : n1)) box.expand(p);
+                    }
+                }
+                pt.bounds = padded(box);
+                parts.push_back(std::move(pt));
+            }
+            if (!fits) continue;
+            std::vector<int> items;
+            for (Polytope& pt : parts) {
+                ++counts_.polytopes;
+                items.push_back(place(std::move(pt), xf, mat, pos, "hull()").node);
+            }
+            return Built::of(scene_.tree.balanced(Op::Union, items));
+        }
     }
 
     [[noreturn]] void refuse(const Node& n) {
@@ -1794,12 +2085,126 @@ class Builder {
         Transform local;
         std::optional<Shape> shape = primitiveShape(n, local);
         if (!shape) return emptyPrimitive();
+        if (facets_ && !std::holds_alternative<Block>(*shape))
+            return facetedPrimitive(n, *shape, xf * local, mat);
         Primitive p = makePrimitive(std::move(*shape), xf * local, mat);
         if (!p.worldBox.isBounded())
             src_.fail(n.pos, n.name + "() is too large: its bounds overflow a double");
         p.origin = src_.where(n.pos);
         scene_.prims.push_back(std::move(p));
         return Built::of(scene_.tree.leaf(uint32_t(scene_.prims.size() - 1)));
+    }
+
+    // ---- OpenSCAD's facets (--facets openscad) ----
+
+    /// The node's $fn, $fa, $fs (OpenSCAD's defaults when absent), checked as OpenSCAD needs
+    /// them to count fragments.
+    FragmentRule fragmentRule(const Node& n) const {
+        FragmentRule f{special(n, "$fn", 0.0), special(n, "$fa", 12.0), special(n, "$fs", 2.0)};
+        if (!(f.fa > 0.0 && f.fs > 0.0))
+            src_.fail(n.pos, n.name + "() needs $fa > 0 and $fs > 0 to count its facets");
+        if (f.fn > double(kMaxFragments))
+            src_.fail(n.pos, n.name + "() with $fn = " + twistText(f.fn) +
+                                 ": Lancer makes at most " + std::to_string(kMaxFragments) +
+                                 " facets of a circle");
+        return f;
+    }
+
+    /// The most a 2D affine map stretches a length.
+    static double planeStretch(const glm::dmat3& af) {
+        Transform t;
+        t.m = Mat4(1.0);
+        t.m[0] = {af[0][0], af[0][1], 0.0, 0.0};
+        t.m[1] = {af[1][0], af[1][1], 0.0, 0.0};
+        return stretch(t);
+    }
+
+    /// Folds the faceted circles of a profile just read into the model's facet error, in model
+    /// units: stretched by the extrusion's transform and its largest scale `grow`.
+    void noteProfileFacets(const Transform& xf, double grow) {
+        counts_.facetError = std::max(counts_.facetError, profileSagitta_ * stretch(xf) * grow);
+        profileSagitta_ = 0.0;
+    }
+
+    /// One band of a faceted solid of revolution about z: the `n`-gon of radius r0 at z0 below
+    /// the one of radius r1 at z1 (their corners at the same angles; a radius of 0 is an apex),
+    /// as OpenSCAD's polyhedron has it: a convex polytope of its n side planes and two caps, cut
+    /// into sectors by planes through the axis when that is over the 255 planes of a polytope.
+    /// Returns the smallest distance of a side plane from the origin.
+    double facetBand(double r0, double z0, double r1, double z1, int n, const Transform& xf,
+                     int mat, size_t pos, const std::string& what, std::vector<int>& items) {
+        const std::vector<Vec2> lo = circlePolygon(r0, n), hi = circlePolygon(r1, n);
+        std::vector<glm::dvec4> sides(static_cast<size_t>(n));
+        double nearest = kInf;
+        for (int j = 0; j < n; ++j) {
+            const int k = (j + 1) % n;
+            const Vec3 p0(lo[size_t(j)], z0), p1(lo[size_t(k)], z0), q0(hi[size_t(j)], z1),
+                q1(hi[size_t(k)], z1);
+            // The plane through the wider ring's edge and the other ring's corner.
+            Vec3 nn = r0 >= r1 ? glm::cross(p1 - p0, q0 - p0) : glm::cross(q1 - q0, p0 - q0);
+            const Vec2 mid = lo[size_t(j)] + lo[size_t(k)] + hi[size_t(j)] + hi[size_t(k)];
+            if (glm::dot(Vec2(nn), mid) < 0.0) nn = -nn;
+            nn = glm::normalize(nn);
+            sides[size_t(j)] = glm::dvec4(nn, glm::dot(nn, r0 >= r1 ? p0 : q0));
+            nearest = std::min(nearest, sides[size_t(j)].w);
+        }
+        const int sectors = n + 2 <= 255 ? 1 : std::max(3, (n + 249) / 250);
+        for (int s = 0; s < sectors; ++s) {
+            const int j0 = int(int64_t(s) * n / sectors), j1 = int(int64_t(s + 1) * n / sectors);
+            Polytope pt;
+            Box3 box;
+            for (int j = j0; j < j1; ++j) pt.planes.push_back(sides[size_t(j)]);
+            for (int j = j0; j <= j1; ++j) {
+                box.expand(Vec3(lo[size_t(j % n)], z0));
+                box.expand(Vec3(hi[size_t(j % n)], z1));
+            }
+            if (sectors > 1) {
+                // Through the axis at the sector's first and last corner (shared planes are
+                // negated exactly, so neighbouring sectors meet to the bit).
+                const double a0 = 360.0 * j0 / n, a1 = 360.0 * (j1 % n) / n;
+                pt.planes.push_back({sinDegrees(a0), -cosDegrees(a0), 0.0, 0.0});
+                pt.planes.push_back({-sinDegrees(a1), cosDegrees(a1), 0.0, 0.0});
+                box.expand(Vec3(0.0, 0.0, z0));
+                box.expand(Vec3(0.0, 0.0, z1));
+            }
+            pt.planes.push_back({0.0, 0.0, -1.0, -z0});
+            pt.planes.push_back({0.0, 0.0, 1.0, z1});
+            pt.bounds = padded(box);
+            ++counts_.polytopes;
+            items.push_back(place(std::move(pt), xf, mat, pos, what).node);
+        }
+        return nearest;
+    }
+
+    /// sphere() or cylinder() as OpenSCAD's polyhedron of it (facetBand per band between two
+    /// rings), its sagitta recorded in OpenScadCounts::facetError.
+    Built facetedPrimitive(const Node& n, const Shape& shape, const Transform& xf, int mat) {
+        const FragmentRule rule = fragmentRule(n);
+        std::vector<int> items;
+        double error = 0.0;
+        const std::string what = n.name + "()";
+        if (const Sphere* s = std::get_if<Sphere>(&shape)) {
+            const int k = rule.fragments(s->r);
+            if (double(k) * double((k + 1) / 2) > kMaxSphereFacets)
+                src_.fail(n.pos, "sphere() of " + std::to_string(k) +
+                                     " fragments: Lancer makes at most " +
+                                     twistText(kMaxSphereFacets) + " facets of a sphere");
+            const SphereRings rings = sphereRings(s->r, k);
+            double nearest = rings.z.front();  // the caps
+            for (size_t i = 0; i + 1 < rings.z.size(); ++i)
+                nearest = std::min(nearest,
+                                   facetBand(rings.radius[i + 1], rings.z[i + 1], rings.radius[i],
+                                             rings.z[i], rings.n, xf, mat, n.pos, what, items));
+            error = s->r - nearest;  // every corner lies on the sphere
+        } else {
+            const Cone& c = std::get<Cone>(shape);
+            const int k = rule.fragments(std::max(c.r1, c.r2));
+            facetBand(c.r1, 0.0, c.r2, c.h, k, xf, mat, n.pos, what, items);
+            error = sagitta(std::max(c.r1, c.r2), k);
+        }
+        ++counts_.facetedShapes;
+        counts_.facetError = std::max(counts_.facetError, error * stretch(xf));
+        return Built::of(scene_.tree.balanced(Op::Union, items));
     }
 
     /// cube(), sphere() or cylinder() as a shape placed by `local` in the node's frame; nothing
@@ -1945,17 +2350,24 @@ class Builder {
     const SourceText& src_;
     Scene& scene_;
     OpenScadCounts& counts_;
+    const bool facets_;  ///< --facets openscad: round shapes as OpenSCAD's polygons and polyhedra
+    const int twistParts_;  ///< ReadOptions::twistParts
+    /// The largest sagitta of the faceted circles of the profile being read (2D units).
+    double profileSagitta_ = 0.0;
     std::map<std::tuple<double, double, double>, int> materialOf_;
     std::vector<Region> regions_;
+    /// The paths (even-odd) of the regions that pieces() made, by region: their outlines, for
+    /// offset(delta).
+    std::map<int, std::vector<std::vector<Vec2>>> outlines_;
     const Node* first2D_ = nullptr;  ///< the first 2D node met among solids
 };
 
 }  // namespace
 
 void buildModel(const SourceText& src, const std::vector<Node>& top, Scene& scene,
-                OpenScadCounts& counts) {
+                OpenScadCounts& counts, const ReadOptions& options) {
     scene.materials[0].color = hexColor(kDefaultColor);
-    scene.tree.root = Builder(src, scene, counts).model(top);
+    scene.tree.root = Builder(src, scene, counts, options).model(top);
 }
 
 }  // namespace lancer::openscad

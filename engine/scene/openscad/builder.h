@@ -15,6 +15,6 @@ namespace lancer::openscad {
 /// (material 0 becomes OpenSCAD's default colour) and CSG tree, whose root is -1 when the model
 /// is empty. Throws SceneError naming file:line:col.
 void buildModel(const SourceText& src, const std::vector<Node>& top, Scene& scene,
-                OpenScadCounts& counts);
+                OpenScadCounts& counts, const ReadOptions& options = {});
 
 }  // namespace lancer::openscad

@@ -46,6 +46,92 @@ void orderAbout(std::vector<int>& face, const std::vector<Vec3>& p, const Vec3& 
     });
 }
 
+/// The supporting plane through the line a b that turning a plane about the directed line
+/// a -> b reaches first (gift wrapping; the turn of a face whose boundary runs a -> b
+/// counter-clockwise about its outward normal finds the face across that edge): false when every
+/// point lies on the line or the plane found does not hold every point on one side.
+bool wrapPlane(const std::vector<Vec3>& p, const Vec3& a, const Vec3& b, double tol,
+               glm::dvec4& plane) {
+    const Vec3 ab = b - a;
+    const double lab = glm::length(ab);
+    const Vec3* c = nullptr;
+    for (const Vec3& q : p) {
+        if (glm::length(glm::cross(ab, q - a)) <= tol * lab) continue;  // on the line
+        if (!c) {
+            c = &q;
+            continue;
+        }
+        const Vec3 nc = glm::cross(a - b, *c - b);
+        if (glm::dot(nc, q - b) > tol * glm::length(nc)) c = &q;  // beyond: turn on to it
+    }
+    if (!c) return false;
+    const Vec3 nn = glm::normalize(glm::cross(a - b, *c - b));
+    plane = glm::dvec4(nn, glm::dot(nn, a));
+    for (const Vec3& q : p)
+        if (glm::dot(nn, q) - plane.w > tol) return false;
+    return true;
+}
+
+/// The faces of the hull of `p` (not flat): from a supporting plane at the lowest point, each
+/// face's neighbours found by wrapping about its edges, O(points x edges). A face is every point
+/// within `tol` of its plane, ordered about it, collinear points dropped.
+void wrapFaces(const std::vector<Vec3>& p, double tol, std::vector<glm::dvec4>& planes,
+               std::vector<std::vector<int>>& faces) {
+    auto known = [&](const glm::dvec4& q) {
+        for (const glm::dvec4& k : planes)
+            if (glm::dot(Vec3(k), Vec3(q)) > 1.0 - 1e-12 && std::abs(k.w - q.w) <= tol) return true;
+        return false;
+    };
+    std::vector<std::pair<int, int>> todo;  // directed edges whose neighbour is sought
+    auto addFace = [&](const glm::dvec4& q) {
+        if (known(q)) return;
+        std::vector<int> face;
+        for (size_t m = 0; m < p.size(); ++m)
+            if (std::abs(glm::dot(Vec3(q), p[m]) - q.w) <= tol) face.push_back(int(m));
+        orderAbout(face, p, Vec3(q));
+        dropCollinear(face, p, tol);
+        planes.push_back(q);
+        for (size_t e = 0; e < face.size(); ++e)
+            todo.push_back({face[e], face[(e + 1) % face.size()]});
+        faces.push_back(std::move(face));
+    };
+    // p[0] is the lowest in x (then y, z): the plane x = p[0].x supports the hull. Turned about
+    // a line through p[0] in it, it meets a face or an edge; about that edge, a face.
+    glm::dvec4 first;
+    const Vec3 a = p[0];
+    bool found = false;
+    for (const Vec3& d : {Vec3(0, 0, 1), Vec3(0, 0, -1), Vec3(0, 1, 0), Vec3(0, -1, 0)}) {
+        if (!wrapPlane(p, a, a + d, tol, first)) continue;
+        std::vector<int> on;
+        for (size_t m = 0; m < p.size(); ++m)
+            if (std::abs(glm::dot(Vec3(first), p[m]) - first.w) <= tol) on.push_back(int(m));
+        // The points on the plane: a face, or (all on one line) an edge to turn about.
+        size_t far = 0;
+        for (size_t k = 0; k < on.size(); ++k)
+            if (glm::length(p[size_t(on[k])] - a) > glm::length(p[size_t(on[far])] - a)) far = k;
+        const Vec3 e = p[size_t(on[far])] - a;
+        bool line = true;
+        for (int m : on)
+            line = line && glm::length(glm::cross(e, p[size_t(m)] - a)) <= tol * glm::length(e);
+        if (!line) {
+            found = true;
+            break;
+        }
+        if (wrapPlane(p, a, a + e, tol, first) || wrapPlane(p, a + e, a, tol, first)) {
+            found = true;
+            break;
+        }
+    }
+    if (!found) return;
+    addFace(first);
+    while (!todo.empty()) {
+        const auto [i, j] = todo.back();
+        todo.pop_back();
+        glm::dvec4 q;
+        if (wrapPlane(p, p[size_t(i)], p[size_t(j)], tol, q)) addFace(q);
+    }
+}
+
 }  // namespace
 
 ConvexHull3 convexHull3(std::vector<Vec3> pts) {
@@ -123,39 +209,7 @@ ConvexHull3 convexHull3(std::vector<Vec3> pts) {
         faces = {ring};
     } else {
         h.dim = 3;
-        const size_t n = pts.size();
-        for (size_t i = 0; i < n; ++i)
-            for (size_t j = i + 1; j < n; ++j)
-                for (size_t k = j + 1; k < n; ++k) {
-                    Vec3 nn = glm::cross(pts[j] - pts[i], pts[k] - pts[i]);
-                    const double len = glm::length(nn);
-                    if (!(len >
-                          1e-12 * glm::length(pts[j] - pts[i]) * glm::length(pts[k] - pts[i])))
-                        continue;
-                    nn /= len;
-                    const double w = glm::dot(nn, pts[i]);
-                    int above = 0, below = 0;
-                    for (const Vec3& p : pts) {
-                        const double d = glm::dot(nn, p) - w;
-                        above += d > tol;
-                        below += d < -tol;
-                    }
-                    if (above && below) continue;
-                    if (above) nn = -nn;
-                    const double ww = glm::dot(nn, pts[i]);
-                    bool known = false;
-                    for (const glm::dvec4& q : h.planes)
-                        known = known ||
-                                (glm::dot(Vec3(q), nn) > 1.0 - 1e-12 && std::abs(q.w - ww) <= tol);
-                    if (known) continue;
-                    std::vector<int> face;
-                    for (size_t m = 0; m < n; ++m)
-                        if (std::abs(glm::dot(nn, pts[m]) - ww) <= tol) face.push_back(int(m));
-                    orderAbout(face, pts, nn);
-                    dropCollinear(face, pts, tol);
-                    h.planes.push_back(glm::dvec4(nn, ww));
-                    faces.push_back(std::move(face));
-                }
+        wrapFaces(pts, tol, h.planes, faces);
     }
     // Renumber the faces' points as the hull's vertices; collect the edges once each.
     std::map<int, int> index;

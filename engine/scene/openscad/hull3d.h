@@ -10,8 +10,8 @@
 
 namespace lancer::openscad {
 
-/// Hulls of more points than this are refused (the search tests every triple of points).
-constexpr size_t kMaxHullPoints = 120;
+/// Hulls of more points than this are refused (gift wrapping takes points times edges).
+constexpr size_t kMaxHullPoints = 20000;
 
 /// The convex hull of a point set.
 struct ConvexHull3 {

@@ -163,6 +163,139 @@ std::vector<ConvexPiece> convexPieces(const std::vector<std::vector<Vec2>>& path
     return trapezoids(paths);
 }
 
+namespace {
+
+/// The sign of the turn a -> b -> c: 1 left, -1 right, 0 on a line.
+int turnSign(const Vec2& a, const Vec2& b, const Vec2& c) {
+    const double t = cross(b - a, c - a);
+    return t > 0.0 ? 1 : t < 0.0 ? -1 : 0;
+}
+
+/// Whether the closed segments ab and cd share a point.
+bool segmentsMeet(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+    const int o1 = turnSign(a, b, c), o2 = turnSign(a, b, d);
+    const int o3 = turnSign(c, d, a), o4 = turnSign(c, d, b);
+    if (o1 == 0 && o2 == 0) {  // on one line: do their extents overlap?
+        const bool alongX = std::abs(b.x - a.x) >= std::abs(b.y - a.y);
+        auto key = [&](const Vec2& p) { return alongX ? p.x : p.y; };
+        return std::max(std::min(key(a), key(b)), std::min(key(c), key(d))) <=
+               std::min(std::max(key(a), key(b)), std::max(key(c), key(d)));
+    }
+    return o1 * o2 <= 0 && o3 * o4 <= 0;
+}
+
+/// Even-odd containment of the point p by the closed path q (p on no edge of q).
+bool encloses(const std::vector<Vec2>& q, const Vec2& p) {
+    bool in = false;
+    for (size_t i = 0, j = q.size() - 1; i < q.size(); j = i++)
+        if ((q[i].y > p.y) != (q[j].y > p.y) &&
+            p.x < q[j].x + (q[i].x - q[j].x) * ((p.y - q[j].y) / (q[i].y - q[j].y)))
+            in = !in;
+    return in;
+}
+
+double signedArea2(const std::vector<Vec2>& q) {
+    double a = 0.0;
+    for (size_t i = 0; i < q.size(); ++i) a += cross(q[i], q[(i + 1) % q.size()]);
+    return a;
+}
+
+}  // namespace
+
+bool regionOutlines(const std::vector<std::vector<Vec2>>& paths, std::vector<Outline>& out) {
+    out.clear();
+    for (size_t i = 0; i < paths.size(); ++i) {
+        std::vector<Vec2> c = cleaned(paths[i]);
+        if (c.size() >= 3) out.push_back({std::move(c), -1, int(i)});
+    }
+    // Every pair of edges that are not neighbours on one path, swept by their x extents.
+    struct Seg {
+        Vec2 a, b;
+        size_t path, index;
+        double x0, x1;
+    };
+    std::vector<Seg> segs;
+    for (size_t k = 0; k < out.size(); ++k) {
+        const std::vector<Vec2>& q = out[k].points;
+        for (size_t i = 0; i < q.size(); ++i) {
+            const Vec2 &a = q[i], &b = q[(i + 1) % q.size()];
+            segs.push_back({a, b, k, i, std::min(a.x, b.x), std::max(a.x, b.x)});
+        }
+    }
+    std::sort(segs.begin(), segs.end(), [](const Seg& s, const Seg& t) { return s.x0 < t.x0; });
+    for (size_t i = 0; i < segs.size(); ++i)
+        for (size_t j = i + 1; j < segs.size() && segs[j].x0 <= segs[i].x1; ++j) {
+            const Seg &s = segs[i], &t = segs[j];
+            if (s.path == t.path) {
+                const size_t n = out[s.path].points.size();
+                if ((s.index + 1) % n == t.index || (t.index + 1) % n == s.index) {
+                    // Neighbours share their corner; they meet elsewhere only folding back.
+                    const Vec2& c = (s.index + 1) % n == t.index ? t.a : s.a;
+                    const Vec2& u = (s.index + 1) % n == t.index ? s.a : t.a;
+                    const Vec2& v = (s.index + 1) % n == t.index ? t.b : s.b;
+                    if (turnSign(u, c, v) == 0 && glm::dot(u - c, v - c) > 0.0) return false;
+                    continue;
+                }
+            }
+            if (segmentsMeet(s.a, s.b, t.a, t.b)) return false;
+        }
+    // No edges meet: each path lies wholly inside or outside each other one.
+    for (size_t k = 0; k < out.size(); ++k) {
+        double best = kInf;
+        for (size_t m = 0; m < out.size(); ++m) {
+            if (m == k || !encloses(out[m].points, out[k].points[0])) continue;
+            const double a = std::abs(signedArea2(out[m].points));
+            if (a < best) best = a, out[k].parent = int(m);
+        }
+    }
+    for (Outline& o : out) {
+        int depth = 0;
+        for (int p = o.parent; p >= 0; p = out[size_t(p)].parent) ++depth;
+        if ((signedArea2(o.points) > 0.0) != (depth % 2 == 0))
+            std::reverse(o.points.begin(), o.points.end());
+    }
+    return true;
+}
+
+std::vector<std::vector<Vec2>> offsetAdditions(const std::vector<std::vector<Vec2>>& outlines,
+                                               double d, bool chamfer) {
+    // Clipper squares a mitre whose 1 + cos(turn) is under 2 / limit^2.
+    constexpr double kMiterLimit = 1e6, kSquareBelow = 2.0 / (kMiterLimit * kMiterLimit);
+    std::vector<std::vector<Vec2>> out;
+    for (const std::vector<Vec2>& q : outlines) {
+        const size_t n = q.size();
+        // Each edge's outward normal (the region is on the left), computed once so that the
+        // rectangles and the corners share their points bit for bit.
+        std::vector<Vec2> normal(n), dir(n);
+        for (size_t i = 0; i < n; ++i) {
+            const Vec2 e = q[(i + 1) % n] - q[i];
+            const double len = glm::length(e);
+            dir[i] = e / len;
+            normal[i] = Vec2(dir[i].y, -dir[i].x);
+            out.push_back(
+                {q[i], q[(i + 1) % n], q[(i + 1) % n] + d * normal[i], q[i] + d * normal[i]});
+        }
+        for (size_t i = 0; i < n; ++i) {
+            const size_t in = (i + n - 1) % n;  // the edge into corner i
+            const Vec2 &v = q[i], &n1 = normal[in], &n2 = normal[i];
+            const double s = cross(n1, n2), c = glm::dot(n1, n2);
+            // Convex: a left turn (or folding straight back); a reflex corner's rectangles
+            // overlap and need nothing more.
+            if (!(s > 0.0 || (s == 0.0 && c < 0.0))) continue;
+            const Vec2 a = v + d * n1, b = v + d * n2;
+            if (!chamfer && 1.0 + c >= kSquareBelow) {
+                out.push_back({v, a, v + d * (n1 + n2) / (1.0 + c), b});
+            } else {
+                // Square to the bisector at distance d from the corner: along each moved edge
+                // by d tan(turn / 4) past its end.
+                const double t = d * std::tan(std::atan2(s, c) / 4.0);
+                out.push_back({v, a, a + t * dir[in], b - t * dir[i], b});
+            }
+        }
+    }
+    return out;
+}
+
 double fragmentsFromR(double r, double fn, double fa, double fs) {
     double f = 3.0;
     if (r < kGridFine || !std::isfinite(fn))

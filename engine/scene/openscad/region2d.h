@@ -36,6 +36,29 @@ constexpr size_t kMaxPieceSides = 250;
 /// x-coordinates of the vertices and crossings, merged along each pair of edges.
 std::vector<ConvexPiece> convexPieces(const std::vector<std::vector<Vec2>>& paths);
 
+/// The outlines of an even-odd region of non-crossing paths: each path (repeated points
+/// dropped) turned so that the region lies on its left (outer outlines counter-clockwise, holes
+/// clockwise), and the index of the innermost other path that encloses it (-1: none). Paths of
+/// fewer than three distinct points are dropped. Returns false, leaving `out` unspecified, when
+/// two edges cross, touch or overlap (the region's outline is then not its paths).
+struct Outline {
+    std::vector<Vec2> points;  ///< the region on the left
+    int parent = -1;           ///< the innermost enclosing outline, or -1
+    int source = 0;            ///< the index of the input path it came from
+};
+bool regionOutlines(const std::vector<std::vector<Vec2>>& paths, std::vector<Outline>& out);
+
+/// What OpenSCAD's offset(delta = d) (Clipper's jtMiter with OpenSCAD's miter limit of 10^6, or
+/// jtSquare with `chamfer`) adds to a region whose outlines have the region on their left, d > 0:
+/// per edge the rectangle of width d outward of it, per convex corner the mitre (the corner of
+/// the two edges' lines moved out by d) or, chamfered, the mitre cut square to the corner's
+/// bisector at distance d from the corner. The region grown is the region and these convex
+/// polygons (Clipper's offset path winds once around each point of that union and of nothing
+/// else). Shrinking by d is growing the complement: the outlines reversed give the polygons to
+/// take away.
+std::vector<std::vector<Vec2>> offsetAdditions(const std::vector<std::vector<Vec2>>& outlines,
+                                               double d, bool chamfer);
+
 /// OpenSCAD's GRID_FINE: a circle of smaller radius is cut into 3 segments.
 constexpr double kGridFine = 0.00000095367431640625;
 
