@@ -11,6 +11,7 @@
 #include "engine/accel/irregular/corner_pointers.h"
 #include "engine/accel/irregular/depth_slabs.h"
 #include "engine/accel/irregular/turned_hulls.h"
+#include "engine/accel/regular/axis_planner.h"
 #include "engine/accel/regular/grid_frame.h"
 #include "engine/util/format.h"
 #include "engine/util/task_fence.h"
@@ -129,6 +130,10 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     if (!hulls.empty()) sp.hulls = &hulls;
     sp.column = ZoneColumn::Parallel;
     sp.hullPad = eps;
+    // A polygon's test costs more than a sphere's (gears2's faces have up to 144 vertices): the
+    // cost stop weighs each as the regular scheme's planner does.
+    const std::vector<float> weights = regular_build::testWeights(scene);
+    sp.weights = &weights;
 
     // The two frames' structures are independent (each within its half of the budget): the
     // projective zones are built as a task beside the camera frame's, which halves the build's

@@ -36,6 +36,9 @@ struct ScreenBspParams {
     const TurnedHulls* hulls = nullptr;
     ZoneColumn column{};   ///< the rays a cell stands for, for `hulls`
     double hullPad = 0.0;  ///< padding of the depth ranges the hulls give a zone (narrowZones)
+    /// What testing each primitive costs, in sphere tests (testWeights(): a polygon weighs
+    /// 1 + vertices / 4), for the cost stop's counts (null: every test alike).
+    const std::vector<float>* weights = nullptr;
 };
 
 /// The screen BSP and its leaves, the zones, each with the primitives whose rectangle it touches.

@@ -54,6 +54,7 @@ class TurnedHulls {
     };
     struct Hull {
         Solid turned, world;
+        bool single = false;  ///< no box of its own axes: the world box alone (`turned` unset)
         /// The turned box's outline, a convex polygon counterclockwise, along each column
         /// (`FromEye`: none when a corner is not in front of the eye).
         std::vector<glm::dvec2> outline[2];
