@@ -130,6 +130,14 @@ TurnedHulls TurnedHulls::make(const Scene& scene, const CameraFrame& frame,
         }
         hull.outline[0] = convexHull(flat);
         if (front) hull.outline[1] = convexHull(eye);
+        for (int c = 0; c < 2; ++c) {
+            hull.outlineLo[c] = glm::dvec2(kInf);
+            hull.outlineHi[c] = glm::dvec2(-kInf);
+            for (glm::dvec2 q : hull.outline[c]) {
+                hull.outlineLo[c] = glm::min(hull.outlineLo[c], q);
+                hull.outlineHi[c] = glm::max(hull.outlineHi[c], q);
+            }
+        }
         h.index_[p] = int32_t(h.hulls_.size());
         h.hulls_.push_back(std::move(hull));
     }
@@ -138,15 +146,12 @@ TurnedHulls TurnedHulls::make(const Scene& scene, const CameraFrame& frame,
 
 bool TurnedHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi) const {
     if (index_.empty() || index_[p] < 0) return true;
-    const std::vector<glm::dvec2>& o = hulls_[index_[p]].outline[int(column)];
+    const Hull& h = hulls_[index_[p]];
+    const std::vector<glm::dvec2>& o = h.outline[int(column)];
     if (o.size() < 3) return true;
     // Separating axes of two convex polygons: the rectangle's (its bound against the outline's)
     // and each outline edge's outward normal, the rectangle's nearest corner beyond it.
-    glm::dvec2 olo(kInf), ohi(-kInf);
-    for (glm::dvec2 q : o) {
-        olo = glm::min(olo, q);
-        ohi = glm::max(ohi, q);
-    }
+    const glm::dvec2 olo = h.outlineLo[int(column)], ohi = h.outlineHi[int(column)];
     if (olo.x > hi.x || ohi.x < lo.x || olo.y > hi.y || ohi.y < lo.y) return false;
     for (size_t i = 0; i < o.size(); ++i) {
         const glm::dvec2 a = o[i], b = o[(i + 1) % o.size()];
@@ -174,6 +179,18 @@ glm::dvec2 TurnedHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, gl
               Vec3(0, 0, -1)};
         cd = {0.0, 0.0, 0.0, 0.0, -zNear};
         planes = 5;
+    }
+    // A column plane that every corner of a box lies within cuts nothing from it; one that
+    // every corner lies beyond leaves nothing (both boxes are convex).
+    std::array<bool, 5> cuts{};
+    for (int k = 0; k < planes; ++k) {
+        for (int s = 0; s < (h.single ? 1 : 2); ++s) {
+            const Solid& box = s == 0 ? h.world : h.turned;
+            int beyond = 0;
+            for (const Vec3& c : box.corner) beyond += glm::dot(cn[k], c) > cd[k];
+            if (beyond == 8) return {whole.x, -kInf};
+            cuts[k] = cuts[k] || beyond > 0;
+        }
     }
     // The extremes in depth of the solid (both boxes and the column) lie on a face of one of
     // the boxes: the column is unbounded in depth (beyond zNear, handled below), so its sides
@@ -203,6 +220,7 @@ glm::dvec2 TurnedHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, gl
                     std::swap(in, out);
                 }
                 for (int k = 0; k < planes && in->n; ++k) {
+                    if (!cuts[k]) continue;
                     clip(*in, cn[k], cd[k], *out);
                     std::swap(in, out);
                 }

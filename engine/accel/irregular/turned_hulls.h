@@ -55,9 +55,11 @@ class TurnedHulls {
     struct Hull {
         Solid turned, world;
         bool single = false;  ///< no box of its own axes: the world box alone (`turned` unset)
-        /// The turned box's outline, a convex polygon counterclockwise, along each column
-        /// (`FromEye`: none when a corner is not in front of the eye).
+        /// The turned box's outline (the world box's when `single`), a convex polygon
+        /// counterclockwise, along each column (`FromEye`: none when a corner is not in front
+        /// of the eye), and its bounding rectangle.
         std::vector<glm::dvec2> outline[2];
+        glm::dvec2 outlineLo[2], outlineHi[2];
     };
     std::vector<int32_t> index_;  ///< per primitive: its hull, or -1
     std::vector<Hull> hulls_;
