@@ -39,6 +39,9 @@ size_t regionBudget(size_t prims, size_t pixels) {
     throw std::invalid_argument("--memory-budget " + guard.describe() +
                                 ": the irregular subdivision " + what + "; raise --memory-budget");
 }
+/// The primitives' hulls (turned_hulls.h) are made when they take at most this share of the
+/// memory budget.
+constexpr size_t kHullShare = 16;
 /// Regions beyond this many are refused: pointers are 32-bit and memory would run out first.
 constexpr size_t kMaxRegions = 50'000'000;
 
@@ -74,8 +77,9 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     // The least a frame's build holds: the primitives' boxes, the screen BSP's root cell, and
     // one zone whose one region lists every primitive. A budget too small for it is refused
     // before anything is built; the limits below are at least a byte, since 0 would mean none.
-    const size_t least = scene.prims.size() * sizeof(Box3) + ScreenBsp::rootBytes(live.size()) +
-                         kMergedZoneBytes + live.size() * mergedRefBytes(scene.tree.unionOnly());
+    const size_t least =
+        scene.prims.size() * sizeof(Box3) + ScreenBsp::rootBytes(live.size()) + kMergedZoneBytes +
+        live.size() * (mergedRefBytes(scene.tree.unionOnly()) + sizeof(glm::dvec2));
     if (least > share)
         refuseOverBudget(guard, "needs at least " + formatBytes(least) + " a frame (" +
                                     std::to_string(frames) + " frame" + (frames > 1 ? "s" : "") +
@@ -122,11 +126,17 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     sp.maxZones = kMaxZones;
     sp.maxBytes = std::max<size_t>(share / 9, 1);
     sp.zoneBytes = kMergedZoneBytes;
-    sp.refBytes = mergedRefBytes(scene.tree.unionOnly());
+    // Each zone reference also gets its depth range for the slabs (narrowZones).
+    sp.refBytes = mergedRefBytes(scene.tree.unionOnly()) + sizeof(glm::dvec2);
     sp.guard = &guard;
     // Turned scenes: zones list what the turned boxes' outlines meet, slabs cut at the depths
     // the boxes take over each zone (turned_hulls.h).
-    const TurnedHulls hulls = TurnedHulls::make(scene, s.frame_, turned, live, eps);
+    // They are the build's scratch, made only when they take at most a sixteenth of the budget
+    // (a tighter budget builds on the boxes alone, as it did before them).
+    const bool hullsFit =
+        TurnedHulls::bytesFor(live.size(), scene.prims.size()) <= guard.budget() / kHullShare;
+    const TurnedHulls hulls =
+        hullsFit ? TurnedHulls::make(scene, s.frame_, turned, live, eps) : TurnedHulls{};
     if (!hulls.empty()) sp.hulls = &hulls;
     sp.column = ZoneColumn::Parallel;
     sp.hullPad = eps;

@@ -128,12 +128,15 @@ TurnedHulls TurnedHulls::make(const Scene& scene, const CameraFrame& frame,
             front = front && c.z > 0.0;
             if (front) eye.push_back({c.x / c.z, c.y / c.z});
         }
-        hull.outline[0] = convexHull(flat);
-        if (front) hull.outline[1] = convexHull(eye);
         for (int c = 0; c < 2; ++c) {
+            std::vector<glm::dvec2> o;
+            if (c == 0) o = convexHull(flat);
+            if (c == 1 && front) o = convexHull(eye);
+            hull.outlineSize[c] = int(o.size());  // the hull of 8 points: at most 8
+            std::copy(o.begin(), o.end(), hull.outline[c].begin());
             hull.outlineLo[c] = glm::dvec2(kInf);
             hull.outlineHi[c] = glm::dvec2(-kInf);
-            for (glm::dvec2 q : hull.outline[c]) {
+            for (glm::dvec2 q : o) {
                 hull.outlineLo[c] = glm::min(hull.outlineLo[c], q);
                 hull.outlineHi[c] = glm::max(hull.outlineHi[c], q);
             }
@@ -147,14 +150,15 @@ TurnedHulls TurnedHulls::make(const Scene& scene, const CameraFrame& frame,
 bool TurnedHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi) const {
     if (index_.empty() || index_[p] < 0) return true;
     const Hull& h = hulls_[index_[p]];
-    const std::vector<glm::dvec2>& o = h.outline[int(column)];
-    if (o.size() < 3) return true;
+    const std::array<glm::dvec2, 8>& o = h.outline[int(column)];
+    const size_t n = size_t(h.outlineSize[int(column)]);
+    if (n < 3) return true;
     // Separating axes of two convex polygons: the rectangle's (its bound against the outline's)
     // and each outline edge's outward normal, the rectangle's nearest corner beyond it.
     const glm::dvec2 olo = h.outlineLo[int(column)], ohi = h.outlineHi[int(column)];
     if (olo.x > hi.x || ohi.x < lo.x || olo.y > hi.y || ohi.y < lo.y) return false;
-    for (size_t i = 0; i < o.size(); ++i) {
-        const glm::dvec2 a = o[i], b = o[(i + 1) % o.size()];
+    for (size_t i = 0; i < n; ++i) {
+        const glm::dvec2 a = o[i], b = o[(i + 1) % n];
         const glm::dvec2 n{b.y - a.y, a.x - b.x};  // outward for a counterclockwise polygon
         const glm::dvec2 c{n.x > 0.0 ? lo.x : hi.x, n.y > 0.0 ? lo.y : hi.y};
         if (glm::dot(n, c - a) > 0.0) return false;

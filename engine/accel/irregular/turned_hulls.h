@@ -33,6 +33,11 @@ class TurnedHulls {
     static TurnedHulls make(const Scene& scene, const CameraFrame& frame, const FrameChoice& turned,
                             const std::vector<uint32_t>& live, double pad);
 
+    /// Bytes the hulls of `prims` primitives take in a scene of `total` (the build's scratch,
+    /// which the memory budget leaves room for before they are made).
+    static size_t bytesFor(size_t prims, size_t total) {
+        return prims * sizeof(Hull) + total * sizeof(int32_t);
+    }
     /// No primitive has a hull: the zones keep their rectangles' lists.
     bool empty() const { return hulls_.empty(); }
     /// Primitive p's turned box, seen along `column`, meets the screen rectangle [lo, hi] (a
@@ -58,7 +63,8 @@ class TurnedHulls {
         /// The turned box's outline (the world box's when `single`), a convex polygon
         /// counterclockwise, along each column (`FromEye`: none when a corner is not in front
         /// of the eye), and its bounding rectangle.
-        std::vector<glm::dvec2> outline[2];
+        std::array<glm::dvec2, 8> outline[2];
+        int outlineSize[2] = {0, 0};
         glm::dvec2 outlineLo[2], outlineHi[2];
     };
     std::vector<int32_t> index_;  ///< per primitive: its hull, or -1
