@@ -9,7 +9,7 @@
 #include <fstream>
 #include <random>
 
-#include "engine/accel/irregular/turned_hulls.h"
+#include "engine/accel/irregular/primitive_hulls.h"
 #include "engine/accel/regular/grid_frame.h"
 #include "engine/model/restriction.h"
 #include "engine/scene/loader.h"
@@ -301,7 +301,7 @@ TEST(Irregular, RegionsTileTheBoundsAndListTheirPrimitives) {
         for (uint32_t p : scene.livePrimitives()) {
             bool listed = std::find(prims.begin(), prims.end(), p) != prims.end();
             // A primitive whose minimized box holds a point inside the region must be listed
-            // (the zones narrow each box to the depths it takes over them: turned_hulls.h).
+            // (the zones narrow each box to the depths it takes over them: primitive_hulls.h).
             bool inside = false;
             for (int i = 0; i < 125 && !inside; ++i) {
                 Vec3 c;
@@ -669,7 +669,7 @@ TEST(IrregularFrame, TurnedSpongeBoundsFollowTheTurn) {
 }
 
 // Random CSG trees of bars turned by one rotation: the zones narrowed by the turned boxes'
-// outlines and depth ranges (turned_hulls.h) lose no hit, in both frames, on random rays, the
+// outlines and depth ranges (primitive_hulls.h) lose no hit, in both frames, on random rays, the
 // pixels' rays and secondary rays (tmin > 0).
 TEST(IrregularFrame, RandomTurnedSubtreesRayForRay) {
     int turned = 0;
@@ -689,12 +689,12 @@ TEST(IrregularFrame, RandomTurnedSubtreesRayForRay) {
     EXPECT_GE(turned, 8);  // most of them are built along the turn
 }
 
-// A turned primitive's hull (turned_hulls.h) in a zone's column, against points sampled in its
+// A turned primitive's hull (primitive_hulls.h) in a zone's column, against points sampled in its
 // turned box: every sample inside the world box and the column lies in the depth range the hull
 // gives, and the outline test never drops a zone such a sample lies in; the ranges are tighter
 // than the camera-frame box's (a bar along a diagonal of the view), and outlines drop zones that
 // the rectangles would keep, or the test would pass with the whole box.
-TEST(TurnedHulls, DepthRangesHoldTheSampledPointsAndAreTighter) {
+TEST(PrimitiveHulls, DepthRangesHoldTheSampledPointsAndAreTighter) {
     size_t pairs = 0, tighter = 0, dropped = 0, samples = 0;
     for (uint64_t seed = 1; seed <= 4; ++seed) {
         Scene s = test::turnedBars(seed * 29 + 1, 16);
@@ -703,7 +703,7 @@ TEST(TurnedHulls, DepthRangesHoldTheSampledPointsAndAreTighter) {
         const CameraFrame frame = CameraFrame::of(s.camera);
         const std::vector<uint32_t> live = s.livePrimitives();
         const double pad = 1e-9 * s.scale();
-        const TurnedHulls hulls = TurnedHulls::make(s, frame, turned, live, pad);
+        const PrimitiveHulls hulls = PrimitiveHulls::make(s, frame, turned, live, pad);
         ASSERT_FALSE(hulls.empty());
         std::mt19937_64 rng(seed);
         std::uniform_real_distribution<double> u01(0.0, 1.0);

@@ -308,7 +308,7 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
             return overlap(b, c);
         };
         // The irregular scheme's zones narrow each primitive's boxes to the depths they take
-        // over the zone (turned_hulls.h), so a slab need not list a primitive whose camera-frame
+        // over the zone (primitive_hulls.h), so a slab need not list a primitive whose camera-frame
         // bound merely overlaps it; it must list one whose bound (its minimized box and, turned,
         // its box along the turn's axes) holds a point of the slab's interior: sampled on a
         // 5 x 5 x 5 grid inside it (`box` in (u, v, depth) for a projective slab).

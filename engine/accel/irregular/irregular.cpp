@@ -10,7 +10,7 @@
 #include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/corner_pointers.h"
 #include "engine/accel/irregular/depth_slabs.h"
-#include "engine/accel/irregular/turned_hulls.h"
+#include "engine/accel/irregular/primitive_hulls.h"
 #include "engine/accel/regular/axis_planner.h"
 #include "engine/accel/regular/grid_frame.h"
 #include "engine/util/format.h"
@@ -39,7 +39,7 @@ size_t regionBudget(size_t prims, size_t pixels) {
     throw std::invalid_argument("--memory-budget " + guard.describe() +
                                 ": the irregular subdivision " + what + "; raise --memory-budget");
 }
-/// The primitives' hulls (turned_hulls.h) are made when they take at most this share of the
+/// The primitives' hulls (primitive_hulls.h) are made when they take at most this share of the
 /// memory budget.
 constexpr size_t kHullShare = 16;
 /// Regions beyond this many are refused: pointers are 32-bit and memory would run out first.
@@ -129,14 +129,14 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     // Each zone reference also gets its depth range for the slabs (narrowZones).
     sp.refBytes = mergedRefBytes(scene.tree.unionOnly()) + sizeof(glm::dvec2);
     sp.guard = &guard;
-    // Turned scenes: zones list what the turned boxes' outlines meet, slabs cut at the depths
-    // the boxes take over each zone (turned_hulls.h).
+    // Zones list what the primitives' hulls meet, slabs cut at the depths the hulls take over
+    // each zone (primitive_hulls.h).
     // They are the build's scratch, made only when they take at most a sixteenth of the budget
     // (a tighter budget builds on the boxes alone, as it did before them).
     const bool hullsFit =
-        TurnedHulls::bytesFor(live.size(), scene.prims.size()) <= guard.budget() / kHullShare;
-    const TurnedHulls hulls =
-        hullsFit ? TurnedHulls::make(scene, s.frame_, turned, live, eps) : TurnedHulls{};
+        PrimitiveHulls::bytesFor(live.size(), scene.prims.size()) <= guard.budget() / kHullShare;
+    const PrimitiveHulls hulls =
+        hullsFit ? PrimitiveHulls::make(scene, s.frame_, turned, live, eps) : PrimitiveHulls{};
     if (!hulls.empty()) sp.hulls = &hulls;
     sp.column = ZoneColumn::Parallel;
     sp.hullPad = eps;

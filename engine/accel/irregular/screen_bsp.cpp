@@ -7,7 +7,7 @@
 
 #include "engine/accel/accelerator.h"
 #include "engine/accel/build_guard.h"
-#include "engine/accel/irregular/turned_hulls.h"
+#include "engine/accel/irregular/primitive_hulls.h"
 
 namespace lancer {
 
@@ -282,8 +282,8 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
                (bsp.zoneLo.size() + queue.size()) * params.zoneBytes +
                (bsp.zonePrims.size() + waitingRefs) * params.refBytes;
     };
-    // Primitive p belongs to the cell [lo, hi]: its rectangle's interior meets the cell's and,
-    // in a turned scene, its turned box's outline meets the cell.
+    // Primitive p belongs to the cell [lo, hi]: its rectangle's interior meets the cell's and
+    // its hull's outline meets the cell.
     auto meets = [&](uint32_t p, glm::dvec2 lo, glm::dvec2 hi) {
         return overlapsOpen(rect[p], lo, hi) &&
                (!params.hulls || params.hulls->touches(p, params.column, lo, hi));

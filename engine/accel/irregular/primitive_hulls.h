@@ -1,13 +1,14 @@
-// The irregular scheme's bounds of primitives in a scene turned off the world's axes (docs/
-// irregular.md, "Turned scenes"). A bar of a turned Menger sponge along a diagonal of the view
-// projects to a thin slanted strip, but its camera-frame box covers the strip's whole screen
-// rectangle and its whole depth range: every zone under that rectangle listed the bar through
-// every slab. Here each primitive keeps its two boxes as the convex solids they are in the camera
-// frame (its minimized box along the turn's own axes, and its minimized world box), and a zone
-// asks them two things: does the turned box's outline on the screen meet the zone (the screen
-// BSP's lists), and what depth range do the two boxes together take over the zone's footprint
-// (the depth slabs' cuts). The zones stay screen rectangles and the slabs depth intervals: only
-// what each lists gets tighter.
+// The irregular scheme's bounds of primitives as solids of the camera frame (docs/irregular.md,
+// "Zones narrowed to each primitive's bound"). A zone is a screen rectangle and its slabs depth
+// intervals, but a primitive's camera-frame box is a poor bound of it there: seen from a camera
+// off the world's axes a flat world box (a gear's face) is as deep as the whole gear, and in a
+// turned scene a bar along a diagonal of the view covers a large screen rectangle. Each
+// primitive keeps its minimized world box and, where it has one, a box along axes of its own
+// (the turn's, or a flat primitive's plane), as the convex solids they are in the camera frame,
+// and a zone asks them two things: does the own box's outline on the screen meet the zone (the
+// screen BSP's lists), and what depth range do the boxes together take over the zone's
+// footprint (the depth slabs' cuts). The zones stay screen rectangles and the slabs depth
+// intervals: only what each lists gets tighter.
 #pragma once
 
 #include <array>
@@ -26,12 +27,14 @@ struct ScreenBsp;  // screen_bsp.h
 /// of (u, v) = (x/z, y/z) (`FromEye`, the projective zones).
 enum class ZoneColumn : uint8_t { Parallel, FromEye };
 
-class TurnedHulls {
+class PrimitiveHulls {
   public:
-    /// The hulls of the primitives `live` when `turned` chose a turned frame (chooseGridFrame),
-    /// each box widened by `pad` on every side; empty otherwise (nothing changes then).
-    static TurnedHulls make(const Scene& scene, const CameraFrame& frame, const FrameChoice& turned,
-                            const std::vector<uint32_t>& live, double pad);
+    /// The hulls of the primitives `live`: each one's minimized world box and its box along the
+    /// turned frame of `turned` (chooseGridFrame) when it has one, else along its own plane for
+    /// a triangle or polygon off the world's axes; each widened by `pad` on every side.
+    static PrimitiveHulls make(const Scene& scene, const CameraFrame& frame,
+                               const FrameChoice& turned, const std::vector<uint32_t>& live,
+                               double pad);
 
     /// Bytes the hulls of `prims` primitives take in a scene of `total` (the build's scratch,
     /// which the memory budget leaves room for before they are made).
@@ -40,8 +43,9 @@ class TurnedHulls {
     }
     /// No primitive has a hull: the zones keep their rectangles' lists.
     bool empty() const { return hulls_.empty(); }
-    /// Primitive p's turned box, seen along `column`, meets the screen rectangle [lo, hi] (a
-    /// primitive without a hull always does; so does one reaching behind the eye, `FromEye`).
+    /// Primitive p's own box (its world box when it has none), seen along `column`, meets the
+    /// screen rectangle [lo, hi] (a primitive without a hull always does; so does one reaching
+    /// behind the eye, `FromEye`).
     bool touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi) const;
     /// The depth range of primitive p's two boxes together within the column over [lo, hi],
     /// at z >= zNear for `FromEye` (lo > hi: they miss it); `whole` (its camera-frame box's
@@ -75,7 +79,7 @@ class TurnedHulls {
 /// hull misses its column, and gives each remaining reference (bsp.zonePrims' order) its depth
 /// range there, padded by `pad` and within the primitive's `box` depths clamped to [zlo, zhi].
 /// Empty hulls: every reference keeps its box's depths.
-std::vector<glm::dvec2> narrowZones(ScreenBsp& bsp, const TurnedHulls& hulls, ZoneColumn column,
+std::vector<glm::dvec2> narrowZones(ScreenBsp& bsp, const PrimitiveHulls& hulls, ZoneColumn column,
                                     const std::vector<Box3>& box, double zlo, double zhi,
                                     double pad);
 

@@ -1,4 +1,4 @@
-#include "engine/accel/irregular/turned_hulls.h"
+#include "engine/accel/irregular/primitive_hulls.h"
 
 #include <algorithm>
 #include <cmath>
@@ -82,10 +82,10 @@ std::optional<GridFrame> flatFrame(const Primitive& prim) {
 
 }  // namespace
 
-TurnedHulls TurnedHulls::make(const Scene& scene, const CameraFrame& frame,
-                              const FrameChoice& turned, const std::vector<uint32_t>& live,
-                              double pad) {
-    TurnedHulls h;
+PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame,
+                                    const FrameChoice& turned, const std::vector<uint32_t>& live,
+                                    double pad) {
+    PrimitiveHulls h;
     // A box along the world-frame axes `axes` (columns) in the camera frame: a rotation keeps it
     // a box, its planes along the camera images of those axes, offset by the eye's position.
     auto solid = [&](const Box3& b, const Mat3& axes) {
@@ -147,7 +147,7 @@ TurnedHulls TurnedHulls::make(const Scene& scene, const CameraFrame& frame,
     return h;
 }
 
-bool TurnedHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi) const {
+bool PrimitiveHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi) const {
     if (index_.empty() || index_[p] < 0) return true;
     const Hull& h = hulls_[index_[p]];
     const std::array<glm::dvec2, 8>& o = h.outline[int(column)];
@@ -166,8 +166,8 @@ bool TurnedHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dve
     return true;
 }
 
-glm::dvec2 TurnedHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi,
-                                double zNear, glm::dvec2 whole) const {
+glm::dvec2 PrimitiveHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi,
+                                   double zNear, glm::dvec2 whole) const {
     if (index_.empty() || index_[p] < 0) return whole;
     const Hull& h = hulls_[index_[p]];
     // The column's planes n . x <= d: the rectangle swept along z, or the rays from the eye
@@ -245,7 +245,7 @@ glm::dvec2 TurnedHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, gl
     return {std::max(range.x, whole.x), std::min(range.y, whole.y)};
 }
 
-std::vector<glm::dvec2> narrowZones(ScreenBsp& bsp, const TurnedHulls& hulls, ZoneColumn column,
+std::vector<glm::dvec2> narrowZones(ScreenBsp& bsp, const PrimitiveHulls& hulls, ZoneColumn column,
                                     const std::vector<Box3>& box, double zlo, double zhi,
                                     double pad) {
     std::vector<glm::dvec2> depth;
