@@ -760,6 +760,54 @@ TEST(PrimitiveHulls, DepthRangesHoldTheSampledPointsAndAreTighter) {
     EXPECT_GT(dropped, pairs / 20) << dropped << " of " << pairs;
 }
 
+// The hulls of an unturned scene (SPD's gears1: polygons on and off the world's axes, seen
+// from a camera off them): points of each polygon (convex combinations of its vertices, inside
+// its own plane's box and its world box) lie in the depth range its hull gives any zone whose
+// column holds them, and the ranges over a small zone are mostly tighter than the box's.
+TEST(PrimitiveHulls, FlatAndWorldBoxesHoldThePolygonsPoints) {
+    Scene s = loadScene(std::string(LANCER_SOURCE_DIR) + "/assets/spd/gears1.nff");
+    const FrameChoice turned = chooseGridFrame(s);
+    ASSERT_FALSE(turned.frame.turned);
+    const CameraFrame frame = CameraFrame::of(s.camera);
+    const std::vector<uint32_t> live = s.livePrimitives();
+    const PrimitiveHulls hulls = PrimitiveHulls::make(s, frame, turned, live, 1e-9 * s.scale());
+    ASSERT_FALSE(hulls.empty());
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    size_t polygons = 0, pairs = 0, tighter = 0, samples = 0;
+    for (uint32_t p : live) {
+        const Polygon* g = std::get_if<Polygon>(&s.prims[p].shape);
+        if (!g || polygons >= 60) continue;
+        ++polygons;
+        const Box3 cam = frame.box(s.minBox[p]);
+        const glm::dvec2 whole(cam.lo.z, cam.hi.z);
+        for (int k = 0; k < 40; ++k) {
+            // A point of the polygon's vertices' hull, and a zone a tenth of its rectangle
+            // across around it.
+            Vec3 w(0.0);
+            double sum = 0.0;
+            for (const Vec3& v : g->p) {
+                const double a = u01(rng);
+                w += a * (s.prims[p].hasXf ? s.prims[p].xf.point(v) : v);
+                sum += a;
+            }
+            const Vec3 c = frame.point(w / sum);
+            const glm::dvec2 e = 0.1 * glm::dvec2(cam.hi.x - cam.lo.x, cam.hi.y - cam.lo.y);
+            const glm::dvec2 lo(c.x - u01(rng) * e.x, c.y - u01(rng) * e.y);
+            const glm::dvec2 d = hulls.depthIn(p, ZoneColumn::Parallel, lo, lo + e, 0.0, whole);
+            ASSERT_TRUE(hulls.touches(p, ZoneColumn::Parallel, lo, lo + e)) << "p" << p;
+            EXPECT_GE(c.z, d.x - 1e-9 * s.scale()) << "p" << p;
+            EXPECT_LE(c.z, d.y + 1e-9 * s.scale()) << "p" << p;
+            ++samples;
+            ++pairs;
+            tighter += d.y - d.x < 0.6 * (whole.y - whole.x);
+        }
+    }
+    EXPECT_GE(polygons, 20u);
+    EXPECT_GT(samples, 800u);
+    EXPECT_GT(tighter, pairs / 4) << tighter << " of " << pairs;
+}
+
 TEST(Irregular, SparseRestrictionEqualsRestrictTree) {
     std::mt19937_64 rng(17);
     for (uint64_t seed = 50; seed < 70; ++seed) {
