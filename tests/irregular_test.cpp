@@ -9,7 +9,7 @@
 #include <fstream>
 #include <random>
 
-#include "engine/accel/irregular/turned_hulls.h"
+#include "engine/accel/irregular/primitive_hulls.h"
 #include "engine/accel/regular/grid_frame.h"
 #include "engine/model/restriction.h"
 #include "engine/scene/loader.h"
@@ -299,12 +299,17 @@ TEST(Irregular, RegionsTileTheBoundsAndListTheirPrimitives) {
         volume += e.x * e.y * e.z;
         auto prims = s.primitives(r);
         for (uint32_t p : scene.livePrimitives()) {
-            Box3 pb = s.frame().box(scene.minBox[p]);
             bool listed = std::find(prims.begin(), prims.end(), p) != prims.end();
-            // Strictly overlapping boxes must be listed (touching ones may be, by the padding).
-            bool strict = pb.lo.x < b.hi.x && b.lo.x < pb.hi.x && pb.lo.y < b.hi.y &&
-                          b.lo.y < pb.hi.y && pb.lo.z < b.hi.z && b.lo.z < pb.hi.z;
-            if (strict) {
+            // A primitive whose minimized box holds a point inside the region must be listed
+            // (the zones narrow each box to the depths it takes over them: primitive_hulls.h).
+            bool inside = false;
+            for (int i = 0; i < 125 && !inside; ++i) {
+                Vec3 c;
+                for (int a = 0, j = i; a < 3; ++a, j /= 5)
+                    c[a] = b.lo[a] + (0.1 + 0.2 * (j % 5)) * (b.hi[a] - b.lo[a]);
+                inside = scene.minBox[p].contains(s.frame().toWorld(c));
+            }
+            if (inside) {
                 EXPECT_TRUE(listed) << "p" << p << " missing from region " << r;
             }
         }
@@ -664,7 +669,7 @@ TEST(IrregularFrame, TurnedSpongeBoundsFollowTheTurn) {
 }
 
 // Random CSG trees of bars turned by one rotation: the zones narrowed by the turned boxes'
-// outlines and depth ranges (turned_hulls.h) lose no hit, in both frames, on random rays, the
+// outlines and depth ranges (primitive_hulls.h) lose no hit, in both frames, on random rays, the
 // pixels' rays and secondary rays (tmin > 0).
 TEST(IrregularFrame, RandomTurnedSubtreesRayForRay) {
     int turned = 0;
@@ -684,12 +689,12 @@ TEST(IrregularFrame, RandomTurnedSubtreesRayForRay) {
     EXPECT_GE(turned, 8);  // most of them are built along the turn
 }
 
-// A turned primitive's hull (turned_hulls.h) in a zone's column, against points sampled in its
+// A turned primitive's hull (primitive_hulls.h) in a zone's column, against points sampled in its
 // turned box: every sample inside the world box and the column lies in the depth range the hull
 // gives, and the outline test never drops a zone such a sample lies in; the ranges are tighter
 // than the camera-frame box's (a bar along a diagonal of the view), and outlines drop zones that
 // the rectangles would keep, or the test would pass with the whole box.
-TEST(TurnedHulls, DepthRangesHoldTheSampledPointsAndAreTighter) {
+TEST(PrimitiveHulls, DepthRangesHoldTheSampledPointsAndAreTighter) {
     size_t pairs = 0, tighter = 0, dropped = 0, samples = 0;
     for (uint64_t seed = 1; seed <= 4; ++seed) {
         Scene s = test::turnedBars(seed * 29 + 1, 16);
@@ -698,7 +703,7 @@ TEST(TurnedHulls, DepthRangesHoldTheSampledPointsAndAreTighter) {
         const CameraFrame frame = CameraFrame::of(s.camera);
         const std::vector<uint32_t> live = s.livePrimitives();
         const double pad = 1e-9 * s.scale();
-        const TurnedHulls hulls = TurnedHulls::make(s, frame, turned, live, pad);
+        const PrimitiveHulls hulls = PrimitiveHulls::make(s, frame, turned, live, pad);
         ASSERT_FALSE(hulls.empty());
         std::mt19937_64 rng(seed);
         std::uniform_real_distribution<double> u01(0.0, 1.0);
@@ -753,6 +758,54 @@ TEST(TurnedHulls, DepthRangesHoldTheSampledPointsAndAreTighter) {
     EXPECT_GT(samples, 10000u);
     EXPECT_GT(tighter, pairs / 4) << tighter << " of " << pairs;
     EXPECT_GT(dropped, pairs / 20) << dropped << " of " << pairs;
+}
+
+// The hulls of an unturned scene (SPD's gears1: polygons on and off the world's axes, seen
+// from a camera off them): points of each polygon (convex combinations of its vertices, inside
+// its own plane's box and its world box) lie in the depth range its hull gives any zone whose
+// column holds them, and the ranges over a small zone are mostly tighter than the box's.
+TEST(PrimitiveHulls, FlatAndWorldBoxesHoldThePolygonsPoints) {
+    Scene s = loadScene(std::string(LANCER_SOURCE_DIR) + "/assets/spd/gears1.nff");
+    const FrameChoice turned = chooseGridFrame(s);
+    ASSERT_FALSE(turned.frame.turned);
+    const CameraFrame frame = CameraFrame::of(s.camera);
+    const std::vector<uint32_t> live = s.livePrimitives();
+    const PrimitiveHulls hulls = PrimitiveHulls::make(s, frame, turned, live, 1e-9 * s.scale());
+    ASSERT_FALSE(hulls.empty());
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    size_t polygons = 0, pairs = 0, tighter = 0, samples = 0;
+    for (uint32_t p : live) {
+        const Polygon* g = std::get_if<Polygon>(&s.prims[p].shape);
+        if (!g || polygons >= 60) continue;
+        ++polygons;
+        const Box3 cam = frame.box(s.minBox[p]);
+        const glm::dvec2 whole(cam.lo.z, cam.hi.z);
+        for (int k = 0; k < 40; ++k) {
+            // A point of the polygon's vertices' hull, and a zone a tenth of its rectangle
+            // across around it.
+            Vec3 w(0.0);
+            double sum = 0.0;
+            for (const Vec3& v : g->p) {
+                const double a = u01(rng);
+                w += a * (s.prims[p].hasXf ? s.prims[p].xf.point(v) : v);
+                sum += a;
+            }
+            const Vec3 c = frame.point(w / sum);
+            const glm::dvec2 e = 0.1 * glm::dvec2(cam.hi.x - cam.lo.x, cam.hi.y - cam.lo.y);
+            const glm::dvec2 lo(c.x - u01(rng) * e.x, c.y - u01(rng) * e.y);
+            const glm::dvec2 d = hulls.depthIn(p, ZoneColumn::Parallel, lo, lo + e, 0.0, whole);
+            ASSERT_TRUE(hulls.touches(p, ZoneColumn::Parallel, lo, lo + e)) << "p" << p;
+            EXPECT_GE(c.z, d.x - 1e-9 * s.scale()) << "p" << p;
+            EXPECT_LE(c.z, d.y + 1e-9 * s.scale()) << "p" << p;
+            ++samples;
+            ++pairs;
+            tighter += d.y - d.x < 0.6 * (whole.y - whole.x);
+        }
+    }
+    EXPECT_GE(polygons, 20u);
+    EXPECT_GT(samples, 800u);
+    EXPECT_GT(tighter, pairs / 4) << tighter << " of " << pairs;
 }
 
 TEST(Irregular, SparseRestrictionEqualsRestrictTree) {

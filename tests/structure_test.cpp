@@ -307,6 +307,24 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
                 c.expand(s->frame().point(fc.frame.toWorld(boxCorner(f, i))));
             return overlap(b, c);
         };
+        // The irregular scheme's zones narrow each primitive's boxes to the depths they take
+        // over the zone (primitive_hulls.h), so a slab need not list a primitive whose camera-frame
+        // bound merely overlaps it; it must list one whose bound (its minimized box and, turned,
+        // its box along the turn's axes) holds a point of the slab's interior: sampled on a
+        // 5 x 5 x 5 grid inside it (`box` in (u, v, depth) for a projective slab).
+        const auto holdsAPointOf = [&](uint32_t p, const Box3& box, bool projective) {
+            for (int i = 0; i < 125; ++i) {
+                Vec3 c;
+                for (int a = 0, j = i; a < 3; ++a, j /= 5)
+                    c[a] = box.lo[a] + (0.1 + 0.2 * (j % 5)) * (box.hi[a] - box.lo[a]);
+                if (projective) c = {c.x * c.z, c.y * c.z, c.z};
+                const Vec3 w = s->frame().toWorld(c);
+                if (scene.minBox[p].contains(w) &&
+                    (!fc.frame.turned || fc.boxes[p].contains(fc.frame.toFrame(w))))
+                    return true;
+            }
+            return false;
+        };
         for (uint32_t id = 0; id < v.regionCount(); ++id) {
             RegionInfo r = v.region(id);
             std::vector<uint32_t> crossed;
@@ -326,30 +344,14 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
                         crossing = crosses(v.regular()->boxes()[p], r.frameBox, margin);
                         break;
                     case RegionKind::Slab:
-                        // The box's bound in the camera frame: a region of the camera frame that
-                        // misses it misses the box.
-                        crossing = crosses(cameraBound(p), r.frameBox, margin);
+                        crossing = holdsAPointOf(p, r.frameBox, false);
                         break;
                     case RegionKind::NearRegion:
                         crossing = cameraBound(p).lo.z < r.frameBox.hi.z - margin;
                         break;
-                    case RegionKind::ProjectiveSlab: {
-                        // The box in (u, v, depth), in front of the first slab's depth.
-                        Box3 cb = cameraBound(p);
-                        const double zn = s->projective().zNear();
-                        if (!(cb.hi.z > zn)) break;
-                        Box3 q;
-                        q.lo.z = std::max(cb.lo.z, zn);
-                        q.hi.z = cb.hi.z;
-                        for (int a = 0; a < 2; ++a)
-                            for (double x : {cb.lo[a], cb.hi[a]})
-                                for (double z : {q.lo.z, q.hi.z}) {
-                                    q.lo[a] = std::min(q.lo[a], x / z);
-                                    q.hi[a] = std::max(q.hi[a], x / z);
-                                }
-                        crossing = crosses(q, r.frameBox, 1e-9);
+                    case RegionKind::ProjectiveSlab:
+                        crossing = holdsAPointOf(p, r.frameBox, true);
                         break;
-                    }
                 }
                 if (crossing) crossed.push_back(p);
             }

@@ -1,6 +1,7 @@
 #include "engine/accel/irregular/depth_slabs.h"
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 
 #include "engine/accel/build_guard.h"
@@ -12,6 +13,8 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
                            const std::vector<glm::dvec2>& depth, double zlo, double zhi,
                            BuildGuard* guard, size_t maxBytes, size_t maxRegions) {
     DepthSlabs out;
+    // Cuts closer than this are one (a thousandth of the padding of irregular.cpp).
+    const double minGap = 1e-12 * std::max({std::abs(zlo), std::abs(zhi), 1e-300});
     // The depth range of the zone reference at p (a pointer into bsp.zonePrims).
     auto range = [&](const uint32_t* p) { return depth[size_t(p - bsp.zonePrims.data())]; };
     // A union-only scene's region is the union of its primitives: the walk merges their spans
@@ -51,6 +54,18 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
         }
         std::sort(cuts.begin(), cuts.end());
         cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+        // Depth ranges clipped per zone (narrowZones) round differently where two primitives'
+        // boxes share a plane: cuts a few rounding errors apart would make slabs of no depth.
+        // The first cut of such a run is kept, and the structure's far end; a coarser cut is
+        // always safe (a slab lists every range overlapping it).
+        size_t k = 1;
+        for (size_t i = 1; i < cuts.size(); ++i) {
+            if (cuts[i] - cuts[k - 1] >= minGap)
+                cuts[k++] = cuts[i];
+            else if (i + 1 == cuts.size())
+                cuts[k > 1 ? k - 1 : k++] = cuts[i];
+        }
+        cuts.resize(k);
     };
     // Whether every zone's full slabs fit (bytes and regions): then no zone is held to its share.
     bool ample = true;

@@ -1,6 +1,6 @@
 // The irregular scheme's 3D step: each zone of the screen BSP cut along depth at the zmin/zmax
 // of the boxes over it (in a turned scene, the depths each primitive's boxes take over that zone:
-// narrowZones, turned_hulls.h). Each slab is a region with the primitives whose depth range
+// narrowZones, primitive_hulls.h). Each slab is a region with the primitives whose depth range
 // overlaps its interior and their restricted tree; equal primitive sets share one tree in the
 // pool. Ranges that only touch a slab are left out: with the padding of irregular.cpp their
 // primitives have no hit there, and a closed overlap would add each box to the slabs on both

@@ -10,7 +10,8 @@
 #include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/corner_pointers.h"
 #include "engine/accel/irregular/depth_slabs.h"
-#include "engine/accel/irregular/turned_hulls.h"
+#include "engine/accel/irregular/primitive_hulls.h"
+#include "engine/accel/regular/axis_planner.h"
 #include "engine/accel/regular/grid_frame.h"
 #include "engine/util/format.h"
 #include "engine/util/task_fence.h"
@@ -38,6 +39,9 @@ size_t regionBudget(size_t prims, size_t pixels) {
     throw std::invalid_argument("--memory-budget " + guard.describe() +
                                 ": the irregular subdivision " + what + "; raise --memory-budget");
 }
+/// The primitives' hulls (primitive_hulls.h) are made when they take at most this share of the
+/// memory budget.
+constexpr size_t kHullShare = 16;
 /// Regions beyond this many are refused: pointers are 32-bit and memory would run out first.
 constexpr size_t kMaxRegions = 50'000'000;
 
@@ -73,8 +77,9 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     // The least a frame's build holds: the primitives' boxes, the screen BSP's root cell, and
     // one zone whose one region lists every primitive. A budget too small for it is refused
     // before anything is built; the limits below are at least a byte, since 0 would mean none.
-    const size_t least = scene.prims.size() * sizeof(Box3) + ScreenBsp::rootBytes(live.size()) +
-                         kMergedZoneBytes + live.size() * mergedRefBytes(scene.tree.unionOnly());
+    const size_t least =
+        scene.prims.size() * sizeof(Box3) + ScreenBsp::rootBytes(live.size()) + kMergedZoneBytes +
+        live.size() * (mergedRefBytes(scene.tree.unionOnly()) + sizeof(glm::dvec2));
     if (least > share)
         refuseOverBudget(guard, "needs at least " + formatBytes(least) + " a frame (" +
                                     std::to_string(frames) + " frame" + (frames > 1 ? "s" : "") +
@@ -121,14 +126,24 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     sp.maxZones = kMaxZones;
     sp.maxBytes = std::max<size_t>(share / 9, 1);
     sp.zoneBytes = kMergedZoneBytes;
-    sp.refBytes = mergedRefBytes(scene.tree.unionOnly());
+    // Each zone reference also gets its depth range for the slabs (narrowZones).
+    sp.refBytes = mergedRefBytes(scene.tree.unionOnly()) + sizeof(glm::dvec2);
     sp.guard = &guard;
-    // Turned scenes: zones list what the turned boxes' outlines meet, slabs cut at the depths
-    // the boxes take over each zone (turned_hulls.h).
-    const TurnedHulls hulls = TurnedHulls::make(scene, s.frame_, turned, live, eps);
+    // Zones list what the primitives' hulls meet, slabs cut at the depths the hulls take over
+    // each zone (primitive_hulls.h).
+    // They are the build's scratch, made only when they take at most a sixteenth of the budget
+    // (a tighter budget builds on the boxes alone, as it did before them).
+    const bool hullsFit =
+        PrimitiveHulls::bytesFor(live.size(), scene.prims.size()) <= guard.budget() / kHullShare;
+    const PrimitiveHulls hulls =
+        hullsFit ? PrimitiveHulls::make(scene, s.frame_, turned, live, eps) : PrimitiveHulls{};
     if (!hulls.empty()) sp.hulls = &hulls;
     sp.column = ZoneColumn::Parallel;
     sp.hullPad = eps;
+    // A polygon's test costs more than a sphere's (gears2's faces have up to 144 vertices): the
+    // cost stop weighs each as the regular scheme's planner does.
+    const std::vector<float> weights = regular_build::testWeights(scene);
+    sp.weights = &weights;
 
     // The two frames' structures are independent (each within its half of the budget): the
     // projective zones are built as a task beside the camera frame's, which halves the build's

@@ -6,7 +6,7 @@
 
 #include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/depth_slabs.h"
-#include "engine/accel/irregular/turned_hulls.h"
+#include "engine/accel/irregular/primitive_hulls.h"
 #include "engine/model/restriction.h"
 
 namespace lancer {
@@ -78,7 +78,7 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     const std::vector<glm::dvec2> depth =
         sp.hulls
             ? narrowZones(s.bsp_, *sp.hulls, ZoneColumn::FromEye, pbox, zNear, zFar, sp.hullPad)
-            : narrowZones(s.bsp_, TurnedHulls{}, ZoneColumn::FromEye, pbox, zNear, zFar, 0.0);
+            : narrowZones(s.bsp_, PrimitiveHulls{}, ZoneColumn::FromEye, pbox, zNear, zFar, 0.0);
     DepthSlabs slabs =
         buildDepthSlabs(scene, s.bsp_, depth, zNear, zFar, sp.guard, maxSlabBytes, maxRegions);
     s.zones_ = s.bsp_.zoneCount();

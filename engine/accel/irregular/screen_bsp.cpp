@@ -7,7 +7,7 @@
 
 #include "engine/accel/accelerator.h"
 #include "engine/accel/build_guard.h"
-#include "engine/accel/irregular/turned_hulls.h"
+#include "engine/accel/irregular/primitive_hulls.h"
 
 namespace lancer {
 
@@ -282,8 +282,8 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
                (bsp.zoneLo.size() + queue.size()) * params.zoneBytes +
                (bsp.zonePrims.size() + waitingRefs) * params.refBytes;
     };
-    // Primitive p belongs to the cell [lo, hi]: its rectangle's interior meets the cell's and,
-    // in a turned scene, its turned box's outline meets the cell.
+    // Primitive p belongs to the cell [lo, hi]: its rectangle's interior meets the cell's and
+    // its hull's outline meets the cell.
     auto meets = [&](uint32_t p, glm::dvec2 lo, glm::dvec2 hi) {
         return overlapsOpen(rect[p], lo, hi) &&
                (!params.hulls || params.hulls->touches(p, params.column, lo, hi));
@@ -315,10 +315,18 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         bHi[cell.split.axis] = cell.split.c;
         aLo[cell.split.axis] = cell.split.c;
         size_t nBelow = 0, nAbove = 0, polled = 0;
+        // The tests of each side and of the cell, each weighing what it costs (sums of
+        // quarters, exact in any order).
+        double wBelow = 0.0, wAbove = 0.0, wCell = 0.0;
         for (uint32_t p : cell.prims) {
             if (params.guard && (++polled & 32767) == 0) params.guard->poll();
-            nBelow += meets(p, cell.lo, bHi);
-            nAbove += meets(p, aLo, cell.hi);
+            const double w = params.weights ? double((*params.weights)[p]) : 1.0;
+            const bool b = meets(p, cell.lo, bHi), a = meets(p, aLo, cell.hi);
+            nBelow += b;
+            nAbove += a;
+            wBelow += b ? w : 0.0;
+            wAbove += a ? w : 0.0;
+            wCell += w;
         }
         // A ray through the cell (the area of a side is its share of the rays) tests its
         // rectangles; split, it crosses one more zone and tests one side's. The gain is the
@@ -326,16 +334,14 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         const double area = (cell.hi.x - cell.lo.x) * (cell.hi.y - cell.lo.y);
         const double aBelow = (bHi.x - cell.lo.x) * (bHi.y - cell.lo.y);
         const double aAbove = (cell.hi.x - aLo.x) * (cell.hi.y - aLo.y);
-        const double split =
-            params.stepCost + (aBelow * double(nBelow) + aAbove * double(nAbove)) / area;
-        const double gain = area > 0.0 ? area * (double(cell.prims.size()) - split) : 0.0;
+        const double split = params.stepCost + (aBelow * wBelow + aAbove * wAbove) / area;
+        const double gain = area > 0.0 ? area * (wCell - split) : 0.0;
         cell.primsBelow = nBelow;
         cell.primsAbove = nAbove;
         // The first levels always split (at most 16 cells): with a handful of primitives the
         // estimate would leave one zone, and the scheme would have no screen structure at all.
         const bool always = cell.depth < kAlwaysSplitLevels;
-        if (params.stepCost > 0.0 && !always && area > 0.0 &&
-            !(split < double(cell.prims.size()))) {
+        if (params.stepCost > 0.0 && !always && area > 0.0 && !(split < wCell)) {
             ++bsp.costStops;
             makeZone(cell);
             return;

@@ -13,8 +13,8 @@ namespace lancer {
 
 enum class BspHeuristic : uint8_t;  // build_params.h
 class BuildGuard;                   // build_guard.h
-class TurnedHulls;                  // turned_hulls.h
-enum class ZoneColumn : uint8_t;    // turned_hulls.h
+class PrimitiveHulls;               // primitive_hulls.h
+enum class ZoneColumn : uint8_t;    // primitive_hulls.h
 
 struct ScreenBspParams {
     BspHeuristic heuristic{};  ///< the choice of splitting line
@@ -31,11 +31,14 @@ struct ScreenBspParams {
     size_t maxBytes = 0;
     size_t zoneBytes = 0, refBytes = 0;
     BuildGuard* guard = nullptr;  ///< polled for cancellation and progress (null: never)
-    /// In a turned scene, a cell lists only the primitives whose turned box's outline (seen
-    /// along `column`) meets it, not every one whose rectangle does (null: rectangles alone).
-    const TurnedHulls* hulls = nullptr;
+    /// A cell lists only the primitives whose hull's outline (seen along `column`) meets it,
+    /// not every one whose rectangle does (null: rectangles alone).
+    const PrimitiveHulls* hulls = nullptr;
     ZoneColumn column{};   ///< the rays a cell stands for, for `hulls`
     double hullPad = 0.0;  ///< padding of the depth ranges the hulls give a zone (narrowZones)
+    /// What testing each primitive costs, in sphere tests (testWeights(): a polygon weighs
+    /// 1 + vertices / 4), for the cost stop's counts (null: every test alike).
+    const std::vector<float>* weights = nullptr;
 };
 
 /// The screen BSP and its leaves, the zones, each with the primitives whose rectangle it touches.

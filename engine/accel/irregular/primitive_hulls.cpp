@@ -1,7 +1,8 @@
-#include "engine/accel/irregular/turned_hulls.h"
+#include "engine/accel/irregular/primitive_hulls.h"
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "engine/accel/irregular/screen_bsp.h"
 
@@ -52,13 +53,39 @@ std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> pts) {
     return h;
 }
 
+/// The frame of a flat primitive (a triangle or a polygon) whose plane is turned off the
+/// world's axes: its first edge, the normal (Newell's sum over its world vertices) and their
+/// cross product. None for other shapes and for planes along the world's axes, whose world box
+/// is already as flat.
+std::optional<GridFrame> flatFrame(const Primitive& prim) {
+    std::vector<Vec3> v;
+    if (const Triangle* t = std::get_if<Triangle>(&prim.shape))
+        v.assign(t->p, t->p + 3);
+    else if (const Polygon* g = std::get_if<Polygon>(&prim.shape))
+        v = g->p;
+    else
+        return std::nullopt;
+    if (prim.hasXf)
+        for (Vec3& q : v) q = prim.xf.point(q);
+    Vec3 n(0.0);
+    for (size_t i = 0; i < v.size(); ++i) n += glm::cross(v[i], v[(i + 1) % v.size()]);
+    const double ln = glm::length(n);
+    const Vec3 e = v[1] - v[0];
+    const double le = glm::length(e);
+    if (!(ln > 0.0) || !(le > 0.0) || !std::isfinite(ln) || !std::isfinite(le)) return std::nullopt;
+    n /= ln;
+    const Vec3 a = glm::abs(n);
+    if (std::max({a.x, a.y, a.z}) > 1.0 - 1e-9) return std::nullopt;  // along the world's axes
+    const Vec3 u = glm::normalize(e - glm::dot(e, n) * n);
+    return GridFrame::fromAxes(Mat3(u, glm::cross(n, u), n));
+}
+
 }  // namespace
 
-TurnedHulls TurnedHulls::make(const Scene& scene, const CameraFrame& frame,
-                              const FrameChoice& turned, const std::vector<uint32_t>& live,
-                              double pad) {
-    TurnedHulls h;
-    if (!turned.frame.turned) return h;
+PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame,
+                                    const FrameChoice& turned, const std::vector<uint32_t>& live,
+                                    double pad) {
+    PrimitiveHulls h;
     // A box along the world-frame axes `axes` (columns) in the camera frame: a rotation keeps it
     // a box, its planes along the camera images of those axes, offset by the eye's position.
     auto solid = [&](const Box3& b, const Mat3& axes) {
@@ -75,40 +102,63 @@ TurnedHulls TurnedHulls::make(const Scene& scene, const CameraFrame& frame,
     };
     h.index_.assign(scene.prims.size(), -1);
     for (uint32_t p : live) {
-        const Box3& fb = turned.boxes[p];
-        if (fb.isEmpty() || scene.minBox[p].isEmpty()) continue;
+        if (scene.minBox[p].isEmpty()) continue;
         Hull hull;
-        hull.turned = solid(fb, turned.frame.axes);
+        if (turned.frame.turned && !turned.boxes[p].isEmpty()) {
+            hull.turned = solid(turned.boxes[p], turned.frame.axes);
+        } else if (const std::optional<GridFrame> own = flatFrame(scene.prims[p])) {
+            // A flat primitive along its own plane: a box as thin as its vertices lie, widened
+            // by twice that thickness, since a polygon's hits lie on its fitted plane, which its
+            // rounded vertices (an NFF file's few digits) leave by up to that much, and its
+            // inside test projects along a world axis (at most sqrt(3) times it in the plane).
+            const Box3 b = frameBoxOf(scene.prims[p], *own, 0.0);
+            const double thick = 2.0 * (b.hi.z - b.lo.z);
+            hull.turned = solid({b.lo - Vec3(thick), b.hi + Vec3(thick)}, own->axes);
+        } else {
+            // Its world box alone: seen from a camera off the world's axes, a box's depths over
+            // a small zone are much narrower than over the whole box (a gear's flat face seen
+            // obliquely).
+            hull.single = true;
+        }
         hull.world = solid(scene.minBox[p], Mat3(1.0));
         std::vector<glm::dvec2> flat, eye;
         bool front = true;
-        for (const Vec3& c : hull.turned.corner) {
+        for (const Vec3& c : (hull.single ? hull.world : hull.turned).corner) {
             flat.push_back({c.x, c.y});
             front = front && c.z > 0.0;
             if (front) eye.push_back({c.x / c.z, c.y / c.z});
         }
-        hull.outline[0] = convexHull(flat);
-        if (front) hull.outline[1] = convexHull(eye);
+        for (int c = 0; c < 2; ++c) {
+            std::vector<glm::dvec2> o;
+            if (c == 0) o = convexHull(flat);
+            if (c == 1 && front) o = convexHull(eye);
+            hull.outlineSize[c] = int(o.size());  // the hull of 8 points: at most 8
+            std::copy(o.begin(), o.end(), hull.outline[c].begin());
+            hull.outlineLo[c] = glm::dvec2(kInf);
+            hull.outlineHi[c] = glm::dvec2(-kInf);
+            for (glm::dvec2 q : o) {
+                hull.outlineLo[c] = glm::min(hull.outlineLo[c], q);
+                hull.outlineHi[c] = glm::max(hull.outlineHi[c], q);
+            }
+        }
         h.index_[p] = int32_t(h.hulls_.size());
         h.hulls_.push_back(std::move(hull));
     }
     return h;
 }
 
-bool TurnedHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi) const {
+bool PrimitiveHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi) const {
     if (index_.empty() || index_[p] < 0) return true;
-    const std::vector<glm::dvec2>& o = hulls_[index_[p]].outline[int(column)];
-    if (o.size() < 3) return true;
+    const Hull& h = hulls_[index_[p]];
+    const std::array<glm::dvec2, 8>& o = h.outline[int(column)];
+    const size_t n = size_t(h.outlineSize[int(column)]);
+    if (n < 3) return true;
     // Separating axes of two convex polygons: the rectangle's (its bound against the outline's)
     // and each outline edge's outward normal, the rectangle's nearest corner beyond it.
-    glm::dvec2 olo(kInf), ohi(-kInf);
-    for (glm::dvec2 q : o) {
-        olo = glm::min(olo, q);
-        ohi = glm::max(ohi, q);
-    }
+    const glm::dvec2 olo = h.outlineLo[int(column)], ohi = h.outlineHi[int(column)];
     if (olo.x > hi.x || ohi.x < lo.x || olo.y > hi.y || ohi.y < lo.y) return false;
-    for (size_t i = 0; i < o.size(); ++i) {
-        const glm::dvec2 a = o[i], b = o[(i + 1) % o.size()];
+    for (size_t i = 0; i < n; ++i) {
+        const glm::dvec2 a = o[i], b = o[(i + 1) % n];
         const glm::dvec2 n{b.y - a.y, a.x - b.x};  // outward for a counterclockwise polygon
         const glm::dvec2 c{n.x > 0.0 ? lo.x : hi.x, n.y > 0.0 ? lo.y : hi.y};
         if (glm::dot(n, c - a) > 0.0) return false;
@@ -116,8 +166,8 @@ bool TurnedHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dve
     return true;
 }
 
-glm::dvec2 TurnedHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi,
-                                double zNear, glm::dvec2 whole) const {
+glm::dvec2 PrimitiveHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi,
+                                   double zNear, glm::dvec2 whole) const {
     if (index_.empty() || index_[p] < 0) return whole;
     const Hull& h = hulls_[index_[p]];
     // The column's planes n . x <= d: the rectangle swept along z, or the rays from the eye
@@ -134,13 +184,25 @@ glm::dvec2 TurnedHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, gl
         cd = {0.0, 0.0, 0.0, 0.0, -zNear};
         planes = 5;
     }
+    // A column plane that every corner of a box lies within cuts nothing from it; one that
+    // every corner lies beyond leaves nothing (both boxes are convex).
+    std::array<bool, 5> cuts{};
+    for (int k = 0; k < planes; ++k) {
+        for (int s = 0; s < (h.single ? 1 : 2); ++s) {
+            const Solid& box = s == 0 ? h.world : h.turned;
+            int beyond = 0;
+            for (const Vec3& c : box.corner) beyond += glm::dot(cn[k], c) > cd[k];
+            if (beyond == 8) return {whole.x, -kInf};
+            cuts[k] = cuts[k] || beyond > 0;
+        }
+    }
     // The extremes in depth of the solid (both boxes and the column) lie on a face of one of
     // the boxes: the column is unbounded in depth (beyond zNear, handled below), so its sides
     // alone hold no extreme. Each face is clipped by the other box and the column.
     glm::dvec2 range(kInf, -kInf);
-    const Solid* solids[2] = {&h.turned, &h.world};
+    const Solid* solids[2] = {&h.world, &h.turned};
     Poly a, b;
-    for (int s = 0; s < 2; ++s) {
+    for (int s = 0; s < (h.single ? 1 : 2); ++s) {
         const Solid& me = *solids[s];
         const Solid& other = *solids[1 - s];
         for (int axis = 0; axis < 3; ++axis) {
@@ -154,7 +216,7 @@ glm::dvec2 TurnedHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, gl
                 a.v[3] = me.corner[base | v];
                 Poly* in = &a;
                 Poly* out = &b;
-                for (int k = 0; k < 3 && in->n; ++k) {
+                for (int k = 0; k < 3 && in->n && !h.single; ++k) {
                     clip(*in, other.axis[k], other.hi[k], *out);
                     std::swap(in, out);
                     if (!in->n) break;
@@ -162,6 +224,7 @@ glm::dvec2 TurnedHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, gl
                     std::swap(in, out);
                 }
                 for (int k = 0; k < planes && in->n; ++k) {
+                    if (!cuts[k]) continue;
                     clip(*in, cn[k], cd[k], *out);
                     std::swap(in, out);
                 }
@@ -175,14 +238,14 @@ glm::dvec2 TurnedHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, gl
     // From the eye, the plane z = zNear closes the column: where the boxes reach in front of
     // it, the solid's nearest points may lie on that plane, inside both boxes.
     if (column == ZoneColumn::FromEye && range.x <= range.y) {
-        for (const Solid* s : solids)
-            for (const Vec3& c : s->corner)
+        for (int s = 0; s < (h.single ? 1 : 2); ++s)
+            for (const Vec3& c : solids[s]->corner)
                 if (c.z < zNear) range.x = zNear;
     }
     return {std::max(range.x, whole.x), std::min(range.y, whole.y)};
 }
 
-std::vector<glm::dvec2> narrowZones(ScreenBsp& bsp, const TurnedHulls& hulls, ZoneColumn column,
+std::vector<glm::dvec2> narrowZones(ScreenBsp& bsp, const PrimitiveHulls& hulls, ZoneColumn column,
                                     const std::vector<Box3>& box, double zlo, double zhi,
                                     double pad) {
     std::vector<glm::dvec2> depth;
