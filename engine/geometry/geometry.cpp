@@ -1,5 +1,6 @@
 #include "engine/geometry/geometry.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -91,6 +92,27 @@ void orthonormalBasis(const Vec3& w, Vec3& u, Vec3& v) {
     Vec3 a = std::abs(w.x) > 0.9 ? Vec3(0, 1, 0) : Vec3(1, 0, 0);
     u = glm::normalize(glm::cross(a, w));
     v = glm::cross(w, u);
+}
+
+std::vector<glm::dvec2> convexHull2(std::vector<glm::dvec2> pts) {
+    std::sort(pts.begin(), pts.end(),
+              [](glm::dvec2 a, glm::dvec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+    if (pts.size() < 3) return pts;
+    auto cross = [](glm::dvec2 o, glm::dvec2 a, glm::dvec2 b) {
+        return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+    };
+    std::vector<glm::dvec2> h(2 * pts.size());
+    size_t k = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {  // the lower chain
+        while (k >= 2 && cross(h[k - 2], h[k - 1], pts[i]) <= 0.0) --k;
+        h[k++] = pts[i];
+    }
+    for (size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {  // the upper chain
+        while (k >= t && cross(h[k - 2], h[k - 1], pts[i - 1]) <= 0.0) --k;
+        h[k++] = pts[i - 1];
+    }
+    h.resize(k - 1);
+    return h;
 }
 
 }  // namespace lancer

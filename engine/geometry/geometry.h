@@ -7,6 +7,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace lancer {
 
@@ -79,6 +80,11 @@ inline Box3 overlap(const Box3& a, const Box3& b) {
 /// Parametric interval [t0, t1] of the ray inside a closed box (over the whole line).
 /// Returns false when the line misses. Axis-parallel rays are handled without 0 * inf.
 bool clipLine(const Ray& r, const Box3& b, double& t0, double& t1);
+
+/// The convex hull of `pts` in the plane, counterclockwise from the least (x, y), without
+/// repeated or collinear points (Andrew's monotone chain); fewer than 3 points when they are
+/// all on one line.
+std::vector<glm::dvec2> convexHull2(std::vector<glm::dvec2> pts);
 
 /// An affine transform with its inverse and the normal matrix (inverse transpose).
 struct Transform {

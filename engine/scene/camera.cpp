@@ -29,18 +29,20 @@ PrimaryRays::PrimaryRays(const Camera& cam, int columns, int rows, int w, int h)
     : from_(cam.from), w_(w), h_(h), ortho_(cam.projection == Projection::Orthographic) {
     cam.basis(f_, r_, u_);
     half_ = ortho_ ? 0.5 * cam.orthoHeight : std::tan(glm::radians(cam.fov) * 0.5);
-    const Vec3 base = ortho_ ? from_ : f_;
     column_.resize(size_t(std::max(columns, 0)));
     row_.resize(size_t(std::max(rows, 0)));
-    for (size_t x = 0; x < column_.size(); ++x)
-        column_[x] = base + (offsetX(double(x), w_, h_) * half_) * r_;
-    for (size_t y = 0; y < row_.size(); ++y) row_[y] = (offsetY(double(y), h_) * half_) * u_;
+    for (size_t x = 0; x < column_.size(); ++x) column_[x] = columnTerm(double(x));
+    for (size_t y = 0; y < row_.size(); ++y) row_[y] = rowTerm(double(y));
 }
 
+Vec3 PrimaryRays::columnTerm(double x) const {
+    return (ortho_ ? from_ : f_) + (offsetX(x, w_, h_) * half_) * r_;
+}
+
+Vec3 PrimaryRays::rowTerm(double y) const { return (offsetY(y, h_) * half_) * u_; }
+
 Ray PrimaryRays::operator()(double x, double y) const {
-    const double sx = offsetX(x, w_, h_), sy = offsetY(y, h_);
-    if (ortho_) return {from_ + (sx * half_) * r_ + (sy * half_) * u_, f_};
-    return {from_, glm::normalize(f_ + (sx * half_) * r_ + (sy * half_) * u_)};
+    return through(columnTerm(x) + rowTerm(y));
 }
 
 std::string Camera::validate() const {

@@ -36,23 +36,26 @@ class PrimaryRays {
     Ray operator()(double x, double y) const;
     /// The ray through the centre of pixel (x, y), 0 <= x < w, 0 <= y < h: operator()(x, y)
     /// bit for bit, from the column's and the row's terms computed once.
-    Ray pixel(int x, int y) const {
-        const Vec3 s = column_[size_t(x)] + row_[size_t(y)];
-        return ortho_ ? Ray{s, f_} : Ray{from_, glm::normalize(s)};
-    }
+    Ray pixel(int x, int y) const { return through(column_[size_t(x)] + row_[size_t(y)]); }
 
   private:
     friend struct Camera;  // primaryRay: one ray, no terms
     /// The rays of a w x h image, with the terms of pixel() for `columns` x `rows` pixels.
     PrimaryRays(const Camera& cam, int columns, int rows, int w, int h);
 
+    /// The sum's terms of a pixel's column x and row y (the per-pixel rays' tables hold them).
+    Vec3 columnTerm(double x) const;
+    Vec3 rowTerm(double y) const;
+    /// The ray whose sum of terms is `s`: from `s` along f (orthographic), or from the eye
+    /// towards it (perspective, f at distance 1).
+    Ray through(const Vec3& s) const { return ortho_ ? Ray{s, f_} : Ray{from_, glm::normalize(s)}; }
+
     Vec3 from_, f_, r_, u_;
     double half_;  ///< half the image height on the image plane (perspective: at distance 1)
     double w_, h_;
     bool ortho_;
-    /// Per column, the sum's first terms (perspective f + sx r, orthographic from + sx r, sx in
-    /// scene units); per row, its last (sy u): operator() adds them in that order. A render
-    /// spent a third of its time outside the walk, much of it in these divisions per pixel.
+    /// columnTerm and rowTerm of every column and row, made once: a render spent a third of its
+    /// time outside the walk, much of it in these divisions per pixel.
     std::vector<Vec3> column_, row_;
 };
 

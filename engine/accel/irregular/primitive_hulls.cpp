@@ -31,28 +31,6 @@ void clip(const Poly& in, const Vec3& n, double d, Poly& out) {
     }
 }
 
-/// The convex hull of `pts`, counterclockwise (Andrew's monotone chain).
-std::vector<glm::dvec2> convexHull(std::vector<glm::dvec2> pts) {
-    std::sort(pts.begin(), pts.end(),
-              [](glm::dvec2 a, glm::dvec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
-    if (pts.size() < 3) return pts;
-    auto cross = [](glm::dvec2 o, glm::dvec2 a, glm::dvec2 b) {
-        return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-    };
-    std::vector<glm::dvec2> h(2 * pts.size());
-    size_t k = 0;
-    for (size_t i = 0; i < pts.size(); ++i) {
-        while (k >= 2 && cross(h[k - 2], h[k - 1], pts[i]) <= 0.0) --k;
-        h[k++] = pts[i];
-    }
-    for (size_t i = pts.size() - 1, t = k + 1; i > 0; --i) {
-        while (k >= t && cross(h[k - 2], h[k - 1], pts[i - 1]) <= 0.0) --k;
-        h[k++] = pts[i - 1];
-    }
-    h.resize(k - 1);
-    return h;
-}
-
 /// The frame of a flat primitive (a triangle or a polygon) whose plane is turned off the
 /// world's axes: its first edge, the normal (Newell's sum over its world vertices) and their
 /// cross product. None for other shapes and for planes along the world's axes, whose world box
@@ -130,8 +108,8 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
         }
         for (int c = 0; c < 2; ++c) {
             std::vector<glm::dvec2> o;
-            if (c == 0) o = convexHull(flat);
-            if (c == 1 && front) o = convexHull(eye);
+            if (c == 0) o = convexHull2(flat);
+            if (c == 1 && front) o = convexHull2(eye);
             hull.outlineSize[c] = int(o.size());  // the hull of 8 points: at most 8
             std::copy(o.begin(), o.end(), hull.outline[c].begin());
             hull.outlineLo[c] = glm::dvec2(kInf);

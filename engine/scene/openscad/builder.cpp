@@ -370,26 +370,8 @@ class Builder {
                                      "circles, polygons, text and their unions and transforms");
             }
         }
-        // Andrew's monotone chain.
-        std::sort(pts.begin(), pts.end(), [](const Vec2& p, const Vec2& q) {
-            return p.x < q.x || (p.x == q.x && p.y < q.y);
-        });
-        pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-        if (pts.size() < 3) return emptyPrimitive();
-        std::vector<Vec2> ring;
-        for (int pass = 0; pass < 2; ++pass) {
-            const size_t base = ring.size();
-            for (const Vec2& p : pts) {
-                while (ring.size() >= base + 2) {
-                    const Vec2 u = ring.back() - ring[ring.size() - 2], v = p - ring.back();
-                    if (u.x * v.y - u.y * v.x > 0.0) break;
-                    ring.pop_back();
-                }
-                ring.push_back(p);
-            }
-            ring.pop_back();
-            std::reverse(pts.begin(), pts.end());
-        }
+        const std::vector<Vec2> ring = convexHull2(std::move(pts));
+        if (ring.size() < 3) return emptyPrimitive();
         ++counts_.hulls;
         return pieces({ring}, n.pos);
     }
