@@ -22,15 +22,21 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
                                              bool buffered, const BuildGuard& guard, Build&& build,
                                              Clock&& elapsedMs) {
     // The buffers stop with the build: a cancelled build waits for them below.
+    // Both are cut by the primitives' boxes along the scene's turned frame, when it has one
+    // (the frame the regular grid takes; chosen here too, which costs a pass over the
+    // transforms when nothing is turned and a minimization per frame scored).
     struct Buffers {
         LightBuffer lights, eye;
+        std::shared_ptr<const FrameChoice> turned;
     };
     std::future<Buffers> lightBuffer;
     if (buffered)
         lightBuffer =
             std::async(std::launch::async, [&scene, &params, stop = guard.control().stop] {
-                Buffers b{LightBuffer(scene, LightBuffer::kBins, stop), {}};
-                b.eye = Accelerator::makeEyeBuffer(scene, scene.camera, params, stop);
+                auto turned = std::make_shared<const FrameChoice>(chooseGridFrame(scene));
+                Buffers b{LightBuffer(scene, LightBuffer::kBins, stop, turned.get()), {}, {}};
+                b.eye = Accelerator::makeEyeBuffer(scene, scene.camera, params, stop, turned.get());
+                if (turned->frame.turned) b.turned = std::move(turned);
                 return b;
             });
     AccelInfo info;
@@ -48,7 +54,8 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
     guard.poll();  // the buffers may have stopped early
     std::shared_ptr<const LightBuffer> eye;
     if (buffered) {
-        info.memoryBytes += lb.lights.memoryBytes() + lb.eye.memoryBytes();
+        info.memoryBytes += lb.lights.memoryBytes() + lb.eye.memoryBytes() +
+                            (lb.turned ? lb.turned->boxes.size() * sizeof(Box3) : 0);
         info.extra["light_buffer_bytes"] = lb.lights.memoryBytes();
         info.extra["light_buffer_lights"] = lb.lights.mappedLights();
         if (Accelerator::hasEyeBuffer(params, scene.camera)) {
@@ -63,7 +70,8 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
     }
     info.buildMs = elapsedMs();
     return std::make_unique<Accelerator>(std::move(*s), params, std::move(info),
-                                         std::move(lb.lights), std::move(eye), scene.camera.from);
+                                         std::move(lb.lights), std::move(eye), scene.camera.from,
+                                         std::move(lb.turned));
 }
 
 /// Scheme `S`'s structure: brute force alone (nothing to walk around, so no light buffer), an

@@ -58,15 +58,18 @@ class Accelerator {
     using Impl = std::variant<BruteForce, RegularGrid, IrregularSubdivision, Bvh>;
 
     /// `eye`: the eye buffer of the camera at `eyeFrom` (eyeBuffer() returns it for a camera
-    /// there), null when none was built with the structure.
+    /// there), null when none was built with the structure; `turned`: the primitives' turned
+    /// boxes the buffers were cut by (null: none), for the eye buffers of other cameras.
     Accelerator(Impl impl, BuildParams params, AccelInfo info, LightBuffer lightBuffer = {},
-                std::shared_ptr<const LightBuffer> eye = {}, Vec3 eyeFrom = Vec3(0.0))
+                std::shared_ptr<const LightBuffer> eye = {}, Vec3 eyeFrom = Vec3(0.0),
+                std::shared_ptr<const FrameChoice> turned = {})
         : impl_(std::move(impl)),
           params_(params),
           info_(std::move(info)),
           lightBuffer_(std::move(lightBuffer)),
           eyeBuffer_(std::move(eye)),
-          eyeFrom_(eyeFrom) {}
+          eyeFrom_(eyeFrom),
+          turned_(std::move(turned)) {}
 
     /// Nearest visible hit with t in (tmin, tmax]; reports the walk to `obs`.
     template <class Obs>
@@ -117,20 +120,22 @@ class Accelerator {
     std::shared_ptr<const LightBuffer> eyeBuffer(const Scene& scene, const Camera& cam) const {
         if (eyeBuffer_ && cam.projection == Projection::Perspective && cam.from == eyeFrom_)
             return eyeBuffer_;
-        return std::make_shared<const LightBuffer>(makeEyeBuffer(scene, cam, params_));
+        return std::make_shared<const LightBuffer>(
+            makeEyeBuffer(scene, cam, params_, {}, turned_.get()));
     }
     /// Whether a scheme built with `params` gives `cam` an eye buffer.
     static bool hasEyeBuffer(const BuildParams& params, const Camera& cam) {
         return params.lightBuffer && params.scheme == SchemeKind::Regular &&
                cam.projection == Projection::Perspective;
     }
-    /// The eye buffer of `cam` for a scheme built with `params` (empty when it has none); a
-    /// requested `stop` ends it early, empty.
+    /// The eye buffer of `cam` for a scheme built with `params` (empty when it has none), the
+    /// boxes cut by their turned ones (`turned`; null: none); a requested `stop` ends it early,
+    /// empty.
     static LightBuffer makeEyeBuffer(const Scene& scene, const Camera& cam,
-                                     const BuildParams& params, std::stop_token stop = {}) {
+                                     const BuildParams& params, std::stop_token stop = {},
+                                     const FrameChoice* turned = nullptr) {
         if (!hasEyeBuffer(params, cam)) return {};
-        return LightBuffer(scene.bounds, scene.minBox, {cam.from}, LightBuffer::kBins, 1,
-                           std::move(stop), LightBuffer::Use::NearOnly);
+        return LightBuffer::forEye(scene, cam.from, std::move(stop), turned);
     }
     bool usesMailboxes() const {
         return params_.mailboxes &&
@@ -162,6 +167,7 @@ class Accelerator {
     LightBuffer lightBuffer_;  ///< empty for brute force and with --no-light-buffer
     std::shared_ptr<const LightBuffer> eyeBuffer_;  ///< the scene camera's eye buffer, or null
     Vec3 eyeFrom_;                                  ///< where eyeBuffer_ was built from
+    std::shared_ptr<const FrameChoice> turned_;     ///< the buffers' turned boxes, or null
 };
 
 // Each alternative of Accelerator::Impl is a scheme, at its SchemeKind's index: a scheme added

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 
+#include "engine/accel/regular/grid_frame.h"
 #include "engine/scene/scene.h"
 #include "engine/util/task_fence.h"
 
@@ -56,9 +57,18 @@ std::vector<Vec3> positions(const std::vector<Light>& lights) {
 
 }  // namespace
 
-LightBuffer::LightBuffer(const Scene& scene, int bins, std::stop_token stop)
-    : LightBuffer(scene.bounds, scene.minBox, positions(scene.lights), bins, kSlots,
-                  std::move(stop)) {}
+LightBuffer::LightBuffer(const Scene& scene, int bins, std::stop_token stop,
+                         const FrameChoice* own) {
+    const FrameChoice chosen = own ? FrameChoice() : chooseGridFrame(scene);
+    *this = LightBuffer(scene.bounds, scene.minBox, positions(scene.lights), bins, kSlots,
+                        std::move(stop), Use::Shadows, own ? own : &chosen);
+}
+
+LightBuffer LightBuffer::forEye(const Scene& scene, const Vec3& eye, std::stop_token stop,
+                                const FrameChoice* own) {
+    return LightBuffer(scene.bounds, scene.minBox, {eye}, kBins, 1, std::move(stop), Use::NearOnly,
+                       own);
+}
 
 /// Add depth interval x to a bin of k intervals (sorted, disjoint, unused ones last): merged
 /// with those it overlaps; then, if three remain, the two with the smaller gap are joined (the
@@ -110,10 +120,12 @@ void LightBuffer::insert(Slot* bin, int k, Slot x) {
 
 LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
                          const std::vector<Vec3>& points, int bins, int slots, std::stop_token stop,
-                         Use use)
+                         Use use, const FrameChoice* own)
     : nearOnly_(use == Use::NearOnly) {
     if (nearOnly_) slots = 1;
     if (bounds.isEmpty() || !bounds.isBounded() || points.empty()) return;
+    // Turned boxes only when there is one per box.
+    if (own && !(own->frame.turned && own->boxes.size() == boxes.size())) own = nullptr;
     const Vec3 e = bounds.extent();
     const double largest = std::max({e.x, e.y, e.z});
     const double size = largest + std::max(glm::length(bounds.lo), glm::length(bounds.hi));
@@ -129,14 +141,16 @@ LightBuffer::LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes,
     std::atomic<bool> stopped{false};
     TaskFence fence;
     tbb::parallel_for(size_t(0), points.size(), fence.task([&](size_t l) {
-        if (!buildMap(maps_[l], points[l], boxes, bins, slots, side, largest, stop)) stopped = true;
+        if (!buildMap(maps_[l], points[l], boxes, own, bins, slots, side, largest, stop))
+            stopped = true;
     }));
     fence.acquire();
     if (stopped) maps_.clear();
 }
 
-bool LightBuffer::buildMap(Map& m, const Vec3& point, const std::vector<Box3>& boxes, int bins,
-                           int slots, double side, double largest, const std::stop_token& stop) {
+bool LightBuffer::buildMap(Map& m, const Vec3& point, const std::vector<Box3>& boxes,
+                           const FrameChoice* own, int bins, int slots, double side, double largest,
+                           const std::stop_token& stop) {
     m.L = point;
     // The face of the box the light is farthest beyond; a light inside gets no map.
     double gap = 0.0;
@@ -166,7 +180,7 @@ bool LightBuffer::buildMap(Map& m, const Vec3& point, const std::vector<Box3>& b
     for (size_t i = 0; i < boxes.size(); ++i) {
         if ((i & 255) == 0 && stop.stop_requested()) return false;
         BoxImage im;
-        if (!image(m, boxes[i], side, largeArea, im)) continue;
+        if (!image(m, boxes, own, i, side, largeArea, im)) continue;
         anyLarge |= im.large;
         if (!im.large) {
             wu0 = std::min(wu0, im.u0), wu1 = std::max(wu1, im.u1);
@@ -184,14 +198,16 @@ bool LightBuffer::buildMap(Map& m, const Vec3& point, const std::vector<Box3>& b
     for (size_t i = 0; i < boxes.size(); ++i) {
         if ((i & 255) == 0 && stop.stop_requested()) return false;
         BoxImage im;
-        if (!image(m, boxes[i], side, largeArea, im)) continue;
+        if (!image(m, boxes, own, i, side, largeArea, im)) continue;
         m.fine.add(im, colLo, colHi, nearOnly_);
         if (window && im.large) m.coarse.add(im, colLo, colHi, nearOnly_);
     }
     return true;
 }
 
-bool LightBuffer::image(const Map& m, const Box3& mb, double side, double largeArea, BoxImage& im) {
+bool LightBuffer::image(const Map& m, const std::vector<Box3>& boxes, const FrameChoice* own,
+                        size_t i, double side, double largeArea, BoxImage& im) {
+    const Box3& mb = boxes[i];
     if (mb.isEmpty()) return false;  // a dropped primitive
     // The box widened across the view axis only, by `side`, seen from the point: what
     // m.project() of the widened box computes, with the differences kept for Grid::add.
@@ -201,8 +217,39 @@ bool LightBuffer::image(const Map& m, const Box3& mb, double side, double largeA
     im.b0 = (coord(mb.lo, m.b) - side) - lb, im.b1 = (coord(mb.hi, m.b) + side) - lb;
     im.c0 = (coord(mb.lo, m.c) - side) - lc, im.c1 = (coord(mb.hi, m.c) + side) - lc;
     Map::quotients(im.dn, im.df, im.b0, im.b1, im.c0, im.c1, im.u0, im.u1, im.v0, im.v1);
+    im.outlineSize = 0;
+    if (own && !own->boxes[i].isEmpty()) cutByTurnedBox(m, own->frame.axes, own->boxes[i], im);
     im.large = (im.u1 - im.u0) * (im.v1 - im.v0) > largeArea;
     return true;
+}
+
+void LightBuffer::cutByTurnedBox(const Map& m, const Mat3& axes, const Box3& fb, BoxImage& im) {
+    // The primitive lies in both boxes (the turned one widened by chooseGridFrame's hair, far
+    // above the rounding of its corners here), so its image lies in the convex hull of the
+    // turned box's corner images (a central projection keeps convex hulls of points in front
+    // of its centre) and its depths within the corners' range. Either bound alone is valid;
+    // where rounding would leave them disjoint, the world box's are kept.
+    const double la = coord(m.L, m.a), lb = coord(m.L, m.b), lc = coord(m.L, m.c);
+    std::vector<glm::dvec2> pts(8);
+    double dn = kInf, df = -kInf;
+    for (int c = 0; c < 8; ++c) {
+        const Vec3 w = axes * boxCorner(fb, c);
+        const double d = m.s > 0.0 ? la - coord(w, m.a) : coord(w, m.a) - la;
+        if (!(d > 0.0)) return;  // behind or beside the point: the outline is not convex
+        pts[size_t(c)] = {(coord(w, m.b) - lb) / d, (coord(w, m.c) - lc) / d};
+        dn = std::min(dn, d), df = std::max(df, d);
+    }
+    const std::vector<glm::dvec2> hull = convexHull2(std::move(pts));
+    if (hull.size() < 3) return;
+    glm::dvec2 lo = hull[0], hi = hull[0];
+    for (const glm::dvec2& p : hull) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    const double u0 = std::max(im.u0, lo.x), u1 = std::min(im.u1, hi.x);
+    const double v0 = std::max(im.v0, lo.y), v1 = std::min(im.v1, hi.y);
+    const double n = std::max(im.dn, dn), f = std::min(im.df, df);
+    if (!(u0 <= u1 && v0 <= v1 && n <= f)) return;
+    im.u0 = u0, im.u1 = u1, im.v0 = v0, im.v1 = v1, im.dn = n, im.df = f;
+    im.outlineSize = int(hull.size());
+    std::copy(hull.begin(), hull.end(), im.outline.begin());
 }
 
 void LightBuffer::Grid::cover(double uLo, double uHi, double vLo, double vHi, int bins,
@@ -284,7 +331,14 @@ void LightBuffer::Grid::add(const BoxImage& im, std::vector<double>& colLo,
         lo = std::max(im.dn, lo * (1.0 - rel));
         hi = std::min(im.df, hi * (1.0 + rel));
         Slot* row = at(0, j);
+        // The turned box's outline, against the bins off the grid's edges (those are unbounded
+        // outward).
+        const bool cut = im.outlineSize >= 3 && j != 0 && j != n - 1;
         for (int i = i0; i <= i1; ++i) {
+            if (cut && i != 0 && i != n - 1 &&
+                !convexMeetsRect(im.outline.data(), size_t(im.outlineSize), {u0 + i * du - pad, va},
+                                 {u0 + (i + 1) * du + pad, vb}))
+                continue;
             const Slot depths{std::max(lo, colLo[size_t(i - i0)]),
                               std::min(hi, colHi[size_t(i - i0)])};
             if (depths.near <= depths.far) insert(row + size_t(i) * size_t(k), k, depths);

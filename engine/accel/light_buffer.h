@@ -6,7 +6,10 @@
 // light, over d. Every point of a ray from the light has the same image point. The image is cut
 // into bins; a bin keeps the depth ranges [near, far] of the primitives' (CSG-minimized) boxes
 // whose images meet it (a box's image lies inside the rectangle of its corners' images), merged
-// into at most kSlots intervals (overlapping ranges join; then the two closest ones).
+// into at most kSlots intervals (overlapping ranges join; then the two closest ones). In a turned
+// scene each box is also bounded by its box along the turned frame (chooseGridFrame's,
+// docs/regular.md "Turned scenes"): its image is cut to the convex outline of that box's corners
+// and its depths to that box's, where a bar along a diagonal has a world box many times its size.
 //
 // A shadow ray heads for its light, so its depth falls as t grows, and its image point is that
 // of its origin o. A blocker at t > 0 lies nearer the light than o, inside a box whose image
@@ -22,6 +25,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <stop_token>
 #include <utility>
@@ -32,6 +36,7 @@
 namespace lancer {
 
 struct Scene;
+struct FrameChoice;
 
 class LightBuffer {
   public:
@@ -51,16 +56,22 @@ class LightBuffer {
 
     LightBuffer() = default;
     /// One depth map per light of the (prepared) scene that lies outside its bounds, kSlots
-    /// intervals per bin.
+    /// intervals per bin, the boxes cut by their turned ones (`own`; null: chooseGridFrame's).
     /// A requested `stop` ends the construction early with an empty buffer (the build that
     /// asked for it is being cancelled).
-    explicit LightBuffer(const Scene& scene, int bins = kBins, std::stop_token stop = {});
+    explicit LightBuffer(const Scene& scene, int bins = kBins, std::stop_token stop = {},
+                         const FrameChoice* own = nullptr);
     /// One depth map per point outside `bounds`, of `boxes` (those inside `bounds`; empty
     /// ones are skipped), `slots` intervals per bin (1 to kSlots): the scene's lights, or the
-    /// eye of a perspective camera (which needs only the least depth: 1).
+    /// eye of a perspective camera (which needs only the least depth: 1). `own`, when turned:
+    /// box i also lies in own->boxes[i] along own->frame's axes.
     LightBuffer(const Box3& bounds, const std::vector<Box3>& boxes, const std::vector<Vec3>& points,
                 int bins = kBins, int slots = kSlots, std::stop_token stop = {},
-                Use use = Use::Shadows);
+                Use use = Use::Shadows, const FrameChoice* own = nullptr);
+    /// The eye buffer of a perspective camera at `eye`: the least depth of each bin (Use::
+    /// NearOnly), the scene's boxes cut by their turned ones (`own`; null: none).
+    static LightBuffer forEye(const Scene& scene, const Vec3& eye, std::stop_token stop = {},
+                              const FrameChoice* own = nullptr);
 
     /// A stretch [t0, t1] of a shadow ray that boxes may occupy.
     struct Segment {
@@ -87,17 +98,22 @@ class LightBuffer {
     }
 
     /// For a ray leaving point `point` itself along `dir` (a primary ray from the eye): a t
-    /// before which it can meet nothing. 0 when the buffer does not know.
+    /// before which it can meet nothing (+inf: nothing at all). 0 when the buffer does not know.
     double nearFrom(const Vec3& dir, uint32_t point) const {
         if (point >= maps_.size()) return 0.0;
         const Map& m = maps_[point];
+        if (m.fine.slots.empty()) return 0.0;
         const double rate = -m.s * dir[m.a];  // depth gained per unit of t
-        if (m.fine.slots.empty() || !(rate > 0.0)) return 0.0;
+        // The point lies beyond the bounds' face along the map's axis: a ray whose depth does
+        // not grow never reaches them.
+        if (!(rate > 0.0)) return kInf;
         // One division, not three: the products stray from the quotients by an ulp or two,
         // which the bins' pad and hair_ (far above rounding) cover.
         const double per = 1.0 / rate;
         const double u = dir[m.b] * per, v = dir[m.c] * per;
-        return std::max(0.0, (m.bin(u, v)[0].near - hair_) * per);
+        // Outside the image of the bounds (the grids cover it, padded), the ray misses them.
+        const Slot* bin = m.binWithin(u, v);
+        return bin ? std::max(0.0, (bin[0].near - hair_) * per) : kInf;
     }
 
     bool empty() const { return maps_.empty(); }
@@ -116,12 +132,15 @@ class LightBuffer {
         double near = kInf, far = -kInf;
     };
     /// A box seen from the map's point: the rectangle holding its image, its extent on the two
-    /// image axes relative to the point, and its depth range.
+    /// image axes relative to the point, and its depth range; in a turned scene, the convex
+    /// outline of its turned box's image too (the rectangle and depths already cut by it).
     struct BoxImage {
         double u0, u1, v0, v1;
         double b0, b1, c0, c1;
         double dn, df;
         bool large;
+        int outlineSize = 0;  ///< points of `outline` (under 3: none)
+        std::array<glm::dvec2, 8> outline;
     };
     /// Bins over a rectangle of the image, k intervals each, row by row.
     struct Grid {
@@ -173,6 +192,11 @@ class LightBuffer {
             if (const Slot* in = fine.within(u, v)) return in;
             return coarse.slots.empty() ? fine.clamped(u, v) : coarse.clamped(u, v);
         }
+        /// The same within the image of the bounds; null outside it.
+        const Slot* binWithin(double u, double v) const {
+            if (const Slot* in = fine.within(u, v)) return in;
+            return coarse.slots.empty() ? nullptr : coarse.within(u, v);
+        }
         void project(const Box3& x, double& dNear, double& u0, double& u1, double& v0,
                      double& v1) const;
         /// The rectangle of project() from the box's depths and its extents relative to the
@@ -193,10 +217,15 @@ class LightBuffer {
         return m.bin((o[m.b] - m.L[m.b]) / d, (o[m.c] - m.L[m.c]) / d);
     }
     /// Map `m` of the light at `point`; false when `stop` ended it.
-    bool buildMap(Map& m, const Vec3& point, const std::vector<Box3>& boxes, int bins, int slots,
-                  double side, double largest, const std::stop_token& stop);
-    /// The image of box `mb` in map `m` (widened sideways by `side`); false for an empty box.
-    static bool image(const Map& m, const Box3& mb, double side, double largeArea, BoxImage& im);
+    bool buildMap(Map& m, const Vec3& point, const std::vector<Box3>& boxes, const FrameChoice* own,
+                  int bins, int slots, double side, double largest, const std::stop_token& stop);
+    /// The image of box i of `boxes` in map `m` (widened sideways by `side`), cut by its turned
+    /// box when `own` has one; false for an empty box.
+    static bool image(const Map& m, const std::vector<Box3>& boxes, const FrameChoice* own,
+                      size_t i, double side, double largeArea, BoxImage& im);
+    /// Cut `im` by the image of `fb`, a box along `axes` (columns: its axes in the world), when
+    /// every corner of it lies in front of the map's point.
+    static void cutByTurnedBox(const Map& m, const Mat3& axes, const Box3& fb, BoxImage& im);
     /// Add depth interval x to a bin of k (1 or 2) intervals.
     static void insert(Slot* bin, int k, Slot x);
     Box3 box_;               ///< the scene bounds, widened by hair_

@@ -86,6 +86,20 @@ bool clipLine(const Ray& r, const Box3& b, double& t0, double& t1);
 /// all on one line.
 std::vector<glm::dvec2> convexHull2(std::vector<glm::dvec2> pts);
 
+/// Whether the counterclockwise convex polygon `poly` (n >= 3 points, as convexHull2 makes it)
+/// meets the closed rectangle [lo, hi]: no separating axis among the rectangle's and the edges'
+/// outward normals. Only the edges' are tested; the caller has checked the bounds.
+inline bool convexMeetsRect(const glm::dvec2* poly, size_t n, glm::dvec2 lo, glm::dvec2 hi) {
+    for (size_t i = 0; i < n; ++i) {
+        const glm::dvec2 a = poly[i], b = poly[i + 1 == n ? 0 : i + 1];
+        const glm::dvec2 out{b.y - a.y, a.x - b.x};  // outward for a counterclockwise polygon
+        // The rectangle's corner farthest inside along the normal.
+        const glm::dvec2 c{out.x > 0.0 ? lo.x : hi.x, out.y > 0.0 ? lo.y : hi.y};
+        if (glm::dot(out, c - a) > 0.0) return false;
+    }
+    return true;
+}
+
 /// An affine transform with its inverse and the normal matrix (inverse transpose).
 struct Transform {
     Mat4 m{1.0};

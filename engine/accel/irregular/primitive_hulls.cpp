@@ -135,13 +135,7 @@ bool PrimitiveHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::
     // and each outline edge's outward normal, the rectangle's nearest corner beyond it.
     const glm::dvec2 olo = h.outlineLo[int(column)], ohi = h.outlineHi[int(column)];
     if (olo.x > hi.x || ohi.x < lo.x || olo.y > hi.y || ohi.y < lo.y) return false;
-    for (size_t i = 0; i < n; ++i) {
-        const glm::dvec2 a = o[i], b = o[(i + 1) % n];
-        const glm::dvec2 n{b.y - a.y, a.x - b.x};  // outward for a counterclockwise polygon
-        const glm::dvec2 c{n.x > 0.0 ? lo.x : hi.x, n.y > 0.0 ? lo.y : hi.y};
-        if (glm::dot(n, c - a) > 0.0) return false;
-    }
-    return true;
+    return convexMeetsRect(o.data(), n, lo, hi);
 }
 
 glm::dvec2 PrimitiveHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi,
