@@ -72,6 +72,49 @@ CsgTree differenceOfUnionAndIntersection() {
     return t;
 }
 
+/// restrictionWithin of `t` with `held` filling the region: the kept primitives as "p0 p2",
+/// "none" (nothing kept) or "as is" (false: left as it is).
+std::string keptWithin(const CsgTree& t, std::vector<uint32_t> held) {
+    std::vector<uint32_t> kept;
+    if (!restrictionWithin(t, held, kept)) return "as is";
+    if (kept.empty()) return "none";
+    std::string out;
+    for (uint32_t p : kept) out += (out.empty() ? "p" : " p") + std::to_string(p);
+    return out;
+}
+
+// Within a region that a primitive's solid fills: union(full, x) = full, intersection(full, x)
+// = x, x - full = empty; a tree empty or full over the whole region keeps nothing (no boundary
+// there); a primitive with two leaves, or nothing held, leaves the tree as it is.
+TEST(Restriction, WithinARegionAPrimitiveFills) {
+    CsgTree d;  // p0 - (p1 u p2): a block less two bars
+    d.root = d.combine(Op::Difference, d.leaf(0), d.combine(Op::Union, d.leaf(1), d.leaf(2)));
+    EXPECT_EQ(keptWithin(d, {}), "as is");
+    EXPECT_EQ(keptWithin(d, {1}), "none");      // inside a bar: nothing of the block is left
+    EXPECT_EQ(keptWithin(d, {0}), "p0 p1 p2");  // inside the block: both bars' boundaries
+    EXPECT_EQ(keptWithin(d, {0, 2}), "none");   // inside the block and a bar
+    CsgTree u;                                  // (p0 u p1) n p2
+    u.root = u.combine(Op::Intersection, u.combine(Op::Union, u.leaf(0), u.leaf(1)), u.leaf(2));
+    EXPECT_EQ(keptWithin(u, {0}), "p0 p2");  // the full side of the union stands for it
+    EXPECT_EQ(keptWithin(u, {2}), "p0 p1 p2");
+    EXPECT_EQ(keptWithin(u, {1, 2}), "none");  // full everywhere in the region
+    CsgTree m;  // (p0 - p1) u (p2 - p3): the full subtrahend empties its side only
+    m.root = m.combine(Op::Union, m.combine(Op::Difference, m.leaf(0), m.leaf(1)),
+                       m.combine(Op::Difference, m.leaf(2), m.leaf(3)));
+    EXPECT_EQ(keptWithin(m, {1}), "p2 p3");
+    EXPECT_EQ(keptWithin(m, {0}), "p0 p1 p2 p3");
+    CsgTree twice;  // p0 - (p1 u p0): p0 has two leaves
+    twice.root = twice.combine(Op::Difference, twice.leaf(0),
+                               twice.combine(Op::Union, twice.leaf(1), twice.leaf(0)));
+    EXPECT_EQ(keptWithin(twice, {1}), "none");  // empty whatever p0's leaves keep
+    EXPECT_EQ(keptWithin(twice, {2}), "as is");
+    // Restricting to the kept list gives the tree the rules give.
+    CsgTree r;
+    std::vector<char> marks(4, 0);
+    r.root = restrictTreeTo(m, {2, 3}, marks, r);
+    EXPECT_EQ(r.toString(), "(p2 − p3)");
+}
+
 TEST(Restriction, ToAListLeavesTheMarksClearAndComposes) {
     const CsgTree t = differenceOfUnionAndIntersection();
     std::vector<char> marks(4, 0);

@@ -878,6 +878,63 @@ TEST(RegularSubTables, DeepLevelBuiltWhereTheFullTableWouldNotFit) {
     EXPECT_EQ(walkErrors(s, *accel, rays), 0u);
 }
 
+/// Whether the sphere `c`, `r` holds the box `b` of the grid's frame, grown by `m`.
+bool sphereHoldsCell(const RegularGrid& g, const RegularLeaf& L, Vec3 c, double r, double m) {
+    for (int k = 0; k < 8; ++k) {
+        Vec3 f;
+        for (int a = 0; a < 3; ++a)
+            f[a] = (k >> a) & 1 ? g.plane(a, L.hi[a]) + m : g.plane(a, L.lo[a]) - m;
+        if (!(glm::length(g.frame().toWorld(f) - c) < r)) return false;
+    }
+    return true;
+}
+
+// A cell that a subtrahend fills (inside a cavity) or that the whole solid fills lists nothing:
+// no boundary of the solid lies there. A turned block less a sphere, split fine by the report's
+// rule: every leaf inside the cavity is empty, the build counts them (`solid_cells`), and every
+// ray, through the leaves' corners and faces too, hits as brute force, both step methods.
+TEST(RegularSolidCells, CellsInsideACavityOrTheSolidListNothing) {
+    for (double turn : {0.0, 30.0}) {
+        Scene s;
+        const Transform xf = Transform::rotate(turn, glm::normalize(Vec3(1, 2, 3)));
+        s.prims.push_back(makePrimitive(Block{Vec3(-2.0), Vec3(2.0)}, xf));
+        s.prims.push_back(makePrimitive(Sphere{Vec3(0.0), 1.5}, Transform()));
+        s.prims.push_back(makePrimitive(Block{{-3, -3, -3}, {3, 3, -1}}, Transform()));  // a cut
+        s.tree.root = s.tree.combine(Op::Difference,
+                                     s.tree.combine(Op::Difference, s.tree.leaf(0), s.tree.leaf(1)),
+                                     s.tree.leaf(2));
+        s.prepare();
+        s.frameCamera({-1.0, 2.0, -1.5}, {0, 0, 1});
+        for (StepMethod step : {StepMethod::Exact, StepMethod::Push}) {
+            BuildParams p = regular(step);
+            p.regular.maxLevel = 12;
+            p.regular.maxObjects = 1;
+            p.regular.costStop = false;
+            auto accel = buildAccelerator(s, p);
+            const RegularGrid& g = gridOf(*accel);
+            size_t inCavity = 0;
+            const double m = 1e-4 * s.scale();
+            for (const RegularLeaf& L : g.leaves())
+                if (sphereHoldsCell(g, L, Vec3(0.0), 1.5, m)) {
+                    ++inCavity;
+                    EXPECT_EQ(L.prims, 0u) << "a leaf inside the cavity lists primitives";
+                }
+            EXPECT_GT(inCavity, 20u) << turn;
+            EXPECT_GT(accel->info().extra["solid_cells"].get<size_t>(), inCavity / 8) << turn;
+            auto rays = hardRays(s, g, 7, 3000);
+            const auto pixels = test::pixelRays(s, 48, 48);
+            rays.insert(rays.end(), pixels.begin(), pixels.end());
+            auto bad = test::compareWithBrute(s, *accel, rays);
+            EXPECT_TRUE(bad.empty()) << turn << " " << stepName(step) << ": " << bad.size()
+                                     << " of " << rays.size() << " rays differ\n"
+                                     << describe(s, bad);
+            EXPECT_EQ(walkErrors(s, *accel, rays), 0u);
+            auto secondary = test::compareWithBrute(s, *accel, rays, 1e-3 * s.scale());
+            EXPECT_TRUE(secondary.empty()) << turn << " tmin > 0\n" << describe(s, secondary);
+        }
+    }
+}
+
 TEST(RegularRefusal, AbsurdLevelAndObjectsAreRefusedWithAMessage) {
     // Overlapping boxes: with max-objects 1 every cell of the overlap splits down to max-level.
     Scene s;

@@ -1,6 +1,7 @@
 #include "engine/model/restriction.h"
 
 #include <algorithm>
+#include <span>
 
 #include "engine/util/hash.h"
 #include "engine/util/huge_pages.h"
@@ -60,6 +61,69 @@ int restrictTreeTo(const CsgTree& src, const std::vector<uint32_t>& prims, std::
     const int root = restrictTree(src, src.root, marks, dst);
     for (uint32_t p : prims) marks[p] = 0;
     return root;
+}
+
+bool restrictionWithin(const CsgTree& tree, std::span<const uint32_t> held,
+                       std::vector<uint32_t>& out) {
+    out.clear();
+    if (held.empty() || tree.root < 0) return false;
+    // Each node's state over the region, children first (they are stored before their
+    // parents, as combine() and the restrictions append them).
+    constexpr uint8_t kEmpty = 0, kFull = 1, kMixed = 2;
+    const size_t n = size_t(tree.root) + 1;
+    std::vector<uint8_t> state(n, kEmpty);
+    for (size_t i = 0; i < n; ++i) {
+        const CsgNode& x = tree.nodes[i];
+        if (x.op == Op::Primitive) {
+            out.push_back(x.prim);
+            state[i] = std::binary_search(held.begin(), held.end(), x.prim) ? kFull : kMixed;
+            continue;
+        }
+        if (size_t(x.left) >= i || size_t(x.right) >= i) return false;
+        const uint8_t a = state[size_t(x.left)], b = state[size_t(x.right)];
+        switch (x.op) {
+            case Op::Union:
+                state[i] = a == kFull || b == kFull ? kFull
+                           : a == kEmpty            ? b
+                           : b == kEmpty            ? a
+                                                    : kMixed;
+                break;
+            case Op::Intersection:
+                state[i] = a == kEmpty || b == kEmpty ? kEmpty
+                           : a == kFull && b == kFull ? kFull
+                                                      : kMixed;
+                break;
+            default:  // difference
+                state[i] = a == kEmpty || b == kFull ? kEmpty : b == kEmpty ? a : kMixed;
+                break;
+        }
+    }
+    // A primitive with two leaves: restricting to a list would keep both.
+    std::sort(out.begin(), out.end());
+    const bool shared = std::adjacent_find(out.begin(), out.end()) != out.end();
+    out.clear();
+    if (state[size_t(tree.root)] != kMixed) return true;  // no boundary in the region
+    if (shared) return false;
+    // The primitives of the subtrees the rules keep: of a full union one full side, of an
+    // intersection both, of a difference its minuend alone when the subtrahend is empty.
+    std::vector<int> stack = {tree.root};
+    while (!stack.empty()) {
+        const CsgNode& x = tree.nodes[size_t(stack.back())];
+        stack.pop_back();
+        if (x.op == Op::Primitive) {
+            out.push_back(x.prim);
+            continue;
+        }
+        const uint8_t a = state[size_t(x.left)], b = state[size_t(x.right)];
+        const bool keepLeft = x.op == Op::Union ? a != kEmpty && !(b == kFull && a != kFull) : true;
+        const bool keepRight = x.op == Op::Union          ? b != kEmpty && a != kFull
+                               : x.op == Op::Intersection ? true
+                                                          : b != kEmpty;
+        if (keepLeft) stack.push_back(x.left);
+        if (keepRight) stack.push_back(x.right);
+    }
+    std::sort(out.begin(), out.end());
+    return true;
 }
 
 TreeRestrictor::TreeRestrictor(const CsgTree& tree) : tree_(&tree) {

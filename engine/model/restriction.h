@@ -24,6 +24,16 @@ int restrictTree(const CsgTree& src, int node, const std::vector<char>& keep, Cs
 int restrictTreeTo(const CsgTree& src, const std::vector<uint32_t>& prims, std::vector<char>& marks,
                    CsgTree& dst);
 
+/// Within a region that each primitive of `held` (sorted) fills (a convex solid holding the
+/// whole region), the primitives of `tree` whose restriction (the rules above) equals `tree`
+/// there, into `out` (sorted): by the rules union(full, x) = full, intersection(full, x) = x and
+/// x - full = empty, a cell inside a subtrahend keeps nothing of the difference, and a tree that
+/// is empty or full over the whole region keeps nothing at all (it has no boundary there).
+/// False when the tree is left as it is: nothing held, a primitive with several leaves (one
+/// rule could keep it and another drop it), or children stored after their parents.
+bool restrictionWithin(const CsgTree& tree, std::span<const uint32_t> held,
+                       std::vector<uint32_t>& out);
+
 /// The restriction of one tree to many sets, visiting only the ancestors of each set's leaves.
 class TreeRestrictor {
   public:

@@ -402,6 +402,27 @@ bool shapeIsSurface(const Shape& s) {
     return std::holds_alternative<Triangle>(s) || std::holds_alternative<Polygon>(s);
 }
 
+bool convexSolidHolds(const Shape& s, const Vec3& p) {
+    return std::visit(
+        Overloaded{[&](const Sphere& x) { return glm::dot(p - x.c, p - x.c) < x.r * x.r; },
+                   [&](const Block& x) {
+                       return glm::all(glm::lessThan(x.lo, p)) && glm::all(glm::lessThan(p, x.hi));
+                   },
+                   [&](const Cone& x) {
+                       if (x.open || !(x.r1 >= 0.0 && x.r2 >= 0.0) || !(0.0 < p.z && p.z < x.h))
+                           return false;  // a frustum with both radii >= 0 is convex
+                       const double r = x.r1 + (x.r2 - x.r1) * (p.z / x.h);
+                       return p.x * p.x + p.y * p.y < r * r;
+                   },
+                   [&](const Polytope& x) {
+                       for (const glm::dvec4& pl : x.planes)
+                           if (!(glm::dot(Vec3(pl), p) < pl.w)) return false;
+                       return !x.planes.empty();
+                   },
+                   [](const auto&) { return false; }},
+        s);
+}
+
 const char* shapeName(const Shape& s) {
     static const char* names[] = {"sphere",  "box",      "cone", "triangle",
                                   "polygon", "polytope", "torus"};

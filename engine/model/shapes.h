@@ -130,6 +130,10 @@ Vec3 shapeNormal(const Shape& s, const Vec3& p, uint8_t part);
 Box3 shapeBounds(const Shape& s);
 /// True for shapes with no inside (polygons, triangles, open cones).
 bool shapeIsSurface(const Shape& s);
+/// Whether `p` (in the shape's frame) lies strictly inside the solid, for the convex solids
+/// (sphere, box, closed cone, polytope); false for every other shape. Points all held by a
+/// convex solid hold their convex hull: a cell whose corners it holds lies inside it.
+bool convexSolidHolds(const Shape& s, const Vec3& p);
 const char* shapeName(const Shape& s);
 
 /// Build a polygon (computes plane and projection axis). Returns false if degenerate.

@@ -40,6 +40,7 @@ void RegularBuilder::LeafCounts::add(const LeafCounts& o) {
     gainLeaves += o.gainLeaves;
     objectsLeaves += o.objectsLeaves;
     levelLeaves += o.levelLeaves;
+    solidCells += o.solidCells;
 }
 
 RegularBuilder::Layout RegularBuilder::layOut(Fragment& root) {

@@ -54,6 +54,9 @@ RegularBuilder::RegularBuilder(const Scene& s, const RegularConfig& p, RegularGr
     if (unionOnly && s.tree.depth() <= kRestrictorDepth) {
         restrictor = std::make_unique<TreeRestrictor>(s.tree);
     }
+    const Vec3 e = g.box_.extent();
+    solidMargin = 1e-5 * (std::max({e.x, e.y, e.z}) +
+                          std::max(glm::length(g.box_.lo), glm::length(g.box_.hi)));
 }
 
 RegularBuilder::Fragment RegularBuilder::buildFragments() {
@@ -224,7 +227,7 @@ uint8_t RegularBuilder::splitInTasks(Fragment& f, int first, int level, const Cu
             Fragment& k = *kid[side];
             if (!onePass) half(prims, level, cut.child[side], cut.axis, cut.mid, side, k.in);
             buildChild(k, 0, level + 1, cut.pos[side], cut.child[side], tree, prims,
-                       onePass ? sc.in[side] : k.in, k.sub, k.live);
+                       onePass ? sc.in[side] : k.in, k.sub, k.live, k.held, k.heldList);
             k.releaseScratch();
         }));
     try {
@@ -246,7 +249,7 @@ uint8_t RegularBuilder::splitInPlace(Fragment& f, int first, int level, const Cu
     for (int side = 0; side < 2; ++side) {
         if (!onePass) half(prims, level, cut.child[side], cut.axis, cut.mid, side, sc.in[side]);
         buildChild(f, first + side, level + 1, cut.pos[side], cut.child[side], tree, prims,
-                   sc.in[side], sc.sub, sc.live);
+                   sc.in[side], sc.sub, sc.live, sc.held, sc.heldList);
         height = std::max<uint8_t>(height, f.bsp.nodes[size_t(first + side)].height + 1);
     }
     return height;
@@ -274,29 +277,71 @@ void RegularBuilder::half(const PrimList& prims, int level, const Box3& child, i
 
 void RegularBuilder::buildChild(Fragment& f, int id, int level, const uint32_t pos[3],
                                 const Box3& box, const CsgTree& tree, const PrimList& parentPrims,
-                                const PrimList& in, CsgTree& sub, PrimList& live) {
+                                const PrimList& in, CsgTree& sub, PrimList& live, CsgTree& held,
+                                PrimList& heldList) {
+    const CsgTree* t = &tree;
+    const PrimList* prims = &in;
     if (in.size() == parentPrims.size()) {
         // Every primitive overlaps the child: the restriction is this tree, whose
         // primitives all count (`prims` are the live ones).
-        build(f, id, level, pos, box, tree, parentPrims);
-    } else if (restrictor) {
-        // A union's restriction drops no primitive it keeps, so the child needs no tree of
-        // its own: its leaves restrict the scene's.
-        build(f, id, level, pos, box, tree, in);
-    } else {
+        prims = &parentPrims;
+    } else if (!restrictor) {
+        // (With a restrictor, a union's restriction drops no primitive it keeps, so the child
+        // needs no tree of its own: its leaves restrict the scene's.)
         sub.nodes.clear();
         f.key.assign(in.begin(), in.end());
         sub.root = restrictTreeTo(tree, f.key, keep.local(), sub);
-        if (unionOnly) {
+        t = &sub;
+        if (!unionOnly) {
             // Restricting a union drops no primitive it keeps: all of them are live.
-            build(f, id, level, pos, box, sub, in);
-        } else {
             f.key = sub.primitives();
             sortedUnique(f.key);
             live.assign(f.key.begin(), f.key.end());
-            build(f, id, level, pos, box, sub, live);
+            prims = &live;
         }
     }
+    if (heldWithin(f, box, *t, *prims, held, heldList))
+        build(f, id, level, pos, box, held, heldList);
+    else
+        build(f, id, level, pos, box, *t, *prims);
+}
+
+bool RegularBuilder::fills(uint32_t p, const Box3& box) const {
+    const Box3 g{box.lo - Vec3(solidMargin), box.hi + Vec3(solidMargin)};
+    // The solid lies in its box: a box not holding the cell rules it out at once.
+    const Box3& b = grid.boxes()[p];
+    if (!(glm::all(glm::lessThanEqual(b.lo, g.lo)) && glm::all(glm::lessThanEqual(g.hi, b.hi))))
+        return false;
+    const Primitive& prim = scene.prims[p];
+    for (int c = 0; c < 8; ++c) {
+        const Vec3 w = grid.frame().toWorld(boxCorner(g, c));
+        const Vec3 local = prim.hasXf ? Vec3(prim.xf.inv * glm::dvec4(w, 1.0)) : w;
+        if (!convexSolidHolds(prim.shape, local)) return false;
+    }
+    return true;
+}
+
+bool RegularBuilder::heldWithin(Fragment& f, const Box3& box, const CsgTree& tree,
+                                const PrimList& prims, CsgTree& held, PrimList& heldList) {
+    f.filling.clear();
+    for (uint32_t p : prims)
+        if (fills(p, box)) f.filling.push_back(p);
+    if (f.filling.empty()) return false;
+    held.nodes.clear();
+    held.root = -1;
+    heldList.clear();
+    ++f.counts.solidCells;
+    // A union with a solid filling the cell is the whole cell: no boundary there.
+    if (unionOnly) return true;
+    if (!restrictionWithin(tree, f.filling, f.kept) || f.kept.size() == prims.size()) {
+        --f.counts.solidCells;
+        return false;
+    }
+    if (!f.kept.empty()) {
+        held.root = restrictTreeTo(tree, f.kept, keep.local(), held);
+        heldList.assign(f.kept.begin(), f.kept.end());
+    }
+    return true;
 }
 
 void RegularBuilder::makeLeaf(Fragment& f, int id, int level, const uint32_t pos[3],

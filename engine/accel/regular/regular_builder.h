@@ -64,12 +64,17 @@ struct RegularBuilder {
         uint32_t maxPrims = 0;
         size_t emptyLeaves = 0, coveredLeaves = 0, costLeaves = 0, gainLeaves = 0;
         size_t objectsLeaves = 0, levelLeaves = 0;
+        /// Cells whose list shrank because a convex solid fills them (restrictionWithin).
+        size_t solidCells = 0;
         /// Another fragment's counts added to these.
         void add(const LeafCounts& o);
     };
     struct Scratch {
         PrimList in[2], live;  ///< the children's primitives, a child's live ones
         CsgTree sub;
+        /// A child's tree and list once the solids filling its cell are known (heldWithin).
+        CsgTree held;
+        PrimList heldList;
     };
     /// What one task builds. Node 0 is the fragment's root (the BSP's root in the first one).
     struct Fragment {
@@ -93,8 +98,11 @@ struct RegularBuilder {
         PrimList in, live;
         std::vector<uint32_t> key;  ///< a set's primitives, for restrictTreeTo()
         CsgTree sub;
-        size_t reported = 0;  ///< bytes() last added to RegularBuilder::bytes
-        LeafCounts counts;    ///< of this fragment's leaves
+        CsgTree held;  ///< its cell's tree and list within the solids filling it
+        PrimList heldList;
+        std::vector<uint32_t> filling, kept;  ///< heldWithin's scratch
+        size_t reported = 0;                  ///< bytes() last added to RegularBuilder::bytes
+        LeafCounts counts;                    ///< of this fragment's leaves
 
         explicit Fragment(int maxLevel) : scratch(size_t(maxLevel) + 2) { bsp.nodes.resize(1); }
         /// Free the working lists once the fragment is built, for the tasks still running to
@@ -106,6 +114,8 @@ struct RegularBuilder {
             PrimList().swap(in);
             PrimList().swap(live);
             CsgTree().nodes.swap(sub.nodes);
+            CsgTree().nodes.swap(held.nodes);
+            PrimList().swap(heldList);
         }
         /// Heap bytes it keeps: vectors by capacity, and its pool with the trees still to make;
         /// each leaf at a RegularLeaf's size, which the layout makes of it.
@@ -155,6 +165,10 @@ struct RegularBuilder {
     bool unitWeights = false;        ///< every weight is 1: their sums are counts
     /// The scene's tree has only unions: a restriction then keeps every primitive it is given.
     bool unionOnly = false;
+    /// How far a primitive's solid must reach beyond a cell to fill it: 1e-5 of the grid's
+    /// size (floatSlack's bound on a float test's t for rays from near the scene), far above the
+    /// rounding of the corners' mapping, so no surface of it lies in or at the cell.
+    double solidMargin = 0.0;
     /// A union-only scene's tree of small depth: the leaves restrict it, visiting only their
     /// primitives' ancestors, and cells keep no tree (restricting each cell's tree for its
     /// children took half of the build on balls:5). Null: each cell restricts its tree.
@@ -219,7 +233,15 @@ struct RegularBuilder {
     /// parent's, over `parentPrims`) to them where needed; `sc` holds the child's tree and list.
     inline void buildChild(Fragment& f, int id, int level, const uint32_t pos[3], const Box3& box,
                            const CsgTree& tree, const PrimList& parentPrims, const PrimList& in,
-                           CsgTree& sub, PrimList& live);
+                           CsgTree& sub, PrimList& live, CsgTree& held, PrimList& heldList);
+    /// Whether primitive p's solid fills the cell `box` of the grid's frame, grown by
+    /// solidMargin: a convex solid holding the grown cell's corners.
+    inline bool fills(uint32_t p, const Box3& box) const;
+    /// The cell's tree and list once the primitives whose solids fill it are known, into
+    /// `held` and `heldList` (restrictionWithin: a cell inside a subtrahend or inside the whole
+    /// solid keeps nothing); false when they stay `tree` and `prims`.
+    inline bool heldWithin(Fragment& f, const Box3& box, const CsgTree& tree, const PrimList& prims,
+                           CsgTree& held, PrimList& heldList);
     /// Node `id` as a leaf over `prims`, its set shared in the fragment's pool.
     inline void makeLeaf(Fragment& f, int id, int level, const uint32_t pos[3], const CsgTree& tree,
                          const PrimList& prims);
