@@ -29,6 +29,18 @@ inline uint64_t ticks() {
 #endif
 }
 
+/// fn(x) for each x in [begin, end) of row y that `pass` contains, in order: the lattice's
+/// columns stepped through, the remainders taken only where the previous pass's lattice may
+/// hold the pixel (a remainder per pixel was a division: 7% of the pixel loop's time).
+template <class Fn>
+inline void forRow(const PassLattice& pass, int y, int begin, int end, Fn&& fn) {
+    const int stride = pass.stride, prev = pass.previousStride;
+    if (y % stride) return;
+    const bool skipPrevious = prev != 0 && y % prev == 0;  // the previous pass did its columns
+    for (int x = begin + (stride - begin % stride) % stride; x < end; x += stride)
+        if (!skipPrevious || x % prev) fn(x);
+}
+
 }  // namespace
 
 TraceContext workerContext(const Scene& scene, const Accelerator& accel, int treeDepth,
@@ -95,8 +107,7 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                         break;
                     }
                     uint64_t t0 = ticks();
-                    for (int x = r.cols().begin(); x < r.cols().end(); ++x) {
-                        if (!pass.contains(x, y)) continue;
+                    forRow(pass, y, r.cols().begin(), r.cols().end(), [&](int x) {
                         // Only the two counters the image keeps, not the whole struct.
                         const uint64_t testsBefore = ctx.counters.primTests;
                         const uint64_t visitsBefore = ctx.counters.regionVisits;
@@ -113,15 +124,15 @@ RenderStats render(const Scene& scene, const Accelerator& accel, const RenderOpt
                         img.timeUs[i] = float(t1 - t0);
                         t0 = t1;
                         ++done;
-                    }
+                    });
                 }
                 const uint64_t spent = ticks() - tileTicks;
                 const double us =
                     std::chrono::duration<double, std::micro>(Clock::now() - tileStart).count();
                 const float usPerTick = spent > 0 ? float(us / double(spent)) : 0.0f;
                 for (int y = r.rows().begin(); y < rowsDone; ++y)
-                    for (int x = r.cols().begin(); x < r.cols().end(); ++x)
-                        if (pass.contains(x, y)) img.timeUs[img.index(x, y)] *= usPerTick;
+                    forRow(pass, y, r.cols().begin(), r.cols().end(),
+                           [&](int x) { img.timeUs[img.index(x, y)] *= usPerTick; });
                 if (progress) progress->fetch_add(done, std::memory_order_relaxed);
             }),
             tbb::simple_partitioner());

@@ -24,6 +24,50 @@ void sortedUnique(std::vector<uint32_t>& v) {
     v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
+/// Per primitive of `tree`: whether its solid filling a region leaves the whole tree empty or
+/// full there whatever the other primitives do (RegularBuilder::decisive). Top down: a node
+/// whose being full (or empty) makes the root empty or full passes that on to the child that
+/// would make it so with its sibling unknown.
+std::vector<char> decisivePrimitives(const CsgTree& tree, size_t prims) {
+    std::vector<char> out(prims, 0);
+    if (tree.root < 0) return out;
+    // For each node on the stack: whether the node full, and the node empty, settles the root.
+    struct Item {
+        int node;
+        bool full, empty;
+    };
+    std::vector<uint32_t> leaves(prims, 0);
+    std::vector<Item> stack = {{tree.root, true, true}};
+    while (!stack.empty()) {
+        const Item it = stack.back();
+        stack.pop_back();
+        const CsgNode& x = tree.nodes[size_t(it.node)];
+        if (x.op == Op::Primitive) {
+            ++leaves[x.prim];
+            out[x.prim] = it.full;
+            continue;
+        }
+        switch (x.op) {
+            case Op::Union:  // a full side makes it full, an empty one leaves the other
+                stack.push_back({x.left, it.full, false});
+                stack.push_back({x.right, it.full, false});
+                break;
+            case Op::Intersection:  // an empty side makes it empty
+                stack.push_back({x.left, false, it.empty});
+                stack.push_back({x.right, false, it.empty});
+                break;
+            default:  // difference: an empty minuend or a full subtrahend empties it
+                stack.push_back({x.left, false, it.empty});
+                stack.push_back({x.right, it.empty, false});
+                break;
+        }
+    }
+    // A primitive with several leaves: one may settle the root, another not.
+    for (size_t p = 0; p < prims; ++p)
+        if (leaves[p] > 1) out[p] = 0;
+    return out;
+}
+
 /// The scene tree's primitives, sorted, each once.
 std::vector<uint32_t> sortedLivePrimitives(const Scene& scene) {
     std::vector<uint32_t> live =
@@ -57,6 +101,7 @@ RegularBuilder::RegularBuilder(const Scene& s, const RegularConfig& p, RegularGr
     const Vec3 e = g.box_.extent();
     solidMargin = 1e-5 * (std::max({e.x, e.y, e.z}) +
                           std::max(glm::length(g.box_.lo), glm::length(g.box_.hi)));
+    if (!unionOnly) decisive = decisivePrimitives(s.tree, s.prims.size());
 }
 
 RegularBuilder::Fragment RegularBuilder::buildFragments() {
@@ -192,7 +237,28 @@ RegularBuilder::Estimate RegularBuilder::splitInOnePass(const PrimList& prims, c
     }
     in0.resize(size_t(lo - in0.data()));
     in1.resize(size_t(hi - in1.data()));
-    return {params.stepCost + params.testCost * all, splitCostOf(box, axis, mid, tests, all)};
+    const double leaf = params.stepCost + params.testCost * all;
+    if (!decisive.empty()) {
+        Box3 child[2] = {box, box};
+        child[0].hi[axis] = child[1].lo[axis] = mid;
+        double shared = tests[0] + tests[1] - all;
+        emptyChildren(prims, child, tests, shared);
+        all = tests[0] + tests[1] - shared;
+    }
+    return {leaf, splitCostOf(box, axis, mid, tests, all)};
+}
+
+bool RegularBuilder::emptiedCell(std::span<const uint32_t> prims, const Box3& cell) const {
+    for (uint32_t p : prims)
+        if (decisive[p] && fills(p, cell)) return true;
+    return false;
+}
+
+void RegularBuilder::emptyChildren(std::span<const uint32_t> prims, const Box3 child[2],
+                                   double tests[2], double& shared) const {
+    if (decisive.empty()) return;
+    for (int side = 0; side < 2; ++side)
+        if (tests[side] > 0.0 && emptiedCell(prims, child[side])) tests[side] = 0.0, shared = 0.0;
 }
 
 void RegularBuilder::split(Fragment& f, int id, int level, const Cut& cut, const CsgTree& tree,
@@ -392,9 +458,12 @@ double RegularBuilder::splitCost(Fragment& f, const Box3& box, std::span<const u
         if (coord(b.hi, axis) >= mid) tests[1] += weight[p], ++count[1];
     }
     const double parentArea = surfaceArea(box);
-    double cost = -retestSaving(child, parentArea, tests[0] + tests[1] - all);
+    double shared = tests[0] + tests[1] - all;
+    emptyChildren(prims, child, tests, shared);
+    double cost = -retestSaving(child, parentArea, shared);
     for (int side = 0; side < 2; ++side) {
         double c = params.stepCost + params.testCost * tests[side];
+        if (tests[side] == 0.0) count[side] = 0;  // emptied: nothing to look further at
         // The look-ahead stops at the gain floor's level, below which a split needs the
         // floor's saving on its own (beyond it, it found splits at the level above that the
         // floor then stopped: 9% more leaves on tetra:7 for the same tests).

@@ -169,6 +169,11 @@ struct RegularBuilder {
     /// size (floatSlack's bound on a float test's t for rays from near the scene), far above the
     /// rounding of the corners' mapping, so no surface of it lies in or at the cell.
     double solidMargin = 0.0;
+    /// Per primitive: its solid filling a cell leaves the whole tree empty or full there,
+    /// whatever the others do (a subtrahend under the root's difference, any primitive of a
+    /// union): the cost estimate then counts that cell as empty. Empty for union-only trees,
+    /// whose cells rays do not enter inside a solid.
+    std::vector<char> decisive;
     /// A union-only scene's tree of small depth: the leaves restrict it, visiting only their
     /// primitives' ancestors, and cells keep no tree (restricting each cell's tree for its
     /// children took half of the build on balls:5). Null: each cell restricts its tree.
@@ -242,6 +247,12 @@ struct RegularBuilder {
     /// solid keeps nothing); false when they stay `tree` and `prims`.
     inline bool heldWithin(Fragment& f, const Box3& box, const CsgTree& tree, const PrimList& prims,
                            CsgTree& held, PrimList& heldList);
+    /// Whether a decisive primitive of `prims` fills `cell`: the cell will be an empty leaf.
+    inline bool emptiedCell(std::span<const uint32_t> prims, const Box3& cell) const;
+    /// The children's tests with each emptied child's set to 0, and `shared` (the tests of
+    /// primitives in both) to 0 when one is.
+    inline void emptyChildren(std::span<const uint32_t> prims, const Box3 child[2], double tests[2],
+                              double& shared) const;
     /// Node `id` as a leaf over `prims`, its set shared in the fragment's pool.
     inline void makeLeaf(Fragment& f, int id, int level, const uint32_t pos[3], const CsgTree& tree,
                          const PrimList& prims);
