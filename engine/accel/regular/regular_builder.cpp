@@ -389,6 +389,9 @@ bool RegularBuilder::fills(uint32_t p, const Box3& box) const {
 
 bool RegularBuilder::heldWithin(Fragment& f, const Box3& box, const CsgTree& tree,
                                 const PrimList& prims, CsgTree& held, PrimList& heldList) {
+    // A union's cells inside a solid hold no boundary, but rays seldom go there (only
+    // refracted ones): union-only scenes are not asked (8% more build on balls:5).
+    if (unionOnly) return false;
     f.filling.clear();
     for (uint32_t p : prims)
         if (fills(p, box)) f.filling.push_back(p);
@@ -397,8 +400,6 @@ bool RegularBuilder::heldWithin(Fragment& f, const Box3& box, const CsgTree& tre
     held.root = -1;
     heldList.clear();
     ++f.counts.solidCells;
-    // A union with a solid filling the cell is the whole cell: no boundary there.
-    if (unionOnly) return true;
     if (!restrictionWithin(tree, f.filling, f.kept) || f.kept.size() == prims.size()) {
         --f.counts.solidCells;
         return false;
