@@ -188,6 +188,101 @@ TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
     release(1000);
 }
 
+TEST(Progressive, AJobBegunInPartsIsFinishedInPartsWhenANewerOneStarts) {
+    auto scene = std::make_shared<const Scene>(loadScene("builtin:default"));
+    std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
+    RenderOptions opt;
+    opt.width = 64;
+    opt.height = 40;
+    Image direct(opt.width, opt.height), direct2;
+    render(*scene, *accel, opt, direct);
+    const RenderOptions moved = movedView(*scene, *accel, opt, direct2);
+    // The worker waits after each band until the test has taken it.
+    std::mutex m;
+    std::condition_variable cv;
+    int bands = 0, released = 0;
+    ProgressiveRenderer pr({8, 4, 1});
+    pr.setOnPass([&] {
+        std::unique_lock lock(m);
+        ++bands;
+        cv.notify_all();
+        cv.wait(lock, [&] { return released >= bands; });
+    });
+    auto waitBands = [&](int n) {
+        std::unique_lock lock(m);
+        return cv.wait_for(lock, std::chrono::seconds(30), [&] { return bands >= n; });
+    };
+    auto release = [&](int n) {
+        std::lock_guard lock(m);
+        released = n;
+        cv.notify_all();
+    };
+    // Every row of `shown` shows the first pass (stride 8) of `d`.
+    auto showsPass = [&](const Image& shown, const Image& d) {
+        for (int y = 0; y < opt.height; ++y)
+            for (int x = 0; x < opt.width; ++x)
+                if (shown.color[shown.index(x, y)] != d.color[d.index(x - x % 8, y - y % 8)])
+                    return false;
+        return true;
+    };
+    constexpr int kMax = 5;
+    Image shown(opt.width, opt.height);  // made ahead, as the viewer does: the first pass in parts
+    uint64_t version = 0;
+    ProgressiveRenderer::Shown what;
+    pr.start({scene, accel, opt});
+    ASSERT_TRUE(waitBands(1));
+    ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+    EXPECT_EQ(what.job, 1u);
+    EXPECT_TRUE(what.behind) << "the first image comes in parts into an image made ahead";
+    EXPECT_EQ(what.changedEnd, kMax);
+    // A newer view renders its first pass; the first is finished in parts all the same.
+    pr.start({scene, accel, moved});
+    release(1);
+    ASSERT_TRUE(waitBands(2));
+    EXPECT_EQ(pr.latest().job, 2u);
+    int next = kMax, parts = 1;
+    do {
+        ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+        EXPECT_EQ(what.job, 1u);
+        EXPECT_EQ(what.changedBegin, next);
+        EXPECT_LE(what.changedEnd - what.changedBegin, kMax);
+        next = what.changedEnd;
+        ++parts;
+    } while (what.behind && parts < 100);
+    EXPECT_TRUE(what.stale) << "the newer job waits";
+    EXPECT_EQ(next, opt.height);
+    EXPECT_EQ(parts, opt.height / kMax);
+    EXPECT_TRUE(showsPass(shown, direct)) << "the first view whole, none of the second's rows";
+    // Then the newer one, in parts from its first row.
+    next = 0;
+    do {
+        ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+        EXPECT_EQ(what.job, 2u);
+        EXPECT_EQ(what.changedBegin, next);
+        EXPECT_FALSE(what.stale);
+        next = what.changedEnd;
+    } while (what.behind && next < opt.height + 1);
+    EXPECT_EQ(next, opt.height);
+    EXPECT_TRUE(showsPass(shown, direct2));
+    EXPECT_FALSE(pr.snapshot(version, shown, &what, kMax)) << "caught up";
+    // A job begun in parts and replaced is dropped by a whole snapshot: the newest comes.
+    pr.start({scene, accel, opt});
+    release(2);
+    ASSERT_TRUE(waitBands(3));
+    ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+    EXPECT_EQ(what.job, 3u);
+    EXPECT_TRUE(what.behind);
+    pr.start({scene, accel, moved});
+    release(3);
+    ASSERT_TRUE(waitBands(4));
+    ASSERT_TRUE(pr.snapshot(version, shown, &what, 0));
+    EXPECT_EQ(what.job, 4u);
+    EXPECT_FALSE(what.behind);
+    EXPECT_FALSE(what.stale);
+    EXPECT_TRUE(showsPass(shown, direct2));
+    release(1000);
+}
+
 TEST(Progressive, PassesEndInTheFullRenderAndCoarsePassesShowAsBlocks) {
     auto scene = std::make_shared<const Scene>(loadScene("builtin:default"));
     std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
