@@ -1,6 +1,7 @@
 #include "app/viewer/image_view.h"
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -10,6 +11,13 @@
 namespace lancer::viewer {
 
 namespace {
+
+/// An RGBA8 texel that adds nothing over the image (premultiplied: alpha and colour zero).
+bool transparent(const uint8_t* p) {
+    uint32_t v;
+    std::memcpy(&v, p, 4);
+    return v == 0;
+}
 
 void setupTexture(GLuint tex) {
     glBindTexture(GL_TEXTURE_2D, tex);
@@ -137,12 +145,23 @@ void ImageView::compose(int rowBegin, int rowEnd) const {
         const int fboRow = height_ - 1 - r;
         const size_t ly = size_t(2 * fboRow + 1) * size_t(overlayHeight_) / size_t(2 * height_);
         const uint8_t* l = overlayRgba_.data() + ly * size_t(overlayWidth_) * 4;
-        for (size_t x = 0; x < w; ++x, c += 4, o += 4) {
+        for (size_t x = 0; x < w;) {
+            // Runs of transparent layer texels (most of a layer of lines: premultiplied, all
+            // zero) are the image's bytes, copied as a run.
+            size_t run = x;
+            while (run < w && transparent(l + column[run])) ++run;
+            if (run > x) {
+                std::memcpy(o + 4 * x, c + 4 * x, 4 * (run - x));
+                x = run;
+                continue;
+            }
             const uint8_t* p = l + column[x];
             const unsigned keep = 255u - p[3];
-            for (int k = 0; k < 3; ++k)
-                o[k] = uint8_t(std::min((unsigned(c[k]) * keep + 127u) / 255u + p[k], 255u));
-            o[3] = 255;
+            for (size_t k = 0; k < 3; ++k)
+                o[4 * x + k] =
+                    uint8_t(std::min((unsigned(c[4 * x + k]) * keep + 127u) / 255u + p[k], 255u));
+            o[4 * x + 3] = 255;
+            ++x;
         }
     }
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
