@@ -33,7 +33,9 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
       overlays_(std::make_unique<overlay::Overlays>()),
       logTimings_(logTimings),
       inspector_(std::make_unique<inspector::Inspector>(wake)) {
-    overlays_->buildInBackground(std::move(wake));
+    overlays_->buildInBackground(wake);
+    inspector_->buildInBackground(std::move(wake));
+    inspector_->drawInParts(1000, 4.0);
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
     // drawn at all, and each is copied from a layer where it is redrawn only when it changes
     // (frame(), PanelCache).

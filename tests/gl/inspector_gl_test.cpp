@@ -5,6 +5,9 @@
 // (after the GL headers)
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
 #include "app/viewer/camera_control.h"
 #include "app/viewer/gl/transforms.h"
 #include "app/viewer/inspector/inspector.h"
@@ -147,15 +150,65 @@ TEST(InspectorGl, TheMainCameraRebuildsTheModelOnlyForItsFrustum) {
     orbit(turned, 0.5, 0.0);
     f.insp->update(f.st, {turned, 64, 48}, kW, kH, -1);
     EXPECT_EQ(f.insp->model().lines.lines.data(), before);
-    // With it, the frustum follows the main camera: its lines start at the eye.
+    // With it, the frustum follows the main camera (its lines start at the eye), built apart:
+    // the model is not built again.
     f.insp->options().frustum = true;
     f.insp->changed();
     f.insp->update(f.st, {turned, 64, 48}, kW, kH, -1);
     const double tol = 1e-4 * glm::length(turned.from - turned.at);
-    EXPECT_TRUE(lineEndsAt(f.insp->model(), turned.from, tol));
+    InspectorModel frustum;
+    frustum.lines = f.insp->frustum();
+    EXPECT_TRUE(lineEndsAt(frustum, turned.from, tol));
+    const uint64_t builds = f.insp->modelBuilds();
     orbit(turned, 0.5, 0.0);
     f.insp->update(f.st, {turned, 64, 48}, kW, kH, -1);
-    EXPECT_TRUE(lineEndsAt(f.insp->model(), turned.from, tol));
+    frustum.lines = f.insp->frustum();
+    EXPECT_TRUE(lineEndsAt(frustum, turned.from, tol));
+    EXPECT_EQ(f.insp->modelBuilds(), builds) << "a turn of the main camera builds the frustum only";
+    EXPECT_FALSE(lineEndsAt(f.insp->model(), turned.from, tol));
+}
+
+TEST(InspectorGl, BuiltInTheBackgroundAndDrawnInPartsTheModelEndsAsTheDirectOne) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    const std::vector<uint8_t> direct = f.draw();
+    const InspectorModel want = f.insp->model();
+    ASSERT_FALSE(want.regions.empty());
+    // The same inspector, its model built on a worker: not there at the update that asks for
+    // it (the frame does not wait), then equal to the direct build.
+    Inspector bg;
+    bg.buildInBackground({});
+    const size_t part = want.lines.lineCount() / 5 + 1;
+    bg.drawInParts(part, 0.0);  // one part a draw
+    bg.options() = f.insp->options();
+    bg.changed();
+    bg.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    EXPECT_EQ(bg.modelBuilds(), 1u);
+    EXPECT_FALSE(bg.settled()) << "not settled while the model is built";
+    const auto start = std::chrono::steady_clock::now();
+    while (!bg.settled() && std::chrono::steady_clock::now() - start < std::chrono::seconds(30)) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        bg.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    }
+    ASSERT_TRUE(bg.settled());
+    EXPECT_EQ(bg.modelBuilds(), 1u);
+    ASSERT_EQ(bg.model().regions.size(), want.regions.size());
+    for (size_t i = 0; i < want.regions.size(); ++i)
+        EXPECT_EQ(bg.model().regions[i].id, want.regions[i].id);
+    ASSERT_EQ(bg.model().lines.lines.size(), want.lines.lines.size());
+    for (size_t i = 0; i < want.lines.lines.size(); ++i)
+        ASSERT_EQ(bg.model().lines.lines[i].position, want.lines.lines[i].position) << i;
+    // Its picture in parts, one a draw, the lines drawn so far always the first ones: whole
+    // after five draws, the direct picture.
+    int draws = 0;
+    do {
+        f.gl.clear(0.0f, 0.0f, 0.0f);
+        bg.draw(kW, kH);
+        ++draws;
+        EXPECT_EQ(bg.picturedLines(), std::min(size_t(draws) * part, want.lines.lineCount()));
+    } while (!bg.settled() && draws < 100);
+    EXPECT_EQ(draws, 5);
+    EXPECT_EQ(f.gl.read(), direct);
 }
 
 TEST(InspectorGl, LevelRangeHidesTheOtherLevels) {
