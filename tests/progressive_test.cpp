@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -81,6 +82,41 @@ std::vector<int> followJob(ProgressiveRenderer& pr, uint64_t job, const Image& d
     return seenStrides;
 }
 
+/// A renderer's onPass (ProgressiveRenderer::setOnPass) that makes its worker wait after each
+/// band it shows until the test releases it: the bands come one by one. Declared before the
+/// renderer, so it outlives the worker.
+class GatedBands {
+  public:
+    std::function<void()> onPass() {
+        return [this] {
+            std::unique_lock lock(m_);
+            ++bands_;
+            cv_.notify_all();
+            cv_.wait(lock, [&] { return released_ >= bands_; });
+        };
+    }
+    /// Wait (up to 30 s) until `n` bands were shown; false if they were not.
+    bool wait(int n) {
+        std::unique_lock lock(m_);
+        return cv_.wait_for(lock, std::chrono::seconds(30), [&] { return bands_ >= n; });
+    }
+    /// Let the worker go on past band `n`.
+    void release(int n) {
+        std::lock_guard lock(m_);
+        released_ = n;
+        cv_.notify_all();
+    }
+    int bands() {
+        std::lock_guard lock(m_);
+        return bands_;
+    }
+
+  private:
+    std::mutex m_;
+    std::condition_variable cv_;
+    int bands_ = 0, released_ = 0;
+};
+
 /// `opt` with the camera moved 30% of the way to its target, and its render into `direct`.
 RenderOptions movedView(const Scene& scene, const Accelerator& accel, const RenderOptions& opt,
                         Image& direct) {
@@ -93,34 +129,33 @@ RenderOptions movedView(const Scene& scene, const Accelerator& accel, const Rend
     return moved;
 }
 
-TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
-    auto scene = std::make_shared<const Scene>(loadScene("builtin:default"));
+/// builtin:default at 64x40 and its render at once.
+struct SmallView {
+    std::shared_ptr<const Scene> scene =
+        std::make_shared<const Scene>(loadScene("builtin:default"));
     std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
-    RenderOptions opt;
-    opt.width = 64;
-    opt.height = 40;
-    Image direct(opt.width, opt.height);
-    render(*scene, *accel, opt, direct);
+    RenderOptions opt = [] {
+        RenderOptions o;
+        o.width = 64;
+        o.height = 40;
+        return o;
+    }();
+    Image direct = [this] {
+        Image d(opt.width, opt.height);
+        render(*scene, *accel, opt, d);
+        return d;
+    }();
+};
+
+TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
+    const SmallView v;
+    const auto& [scene, accel, opt, direct] = v;
     // The worker waits after each band until the test has taken it: the bands come one by one.
-    std::mutex m;
-    std::condition_variable cv;
-    int bands = 0, released = 0;
+    GatedBands gate;
     ProgressiveRenderer pr({8, 4, 1});
-    pr.setOnPass([&] {
-        std::unique_lock lock(m);
-        ++bands;
-        cv.notify_all();
-        cv.wait(lock, [&] { return released >= bands; });
-    });
-    auto waitBands = [&](int n) {
-        std::unique_lock lock(m);
-        return cv.wait_for(lock, std::chrono::seconds(30), [&] { return bands >= n; });
-    };
-    auto release = [&](int n) {
-        std::lock_guard lock(m);
-        released = n;
-        cv.notify_all();
-    };
+    pr.setOnPass(gate.onPass());
+    auto waitBands = [&](int n) { return gate.wait(n); };
+    auto release = [&](int n) { gate.release(n); };
     // Row y of `shown` shows the pass of `stride`: the corner pixel of its block.
     auto rowShows = [&](const Image& shown, int y, int stride) {
         for (int x = 0; x < opt.width; ++x)
@@ -166,11 +201,7 @@ TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
     // part still the old view's, until the snapshot catches up.
     Image direct2;
     const RenderOptions moved = movedView(*scene, *accel, opt, direct2);
-    int before = 0;
-    {
-        std::lock_guard lock(m);
-        before = bands;
-    }
+    const int before = gate.bands();
     release(before);  // the worker waits after the new job's first band
     pr.start({scene, accel, moved});
     ASSERT_TRUE(waitBands(before + 1));
@@ -189,34 +220,16 @@ TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
 }
 
 TEST(Progressive, AJobBegunInPartsIsFinishedInPartsWhenANewerOneStarts) {
-    auto scene = std::make_shared<const Scene>(loadScene("builtin:default"));
-    std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
-    RenderOptions opt;
-    opt.width = 64;
-    opt.height = 40;
-    Image direct(opt.width, opt.height), direct2;
-    render(*scene, *accel, opt, direct);
+    const SmallView v;
+    const auto& [scene, accel, opt, direct] = v;
+    Image direct2;
     const RenderOptions moved = movedView(*scene, *accel, opt, direct2);
     // The worker waits after each band until the test has taken it.
-    std::mutex m;
-    std::condition_variable cv;
-    int bands = 0, released = 0;
+    GatedBands gate;
     ProgressiveRenderer pr({8, 4, 1});
-    pr.setOnPass([&] {
-        std::unique_lock lock(m);
-        ++bands;
-        cv.notify_all();
-        cv.wait(lock, [&] { return released >= bands; });
-    });
-    auto waitBands = [&](int n) {
-        std::unique_lock lock(m);
-        return cv.wait_for(lock, std::chrono::seconds(30), [&] { return bands >= n; });
-    };
-    auto release = [&](int n) {
-        std::lock_guard lock(m);
-        released = n;
-        cv.notify_all();
-    };
+    pr.setOnPass(gate.onPass());
+    auto waitBands = [&](int n) { return gate.wait(n); };
+    auto release = [&](int n) { gate.release(n); };
     // Every row of `shown` shows the first pass (stride 8) of `d`.
     auto showsPass = [&](const Image& shown, const Image& d) {
         for (int y = 0; y < opt.height; ++y)

@@ -678,12 +678,11 @@ TEST(Overlays, BatchesBuiltInTheBackgroundAreCopiedInPartsAndTheLayerFollowsThem
     ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
     auto s = twoBoxes(SchemeKind::Regular, 8);
     const Camera& cam = s->scene->camera;
-    Overlays direct;
-    direct.options.leaves = true;
+    // The leaves built at once, and on a worker copied to GL in parts.
+    Overlays direct, ov;
+    direct.options.leaves = ov.options.leaves = true;
     direct.update(s, cam, kW, kH);
-    Overlays ov;
     ov.buildInBackground({});
-    ov.options.leaves = true;
     ov.look.uploadBytes = 16 * sizeof(gl::BatchVertex);  // 8 lines a part
     ov.look.uploadMs = 0.0;                              // one part a frame
     ov.look.restMs = 0.0;
