@@ -211,6 +211,34 @@ TEST(InspectorGl, BuiltInTheBackgroundAndDrawnInPartsTheModelEndsAsTheDirectOne)
     EXPECT_EQ(f.gl.read(), direct);
 }
 
+TEST(InspectorGl, WithItsSurfacesThePictureInPartsEqualsTheOneDrawnAtOnce) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    f.insp->options().surfaces = true;
+    f.insp->changed();
+    f.insp->update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    ASSERT_TRUE(f.insp->waitSurfaces(60000));
+    const std::vector<uint8_t> direct = f.draw();
+    // Drawn in parts, one a draw: the surfaces in three bands of rows, then the lines.
+    Inspector parts;
+    parts.options() = f.insp->options();
+    parts.drawInParts(f.insp->model().lines.lineCount() / 2 + 1, 0.0);
+    parts.changed();
+    parts.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    ASSERT_TRUE(parts.waitSurfaces(60000));
+    int draws = 0;
+    do {
+        f.gl.clear(0.0f, 0.0f, 0.0f);
+        parts.draw(kW, kH);
+        ++draws;
+        if (draws <= 2) {
+            EXPECT_EQ(parts.picturedLines(), 0u) << "surfaces first";
+        }
+    } while (!parts.settled() && draws < 100);
+    EXPECT_EQ(draws, 4);
+    EXPECT_EQ(f.gl.read(), direct);
+}
+
 TEST(InspectorGl, LevelRangeHidesTheOtherLevels) {
     Fixture f;
     ASSERT_TRUE(f.gl.ok());

@@ -360,33 +360,10 @@ void Inspector::render() {
             glBindTexture(GL_TEXTURE_2D, 0);
             surfUploaded_ = true;
         }
-        // The traced picture, its depth written as the line pass's projection would write it.
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_ALWAYS);
-        glDisable(GL_BLEND);
-        const unsigned prog = surfaceProgram_->id();
-        glUseProgram(prog);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, surfColorTex_);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, surfDepthTex_);
-        glUniform1i(surfaceProgram_->uniform("colorTex"), 0);
-        glUniform1i(surfaceProgram_->uniform("depthTex"), 1);
-        glUniform1i(surfaceProgram_->uniform("ortho"),
-                    camera_.projection == Projection::Orthographic ? 1 : 0);
-        glUniform1f(surfaceProgram_->uniform("nearDepth"), float(near));
-        glUniform1f(surfaceProgram_->uniform("farDepth"), float(far));
-        glBindVertexArray(vao_);
-        glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-        glBindVertexArray(0);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, 0);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, 0);
-        glUseProgram(0);
-        glDepthFunc(GL_LESS);
-        glDisable(GL_DEPTH_TEST);
     }
+    pictureNear_ = near;
+    pictureFar_ = far;
+    surfaceRows_ = surfaces ? 0 : vh_;
     if (dirtyBatch_) {
         lines_->beginUpload(model_.lines);
         selection_->upload(model_.selection);
@@ -396,11 +373,60 @@ void Inspector::render() {
     renderMore();
 }
 
+void Inspector::drawSurfaceRows(int rowBegin, int rowEnd) {
+    // The traced picture, its depth written as the line pass's projection would write it; rows
+    // [rowBegin, rowEnd) of the viewport (GL's, from the bottom).
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, rowBegin, vw_, rowEnd - rowBegin);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    glDisable(GL_BLEND);
+    const unsigned prog = surfaceProgram_->id();
+    glUseProgram(prog);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, surfColorTex_);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, surfDepthTex_);
+    glUniform1i(surfaceProgram_->uniform("colorTex"), 0);
+    glUniform1i(surfaceProgram_->uniform("depthTex"), 1);
+    glUniform1i(surfaceProgram_->uniform("ortho"),
+                camera_.projection == Projection::Orthographic ? 1 : 0);
+    glUniform1f(surfaceProgram_->uniform("nearDepth"), float(pictureNear_));
+    glUniform1f(surfaceProgram_->uniform("farDepth"), float(pictureFar_));
+    glBindVertexArray(vao_);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    glBindVertexArray(0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glUseProgram(0);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_SCISSOR_TEST);
+}
+
 void Inspector::renderMore() {
     const auto t0 = std::chrono::steady_clock::now();
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, vw_, vh_);
     glDisable(GL_SCISSOR_TEST);
+    // The surfaces first (the lines are tested against their depth), in bands of a third of
+    // the rows a part: a quad over the whole viewport took llvmpipe 23-29 ms (2026-12-06).
+    while (surfaceRows_ < vh_) {
+        const int band = partLines_ > 0 ? std::max(1, (vh_ + 2) / 3) : vh_;
+        const int end = std::min(vh_, surfaceRows_ + band);
+        drawSurfaceRows(surfaceRows_, end);
+        surfaceRows_ = end;
+        if (partLines_ == 0 || surfaceRows_ >= vh_) break;
+        glFinish();  // timed: the band is drawn
+        if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count() >= partMs_) {
+            picturePending_ = true;
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            return;
+        }
+    }
     gl::DrawOptions o;
     o.depthTest = pictureSurfaces_;
     // The model's lines in order, in parts (drawInParts()) as they are copied to GL: the

@@ -115,8 +115,11 @@ class Inspector {
     void takeSurfaces();
     /// Start the picture again: the surfaces, then the lines (renderMore()).
     void render();
-    /// The next lines of the picture, for the part's time, and the lines over them.
+    /// The next surface rows or lines of the picture, for the part's time, and the lines over
+    /// them.
     void renderMore();
+    /// Rows [rowBegin, rowEnd) of the traced surfaces into the picture (GL's rows).
+    void drawSurfaceRows(int rowBegin, int rowEnd);
     /// Near and far depths of everything drawn, for the inspector's camera.
     void depthBounds(double& near, double& far) const;
 
@@ -166,6 +169,8 @@ class Inspector {
     size_t picturedLines_ = 0;
     bool picturePending_ = false;
     bool pictureSurfaces_ = false;
+    double pictureNear_ = 0.0, pictureFar_ = 1.0;
+    int surfaceRows_ = 0;  ///< rows of the surfaces in the picture so far
     glm::mat4 pictureToClip_{1.0f};
     BackgroundJob<InspectorModel> job_;  ///< last: its worker joined before the rest is destroyed
 };
