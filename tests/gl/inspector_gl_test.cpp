@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <functional>
 #include <thread>
 
 #include "app/viewer/camera_control.h"
@@ -168,6 +169,18 @@ TEST(InspectorGl, TheMainCameraRebuildsTheModelOnlyForItsFrustum) {
     EXPECT_FALSE(lineEndsAt(f.insp->model(), turned.from, tol));
 }
 
+/// Draw `insp` into `f`'s framebuffer until it is settled (at most 100 draws), calling
+/// `check(n)` after the n-th draw; returns the draws.
+int drawUntilSettled(Fixture& f, Inspector& insp, const std::function<void(int)>& check) {
+    int draws = 0;
+    do {
+        f.gl.clear(0.0f, 0.0f, 0.0f);
+        insp.draw(kW, kH);
+        check(++draws);
+    } while (!insp.settled() && draws < 100);
+    return draws;
+}
+
 TEST(InspectorGl, BuiltInTheBackgroundAndDrawnInPartsTheModelEndsAsTheDirectOne) {
     Fixture f;
     ASSERT_TRUE(f.gl.ok());
@@ -200,13 +213,9 @@ TEST(InspectorGl, BuiltInTheBackgroundAndDrawnInPartsTheModelEndsAsTheDirectOne)
         ASSERT_EQ(bg.model().lines.lines[i].position, want.lines.lines[i].position) << i;
     // Its picture in parts, one a draw, the lines drawn so far always the first ones: whole
     // after five draws, the direct picture.
-    int draws = 0;
-    do {
-        f.gl.clear(0.0f, 0.0f, 0.0f);
-        bg.draw(kW, kH);
-        ++draws;
-        EXPECT_EQ(bg.picturedLines(), std::min(size_t(draws) * part, want.lines.lineCount()));
-    } while (!bg.settled() && draws < 100);
+    const int draws = drawUntilSettled(f, bg, [&](int n) {
+        EXPECT_EQ(bg.picturedLines(), std::min(size_t(n) * part, want.lines.lineCount()));
+    });
     EXPECT_EQ(draws, 5);
     EXPECT_EQ(f.gl.read(), direct);
 }
@@ -226,15 +235,11 @@ TEST(InspectorGl, WithItsSurfacesThePictureInPartsEqualsTheOneDrawnAtOnce) {
     parts.changed();
     parts.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
     ASSERT_TRUE(parts.waitSurfaces(60000));
-    int draws = 0;
-    do {
-        f.gl.clear(0.0f, 0.0f, 0.0f);
-        parts.draw(kW, kH);
-        ++draws;
-        if (draws <= 2) {
+    const int draws = drawUntilSettled(f, parts, [&](int n) {
+        if (n <= 2) {
             EXPECT_EQ(parts.picturedLines(), 0u) << "surfaces first";
         }
-    } while (!parts.settled() && draws < 100);
+    });
     EXPECT_EQ(draws, 4);
     EXPECT_EQ(f.gl.read(), direct);
 }
