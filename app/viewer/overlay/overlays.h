@@ -42,7 +42,9 @@ struct OverlayLook {
     /// 18-31 ms (2026-12-06).
     size_t restLines = 500;
     /// Milliseconds of a frame at rest given to drawing the layer's parts (0: one part a frame).
-    double restMs = 8.0;
+    /// Each part drawn also composites the whole image again (8-10 ms at 1280x720), so a part
+    /// frame at 8 ms took 33-37 ms of CPU on balls4's slabs (2026-12-06).
+    double restMs = 5.0;
     /// Batches built in the background are copied to GL in parts of uploadBytes, for
     /// uploadMs of each frame (0: one part a frame), the layer drawn from what is copied:
     /// balls4's slab batches (1.2 M lines, 77 MB) took one frame 31 ms (2026-12-06).
