@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -81,6 +82,41 @@ std::vector<int> followJob(ProgressiveRenderer& pr, uint64_t job, const Image& d
     return seenStrides;
 }
 
+/// A renderer's onPass (ProgressiveRenderer::setOnPass) that makes its worker wait after each
+/// band it shows until the test releases it: the bands come one by one. Declared before the
+/// renderer, so it outlives the worker.
+class GatedBands {
+  public:
+    std::function<void()> onPass() {
+        return [this] {
+            std::unique_lock lock(m_);
+            ++bands_;
+            cv_.notify_all();
+            cv_.wait(lock, [&] { return released_ >= bands_; });
+        };
+    }
+    /// Wait (up to 30 s) until `n` bands were shown; false if they were not.
+    bool wait(int n) {
+        std::unique_lock lock(m_);
+        return cv_.wait_for(lock, std::chrono::seconds(30), [&] { return bands_ >= n; });
+    }
+    /// Let the worker go on past band `n`.
+    void release(int n) {
+        std::lock_guard lock(m_);
+        released_ = n;
+        cv_.notify_all();
+    }
+    int bands() {
+        std::lock_guard lock(m_);
+        return bands_;
+    }
+
+  private:
+    std::mutex m_;
+    std::condition_variable cv_;
+    int bands_ = 0, released_ = 0;
+};
+
 /// `opt` with the camera moved 30% of the way to its target, and its render into `direct`.
 RenderOptions movedView(const Scene& scene, const Accelerator& accel, const RenderOptions& opt,
                         Image& direct) {
@@ -93,34 +129,33 @@ RenderOptions movedView(const Scene& scene, const Accelerator& accel, const Rend
     return moved;
 }
 
-TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
-    auto scene = std::make_shared<const Scene>(loadScene("builtin:default"));
+/// builtin:default at 64x40 and its render at once.
+struct SmallView {
+    std::shared_ptr<const Scene> scene =
+        std::make_shared<const Scene>(loadScene("builtin:default"));
     std::shared_ptr<const Accelerator> accel = buildAccelerator(*scene, BuildParams{});
-    RenderOptions opt;
-    opt.width = 64;
-    opt.height = 40;
-    Image direct(opt.width, opt.height);
-    render(*scene, *accel, opt, direct);
+    RenderOptions opt = [] {
+        RenderOptions o;
+        o.width = 64;
+        o.height = 40;
+        return o;
+    }();
+    Image direct = [this] {
+        Image d(opt.width, opt.height);
+        render(*scene, *accel, opt, d);
+        return d;
+    }();
+};
+
+TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
+    const SmallView v;
+    const auto& [scene, accel, opt, direct] = v;
     // The worker waits after each band until the test has taken it: the bands come one by one.
-    std::mutex m;
-    std::condition_variable cv;
-    int bands = 0, released = 0;
+    GatedBands gate;
     ProgressiveRenderer pr({8, 4, 1});
-    pr.setOnPass([&] {
-        std::unique_lock lock(m);
-        ++bands;
-        cv.notify_all();
-        cv.wait(lock, [&] { return released >= bands; });
-    });
-    auto waitBands = [&](int n) {
-        std::unique_lock lock(m);
-        return cv.wait_for(lock, std::chrono::seconds(30), [&] { return bands >= n; });
-    };
-    auto release = [&](int n) {
-        std::lock_guard lock(m);
-        released = n;
-        cv.notify_all();
-    };
+    pr.setOnPass(gate.onPass());
+    auto waitBands = [&](int n) { return gate.wait(n); };
+    auto release = [&](int n) { gate.release(n); };
     // Row y of `shown` shows the pass of `stride`: the corner pixel of its block.
     auto rowShows = [&](const Image& shown, int y, int stride) {
         for (int x = 0; x < opt.width; ++x)
@@ -166,11 +201,7 @@ TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
     // part still the old view's, until the snapshot catches up.
     Image direct2;
     const RenderOptions moved = movedView(*scene, *accel, opt, direct2);
-    int before = 0;
-    {
-        std::lock_guard lock(m);
-        before = bands;
-    }
+    const int before = gate.bands();
     release(before);  // the worker waits after the new job's first band
     pr.start({scene, accel, moved});
     ASSERT_TRUE(waitBands(before + 1));
@@ -185,6 +216,83 @@ TEST(Progressive, APassComesInPartsOfAtMostMaxRowsUntilTheSnapshotCatchesUp) {
                                        : direct.color[direct.index(x, y)];
             ASSERT_EQ(shown.color[shown.index(x, y)], glm::vec3(want)) << x << "," << y;
         }
+    release(1000);
+}
+
+TEST(Progressive, AJobBegunInPartsIsFinishedInPartsWhenANewerOneStarts) {
+    const SmallView v;
+    const auto& [scene, accel, opt, direct] = v;
+    Image direct2;
+    const RenderOptions moved = movedView(*scene, *accel, opt, direct2);
+    // The worker waits after each band until the test has taken it.
+    GatedBands gate;
+    ProgressiveRenderer pr({8, 4, 1});
+    pr.setOnPass(gate.onPass());
+    auto waitBands = [&](int n) { return gate.wait(n); };
+    auto release = [&](int n) { gate.release(n); };
+    // Every row of `shown` shows the first pass (stride 8) of `d`.
+    auto showsPass = [&](const Image& shown, const Image& d) {
+        for (int y = 0; y < opt.height; ++y)
+            for (int x = 0; x < opt.width; ++x)
+                if (shown.color[shown.index(x, y)] != d.color[d.index(x - x % 8, y - y % 8)])
+                    return false;
+        return true;
+    };
+    constexpr int kMax = 5;
+    Image shown(opt.width, opt.height);  // made ahead, as the viewer does: the first pass in parts
+    uint64_t version = 0;
+    ProgressiveRenderer::Shown what;
+    pr.start({scene, accel, opt});
+    ASSERT_TRUE(waitBands(1));
+    ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+    EXPECT_EQ(what.job, 1u);
+    EXPECT_TRUE(what.behind) << "the first image comes in parts into an image made ahead";
+    EXPECT_EQ(what.changedEnd, kMax);
+    // A newer view renders its first pass; the first is finished in parts all the same.
+    pr.start({scene, accel, moved});
+    release(1);
+    ASSERT_TRUE(waitBands(2));
+    EXPECT_EQ(pr.latest().job, 2u);
+    int next = kMax, parts = 1;
+    do {
+        ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+        EXPECT_EQ(what.job, 1u);
+        EXPECT_EQ(what.changedBegin, next);
+        EXPECT_LE(what.changedEnd - what.changedBegin, kMax);
+        next = what.changedEnd;
+        ++parts;
+    } while (what.behind && parts < 100);
+    EXPECT_TRUE(what.stale) << "the newer job waits";
+    EXPECT_EQ(next, opt.height);
+    EXPECT_EQ(parts, opt.height / kMax);
+    EXPECT_TRUE(showsPass(shown, direct)) << "the first view whole, none of the second's rows";
+    // Then the newer one, in parts from its first row.
+    next = 0;
+    do {
+        ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+        EXPECT_EQ(what.job, 2u);
+        EXPECT_EQ(what.changedBegin, next);
+        EXPECT_FALSE(what.stale);
+        next = what.changedEnd;
+    } while (what.behind && next < opt.height + 1);
+    EXPECT_EQ(next, opt.height);
+    EXPECT_TRUE(showsPass(shown, direct2));
+    EXPECT_FALSE(pr.snapshot(version, shown, &what, kMax)) << "caught up";
+    // A job begun in parts and replaced is dropped by a whole snapshot: the newest comes.
+    pr.start({scene, accel, opt});
+    release(2);
+    ASSERT_TRUE(waitBands(3));
+    ASSERT_TRUE(pr.snapshot(version, shown, &what, kMax));
+    EXPECT_EQ(what.job, 3u);
+    EXPECT_TRUE(what.behind);
+    pr.start({scene, accel, moved});
+    release(3);
+    ASSERT_TRUE(waitBands(4));
+    ASSERT_TRUE(pr.snapshot(version, shown, &what, 0));
+    EXPECT_EQ(what.job, 4u);
+    EXPECT_FALSE(what.behind);
+    EXPECT_FALSE(what.stale);
+    EXPECT_TRUE(showsPass(shown, direct2));
     release(1000);
 }
 

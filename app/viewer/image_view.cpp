@@ -1,6 +1,7 @@
 #include "app/viewer/image_view.h"
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -10,6 +11,13 @@
 namespace lancer::viewer {
 
 namespace {
+
+/// An RGBA8 texel that adds nothing over the image (premultiplied: alpha and colour zero).
+bool transparent(const uint8_t* p) {
+    uint32_t v;
+    std::memcpy(&v, p, 4);
+    return v == 0;
+}
 
 void setupTexture(GLuint tex) {
     glBindTexture(GL_TEXTURE_2D, tex);
@@ -54,7 +62,6 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
                        const std::vector<float>* heat) {
     if (img.width <= 0 || img.height <= 0) return;
     const bool resized = img.width != width_ || img.height != height_;
-    if (resized) rowBegin = 0, rowEnd = img.height;
     if (rowEnd < 0 || rowEnd > img.height) rowEnd = img.height;
     rowBegin = std::clamp(rowBegin, 0, rowEnd);
     const int rows = rowEnd - rowBegin;
@@ -62,15 +69,9 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
     height_ = img.height;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    if (resized) {  // storage for both textures at the new size, the FBO on the shaded one
+    if (resized) {  // the counters' texture at the new size; the shaded one when it is shaded
         glBindTexture(GL_TEXTURE_2D, heatTex_);
         glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, width_, height_, 0, GL_RED, GL_FLOAT, nullptr);
-        glBindTexture(GL_TEXTURE_2D, shadedTex_);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
-                     nullptr);
-        glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, shadedTex_, 0);
-        glBindFramebuffer(GL_FRAMEBUFFER, 0);
         colorRgba_.assign(size_t(width_) * size_t(height_) * 4, 0);
     }
     if (rows > 0) {
@@ -144,12 +145,23 @@ void ImageView::compose(int rowBegin, int rowEnd) const {
         const int fboRow = height_ - 1 - r;
         const size_t ly = size_t(2 * fboRow + 1) * size_t(overlayHeight_) / size_t(2 * height_);
         const uint8_t* l = overlayRgba_.data() + ly * size_t(overlayWidth_) * 4;
-        for (size_t x = 0; x < w; ++x, c += 4, o += 4) {
+        for (size_t x = 0; x < w;) {
+            // Runs of transparent layer texels (most of a layer of lines: premultiplied, all
+            // zero) are the image's bytes, copied as a run.
+            size_t run = x;
+            while (run < w && transparent(l + column[run])) ++run;
+            if (run > x) {
+                std::memcpy(o + 4 * x, c + 4 * x, 4 * (run - x));
+                x = run;
+                continue;
+            }
             const uint8_t* p = l + column[x];
             const unsigned keep = 255u - p[3];
-            for (int k = 0; k < 3; ++k)
-                o[k] = uint8_t(std::min((unsigned(c[k]) * keep + 127u) / 255u + p[k], 255u));
-            o[3] = 255;
+            for (size_t k = 0; k < 3; ++k)
+                o[4 * x + k] =
+                    uint8_t(std::min((unsigned(c[4 * x + k]) * keep + 127u) / 255u + p[k], 255u));
+            o[4 * x + 3] = 255;
+            ++x;
         }
     }
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
@@ -201,8 +213,10 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     if (width_ == 0) return;
     scale = scale > 0.0f ? scale : 1.0f;
     diverging = diverging && mode != ViewMode::Color;
-    // Held (setHold): drawn as shaded before.
-    const bool held = hold_ && shadedWidth_ == width_ && shadedHeight_ == height_;
+    // Held (setHold): drawn as shaded before, whatever its size; nothing before a first
+    // picture (showsPicture()).
+    if (!showsPicture()) return;
+    const bool held = hold_;
     const bool whole =
         !shadedValid_ || mode != shadedMode_ ||
         (mode != ViewMode::Color &&
@@ -216,8 +230,9 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     glDisable(GL_SCISSOR_TEST);
     const PixelRect d = viewport(fbWidth, fbHeight);
     const int dw = d.x1 - d.x0, dh = d.y1 - d.y0;
-    if (covered.empty() || width_ != dw || height_ != dh) {
-        glBlitFramebuffer(0, 0, width_, height_, d.x0, fbHeight - d.y1, d.x1, fbHeight - d.y0,
+    const int sw = shadedWidth_, sh = shadedHeight_;  // a held picture may be of another size
+    if (covered.empty() || sw != dw || sh != dh) {
+        glBlitFramebuffer(0, 0, sw, sh, d.x0, fbHeight - d.y1, d.x1, fbHeight - d.y0,
                           GL_COLOR_BUFFER_BIT, GL_NEAREST);
     } else {
         // One texel per pixel: each uncovered rectangle is copied as is (GL's rows go up).
@@ -240,6 +255,19 @@ PixelRect ImageView::viewport(int fbWidth, int fbHeight) const {
 
 void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging, int rowBegin,
                       int rowEnd) const {
+    if (shadedWidth_ != width_ || shadedHeight_ != height_) {
+        // The shaded texture at the new size (made only now: until then a hold drew the last
+        // picture), the FBO on it; shaded whole.
+        glBindTexture(GL_TEXTURE_2D, shadedTex_);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                     nullptr);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, shadedTex_, 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        rowBegin = 0;
+        rowEnd = height_;
+    }
     if (mode == ViewMode::Color)
         compose(rowBegin, rowEnd);
     else

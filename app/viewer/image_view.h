@@ -32,8 +32,9 @@ class ImageView {
     ImageView& operator=(const ImageView&) = delete;
 
     /// Upload rows [rowBegin, rowEnd) (-1: to the last) of the colour and of the counter `mode`
-    /// shows; the whole image when its size differs from the last upload's. The other rows keep
-    /// what earlier uploads put there, so after a change of mode upload the whole image.
+    /// shows. The other rows keep what earlier uploads put there (nothing, after a change of
+    /// size: upload every row of a new size before it is drawn unheld), so after a change of
+    /// mode upload the whole image.
     /// `heat` (optional) replaces the counter: the values of those rows (the whole image's when
     /// its size differs), e.g. an A/B's difference; it must hold one value per pixel of them.
     void upload(const Image& img, ViewMode mode, int rowBegin = 0, int rowEnd = -1,
@@ -65,8 +66,11 @@ class ImageView {
     void setOverlay(unsigned texture, uint64_t version);
     /// While held, draw() shows what it showed before and shades nothing: uploads go on, and
     /// the rows they changed are shaded once the hold ends (a new view's image coming in parts
-    /// is never shown half). A hold does not keep an image of another size.
+    /// is never shown half). A hold keeps a picture of another size (drawn scaled), and before
+    /// the first picture draws nothing.
     void setHold(bool hold) { hold_ = hold; }
+    /// draw() draws a picture: something was uploaded, and it is not held before a first one.
+    bool showsPicture() const { return width_ > 0 && (!hold_ || shadedWidth_ > 0); }
     /// Size of the uploaded image (0 x 0 before the first upload).
     int width() const { return width_; }
     int height() const { return height_; }

@@ -33,7 +33,9 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
       overlays_(std::make_unique<overlay::Overlays>()),
       logTimings_(logTimings),
       inspector_(std::make_unique<inspector::Inspector>(wake)) {
-    overlays_->buildInBackground(std::move(wake));
+    overlays_->buildInBackground(wake);
+    inspector_->buildInBackground(std::move(wake));
+    inspector_->drawInParts(1000, 4.0);
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
     // drawn at all, and each is copied from a layer where it is redrawn only when it changes
     // (frame(), PanelCache).
@@ -231,7 +233,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     glViewport(0, 0, fbWidth, fbHeight);
     glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
     std::vector<PixelRect> views;
-    if (view_->width() > 0) views.push_back(area);
+    view_->setHold(state_.holdImage());
+    if (view_->showsPicture()) views.push_back(area);
     if (inspector_->shown()) views.push_back(inspector_->area(fbWidth, fbHeight));
     glEnable(GL_SCISSOR_TEST);
     for (const PixelRect& r : uncovered(fbWidth, fbHeight, views)) {
@@ -244,7 +247,6 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         if (r.x0 < area.x1 && area.x0 < r.x1 && r.y0 < area.y1 && area.y0 < r.y1)
             covered.push_back(r);
     view_->setViewport(area);
-    view_->setHold(state_.holdImage());
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale,
                 state_.heatDiverging());
     phases_.mark("image");
@@ -332,9 +334,8 @@ void ViewerApp::treePanel(bool* open) {
 }
 
 void ViewerApp::uploadImage(int rowBegin, int rowEnd) {
+    // A new size comes in parts too, held off the screen until whole (ViewerState).
     const Image& shown = state_.shown();
-    if (shown.width != view_->width() || shown.height != view_->height())
-        rowBegin = 0, rowEnd = -1;  // a new size is uploaded whole
     const std::vector<float> heat = state_.heatRows(rowBegin, rowEnd);
     view_->upload(shown, state_.settings().mode, rowBegin, rowEnd, heat.empty() ? nullptr : &heat);
 }

@@ -303,19 +303,16 @@ bool ViewerState::takeSnapshot(bool whole) {
     ProgressiveRenderer::Shown what;
     // A pass comes in parts: a whole 1280x720 image (32 bytes a pixel) took 13-17 ms of the UI
     // thread to copy, and its conversion and upload as much again. A new view's rows are held
-    // off the screen (holdImage) until the last part is in, never mixed with the old view's;
-    // after kHoldFrames frames of holding the rest comes whole, so that a drag, whose every
-    // frame may bring a new view, still shows one.
-    const bool hurry = holdFrames_ >= kHoldFrames;
+    // off the screen (holdImage) until the last part is in, never mixed with the old view's.
+    // A drag may bring a new view every frame: the renderer keeps the view begun for the
+    // parts still to come, so each view begun is finished in parts (taking one whole every
+    // third frame, to show one, took 40-45 ms of CPU). shown_ has the render's size before
+    // its first pass (startWork), so the first image of a size comes in parts too.
     const int maxRows =
-        whole || hurry || shown_.width <= 0 ? 0 : std::max(1, kSnapshotPixels / shown_.width);
-    if (!renderer_.snapshot(shownVersion_, shown_, &what, maxRows)) {
-        if (holding_) ++holdFrames_;
-        return false;
-    }
-    snapshotBehind_ = what.behind;
+        whole || shown_.width <= 0 ? 0 : std::max(1, kSnapshotPixels / shown_.width);
+    if (!renderer_.snapshot(shownVersion_, shown_, &what, maxRows)) return false;
+    snapshotBehind_ = what.behind || what.stale;
     holding_ = what.behind && (holding_ || what.job != screenJob_);
-    holdFrames_ = holding_ ? holdFrames_ + 1 : 0;
     if (!what.behind) screenJob_ = what.job;
     uploadDue_ = true;
     changed_.add(what.changedBegin, what.changedEnd < 0 ? shown_.height : what.changedEnd);
@@ -327,6 +324,7 @@ bool ViewerState::takeSnapshot(bool whole) {
     if (!logTimings_) return true;
     // Passes this snapshot holds whole (one may have finished since it was taken), logged once
     // the frame showing them is on screen (presented()).
+    if (what.job != startedJob_) return true;  // a replaced job's: its passes are gone
     std::vector<PassRecord> passes = renderer_.passes();
     for (; passesLogged_ < passes.size(); ++passesLogged_) {
         const PassRecord& p = passes[passesLogged_];
@@ -359,6 +357,16 @@ void ViewerState::startWork(int fbWidth, int fbHeight) {
         jobWidth_ = fbWidth;
         jobHeight_ = fbHeight;
         if (!renderDirty_) markRender("window size");  // else keep the pending change's time
+        // The image of the new size made now, frames before its first pass: its snapshots
+        // then come in parts (held off the screen until whole) like any other. Made by the
+        // first snapshot, it was a whole copy into a new image: 40-41 ms of CPU in one frame
+        // (poll 14-15, upload 11, image 9-10; 2026-12-06, scripts/frame-times).
+        shown_ = Image(jobWidth_, jobHeight_);
+        // Rows of the old size not uploaded yet: the screen keeps its picture until the new
+        // size's is whole.
+        changed_.clear();
+        uploadDue_ = false;
+        shownComplete_ = false;
     }
     // The irregular scheme's regions live in the camera frame: rebuild once the drag ends.
     if (cameraMovedForBuild_ && !ImGui::IsAnyMouseDown()) {

@@ -64,8 +64,6 @@ struct SpeedupResult {
 /// The pixels of a finer pass that one frame takes from the renderer at most (a third of a
 /// 1280x720 image): the rest comes in the next frames (ViewerState::takeSnapshot).
 inline constexpr int kSnapshotPixels = 1280 * 720 / 3;
-/// The frames a new view's image may be held off the screen before its rest comes whole.
-inline constexpr int kHoldFrames = 2;
 
 class ViewerState {
   public:
@@ -239,7 +237,6 @@ class ViewerState {
     bool snapshotBehind_ = false;  ///< the last snapshot left rows of its pass to the next
     uint64_t screenJob_ = 0;       ///< the job whose rows the screen may show (caught up with)
     bool holding_ = false;         ///< a new job's rows are coming in parts: holdImage()
-    int holdFrames_ = 0;           ///< snapshots (frames) it has been held
     bool uploadDue_ = false;
     int jobWidth_ = 0, jobHeight_ = 0;
     bool renderDirty_ = false, cameraMovedForBuild_ = false;

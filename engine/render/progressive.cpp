@@ -88,10 +88,35 @@ void ProgressiveRenderer::cancel() {
 
 bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown, int maxRows) {
     std::lock_guard lock(mutex_);
+    if (keeping_) {
+        // The job the caller began in parts, replaced since: its next rows, until it is whole.
+        const bool fits = out.width == kept_.width && out.height == kept_.height;
+        keeping_ = maxRows > 0 && fits && !keptChanged_.empty();
+        if (keeping_) {
+            const int end = std::min(keptChanged_.end, keptChanged_.begin + maxRows);
+            copyRows(kept_, out, keptChanged_.begin, end);
+            Shown s = keptShown_;
+            s.changedBegin = keptChanged_.begin;
+            s.changedEnd = end;
+            keptChanged_.begin = end;
+            s.behind = end < keptChanged_.end;
+            if (s.behind) {
+                s.rows = std::min(s.rows, end);
+            } else {
+                keeping_ = false;
+                caughtUp_ = s.job;
+                s.stale = true;  // the newer job's rows are next
+            }
+            if (shown) *shown = s;
+            return true;
+        }
+    }
     if (version == displayVersion_) return false;
     // Only the rows written since the last snapshot, unless `out` is new or of another size.
     Shown s = displayShown_;
     const bool whole = out.width != display_.width || out.height != display_.height;
+    // A replaced job's image of another size: the caller made `out` for the newer job.
+    if (whole && out.width > 0 && displayShown_.job != jobs_) return false;
     int end = changed_.end;
     if (!whole && maxRows > 0 && end - changed_.begin > maxRows) end = changed_.begin + maxRows;
     copyRows(display_, out, changed_.begin, end);  // whole when the size differs
@@ -101,9 +126,12 @@ bool ProgressiveRenderer::snapshot(uint64_t& version, Image& out, Shown* shown, 
         changed_.begin = end;
         s.rows = std::min(s.rows, end);  // the pass's rows that `out` holds
         s.behind = true;
+        partTaken_ = partTaken_ || s.job != caughtUp_;
     } else {
         changed_.clear();
         version = displayVersion_;
+        partTaken_ = false;
+        caughtUp_ = s.job;
     }
     if (shown) *shown = s;
     return true;
@@ -199,6 +227,18 @@ void ProgressiveRenderer::run() {
                 if (cancel_) {  // a newer job arrived while the band finished: do not show it
                     complete = false;
                     break;
+                }
+                if (previous == 0 && y0 == 0) {
+                    // A new job's first rows. A job the caller began to take in parts is kept
+                    // for it to finish (snapshot()); this one goes into the spare image.
+                    if (partTaken_ && !keeping_) {
+                        std::swap(display_, kept_);
+                        keptChanged_ = changed_;
+                        keptShown_ = displayShown_;
+                        keeping_ = true;
+                    }
+                    partTaken_ = false;
+                    changed_.clear();
                 }
                 // The band's rows, as blocks of the pass, straight into the displayed image (the
                 // first pass of a job fills it whole; another size is refilled whole).

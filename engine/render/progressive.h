@@ -85,6 +85,9 @@ class ProgressiveRenderer {
         int changedBegin = 0, changedEnd = 0;
         uint64_t job = 0;
         bool behind = false;
+        /// The snapshot finished a job that a newer one replaced while it came in parts (see
+        /// snapshot()): the newer job's rows wait for the next snapshots.
+        bool stale = false;
     };
     /// The number of the last job started (1 for the first; 0: none yet). A caller whose last
     /// snapshot has another number has not yet seen anything of the current job.
@@ -97,7 +100,13 @@ class ProgressiveRenderer {
     /// most that many of them: the next snapshot copies the next ones, and `version` is updated
     /// only by the snapshot that catches up (Shown::behind false). The rows of a new job's
     /// first snapshots then lie beside the previous job's: a caller that must not show two
-    /// views at once waits for the catch-up.
+    /// views at once waits for the catch-up. A job whose rows a caller has begun to take in
+    /// parts is kept for it when a newer job starts (the newer one renders into a second
+    /// image): the next snapshots finish it in parts, the last one Shown::stale, and only then
+    /// take the newer job's, so a caller given a new view every frame (a drag) still finishes
+    /// each view it began, never taking one whole. With `maxRows` 0, or into an image of
+    /// another size, the kept job is dropped for the newest. A replaced job's image of another
+    /// size than a non-empty `out` is not taken (`out` was made for the newer job's size).
     bool snapshot(uint64_t& version, Image& out, Shown* shown = nullptr, int maxRows = 0);
     /// What a snapshot taken now would show (its changed rows left at 0): a caller that has
     /// shown another job or stride is behind by a pass.
@@ -130,6 +139,17 @@ class ProgressiveRenderer {
     RowRange changed_;  ///< rows of display_ written since the last snapshot
     uint64_t displayVersion_ = 0;
     Shown displayShown_;
+    /// A job the caller began to take in parts when a newer one started (snapshot()): its
+    /// image, its rows not taken yet and what it shows. `kept_` false: none (the image is
+    /// kept as the next job's spare buffer).
+    Image kept_;
+    RowRange keptChanged_;
+    Shown keptShown_;
+    bool keeping_ = false;
+    /// The caller took part of display_'s rows of a job it had not caught up with before
+    /// (caughtUp_: the job of the last snapshot that caught up).
+    bool partTaken_ = false;
+    uint64_t caughtUp_ = 0;
     Image work_;  ///< the worker's lattice buffer, kept between jobs of the same size
     std::vector<PassRecord> passes_;
     std::function<void()> onPass_;

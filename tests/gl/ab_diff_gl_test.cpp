@@ -178,7 +178,7 @@ TEST_F(AbFrames, ARebuildBeforeTheOldImageIsCompleteGivesNoDiff) {
     app_->setViewMode(ViewMode::PrimTests);
     app_->setAbView(compare::AbView::Diff);
     auto start = std::chrono::steady_clock::now();
-    while (app_->displayed().width == 0 &&
+    while (app_->state().shownJob() == 0 &&  // no snapshot yet (the image is made ahead)
            std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
         frame();
         std::this_thread::sleep_for(std::chrono::milliseconds(2));

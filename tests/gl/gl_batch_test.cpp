@@ -101,6 +101,55 @@ TEST(GlRoom, ImageSpaceLinesAndTranslucentFillsLandOnTheirPixels) {
     EXPECT_TRUE(isColor(at(px, w, 30, 5), 128, 128, 128, 2));
 }
 
+TEST(GlRoom, ABatchOfSeveralBuffersIsCopiedInPartsAndDrawsRangesAcrossThem) {
+    const int w = 64, h = 48;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    BatchRenderer renderer;
+    // Line k across row k % h: more lines than two buffers hold.
+    const size_t perChunk = GpuBatch::kChunkVertices / 2, n = 2 * perChunk + 100;
+    Batch b;
+    for (size_t k = 0; k < n; ++k) {
+        const float y = float(k % size_t(h)) + 0.5f;
+        b.line(glm::vec2(0.0f, y), glm::vec2(float(w), y), rgba8(glm::vec3(1, 1, 1)));
+    }
+    GpuBatch gpu;
+    gpu.beginUpload(b);
+    EXPECT_EQ(gpu.lineCount(), 0u);
+    int parts = 0;
+    size_t before = 0;
+    while (!gpu.uploadMore(size_t(1) << 20) && parts < 100) {
+        ++parts;
+        EXPECT_GT(gpu.lineCount(), before) << "copied in order, a part at a time";
+        before = gpu.lineCount();
+        EXPECT_LT(before, n);
+    }
+    EXPECT_GE(parts, 3);
+    EXPECT_EQ(gpu.lineCount(), n);
+    EXPECT_TRUE(gpu.uploaded());
+    // A range across the first buffers' boundary draws its lines and no other.
+    DrawOptions range;
+    range.firstLine = perChunk - 5;
+    range.lineLimit = 10;
+    gl.clear(0, 0, 0);
+    renderer.draw(gpu, imagePixelsToClip(float(w), float(h)), range);
+    auto px = gl.read();
+    for (size_t k = range.firstLine - 3; k < range.firstLine + range.lineLimit + 3; ++k) {
+        const bool in = k >= range.firstLine && k < range.firstLine + range.lineLimit;
+        EXPECT_EQ(isColor(at(px, w, w / 2, int(k % size_t(h))), 255, 255, 255), in) << k;
+    }
+    // Every line of a batch copied again in one go (smaller: a buffer given back).
+    Batch small;
+    small.line(glm::vec2(0.0f, 3.5f), glm::vec2(float(w), 3.5f), rgba8(glm::vec3(0, 1, 0)));
+    gpu.upload(small);
+    EXPECT_EQ(gpu.lineCount(), 1u);
+    gl.clear(0, 0, 0);
+    renderer.draw(gpu, imagePixelsToClip(float(w), float(h)));
+    px = gl.read();
+    EXPECT_TRUE(isColor(at(px, w, w / 2, 3), 0, 255, 0));
+    EXPECT_TRUE(isColor(at(px, w, w / 2, 4), 0, 0, 0));
+}
+
 Camera orthoCamera() {
     Camera c;
     c.from = {0.0, 0.0, 10.0};

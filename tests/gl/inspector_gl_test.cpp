@@ -5,6 +5,10 @@
 // (after the GL headers)
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <functional>
+#include <thread>
+
 #include "app/viewer/camera_control.h"
 #include "app/viewer/gl/transforms.h"
 #include "app/viewer/inspector/inspector.h"
@@ -147,15 +151,97 @@ TEST(InspectorGl, TheMainCameraRebuildsTheModelOnlyForItsFrustum) {
     orbit(turned, 0.5, 0.0);
     f.insp->update(f.st, {turned, 64, 48}, kW, kH, -1);
     EXPECT_EQ(f.insp->model().lines.lines.data(), before);
-    // With it, the frustum follows the main camera: its lines start at the eye.
+    // With it, the frustum follows the main camera (its lines start at the eye), built apart:
+    // the model is not built again.
     f.insp->options().frustum = true;
     f.insp->changed();
     f.insp->update(f.st, {turned, 64, 48}, kW, kH, -1);
     const double tol = 1e-4 * glm::length(turned.from - turned.at);
-    EXPECT_TRUE(lineEndsAt(f.insp->model(), turned.from, tol));
+    InspectorModel frustum;
+    frustum.lines = f.insp->frustum();
+    EXPECT_TRUE(lineEndsAt(frustum, turned.from, tol));
+    const uint64_t builds = f.insp->modelBuilds();
     orbit(turned, 0.5, 0.0);
     f.insp->update(f.st, {turned, 64, 48}, kW, kH, -1);
-    EXPECT_TRUE(lineEndsAt(f.insp->model(), turned.from, tol));
+    frustum.lines = f.insp->frustum();
+    EXPECT_TRUE(lineEndsAt(frustum, turned.from, tol));
+    EXPECT_EQ(f.insp->modelBuilds(), builds) << "a turn of the main camera builds the frustum only";
+    EXPECT_FALSE(lineEndsAt(f.insp->model(), turned.from, tol));
+}
+
+/// Draw `insp` into `f`'s framebuffer until it is settled (at most 100 draws), calling
+/// `check(n)` after the n-th draw; returns the draws.
+int drawUntilSettled(Fixture& f, Inspector& insp, const std::function<void(int)>& check) {
+    int draws = 0;
+    do {
+        f.gl.clear(0.0f, 0.0f, 0.0f);
+        insp.draw(kW, kH);
+        check(++draws);
+    } while (!insp.settled() && draws < 100);
+    return draws;
+}
+
+TEST(InspectorGl, BuiltInTheBackgroundAndDrawnInPartsTheModelEndsAsTheDirectOne) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    const std::vector<uint8_t> direct = f.draw();
+    const InspectorModel want = f.insp->model();
+    ASSERT_FALSE(want.regions.empty());
+    // The same inspector, its model built on a worker: not there at the update that asks for
+    // it (the frame does not wait), then equal to the direct build.
+    Inspector bg;
+    bg.buildInBackground({});
+    const size_t part = want.lines.lineCount() / 5 + 1;
+    bg.drawInParts(part, 0.0);  // one part a draw
+    bg.options() = f.insp->options();
+    bg.changed();
+    bg.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    EXPECT_EQ(bg.modelBuilds(), 1u);
+    EXPECT_FALSE(bg.settled()) << "not settled while the model is built";
+    const auto start = std::chrono::steady_clock::now();
+    while (!bg.settled() && std::chrono::steady_clock::now() - start < std::chrono::seconds(30)) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        bg.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    }
+    ASSERT_TRUE(bg.settled());
+    EXPECT_EQ(bg.modelBuilds(), 1u);
+    ASSERT_EQ(bg.model().regions.size(), want.regions.size());
+    for (size_t i = 0; i < want.regions.size(); ++i)
+        EXPECT_EQ(bg.model().regions[i].id, want.regions[i].id);
+    ASSERT_EQ(bg.model().lines.lines.size(), want.lines.lines.size());
+    for (size_t i = 0; i < want.lines.lines.size(); ++i)
+        ASSERT_EQ(bg.model().lines.lines[i].position, want.lines.lines[i].position) << i;
+    // Its picture in parts, one a draw, the lines drawn so far always the first ones: whole
+    // after five draws, the direct picture.
+    const int draws = drawUntilSettled(f, bg, [&](int n) {
+        EXPECT_EQ(bg.picturedLines(), std::min(size_t(n) * part, want.lines.lineCount()));
+    });
+    EXPECT_EQ(draws, 5);
+    EXPECT_EQ(f.gl.read(), direct);
+}
+
+TEST(InspectorGl, WithItsSurfacesThePictureInPartsEqualsTheOneDrawnAtOnce) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    f.insp->options().surfaces = true;
+    f.insp->changed();
+    f.insp->update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    ASSERT_TRUE(f.insp->waitSurfaces(60000));
+    const std::vector<uint8_t> direct = f.draw();
+    // Drawn in parts, one a draw: the surfaces in six bands of rows, then the lines.
+    Inspector parts;
+    parts.options() = f.insp->options();
+    parts.drawInParts(f.insp->model().lines.lineCount() / 2 + 1, 0.0);
+    parts.changed();
+    parts.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    ASSERT_TRUE(parts.waitSurfaces(60000));
+    const int draws = drawUntilSettled(f, parts, [&](int n) {
+        if (n <= 5) {
+            EXPECT_EQ(parts.picturedLines(), 0u) << "surfaces first";
+        }
+    });
+    EXPECT_EQ(draws, 7);
+    EXPECT_EQ(f.gl.read(), direct);
 }
 
 TEST(InspectorGl, LevelRangeHidesTheOtherLevels) {

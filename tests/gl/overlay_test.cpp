@@ -9,6 +9,7 @@
 #include <mutex>
 #include <set>
 #include <stdexcept>
+#include <thread>
 
 #include "app/viewer/gl/transforms.h"
 #include "app/viewer/image_view.h"
@@ -588,7 +589,7 @@ TEST(Overlays, BuiltInTheBackgroundTheBatchesComeAtALaterUpdateAndEqualTheDirect
     EXPECT_EQ(drawn(gl, ov, cam), drawn(gl, direct, cam));
 }
 
-TEST(Overlays, AtRestALargeLayerIsDrawnInPartsLongestFirstUntilWhole) {
+TEST(Overlays, ALargeLayerIsDrawnInPartsLongestFirstWithinAFramesBudget) {
     OffscreenGl gl(kW, kH);
     ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
     auto s = twoBoxes(SchemeKind::Regular, 8);
@@ -658,6 +659,83 @@ TEST(Overlays, AtRestALargeLayerIsDrawnInPartsLongestFirstUntilWhole) {
     ov.layerTexture(moved, kW, kH);
     EXPECT_EQ(ov.layerDrawn(), 3u + ov.look.restLines);
     EXPECT_TRUE(ov.layerPending());
+    // While moving, parts too: a frame's budget spent after its first part (movingMs 0), the
+    // cap not reached; with time to spare, up to the cap.
+    ov.look.movingLines = total;
+    ov.look.movingMs = 0.0;
+    moved.from.y += 0.5;
+    ov.layerTexture(moved, kW, kH, true);
+    EXPECT_EQ(ov.layerDrawn(), ov.look.restLines);
+    ov.look.movingMs = 1e9;
+    ov.look.movingLines = 2 * ov.look.restLines;
+    moved.from.y += 0.5;
+    ov.layerTexture(moved, kW, kH, true);
+    EXPECT_EQ(ov.layerDrawn(), 2 * ov.look.restLines);
+}
+
+TEST(Overlays, BatchesBuiltInTheBackgroundAreCopiedInPartsAndTheLayerFollowsThem) {
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto s = twoBoxes(SchemeKind::Regular, 8);
+    const Camera& cam = s->scene->camera;
+    // The leaves built at once, and on a worker copied to GL in parts.
+    Overlays direct, ov;
+    direct.options.leaves = ov.options.leaves = true;
+    direct.update(s, cam, kW, kH);
+    ov.buildInBackground({});
+    ov.look.uploadBytes = 16 * sizeof(gl::BatchVertex);  // 8 lines a part
+    ov.look.uploadMs = 0.0;                              // one part a frame
+    ov.look.restMs = 0.0;
+    ov.look.restLines = 4;
+    const auto start = std::chrono::steady_clock::now();
+    while (ov.rebuilds() == 0 &&
+           std::chrono::steady_clock::now() - start < std::chrono::seconds(30)) {
+        ov.update(s, cam, kW, kH);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    ASSERT_EQ(ov.rebuilds(), 1u);
+    const size_t total = ov.layerLines();
+    ASSERT_GT(total, 24u);
+    // Taken: one part copied, the rest in the next frames; the layer drawn meanwhile holds only
+    // lines already copied, and never more than a frame's part.
+    EXPECT_FALSE(ov.uploaded());
+    EXPECT_TRUE(ov.building()) << "not settled while copying";
+    int frames = 0;
+    size_t ready = ov.layerReady();
+    EXPECT_LT(ready, total);
+    while ((!ov.uploaded() || ov.layerPending()) && frames < 10000) {
+        const size_t before = ov.layerDrawn();
+        ov.layerTexture(cam, kW, kH);
+        EXPECT_LE(ov.layerDrawn(), std::min(ov.layerReady(), total));
+        EXPECT_LE(ov.layerDrawn(), before + ov.look.restLines) << frames;
+        ov.update(s, cam, kW, kH);
+        EXPECT_GE(ov.layerReady(), ready) << "copied in order";
+        ready = ov.layerReady();
+        ++frames;
+    }
+    EXPECT_GT(frames, int(total / 8) - 1) << "copied over many frames";
+    EXPECT_TRUE(ov.uploaded());
+    EXPECT_FALSE(ov.building());
+    EXPECT_EQ(ov.layerDrawn(), total);
+    // Whole, the batches are the direct build's, and the layer lights what it lights.
+    EXPECT_EQ(drawn(gl, ov, cam), drawn(gl, direct, cam));
+    auto layerPixels = [&](Overlays& o) {
+        gl.clear(0, 0, 0);
+        ImageView view;
+        view.upload(Image(kW, kH), ViewMode::Color);
+        view.setOverlay(o.layerTexture(cam, kW, kH), o.layerVersion());
+        view.draw(kW, kH, ViewMode::Color, 1.0f);
+        return gl.read();
+    };
+    const std::vector<uint8_t> mine = layerPixels(ov), theirs = layerPixels(direct);
+    size_t differ = 0, lits = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            differ += lit(mine, x, y) != lit(theirs, x, y);
+            lits += lit(theirs, x, y);
+        }
+    EXPECT_GT(lits, 0u);
+    EXPECT_EQ(differ, 0u);
 }
 
 TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShows) {

@@ -9,7 +9,9 @@
 #include <imgui_impl_opengl3.h>
 #include <imgui_internal.h>  // FindWindowByName: where the panels are
 
+#include <algorithm>
 #include <chrono>
+#include <set>
 #include <thread>
 
 #include "app/viewer/camera_control.h"
@@ -104,7 +106,7 @@ std::pair<Image, Image> twoPlainImages(int w, int h) {
     return {a, b};
 }
 
-TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnlyAndAHoldDefersThem) {
+TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnlyAndAHoldDefersThemAtAnySize) {
     const int w = 120, h = 80;
     OffscreenGl gl(w, h);
     ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
@@ -150,13 +152,107 @@ TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnlyAndAHoldDefersThem) {
     shown = gl.read();
     for (int y : {0, 39, 40, 79})
         ASSERT_LE(maxDiff(&shown[4 * a.index(7, y)], b.color[0]), 1) << "released: row " << y;
-    // A hold does not keep an image of another size: the new size is shown at once.
+    // A hold keeps a picture of another size too: a new size comes in parts (its first part
+    // uploaded alone), the old picture drawn until the hold ends.
     Image c(w / 2, h / 2);
     for (glm::vec3& col : c.color) col = glm::vec3(0.0f, 1.0f, 0.0f);
     view.setHold(true);
-    view.upload(c, ViewMode::Color);
+    view.upload(c, ViewMode::Color, 0, h / 4);
     view.draw(w, h, ViewMode::Color, 1.0f);
-    EXPECT_LE(maxDiff(&gl.read()[4 * a.index(w / 2, h / 2)], c.color[0]), 1);
+    shown = gl.read();
+    for (int y : {0, h / 2, h - 1})
+        ASSERT_LE(maxDiff(&shown[4 * a.index(w / 2, y)], b.color[0]), 1) << "held: row " << y;
+    view.upload(c, ViewMode::Color, h / 4, h / 2);
+    view.setHold(false);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    shown = gl.read();
+    for (int y : {0, h / 2, h - 1})
+        ASSERT_LE(maxDiff(&shown[4 * a.index(w / 2, y)], c.color[0]), 1) << "released: " << y;
+    // The first picture of a view, held while its parts come, draws nothing until whole.
+    ImageView first;
+    glClearColor(0.0f, 0.0f, 1.0f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    first.setHold(true);
+    first.upload(a, ViewMode::Color, 0, h / 2);
+    EXPECT_FALSE(first.showsPicture());
+    first.draw(w, h, ViewMode::Color, 1.0f);
+    shown = gl.read();
+    for (int y : {0, h - 1})
+        ASSERT_LE(maxDiff(&shown[4 * a.index(7, y)], glm::vec3(0.0f, 0.0f, 1.0f)), 1) << y;
+    first.upload(a, ViewMode::Color, h / 2, h);
+    first.setHold(false);
+    EXPECT_TRUE(first.showsPicture());
+    first.draw(w, h, ViewMode::Color, 1.0f);
+    shown = gl.read();
+    for (int y : {0, h - 1}) ASSERT_LE(maxDiff(&shown[4 * a.index(7, y)], a.color[0]), 1) << y;
+}
+
+TEST(ViewerImage, TheFirstImageAndEachViewOfADragComeInPartsNeverWhole) {
+    // The state alone (no GL): its snapshots at 1280x720, where a part is a third of the rows.
+    ImGui::CreateContext();
+    ViewerSettings settings;
+    settings.scene = "builtin:default";
+    constexpr int kW = 1280, kH = 720;
+    const int maxRows = kSnapshotPixels / kW;
+    ASSERT_LT(maxRows, kH);
+    {
+        ViewerState state(settings, false, {});
+        // Rows the screen's job has uploaded since it became the shown job; a job is shown
+        // (not held) only once all of its rows are in: never two views at once.
+        std::vector<bool> covered(kH, false);
+        uint64_t job = 0;
+        int uploads = 0, partsHeld = 0, viewsShown = 0;
+        bool firstHeld = false;
+        auto frame = [&] {
+            state.poll();
+            RowRange rows;
+            if (state.takeUpload(rows)) {
+                ++uploads;
+                EXPECT_LE(rows.end - rows.begin, maxRows) << "upload " << uploads << " came whole";
+                if (state.shownJob() != job) {
+                    job = state.shownJob();
+                    covered.assign(kH, false);
+                }
+                for (int y = std::max(rows.begin, 0); y < std::min(rows.end, kH); ++y)
+                    covered[size_t(y)] = true;
+                if (uploads == 1) firstHeld = state.holdImage();
+                if (state.holdImage()) {
+                    ++partsHeld;
+                } else {
+                    EXPECT_EQ(std::count(covered.begin(), covered.end(), true), kH)
+                        << "job " << job << " shown before all its rows were in";
+                    ++viewsShown;
+                }
+            }
+            state.startWork(kW, kH);
+        };
+        auto start = std::chrono::steady_clock::now();
+        const auto within = [&] {
+            return std::chrono::steady_clock::now() - start < std::chrono::seconds(60);
+        };
+        while (viewsShown == 0 && within()) {
+            frame();
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
+        ASSERT_GT(viewsShown, 0);
+        EXPECT_TRUE(firstHeld) << "the first image's first part is held off the screen";
+        EXPECT_GE(partsHeld, 2) << "the first image came in parts";
+        // A drag: a new view every frame. Each view begun is finished in parts (the renderer
+        // keeps it while newer ones render), and some are shown while the camera turns.
+        const int shownBefore = viewsShown;
+        std::set<uint64_t> jobsShown;
+        for (int f = 0; f < 60 && within(); ++f) {
+            Camera c = state.camera();
+            orbit(c, 2.0 * 3.14159265358979 / 180.0, 0.0);
+            state.setCamera(c);
+            const int before = viewsShown;
+            frame();
+            if (viewsShown > before) jobsShown.insert(state.shownJob());
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+        EXPECT_GE(jobsShown.size(), 2u) << viewsShown - shownBefore << " views shown";
+    }
+    ImGui::DestroyContext();
 }
 
 TEST(ViewerGl, PanelsFromTheirTexturesMatchImGuisOwnDrawingAndRedrawOnlyWhenChanged) {

@@ -247,43 +247,86 @@ Batch subtractCovered(const Batch& in, const Batch& cover) {
     return out;
 }
 
-GpuBatch::GpuBatch() {
-    glGenVertexArrays(2, vao_);
-    glGenBuffers(2, vbo_);
-    for (int i = 0; i < 2; ++i) {
-        glBindVertexArray(vao_[i]);
-        glBindBuffer(GL_ARRAY_BUFFER, vbo_[i]);
+GpuBatch::GpuBatch() = default;
+
+GpuBatch::~GpuBatch() {
+    for (auto& kind : chunks_)
+        for (Chunk& c : kind) {
+            glDeleteBuffers(1, &c.vbo);
+            glDeleteVertexArrays(1, &c.vao);
+        }
+}
+
+GpuBatch::Chunk& GpuBatch::chunk(int kind, size_t k, size_t vertices) {
+    std::vector<Chunk>& list = chunks_[kind];
+    while (list.size() <= k) {
+        Chunk c;
+        glGenVertexArrays(1, &c.vao);
+        glGenBuffers(1, &c.vbo);
+        glBindVertexArray(c.vao);
+        glBindBuffer(GL_ARRAY_BUFFER, c.vbo);
         glEnableVertexAttribArray(0);
         glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(BatchVertex),
                               reinterpret_cast<void*>(offsetof(BatchVertex, position)));
         glEnableVertexAttribArray(1);
         glVertexAttribPointer(1, 4, GL_UNSIGNED_BYTE, GL_TRUE, sizeof(BatchVertex),
                               reinterpret_cast<void*>(offsetof(BatchVertex, color)));
+        glBindVertexArray(0);
+        list.push_back(c);
     }
-    glBindVertexArray(0);
-    glBindBuffer(GL_ARRAY_BUFFER, 0);
-}
-
-GpuBatch::~GpuBatch() {
-    glDeleteBuffers(2, vbo_);
-    glDeleteVertexArrays(2, vao_);
+    Chunk& c = list[k];
+    if (vertices > c.capacity || vertices < c.capacity / 4) {  // grow, or give memory back
+        glBindBuffer(GL_ARRAY_BUFFER, c.vbo);
+        glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices * sizeof(BatchVertex)), nullptr,
+                     GL_DYNAMIC_DRAW);
+        c.capacity = vertices;
+    }
+    return c;
 }
 
 void GpuBatch::upload(const Batch& batch) {
-    const std::vector<BatchVertex>* parts[2] = {&batch.lines, &batch.triangles};
+    beginUpload(batch);
+    uploadMore(SIZE_MAX);
+}
+
+void GpuBatch::beginUpload(const Batch& batch) {
+    const size_t sizes[2] = {batch.lines.size(), batch.triangles.size()};
     for (int i = 0; i < 2; ++i) {
-        const size_t bytes = parts[i]->size() * sizeof(BatchVertex);
-        glBindBuffer(GL_ARRAY_BUFFER, vbo_[i]);
-        if (bytes > capacity_[i] || bytes < capacity_[i] / 4) {  // grow, or give memory back
-            glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(bytes), parts[i]->data(), GL_DYNAMIC_DRAW);
-            capacity_[i] = bytes;
-        } else if (bytes > 0) {
-            glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(bytes), parts[i]->data());
+        // Chunks beyond the batch's give their memory back.
+        const size_t keep = (sizes[i] + kChunkVertices - 1) / kChunkVertices;
+        while (chunks_[i].size() > keep) {
+            glDeleteBuffers(1, &chunks_[i].back().vbo);
+            glDeleteVertexArrays(1, &chunks_[i].back().vao);
+            chunks_[i].pop_back();
+        }
+    }
+    lineVertices_ = triangleVertices_ = 0;
+    pending_ = &batch;
+}
+
+bool GpuBatch::uploadMore(size_t bytes) {
+    if (!pending_) return true;
+    const std::vector<BatchVertex>* parts[2] = {&pending_->lines, &pending_->triangles};
+    size_t* done[2] = {&lineVertices_, &triangleVertices_};
+    for (int i = 0; i < 2 && bytes > 0; ++i) {
+        const size_t per = i == 0 ? 2 : 3;
+        while (*done[i] < parts[i]->size() && bytes > 0) {
+            const size_t k = *done[i] / kChunkVertices, at = *done[i] % kChunkVertices;
+            const size_t chunkEnd = std::min(parts[i]->size(), (k + 1) * kChunkVertices);
+            const size_t want = std::max(bytes / sizeof(BatchVertex) / per, size_t(1)) * per;
+            const size_t n = std::min(chunkEnd - *done[i], want);
+            Chunk& c = chunk(i, k, chunkEnd - k * kChunkVertices);
+            glBindBuffer(GL_ARRAY_BUFFER, c.vbo);
+            glBufferSubData(GL_ARRAY_BUFFER, GLintptr(at * sizeof(BatchVertex)),
+                            GLsizeiptr(n * sizeof(BatchVertex)), parts[i]->data() + *done[i]);
+            *done[i] += n;
+            bytes -= std::min(bytes, n * sizeof(BatchVertex));
         }
     }
     glBindBuffer(GL_ARRAY_BUFFER, 0);
-    lineVertices_ = batch.lines.size();
-    triangleVertices_ = batch.triangles.size();
+    if (lineVertices_ == parts[0]->size() && triangleVertices_ == parts[1]->size())
+        pending_ = nullptr;
+    return pending_ == nullptr;
 }
 
 BatchRenderer::BatchRenderer()
@@ -317,14 +360,19 @@ void BatchRenderer::draw(const GpuBatch& b, const glm::mat4& toClip, const DrawO
     } else {
         glDisable(GL_DEPTH_TEST);
     }
-    if (o.triangles && tn > 0) {
-        glBindVertexArray(b.vao_[1]);
-        glDrawArrays(GL_TRIANGLES, GLint(3 * t0), GLsizei(3 * tn));
-    }
-    if (o.lines && ln > 0) {
-        glBindVertexArray(b.vao_[0]);
-        glDrawArrays(GL_LINES, GLint(2 * l0), GLsizei(2 * ln));
-    }
+    // Vertices [first, first + count) of a kind, chunk by chunk (no primitive spans two).
+    auto drawRange = [&](int kind, GLenum mode, size_t first, size_t count) {
+        const size_t end = first + count;
+        for (size_t v = first; v < end;) {
+            const size_t k = v / GpuBatch::kChunkVertices;
+            const size_t chunkEnd = std::min(end, (k + 1) * GpuBatch::kChunkVertices);
+            glBindVertexArray(b.chunks_[kind][k].vao);
+            glDrawArrays(mode, GLint(v - k * GpuBatch::kChunkVertices), GLsizei(chunkEnd - v));
+            v = chunkEnd;
+        }
+    };
+    if (o.triangles && tn > 0) drawRange(1, GL_TRIANGLES, 3 * t0, 3 * tn);
+    if (o.lines && ln > 0) drawRange(0, GL_LINES, 2 * l0, 2 * ln);
     glBindVertexArray(0);
     glUseProgram(0);
     glDisable(GL_DEPTH_TEST);

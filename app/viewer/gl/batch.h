@@ -101,14 +101,36 @@ class GpuBatch {
 
     /// Replace the buffers' contents with `batch`.
     void upload(const Batch& batch);
+    /// Begin replacing them with `batch` in parts (uploadMore()): `batch` must stay alive and
+    /// unchanged until uploaded(). Meanwhile only what was copied is drawn (lineCount(),
+    /// triangleCount(): the first lines and triangles, in order).
+    void beginUpload(const Batch& batch);
+    /// Copy about `bytes` more (whole lines or triangles, at least one) of the batch begun;
+    /// true once all of it is.
+    bool uploadMore(size_t bytes);
+    /// Nothing is left to copy.
+    bool uploaded() const { return pending_ == nullptr; }
+    /// Segments and triangles drawn (copied so far).
     size_t lineCount() const { return lineVertices_ / 2; }
     size_t triangleCount() const { return triangleVertices_ / 3; }
 
+    /// Vertices a GL buffer holds at most (2 MB; whole lines and triangles): a batch lives in
+    /// several, each allocated when the copy reaches it, because llvmpipe zeroes a buffer when
+    /// it allocates it (balls4's slab batches, 77 MB in one buffer each, took 52 ms).
+    static constexpr size_t kChunkVertices = 6 * 21845;
+
   private:
     friend class BatchRenderer;
-    unsigned vao_[2] = {}, vbo_[2] = {};  ///< [0] the segments, [1] the triangles
+    /// One GL buffer of a batch's vertices [k * kChunkVertices, (k + 1) * kChunkVertices).
+    struct Chunk {
+        unsigned vao = 0, vbo = 0;
+        size_t capacity = 0;  ///< vertices allocated
+    };
+    /// Make chunk `k` of kind `kind` (0 the segments, 1 the triangles) hold `vertices`.
+    Chunk& chunk(int kind, size_t k, size_t vertices);
+    std::vector<Chunk> chunks_[2];  ///< [0] the segments, [1] the triangles
     size_t lineVertices_ = 0, triangleVertices_ = 0;
-    size_t capacity_[2] = {};  ///< bytes allocated in each buffer
+    const Batch* pending_ = nullptr;  ///< the batch being copied (beginUpload())
 };
 
 /// Draws batches: owns the program (shaders/batch.vert, batch.frag) and a scratch buffer for

@@ -43,6 +43,7 @@ Inspector::Inspector(std::function<void()> wake) {
     batches_ = std::make_unique<gl::BatchRenderer>();
     lines_ = std::make_unique<gl::GpuBatch>();
     selection_ = std::make_unique<gl::GpuBatch>();
+    frustumGpu_ = std::make_unique<gl::GpuBatch>();
     surfaceProgram_ =
         std::make_unique<gl::Program>("inspector_surface.vert", "inspector_surface.frag");
     glGenFramebuffers(1, &fbo_);
@@ -110,8 +111,9 @@ void Inspector::update(const std::shared_ptr<const SceneBuild>& structure, const
     if (structure != structure_) {
         const bool newScene = !structure_ || !structure || structure_->spec != structure->spec;
         structure_ = structure;
-        view_ = structure_ ? std::make_unique<StructureView>(*structure_->scene, *structure_->accel)
-                           : nullptr;
+        view_ = structure_
+                    ? std::make_shared<const StructureView>(*structure_->scene, *structure_->accel)
+                    : nullptr;
         if (structure_ && (newScene || !cameraFramed_)) {
             if (restore_ && restore_->scene == structure_->spec) {
                 camera_ = restore_->camera;
@@ -136,32 +138,60 @@ void Inspector::update(const std::shared_ptr<const SceneBuild>& structure, const
     if (!sameCamera(main.camera, main_.camera) || main.width != main_.width ||
         main.height != main_.height) {
         main_ = main;
-        // Of the model only the frustum shows the main camera: without it, a turn of the main
-        // camera rebuilt all of balls4's leaves each frame (106 ms a frame, 2026-12-06).
-        if (opt_.frustum) dirtyModel_ = true;
+        // Only the frustum shows the main camera, and it is built apart from the model: a turn
+        // of the main camera rebuilt all of balls4's leaves each frame (106 ms a frame), and
+        // with the frustum on 4-10 ms of the irregular slabs' model (2026-12-06).
+        if (opt_.frustum) rebuildFrustum();
     }
     if (selected != selected_) {
         selected_ = selected;
         dirtyModel_ = true;
     }
-    if (dirtyModel_ && !dragging_) rebuildModel();
+    if (job_.pending()) {
+        if (std::optional<InspectorModel> m = job_.poll()) {
+            model_ = std::move(*m);
+            dirtyBatch_ = true;
+            dirtyPicture_ = true;
+        }
+    }
+    if (dirtyModel_ && !dragging_ && !job_.pending()) rebuildModel();
+}
+
+void Inspector::buildInBackground(std::function<void()> wake) {
+    background_ = true;
+    wake_ = std::move(wake);
+}
+
+void Inspector::rebuildFrustum() {
+    frustum_ = view_ && opt_.frustum ? frustumLines(*view_, main_) : gl::Batch{};
+    frustumGpu_->upload(frustum_);  // a few lines: the model's batch is not copied again
+    dirtyPicture_ = true;
 }
 
 void Inspector::rebuildModel() {
     dirtyModel_ = false;
-    if (!view_) {
-        model_ = {};
-    } else {
-        InspectorView iv{camera_, vw_, vh_};
-        model_ = buildModel(*view_, opt_, main_, iv, selected_);
+    ++modelBuilds_;
+    rebuildFrustum();
+    InspectorOptions opt = opt_;
+    opt.frustum = false;  // frustum_, apart
+    const InspectorView iv{camera_, vw_, vh_};
+    if (!view_ || !background_) {
+        model_ = view_ ? buildModel(*view_, opt, main_, iv, selected_) : InspectorModel{};
+        dirtyBatch_ = true;
+        dirtyPicture_ = true;
+        return;
     }
-    dirtyBatch_ = true;
-    dirtyPicture_ = true;
+    // The view and the structure it reads kept alive by the worker; the last model is drawn
+    // until this one comes (update()).
+    job_.start([view = view_, structure = structure_, opt, main = main_, iv,
+                selected = selected_] { return buildModel(*view, opt, main, iv, selected); },
+               wake_);
 }
 
 void Inspector::depthBounds(double& near, double& far) const {
     Box3 all = view_ ? view_->worldBounds() : Box3{Vec3(-1.0), Vec3(1.0)};
-    for (const gl::BatchVertex& v : model_.lines.lines) all.expand(Vec3(v.position));
+    for (const gl::Batch* b : {&model_.lines, &frustum_})
+        for (const gl::BatchVertex& v : b->lines) all.expand(Vec3(v.position));
     depthRange(camera_, all, near, far);
 }
 
@@ -220,7 +250,9 @@ int64_t Inspector::pick(double x, double y) const {
 }
 
 bool Inspector::settled() const {
-    return !opt_.show || !structure_ || (!dirtyModel_ && (!opt_.surfaces || surfacesShown()));
+    return !opt_.show || !structure_ ||
+           (!dirtyModel_ && !job_.pending() && !picturePending_ &&
+            (!opt_.surfaces || surfacesShown()));
 }
 
 bool Inspector::surfacesShown() const {
@@ -289,6 +321,8 @@ void Inspector::render() {
     double near, far;
     depthBounds(near, far);
     const bool surfaces = surfacesShown();
+    pictureToClip_ = gl::worldToClip(camera_, vw_, vh_, near, far);
+    pictureSurfaces_ = surfaces;
     if (surfaces) {
         const Image& img = surfaces_->image;
         if (!surfUploaded_) {
@@ -326,47 +360,106 @@ void Inspector::render() {
             glBindTexture(GL_TEXTURE_2D, 0);
             surfUploaded_ = true;
         }
-        // The traced picture, its depth written as the line pass's projection would write it.
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_ALWAYS);
-        glDisable(GL_BLEND);
-        const unsigned prog = surfaceProgram_->id();
-        glUseProgram(prog);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, surfColorTex_);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, surfDepthTex_);
-        glUniform1i(surfaceProgram_->uniform("colorTex"), 0);
-        glUniform1i(surfaceProgram_->uniform("depthTex"), 1);
-        glUniform1i(surfaceProgram_->uniform("ortho"),
-                    camera_.projection == Projection::Orthographic ? 1 : 0);
-        glUniform1f(surfaceProgram_->uniform("nearDepth"), float(near));
-        glUniform1f(surfaceProgram_->uniform("farDepth"), float(far));
-        glBindVertexArray(vao_);
-        glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-        glBindVertexArray(0);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, 0);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, 0);
-        glUseProgram(0);
-        glDepthFunc(GL_LESS);
-        glDisable(GL_DEPTH_TEST);
     }
+    pictureNear_ = near;
+    pictureFar_ = far;
+    surfaceRows_ = surfaces ? 0 : vh_;
     if (dirtyBatch_) {
-        lines_->upload(model_.lines);
+        lines_->beginUpload(model_.lines);
         selection_->upload(model_.selection);
         dirtyBatch_ = false;
     }
-    const glm::mat4 toClip = gl::worldToClip(camera_, vw_, vh_, near, far);
+    picturedLines_ = 0;
+    renderMore();
+}
+
+void Inspector::drawSurfaceRows(int rowBegin, int rowEnd) {
+    // The traced picture, its depth written as the line pass's projection would write it; rows
+    // [rowBegin, rowEnd) of the viewport (GL's, from the bottom).
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, rowBegin, vw_, rowEnd - rowBegin);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    glDisable(GL_BLEND);
+    const unsigned prog = surfaceProgram_->id();
+    glUseProgram(prog);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, surfColorTex_);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, surfDepthTex_);
+    glUniform1i(surfaceProgram_->uniform("colorTex"), 0);
+    glUniform1i(surfaceProgram_->uniform("depthTex"), 1);
+    glUniform1i(surfaceProgram_->uniform("ortho"),
+                camera_.projection == Projection::Orthographic ? 1 : 0);
+    glUniform1f(surfaceProgram_->uniform("nearDepth"), float(pictureNear_));
+    glUniform1f(surfaceProgram_->uniform("farDepth"), float(pictureFar_));
+    glBindVertexArray(vao_);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    glBindVertexArray(0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glUseProgram(0);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_SCISSOR_TEST);
+}
+
+void Inspector::renderMore() {
+    const auto t0 = std::chrono::steady_clock::now();
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glViewport(0, 0, vw_, vh_);
+    glDisable(GL_SCISSOR_TEST);
+    // The surfaces first (the lines are tested against their depth), in bands of a sixth of
+    // the rows a part, about the part's time: a quad over the whole viewport took llvmpipe
+    // 23-29 ms (2026-12-06).
+    while (surfaceRows_ < vh_) {
+        const int band = partLines_ > 0 ? std::max(1, (vh_ + 5) / 6) : vh_;
+        const int end = std::min(vh_, surfaceRows_ + band);
+        drawSurfaceRows(surfaceRows_, end);
+        surfaceRows_ = end;
+        if (partLines_ == 0 || surfaceRows_ >= vh_) break;
+        glFinish();  // timed: the band is drawn
+        if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count() >= partMs_) {
+            picturePending_ = true;
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            return;
+        }
+    }
     gl::DrawOptions o;
-    o.depthTest = surfaces;
-    batches_->draw(*lines_, toClip, o);
+    o.depthTest = pictureSurfaces_;
+    // The model's lines in order, in parts (drawInParts()) as they are copied to GL: the
+    // picture is the one drawing them at once would give.
+    const size_t part = partLines_ > 0 ? partLines_ : SIZE_MAX;
+    for (;;) {
+        if (!lines_->uploaded()) lines_->uploadMore(partLines_ > 0 ? kPartBytes : SIZE_MAX);
+        gl::DrawOptions range = o;
+        range.firstLine = picturedLines_;
+        range.lineLimit = std::min(part, lines_->lineCount() - picturedLines_);
+        batches_->draw(*lines_, pictureToClip_, range);
+        picturedLines_ += range.lineLimit;
+        if (lines_->uploaded() && picturedLines_ >= lines_->lineCount()) break;
+        if (partLines_ == 0) continue;
+        glFinish();  // timed: the part is drawn
+        if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count() >= partMs_)
+            break;
+    }
+    picturePending_ = !lines_->uploaded() || picturedLines_ < lines_->lineCount();
+    // Over the lines drawn so far (again after each part: the same pixels once whole).
+    batches_->draw(*frustumGpu_, pictureToClip_, o);
     // The selection over everything: it must be found even behind a surface.
-    batches_->draw(*selection_, toClip, {});
+    batches_->draw(*selection_, pictureToClip_, {});
     // Lines another room adds (the ray played), over everything as the selection is.
-    if (!extra_.empty()) batches_->drawNow(extra_, toClip, {});
+    if (!extra_.empty()) batches_->drawNow(extra_, pictureToClip_, {});
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void Inspector::drawInParts(size_t lines, double ms) {
+    partLines_ = lines;
+    partMs_ = ms;
 }
 
 void Inspector::setExtraLines(gl::Batch batch) {
@@ -379,7 +472,10 @@ void Inspector::draw(int fbWidth, int fbHeight) {
     requestSurfaces();
     takeSurfaces();
     if (dirtyBatch_) dirtyPicture_ = true;
-    if (dirtyPicture_) render();
+    if (dirtyPicture_)
+        render();
+    else if (picturePending_)
+        renderMore();
     const PixelRect v = area(fbWidth, fbHeight);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);

@@ -8,10 +8,12 @@
 
 #include <cstdint>
 #include <functional>
+#include <glm/mat4x4.hpp>
 #include <memory>
 #include <optional>
 #include <string>
 
+#include "app/viewer/background_job.h"
 #include "app/viewer/image_view.h"  // PixelRect
 #include "app/viewer/inspector/inspector_model.h"
 #include "app/viewer/inspector/surface_tracer.h"
@@ -83,8 +85,23 @@ class Inspector {
     /// Hidden, or showing everything asked for: the surfaces of its camera (when on) are traced
     /// and the model is up to date.
     bool settled() const;
-    /// What is drawn (for the panel and tests).
+    /// What is drawn (for the panel and tests): the model (without the frustum) and the main
+    /// camera's frustum, apart, so a turn of the main camera builds only the frustum again.
     const InspectorModel& model() const { return model_; }
+    const gl::Batch& frustum() const { return frustum_; }
+    /// Build the model on a worker thread from now on, `wake` (may be empty) called from it
+    /// when it is ready; until then the last model is drawn. Otherwise (tests) update() builds
+    /// it itself. balls4's irregular slabs took the UI thread 57-111 ms a structure (2026-12-06).
+    void buildInBackground(std::function<void()> wake);
+    /// Times the model was built (tests: what changes it and what does not).
+    uint64_t modelBuilds() const { return modelBuilds_; }
+    /// Draw the picture's lines in parts of `lines` (copied to GL in parts too) until `ms` of
+    /// a draw() have passed (0: one part a draw), the rest at the next draws; 0 lines: whole
+    /// (the default). balls4's inspector picture (20,000 regions, 240,000 lines) took
+    /// llvmpipe 50-75 ms in one frame (2026-12-06).
+    void drawInParts(size_t lines, double ms);
+    /// Lines of the model in the picture so far (all of them once it is whole).
+    size_t picturedLines() const { return picturedLines_; }
     /// Surfaces of the current camera are on screen (the trace arrived).
     bool surfacesShown() const;
     /// Wait (tests) until the surfaces of the current camera are traced, up to `ms`.
@@ -92,9 +109,17 @@ class Inspector {
 
   private:
     void rebuildModel();
+    /// The main camera's frustum again (frustum_), for the picture.
+    void rebuildFrustum();
     void requestSurfaces();
     void takeSurfaces();
+    /// Start the picture again: the surfaces, then the lines (renderMore()).
     void render();
+    /// The next surface rows or lines of the picture, for the part's time, and the lines over
+    /// them.
+    void renderMore();
+    /// Rows [rowBegin, rowEnd) of the traced surfaces into the picture (GL's rows).
+    void drawSurfaceRows(int rowBegin, int rowEnd);
     /// Near and far depths of everything drawn, for the inspector's camera.
     void depthBounds(double& near, double& far) const;
 
@@ -109,13 +134,17 @@ class Inspector {
     std::optional<Restore> restore_;
     std::optional<Box3> pendingFrame_;  ///< frame()
     std::shared_ptr<const SceneBuild> structure_;
-    std::unique_ptr<StructureView> view_;
+    std::shared_ptr<const StructureView> view_;
     MainView main_;
     int64_t selected_ = -1;
     PixelRect area_;       ///< setArea()
     int vw_ = 0, vh_ = 0;  ///< viewport size
     InspectorModel model_;
+    gl::Batch frustum_;  ///< frustumLines() of main_ (empty without InspectorOptions::frustum)
     bool dirtyModel_ = true, dirtyPicture_ = true, dirtyBatch_ = true;
+    uint64_t modelBuilds_ = 0;
+    bool background_ = false;
+    std::function<void()> wake_;
     bool dragging_ = false;  ///< a drag that began in the inspector is under way
     int dragButton_ = -1;
 
@@ -128,11 +157,22 @@ class Inspector {
 
     // GL.
     std::unique_ptr<gl::BatchRenderer> batches_;
-    std::unique_ptr<gl::GpuBatch> lines_, selection_;
+    std::unique_ptr<gl::GpuBatch> lines_, selection_, frustumGpu_;
     std::unique_ptr<gl::Program> surfaceProgram_;
     unsigned fbo_ = 0, colorTex_ = 0, depthRb_ = 0, surfColorTex_ = 0, surfDepthTex_ = 0, vao_ = 0;
     int fboW_ = 0, fboH_ = 0, surfW_ = 0, surfH_ = 0;
     bool surfUploaded_ = false;
+    // The picture in parts (drawInParts()).
+    static constexpr size_t kPartBytes = size_t(2) << 20;  ///< copied to GL per part
+    size_t partLines_ = 0;
+    double partMs_ = 0.0;
+    size_t picturedLines_ = 0;
+    bool picturePending_ = false;
+    bool pictureSurfaces_ = false;
+    double pictureNear_ = 0.0, pictureFar_ = 1.0;
+    int surfaceRows_ = 0;  ///< rows of the surfaces in the picture so far
+    glm::mat4 pictureToClip_{1.0f};
+    BackgroundJob<InspectorModel> job_;  ///< last: its worker joined before the rest is destroyed
 };
 
 }  // namespace lancer::viewer::inspector

@@ -153,7 +153,10 @@ void directoryBlocks(InspectorModel& m, const StructureView& view, const Inspect
     }
 }
 
-void cameraFrustum(InspectorModel& m, const StructureView& view, const MainView& main) {
+}  // namespace
+
+gl::Batch frustumLines(const StructureView& view, const MainView& main) {
+    gl::Batch lines;
     const Camera& cam = main.camera;
     double near, far;
     depthRange(cam, view.worldBounds(), near, far);
@@ -161,23 +164,22 @@ void cameraFrustum(InspectorModel& m, const StructureView& view, const MainView&
     if (cam.projection == Projection::Perspective) {
         // From the eye to the far side of the structure: the eye's rays, then the far face.
         const Corners c = frustumCorners(cam, main.width, main.height, 0.0, far);
-        for (int i = 4; i < 8; ++i) addLine(m.lines, cam.from, c[size_t(i)], kFrustumColor);
+        for (int i = 4; i < 8; ++i) addLine(lines, cam.from, c[size_t(i)], kFrustumColor);
         for (const auto& e : cornerEdges())
-            if (e[0] & e[1] & 4) addLine(m.lines, c[size_t(e[0])], c[size_t(e[1])], kFrustumColor);
+            if (e[0] & e[1] & 4) addLine(lines, c[size_t(e[0])], c[size_t(e[1])], kFrustumColor);
     } else {
-        addVolume(m.lines, frustumCorners(cam, main.width, main.height, 0.0, far), kFrustumColor);
+        addVolume(lines, frustumCorners(cam, main.width, main.height, 0.0, far), kFrustumColor);
     }
     const std::array<Vec3, 4> plane = imagePlane(cam, main.width, main.height);
     for (int i = 0; i < 4; ++i)
-        addLine(m.lines, plane[size_t(i)], plane[size_t(i + 1) % 4], kImagePlaneColor);
+        addLine(lines, plane[size_t(i)], plane[size_t(i + 1) % 4], kImagePlaneColor);
     // A small triangle on its top edge, as cameras are drawn: which way is up.
     const Vec3 mid = 0.5 * (plane[0] + plane[1]), up = 0.15 * (plane[0] - plane[3]);
     const Vec3 side = 0.15 * (plane[1] - plane[0]);
-    addLine(m.lines, mid - side, mid + up, kImagePlaneColor);
-    addLine(m.lines, mid + up, mid + side, kImagePlaneColor);
+    addLine(lines, mid - side, mid + up, kImagePlaneColor);
+    addLine(lines, mid + up, mid + side, kImagePlaneColor);
+    return lines;
 }
-
-}  // namespace
 
 InspectorModel buildModel(const StructureView& view, const InspectorOptions& opt,
                           const MainView& main, const InspectorView& insp, int64_t selected) {
@@ -211,7 +213,7 @@ InspectorModel buildModel(const StructureView& view, const InspectorOptions& opt
             addVolume(m.lines, c, kBoxColor);
         }
     }
-    if (opt.frustum) cameraFrustum(m, view, main);
+    if (opt.frustum) m.lines.append(frustumLines(view, main));
     if (selected >= 0 && uint64_t(selected) < view.regionCount())
         addVolume(m.selection, view.regionCorners(uint32_t(selected)), kSelectionColor);
     return m;

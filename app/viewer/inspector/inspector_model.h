@@ -64,6 +64,10 @@ struct InspectorModel {
 /// edge of the image (or behind a perspective eye).
 bool maybeVisible(const Camera& cam, int w, int h, const Corners& c);
 
+/// The main camera's frustum (from its eye to the far side of the structure) and image plane,
+/// as lines: what buildModel() adds with InspectorOptions::frustum.
+gl::Batch frustumLines(const StructureView& view, const MainView& main);
+
 /// The model of `view`'s structure as the options ask, seen from `insp`, with region
 /// `selected` (-1: none) highlighted.
 InspectorModel buildModel(const StructureView& view, const InspectorOptions& opt,

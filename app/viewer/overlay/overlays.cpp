@@ -108,6 +108,7 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
         }
     }
     if (!view_) return;
+    uploadMore();
     if (job_.pending()) {  // a build under way: the batches on screen stay until it is done
         std::optional<OverlayGeometry> g = job_.poll();
         if (!g) return;
@@ -156,10 +157,16 @@ OverlayGeometry Overlays::build(const BuildInputs& in) {
 
 void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms) {
     geometry_ = std::move(geometry);
-    cuts_->upload(geometry_.cuts);
-    fills_->upload(geometry_.fills);
-    wires_->upload(geometry_.wires);
-    wiresLongestFirst_->upload(geometry_.wiresLongestFirst);
+    cuts_->beginUpload(geometry_.cuts);
+    fills_->beginUpload(geometry_.fills);
+    wiresLongestFirst_->beginUpload(geometry_.wiresLongestFirst);
+    wires_->beginUpload(geometry_.wires);
+    if (background_) {
+        uploadMore();  // the rest in the next frames
+    } else {
+        for (gl::GpuBatch* b : {cuts_.get(), fills_.get(), wiresLongestFirst_.get(), wires_.get()})
+            b->uploadMore(SIZE_MAX);
+    }
     lastBuildMs_ = ms;
     builtView_ = in.view.get();
     builtCosts_ = in.costs;
@@ -168,6 +175,31 @@ void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms) 
     builtWidth_ = in.width;
     builtHeight_ = in.height;
     ++rebuilds_;
+}
+
+void Overlays::uploadMore() {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (gl::GpuBatch* b : {cuts_.get(), fills_.get(), wiresLongestFirst_.get(), wires_.get()})
+        while (!b->uploaded()) {
+            b->uploadMore(look.uploadBytes);
+            glFinish();  // timed: the copy is done
+            if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                    .count() >= look.uploadMs)
+                return;
+        }
+}
+
+bool Overlays::uploaded() const {
+    return cuts_->uploaded() && fills_->uploaded() && wiresLongestFirst_->uploaded() &&
+           wires_->uploaded();
+}
+
+size_t Overlays::layerReady() const {
+    auto ready = [](const gl::GpuBatch& b, size_t copied) {
+        return b.uploaded() ? SIZE_MAX : copied;
+    };
+    return std::min({ready(*cuts_, cuts_->lineCount()), ready(*fills_, fills_->triangleCount() / 2),
+                     ready(*wiresLongestFirst_, wiresLongestFirst_->lineCount())});
 }
 
 void Overlays::drawLayerRange(const Camera& view, int width, int height, size_t first, size_t count,
@@ -263,25 +295,32 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
     // At rest a layer too large for one frame goes on from where the texture stands (a moving
     // camera's cap is its first part, longest lines first); else it starts afresh.
     const size_t total = layerLines();
-    const bool inParts = !moving && total > look.restLines;
+    // Batches still being copied to GL are drawn in parts as they come, from what is copied.
+    const size_t ready = std::min(total, layerReady());
+    const bool inParts = !moving && (total > look.restLines || !uploaded());
     const bool resume = inParts && sameLayer && layerPartial_ && layerDrawn_ < total;
+    if (resume && layerDrawn_ >= ready) {  // nothing more copied yet: the texture is unchanged
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        return layerTex_;
+    }
     if (!resume) {
         glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
         glClear(GL_COLOR_BUFFER_BIT);
         layerDrawn_ = 0;
     }
-    if (moving) {
-        drawLayers(view, width, height, look.movingLines);
-        layerDrawn_ = std::min(look.movingLines, total);
-    } else if (inParts) {  // parts until the frame's share is spent (GL finished: timed)
+    if (moving || inParts) {
+        // Parts until the frame's share is spent (GL finished: timed), the longest lines
+        // first; while moving, up to the cap.
+        const size_t end = moving ? std::min(look.movingLines, ready) : ready;
+        const double budget = moving ? look.movingMs : look.restMs;
         do {
-            const size_t part = std::min(std::max<size_t>(look.restLines, 1), total - layerDrawn_);
+            const size_t part = std::min(std::max<size_t>(look.restLines, 1), end - layerDrawn_);
             drawLayerRange(view, width, height, layerDrawn_, part, true);
             layerDrawn_ += part;
             glFinish();
-        } while (layerDrawn_ < total &&
+        } while (layerDrawn_ < end &&
                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                         .count() < look.restMs);
+                         .count() < budget);
     } else {  // whole in one frame, the wireframe in its own order
         drawLayers(view, width, height, SIZE_MAX);
         layerDrawn_ = total;
@@ -439,7 +478,7 @@ void Overlays::panel(bool* open) {
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("Lines drawn while the camera moves");
     const size_t lines = geometry_.wires.lineCount();
     if (lines > 0)
-        ImGui::TextDisabled("%zu lines; %zu drawn while the camera moves", lines,
+        ImGui::TextDisabled("%zu lines; up to %zu drawn while the camera moves", lines,
                             std::min(lines, look.movingLines));
     int cap = int(std::min<size_t>(o.cap, 10000000));
     if (ImGui::InputInt("cap", &cap, 1000, 100000)) o.cap = size_t(std::max(0, cap));

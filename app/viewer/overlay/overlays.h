@@ -26,16 +26,30 @@ struct OverlayLook {
     float fillOpacity = 0.35f;  ///< zones' fills
     float lineOpacity = 0.9f;   ///< cut lines and wireframes
     bool tooltip = true;        ///< the hover tooltip over the image
-    /// Wireframe lines drawn while the camera moves (the longest first; cut lines and fills
-    /// capped alike): the whole layer is drawn again when it rests. 0: none while it moves.
+    /// Wireframe lines drawn while the camera moves at most (the longest first; cut lines and
+    /// fills capped alike), in parts of restLines until movingMs have passed: the whole layer
+    /// is drawn again when it rests. 0: none while it moves.
     size_t movingLines = 2000;
+    /// Milliseconds of a frame while the camera moves given to drawing the layer (0: one part).
+    /// balls4's 2,000 longest slab lines took llvmpipe 14-20 ms a frame (2026-12-06).
+    double movingMs = 6.0;
     /// At rest a layer of more lines than this is drawn in parts of this many, the longest
     /// lines first (cut lines and fills in step), parts added in a frame until restMs have
     /// passed, and completed over the next frames: no frame draws it whole (balls4's 1.2 M
-    /// slab lines took one frame 0.43-0.79 s, 2026-12-06).
-    size_t restLines = 2000;
+    /// slab lines took one frame 0.43-0.79 s, 2026-12-06). Coarse first: the longest lines
+    /// (the largest regions) are in every frame's first part, the detail comes after. Small
+    /// parts keep a frame near its budget: a part of 2,000 of balls4's longest slab lines took
+    /// 18-31 ms (2026-12-06).
+    size_t restLines = 500;
     /// Milliseconds of a frame at rest given to drawing the layer's parts (0: one part a frame).
-    double restMs = 12.0;
+    /// Each part drawn also composites the whole image again (8-10 ms at 1280x720), so a part
+    /// frame at 8 ms took 33-37 ms of CPU on balls4's slabs (2026-12-06).
+    double restMs = 5.0;
+    /// Batches built in the background are copied to GL in parts of uploadBytes, for
+    /// uploadMs of each frame (0: one part a frame), the layer drawn from what is copied:
+    /// balls4's slab batches (1.2 M lines, 77 MB) took one frame 31 ms (2026-12-06).
+    size_t uploadBytes = size_t(2) << 20;
+    double uploadMs = 4.0;
 };
 
 /// The region picked in the image (or set by --select, or by the inspector).
@@ -88,9 +102,10 @@ class Overlays {
     /// again only when the batches, the camera, the size or the look changed: the image view
     /// composites it when it shades the image (ImageView::setOverlay), so layers of a million
     /// lines cost nothing in a frame where nothing changed. 0 when no layer is on.
-    /// With `moving` (the camera is being moved), the texture holds only the first
-    /// look.movingLines lines (OverlayGeometry::wiresLongestFirst) and is drawn whole again
-    /// at the first call without; 0 while moving when look.movingLines is 0. At rest a layer
+    /// With `moving` (the camera is being moved), the texture holds only the first lines
+    /// (OverlayGeometry::wiresLongestFirst): parts of look.restLines until look.movingMs have
+    /// passed, at most look.movingLines; it goes on at the first call without (below); 0 while
+    /// moving when look.movingLines is 0. At rest a layer
     /// of more than look.restLines lines is drawn in parts of look.restLines, longest first,
     /// for look.restMs at each call, until it is whole (layerPending()).
     unsigned layerTexture(const Camera& view, int width, int height, bool moving = false);
@@ -145,8 +160,14 @@ class Overlays {
     /// when they are ready (the viewer: a frame never waits for them; until they come the
     /// previous ones are drawn). Otherwise (tests) update() builds them itself.
     void buildInBackground(std::function<void()> wake);
-    /// A build of the batches is under way on the worker.
-    bool building() const { return job_.pending(); }
+    /// A build of the batches is under way on the worker, or its batches are being copied to
+    /// GL (OverlayLook::uploadMs).
+    bool building() const { return job_.pending() || !uploaded(); }
+    /// The batches built are all copied to GL.
+    bool uploaded() const;
+    /// The layer's first lines (in longest-first order) whose wires, cut lines and fills are
+    /// all copied to GL: what its parts may draw.
+    size_t layerReady() const;
     /// The cached geometry (what the last update built).
     const OverlayGeometry& geometry() const { return geometry_; }
     /// Times the batches were rebuilt (tests: a change rebuilds, nothing else does).
@@ -177,8 +198,12 @@ class Overlays {
         std::shared_ptr<const ImageCosts> costs;
     };
     static OverlayGeometry build(const BuildInputs& in);
-    /// The built geometry into the GL batches, and what it was built for.
+    /// The built geometry into the GL batches (in parts, from a worker's build), and what it
+    /// was built for.
     void take(OverlayGeometry geometry, const BuildInputs& in, double ms);
+    /// Copy more of the batches taken, for look.uploadMs: cut lines, fills and the longest-
+    /// first wireframe first (what the layer's parts draw), the wireframe in its own order last.
+    void uploadMore();
 
     std::shared_ptr<const SceneBuild> structure_;
     std::shared_ptr<const StructureView> view_;
