@@ -1,5 +1,6 @@
 #include "engine/accel/irregular/irregular.h"
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
@@ -44,6 +45,54 @@ size_t regionBudget(size_t prims, size_t pixels) {
 constexpr size_t kHullShare = 16;
 /// Regions beyond this many are refused: pointers are 32-bit and memory would run out first.
 constexpr size_t kMaxRegions = 50'000'000;
+
+/// Lights beyond this many (outside the bounds) get no structure of their own: each costs about
+/// as much to build as the eye's zones.
+constexpr size_t kMaxLightStructures = 8;
+
+/// The primitives' boxes in `frame`, padded by `eps`: the bound there of each minimized box, cut
+/// in a turned scene by the bound of its box along the turn's own axes (grid_frame.h), an
+/// oriented box of the world much smaller than its world box.
+std::vector<Box3> frameBoxes(const Scene& scene, const CameraFrame& frame,
+                             const FrameChoice& turned, const std::vector<uint32_t>& live,
+                             double eps) {
+    std::vector<Box3> box(scene.prims.size());
+    for (uint32_t p : live) {
+        box[p] = frame.box(scene.minBox[p]);
+        if (turned.frame.turned) {
+            const Box3& fb = turned.boxes[p];
+            Box3 c;
+            for (int i = 0; i < 8 && !fb.isEmpty(); ++i)
+                c.expand(frame.point(turned.frame.toWorld(boxCorner(fb, i))));
+            box[p] = overlap(box[p], c);
+        }
+        box[p].lo -= eps;
+        box[p].hi += eps;
+    }
+    return box;
+}
+
+/// The frame of a point light outside `bounds`: origin at the light, depth along the world axis
+/// it lies farthest beyond, toward the scene (the axis its light buffer looks along), so every
+/// box lies in front of it. None for a light inside the bounds (no one frustum holds the scene).
+std::optional<CameraFrame> lightFrame(const Box3& bounds, const Vec3& light) {
+    int axis = -1;
+    double beyond = 0.0, sign = 1.0;
+    for (int a = 0; a < 3; ++a) {
+        if (bounds.lo[a] - light[a] > beyond) axis = a, beyond = bounds.lo[a] - light[a], sign = 1;
+        if (light[a] - bounds.hi[a] > beyond) axis = a, beyond = light[a] - bounds.hi[a], sign = -1;
+    }
+    if (axis < 0) return std::nullopt;
+    CameraFrame f;
+    f.origin = light;
+    f.z = Vec3(0.0);
+    f.z[axis] = sign;
+    f.x = Vec3(0.0);
+    f.x[(axis + 1) % 3] = 1.0;
+    f.y = Vec3(0.0);
+    f.y[(axis + 2) % 3] = 1.0;
+    return f;
+}
 
 }  // namespace
 
@@ -93,24 +142,9 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     double scale = std::max({maxAbs(cam.lo), maxAbs(cam.hi), maxAbs(scene.bounds.lo),
                              maxAbs(scene.bounds.hi), maxAbs(scene.camera.from), 1e-300});
     double eps = 1e-9 * scale;
-    std::vector<Box3> box(scene.prims.size());
     guard.poll();
-    // In a scene turned off the world's axes, each primitive's minimized box along the turn's
-    // own axes (grid_frame.h) is an oriented box of the world much smaller than its world box:
-    // the camera-frame box of its corners cuts the camera-frame box of the world one.
     const FrameChoice turned = chooseGridFrame(scene);
-    for (uint32_t p : live) {
-        box[p] = s.frame_.box(scene.minBox[p]);
-        if (turned.frame.turned) {
-            const Box3& fb = turned.boxes[p];
-            Box3 c;
-            for (int i = 0; i < 8 && !fb.isEmpty(); ++i)
-                c.expand(s.frame_.point(turned.frame.toWorld(boxCorner(fb, i))));
-            box[p] = overlap(box[p], c);
-        }
-        box[p].lo -= eps;
-        box[p].hi += eps;
-    }
+    const std::vector<Box3> box = frameBoxes(scene, s.frame_, turned, live, eps);
     s.bounds_ = {cam.lo - 2.0 * eps, cam.hi + 2.0 * eps};
 
     const size_t pixels = size_t(std::max(scene.width, 1)) * size_t(std::max(scene.height, 1));
@@ -213,6 +247,9 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     s.listPrims_ = std::move(slabs.listPrims);
     s.unionOnly_ = slabs.unionOnly;
     s.budget_ = 16 * s.regions_.size() + 1024;
+    if (params.frame == IrregularFrame::Projective)
+        s.buildLights(scene, live, turned, sp, maxRegions, guard, extra);
+
     extra["frame"] = irregularFrameName(params.frame);
 
     size_t refs = 0, most = 0;
@@ -327,7 +364,101 @@ int64_t IrregularSubdivision::walkTo(uint32_t from, const Vec3& p) const {
 size_t IrregularSubdivision::memoryBytes() const {
     return sizeof(*this) + regions_.size() * sizeof(IrregularRegion) + bsp_.memoryBytes() +
            zoneFirstRegion_.size() * sizeof(uint32_t) + pool_.nodes.size() * sizeof(CsgNode) +
-           (listFirst_.size() + listPrims_.size()) * sizeof(uint32_t) + projective_.memoryBytes();
+           (listFirst_.size() + listPrims_.size()) * sizeof(uint32_t) + projective_.memoryBytes() +
+           lightBytes();
+}
+
+size_t IrregularSubdivision::lightBytes() const {
+    size_t n = lightFirstRegion_.size() * sizeof(uint32_t);
+    for (const ProjectiveZones& lz : lights_) n += sizeof(lz) + lz.memoryBytes();
+    return n;
+}
+
+void IrregularSubdivision::buildLights(const Scene& scene, const std::vector<uint32_t>& live,
+                                       const FrameChoice& turned, const ScreenBspParams& eyeSp,
+                                       size_t maxRegions, BuildGuard& guard,
+                                       nlohmann::json& extra) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    const size_t n = scene.lights.size();
+    lights_.assign(n, ProjectiveZones{});
+    std::vector<std::optional<CameraFrame>> frames(n);
+    size_t outside = 0;
+    size_t overLimit = 0;
+    for (size_t i = 0; i < n; ++i) {
+        frames[i] = lightFrame(scene.bounds, scene.lights[i].position);
+        if (frames[i] && outside == kMaxLightStructures) {
+            frames[i].reset();  // its shadow rays take the camera-frame walk
+            ++overLimit;
+        }
+        outside += frames[i].has_value();
+    }
+    // The lights' structures share what the camera frame and the eye's zones left of the
+    // budget, equally; each keeps within its share as they do within theirs (the screen BSP a
+    // ninth, the slabs two ninths), and one that needs more than its share is not built (its
+    // shadow rays take the camera-frame walk), counted in lights_over_budget.
+    const size_t used = memoryBytes();
+    const size_t share =
+        outside == 0 || guard.budget() <= used ? 0 : (guard.budget() - used) / outside;
+    const size_t least =
+        scene.prims.size() * sizeof(Box3) + ScreenBsp::rootBytes(live.size()) + kMergedZoneBytes +
+        live.size() * (mergedRefBytes(scene.tree.unionOnly()) + sizeof(glm::dvec2));
+    const bool hullsFit =
+        PrimitiveHulls::bytesFor(live.size(), scene.prims.size()) <= guard.budget() / kHullShare;
+    std::vector<char> overBudget(n, 0);
+    TaskFence fence;
+    // Each light's structure is built from its own boxes and hulls, independent of the others':
+    // they are built in parallel (gears2's five lights on two cores).
+    auto one = [&](size_t i) {
+        if (!frames[i]) return;
+        if (least > share) {
+            overBudget[i] = 1;
+            return;
+        }
+        const CameraFrame& f = *frames[i];
+        // The padding of the camera-frame boxes, from this frame's coordinates: a shadow ray's
+        // line passes through the light to rounding of its length, far below it.
+        const Box3 b = f.box(scene.bounds);
+        const double eps = 1e-9 * std::max({maxAbs(b.lo), maxAbs(b.hi), maxAbs(scene.bounds.lo),
+                                            maxAbs(scene.bounds.hi), maxAbs(f.origin), 1e-300});
+        const std::vector<Box3> box = frameBoxes(scene, f, turned, live, eps);
+        const PrimitiveHulls hulls =
+            hullsFit ? PrimitiveHulls::make(scene, f, turned, live, eps) : PrimitiveHulls{};
+        ScreenBspParams sp = eyeSp;
+        sp.hulls = hulls.empty() ? nullptr : &hulls;
+        sp.hullPad = eps;
+        sp.maxBytes = std::max<size_t>(share / 9, 1);
+        ProjectiveZones lz = ProjectiveZones::buildForLight(
+            scene, f, box, live, sp, std::max<size_t>(2 * share / 9, 1), maxRegions);
+        if (lz.memoryBytes() > share)
+            overBudget[i] = 1;
+        else
+            lights_[i] = std::move(lz);
+    };
+    tbb::parallel_for(size_t(0), n, fence.task(one));
+    fence.acquire();
+
+    lightFirstRegion_.assign(1, uint32_t(regions_.size() + projective_.regionCount()));
+    size_t built = 0, zones = 0, slabs = 0, empty = 0, over = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const ProjectiveZones& lz = lights_[i];
+        lightFirstRegion_.push_back(lightFirstRegion_.back() + uint32_t(lz.regionCount()));
+        built += lz.zoneCount() > 0;
+        zones += lz.zoneCount();
+        slabs += lz.zoneFirst().empty() ? 0 : lz.zoneFirst().back();
+        empty += lz.emptySlabs();
+        over += size_t(overBudget[i]);
+    }
+    extra["light_structures"] = built;
+    extra["lights_inside"] = n - outside - overLimit;
+    extra["lights_over_limit"] = overLimit;
+    extra["lights_over_budget"] = over;
+    extra["light_zones"] = zones;
+    extra["light_slabs"] = slabs;
+    extra["light_empty_slabs"] = empty;
+    extra["light_regions"] = lightFirstRegion_.back() - lightFirstRegion_.front();
+    extra["light_bytes"] = lightBytes();
+    extra["light_ms"] = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
 }  // namespace lancer
