@@ -1,6 +1,5 @@
 #include "engine/accel/irregular/irregular.h"
 
-#include <tbb/parallel_for.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
@@ -94,6 +93,54 @@ std::optional<CameraFrame> lightFrame(const Box3& bounds, const Vec3& light) {
     return f;
 }
 
+/// Which scene lights get a structure of their own: those outside the bounds, at most
+/// kMaxLightStructures (frames[i] set); the others' shadow rays take the camera-frame walk.
+struct LightPlan {
+    std::vector<std::optional<CameraFrame>> frames;
+    size_t outside = 0, inside = 0, overLimit = 0;
+};
+
+LightPlan planLights(const Scene& scene) {
+    LightPlan plan;
+    for (const Light& light : scene.lights) {
+        std::optional<CameraFrame> f = lightFrame(scene.bounds, light.position);
+        if (!f)
+            ++plan.inside;
+        else if (plan.outside == kMaxLightStructures)
+            f.reset(), ++plan.overLimit;
+        else
+            ++plan.outside;
+        plan.frames.push_back(f);
+    }
+    return plan;
+}
+
+/// The structure of the light whose frame is `f` (lightFrame), within `share` bytes as the
+/// frames keep within theirs: the screen BSP a ninth, the slabs two ninths. Its boxes and hulls
+/// are those of the camera frame made in the light's frame.
+ProjectiveZones buildLightZones(const Scene& scene, const CameraFrame& f, const FrameChoice& turned,
+                                const std::vector<uint32_t>& live, const ScreenBspParams& frameSp,
+                                size_t share, size_t maxRegions) {
+    // The padding of the camera-frame boxes, from this frame's coordinates: a shadow ray's line
+    // passes through the light to rounding of its length, far below it.
+    const Box3 b = f.box(scene.bounds);
+    const double eps = 1e-9 * std::max({maxAbs(b.lo), maxAbs(b.hi), maxAbs(scene.bounds.lo),
+                                        maxAbs(scene.bounds.hi), maxAbs(f.origin), 1e-300});
+    const std::vector<Box3> box = frameBoxes(scene, f, turned, live, eps);
+    // The hulls are scratch: within a sixteenth of the light's share, as each frame's within a
+    // sixteenth of the budget, so the tasks running at once stay within it.
+    const bool hullsFit =
+        PrimitiveHulls::bytesFor(live.size(), scene.prims.size()) <= share / kHullShare;
+    const PrimitiveHulls hulls =
+        hullsFit ? PrimitiveHulls::make(scene, f, turned, live, eps) : PrimitiveHulls{};
+    ScreenBspParams sp = frameSp;
+    sp.hulls = hulls.empty() ? nullptr : &hulls;
+    sp.hullPad = eps;
+    sp.maxBytes = std::max<size_t>(share / 9, 1);
+    return ProjectiveZones::buildForLight(scene, f, box, live, sp,
+                                          std::max<size_t>(2 * share / 9, 1), maxRegions);
+}
+
 }  // namespace
 
 IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const IrregularConfig& params,
@@ -122,13 +169,20 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     }
 
     const size_t frames = params.frame == IrregularFrame::Projective ? 2 : 1;
-    const size_t share = guard.budget() / frames;
     // The least a frame's build holds: the primitives' boxes, the screen BSP's root cell, and
     // one zone whose one region lists every primitive. A budget too small for it is refused
     // before anything is built; the limits below are at least a byte, since 0 would mean none.
     const size_t least =
         scene.prims.size() * sizeof(Box3) + ScreenBsp::rootBytes(live.size()) + kMergedZoneBytes +
         live.size() * (mergedRefBytes(scene.tree.unionOnly()) + sizeof(glm::dvec2));
+    // Each light outside the bounds gets a projective structure of its own (shadow rays toward
+    // it), built beside the two frames' with an equal share of the budget; when the shares
+    // would be smaller than the least a frame holds, none is built (lights_over_budget).
+    const LightPlan lights =
+        params.frame == IrregularFrame::Projective ? planLights(scene) : LightPlan{};
+    size_t lightShares = lights.outside;
+    if (lightShares > 0 && least > guard.budget() / (frames + lightShares)) lightShares = 0;
+    const size_t share = guard.budget() / (frames + lightShares);
     if (least > share)
         refuseOverBudget(guard, "needs at least " + formatBytes(least) + " a frame (" +
                                     std::to_string(frames) + " frame" + (frames > 1 ? "s" : "") +
@@ -195,6 +249,28 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
             eyeMs = ms(t3);
         }));
     }
+    // The lights' structures, each a task of its own beside the frames' (gears2: five lights).
+    s.lights_.assign(scene.lights.size(), ProjectiveZones{});
+    std::vector<char> lightOver(scene.lights.size(), 0);
+    std::vector<double> lightMs(scene.lights.size(), 0.0);
+    for (size_t i = 0; i < lights.frames.size(); ++i) {
+        if (!lights.frames[i]) continue;
+        if (lightShares == 0) {
+            lightOver[i] = 1;
+            continue;
+        }
+        tasks.run(fence.task([&, i] {
+            auto t4 = Clock::now();
+            ProjectiveZones lz =
+                buildLightZones(scene, *lights.frames[i], turned, live, sp, share, maxRegions);
+            // A structure over its share is not kept: its shadow rays take the camera frame.
+            if (lz.memoryBytes() > share)
+                lightOver[i] = 1;
+            else
+                s.lights_[i] = std::move(lz);
+            lightMs[i] = ms(t4);
+        }));
+    }
     double bspMs = 0.0, slabMs = 0.0, linkMs = 0.0;
     DepthSlabs slabs;
     try {
@@ -247,8 +323,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     s.listPrims_ = std::move(slabs.listPrims);
     s.unionOnly_ = slabs.unionOnly;
     s.budget_ = 16 * s.regions_.size() + 1024;
-    if (params.frame == IrregularFrame::Projective)
-        s.buildLights(scene, live, turned, sp, maxRegions, guard, extra);
+    s.finishLights(lights.inside, lights.overLimit, lightOver, lightMs, extra);
 
     extra["frame"] = irregularFrameName(params.frame);
 
@@ -374,91 +449,32 @@ size_t IrregularSubdivision::lightBytes() const {
     return n;
 }
 
-void IrregularSubdivision::buildLights(const Scene& scene, const std::vector<uint32_t>& live,
-                                       const FrameChoice& turned, const ScreenBspParams& eyeSp,
-                                       size_t maxRegions, BuildGuard& guard,
-                                       nlohmann::json& extra) {
-    using Clock = std::chrono::steady_clock;
-    const auto t0 = Clock::now();
-    const size_t n = scene.lights.size();
-    lights_.assign(n, ProjectiveZones{});
-    std::vector<std::optional<CameraFrame>> frames(n);
-    size_t outside = 0;
-    size_t overLimit = 0;
-    for (size_t i = 0; i < n; ++i) {
-        frames[i] = lightFrame(scene.bounds, scene.lights[i].position);
-        if (frames[i] && outside == kMaxLightStructures) {
-            frames[i].reset();  // its shadow rays take the camera-frame walk
-            ++overLimit;
-        }
-        outside += frames[i].has_value();
-    }
-    // The lights' structures share what the camera frame and the eye's zones left of the
-    // budget, equally; each keeps within its share as they do within theirs (the screen BSP a
-    // ninth, the slabs two ninths), and one that needs more than its share is not built (its
-    // shadow rays take the camera-frame walk), counted in lights_over_budget.
-    const size_t used = memoryBytes();
-    const size_t share =
-        outside == 0 || guard.budget() <= used ? 0 : (guard.budget() - used) / outside;
-    const size_t least =
-        scene.prims.size() * sizeof(Box3) + ScreenBsp::rootBytes(live.size()) + kMergedZoneBytes +
-        live.size() * (mergedRefBytes(scene.tree.unionOnly()) + sizeof(glm::dvec2));
-    const bool hullsFit =
-        PrimitiveHulls::bytesFor(live.size(), scene.prims.size()) <= guard.budget() / kHullShare;
-    std::vector<char> overBudget(n, 0);
-    TaskFence fence;
-    // Each light's structure is built from its own boxes and hulls, independent of the others':
-    // they are built in parallel (gears2's five lights on two cores).
-    auto one = [&](size_t i) {
-        if (!frames[i]) return;
-        if (least > share) {
-            overBudget[i] = 1;
-            return;
-        }
-        const CameraFrame& f = *frames[i];
-        // The padding of the camera-frame boxes, from this frame's coordinates: a shadow ray's
-        // line passes through the light to rounding of its length, far below it.
-        const Box3 b = f.box(scene.bounds);
-        const double eps = 1e-9 * std::max({maxAbs(b.lo), maxAbs(b.hi), maxAbs(scene.bounds.lo),
-                                            maxAbs(scene.bounds.hi), maxAbs(f.origin), 1e-300});
-        const std::vector<Box3> box = frameBoxes(scene, f, turned, live, eps);
-        const PrimitiveHulls hulls =
-            hullsFit ? PrimitiveHulls::make(scene, f, turned, live, eps) : PrimitiveHulls{};
-        ScreenBspParams sp = eyeSp;
-        sp.hulls = hulls.empty() ? nullptr : &hulls;
-        sp.hullPad = eps;
-        sp.maxBytes = std::max<size_t>(share / 9, 1);
-        ProjectiveZones lz = ProjectiveZones::buildForLight(
-            scene, f, box, live, sp, std::max<size_t>(2 * share / 9, 1), maxRegions);
-        if (lz.memoryBytes() > share)
-            overBudget[i] = 1;
-        else
-            lights_[i] = std::move(lz);
-    };
-    tbb::parallel_for(size_t(0), n, fence.task(one));
-    fence.acquire();
-
+void IrregularSubdivision::finishLights(size_t inside, size_t overLimit,
+                                        const std::vector<char>& over,
+                                        const std::vector<double>& ms, nlohmann::json& extra) {
     lightFirstRegion_.assign(1, uint32_t(regions_.size() + projective_.regionCount()));
-    size_t built = 0, zones = 0, slabs = 0, empty = 0, over = 0;
-    for (size_t i = 0; i < n; ++i) {
+    size_t built = 0, zones = 0, slabs = 0, empty = 0, overBudget = 0;
+    double total = 0.0;
+    for (size_t i = 0; i < lights_.size(); ++i) {
         const ProjectiveZones& lz = lights_[i];
         lightFirstRegion_.push_back(lightFirstRegion_.back() + uint32_t(lz.regionCount()));
         built += lz.zoneCount() > 0;
         zones += lz.zoneCount();
         slabs += lz.zoneFirst().empty() ? 0 : lz.zoneFirst().back();
         empty += lz.emptySlabs();
-        over += size_t(overBudget[i]);
+        overBudget += size_t(over[i]);
+        total += ms[i];
     }
     extra["light_structures"] = built;
-    extra["lights_inside"] = n - outside - overLimit;
+    extra["lights_inside"] = inside;
     extra["lights_over_limit"] = overLimit;
-    extra["lights_over_budget"] = over;
+    extra["lights_over_budget"] = overBudget;
     extra["light_zones"] = zones;
     extra["light_slabs"] = slabs;
     extra["light_empty_slabs"] = empty;
     extra["light_regions"] = lightFirstRegion_.back() - lightFirstRegion_.front();
     extra["light_bytes"] = lightBytes();
-    extra["light_ms"] = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    extra["light_ms"] = total;
 }
 
 }  // namespace lancer

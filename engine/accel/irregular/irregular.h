@@ -116,11 +116,11 @@ class IrregularSubdivision {
     int64_t walkTo(uint32_t from, const Vec3& p) const;
 
   private:
-    /// The projective structure of each scene light outside the bounds, in parallel, within
-    /// what the budget has left (lights_, lightFirstRegion_); figures to `extra`.
-    void buildLights(const Scene& scene, const std::vector<uint32_t>& live,
-                     const FrameChoice& turned, const ScreenBspParams& eyeSp, size_t maxRegions,
-                     BuildGuard& guard, nlohmann::json& extra);
+    /// Region ids of the lights' structures (built into lights_) and their figures to `extra`:
+    /// `inside` lights in the bounds, `overLimit` beyond the most that get one, over[i] light i's
+    /// over its share of the budget, ms[i] its build time.
+    void finishLights(size_t inside, size_t overLimit, const std::vector<char>& over,
+                      const std::vector<double>& ms, nlohmann::json& extra);
     /// Bytes of the lights' structures.
     size_t lightBytes() const;
     /// p is below region r on axis a (or on its low face, going down).
