@@ -795,8 +795,8 @@ std::optional<std::vector<size_t>> StructureView::treePath(const StructureTree& 
             const RegionInfo r = region(id);
             const bool inFrame = tree.frame == ZoneFrameKind::Camera
                                      ? r.kind == RegionKind::Slab
-                                     : r.kind == RegionKind::ProjectiveSlab;
-            if (!inFrame || r.zone < 0) return std::nullopt;
+                                     : r.kind == RegionKind::ProjectiveSlab && r.light < 0;
+            if (!inFrame || r.zone < 0) return std::nullopt;  // a light's regions: no frame's
             const ZoneFrameView& f = *frame(tree.frame);
             const uint32_t z = uint32_t(r.zone);
             const glm::dvec2 c = 0.5 * (f.zoneLo(z) + f.zoneHi(z));
