@@ -319,7 +319,10 @@ TEST(Irregular, RegionsTileTheBoundsAndListTheirPrimitives) {
     const nlohmann::json& x = accel->info().extra;
     EXPECT_GT(x["zones"].get<size_t>(), 1u);
     EXPECT_EQ(x["zones"].get<size_t>(), s.screen().zoneCount());
-    EXPECT_EQ(accel->info().regions, s.regions().size() + s.projective().regionCount());
+    size_t lightRegions = 0;
+    for (const ProjectiveZones& lz : s.lights()) lightRegions += lz.regionCount();
+    EXPECT_EQ(accel->info().regions,
+              s.regions().size() + s.projective().regionCount() + lightRegions);
     EXPECT_GT(s.projective().regionCount(), 0u);
     EXPECT_TRUE(accel->usesMailboxes());
 }

@@ -298,13 +298,17 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
         // the turn's axes (grid_frame.h), which the regular grid is built in and which cuts the
         // irregular scheme's camera-frame bound.
         const FrameChoice fc = chooseGridFrame(scene);
-        const auto cameraBound = [&](uint32_t p) {
-            Box3 b = s->frame().box(scene.minBox[p]);
+        // A light's projective regions are in the light's frame (RegionInfo::light).
+        const auto frameOf = [&](const RegionInfo& r) -> const CameraFrame& {
+            return r.light >= 0 ? s->lights()[size_t(r.light)].frame() : s->frame();
+        };
+        const auto cameraBound = [&](uint32_t p, const CameraFrame& frame) {
+            Box3 b = frame.box(scene.minBox[p]);
             if (!fc.frame.turned) return b;
             const Box3& f = fc.boxes[p];
             Box3 c;
             for (int i = 0; i < 8 && !f.isEmpty(); ++i)
-                c.expand(s->frame().point(fc.frame.toWorld(boxCorner(f, i))));
+                c.expand(frame.point(fc.frame.toWorld(boxCorner(f, i))));
             return overlap(b, c);
         };
         // The irregular scheme's zones narrow each primitive's boxes to the depths they take
@@ -312,13 +316,14 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
         // bound merely overlaps it; it must list one whose bound (its minimized box and, turned,
         // its box along the turn's axes) holds a point of the slab's interior: sampled on a
         // 5 x 5 x 5 grid inside it (`box` in (u, v, depth) for a projective slab).
-        const auto holdsAPointOf = [&](uint32_t p, const Box3& box, bool projective) {
+        const auto holdsAPointOf = [&](uint32_t p, const Box3& box, bool projective,
+                                       const CameraFrame& frame) {
             for (int i = 0; i < 125; ++i) {
                 Vec3 c;
                 for (int a = 0, j = i; a < 3; ++a, j /= 5)
                     c[a] = box.lo[a] + (0.1 + 0.2 * (j % 5)) * (box.hi[a] - box.lo[a]);
                 if (projective) c = {c.x * c.z, c.y * c.z, c.z};
-                const Vec3 w = s->frame().toWorld(c);
+                const Vec3 w = frame.toWorld(c);
                 if (scene.minBox[p].contains(w) &&
                     (!fc.frame.turned || fc.boxes[p].contains(fc.frame.toFrame(w))))
                     return true;
@@ -344,13 +349,13 @@ TEST(StructureView, RegionsListThePrimitivesWhoseBoxesCrossThem) {
                         crossing = crosses(v.regular()->boxes()[p], r.frameBox, margin);
                         break;
                     case RegionKind::Slab:
-                        crossing = holdsAPointOf(p, r.frameBox, false);
+                        crossing = holdsAPointOf(p, r.frameBox, false, frameOf(r));
                         break;
                     case RegionKind::NearRegion:
-                        crossing = cameraBound(p).lo.z < r.frameBox.hi.z - margin;
+                        crossing = cameraBound(p, frameOf(r)).lo.z < r.frameBox.hi.z - margin;
                         break;
                     case RegionKind::ProjectiveSlab:
-                        crossing = holdsAPointOf(p, r.frameBox, true);
+                        crossing = holdsAPointOf(p, r.frameBox, true, frameOf(r));
                         break;
                 }
                 if (crossing) crossed.push_back(p);

@@ -99,7 +99,7 @@ class Accelerator {
                     obs.stretch(i, seg[i].t0, seg[i].t1);
                     double t0 = seg[i].t0, t1 = seg[i].t1;
                     if (ctx.precision == Precision::Float) widenForFloat(ray, t0, t1, 0.0, tmax);
-                    if (blockedIn(ray, t0, t1, ctx, obs, hit)) {
+                    if (blockedIn(ray, light, t0, t1, ctx, obs, hit)) {
                         obs.blocker(hit);
                         return true;
                     }
@@ -107,7 +107,7 @@ class Accelerator {
                 return false;
             }
         }
-        const bool blocked = blockedIn(ray, 0.0, tmax, ctx, obs, hit);
+        const bool blocked = blockedIn(ray, light, 0.0, tmax, ctx, obs, hit);
         if constexpr (Obs::kActive)
             if (blocked) obs.blocker(hit);
         return blocked;
@@ -146,14 +146,19 @@ class Accelerator {
     const Impl& impl() const { return impl_; }
 
   private:
-    /// intersect()'s answer for a shadow ray's stretch: by the scheme's own `occluded` walk
-    /// when it has one (it may stop at any boundary, `hit`, rather than the nearest).
+    /// intersect()'s answer for a shadow ray's stretch toward scene light `light`: by the
+    /// scheme's own `occluded` walk when it has one (it may stop at any boundary, `hit`, rather
+    /// than the nearest), or its walk toward that light.
     template <class Obs>
-    bool blockedIn(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
-                   Hit& hit) const {
+    bool blockedIn(const Ray& ray, uint32_t light, double tmin, double tmax, TraceContext& ctx,
+                   Obs& obs, Hit& hit) const {
         return std::visit(
             [&](const auto& s) {
-                if constexpr (requires { s.occluded(ray, tmin, tmax, ctx, obs, hit); })
+                if constexpr (requires {
+                                  s.intersectTowardLight(ray, light, tmin, tmax, ctx, obs, hit);
+                              })
+                    return s.intersectTowardLight(ray, light, tmin, tmax, ctx, obs, hit);
+                else if constexpr (requires { s.occluded(ray, tmin, tmax, ctx, obs, hit); })
                     return s.occluded(ray, tmin, tmax, ctx, obs, hit);
                 else
                     return s.intersect(ray, tmin, tmax, ctx, obs, hit);

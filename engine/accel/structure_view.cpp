@@ -286,6 +286,43 @@ size_t StructureView::regionCount() const {
     return std::visit([](const auto& s) { return s.regionCount(); }, accel_->impl());
 }
 
+namespace {
+
+/// Region i of the projective structure `pz` (the eye's or a light's), whose ids start at
+/// `base`: a slab (by increasing depth) of a zone, or the near region last.
+RegionInfo projectiveRegion(const ProjectiveZones& pz, size_t base, uint32_t i, RegionInfo r) {
+    const uint32_t slabs = pz.zoneFirst().back();
+    r.pool = &pz.treePool();
+    for (int a = 0; a < 2; ++a) r.lo[a] = r.hi[a] = kNotLinked;
+    if (i == slabs) {
+        r.kind = RegionKind::NearRegion;
+        r.frameBox = {Vec3(pz.rectLo(), 0.0), Vec3(pz.rectHi(), pz.zNear())};
+        r.prims = pz.nearPrimitives();
+        r.root = pz.nearRoot();
+        r.lo[2] = kNoNeighbour;
+        r.hi[2] = kNotLinked;  // the first slab of the ray's zone
+        return r;
+    }
+    const std::vector<uint32_t>& first = pz.zoneFirst();
+    const uint32_t z =
+        uint32_t(std::upper_bound(first.begin(), first.end(), i) - first.begin() - 1);
+    const ScreenBsp& bsp = pz.screen();
+    const bool lastSlab = i + 1 == first[z + 1];
+    r.kind = RegionKind::ProjectiveSlab;
+    r.frameBox = {Vec3(bsp.zoneLo[z], pz.slabLo(i)),
+                  Vec3(bsp.zoneHi[z], lastSlab ? pz.zFar() : pz.slabLo(i + 1))};
+    r.zone = z;
+    r.slab = i - first[z];
+    r.prims = pz.slabPrimitives(i);
+    r.root = pz.slabRoot(i);
+    r.lo[2] = i > first[z] ? int64_t(base + i - 1)
+                           : (pz.hasNearRegion() ? int64_t(base + slabs) : kNoNeighbour);
+    r.hi[2] = lastSlab ? kNoNeighbour : int64_t(base + i + 1);
+    return r;
+}
+
+}  // namespace
+
 std::array<Vec3, 8> StructureView::regionCorners(uint32_t id) const {
     if (const RegularGrid* g = regular()) {
         const RegularLeaf& L = g->leaves().at(id);
@@ -298,9 +335,9 @@ std::array<Vec3, 8> StructureView::regionCorners(uint32_t id) const {
     }
     const IrregularSubdivision* s = irregular();
     if (!s) return boxCorners(scene_->bounds);
-    const CameraFrame& f = s->frame();
-    std::array<Vec3, 8> c;
     const RegionInfo r = region(id);
+    const CameraFrame& f = r.light >= 0 ? s->lights()[size_t(r.light)].frame() : s->frame();
+    std::array<Vec3, 8> c;
     const Box3& b = r.frameBox;
     for (int i = 0; i < 8; ++i) {
         const double x = (i & 1) ? b.hi.x : b.lo.x, y = (i & 2) ? b.hi.y : b.lo.y,
@@ -368,37 +405,18 @@ RegionInfo StructureView::region(uint32_t id) const {
         }
         return r;
     }
-    const ProjectiveZones& pz = s->projective();
-    if (id >= base + pz.regionCount()) throw std::out_of_range("no region " + std::to_string(id));
-    const uint32_t i = uint32_t(id - base);
-    const uint32_t slabs = pz.zoneFirst().back();
-    r.pool = &pz.treePool();
-    for (int a = 0; a < 2; ++a) r.lo[a] = r.hi[a] = kNotLinked;
-    if (i == slabs) {
-        r.kind = RegionKind::NearRegion;
-        r.frameBox = {Vec3(pz.rectLo(), 0.0), Vec3(pz.rectHi(), pz.zNear())};
-        r.prims = pz.nearPrimitives();
-        r.root = pz.nearRoot();
-        r.lo[2] = kNoNeighbour;
-        r.hi[2] = kNotLinked;  // the first slab of the pixel's zone
-        return r;
+    const ProjectiveZones* pz = &s->projective();
+    size_t first = base;
+    if (id >= base + pz->regionCount()) {
+        const std::vector<uint32_t>& lf = s->lightFirstRegion();
+        if (lf.empty() || id >= lf.back())
+            throw std::out_of_range("no region " + std::to_string(id));
+        const auto it = std::upper_bound(lf.begin(), lf.end(), id) - 1;
+        r.light = int(it - lf.begin());
+        pz = &s->lights()[size_t(r.light)];
+        first = *it;
     }
-    const std::vector<uint32_t>& first = pz.zoneFirst();
-    const uint32_t z =
-        uint32_t(std::upper_bound(first.begin(), first.end(), i) - first.begin() - 1);
-    const ScreenBsp& bsp = pz.screen();
-    const bool lastSlab = i + 1 == first[z + 1];
-    r.kind = RegionKind::ProjectiveSlab;
-    r.frameBox = {Vec3(bsp.zoneLo[z], pz.slabLo(i)),
-                  Vec3(bsp.zoneHi[z], lastSlab ? pz.zFar() : pz.slabLo(i + 1))};
-    r.zone = z;
-    r.slab = i - first[z];
-    r.prims = pz.slabPrimitives(i);
-    r.root = pz.slabRoot(i);
-    r.lo[2] = i > first[z] ? int64_t(base + i - 1)
-                           : (pz.hasNearRegion() ? int64_t(base + slabs) : kNoNeighbour);
-    r.hi[2] = lastSlab ? kNoNeighbour : int64_t(base + i + 1);
-    return r;
+    return projectiveRegion(*pz, first, uint32_t(id - first), r);
 }
 
 std::string StructureView::toString(uint32_t id) const {
@@ -777,8 +795,8 @@ std::optional<std::vector<size_t>> StructureView::treePath(const StructureTree& 
             const RegionInfo r = region(id);
             const bool inFrame = tree.frame == ZoneFrameKind::Camera
                                      ? r.kind == RegionKind::Slab
-                                     : r.kind == RegionKind::ProjectiveSlab;
-            if (!inFrame || r.zone < 0) return std::nullopt;
+                                     : r.kind == RegionKind::ProjectiveSlab && r.light < 0;
+            if (!inFrame || r.zone < 0) return std::nullopt;  // a light's regions: no frame's
             const ZoneFrameView& f = *frame(tree.frame);
             const uint32_t z = uint32_t(r.zone);
             const glm::dvec2 c = 0.5 * (f.zoneLo(z) + f.zoneHi(z));

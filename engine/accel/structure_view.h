@@ -62,6 +62,10 @@ struct RegionInfo {
     int level = -1;  ///< regular: BSP level of the leaf; BVH: the node's depth; -1 otherwise
     uint32_t cellLo[3] = {}, cellHi[3] = {};  ///< regular: directory cells [lo, hi) per axis
     int64_t zone = -1;  ///< irregular: zone in its frame's BSP; -1 for the near region
+    /// Irregular projective slabs and near regions: the scene light whose structure holds the
+    /// region (its frame is centred on the light; shadow rays walk it toward the light); -1:
+    /// the eye's.
+    int light = -1;
     uint32_t slab = 0;  ///< irregular: index of the slab in its zone, by increasing depth
     /// Primitives listed in the region (tracer ids), sorted: those whose minimized box (its
     /// bound in the region's frame, irregular) crosses the region; the regular scheme keeps

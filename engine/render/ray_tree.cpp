@@ -153,18 +153,21 @@ std::string primText(uint32_t p, const Scene* scene) {
 
 /// How a region step's frame runs along the ray: per axis +1 (the ray goes to the high side),
 /// -1 or 0; brute force in the world's axes, regular in its grid's, camera-frame slabs in the
-/// camera frame's, projective regions in depth alone (a ray from the eye keeps its u and v).
+/// camera frame's, projective regions in depth alone (a ray from the eye keeps its u and v and
+/// goes deeper; a shadow ray in its light's structure keeps them too and heads up to the light).
 struct FrameSides {
     int sign[3] = {0, 0, 0};
     bool irregular = false;
 };
 
-FrameSides sidesOf(const StructureView& view, RegionKind kind, const Vec3& dir) {
+FrameSides sidesOf(const StructureView& view, const RegionInfo& info, const Vec3& dir) {
     FrameSides f;
+    const RegionKind kind = info.kind;
     Vec3 d = dir;
     if (kind == RegionKind::Slab) d = view.irregular()->frame().vector(dir);
     if (kind == RegionKind::Leaf) d = view.regular()->frame().toFrame(dir);
-    if (kind == RegionKind::ProjectiveSlab || kind == RegionKind::NearRegion) d = Vec3(0, 0, 1);
+    if (kind == RegionKind::ProjectiveSlab || kind == RegionKind::NearRegion)
+        d = Vec3(0, 0, info.light >= 0 ? -1 : 1);
     f.irregular = kind == RegionKind::Slab || kind == RegionKind::ProjectiveSlab ||
                   kind == RegionKind::NearRegion;
     for (int a = 0; a < 3; ++a) f.sign[a] = d[a] > 0.0 ? 1 : (d[a] < 0.0 ? -1 : 0);
@@ -220,10 +223,11 @@ std::string startText(const StructureView& view, const walk::Locate* locate,
                regionName(view, region);
     }
     if (locate) {
-        const RegionKind k = view.region(locate->region).kind;
+        const RegionInfo at = view.region(locate->region);
         s = "starts at " + pt6(locate->point) +
-            (k == RegionKind::Slab ? ", located by the screen BSP and the zone's depth slabs"
-                                   : " in its pixel's projective zone");
+            (at.kind == RegionKind::Slab ? ", located by the screen BSP and the zone's depth slabs"
+             : at.light >= 0 ? " in the zone of its light's projective structure that holds it"
+                             : " in its pixel's projective zone");
         return s + (arrow ? " " + nextName(view, region) : ", in " + regionName(view, region));
     }
     return arrow ? "starts " + nextName(view, region)
@@ -235,6 +239,8 @@ std::string startText(const StructureView& view, const walk::Locate* locate,
 std::string regionName(const StructureView& view, uint32_t region) {
     const RegionInfo r = view.region(region);
     const std::string id = " (region " + std::to_string(region) + ")";
+    // A light's structure: "light 1's projective slab 3 of zone 40 (region 9000)".
+    const std::string owner = r.light >= 0 ? "light " + std::to_string(r.light) + "'s " : "";
     switch (r.kind) {
         case RegionKind::SceneBox:
             return "the scene box";
@@ -243,10 +249,10 @@ std::string regionName(const StructureView& view, uint32_t region) {
         case RegionKind::Slab:
             return "slab " + std::to_string(r.slab) + " of zone " + std::to_string(r.zone) + id;
         case RegionKind::ProjectiveSlab:
-            return "projective slab " + std::to_string(r.slab) + " of zone " +
+            return owner + "projective slab " + std::to_string(r.slab) + " of zone " +
                    std::to_string(r.zone) + id;
         case RegionKind::NearRegion:
-            return "the near region" + id;
+            return (owner.empty() ? "the " : owner) + "near region" + id;
         case RegionKind::BvhInner:
             return "node " + std::to_string(region) + " (depth " + std::to_string(r.level) + ")";
         case RegionKind::BvhLeaf:
@@ -335,7 +341,7 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
         const walk::Region& reg = ev[steps[k]].as<walk::Region>();
         const size_t end = k + 1 < steps.size() ? steps[k + 1] : ev.size();
         const RegionInfo info = view.region(reg.region);
-        const FrameSides sides = sidesOf(view, info.kind, r.direction);
+        const FrameSides sides = sidesOf(view, info, r.direction);
         const std::string here = regionName(view, reg.region);
         std::string s;
 
@@ -430,7 +436,9 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
             } else if (nextInWalk) {
                 s += info.kind == RegionKind::NearRegion
                          ? ": the first slab of the pixel's zone " + nextName(view, next)
-                         : ": the next slab of the same zone " + nextName(view, next);
+                     : info.light >= 0 ? ": the next slab of the same zone toward the light " +
+                                             nextName(view, next)
+                                       : ": the next slab of the same zone " + nextName(view, next);
             } else if (!error) {
                 s += ", on the structure's border: the ray leaves the structure's box there";
             }

@@ -108,7 +108,9 @@ void irregularRegions(InspectorModel& m, const StructureView& view, const Inspec
     int64_t selectedZone = -1;
     if (selected >= 0 && uint64_t(selected) < view.regionCount()) {
         RegionInfo info = view.region(uint32_t(selected));
-        if (info.kind == RegionKind::Slab || info.kind == RegionKind::ProjectiveSlab)
+        // A light's slab is a zone of the light's structure, none of the eye's frames.
+        if ((info.kind == RegionKind::Slab || info.kind == RegionKind::ProjectiveSlab) &&
+            info.light < 0)
             selectedZone = info.zone;
     }
     size_t columns = 0;

@@ -87,7 +87,8 @@ bool Overlays::select(uint32_t id) {
     const RegionInfo r = view_->region(id);
     Selection s;
     s.region = id;
-    s.zone = r.zone;
+    // A light's slab is a zone of the light's structure, none of the frames the overlay draws.
+    s.zone = r.light >= 0 ? -1 : r.zone;
     s.frame =
         r.kind == RegionKind::ProjectiveSlab ? ZoneFrameKind::Projective : ZoneFrameKind::Camera;
     selection_ = s;

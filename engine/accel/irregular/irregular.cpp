@@ -45,6 +45,102 @@ constexpr size_t kHullShare = 16;
 /// Regions beyond this many are refused: pointers are 32-bit and memory would run out first.
 constexpr size_t kMaxRegions = 50'000'000;
 
+/// Lights beyond this many (outside the bounds) get no structure of their own: each costs about
+/// as much to build as the eye's zones.
+constexpr size_t kMaxLightStructures = 8;
+
+/// The primitives' boxes in `frame`, padded by `eps`: the bound there of each minimized box, cut
+/// in a turned scene by the bound of its box along the turn's own axes (grid_frame.h), an
+/// oriented box of the world much smaller than its world box.
+std::vector<Box3> frameBoxes(const Scene& scene, const CameraFrame& frame,
+                             const FrameChoice& turned, const std::vector<uint32_t>& live,
+                             double eps) {
+    std::vector<Box3> box(scene.prims.size());
+    for (uint32_t p : live) {
+        box[p] = frame.box(scene.minBox[p]);
+        if (turned.frame.turned) {
+            const Box3& fb = turned.boxes[p];
+            Box3 c;
+            for (int i = 0; i < 8 && !fb.isEmpty(); ++i)
+                c.expand(frame.point(turned.frame.toWorld(boxCorner(fb, i))));
+            box[p] = overlap(box[p], c);
+        }
+        box[p].lo -= eps;
+        box[p].hi += eps;
+    }
+    return box;
+}
+
+/// The frame of a point light outside `bounds`: origin at the light, depth along the world axis
+/// it lies farthest beyond, toward the scene (the axis its light buffer looks along), so every
+/// box lies in front of it. None for a light inside the bounds (no one frustum holds the scene).
+std::optional<CameraFrame> lightFrame(const Box3& bounds, const Vec3& light) {
+    int axis = -1;
+    double beyond = 0.0, sign = 1.0;
+    for (int a = 0; a < 3; ++a) {
+        if (bounds.lo[a] - light[a] > beyond) axis = a, beyond = bounds.lo[a] - light[a], sign = 1;
+        if (light[a] - bounds.hi[a] > beyond) axis = a, beyond = light[a] - bounds.hi[a], sign = -1;
+    }
+    if (axis < 0) return std::nullopt;
+    CameraFrame f;
+    f.origin = light;
+    f.z = Vec3(0.0);
+    f.z[axis] = sign;
+    f.x = Vec3(0.0);
+    f.x[(axis + 1) % 3] = 1.0;
+    f.y = Vec3(0.0);
+    f.y[(axis + 2) % 3] = 1.0;
+    return f;
+}
+
+/// Which scene lights get a structure of their own: those outside the bounds, at most
+/// kMaxLightStructures (frames[i] set); the others' shadow rays take the camera-frame walk.
+struct LightPlan {
+    std::vector<std::optional<CameraFrame>> frames;
+    size_t outside = 0, inside = 0, overLimit = 0;
+};
+
+LightPlan planLights(const Scene& scene) {
+    LightPlan plan;
+    for (const Light& light : scene.lights) {
+        std::optional<CameraFrame> f = lightFrame(scene.bounds, light.position);
+        if (!f)
+            ++plan.inside;
+        else if (plan.outside == kMaxLightStructures)
+            f.reset(), ++plan.overLimit;
+        else
+            ++plan.outside;
+        plan.frames.push_back(f);
+    }
+    return plan;
+}
+
+/// The structure of the light whose frame is `f` (lightFrame), within `share` bytes as the
+/// frames keep within theirs: the screen BSP a ninth, the slabs two ninths. Its boxes and hulls
+/// are those of the camera frame made in the light's frame.
+ProjectiveZones buildLightZones(const Scene& scene, const CameraFrame& f, const FrameChoice& turned,
+                                const std::vector<uint32_t>& live, const ScreenBspParams& frameSp,
+                                size_t share, size_t maxRegions) {
+    // The padding of the camera-frame boxes, from this frame's coordinates: a shadow ray's line
+    // passes through the light to rounding of its length, far below it.
+    const Box3 b = f.box(scene.bounds);
+    const double eps = 1e-9 * std::max({maxAbs(b.lo), maxAbs(b.hi), maxAbs(scene.bounds.lo),
+                                        maxAbs(scene.bounds.hi), maxAbs(f.origin), 1e-300});
+    const std::vector<Box3> box = frameBoxes(scene, f, turned, live, eps);
+    // The hulls are scratch: within a sixteenth of the light's share, as each frame's within a
+    // sixteenth of the budget, so the tasks running at once stay within it.
+    const bool hullsFit =
+        PrimitiveHulls::bytesFor(live.size(), scene.prims.size()) <= share / kHullShare;
+    const PrimitiveHulls hulls =
+        hullsFit ? PrimitiveHulls::make(scene, f, turned, live, eps) : PrimitiveHulls{};
+    ScreenBspParams sp = frameSp;
+    sp.hulls = hulls.empty() ? nullptr : &hulls;
+    sp.hullPad = eps;
+    sp.maxBytes = std::max<size_t>(share / 9, 1);
+    return ProjectiveZones::buildForLight(scene, f, box, live, sp,
+                                          std::max<size_t>(2 * share / 9, 1), maxRegions);
+}
+
 }  // namespace
 
 IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const IrregularConfig& params,
@@ -73,13 +169,20 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     }
 
     const size_t frames = params.frame == IrregularFrame::Projective ? 2 : 1;
-    const size_t share = guard.budget() / frames;
     // The least a frame's build holds: the primitives' boxes, the screen BSP's root cell, and
     // one zone whose one region lists every primitive. A budget too small for it is refused
     // before anything is built; the limits below are at least a byte, since 0 would mean none.
     const size_t least =
         scene.prims.size() * sizeof(Box3) + ScreenBsp::rootBytes(live.size()) + kMergedZoneBytes +
         live.size() * (mergedRefBytes(scene.tree.unionOnly()) + sizeof(glm::dvec2));
+    // Each light outside the bounds gets a projective structure of its own (shadow rays toward
+    // it), built beside the two frames' with an equal share of the budget; when the shares
+    // would be smaller than the least a frame holds, none is built (lights_over_budget).
+    const LightPlan lights =
+        params.frame == IrregularFrame::Projective ? planLights(scene) : LightPlan{};
+    size_t lightShares = lights.outside;
+    if (lightShares > 0 && least > guard.budget() / (frames + lightShares)) lightShares = 0;
+    const size_t share = guard.budget() / (frames + lightShares);
     if (least > share)
         refuseOverBudget(guard, "needs at least " + formatBytes(least) + " a frame (" +
                                     std::to_string(frames) + " frame" + (frames > 1 ? "s" : "") +
@@ -93,24 +196,9 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     double scale = std::max({maxAbs(cam.lo), maxAbs(cam.hi), maxAbs(scene.bounds.lo),
                              maxAbs(scene.bounds.hi), maxAbs(scene.camera.from), 1e-300});
     double eps = 1e-9 * scale;
-    std::vector<Box3> box(scene.prims.size());
     guard.poll();
-    // In a scene turned off the world's axes, each primitive's minimized box along the turn's
-    // own axes (grid_frame.h) is an oriented box of the world much smaller than its world box:
-    // the camera-frame box of its corners cuts the camera-frame box of the world one.
     const FrameChoice turned = chooseGridFrame(scene);
-    for (uint32_t p : live) {
-        box[p] = s.frame_.box(scene.minBox[p]);
-        if (turned.frame.turned) {
-            const Box3& fb = turned.boxes[p];
-            Box3 c;
-            for (int i = 0; i < 8 && !fb.isEmpty(); ++i)
-                c.expand(s.frame_.point(turned.frame.toWorld(boxCorner(fb, i))));
-            box[p] = overlap(box[p], c);
-        }
-        box[p].lo -= eps;
-        box[p].hi += eps;
-    }
+    const std::vector<Box3> box = frameBoxes(scene, s.frame_, turned, live, eps);
     s.bounds_ = {cam.lo - 2.0 * eps, cam.hi + 2.0 * eps};
 
     const size_t pixels = size_t(std::max(scene.width, 1)) * size_t(std::max(scene.height, 1));
@@ -159,6 +247,28 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
             s.projective_ = ProjectiveZones::build(scene, s.frame_, box, live, sp, eyeExtra,
                                                    slabBytes, maxRegions);
             eyeMs = ms(t3);
+        }));
+    }
+    // The lights' structures, each a task of its own beside the frames' (gears2: five lights).
+    s.lights_.assign(scene.lights.size(), ProjectiveZones{});
+    std::vector<char> lightOver(scene.lights.size(), 0);
+    std::vector<double> lightMs(scene.lights.size(), 0.0);
+    for (size_t i = 0; i < lights.frames.size(); ++i) {
+        if (!lights.frames[i]) continue;
+        if (lightShares == 0) {
+            lightOver[i] = 1;
+            continue;
+        }
+        tasks.run(fence.task([&, i] {
+            auto t4 = Clock::now();
+            ProjectiveZones lz =
+                buildLightZones(scene, *lights.frames[i], turned, live, sp, share, maxRegions);
+            // A structure over its share is not kept: its shadow rays take the camera frame.
+            if (lz.memoryBytes() > share)
+                lightOver[i] = 1;
+            else
+                s.lights_[i] = std::move(lz);
+            lightMs[i] = ms(t4);
         }));
     }
     double bspMs = 0.0, slabMs = 0.0, linkMs = 0.0;
@@ -213,6 +323,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     s.listPrims_ = std::move(slabs.listPrims);
     s.unionOnly_ = slabs.unionOnly;
     s.budget_ = 16 * s.regions_.size() + 1024;
+    s.finishLights(lights.inside, lights.overLimit, lightOver, lightMs, extra);
+
     extra["frame"] = irregularFrameName(params.frame);
 
     size_t refs = 0, most = 0;
@@ -327,7 +439,42 @@ int64_t IrregularSubdivision::walkTo(uint32_t from, const Vec3& p) const {
 size_t IrregularSubdivision::memoryBytes() const {
     return sizeof(*this) + regions_.size() * sizeof(IrregularRegion) + bsp_.memoryBytes() +
            zoneFirstRegion_.size() * sizeof(uint32_t) + pool_.nodes.size() * sizeof(CsgNode) +
-           (listFirst_.size() + listPrims_.size()) * sizeof(uint32_t) + projective_.memoryBytes();
+           (listFirst_.size() + listPrims_.size()) * sizeof(uint32_t) + projective_.memoryBytes() +
+           lightBytes();
+}
+
+size_t IrregularSubdivision::lightBytes() const {
+    size_t n = lightFirstRegion_.size() * sizeof(uint32_t);
+    for (const ProjectiveZones& lz : lights_) n += sizeof(lz) + lz.memoryBytes();
+    return n;
+}
+
+void IrregularSubdivision::finishLights(size_t inside, size_t overLimit,
+                                        const std::vector<char>& over,
+                                        const std::vector<double>& ms, nlohmann::json& extra) {
+    lightFirstRegion_.assign(1, uint32_t(regions_.size() + projective_.regionCount()));
+    size_t built = 0, zones = 0, slabs = 0, empty = 0, overBudget = 0;
+    double total = 0.0;
+    for (size_t i = 0; i < lights_.size(); ++i) {
+        const ProjectiveZones& lz = lights_[i];
+        lightFirstRegion_.push_back(lightFirstRegion_.back() + uint32_t(lz.regionCount()));
+        built += lz.zoneCount() > 0;
+        zones += lz.zoneCount();
+        slabs += lz.zoneFirst().empty() ? 0 : lz.zoneFirst().back();
+        empty += lz.emptySlabs();
+        overBudget += size_t(over[i]);
+        total += ms[i];
+    }
+    extra["light_structures"] = built;
+    extra["lights_inside"] = inside;
+    extra["lights_over_limit"] = overLimit;
+    extra["lights_over_budget"] = overBudget;
+    extra["light_zones"] = zones;
+    extra["light_slabs"] = slabs;
+    extra["light_empty_slabs"] = empty;
+    extra["light_regions"] = lightFirstRegion_.back() - lightFirstRegion_.front();
+    extra["light_bytes"] = lightBytes();
+    extra["light_ms"] = total;
 }
 
 }  // namespace lancer

@@ -41,7 +41,8 @@
 
 namespace lancer {
 
-class BuildGuard;  // build_guard.h
+class BuildGuard;    // build_guard.h
+struct FrameChoice;  // regular/grid_frame.h
 
 class IrregularSubdivision {
   public:
@@ -60,8 +61,17 @@ class IrregularSubdivision {
     template <class Obs>
     bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
                    Hit& hit) const;
+    /// intersect()'s answer for a shadow ray toward scene light `light` (its direction points at
+    /// the light): walked in the light's projective structure when it has one and covers the
+    /// ray (in double precision), else as intersect() walks it.
+    template <class Obs>
+    bool intersectTowardLight(const Ray& ray, uint32_t light, double tmin, double tmax,
+                              TraceContext& ctx, Obs& obs, Hit& hit) const;
 
-    size_t regionCount() const { return regions_.size() + projective_.regionCount(); }
+    size_t regionCount() const {
+        return lightFirstRegion_.empty() ? regions_.size() + projective_.regionCount()
+                                         : lightFirstRegion_.back();
+    }
     size_t memoryBytes() const;
     bool usesMailboxes() const { return true; }
 
@@ -73,6 +83,13 @@ class IrregularSubdivision {
     const ScreenBsp& screen() const { return bsp_; }
     /// The projective zones that primary rays walk (empty with --irregular-frame camera).
     const ProjectiveZones& projective() const { return projective_; }
+    /// Per scene light, the projective structure centred on it that shadow rays toward it walk
+    /// (empty: the light lies inside the scene's bounds, or its structure was not built; the
+    /// rays take the camera-frame walk).
+    const std::vector<ProjectiveZones>& lights() const { return lights_; }
+    /// Region ids of light i's structure start at lightFirstRegion()[i] (after the camera
+    /// frame's and the eye's); the last entry is regionCount().
+    const std::vector<uint32_t>& lightFirstRegion() const { return lightFirstRegion_; }
     /// Zone z's regions are [zoneFirstRegion()[z], zoneFirstRegion()[z + 1]), by depth.
     const std::vector<uint32_t>& zoneFirstRegion() const { return zoneFirstRegion_; }
     /// The pool of the regions' restricted trees (empty when unionOnly()).
@@ -99,6 +116,13 @@ class IrregularSubdivision {
     int64_t walkTo(uint32_t from, const Vec3& p) const;
 
   private:
+    /// Region ids of the lights' structures (built into lights_) and their figures to `extra`:
+    /// `inside` lights in the bounds, `overLimit` beyond the most that get one, over[i] light i's
+    /// over its share of the budget, ms[i] its build time.
+    void finishLights(size_t inside, size_t overLimit, const std::vector<char>& over,
+                      const std::vector<double>& ms, nlohmann::json& extra);
+    /// Bytes of the lights' structures.
+    size_t lightBytes() const;
     /// p is below region r on axis a (or on its low face, going down).
     bool below(uint32_t r, int a, const Vec3& p, const Vec3& d) const {
         const Box3& b = regions_[r].box;
@@ -126,7 +150,9 @@ class IrregularSubdivision {
     CameraFrame frame_;
     Box3 bounds_;
     ScreenBsp bsp_;
-    ProjectiveZones projective_;  ///< primary rays (region ids from regions_.size() on)
+    ProjectiveZones projective_;              ///< primary rays (region ids from regions_.size() on)
+    std::vector<ProjectiveZones> lights_;     ///< per scene light: shadow rays toward it
+    std::vector<uint32_t> lightFirstRegion_;  ///< region ids of lights_[i] from [i] on
     std::vector<IrregularRegion> regions_;
     std::vector<uint32_t> zoneFirstRegion_;  ///< zone z: regions [zoneFirstRegion_[z], [z + 1])
     CsgTree pool_;
@@ -177,6 +203,23 @@ int64_t IrregularSubdivision::cross(uint32_t r, int axis, const Vec3& p, const V
         n = m;
     }
     return n;
+}
+
+template <class Obs>
+bool IrregularSubdivision::intersectTowardLight(const Ray& ray, uint32_t light, double tmin,
+                                                double tmax, TraceContext& ctx, Obs& obs,
+                                                Hit& hit) const {
+    // A float test (--precision float) strays by up to floatSlack, far beyond the boxes'
+    // padding: near its origin a shadow ray may meet in float a primitive whose padded box it
+    // never enters (its own surface, offset 1e-7 off it), which the light's slab, cut at that
+    // box's depth, does not list. Those rays keep the camera-frame walk.
+    if (light < lights_.size() && ctx.precision == Precision::Double) {
+        const ProjectiveZones& lz = lights_[light];
+        const Ray rl = lz.frame().ray(ray);
+        if (double u, v; lz.coversFromCentre(rl, u, v))
+            return lz.intersect(ray, rl, u, v, tmin, tmax, lightFirstRegion_[light], ctx, obs, hit);
+    }
+    return intersect(ray, tmin, tmax, ctx, obs, hit);
 }
 
 template <class Obs>

@@ -16,27 +16,64 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
                                        const std::vector<uint32_t>& live, const ScreenBspParams& sp,
                                        nlohmann::json& extra, size_t maxSlabBytes,
                                        size_t maxRegions) {
-    ProjectiveZones s;
-    s.scene_ = &scene;
-    s.frame_ = frame;
-    s.eyePoint_ = frame.origin;
     const Camera& cam = scene.camera;
-    if (cam.projection != Projection::Perspective) return s;
-
-    // zNear: the nearest box wholly in front of the eye.
-    double zNear = kInf, zFar = 0.0;
-    for (uint32_t p : live) {
-        if (box[p].lo.z > 0.0) zNear = std::min(zNear, box[p].lo.z);
-        zFar = std::max(zFar, box[p].hi.z);
+    if (cam.projection != Projection::Perspective) {
+        ProjectiveZones s;
+        s.scene_ = &scene;
+        s.frame_ = frame;
+        s.eyePoint_ = frame.origin;
+        return s;
     }
-    if (!(zFar > 0.0)) return s;  // nothing in front of the eye
-    if (zNear == kInf) zNear = 1e-3 * zFar;
     // The screen rectangle: every pixel of the scene's camera for any aspect ratio up to 4:1
     // (wider images, and rays outside it, take the camera-frame walk).
     double half = std::tan(glm::radians(cam.fov) * 0.5);
     double aspect = std::max(4.0, double(scene.width) / double(std::max(scene.height, 1)));
     glm::dvec2 limLo(-half * aspect, -half * (1.0 + 1e-6)),
         limHi(half * aspect, half * (1.0 + 1e-6));
+    ProjectiveZones s =
+        buildCentred(scene, frame, limLo, limHi, false, box, live, sp, maxSlabBytes, maxRegions);
+    if (s.zones_ == 0) return s;
+    extra["projective_zones"] = s.zones_;
+    extra["projective_slabs"] = s.slabRoot_.size();
+    extra["projective_empty_slabs"] = s.emptySlabs_;
+    extra["projective_bsp_stopped"] = s.bsp_.stopped;
+    extra["projective_merged_zones"] = s.mergedZones_;
+    extra["projective_coarse_zones"] = s.coarseZones_;
+    extra["projective_near_primitives"] = s.nearPrims_.size();
+    extra["projective_znear"] = s.zNear_;
+    return s;
+}
+
+ProjectiveZones ProjectiveZones::buildForLight(const Scene& scene, const CameraFrame& frame,
+                                               const std::vector<Box3>& box,
+                                               const std::vector<uint32_t>& live,
+                                               const ScreenBspParams& sp, size_t maxSlabBytes,
+                                               size_t maxRegions) {
+    // Every direction from the light: a shadow ray's zone is where its origin's (u, v) falls.
+    return buildCentred(scene, frame, glm::dvec2(-kInf), glm::dvec2(kInf), true, box, live, sp,
+                        maxSlabBytes, maxRegions);
+}
+
+ProjectiveZones ProjectiveZones::buildCentred(const Scene& scene, const CameraFrame& frame,
+                                              glm::dvec2 limLo, glm::dvec2 limHi, bool inward,
+                                              const std::vector<Box3>& box,
+                                              const std::vector<uint32_t>& live,
+                                              const ScreenBspParams& sp, size_t maxSlabBytes,
+                                              size_t maxRegions) {
+    ProjectiveZones s;
+    s.scene_ = &scene;
+    s.frame_ = frame;
+    s.eyePoint_ = frame.origin;
+    s.inward_ = inward;
+
+    // zNear: the nearest box wholly in front of the centre.
+    double zNear = kInf, zFar = 0.0;
+    for (uint32_t p : live) {
+        if (box[p].lo.z > 0.0) zNear = std::min(zNear, box[p].lo.z);
+        zFar = std::max(zFar, box[p].hi.z);
+    }
+    if (!(zFar > 0.0)) return s;  // nothing in front of the centre
+    if (zNear == kInf) zNear = 1e-3 * zFar;
 
     // Projected boxes: x/z over a box in front of the eye is extreme at its corners. A relative
     // pad of 1e-12 covers the rounding of these divisions (the camera-frame padding gives the
@@ -101,15 +138,9 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     if (!nearPrims.empty() && !s.unionOnly_)
         s.nearRoot_ = TreeRestrictor(scene.tree).restrict(nearPrims, s.pool_);
     s.nearPrims_ = nearPrims;
-
-    extra["projective_zones"] = s.zones_;
-    extra["projective_slabs"] = s.slabRoot_.size();
-    extra["projective_empty_slabs"] = slabs.emptySlabs + slabs.emptyZones;
-    extra["projective_bsp_stopped"] = s.bsp_.stopped;
-    extra["projective_merged_zones"] = slabs.mergedZones;
-    extra["projective_coarse_zones"] = slabs.coarseZones;
-    extra["projective_near_primitives"] = nearPrims.size();
-    extra["projective_znear"] = zNear;
+    s.emptySlabs_ = slabs.emptySlabs + slabs.emptyZones;
+    s.mergedZones_ = slabs.mergedZones;
+    s.coarseZones_ = slabs.coarseZones;
     return s;
 }
 
@@ -126,17 +157,37 @@ void ProjectiveZones::buildEntering() {
             out.erase(std::unique(out.begin(), out.end()), out.end());
         }
     };
+    // Slab i's entering list is against the slab the walk comes from: the one before it in
+    // depth from the eye, the one after it toward a light (a zone's lists are made in the
+    // walk's order, then stored in the slabs' order).
     enterFirst_.assign(1, 0);
     enterPrims_.clear();
-    std::vector<uint32_t> before, here;
+    std::vector<uint32_t> before, here, zonePrims, zoneCount;
     for (size_t z = 0; z < zones_; ++z) {
         before.clear();
-        for (uint32_t i = zoneFirst_[z]; i < zoneFirst_[z + 1]; ++i) {
-            treePrims(i, here);
+        zonePrims.clear();
+        zoneCount.clear();
+        const uint32_t n = zoneFirst_[z + 1] - zoneFirst_[z];
+        for (uint32_t k = 0; k < n; ++k) {
+            treePrims(inward_ ? zoneFirst_[z + 1] - 1 - k : zoneFirst_[z] + k, here);
+            const size_t at = zonePrims.size();
             std::set_difference(here.begin(), here.end(), before.begin(), before.end(),
-                                std::back_inserter(enterPrims_));
-            enterFirst_.push_back(uint32_t(enterPrims_.size()));
+                                std::back_inserter(zonePrims));
+            zoneCount.push_back(uint32_t(zonePrims.size() - at));
             std::swap(before, here);
+        }
+        if (!inward_) {
+            enterPrims_.insert(enterPrims_.end(), zonePrims.begin(), zonePrims.end());
+            for (uint32_t c : zoneCount) enterFirst_.push_back(enterFirst_.back() + c);
+            continue;
+        }
+        // Walked from the last slab down: slab k's list is the (n - 1 - k)-th piece.
+        std::vector<size_t> start(n + 1, 0);
+        for (uint32_t k = 0; k < n; ++k) start[k + 1] = start[k] + zoneCount[k];
+        for (uint32_t k = n; k-- > 0;) {
+            enterPrims_.insert(enterPrims_.end(), zonePrims.begin() + ptrdiff_t(start[k]),
+                               zonePrims.begin() + ptrdiff_t(start[k + 1]));
+            enterFirst_.push_back(uint32_t(enterPrims_.size()));
         }
     }
 }

@@ -36,18 +36,36 @@ class ProjectiveZones {
                                  const std::vector<Box3>& box, const std::vector<uint32_t>& live,
                                  const ScreenBspParams& sp, nlohmann::json& extra,
                                  size_t maxSlabBytes = 0, size_t maxRegions = 0);
+    /// Build centred on a point light, `frame`'s origin (its depth axis toward the scene), over
+    /// the boxes `box` of that frame (padded): the structure shadow rays toward the light walk
+    /// (covered by coversFromCentre), slab by slab toward the light. Unbounded in (u, v).
+    static ProjectiveZones buildForLight(const Scene& scene, const CameraFrame& frame,
+                                         const std::vector<Box3>& box,
+                                         const std::vector<uint32_t>& live,
+                                         const ScreenBspParams& sp, size_t maxSlabBytes = 0,
+                                         size_t maxRegions = 0);
 
     /// This structure answers the ray: it starts exactly at the eye and its (u, v) is inside the
     /// screen rectangle. `rc` is the ray in the camera frame.
     bool covers(const Ray& world, const Ray& rc, double& u, double& v) const {
-        if (zones_ == 0 || world.o != eyePoint_ || !(rc.d.z > 0.0)) return false;
+        if (zones_ == 0 || inward_ || world.o != eyePoint_ || !(rc.d.z > 0.0)) return false;
         u = rc.d.x / rc.d.z;
         v = rc.d.y / rc.d.z;
         return u >= lo_.x && u <= hi_.x && v >= lo_.y && v <= hi_.y;
     }
+    /// A light's structure answers the ray `rc` (in its frame) that heads for the centre from in
+    /// front of it, its origin's (u, v) inside the zones' rectangle: the caller's shadow ray
+    /// toward this light, whose line passes through the centre to rounding.
+    bool coversFromCentre(const Ray& rc, double& u, double& v) const {
+        if (zones_ == 0 || !inward_ || !(rc.o.z > 0.0) || !(rc.d.z < 0.0)) return false;
+        u = rc.o.x / rc.o.z;
+        v = rc.o.y / rc.o.z;
+        return u >= lo_.x && u <= hi_.x && v >= lo_.y && v <= hi_.y;
+    }
 
-    /// Walk a covered ray: the near region, then the slabs of its zone in depth. Region ids
-    /// reported to the observer start at `firstId`.
+    /// Walk a covered ray: from the eye, the near region, then the slabs of its zone in depth;
+    /// toward a light, the slabs of its zone from its origin's depth down, then the near region.
+    /// Region ids reported to the observer start at `firstId`.
     template <class Obs>
     bool intersect(const Ray& ray, const Ray& rc, double u, double v, double tmin, double tmax,
                    uint32_t firstId, TraceContext& ctx, Obs& obs, Hit& hit) const;
@@ -55,6 +73,12 @@ class ProjectiveZones {
     size_t regionCount() const { return zones_ == 0 ? 0 : slabRoot_.size() + 1; }
     size_t memoryBytes() const;
     size_t zoneCount() const { return zones_; }
+    /// Slabs that list nothing, zones with none but empty slabs.
+    size_t emptySlabs() const { return emptySlabs_; }
+    /// Built around a light: walked toward the centre (coversFromCentre), not from it.
+    bool inward() const { return inward_; }
+    /// The frame the structure is built in (the camera's, or the light's).
+    const CameraFrame& frame() const { return frame_; }
     double zNear() const { return zNear_; }
     /// The zones, in (u, v).
     const ScreenBsp& screen() const { return bsp_; }
@@ -80,9 +104,10 @@ class ProjectiveZones {
         uint32_t l = slabList_[i];
         return {listPrims_.data() + listFirst_[l], listPrims_.data() + listFirst_[l + 1]};
     }
-    /// What slab i adds to the slab before it in its zone (all of the first slab's): the
-    /// primitives of its restricted tree (union-only: its list) that the tree of the slab before
-    /// lacks. A walk stepping from slab i - 1 fetches only these; the others it already holds.
+    /// What slab i adds to the slab the walk leaves for it (the one before it in depth, or, in a
+    /// light's structure, the one after it; all of the zone's first slab walked): the primitives
+    /// of its restricted tree (union-only: its list) that the tree of that slab lacks. A walk
+    /// stepping from there fetches only these; the others it already holds.
     std::span<const uint32_t> slabEntering(uint32_t i) const {
         return {enterPrims_.data() + enterFirst_[i], enterPrims_.data() + enterFirst_[i + 1]};
     }
@@ -90,6 +115,13 @@ class ProjectiveZones {
     std::span<const uint32_t> nearPrimitives() const { return nearPrims_; }
 
   private:
+    /// The zones and slabs over `box` seen from `frame`'s origin, within [limLo, limHi] in (u, v).
+    static ProjectiveZones buildCentred(const Scene& scene, const CameraFrame& frame,
+                                        glm::dvec2 limLo, glm::dvec2 limHi, bool inward,
+                                        const std::vector<Box3>& box,
+                                        const std::vector<uint32_t>& live,
+                                        const ScreenBspParams& sp, size_t maxSlabBytes,
+                                        size_t maxRegions);
     void buildEntering();
 
     const Scene* scene_ = nullptr;
@@ -110,6 +142,8 @@ class ProjectiveZones {
     std::vector<uint32_t> nearPrims_;
     std::vector<uint32_t> enterFirst_, enterPrims_;  ///< slab i's entering list (slabEntering)
     bool unionOnly_ = false;
+    bool inward_ = false;  ///< a light's structure (coversFromCentre)
+    size_t emptySlabs_ = 0, mergedZones_ = 0, coarseZones_ = 0;
 };
 
 template <class Obs>
@@ -117,11 +151,15 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
                                 double tmax, uint32_t firstId, TraceContext& ctx, Obs& obs,
                                 Hit& hit) const {
     const Scene& scene = *scene_;
-    const double dz = rc.d.z;
+    // A slab boundary at depth z is crossed at t = (z - oz) / dz, computed the same way for both
+    // neighbours, so the intervals tile the ray (from the eye oz is 0 exactly: t = z / dz).
+    const double oz = rc.o.z, dz = rc.d.z;
+    auto tAt = [&](double z) { return (z - oz) / dz; };
     // The walk's events as the camera-frame walk tells them: the region the walk starts in
-    // (Locate), then each region left before tmax through its far depth plane (Exit: axis 2,
-    // the high side), the point exactly on that plane. The next region is the next slab of the
-    // zone (the near region's next is the zone's first slab): no pointer to follow.
+    // (Locate), then each region left before tmax through its far depth plane (from the eye) or
+    // its near one (toward a light) (Exit: axis 2), the point (u z, v z, z) exactly on that
+    // plane. The next region is the next slab of the zone in the walk's direction (the near
+    // region's next is the zone's first slab, from the eye): no pointer to follow.
     [[maybe_unused]] bool located = false;
     [[maybe_unused]] auto enter = [&](uint32_t id, double t0) {
         if constexpr (Obs::kActive) {
@@ -131,50 +169,78 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
     };
     [[maybe_unused]] auto leave = [&](double z) {
         if constexpr (Obs::kActive) {
-            const double te = z / dz;
+            const double te = tAt(z);
             if (te < tmax) obs.regionExit(te, frame_.toWorld({u * z, v * z, z}), 2, 4);
         }
     };
-    double t = tmin;
-    ctx.beginLeafWalk();
-    if (hasNearRegion()) {
-        double t1 = std::min(zNear_ / dz, tmax);
-        if (t <= t1) {
-            const uint32_t id = firstId + uint32_t(slabRoot_.size());
-            enter(id, t);
-            ++ctx.counters.regionVisits;
-            obs.region(id, t, t1);
-            if (hitInIrregularRegion(scene, unionOnly_, nearPrims_, pool_, nearRoot_, ray, tmin, t,
-                                     t1, ctx, obs, hit))
-                return true;
-            leave(zNear_);
-        }
-    }
-    uint32_t zone = bsp_.locate(u, v, 0, 0);
-    uint32_t i = zoneFirst_[zone], last = zoneFirst_[zone + 1];
-    // Skip the slabs wholly before tmin (a primary ray has tmin = 0: none).
-    while (i + 1 < last && slabLo_[i + 1] / dz < t) ++i;
+    auto nearRegion = [&](double t0, double t1) {
+        const uint32_t id = firstId + uint32_t(slabRoot_.size());
+        enter(id, t0);
+        ++ctx.counters.regionVisits;
+        obs.region(id, t0, t1);
+        return hitInIrregularRegion(scene, unionOnly_, nearPrims_, pool_, nearRoot_, ray, tmin, t0,
+                                    t1, ctx, obs, hit);
+    };
     // The first slab walked fetches its whole list, each later one what it adds, unless the
     // slab before it was evaluated lazily (hitInLeaf), fetching only part.
     bool heldBefore = false;
-    for (; i < last; ++i) {
-        double t0 = std::max(slabLo_[i] / dz, t);
-        double z1 = i + 1 < last ? slabLo_[i + 1] : zFar_;
-        double t1 = std::min(z1 / dz, tmax);
-        if (t0 > tmax) return false;
+    auto slab = [&](uint32_t i, double t0, double t1) {
         enter(firstId + i, t0);
         ++ctx.counters.regionVisits;
         obs.region(firstId + i, t0, t1);
-        const std::span<const uint32_t> prims = slabPrimitives(i);
         std::optional<std::span<const uint32_t>> tests;
         if (heldBefore) tests = slabEntering(i);
-        if (hitInIrregularRegion(scene, unionOnly_, prims, pool_, slabRoot_[i], ray, tmin, t0, t1,
-                                 ctx, obs, hit, tests))
-            return true;
+        const bool found =
+            hitInIrregularRegion(scene, unionOnly_, slabPrimitives(i), pool_, slabRoot_[i], ray,
+                                 tmin, t0, t1, ctx, obs, hit, tests);
         heldBefore = ctx.pending.tested;
-        leave(z1);
+        return found;
+    };
+    double t = tmin;
+    ctx.beginLeafWalk();
+    const uint32_t zone = bsp_.locate(u, v, 0, 0);
+    const uint32_t first = zoneFirst_[zone], last = zoneFirst_[zone + 1];
+    if (!inward_) {
+        if (hasNearRegion()) {
+            const double t1 = std::min(tAt(zNear_), tmax);
+            if (t <= t1) {
+                if (nearRegion(t, t1)) return true;
+                leave(zNear_);
+            }
+        }
+        uint32_t i = first;
+        // Skip the slabs wholly before tmin (a primary ray has tmin = 0: none).
+        while (i + 1 < last && tAt(slabLo_[i + 1]) < t) ++i;
+        for (; i < last; ++i) {
+            const double t0 = std::max(tAt(slabLo_[i]), t);
+            const double z1 = i + 1 < last ? slabLo_[i + 1] : zFar_;
+            const double t1 = std::min(tAt(z1), tmax);
+            if (t0 > tmax) return false;
+            if (slab(i, t0, t1)) return true;
+            leave(z1);
+        }
+        return false;
     }
-    return false;
+    // Toward the light: depth falls as t grows. Skip the slabs wholly before tmin (those beyond
+    // the origin's depth), then walk down to the zone's first slab and the near region, whose
+    // interval runs to tmax (the ray ends at the light, where only near primitives can lie).
+    uint32_t i = last - 1;
+    while (i > first && tAt(slabLo_[i]) < t) --i;
+    for (;; --i) {
+        const double z1 = i + 1 < last ? slabLo_[i + 1] : zFar_;
+        const double t0 = std::max(tAt(z1), t);
+        const bool lastSlab = i == first && !hasNearRegion();
+        const double t1 = lastSlab ? tmax : std::min(tAt(slabLo_[i]), tmax);
+        if (t0 > tmax) return false;
+        if (t0 <= t1) {
+            if (slab(i, t0, t1)) return true;
+            if (!lastSlab) leave(slabLo_[i]);
+        }
+        if (i == first) break;
+    }
+    if (!hasNearRegion()) return false;
+    const double t0 = std::max(tAt(zNear_), t);
+    return t0 <= tmax && nearRegion(t0, tmax);
 }
 
 }  // namespace lancer
