@@ -396,14 +396,11 @@ bool RegularBuilder::heldWithin(Fragment& f, const Box3& box, const CsgTree& tre
     for (uint32_t p : prims)
         if (fills(p, box)) f.filling.push_back(p);
     if (f.filling.empty()) return false;
+    if (!restrictionWithin(tree, f.filling, f.kept) || f.kept.size() == prims.size()) return false;
+    ++f.counts.solidCells;
     held.nodes.clear();
     held.root = -1;
     heldList.clear();
-    ++f.counts.solidCells;
-    if (!restrictionWithin(tree, f.filling, f.kept) || f.kept.size() == prims.size()) {
-        --f.counts.solidCells;
-        return false;
-    }
     if (!f.kept.empty()) {
         held.root = restrictTreeTo(tree, f.kept, keep.local(), held);
         heldList.assign(f.kept.begin(), f.kept.end());
