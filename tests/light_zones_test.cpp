@@ -284,9 +284,9 @@ TEST(LightZones, ABuildForAnotherViewTakesTheLightsStructuresOfThePrevious) {
     EXPECT_FALSE(xf["light_buffer_lent"].get<bool>());
     EXPECT_EQ(xl["light_ms"].get<double>(), 0.0);
     // What is lent is what the build would have made: the same structures and light buffer.
-    for (const char* k : {"light_structures", "light_zones", "light_slabs", "light_empty_slabs",
-                          "light_regions", "light_bytes", "light_buffer_bytes", "zones",
-                          "projective_zones"})
+    for (const char* k :
+         {"light_structures", "light_zones", "light_slabs", "light_empty_slabs", "light_regions",
+          "light_bytes", "light_buffer_bytes", "zones", "projective_zones"})
         EXPECT_EQ(xl[k], xf[k]) << k;
     EXPECT_EQ(lent->info().regions, fresh->info().regions);
     EXPECT_EQ(lent->info().memoryBytes, fresh->info().memoryBytes);

@@ -40,13 +40,13 @@ std::unique_ptr<Accelerator> withLightBuffer(const Scene& scene, const BuildPara
                       previous->params().memoryBudget == params.memoryBudget;
     std::future<Buffers> lightBuffer;
     if (lend)
-        lightBuffer = std::async(std::launch::async, [&scene, &params, previous,
-                                                      stop = guard.control().stop] {
-            std::shared_ptr<const FrameChoice> turned = previous->turnedBoxes();
-            Buffers b{previous->lightBuffer(), {}, turned};
-            b.eye = Accelerator::makeEyeBuffer(scene, scene.camera, params, stop, turned.get());
-            return b;
-        });
+        lightBuffer = std::async(
+            std::launch::async, [&scene, &params, previous, stop = guard.control().stop] {
+                std::shared_ptr<const FrameChoice> turned = previous->turnedBoxes();
+                Buffers b{previous->lightBuffer(), {}, turned};
+                b.eye = Accelerator::makeEyeBuffer(scene, scene.camera, params, stop, turned.get());
+                return b;
+            });
     else if (buffered)
         lightBuffer =
             std::async(std::launch::async, [&scene, &params, stop = guard.control().stop] {
@@ -117,8 +117,9 @@ std::unique_ptr<Accelerator> buildOne(const Scene& scene, const BuildParams& par
         return withLightBuffer<S>(
             scene, params, buffered, guard, previous,
             [&](AccelInfo& info) {
-                if constexpr (requires { S::build(scene, S::config(params), info.extra, &guard,
-                                                  prev); })
+                if constexpr (requires {
+                                  S::build(scene, S::config(params), info.extra, &guard, prev);
+                              })
                     return S::build(scene, S::config(params), info.extra, &guard, prev);
                 else
                     return S::build(scene, S::config(params), info.extra, &guard);
