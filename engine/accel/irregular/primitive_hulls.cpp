@@ -111,16 +111,18 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
             hull.aligned = true;
             for (const Vec3& q : hull.world.corner) hull.box.expand(q);
         }
+        // An aligned hull's outline is its box's, tested in closed form (touches).
         std::vector<glm::dvec2> flat, eye;
-        bool front = true;
+        bool front = !hull.aligned;
         for (const Vec3& c : (hull.single ? hull.world : hull.turned).corner) {
+            if (hull.aligned) break;
             flat.push_back({c.x, c.y});
             front = front && c.z > 0.0;
             if (front) eye.push_back({c.x / c.z, c.y / c.z});
         }
         for (int c = 0; c < 2; ++c) {
             std::vector<glm::dvec2> o;
-            if (c == 0) o = convexHull2(flat);
+            if (c == 0 && !hull.aligned) o = convexHull2(flat);
             if (c == 1 && front) o = convexHull2(eye);
             hull.outlineSize[c] = int(o.size());  // the hull of 8 points: at most 8
             std::copy(o.begin(), o.end(), hull.outline[c].begin());
