@@ -763,6 +763,82 @@ TEST(PrimitiveHulls, DepthRangesHoldTheSampledPointsAndAreTighter) {
     EXPECT_GT(dropped, pairs / 20) << dropped << " of " << pairs;
 }
 
+// In a frame along the world's axes (a light's structure) a primitive with only its world box
+// has its outline and depths in closed form: every sampled point of a box that a zone's column
+// holds lies within the depth range given and keeps the primitive in the zone, and both ends of
+// the range are depths where the column meets the box.
+TEST(PrimitiveHulls, AlongTheWorldsAxesTheClosedFormHoldsTheBoxesPoints) {
+    Scene s = loadScene("builtin:balls:2");
+    const std::vector<uint32_t> live = s.livePrimitives();
+    const double pad = 1e-9 * s.scale();
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    size_t samples = 0, pairs = 0, misses = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+        // The frame of a light beyond the bounds' high side on `axis`, looking back into them.
+        CameraFrame f;
+        f.origin = s.bounds.center();
+        f.origin[axis] = s.bounds.hi[axis] + 0.7 * s.bounds.extent()[axis];
+        f.z = Vec3(0.0), f.x = Vec3(0.0), f.y = Vec3(0.0);
+        f.z[axis] = -1.0, f.x[(axis + 1) % 3] = 1.0, f.y[(axis + 2) % 3] = 1.0;
+        const PrimitiveHulls hulls = PrimitiveHulls::make(s, f, FrameChoice{}, live, pad);
+        for (uint32_t p : live) {
+            if (p % 7 != 0) continue;
+            const Box3 cam = f.box(s.minBox[p]);
+            const glm::dvec2 whole(cam.lo.z, cam.hi.z);
+            std::vector<Vec3> pts;
+            for (int i = 0; i < 3000; ++i) {
+                Vec3 w;
+                for (int a = 0; a < 3; ++a)
+                    w[a] = s.minBox[p].lo[a] + u01(rng) * s.minBox[p].extent()[a];
+                pts.push_back(f.point(w));
+            }
+            for (ZoneColumn column : {ZoneColumn::Parallel, ZoneColumn::FromEye}) {
+                auto screen = [&](const Vec3& c) {
+                    return column == ZoneColumn::Parallel ? glm::dvec2(c.x, c.y)
+                                                          : glm::dvec2(c.x / c.z, c.y / c.z);
+                };
+                glm::dvec2 lo(kInf), hi(-kInf);
+                for (const Vec3& c : pts)
+                    lo = glm::min(lo, screen(c)), hi = glm::max(hi, screen(c));
+                for (int k = 0; k < 16; ++k) {
+                    const glm::dvec2 e = 0.3 * (hi - lo);
+                    const glm::dvec2 zlo(lo.x - e.x + u01(rng) * (hi.x - lo.x + e.x),
+                                         lo.y - e.y + u01(rng) * (hi.y - lo.y + e.y));
+                    const glm::dvec2 zhi = zlo + e;
+                    const bool touches = hulls.touches(p, column, zlo, zhi);
+                    const glm::dvec2 d = hulls.depthIn(p, column, zlo, zhi, 1e-3, whole);
+                    ++pairs;
+                    misses += !touches;
+                    EXPECT_EQ(touches, d.x <= d.y) << "p" << p;
+                    for (const Vec3& c : pts) {
+                        const glm::dvec2 q = screen(c);
+                        if (q.x < zlo.x || q.x > zhi.x || q.y < zlo.y || q.y > zhi.y) continue;
+                        ++samples;
+                        EXPECT_TRUE(touches) << "p" << p << " dropped from a zone it reaches";
+                        EXPECT_GE(c.z, d.x - pad) << "p" << p;
+                        EXPECT_LE(c.z, d.y + pad) << "p" << p;
+                    }
+                    // Each end is attained: at that depth the column's cross-section meets
+                    // the box's (the depths the column meets form an interval).
+                    for (double z : {d.x, d.y}) {
+                        if (!(d.x <= d.y)) break;
+                        const glm::dvec2 a = column == ZoneColumn::Parallel ? zlo : zlo * z;
+                        const glm::dvec2 b = column == ZoneColumn::Parallel ? zhi : zhi * z;
+                        const double tol = 4.0 * pad;
+                        EXPECT_TRUE(a.x <= cam.hi.x + tol && b.x >= cam.lo.x - tol &&
+                                    a.y <= cam.hi.y + tol && b.y >= cam.lo.y - tol &&
+                                    z >= cam.lo.z - tol && z <= cam.hi.z + tol)
+                            << "p" << p << ": depth " << z << " of the range is not attained";
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_GT(samples, 10000u);
+    EXPECT_GT(misses, 0u) << pairs << " pairs";
+}
+
 // The hulls of an unturned scene (SPD's gears1: polygons on and off the world's axes, seen
 // from a camera off them): points of each polygon (convex combinations of its vertices, inside
 // its own plane's box and its world box) lie in the depth range its hull gives any zone whose

@@ -5,6 +5,7 @@
 // the walk as the observer and `lancer trace` tell it; the budget that skips them.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <random>
 
@@ -255,6 +256,75 @@ TEST(LightZones, TraceTellsTheWalkInTheLightsStructure) {
         }
     EXPECT_GT(walks, 10u);
     EXPECT_GT(exits, 10u);
+}
+
+/// `s`'s camera turned about its up vector by `degrees` around the point it looks at.
+void lzTurnCamera(Scene& s, double degrees) {
+    const Vec3 k = glm::normalize(s.camera.up), d = s.camera.from - s.camera.at;
+    const double a = degrees * 3.14159265358979323846 / 180.0;
+    s.camera.from = s.camera.at + d * std::cos(a) + glm::cross(k, d) * std::sin(a) +
+                    k * glm::dot(k, d) * (1.0 - std::cos(a));
+}
+
+TEST(LightZones, ABuildForAnotherViewTakesTheLightsStructuresOfThePrevious) {
+    auto scene = std::make_unique<Scene>(loadScene(std::string(LANCER_SPD_DIR) + "/balls2.nff"));
+    BuildParams p;
+    p.scheme = SchemeKind::Irregular;
+    p.irregular.frame = IrregularFrame::Projective;
+    auto first = buildAccelerator(*scene, p);
+    // Another view of the same prepared scene (the viewer's rebuild after a camera move).
+    Scene turned = *scene;
+    lzTurnCamera(turned, 35.0);
+    auto lent = buildAccelerator(turned, p, {{}, {}, first.get()});
+    auto fresh = buildAccelerator(turned, p);
+    const nlohmann::json &xl = lent->info().extra, &xf = fresh->info().extra;
+    EXPECT_TRUE(xl["lights_lent"].get<bool>());
+    EXPECT_TRUE(xl["light_buffer_lent"].get<bool>());
+    EXPECT_FALSE(xf["lights_lent"].get<bool>());
+    EXPECT_FALSE(xf["light_buffer_lent"].get<bool>());
+    EXPECT_EQ(xl["light_ms"].get<double>(), 0.0);
+    // What is lent is what the build would have made: the same structures and light buffer.
+    for (const char* k :
+         {"light_structures", "light_zones", "light_slabs", "light_empty_slabs", "light_regions",
+          "light_bytes", "light_buffer_bytes", "zones", "projective_zones"})
+        EXPECT_EQ(xl[k], xf[k]) << k;
+    EXPECT_EQ(lent->info().regions, fresh->info().regions);
+    EXPECT_EQ(lent->info().memoryBytes, fresh->info().memoryBytes);
+    // Changed knobs, or a scene prepared again, lend nothing.
+    BuildParams other = p;
+    other.irregular.maxObjects = 2;
+    EXPECT_FALSE(buildAccelerator(turned, other, {{}, {}, first.get()})
+                     ->info()
+                     .extra["lights_lent"]
+                     .get<bool>());
+    Scene again = loadScene(std::string(LANCER_SPD_DIR) + "/balls2.nff");
+    lzTurnCamera(again, 35.0);
+    auto notLent = buildAccelerator(again, p, {{}, {}, first.get()});
+    EXPECT_FALSE(notLent->info().extra["lights_lent"].get<bool>());
+    EXPECT_FALSE(notLent->info().extra["light_buffer_lent"].get<bool>());
+    // The lent structures refer to the new scene, not the one they were built over: with the
+    // first build and its scene gone, every shadow ray and pixel is still brute force's.
+    first.reset();
+    scene.reset();
+    const IrregularSubdivision& irr = lzIrregular(*lent);
+    TraceContext ctx(turned.prims.size(), turned.tree.depth());
+    NullObserver obs;
+    size_t failures = 0, inLightZones = 0;
+    for (const LzShadowRay& sr : lzShadowRays(turned, irr, 3)) {
+        Hit want, got;
+        const bool blocked = test::bruteHit(turned, sr.ray, want) && want.t <= sr.tmax;
+        double u, v;
+        const ProjectiveZones& lz = irr.lights()[sr.light];
+        inLightZones += lz.coversFromCentre(lz.frame().ray(sr.ray), u, v);
+        ctx.beginRay();
+        const bool found = irr.intersectTowardLight(sr.ray, sr.light, 0.0, sr.tmax, ctx, obs, got);
+        ctx.beginRay();
+        failures += found != blocked || (found && got.prim != want.prim) ||
+                    lent->occluded(sr.ray, sr.tmax, sr.light, ctx, obs) != blocked;
+    }
+    EXPECT_GT(inLightZones, 0u);
+    EXPECT_EQ(failures, 0u);
+    test::expectSamePixelsAndSecondaries(turned, *lent, 24, 11, "lent lights' structures");
 }
 
 TEST(LightZones, BudgetLeftByTheEyeSkipsThemCounted) {

@@ -34,7 +34,7 @@ BuildResult buildStructure(const BuildRequest& r, std::stop_token stop) {
         scene = viewed;
     }
     try {
-        s->accel = buildAccelerator(*scene, r.params, {std::move(stop), {}});
+        s->accel = buildAccelerator(*scene, r.params, {std::move(stop), {}, r.previous.get()});
     } catch (const std::exception& e) {
         out.error = e.what();
         return out;

@@ -35,6 +35,9 @@ struct BuildRequest {
     /// --camera: a .camera.json replacing the camera of the scene read (its home view).
     std::string cameraFile;
     ReadOptions read;  ///< --facets: how the scene is read
+    /// The structure built over `loaded` for an earlier view: it lends what does not depend on
+    /// the camera (BuildControl::previous). Null: none.
+    std::shared_ptr<const Accelerator> previous;
 };
 
 struct BuildResult {

@@ -182,6 +182,7 @@ void ViewerState::requestBuild(bool reloadScene, const char* why) {
         r.spec = sceneBuild_->spec;
         r.loaded = sceneBuild_->scene;
         r.camera = camera_;
+        r.previous = sceneBuild_->accel;
     }
     buildChangeAt_ = Clock::now();
     buildWhy_ = why;

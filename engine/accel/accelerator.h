@@ -50,6 +50,7 @@ struct AccelInfo {
     /// Depth of the scene's tree the structure was built on (TraceContext's scratch buffers),
     /// so a render need not walk the tree again (10 ms on a union of 600,000); -1: not known.
     int treeDepth = -1;
+    uint64_t sceneId = 0;  ///< Scene::preparedId of the scene it was built over
 };
 
 class Accelerator {
@@ -143,6 +144,10 @@ class Accelerator {
     }
     const BuildParams& params() const { return params_; }
     const AccelInfo& info() const { return info_; }
+    /// The lights' buffer (light_buffer.h): empty for brute force and with --no-light-buffer.
+    const LightBuffer& lightBuffer() const { return lightBuffer_; }
+    /// The primitives' turned boxes the buffers were cut by, or null.
+    const std::shared_ptr<const FrameChoice>& turnedBoxes() const { return turned_; }
     const Impl& impl() const { return impl_; }
 
   private:

@@ -14,6 +14,8 @@
 
 namespace lancer {
 
+class Accelerator;  // accelerator.h
+
 /// A build ended by a stop request (a newer build superseded it). Not an input error.
 class BuildCancelled : public std::runtime_error {
   public:
@@ -42,6 +44,12 @@ struct BuildProgress {
 struct BuildControl {
     std::stop_token stop;  ///< a stop request ends the build with BuildCancelled
     std::function<void(const BuildProgress&)> progress;  ///< long builds report here
+    /// A structure built over a copy of the same prepared scene (Scene::preparedId) for another
+    /// camera, or null. The build takes from it what does not depend on the camera and was
+    /// built with the same parameters (the light buffer; the irregular scheme's lights'
+    /// structures) instead of building it again: the viewer's rebuild after a camera move.
+    /// The caller keeps it alive during the build; the new structure does not refer to it.
+    const Accelerator* previous = nullptr;
 };
 
 /// Checks a running build against its control: builders call poll() in their loops (an atomic

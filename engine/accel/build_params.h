@@ -170,6 +170,7 @@ struct IrregularConfig {
     int objects() const { return maxObjects == kAutoObjects ? kAutoObjectsCount : maxObjects; }
     /// Whether the cost stop decides: with the automatic max-objects, unless turned off.
     bool usesCostStop() const { return costStop && maxObjects == kAutoObjects; }
+    bool operator==(const IrregularConfig&) const = default;  ///< every knob equal
 };
 
 /// Builder parameters: the scheme, the knobs every scheme reads, and each scheme's Config.

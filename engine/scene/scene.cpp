@@ -1,5 +1,6 @@
 #include "engine/scene/scene.h"
 
+#include <atomic>
 #include <cmath>
 
 #include "engine/model/restriction.h"
@@ -31,6 +32,8 @@ void Scene::prepare() {
         if (const Sphere* sp = std::get_if<Sphere>(&prims[i].shape); sp && !prims[i].hasXf)
             packedSpheres[i] = {sp->c, sp->r};
     prepared = true;
+    static std::atomic<uint64_t> preparations{0};
+    preparedId = ++preparations;
 }
 
 int Scene::primSpansFloat(uint32_t p, const Ray& ray, Span* out) const {

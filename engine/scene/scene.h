@@ -79,6 +79,10 @@ struct Scene {
     /// a call, and reads 7,000 of them from a quarter of a megabyte, not from the primitives.
     std::vector<PackedSphere> packedSpheres;
     bool prepared = false;
+    /// Set by prepare(), a different value at each preparation: copies share it, so a structure
+    /// built over one copy may lend its camera-independent parts to a build over another with
+    /// only its camera changed (BuildControl::previous). 0: not prepared.
+    uint64_t preparedId = 0;
 
     /// Validate (surfaces under unions only), minimize boxes, drop primitives that cannot
     /// contribute (restricting the tree to the rest). Throws SceneError.

@@ -91,14 +91,14 @@ TEST(StructureBuilder, ASupersededBuildIsCancelledWithin100Ms) {
         StructureBuilder builder;
         returns.hook(builder);
         const Clock::time_point started = Clock::now();
-        builder.request({"builtin:balls:5", big, slow, {}, {}, {}});
+        builder.request({"builtin:balls:5", big, slow, {}, {}, {}, {}});
         std::this_thread::sleep_for(half);
         ASSERT_EQ(returns.count(), 0u) << "the build ended within half its own time";
         // The viewer's next request: a slider moved, the same scene at other parameters.
         BuildParams quick;
         quick.scheme = SchemeKind::Regular;
         const Clock::time_point asked = Clock::now();
-        const uint64_t id = builder.request({"builtin:default", small, quick, {}, {}, {}});
+        const uint64_t id = builder.request({"builtin:default", small, quick, {}, {}, {}, {}});
         const double latency = msBetween(asked, returns.wait(1));
         std::printf("%s build superseded after %.0f ms: returned in %.1f ms\n",
                     schemeName(slow.scheme), msBetween(started, asked), latency);
@@ -126,7 +126,7 @@ TEST(StructureBuilder, ClosingCancelsTheBuildInProgress) {
         Returns returns;
         auto builder = std::make_unique<StructureBuilder>();
         returns.hook(*builder);
-        builder->request({"builtin:balls:5", big, slow, {}, {}, {}});
+        builder->request({"builtin:balls:5", big, slow, {}, {}, {}, {}});
         std::this_thread::sleep_for(half);
         ASSERT_EQ(returns.count(), 0u) << "the build ended within half its own time";
         const Clock::time_point asked = Clock::now();

@@ -255,6 +255,42 @@ TEST(ViewerImage, TheFirstImageAndEachViewOfADragComeInPartsNeverWhole) {
     ImGui::DestroyContext();
 }
 
+TEST(ViewerState, ARebuildAfterACameraMoveTakesTheLightsStructuresOfTheLastBuild) {
+    // The irregular scheme's structure follows the camera; its lights' structures and the light
+    // buffer do not, so the rebuild after a move takes them from the structure it replaces.
+    ImGui::CreateContext();
+    ViewerSettings settings;
+    settings.scene = "builtin:balls:2";
+    settings.build.scheme = SchemeKind::Irregular;
+    {
+        ViewerState state(settings, false, {});
+        const auto start = std::chrono::steady_clock::now();
+        const auto waitFor = [&](auto done) {
+            while (!done() && std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
+                state.poll();
+                state.startWork(320, 200);  // where a camera move asks for the rebuild
+                std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            }
+            return done();
+        };
+        ASSERT_TRUE(waitFor([&] { return state.sceneBuild() != nullptr; }));
+        const std::shared_ptr<const SceneBuild> first = state.sceneBuild();
+        const nlohmann::json& x0 = first->accel->info().extra;
+        ASSERT_GT(x0["light_structures"].get<size_t>(), 0u);
+        EXPECT_FALSE(x0["lights_lent"].get<bool>());
+        Camera c = state.camera();
+        orbit(c, 0.5, 0.0);
+        state.setCamera(c);
+        ASSERT_TRUE(waitFor([&] { return state.sceneBuild() != first; }));
+        const nlohmann::json& x1 = state.sceneBuild()->accel->info().extra;
+        EXPECT_TRUE(x1["lights_lent"].get<bool>());
+        EXPECT_TRUE(x1["light_buffer_lent"].get<bool>());
+        EXPECT_EQ(x1["light_slabs"], x0["light_slabs"]);
+        EXPECT_EQ(state.sceneBuild()->scene->camera.from, c.from);
+    }
+    ImGui::DestroyContext();
+}
+
 TEST(ViewerGl, PanelsFromTheirTexturesMatchImGuisOwnDrawingAndRedrawOnlyWhenChanged) {
     const int w = 420, h = 300;
     OffscreenGl gl(w, h);

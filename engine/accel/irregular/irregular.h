@@ -54,9 +54,12 @@ class IrregularSubdivision {
     /// std::invalid_argument for refused parameters or a structure over its limits,
     /// BuildCancelled when `guard`'s stop is requested. Within the guard's memory budget the 2D
     /// step stops and slabs merge. `guard` null: a default BuildGuard (the default budget, no
-    /// cancellation).
+    /// cancellation). `previous`: a structure built over a copy of the same prepared scene
+    /// for another camera (BuildControl::previous), whose lights' structures are taken (copied)
+    /// when they were built with the same knobs, budget and image size; null: none.
     static IrregularSubdivision build(const Scene& scene, const IrregularConfig& params,
-                                      nlohmann::json& extra, BuildGuard* guard = nullptr);
+                                      nlohmann::json& extra, BuildGuard* guard = nullptr,
+                                      const IrregularSubdivision* previous = nullptr);
 
     template <class Obs>
     bool intersect(const Ray& ray, double tmin, double tmax, TraceContext& ctx, Obs& obs,
@@ -116,13 +119,22 @@ class IrregularSubdivision {
     int64_t walkTo(uint32_t from, const Vec3& p) const;
 
   private:
-    /// Region ids of the lights' structures (built into lights_) and their figures to `extra`:
-    /// `inside` lights in the bounds, `overLimit` beyond the most that get one, over[i] light i's
-    /// over its share of the budget, ms[i] its build time.
-    void finishLights(size_t inside, size_t overLimit, const std::vector<char>& over,
-                      const std::vector<double>& ms, nlohmann::json& extra);
+    /// Region ids of the lights' structures (lights_, with lightsInside_, lightsOverLimit_ and
+    /// lightOver_ set) and their figures to `extra`: ms[i] light i's build time (empty: taken
+    /// from `previous` build, not built).
+    void finishLights(const std::vector<double>& ms, nlohmann::json& extra);
     /// Bytes of the lights' structures.
     size_t lightBytes() const;
+
+    /// What the lights' structures depend on besides the scene's geometry and lights (none of
+    /// it the camera): a build over the same prepared scene with an equal key takes them.
+    struct LightKey {
+        uint64_t scene = 0;  ///< Scene::preparedId
+        IrregularConfig config;
+        size_t share = 0;       ///< each structure's share of the budget
+        size_t maxRegions = 0;  ///< the slabs' region bound (it follows the image size)
+        bool operator==(const LightKey&) const = default;
+    };
     /// p is below region r on axis a (or on its low face, going down).
     bool below(uint32_t r, int a, const Vec3& p, const Vec3& d) const {
         const Box3& b = regions_[r].box;
@@ -153,6 +165,11 @@ class IrregularSubdivision {
     ProjectiveZones projective_;              ///< primary rays (region ids from regions_.size() on)
     std::vector<ProjectiveZones> lights_;     ///< per scene light: shadow rays toward it
     std::vector<uint32_t> lightFirstRegion_;  ///< region ids of lights_[i] from [i] on
+    LightKey lightKey_;                       ///< what lights_ were built for
+    /// Lights inside the bounds, beyond the limit, and whether each was over its share: the
+    /// counts of the build that made lights_, reported again by one that takes them.
+    size_t lightsInside_ = 0, lightsOverLimit_ = 0;
+    std::vector<char> lightOver_;
     std::vector<IrregularRegion> regions_;
     std::vector<uint32_t> zoneFirstRegion_;  ///< zone z: regions [zoneFirstRegion_[z], [z + 1])
     CsgTree pool_;

@@ -78,6 +78,14 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
         for (int c = 0; c < 8; ++c) s.corner[c] = frame.point(axes * boxCorner(w, c));
         return s;
     };
+    // A frame along the world's axes (each axis one world axis, either way: a light's frame)
+    // keeps a world box a box along its own axes.
+    auto worldAxis = [](const Vec3& a) {
+        const Vec3 m = glm::abs(a);
+        return (m.x == 1.0 && m.y == 0.0 && m.z == 0.0) ||
+               (m.x == 0.0 && m.y == 1.0 && m.z == 0.0) || (m.x == 0.0 && m.y == 0.0 && m.z == 1.0);
+    };
+    const bool alongWorld = worldAxis(frame.x) && worldAxis(frame.y) && worldAxis(frame.z);
     h.index_.assign(scene.prims.size(), -1);
     for (uint32_t p : live) {
         if (scene.minBox[p].isEmpty()) continue;
@@ -99,16 +107,22 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
             hull.single = true;
         }
         hull.world = solid(scene.minBox[p], Mat3(1.0));
+        if (hull.single && alongWorld) {
+            hull.aligned = true;
+            for (const Vec3& q : hull.world.corner) hull.box.expand(q);
+        }
+        // An aligned hull's outline is its box's, tested in closed form (touches).
         std::vector<glm::dvec2> flat, eye;
-        bool front = true;
+        bool front = !hull.aligned;
         for (const Vec3& c : (hull.single ? hull.world : hull.turned).corner) {
+            if (hull.aligned) break;
             flat.push_back({c.x, c.y});
             front = front && c.z > 0.0;
             if (front) eye.push_back({c.x / c.z, c.y / c.z});
         }
         for (int c = 0; c < 2; ++c) {
             std::vector<glm::dvec2> o;
-            if (c == 0) o = convexHull2(flat);
+            if (c == 0 && !hull.aligned) o = convexHull2(flat);
             if (c == 1 && front) o = convexHull2(eye);
             hull.outlineSize[c] = int(o.size());  // the hull of 8 points: at most 8
             std::copy(o.begin(), o.end(), hull.outline[c].begin());
@@ -125,9 +139,46 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
     return h;
 }
 
+glm::dvec2 PrimitiveHulls::alignedDepth(const Box3& b, ZoneColumn column, glm::dvec2 lo,
+                                        glm::dvec2 hi, double zNear) {
+    constexpr glm::dvec2 kMiss(kInf, -kInf);
+    if (column == ZoneColumn::Parallel)
+        return b.lo.x > hi.x || b.hi.x < lo.x || b.lo.y > hi.y || b.hi.y < lo.y
+                   ? kMiss
+                   : glm::dvec2(b.lo.z, b.hi.z);
+    // The rays from the eye through [lo, hi] at depth z > 0 cover [lo z, hi z] in x and y: the
+    // box's points there, if any, are where lo.x z <= b.hi.x and hi.x z >= b.lo.x (and in y),
+    // each a half-line of depths. The extremes are those of the box cut by the column, whose
+    // sides are planes: a face of the box or a column side holds them, as clipping finds.
+    double z0 = std::max(b.lo.z, zNear), z1 = b.hi.z;
+    for (int k = 0; k < 2; ++k) {
+        // lo[k] z <= b.hi[k]
+        if (lo[k] > 0.0)
+            z1 = std::min(z1, b.hi[k] / lo[k]);
+        else if (lo[k] < 0.0)
+            z0 = std::max(z0, b.hi[k] / lo[k]);
+        else if (b.hi[k] < 0.0)
+            return kMiss;
+        // hi[k] z >= b.lo[k]
+        if (hi[k] > 0.0)
+            z0 = std::max(z0, b.lo[k] / hi[k]);
+        else if (hi[k] < 0.0)
+            z1 = std::min(z1, b.lo[k] / hi[k]);
+        else if (b.lo[k] > 0.0)
+            return kMiss;
+    }
+    return z0 <= z1 ? glm::dvec2(z0, z1) : kMiss;
+}
+
 bool PrimitiveHulls::touches(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi) const {
     if (index_.empty() || index_[p] < 0) return true;
     const Hull& h = hulls_[index_[p]];
+    // In front of the eye, the rectangle meets the box's outline where the rays through it meet
+    // the box. The quotients' rounding (a few ulps of the depth) is kept on the side of meeting.
+    if (h.aligned && (column == ZoneColumn::Parallel || h.box.lo.z > 0.0)) {
+        const glm::dvec2 d = alignedDepth(h.box, column, lo, hi, 0.0);
+        return d.x <= d.y + 1e-12 * std::abs(d.y);
+    }
     const std::array<glm::dvec2, 8>& o = h.outline[int(column)];
     const size_t n = size_t(h.outlineSize[int(column)]);
     if (n < 3) return true;
@@ -142,6 +193,10 @@ glm::dvec2 PrimitiveHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo,
                                    double zNear, glm::dvec2 whole) const {
     if (index_.empty() || index_[p] < 0) return whole;
     const Hull& h = hulls_[index_[p]];
+    if (h.aligned && (column == ZoneColumn::Parallel || zNear > 0.0)) {
+        const glm::dvec2 d = alignedDepth(h.box, column, lo, hi, zNear);
+        return {std::max(d.x, whole.x), std::min(d.y, whole.y)};
+    }
     // The column's planes n . x <= d: the rectangle swept along z, or the rays from the eye
     // through it (u0 <= x / z <= u1 .. for z > 0) and z >= zNear.
     std::array<Vec3, 5> cn;

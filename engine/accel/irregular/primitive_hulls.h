@@ -64,6 +64,11 @@ class PrimitiveHulls {
     struct Hull {
         Solid turned, world;
         bool single = false;  ///< no box of its own axes: the world box alone (`turned` unset)
+        /// `single`, in a frame whose axes are the world's (a light's, lightFrame): the world box
+        /// is `box` there, and its outline and depths over a column come in closed form
+        /// (alignedDepth) instead of by clipping its faces.
+        bool aligned = false;
+        Box3 box;
         /// The turned box's outline (the world box's when `single`), a convex polygon
         /// counterclockwise, along each column (`FromEye`: none when a corner is not in front
         /// of the eye), and its bounding rectangle.
@@ -71,6 +76,11 @@ class PrimitiveHulls {
         int outlineSize[2] = {0, 0};
         glm::dvec2 outlineLo[2], outlineHi[2];
     };
+    /// The depth range of an `aligned` hull's box within the column over [lo, hi] at
+    /// z >= zNear (lo > hi: it misses the column).
+    static glm::dvec2 alignedDepth(const Box3& b, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi,
+                                   double zNear);
+
     std::vector<int32_t> index_;  ///< per primitive: its hull, or -1
     std::vector<Hull> hulls_;
 };

@@ -71,6 +71,9 @@ class ProjectiveZones {
                    uint32_t firstId, TraceContext& ctx, Obs& obs, Hit& hit) const;
 
     size_t regionCount() const { return zones_ == 0 ? 0 : slabRoot_.size() + 1; }
+    /// Walk over `scene`'s primitives from now on: a copy of the scene it was built over
+    /// (the same Scene::preparedId), for a structure another build lends (BuildControl::previous).
+    void rebind(const Scene& scene) { scene_ = &scene; }
     size_t memoryBytes() const;
     size_t zoneCount() const { return zones_; }
     /// Slabs that list nothing, zones with none but empty slabs.
