@@ -9,7 +9,9 @@
 #include <fstream>
 #include <random>
 
+#include "engine/accel/build_guard.h"
 #include "engine/accel/irregular/primitive_hulls.h"
+#include "engine/accel/irregular/screen_bsp.h"
 #include "engine/accel/regular/grid_frame.h"
 #include "engine/model/restriction.h"
 #include "engine/scene/loader.h"
@@ -837,6 +839,32 @@ TEST(PrimitiveHulls, AlongTheWorldsAxesTheClosedFormHoldsTheBoxesPoints) {
     }
     EXPECT_GT(samples, 10000u);
     EXPECT_GT(misses, 0u) << pairs << " pairs";
+}
+
+// The hulls and the zones' depth ranges are made in loops that grow with the scene (balls:5:
+// about a tenth of a second each): both stop at a cancellation, as the rest of the build does.
+TEST(PrimitiveHulls, MakingAndNarrowingStopWhenTheBuildIsCancelled) {
+    Scene s = loadScene(std::string(LANCER_SOURCE_DIR) + "/assets/spd/gears1.nff");
+    const CameraFrame frame = CameraFrame::of(s.camera);
+    const std::vector<uint32_t> live = s.livePrimitives();
+    const double pad = 1e-9 * s.scale();
+    const PrimitiveHulls hulls = PrimitiveHulls::make(s, frame, FrameChoice{}, live, pad);
+    std::vector<Box3> box(s.prims.size());
+    for (uint32_t p : live) box[p] = frame.box(s.minBox[p]);
+    const Box3 cam = frame.box(s.bounds);
+    ScreenBsp bsp = ScreenBsp::build(box, live, {cam.lo.x, cam.lo.y}, {cam.hi.x, cam.hi.y}, {});
+    std::stop_source stop;
+    BuildGuard running(0, {stop.get_token(), {}});
+    EXPECT_NO_THROW(PrimitiveHulls::make(s, frame, FrameChoice{}, live, pad, &running));
+    ScreenBsp copy = bsp;
+    EXPECT_NO_THROW(
+        narrowZones(copy, hulls, ZoneColumn::Parallel, box, cam.lo.z, cam.hi.z, pad, &running));
+    stop.request_stop();
+    EXPECT_THROW(PrimitiveHulls::make(s, frame, FrameChoice{}, live, pad, &running),
+                 BuildCancelled);
+    EXPECT_THROW(
+        narrowZones(bsp, hulls, ZoneColumn::Parallel, box, cam.lo.z, cam.hi.z, pad, &running),
+        BuildCancelled);
 }
 
 // The hulls of an unturned scene (SPD's gears1: polygons on and off the world's axes, seen

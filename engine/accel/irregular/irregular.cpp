@@ -132,7 +132,8 @@ ProjectiveZones buildLightZones(const Scene& scene, const CameraFrame& f, const 
     const bool hullsFit =
         PrimitiveHulls::bytesFor(live.size(), scene.prims.size()) <= share / kHullShare;
     const PrimitiveHulls hulls =
-        hullsFit ? PrimitiveHulls::make(scene, f, turned, live, eps) : PrimitiveHulls{};
+        hullsFit ? PrimitiveHulls::make(scene, f, turned, live, eps, frameSp.guard)
+                 : PrimitiveHulls{};
     ScreenBspParams sp = frameSp;
     sp.hulls = hulls.empty() ? nullptr : &hulls;
     sp.hullPad = eps;
@@ -225,7 +226,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     const bool hullsFit =
         PrimitiveHulls::bytesFor(live.size(), scene.prims.size()) <= guard.budget() / kHullShare;
     const PrimitiveHulls hulls =
-        hullsFit ? PrimitiveHulls::make(scene, s.frame_, turned, live, eps) : PrimitiveHulls{};
+        hullsFit ? PrimitiveHulls::make(scene, s.frame_, turned, live, eps, &guard)
+                 : PrimitiveHulls{};
     if (!hulls.empty()) sp.hulls = &hulls;
     sp.column = ZoneColumn::Parallel;
     sp.hullPad = eps;
@@ -296,8 +298,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
         // 3D step.
         guard.poll();
         auto t1 = Clock::now();
-        const std::vector<glm::dvec2> depth = narrowZones(s.bsp_, hulls, ZoneColumn::Parallel, box,
-                                                          s.bounds_.lo.z, s.bounds_.hi.z, eps);
+        const std::vector<glm::dvec2> depth = narrowZones(
+            s.bsp_, hulls, ZoneColumn::Parallel, box, s.bounds_.lo.z, s.bounds_.hi.z, eps, &guard);
         slabs = buildDepthSlabs(scene, s.bsp_, depth, s.bounds_.lo.z, s.bounds_.hi.z, &guard,
                                 slabBytes, maxRegions);
         if (slabs.regions.size() > kMaxRegions)

@@ -20,6 +20,7 @@
 
 namespace lancer {
 
+class BuildGuard;  // build_guard.h
 struct ScreenBsp;  // screen_bsp.h
 
 /// The rays a screen zone stands for: its rectangle swept along depth in the camera frame
@@ -32,9 +33,10 @@ class PrimitiveHulls {
     /// The hulls of the primitives `live`: each one's minimized world box and its box along the
     /// turned frame of `turned` (chooseGridFrame) when it has one, else along its own plane for
     /// a triangle or polygon off the world's axes; each widened by `pad` on every side.
+    /// `guard` (null: none) is polled for cancellation.
     static PrimitiveHulls make(const Scene& scene, const CameraFrame& frame,
                                const FrameChoice& turned, const std::vector<uint32_t>& live,
-                               double pad);
+                               double pad, const BuildGuard* guard = nullptr);
 
     /// Bytes the hulls of `prims` primitives take in a scene of `total` (the build's scratch,
     /// which the memory budget leaves room for before they are made).
@@ -88,9 +90,10 @@ class PrimitiveHulls {
 /// Narrows the zones of `bsp` to what the hulls hold: drops from each zone the primitives whose
 /// hull misses its column, and gives each remaining reference (bsp.zonePrims' order) its depth
 /// range there, padded by `pad` and within the primitive's `box` depths clamped to [zlo, zhi].
-/// Empty hulls: every reference keeps its box's depths.
+/// Empty hulls: every reference keeps its box's depths. `guard` (null: none) is polled for
+/// cancellation.
 std::vector<glm::dvec2> narrowZones(ScreenBsp& bsp, const PrimitiveHulls& hulls, ZoneColumn column,
                                     const std::vector<Box3>& box, double zlo, double zhi,
-                                    double pad);
+                                    double pad, const BuildGuard* guard = nullptr);
 
 }  // namespace lancer

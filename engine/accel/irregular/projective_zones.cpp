@@ -114,7 +114,8 @@ ProjectiveZones ProjectiveZones::buildCentred(const Scene& scene, const CameraFr
     s.bsp_ = ScreenBsp::build(pbox, inside, lo, hi, eyeParams);
     const std::vector<glm::dvec2> depth =
         sp.hulls
-            ? narrowZones(s.bsp_, *sp.hulls, ZoneColumn::FromEye, pbox, zNear, zFar, sp.hullPad)
+            ? narrowZones(s.bsp_, *sp.hulls, ZoneColumn::FromEye, pbox, zNear, zFar, sp.hullPad,
+                          sp.guard)
             : narrowZones(s.bsp_, PrimitiveHulls{}, ZoneColumn::FromEye, pbox, zNear, zFar, 0.0);
     DepthSlabs slabs =
         buildDepthSlabs(scene, s.bsp_, depth, zNear, zFar, sp.guard, maxSlabBytes, maxRegions);
