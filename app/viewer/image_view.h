@@ -71,6 +71,14 @@ class ImageView {
     void setHold(bool hold) { hold_ = hold; }
     /// draw() draws a picture: something was uploaded, and it is not held before a first one.
     bool showsPicture() const { return width_ > 0 && (!hold_ || shadedWidth_ > 0); }
+    /// What the last draw() that shaded composited: image rows composited whole, texels
+    /// composited again for a new layer's changes, and the texels those uploaded (the
+    /// rectangles around them).
+    struct ShadeCount {
+        int rows = 0;
+        size_t texels = 0, uploadedTexels = 0;
+    };
+    const ShadeCount& lastShade() const { return lastShade_; }
     /// Size of the uploaded image (0 x 0 before the first upload).
     int width() const { return width_; }
     int height() const { return height_; }
@@ -83,6 +91,12 @@ class ImageView {
     /// The colour image's rows [rowBegin, rowEnd) with the layer over them, into the FBO's
     /// texture.
     void compose(int rowBegin, int rowEnd) const;
+    /// The texels where the layer differs from the one the picture was composited with, into
+    /// the FBO's texture: the other texels are already right. Image rows [skipBegin, skipEnd)
+    /// are left out (composited whole by compose()).
+    void composeLayerChanges(int skipBegin, int skipEnd) const;
+    /// The layer's pixels are one per image pixel (the viewer draws it at the image's size).
+    bool layerAtImageSize() const;
     /// The heat map's rows [rowBegin, rowEnd) through the colour-map shader.
     void shadeHeat(float scale, bool logScale, bool diverging, int rowBegin, int rowEnd) const;
 
@@ -91,7 +105,13 @@ class ImageView {
     std::vector<uint8_t> colorRgba_;    ///< the colour image as 8-bit RGBA, row 0 on top
     std::vector<uint8_t> overlayRgba_;  ///< the layer's pixels (row 0 at the bottom); empty: none
     int overlayWidth_ = 0, overlayHeight_ = 0;
-    mutable std::vector<uint8_t> composed_;  ///< compose()'s rows, reused
+    /// The composited colour image (FBO rows, row 0 at the bottom), as in the FBO's texture.
+    mutable std::vector<uint8_t> composed_;
+    /// The layer's pixels composed_ was composited with (empty: a layer of another size or
+    /// none; then a new layer composites the whole image).
+    mutable std::vector<uint8_t> composedLayer_;
+    mutable bool layerChanged_ = false;  ///< a new layer since the last shade()
+    mutable ShadeCount lastShade_;
     mutable bool shadedValid_ = false;
     mutable ViewMode shadedMode_ = ViewMode::Color;
     mutable float shadedScale_ = 0.0f;

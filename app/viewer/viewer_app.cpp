@@ -36,6 +36,16 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
     overlays_->buildInBackground(wake);
     inspector_->buildInBackground(std::move(wake));
     inspector_->drawInParts(1000, 4.0);
+    // One budget for the frame (FrameBudget): each step that may leave work for the next
+    // frame keeps back what the steps after it take in a frame that runs them all (balls4's
+    // slabs with the inspector, the slow-frame lines of --log-timings, 2026-12-06): after the
+    // layer, the image's changed texels (3-5 ms), a band of the inspector's picture (about
+    // 4 ms) and the panel layer; after the inspector, the panel layer (its copies about 3 ms,
+    // a changed panel about 1 ms more) and the swap; after a panel, the copies of the panels
+    // and the swap.
+    overlays_->setFrameBudget(&budget_, 12.0);
+    inspector_->setFrameBudget(&budget_, 8.0);
+    panels_.setFrameBudget(&budget_, 5.0);
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
     // drawn at all, and each is copied from a layer where it is redrawn only when it changes
     // (frame(), PanelCache).
@@ -120,6 +130,7 @@ PixelRect toPixels(const Rect& r, glm::vec2 scale) {
 void ViewerApp::frame(int fbWidth, int fbHeight) {
     // 1. Poll: the structure and the image the workers finished since the last frame.
     phases_.begin();
+    budget_.begin();
     state_.poll();
     phases_.mark("poll");
 
@@ -312,7 +323,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         notes.pendingScreenshot.clear();
     }
     settled_ = state_.settledSince() && inspector_->settled() && !overlays_->building() &&
-               !overlays_->layerPending() && !player_.pending() && !player_.playback().playing();
+               !overlays_->layerPending() && !player_.pending() && !player_.playback().playing() &&
+               panels_.deferred() == 0;
     keepSettings();
 }
 

@@ -187,6 +187,110 @@ TEST(ViewerGl, AnUploadOfSomeRowsReplacesThoseRowsOnlyAndAHoldDefersThemAtAnySiz
     for (int y : {0, h - 1}) ASSERT_LE(maxDiff(&shown[4 * a.index(7, y)], a.color[0]), 1) << y;
 }
 
+/// A w x h RGBA8 texture of premultiplied texels (GL's rows: row 0 at the bottom).
+unsigned layerTextureOf(int w, int h, const std::vector<uint8_t>& texels) {
+    unsigned tex = 0;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, texels.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
+    return tex;
+}
+
+TEST(ViewerGl, ANewLayerCompositesOnlyTheTexelsItChangedAndEqualsTheWholeComposite) {
+    const int w = 160, h = 96;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    // An image of many colours and a layer of scattered premultiplied texels.
+    Image img(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            img.color[img.index(x, y)] =
+                glm::vec3(float(x) / w, float(y) / h, float((x * 7 + y * 3) % 11) / 11.0f);
+    std::vector<uint8_t> texels(size_t(w) * h * 4, 0);
+    auto put = [&](int x, int y, uint8_t v, uint8_t a) {
+        uint8_t* p = &texels[(size_t(y) * w + size_t(x)) * 4];
+        p[0] = v, p[1] = uint8_t(v / 2), p[2] = 0, p[3] = a;
+    };
+    for (int i = 0; i < w * h; i += 37) put(i % w, i / w, 120, 200);
+    const unsigned tex = layerTextureOf(w, h, texels);
+    // The picture a view shows with `layer` composited whole (a view that never saw another).
+    auto whole = [&](const std::vector<uint8_t>& layer) {
+        const unsigned t = layerTextureOf(w, h, layer);
+        ImageView fresh;
+        fresh.upload(img, ViewMode::Color);
+        fresh.setOverlay(t, 1);
+        gl.clear(0, 0, 0);
+        fresh.draw(w, h, ViewMode::Color, 1.0f);
+        glDeleteTextures(1, &t);
+        return gl.read();
+    };
+    ImageView view;
+    view.upload(img, ViewMode::Color);
+    view.setOverlay(tex, 1);
+    gl.clear(0, 0, 0);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    EXPECT_EQ(view.lastShade().rows, h) << "the first layer: the whole image";
+    // A part of the layer lights a few texels in rows 40-42 and clears one: only those are
+    // composited again, and uploaded in their band's rectangle.
+    size_t changed = 0;
+    for (int x = 20; x < 50; ++x)
+        for (int y = 40; y < 43; ++y) {
+            uint8_t* p = &texels[(size_t(y) * w + size_t(x)) * 4];
+            const bool was = p[3] == 230;
+            put(x, y, 230, 230);
+            changed += !was;
+        }
+    ASSERT_EQ(texels[(size_t(37) * w + 0) * 4 + 3], 200);  // (0, 37), lit: back to transparent
+    std::fill_n(&texels[(size_t(37) * w + 0) * 4], 4, uint8_t(0));
+    ++changed;
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, texels.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
+    view.setOverlay(tex, 2);
+    gl.clear(0, 0, 0);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    EXPECT_EQ(view.lastShade().rows, 0) << "no row composited whole";
+    EXPECT_EQ(view.lastShade().texels, changed);
+    EXPECT_LT(view.lastShade().uploadedTexels, size_t(w) * 16 * 2) << "two bands at most";
+    EXPECT_EQ(gl.read(), whole(texels)) << "the same picture as the whole composite";
+    // The same layer again: nothing composited.
+    view.setOverlay(tex, 2);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    EXPECT_EQ(view.lastShade().texels, 0u);
+    // Rows of a new pass and a new layer in one frame: the rows whole, the other rows' changed
+    // texels; the picture is the whole composite of both.
+    for (int y = 60; y < 70; ++y)
+        for (int x = 0; x < w; ++x) img.color[img.index(x, y)] = glm::vec3(0.9f, 0.2f, 0.1f);
+    view.upload(img, ViewMode::Color, 60, 70);
+    for (int x = 0; x < w; x += 3) put(x, h - 1 - 65, 90, 90);  // inside the new rows
+    for (int x = 0; x < w; x += 5) put(x, 10, 60, 255);         // outside them
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, texels.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
+    view.setOverlay(tex, 3);
+    gl.clear(0, 0, 0);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    EXPECT_EQ(view.lastShade().rows, 10);
+    EXPECT_EQ(view.lastShade().texels, size_t((w + 4) / 5));
+    EXPECT_EQ(gl.read(), whole(texels));
+    // While held, a new layer waits with the rows; once released the picture is the whole one.
+    view.setHold(true);
+    for (int x = 0; x < w; x += 2) put(x, 80, 200, 210);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, texels.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
+    view.setOverlay(tex, 4);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    view.setHold(false);
+    gl.clear(0, 0, 0);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    EXPECT_EQ(view.lastShade().texels, size_t(w / 2));
+    EXPECT_EQ(gl.read(), whole(texels));
+    glDeleteTextures(1, &tex);
+}
+
 TEST(ViewerImage, TheFirstImageAndEachViewOfADragComeInPartsNeverWhole) {
     // The state alone (no GL): its snapshots at 1280x720, where a part is a third of the rows.
     ImGui::CreateContext();
