@@ -152,6 +152,8 @@ class ViewerApp {
     /// The frame's budget shared by the steps that may leave work for the next frame (the
     /// overlays' copy and layer parts, the inspector's picture, the panel redraws).
     FrameBudget& frameBudget() { return budget_; }
+    /// Panels the last frame rasterized again (the rest were copied from the panel layer).
+    int panelsRedrawn() const { return panels_.redrawn(); }
     const FrameBudget& frameBudget() const { return budget_; }
 
   private:
