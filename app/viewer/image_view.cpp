@@ -136,6 +136,39 @@ void blendTexel(const uint8_t* c, const uint8_t* p, uint8_t* o) {
     o[3] = 255;
 }
 
+/// Texels [x0, x1) of an image row `c` with the layer's texels `l` (texel x at l + column[x])
+/// over them, into `o`. Runs of transparent layer texels (most of a layer of lines:
+/// premultiplied, all zero) are the image's bytes, copied as a run.
+void composeSpan(const uint8_t* c, const uint8_t* l, const size_t* column, uint8_t* o, size_t x0,
+                 size_t x1) {
+    for (size_t x = x0; x < x1;) {
+        size_t run = x;
+        while (run < x1 && transparent(l + column[run])) ++run;
+        if (run > x) {
+            std::memcpy(o + 4 * x, c + 4 * x, 4 * (run - x));
+            x = run;
+            continue;
+        }
+        blendTexel(c + 4 * x, l + column[x], o + 4 * x);
+        ++x;
+    }
+}
+
+/// The first texel at or after `x` where rows `a` and `b` of `w` texels differ (w: none),
+/// blocks of 16 equal texels skipped at once.
+size_t firstDiff(const uint8_t* a, const uint8_t* b, size_t x, size_t w) {
+    while (x + 16 <= w && std::memcmp(a + 4 * x, b + 4 * x, 64) == 0) x += 16;
+    while (x < w && std::memcmp(a + 4 * x, b + 4 * x, 4) == 0) ++x;
+    return x;
+}
+
+/// One past the last texel before `x` where the rows differ (0: none), from the right.
+size_t lastDiff(const uint8_t* a, const uint8_t* b, size_t x) {
+    while (x >= 16 && std::memcmp(a + 4 * (x - 16), b + 4 * (x - 16), 64) == 0) x -= 16;
+    while (x > 0 && std::memcmp(a + 4 * (x - 1), b + 4 * (x - 1), 4) == 0) --x;
+    return x;
+}
+
 }  // namespace
 
 bool ImageView::layerAtImageSize() const {
@@ -164,20 +197,8 @@ void ImageView::compose(int rowBegin, int rowEnd) const {
         }
         const int fboRow = height_ - 1 - r;
         const size_t ly = size_t(2 * fboRow + 1) * size_t(overlayHeight_) / size_t(2 * height_);
-        const uint8_t* l = overlayRgba_.data() + ly * size_t(overlayWidth_) * 4;
-        for (size_t x = 0; x < w;) {
-            // Runs of transparent layer texels (most of a layer of lines: premultiplied, all
-            // zero) are the image's bytes, copied as a run.
-            size_t run = x;
-            while (run < w && transparent(l + column[run])) ++run;
-            if (run > x) {
-                std::memcpy(o + 4 * x, c + 4 * x, 4 * (run - x));
-                x = run;
-                continue;
-            }
-            blendTexel(c + 4 * x, l + column[x], o + 4 * x);
-            ++x;
-        }
+        composeSpan(c, overlayRgba_.data() + ly * size_t(overlayWidth_) * 4, column.data(), o, 0,
+                    w);
     }
     // The layer these rows were composited with, for the next version's changed texels.
     if (layerAtImageSize() && (composedLayer_.size() == overlayRgba_.size() || rows == height_)) {
@@ -198,11 +219,14 @@ void ImageView::compose(int rowBegin, int rowEnd) const {
 
 void ImageView::composeLayerChanges(int skipBegin, int skipEnd) const {
     // Only texels where the layer differs from the one composited change the picture: rows of
-    // the layer equal to the old ones are skipped whole (memcmp), the others blend only their
-    // changed texels, and each band of kBand rows uploads the rectangle of its changed texels.
-    // Image rows [skipBegin, skipEnd) were composited whole with this layer already.
+    // the layer equal to the old ones are skipped whole (memcmp), the others composite again
+    // the span from their first to their last changed texel, and each band of kBand rows
+    // uploads the rectangle of its spans. Image rows [skipBegin, skipEnd) were composited
+    // whole with this layer already.
     constexpr int kBand = 16;
     const size_t w = size_t(width_), rowBytes = w * 4;
+    std::vector<size_t> column(w);
+    for (size_t x = 0; x < w; ++x) column[x] = 4 * x;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, width_);
     glBindTexture(GL_TEXTURE_2D, shadedTex_);
@@ -215,27 +239,17 @@ void ImageView::composeLayerChanges(int skipBegin, int skipEnd) const {
             const size_t at = size_t(fr) * rowBytes;
             const uint8_t* nl = overlayRgba_.data() + at;
             uint8_t* ol = composedLayer_.data() + at;
-            if (std::memcmp(nl, ol, rowBytes) == 0) continue;
-            const uint8_t* c = colorRgba_.data() + size_t(r) * rowBytes;
-            uint8_t* o = composed_.data() + at;
-            for (size_t x = 0; x < w; ++x) {
-                // Blocks of 16 equal texels skipped at once: most of a changed row is equal.
-                if (x % 16 == 0 && x + 16 <= w && std::memcmp(nl + 4 * x, ol + 4 * x, 64) == 0) {
-                    x += 15;
-                    continue;
-                }
-                if (std::memcmp(nl + 4 * x, ol + 4 * x, 4) == 0) continue;
-                if (transparent(nl + 4 * x))
-                    std::memcpy(o + 4 * x, c + 4 * x, 4);
-                else
-                    blendTexel(c + 4 * x, nl + 4 * x, o + 4 * x);
-                std::memcpy(ol + 4 * x, nl + 4 * x, 4);
-                x0 = std::min(x0, x);
-                x1 = std::max(x1, x + 1);
-                y0 = std::min(y0, fr);
-                y1 = std::max(y1, fr + 1);
-                ++lastShade_.texels;
-            }
+            const size_t a = firstDiff(nl, ol, 0, w);
+            if (a == w) continue;
+            const size_t b = lastDiff(nl, ol, w);
+            composeSpan(colorRgba_.data() + size_t(r) * rowBytes, nl, column.data(),
+                        composed_.data() + at, a, b);
+            std::memcpy(ol + 4 * a, nl + 4 * a, 4 * (b - a));
+            x0 = std::min(x0, a);
+            x1 = std::max(x1, b);
+            y0 = std::min(y0, fr);
+            y1 = std::max(y1, fr + 1);
+            lastShade_.texels += b - a;
         }
         if (y0 >= y1) continue;
         glTexSubImage2D(GL_TEXTURE_2D, 0, GLint(x0), y0, GLsizei(x1 - x0), y1 - y0, GL_RGBA,

@@ -58,11 +58,14 @@ class ImageView {
     PixelRect viewport(int fbWidth, int fbHeight) const;
     /// Composite a layer over the image when it is shaded: `texture` an RGBA8 texture of
     /// premultiplied colour drawn like the framebuffer (row 0 at the bottom), any size; 0: none.
-    /// A new `version` shades the whole image again; otherwise only uploaded rows are, so a
-    /// layer that does not change costs nothing per frame (the draw stays one copy). The colour
-    /// image is composited on the CPU from the layer's pixels, read back here once per version:
-    /// llvmpipe shaded a 1280x720 image in 37-41 ms of the UI thread, each pass that arrived
-    /// with an overlay shown.
+    /// A layer that does not change costs nothing per frame (the draw stays one copy). The
+    /// colour image is composited on the CPU from the layer's pixels, read back here once per
+    /// version: llvmpipe shaded a 1280x720 image in 37-41 ms of the UI thread, each pass that
+    /// arrived with an overlay shown. A new `version` of the same texture at the image's size
+    /// composites again only the texels that differ from the layer the picture was made with
+    /// (a part of a layer drawn over several frames changes few; each part composited the
+    /// whole image before, 8-10 ms at 1280x720); another texture, or a heat map, shades the
+    /// whole image again.
     void setOverlay(unsigned texture, uint64_t version);
     /// While held, draw() shows what it showed before and shades nothing: uploads go on, and
     /// the rows they changed are shaded once the hold ends (a new view's image coming in parts
@@ -72,8 +75,9 @@ class ImageView {
     /// draw() draws a picture: something was uploaded, and it is not held before a first one.
     bool showsPicture() const { return width_ > 0 && (!hold_ || shadedWidth_ > 0); }
     /// What the last draw() that shaded composited: image rows composited whole, texels
-    /// composited again for a new layer's changes, and the texels those uploaded (the
-    /// rectangles around them).
+    /// composited again for a new layer's changes (in each changed row, the span from its
+    /// first to its last changed texel), and the texels those uploaded (for each band of 16
+    /// rows, the rectangle around its spans).
     struct ShadeCount {
         int rows = 0;
         size_t texels = 0, uploadedTexels = 0;

@@ -674,12 +674,12 @@ TEST(Overlays, ALargeLayerIsDrawnInPartsLongestFirstWithinAFramesBudget) {
 }
 
 TEST(Overlays, WithTheFramesBudgetSpentTheLayerWaitsAndEndsAsTheOneDrawnWithoutIt) {
-    OffscreenGl gl(kW, kH);
-    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
-    auto s = twoBoxes(SchemeKind::Regular, 8);
-    const Camera& cam = s->scene->camera;
     // The same layer drawn in parts without a budget and with one that earlier steps of the
     // frame spent in some frames.
+    auto s = twoBoxes(SchemeKind::Regular, 8);
+    const Camera& cam = s->scene->camera;
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
     Overlays free, ov;
     for (Overlays* o : {&free, &ov}) {
         o->options.leaves = true;

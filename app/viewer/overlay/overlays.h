@@ -42,9 +42,11 @@ struct OverlayLook {
     /// parts keep a frame near its budget: a part of 2,000 of balls4's longest slab lines took
     /// 18-31 ms (2026-12-06).
     size_t restLines = 500;
-    /// Milliseconds of a frame at rest given to drawing the layer's parts (0: one part a frame).
-    /// Each part drawn also composites the whole image again (8-10 ms at 1280x720), so a part
-    /// frame at 8 ms took 33-37 ms of CPU on balls4's slabs (2026-12-06).
+    /// Milliseconds of a frame at rest given to drawing the layer's parts (0: one part a frame),
+    /// within what the frame's budget leaves (setFrameBudget()). Each part drawn composites the
+    /// image's texels it changed again (ImageView::setOverlay); at 8 ms, when each part
+    /// composited the whole image (8-10 ms at 1280x720), a part frame took 33-37 ms of CPU on
+    /// balls4's slabs (2026-12-06).
     double restMs = 5.0;
     /// Batches built in the background are copied to GL in parts of uploadBytes, for
     /// uploadMs of each frame (0: one part a frame), the layer drawn from what is copied:
