@@ -79,9 +79,11 @@ class ImageView {
     /// first to its last changed texel), and the texels those uploaded (for each band of 16
     /// rows, the rectangle around its spans).
     struct ShadeCount {
-        int rows = 0;
-        size_t texels = 0, uploadedTexels = 0;
+        int rows = 0;               ///< image rows composited whole
+        size_t texels = 0;          ///< texels composited again for a new layer's changes
+        size_t uploadedTexels = 0;  ///< texels those uploaded
     };
+    /// What the last draw() that shaded composited (tests: a layer part costs what it changed).
     const ShadeCount& lastShade() const { return lastShade_; }
     /// The UI thread's CPU time the next draw() in `mode` would take to shade what is pending
     /// (rows uploaded, the whole image after a change), in ms: the rows times the time per row
