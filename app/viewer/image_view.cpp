@@ -7,6 +7,7 @@
 
 #include "app/viewer/gl.h"
 #include "app/viewer/gl/program.h"
+#include "app/viewer/timing/frame_times.h"
 
 namespace lancer::viewer {
 
@@ -102,9 +103,12 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
 
 void ImageView::setOverlay(unsigned texture, uint64_t version) {
     if (texture == overlayTex_ && (texture == 0 || version == overlayVersion_)) return;
+    // A new version of the same texture: the colour image composites again only the texels
+    // that changed (shade()); anything else shades the whole image.
+    if (texture == 0 || texture != overlayTex_) shadedValid_ = false;
+    layerChanged_ = true;
     overlayTex_ = texture;
     overlayVersion_ = version;
-    shadedValid_ = false;
     // The colour image is composited on the CPU (compose()): the layer's pixels are read back
     // once per version, not once per pass.
     overlayRgba_.clear();
@@ -121,15 +125,64 @@ void ImageView::setOverlay(unsigned texture, uint64_t version) {
     glBindTexture(GL_TEXTURE_2D, 0);
 }
 
+namespace {
+
+/// One composited pixel: the image's colour `c` under the premultiplied layer texel `p`
+/// (out = image (1 - a) + layer, rounded as the shader's 8-bit target rounds), opaque.
+void blendTexel(const uint8_t* c, const uint8_t* p, uint8_t* o) {
+    const unsigned keep = 255u - p[3];
+    for (size_t k = 0; k < 3; ++k)
+        o[k] = uint8_t(std::min((unsigned(c[k]) * keep + 127u) / 255u + p[k], 255u));
+    o[3] = 255;
+}
+
+/// Texels [x0, x1) of an image row `c` with the layer's texels `l` (texel x at l + column[x])
+/// over them, into `o`. Runs of transparent layer texels (most of a layer of lines:
+/// premultiplied, all zero) are the image's bytes, copied as a run.
+void composeSpan(const uint8_t* c, const uint8_t* l, const size_t* column, uint8_t* o, size_t x0,
+                 size_t x1) {
+    for (size_t x = x0; x < x1;) {
+        size_t run = x;
+        while (run < x1 && transparent(l + column[run])) ++run;
+        if (run > x) {
+            std::memcpy(o + 4 * x, c + 4 * x, 4 * (run - x));
+            x = run;
+            continue;
+        }
+        blendTexel(c + 4 * x, l + column[x], o + 4 * x);
+        ++x;
+    }
+}
+
+/// The first texel at or after `x` where rows `a` and `b` of `w` texels differ (w: none),
+/// blocks of 16 equal texels skipped at once.
+size_t firstDiff(const uint8_t* a, const uint8_t* b, size_t x, size_t w) {
+    while (x + 16 <= w && std::memcmp(a + 4 * x, b + 4 * x, 64) == 0) x += 16;
+    while (x < w && std::memcmp(a + 4 * x, b + 4 * x, 4) == 0) ++x;
+    return x;
+}
+
+/// One past the last texel before `x` where the rows differ (0: none), from the right.
+size_t lastDiff(const uint8_t* a, const uint8_t* b, size_t x) {
+    while (x >= 16 && std::memcmp(a + 4 * (x - 16), b + 4 * (x - 16), 64) == 0) x -= 16;
+    while (x > 0 && std::memcmp(a + 4 * (x - 1), b + 4 * (x - 1), 4) == 0) --x;
+    return x;
+}
+
+}  // namespace
+
+bool ImageView::layerAtImageSize() const {
+    return !overlayRgba_.empty() && overlayWidth_ == width_ && overlayHeight_ == height_;
+}
+
 void ImageView::compose(int rowBegin, int rowEnd) const {
     // Image row r is FBO row height - 1 - r: rows [b, e) are FBO rows [h - e, h - b), written
-    // bottom row first. The layer is premultiplied: out = image (1 - a) + layer, rounded as the
-    // shader's 8-bit target rounds; a layer of another size is sampled at the nearest texel, as
-    // the heat maps' shader samples it.
+    // bottom row first. The layer is premultiplied (blendTexel); a layer of another size is
+    // sampled at the nearest texel, as the heat maps' shader samples it.
     const int rows = rowEnd - rowBegin;
     if (rows <= 0) return;
     const size_t w = size_t(width_);
-    composed_.resize(w * size_t(rows) * 4);
+    composed_.resize(w * size_t(height_) * 4);
     const bool layer = !overlayRgba_.empty();
     std::vector<size_t> column;
     if (layer)
@@ -137,39 +190,74 @@ void ImageView::compose(int rowBegin, int rowEnd) const {
             column.push_back(4 * ((2 * x + 1) * size_t(overlayWidth_) / (2 * w)));
     for (int r = rowBegin; r < rowEnd; ++r) {
         const uint8_t* c = colorRgba_.data() + size_t(r) * w * 4;
-        uint8_t* o = composed_.data() + size_t(rowEnd - 1 - r) * w * 4;
+        uint8_t* o = composed_.data() + size_t(height_ - 1 - r) * w * 4;
         if (!layer) {
             std::copy_n(c, w * 4, o);
             continue;
         }
         const int fboRow = height_ - 1 - r;
         const size_t ly = size_t(2 * fboRow + 1) * size_t(overlayHeight_) / size_t(2 * height_);
-        const uint8_t* l = overlayRgba_.data() + ly * size_t(overlayWidth_) * 4;
-        for (size_t x = 0; x < w;) {
-            // Runs of transparent layer texels (most of a layer of lines: premultiplied, all
-            // zero) are the image's bytes, copied as a run.
-            size_t run = x;
-            while (run < w && transparent(l + column[run])) ++run;
-            if (run > x) {
-                std::memcpy(o + 4 * x, c + 4 * x, 4 * (run - x));
-                x = run;
-                continue;
-            }
-            const uint8_t* p = l + column[x];
-            const unsigned keep = 255u - p[3];
-            for (size_t k = 0; k < 3; ++k)
-                o[4 * x + k] =
-                    uint8_t(std::min((unsigned(c[4 * x + k]) * keep + 127u) / 255u + p[k], 255u));
-            o[4 * x + 3] = 255;
-            ++x;
-        }
+        composeSpan(c, overlayRgba_.data() + ly * size_t(overlayWidth_) * 4, column.data(), o, 0,
+                    w);
+    }
+    // The layer these rows were composited with, for the next version's changed texels.
+    if (layerAtImageSize() && (composedLayer_.size() == overlayRgba_.size() || rows == height_)) {
+        composedLayer_.resize(overlayRgba_.size());
+        const size_t from = size_t(height_ - rowEnd) * w * 4;
+        std::copy_n(overlayRgba_.data() + from, size_t(rows) * w * 4, composedLayer_.data() + from);
+    } else {
+        composedLayer_.clear();
     }
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
     glBindTexture(GL_TEXTURE_2D, shadedTex_);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, height_ - rowEnd, width_, rows, GL_RGBA, GL_UNSIGNED_BYTE,
-                    composed_.data());
+                    composed_.data() + size_t(height_ - rowEnd) * w * 4);
     glBindTexture(GL_TEXTURE_2D, 0);
+    lastShade_.rows += rows;
+}
+
+void ImageView::composeLayerChanges(int skipBegin, int skipEnd) const {
+    // Only texels where the layer differs from the one composited change the picture: rows of
+    // the layer equal to the old ones are skipped whole (memcmp), the others composite again
+    // the span from their first to their last changed texel, and each band of kBand rows
+    // uploads the rectangle of its spans. Image rows [skipBegin, skipEnd) were composited
+    // whole with this layer already.
+    constexpr int kBand = 16;
+    const size_t w = size_t(width_), rowBytes = w * 4;
+    std::vector<size_t> column(w);
+    for (size_t x = 0; x < w; ++x) column[x] = 4 * x;
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, width_);
+    glBindTexture(GL_TEXTURE_2D, shadedTex_);
+    for (int band = 0; band < height_; band += kBand) {
+        int y0 = height_, y1 = 0;
+        size_t x0 = w, x1 = 0;
+        for (int fr = band; fr < std::min(height_, band + kBand); ++fr) {
+            const int r = height_ - 1 - fr;
+            if (r >= skipBegin && r < skipEnd) continue;
+            const size_t at = size_t(fr) * rowBytes;
+            const uint8_t* nl = overlayRgba_.data() + at;
+            uint8_t* ol = composedLayer_.data() + at;
+            const size_t a = firstDiff(nl, ol, 0, w);
+            if (a == w) continue;
+            const size_t b = lastDiff(nl, ol, w);
+            composeSpan(colorRgba_.data() + size_t(r) * rowBytes, nl, column.data(),
+                        composed_.data() + at, a, b);
+            std::memcpy(ol + 4 * a, nl + 4 * a, 4 * (b - a));
+            x0 = std::min(x0, a);
+            x1 = std::max(x1, b);
+            y0 = std::min(y0, fr);
+            y1 = std::max(y1, fr + 1);
+            lastShade_.texels += b - a;
+        }
+        if (y0 >= y1) continue;
+        glTexSubImage2D(GL_TEXTURE_2D, 0, GLint(x0), y0, GLsizei(x1 - x0), y1 - y0, GL_RGBA,
+                        GL_UNSIGNED_BYTE, composed_.data() + size_t(y0) * rowBytes + 4 * x0);
+        lastShade_.uploadedTexels += (x1 - x0) * size_t(y1 - y0);
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
 }
 
 std::vector<PixelRect> uncovered(int width, int height, const std::vector<PixelRect>& covered) {
@@ -217,13 +305,18 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     // picture (showsPicture()).
     if (!showsPicture()) return;
     const bool held = hold_;
+    // A new layer composites only its changed texels over a colour image already composited
+    // with the layer before it, at the image's size; anything else shades the whole image.
+    const bool layerInPlace = mode == ViewMode::Color && layerAtImageSize() &&
+                              composedLayer_.size() == overlayRgba_.size();
     const bool whole =
-        !shadedValid_ || mode != shadedMode_ ||
+        !shadedValid_ || mode != shadedMode_ || (layerChanged_ && !layerInPlace) ||
         (mode != ViewMode::Color &&
          (scale != shadedScale_ || logScale != shadedLog_ || diverging != shadedDiverging_));
+    if (!held) lastShade_ = {};
     if (!held && whole)
         shade(mode, scale, logScale, diverging, 0, height_);
-    else if (!held && !dirty_.empty())
+    else if (!held && (!dirty_.empty() || layerChanged_))
         shade(mode, scale, logScale, diverging, dirty_.begin, dirty_.end);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
@@ -247,6 +340,14 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     glViewport(0, 0, fbWidth, fbHeight);
 }
 
+double ImageView::shadeEstimateMs(ViewMode mode) const {
+    if (width_ == 0 || hold_ || mode != ViewMode::Color) return 0.0;
+    const bool whole =
+        !shadedValid_ || mode != shadedMode_ || shadedWidth_ != width_ || shadedHeight_ != height_;
+    const int rows = whole ? height_ : dirty_.end - dirty_.begin;
+    return msPerRow_ * std::max(rows, 0);
+}
+
 PixelRect ImageView::viewport(int fbWidth, int fbHeight) const {
     if (viewport_.x1 <= viewport_.x0 || viewport_.y1 <= viewport_.y0)
         return {0, 0, fbWidth, fbHeight};
@@ -268,10 +369,19 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
         rowBegin = 0;
         rowEnd = height_;
     }
-    if (mode == ViewMode::Color)
+    if (mode == ViewMode::Color) {
+        const double start = threadCpuMs();
         compose(rowBegin, rowEnd);
-    else
+        if (rowEnd - rowBegin >= 64)  // the running mean of the time a row takes
+            msPerRow_ += 0.25 * ((threadCpuMs() - start) / (rowEnd - rowBegin) - msPerRow_);
+        const bool wholeRows = rowBegin <= 0 && rowEnd >= height_;
+        if (layerChanged_ && !wholeRows && layerAtImageSize() &&
+            composedLayer_.size() == overlayRgba_.size())
+            composeLayerChanges(rowBegin, rowEnd);
+    } else {
         shadeHeat(scale, logScale, diverging, rowBegin, rowEnd);
+    }
+    layerChanged_ = false;
     dirty_.clear();
     shadedValid_ = true;
     shadedWidth_ = width_;

@@ -58,11 +58,14 @@ class ImageView {
     PixelRect viewport(int fbWidth, int fbHeight) const;
     /// Composite a layer over the image when it is shaded: `texture` an RGBA8 texture of
     /// premultiplied colour drawn like the framebuffer (row 0 at the bottom), any size; 0: none.
-    /// A new `version` shades the whole image again; otherwise only uploaded rows are, so a
-    /// layer that does not change costs nothing per frame (the draw stays one copy). The colour
-    /// image is composited on the CPU from the layer's pixels, read back here once per version:
-    /// llvmpipe shaded a 1280x720 image in 37-41 ms of the UI thread, each pass that arrived
-    /// with an overlay shown.
+    /// A layer that does not change costs nothing per frame (the draw stays one copy). The
+    /// colour image is composited on the CPU from the layer's pixels, read back here once per
+    /// version: llvmpipe shaded a 1280x720 image in 37-41 ms of the UI thread, each pass that
+    /// arrived with an overlay shown. A new `version` of the same texture at the image's size
+    /// composites again only the texels that differ from the layer the picture was made with
+    /// (a part of a layer drawn over several frames changes few; each part composited the
+    /// whole image before, 8-10 ms at 1280x720); another texture, or a heat map, shades the
+    /// whole image again.
     void setOverlay(unsigned texture, uint64_t version);
     /// While held, draw() shows what it showed before and shades nothing: uploads go on, and
     /// the rows they changed are shaded once the hold ends (a new view's image coming in parts
@@ -71,6 +74,21 @@ class ImageView {
     void setHold(bool hold) { hold_ = hold; }
     /// draw() draws a picture: something was uploaded, and it is not held before a first one.
     bool showsPicture() const { return width_ > 0 && (!hold_ || shadedWidth_ > 0); }
+    /// What the last draw() that shaded composited: image rows composited whole, texels
+    /// composited again for a new layer's changes (in each changed row, the span from its
+    /// first to its last changed texel), and the texels those uploaded (for each band of 16
+    /// rows, the rectangle around its spans).
+    struct ShadeCount {
+        int rows = 0;               ///< image rows composited whole
+        size_t texels = 0;          ///< texels composited again for a new layer's changes
+        size_t uploadedTexels = 0;  ///< texels those uploaded
+    };
+    /// What the last draw() that shaded composited (tests: a layer part costs what it changed).
+    const ShadeCount& lastShade() const { return lastShade_; }
+    /// The UI thread's CPU time the next draw() in `mode` would take to shade what is pending
+    /// (rows uploaded, the whole image after a change), in ms: the rows times the time per row
+    /// measured in the colour image's earlier composites; 0 while held.
+    double shadeEstimateMs(ViewMode mode) const;
     /// Size of the uploaded image (0 x 0 before the first upload).
     int width() const { return width_; }
     int height() const { return height_; }
@@ -83,6 +101,12 @@ class ImageView {
     /// The colour image's rows [rowBegin, rowEnd) with the layer over them, into the FBO's
     /// texture.
     void compose(int rowBegin, int rowEnd) const;
+    /// The texels where the layer differs from the one the picture was composited with, into
+    /// the FBO's texture: the other texels are already right. Image rows [skipBegin, skipEnd)
+    /// are left out (composited whole by compose()).
+    void composeLayerChanges(int skipBegin, int skipEnd) const;
+    /// The layer's pixels are one per image pixel (the viewer draws it at the image's size).
+    bool layerAtImageSize() const;
     /// The heat map's rows [rowBegin, rowEnd) through the colour-map shader.
     void shadeHeat(float scale, bool logScale, bool diverging, int rowBegin, int rowEnd) const;
 
@@ -91,7 +115,17 @@ class ImageView {
     std::vector<uint8_t> colorRgba_;    ///< the colour image as 8-bit RGBA, row 0 on top
     std::vector<uint8_t> overlayRgba_;  ///< the layer's pixels (row 0 at the bottom); empty: none
     int overlayWidth_ = 0, overlayHeight_ = 0;
-    mutable std::vector<uint8_t> composed_;  ///< compose()'s rows, reused
+    /// The composited colour image (FBO rows, row 0 at the bottom), as in the FBO's texture.
+    mutable std::vector<uint8_t> composed_;
+    /// The layer's pixels composed_ was composited with (empty: a layer of another size or
+    /// none; then a new layer composites the whole image).
+    mutable std::vector<uint8_t> composedLayer_;
+    mutable bool layerChanged_ = false;  ///< a new layer since the last shade()
+    mutable ShadeCount lastShade_;
+    /// Milliseconds of the UI thread's CPU per row composited and uploaded (a running mean of
+    /// the composites of 64 rows or more); 8.6 ms for a 720-row image to begin with (the
+    /// composite of balls4 at 1280x720, 2026-12-06).
+    mutable double msPerRow_ = 8.6 / 720.0;
     mutable bool shadedValid_ = false;
     mutable ViewMode shadedMode_ = ViewMode::Color;
     mutable float shadedScale_ = 0.0f;

@@ -104,6 +104,7 @@ const std::vector<PixelRect>& PanelCache::layout(ImDrawData* dd, int fbWidth, in
 
 void PanelCache::render() {
     redrawn_ = 0;
+    deferred_ = 0;
     if (!dd_) return;
     if (direct_) {
         last_.clear();
@@ -130,19 +131,57 @@ void PanelCache::render() {
         w_ = fbWidth, h_ = fbHeight;
         redrawAll = true;
     }
-    // A panel that moved, appeared, vanished or changed places leaves the layer stale where it
-    // was: then every panel is drawn again (windows move rarely; a tooltip follows the mouse).
-    bool sameLayout = panels_.size() == last_.size();
-    for (size_t i = 0; sameLayout && i < panels_.size(); ++i)
-        sameLayout = panels_[i].id == last_[i].id && panels_[i].rect == last_[i].rect;
-    if (!sameLayout) redrawAll = true;
-    // Otherwise a panel whose content changed is drawn again, with every panel above that
-    // overlaps it (drawing it covers their pixels in the layer).
-    std::vector<char> dirty(panels_.size(), redrawAll ? 1 : 0);
+    // The layer must hold, under every panel's rectangle, the topmost panel there as it is
+    // now. A panel is drawn again when it is new, moved or resized (its rectangle in the layer
+    // is stale), when a panel of the last frame that vanished or moved overlapped it (that
+    // panel's pixels are left in the layer), when a panel drawn again below it overlaps it
+    // (drawing that one covers its pixels), and when its content changed. Only the last is
+    // optional: with the frame's budget spent it waits for a later frame, the layer showing
+    // its last content meanwhile. A change of the panels' order redraws them all.
+    enum Need : char { kNone, kContent, kMust };
+    std::vector<char> need(panels_.size(), redrawAll ? kMust : kNone);
+    std::vector<char> matched(last_.size(), 0);
+    std::vector<size_t> lastOf(panels_.size(), SIZE_MAX);
     for (size_t i = 0; !redrawAll && i < panels_.size(); ++i) {
-        if (panels_[i].hash != last_[i].hash ||
+        for (size_t j = 0; j < last_.size(); ++j)
+            if (last_[j].id == panels_[i].id) lastOf[i] = j;
+        if (lastOf[i] == SIZE_MAX) {
+            need[i] = kMust;
+            continue;
+        }
+        const Panel& was = last_[lastOf[i]];
+        if (!(was.rect == panels_[i].rect)) {
+            need[i] = kMust;
+            continue;
+        }
+        matched[lastOf[i]] = 1;
+        if (was.hash != panels_[i].hash ||
             std::find(invalid_.begin(), invalid_.end(), panels_[i].id) != invalid_.end())
-            dirty[i] = 1;
+            need[i] = kContent;
+    }
+    for (size_t i = 1; !redrawAll && i < panels_.size(); ++i)  // the order kept
+        for (size_t k = 0; k < i; ++k)
+            if (lastOf[i] != SIZE_MAX && lastOf[k] != SIZE_MAX && lastOf[k] > lastOf[i])
+                redrawAll = true;
+    if (redrawAll) std::fill(need.begin(), need.end(), char(kMust));
+    for (size_t j = 0; j < last_.size(); ++j) {  // vanished or moved: its old place is stale
+        if (matched[j]) continue;
+        for (size_t i = 0; i < panels_.size(); ++i)
+            if (overlap(last_[j].rect, panels_[i].rect)) need[i] = kMust;
+    }
+    // Which are drawn: bottom to top, a content change within the budget; each drawn panel
+    // makes the ones above it that it overlaps drawn too.
+    std::vector<char> dirty(panels_.size(), 0);
+    std::vector<unsigned> stillInvalid;
+    for (size_t i = 0; i < panels_.size(); ++i) {
+        if (need[i] == kContent && !dirty[i] && budget_ && !budget_->allows(budgetReserveMs_)) {
+            ++deferred_;
+            if (std::find(invalid_.begin(), invalid_.end(), panels_[i].id) != invalid_.end())
+                stillInvalid.push_back(panels_[i].id);
+            panels_[i].hash = last_[lastOf[i]].hash;  // still the layer's content
+            continue;
+        }
+        if (need[i] != kNone) dirty[i] = 1;
         if (!dirty[i]) continue;
         for (size_t j = i + 1; j < panels_.size(); ++j)
             if (overlap(panels_[i].rect, panels_[j].rect)) dirty[j] = 1;
@@ -167,6 +206,8 @@ void PanelCache::render() {
             glDisable(GL_SCISSOR_TEST);
             drawLists(*dd_, r.lists);
             ++redrawn_;
+            // Drawn now (the blit below reads it), so the budget sees what the redraw cost.
+            if (budget_) glFinish();
         }
         glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
@@ -177,7 +218,7 @@ void PanelCache::render() {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
     last_ = panels_;
-    invalid_.clear();
+    invalid_ = std::move(stillInvalid);
 }
 
 }  // namespace lancer::viewer

@@ -16,6 +16,7 @@ struct ImGuiWindow;  // imgui_internal.h
 #include <vector>
 
 #include "app/viewer/image_view.h"  // PixelRect
+#include "app/viewer/timing/frame_budget.h"
 
 namespace lancer::viewer {
 
@@ -40,6 +41,16 @@ class PanelCache {
     void invalidate(unsigned windowId) { invalid_.push_back(windowId); }
     /// Panels rasterized again by the last render() (for tests and timings).
     int redrawn() const { return redrawn_; }
+    /// Panels whose new content the last render() left for a later frame (the budget).
+    int deferred() const { return deferred_; }
+    /// Share a frame's budget from now on (null: none): a panel whose content changed (and
+    /// nothing else: not moved, not uncovered, nothing redrawn under it) is rasterized again
+    /// only while more than `reserveMs` of the frame's budget is left; else the layer shows its
+    /// last content until a later frame. The budget must outlive the cache or be unset.
+    void setFrameBudget(FrameBudget* budget, double reserveMs) {
+        budget_ = budget;
+        budgetReserveMs_ = reserveMs;
+    }
 
   private:
     struct Panel {
@@ -68,6 +79,9 @@ class PanelCache {
     unsigned tex_ = 0, fbo_ = 0;
     int w_ = 0, h_ = 0;  ///< the layer's size
     int redrawn_ = 0;
+    int deferred_ = 0;
+    FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
+    double budgetReserveMs_ = 0.0;
 };
 
 }  // namespace lancer::viewer

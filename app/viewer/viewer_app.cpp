@@ -20,6 +20,10 @@ namespace lancer::viewer {
 
 namespace {
 
+/// What the overlays' optional work keeps back of the frame's budget for the steps after it
+/// (the image's rows to composite are added each frame): see the constructor.
+constexpr double kLayerReserveMs = 12.0;
+
 bool sameCamera(const Camera& a, const Camera& b) {
     return a.from == b.from && a.at == b.at && a.up == b.up && a.fov == b.fov &&
            a.projection == b.projection && a.orthoHeight == b.orthoHeight;
@@ -36,6 +40,16 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
     overlays_->buildInBackground(wake);
     inspector_->buildInBackground(std::move(wake));
     inspector_->drawInParts(1000, 4.0);
+    // One budget for the frame (FrameBudget): each step that may leave work for the next
+    // frame keeps back what the steps after it take in a frame that runs them all (balls4's
+    // slabs with the inspector, the slow-frame lines of --log-timings, 2026-12-06): after the
+    // layer, the image's changed texels (3-5 ms), a band of the inspector's picture (about
+    // 4 ms) and the panel layer; after the inspector, the panel layer (its copies about 3 ms,
+    // a changed panel about 1 ms more) and the swap; after a panel, the copies of the panels
+    // and the swap.
+    overlays_->setFrameBudget(&budget_, kLayerReserveMs);
+    inspector_->setFrameBudget(&budget_, 8.0);
+    panels_.setFrameBudget(&budget_, 5.0);
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
     // drawn at all, and each is copied from a layer where it is redrawn only when it changes
     // (frame(), PanelCache).
@@ -120,6 +134,7 @@ PixelRect toPixels(const Rect& r, glm::vec2 scale) {
 void ViewerApp::frame(int fbWidth, int fbHeight) {
     // 1. Poll: the structure and the image the workers finished since the last frame.
     phases_.begin();
+    budget_.begin();
     state_.poll();
     phases_.mark("poll");
 
@@ -144,11 +159,11 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     overlays_->setCosts(state_.costs());
     overlays_->update(state_.sceneBuild(), state_.camera(), imageW, imageH, cameraMoving());
     inspector_->setShown(s.showInspector);
-    phases_.mark("overlays");
+    phases_.mark("overlay update");
     inspector_->update(state_.sceneBuild(),
                        {state_.camera(), std::max(state_.width(), 1), std::max(state_.height(), 1)},
                        fbWidth, fbHeight, selectedRegion());
-    phases_.mark("inspector");
+    phases_.mark("inspector update");
     // The inspector's half of the window moves the inspector's camera, and a click there picks.
     std::optional<int64_t> picked;
     if (inspector_->handleMouse(fbWidth, fbHeight, picked)) {
@@ -228,12 +243,16 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // no image: one full-window fill less per frame, which software GL feels.
     if (RowRange rows; state_.takeUpload(rows)) uploadImage(rows.begin, rows.end);
     phases_.mark("upload");
+    // The image's rows to composite in this frame come before the layer's optional work: a
+    // new view released whole took 8-16 ms of the image step (balls4, 2026-12-06), so the
+    // layer keeps that back too.
+    view_->setHold(state_.holdImage());
+    overlays_->setFrameBudget(&budget_, kLayerReserveMs + view_->shadeEstimateMs(s.mode));
     prepareOverlays(imageW, imageH);
     phases_.mark("overlays");
     glViewport(0, 0, fbWidth, fbHeight);
     glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
     std::vector<PixelRect> views;
-    view_->setHold(state_.holdImage());
     if (view_->showsPicture()) views.push_back(area);
     if (inspector_->shown()) views.push_back(inspector_->area(fbWidth, fbHeight));
     glEnable(GL_SCISSOR_TEST);
@@ -312,7 +331,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         notes.pendingScreenshot.clear();
     }
     settled_ = state_.settledSince() && inspector_->settled() && !overlays_->building() &&
-               !overlays_->layerPending() && !player_.pending() && !player_.playback().playing();
+               !overlays_->layerPending() && !player_.pending() && !player_.playback().playing() &&
+               panels_.deferred() == 0;
     keepSettings();
 }
 

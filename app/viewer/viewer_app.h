@@ -20,6 +20,7 @@
 #include "app/viewer/panels/panels.h"
 #include "app/viewer/panels/tree_panel.h"
 #include "app/viewer/playback/ray_player.h"
+#include "app/viewer/timing/frame_budget.h"
 #include "app/viewer/timing/frame_times.h"
 #include "app/viewer/viewer_state.h"
 
@@ -56,7 +57,10 @@ class ViewerApp {
     /// screen has begun to show, or the render is complete. Otherwise the render is only
     /// refining the pass on screen band by band, and a window may show its bands at a lower
     /// rate. Also while the overlays' layer is drawn over several frames.
-    bool eager() const { return state_.eager(settled_) || overlays_->layerPending(); }
+    bool eager() const {
+        return state_.eager(settled_) || overlays_->layerPending() ||
+               inspector_->picturePending() || panels_.deferred() > 0;
+    }
     /// The frame drawn by the last frame() is on screen (after the window's swap): logs, with
     /// --log-timings, the passes it shows for the first time, with their latency.
     void presented() { state_.presented(); }
@@ -145,6 +149,12 @@ class ViewerApp {
     const KeyReport& keys() const { return keys_; }
     /// Where the last frame()'s UI CPU time went, by step (--log-timings' slow frames).
     const FramePhases& phases() const { return phases_; }
+    /// The frame's budget shared by the steps that may leave work for the next frame (the
+    /// overlays' copy and layer parts, the inspector's picture, the panel redraws).
+    FrameBudget& frameBudget() { return budget_; }
+    /// Panels the last frame rasterized again (the rest were copied from the panel layer).
+    int panelsRedrawn() const { return panels_.redrawn(); }
+    const FrameBudget& frameBudget() const { return budget_; }
 
   private:
     /// Upload rows [rowBegin, rowEnd) (-1: to the last) of the image on screen, with the heat
@@ -182,7 +192,8 @@ class ViewerApp {
     TreeBrowser tree_;
     std::unique_ptr<gl::BatchRenderer> rayRenderer_;
     Clock::time_point lastFrame_ = Clock::now();
-    FramePhases phases_;  ///< the last frame's CPU time by step
+    FramePhases phases_;                  ///< the last frame's CPU time by step
+    FrameBudget budget_{kFrameBudgetMs};  ///< begun at each frame()
     /// The region the playback selected last (-1: none), so a click elsewhere is not undone.
     int64_t playedRegion_ = -1;
     gl::Batch inspectorRay_;     ///< the lines last handed to the inspector

@@ -338,9 +338,10 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 if (v.logTimings && cpuMs > kFrameBudgetMs)
                     std::fprintf(stderr,
                                  "timing: slow frame %d (%s): %.1f ms, %.1f ms of UI CPU: %s, "
-                                 "swap and rest %.1f\n",
+                                 "swap and rest %.1f; %d panels redrawn, %d steps deferred\n",
                                  frames, turnDue ? "turning" : "still", workMs, cpuMs,
-                                 app.phases().summary().c_str(), cpuMs - app.phases().totalMs());
+                                 app.phases().summary().c_str(), cpuMs - app.phases().totalMs(),
+                                 app.panelsRedrawn(), app.frameBudget().deferred());
             }
             ++statFrames;
             if (v.logTimings && Clock::now() - statStart > std::chrono::seconds(2)) {

@@ -220,6 +220,54 @@ TEST(InspectorGl, BuiltInTheBackgroundAndDrawnInPartsTheModelEndsAsTheDirectOne)
     EXPECT_EQ(f.gl.read(), direct);
 }
 
+TEST(InspectorGl, WithTheFramesBudgetSpentThePictureWaitsAndEndsAsTheDirectOne) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    const std::vector<uint8_t> direct = f.draw();
+    const size_t lines = f.insp->model().lines.lineCount();
+    ASSERT_GT(lines, 10u);
+    // Parts of a fifth, as many a draw as the frame's budget allows; `now += 30` stands for
+    // the frame's earlier steps (the clock moves 6 ms a reading otherwise).
+    Inspector parts;
+    parts.options() = f.insp->options();
+    parts.drawInParts(lines / 5 + 1, 1e9);
+    double now = 0.0;
+    FrameBudget budget(33.0, [&] { return now += 6.0; });
+    parts.setFrameBudget(&budget, 8.0);
+    parts.changed();
+    parts.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    // Spent before it: nothing drawn (the window shows what it had), the picture pending.
+    budget.begin();
+    now += 30.0;
+    f.gl.clear(0.0f, 0.0f, 0.0f);
+    parts.draw(kW, kH);
+    EXPECT_EQ(parts.picturedLines(), 0u);
+    EXPECT_TRUE(parts.picturePending());
+    EXPECT_FALSE(parts.settled());
+    EXPECT_GE(budget.deferred(), 1);
+    // Frames with room, every other one spent: a few parts a frame, then the direct picture.
+    int frames = 0;
+    size_t before = 0;
+    do {
+        budget.begin();
+        if (frames % 2 == 1) now += 30.0;
+        f.gl.clear(0.0f, 0.0f, 0.0f);
+        parts.draw(kW, kH);
+        if (frames % 2 == 1) {
+            EXPECT_EQ(parts.picturedLines(), before) << "frame " << frames;
+        } else {
+            EXPECT_GT(parts.picturedLines(), before) << "frame " << frames;
+            EXPECT_TRUE(frames > 0 || parts.picturedLines() < lines) << "not whole in one frame";
+        }
+        before = parts.picturedLines();
+        ++frames;
+    } while (!parts.settled() && frames < 100);
+    EXPECT_TRUE(parts.settled());
+    EXPECT_FALSE(parts.picturePending());
+    EXPECT_EQ(parts.picturedLines(), lines);
+    EXPECT_EQ(f.gl.read(), direct);
+}
+
 TEST(InspectorGl, WithItsSurfacesThePictureInPartsEqualsTheOneDrawnAtOnce) {
     Fixture f;
     ASSERT_TRUE(f.gl.ok());

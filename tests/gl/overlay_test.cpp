@@ -673,6 +673,82 @@ TEST(Overlays, ALargeLayerIsDrawnInPartsLongestFirstWithinAFramesBudget) {
     EXPECT_EQ(ov.layerDrawn(), 2 * ov.look.restLines);
 }
 
+TEST(Overlays, WithTheFramesBudgetSpentTheLayerWaitsAndEndsAsTheOneDrawnWithoutIt) {
+    // The same layer drawn in parts without a budget and with one that earlier steps of the
+    // frame spent in some frames.
+    auto s = twoBoxes(SchemeKind::Regular, 8);
+    const Camera& cam = s->scene->camera;
+    OffscreenGl gl(kW, kH);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    Overlays free, ov;
+    for (Overlays* o : {&free, &ov}) {
+        o->options.leaves = true;
+        o->look.lineOpacity = 1.0f;
+        o->update(s, cam, kW, kH);
+    }
+    const size_t total = ov.layerLines();
+    ASSERT_GT(total, 12u);
+    for (Overlays* o : {&free, &ov}) {
+        o->look.restLines = total / 4 + 1;  // four parts
+        o->look.restMs = 1e9;               // each as many parts as the frame allows
+    }
+    free.look.restMs = 0.0;  // one part a call
+    // The clock: 6 ms a reading, so a frame of 33 ms keeping 10 for later steps has room for
+    // three parts of the four; `now += 30` stands for the frame's earlier steps.
+    double now = 0.0;
+    FrameBudget budget(33.0, [&] { return now += 6.0; });
+    ov.setFrameBudget(&budget, 10.0);
+    Image black(kW, kH);
+    ImageView view;
+    view.upload(black, ViewMode::Color);
+    auto composited = [&](Overlays& o) {
+        view.setOverlay(o.layerTexture(cam, kW, kH), o.layerVersion());
+        gl.clear(0, 0, 0);
+        view.draw(kW, kH, ViewMode::Color, 1.0f);
+        return gl.read();
+    };
+    // A frame whose earlier steps spent the budget: no part, nothing drawn, the layer pending
+    // (the window stays eager).
+    budget.begin();
+    now += 30.0;
+    ov.layerTexture(cam, kW, kH);
+    EXPECT_EQ(ov.layerDrawn(), 0u);
+    EXPECT_EQ(ov.layerVersion(), 0u) << "nothing drawn";
+    EXPECT_TRUE(ov.layerPending()) << "deferred: pending";
+    EXPECT_GE(budget.deferred(), 1);
+    // A frame with room: parts until the budget less the reserve is spent, not the whole.
+    budget.begin();
+    ov.layerTexture(cam, kW, kH);
+    const size_t first = ov.layerDrawn();
+    EXPECT_GE(first, ov.look.restLines);
+    EXPECT_LT(first, total) << "stopped by the frame's budget, not by restMs";
+    int frames = 1;
+    while (ov.layerPending() && frames < 100) {
+        budget.begin();
+        if (frames % 2 == 1) now += 30.0;  // every other frame spent before the layer
+        const size_t before = ov.layerDrawn();
+        ov.layerTexture(cam, kW, kH);
+        if (frames % 2 == 1) {
+            EXPECT_EQ(ov.layerDrawn(), before) << "frame " << frames;
+        }
+        ++frames;
+    }
+    EXPECT_FALSE(ov.layerPending());
+    EXPECT_EQ(ov.layerDrawn(), total);
+    // The same picture as the layer drawn in parts without a budget.
+    while (free.layerPending() || free.layerVersion() == 0) free.layerTexture(cam, kW, kH);
+    EXPECT_EQ(composited(ov), composited(free));
+    // A moving camera's layer draws its first part whatever the budget.
+    Camera moved = cam;
+    moved.from.x += 0.5;
+    ov.look.movingLines = total;
+    budget.begin();
+    now += 100.0;
+    ov.layerTexture(moved, kW, kH, true);
+    EXPECT_EQ(ov.layerDrawn(), ov.look.restLines);
+    ov.setFrameBudget(nullptr, 0.0);
+}
+
 TEST(Overlays, BatchesBuiltInTheBackgroundAreCopiedInPartsAndTheLayerFollowsThem) {
     OffscreenGl gl(kW, kH);
     ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";

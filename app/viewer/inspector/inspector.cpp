@@ -251,7 +251,7 @@ int64_t Inspector::pick(double x, double y) const {
 
 bool Inspector::settled() const {
     return !opt_.show || !structure_ ||
-           (!dirtyModel_ && !job_.pending() && !picturePending_ &&
+           (!dirtyModel_ && !job_.pending() && !picturePending() &&
             (!opt_.surfaces || surfacesShown()));
 }
 
@@ -422,7 +422,8 @@ void Inspector::renderMore() {
         if (partLines_ == 0 || surfaceRows_ >= vh_) break;
         glFinish();  // timed: the band is drawn
         if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                .count() >= partMs_) {
+                    .count() >= partMs_ ||
+            (budget_ && !budget_->allows(budgetReserveMs_))) {
             picturePending_ = true;
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
             return;
@@ -444,7 +445,8 @@ void Inspector::renderMore() {
         if (partLines_ == 0) continue;
         glFinish();  // timed: the part is drawn
         if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                .count() >= partMs_)
+                    .count() >= partMs_ ||
+            (budget_ && !budget_->allows(budgetReserveMs_)))
             break;
     }
     picturePending_ = !lines_->uploaded() || picturedLines_ < lines_->lineCount();
@@ -472,9 +474,17 @@ void Inspector::draw(int fbWidth, int fbHeight) {
     requestSurfaces();
     takeSurfaces();
     if (dirtyBatch_) dirtyPicture_ = true;
-    if (dirtyPicture_)
+    // The picture is optional work under the frame's budget: with it spent, the picture on
+    // screen stays as it is (dirtyPicture_ or picturePending_ kept) and is drawn later.
+    const bool work = dirtyPicture_ || picturePending_;
+    // The frame's GL work so far finished first, so the budget sees what it cost (llvmpipe
+    // draws at a flush; the first part's flush took 11-23 ms of such work, 2026-12-06).
+    if (work && budget_) glFinish();
+    const bool deferred = work && budget_ && !budget_->allows(budgetReserveMs_);
+    pictureDeferred_ = deferred;
+    if (!deferred && dirtyPicture_)
         render();
-    else if (picturePending_)
+    else if (!deferred && picturePending_)
         renderMore();
     const PixelRect v = area(fbWidth, fbHeight);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);

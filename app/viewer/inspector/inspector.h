@@ -17,6 +17,7 @@
 #include "app/viewer/image_view.h"  // PixelRect
 #include "app/viewer/inspector/inspector_model.h"
 #include "app/viewer/inspector/surface_tracer.h"
+#include "app/viewer/timing/frame_budget.h"
 
 namespace lancer::viewer::gl {
 class BatchRenderer;
@@ -100,6 +101,17 @@ class Inspector {
     /// (the default). balls4's inspector picture (20,000 regions, 240,000 lines) took
     /// llvmpipe 50-75 ms in one frame (2026-12-06).
     void drawInParts(size_t lines, double ms);
+    /// Share a frame's budget from now on (null: none): draw() starts or goes on with the
+    /// picture only while more than `reserveMs` of the frame's budget is left, and stops its
+    /// parts once no more is; the picture on screen stays until then. The budget must outlive
+    /// the inspector or be unset.
+    void setFrameBudget(FrameBudget* budget, double reserveMs) {
+        budget_ = budget;
+        budgetReserveMs_ = reserveMs;
+    }
+    /// The last draw() left the picture to be completed, or drawn again (the budget), by
+    /// later draws.
+    bool picturePending() const { return opt_.show && (picturePending_ || pictureDeferred_); }
     /// Lines of the model in the picture so far (all of them once it is whole).
     size_t picturedLines() const { return picturedLines_; }
     /// Surfaces of the current camera are on screen (the trace arrived).
@@ -170,7 +182,10 @@ class Inspector {
     bool picturePending_ = false;
     bool pictureSurfaces_ = false;
     double pictureNear_ = 0.0, pictureFar_ = 1.0;
-    int surfaceRows_ = 0;  ///< rows of the surfaces in the picture so far
+    int surfaceRows_ = 0;            ///< rows of the surfaces in the picture so far
+    FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
+    double budgetReserveMs_ = 0.0;
+    bool pictureDeferred_ = false;  ///< the last draw() left the picture for the budget
     glm::mat4 pictureToClip_{1.0f};
     BackgroundJob<InspectorModel> job_;  ///< last: its worker joined before the rest is destroyed
 };

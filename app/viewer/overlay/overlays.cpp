@@ -179,9 +179,16 @@ void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms) 
 }
 
 void Overlays::uploadMore() {
+    // With the frame's budget: once a frame (update() runs twice in one), and only while the
+    // budget is not spent; the copy goes on in the next frames.
+    if (budget_ && !uploaded()) {
+        if (budget_->frame() == uploadFrame_ || !budget_->allows(budgetReserveMs_)) return;
+        uploadFrame_ = budget_->frame();
+    }
     const auto t0 = std::chrono::steady_clock::now();
     for (gl::GpuBatch* b : {cuts_.get(), fills_.get(), wiresLongestFirst_.get(), wires_.get()})
         while (!b->uploaded()) {
+            if (budget_ && !budget_->allows(budgetReserveMs_)) return;
             b->uploadMore(look.uploadBytes);
             glFinish();  // timed: the copy is done
             if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
@@ -264,6 +271,7 @@ bool Overlays::layerStale(const Camera& view, int width, int height) const {
 }
 
 unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool moving) {
+    layerDeferred_ = false;
     if (!view_ || !options.any() || width <= 0 || height <= 0) return 0;
     if (!layerStale(view, width, height)) return layerTex_;
     if (moving && look.movingLines == 0) return 0;
@@ -304,6 +312,14 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         return layerTex_;
     }
+    // At rest the layer is optional work: with the frame's budget spent the texture stays as
+    // it is (the last one, whole or in part) and is drawn in a later frame. A moving camera's
+    // layer draws its first part in any case (it follows the view), its others within budget.
+    layerDeferred_ = !moving && budget_ && !budget_->allows(budgetReserveMs_);
+    if (layerDeferred_) {
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        return layerTex_;
+    }
     if (!resume) {
         glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
         glClear(GL_COLOR_BUFFER_BIT);
@@ -321,7 +337,8 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
             glFinish();
         } while (layerDrawn_ < end &&
                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                         .count() < budget);
+                         .count() < budget &&
+                 (!budget_ || budget_->allows(budgetReserveMs_)));
     } else {  // whole in one frame, the wireframe in its own order
         drawLayers(view, width, height, SIZE_MAX);
         layerDrawn_ = total;

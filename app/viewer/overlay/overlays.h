@@ -15,6 +15,7 @@
 #include "app/viewer/image_costs.h"
 #include "app/viewer/overlay/overlay_geometry.h"
 #include "app/viewer/structure_builder.h"
+#include "app/viewer/timing/frame_budget.h"
 #include "engine/render/ray_csg.h"
 
 namespace lancer::viewer::overlay {
@@ -41,9 +42,11 @@ struct OverlayLook {
     /// parts keep a frame near its budget: a part of 2,000 of balls4's longest slab lines took
     /// 18-31 ms (2026-12-06).
     size_t restLines = 500;
-    /// Milliseconds of a frame at rest given to drawing the layer's parts (0: one part a frame).
-    /// Each part drawn also composites the whole image again (8-10 ms at 1280x720), so a part
-    /// frame at 8 ms took 33-37 ms of CPU on balls4's slabs (2026-12-06).
+    /// Milliseconds of a frame at rest given to drawing the layer's parts (0: one part a frame),
+    /// within what the frame's budget leaves (setFrameBudget()). Each part drawn composites the
+    /// image's texels it changed again (ImageView::setOverlay); at 8 ms, when each part
+    /// composited the whole image (8-10 ms at 1280x720), a part frame took 33-37 ms of CPU on
+    /// balls4's slabs (2026-12-06).
     double restMs = 5.0;
     /// Batches built in the background are copied to GL in parts of uploadBytes, for
     /// uploadMs of each frame (0: one part a frame), the layer drawn from what is copied:
@@ -115,8 +118,19 @@ class Overlays {
     /// The texture holds a moving camera's capped layer, or a layer not yet drawn whole.
     bool layerPartial() const { return layerPartial_; }
     /// At rest, the layer is being drawn over several frames: more calls to layerTexture()
-    /// complete it.
-    bool layerPending() const { return layerPartial_ && !layerMoving_ && options.any() && view_; }
+    /// complete it (also when the frame's budget deferred it).
+    bool layerPending() const {
+        return (layerDeferred_ || (layerPartial_ && !layerMoving_)) && options.any() && view_;
+    }
+    /// Share a frame's budget from now on (null: none, each step only its own share): the
+    /// batches' copy to GL (once a frame) and the layer's parts stop while no more than
+    /// `reserveMs` of the frame's budget is left (kept for the steps after them), and go on in
+    /// the next frames. At rest no part is drawn then; a moving camera's layer draws its first
+    /// part in any case. The budget must outlive the overlays or be unset.
+    void setFrameBudget(FrameBudget* budget, double reserveMs) {
+        budget_ = budget;
+        budgetReserveMs_ = reserveMs;
+    }
     /// Lines of the layer drawn into the texture so far, of layerLines().
     size_t layerDrawn() const { return layerDrawn_; }
     /// The layer's lines (the wireframe's, or the cuts' or zones' when they are more).
@@ -226,8 +240,12 @@ class Overlays {
     uint64_t layerVersion_ = 0, layerRebuild_ = ~uint64_t(0);
     double lastLayerMs_ = 0.0;
     bool layerPartial_ = false;
-    bool layerMoving_ = false;  ///< the partial texture is a moving camera's cap
-    size_t layerDrawn_ = 0;     ///< layerDrawn()
+    bool layerMoving_ = false;       ///< the partial texture is a moving camera's cap
+    size_t layerDrawn_ = 0;          ///< layerDrawn()
+    bool layerDeferred_ = false;     ///< the last layerTexture() drew nothing for the budget
+    FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
+    double budgetReserveMs_ = 0.0;
+    unsigned long uploadFrame_ = 0;  ///< the budget's frame the batches were last copied in
     Camera layerCamera_;
     OverlayLook layerLook_;
     std::optional<Selection> selection_;
