@@ -948,13 +948,16 @@ TEST(Irregular, WalkModelSplitsOnlyWhereRaysGoOn) {
                 prims.push_back(uint32_t(prims.size()));
             }
         const std::vector<float> stops(rect.size(), 1.0f);
-        ZoneWalkModel m;
-        m.visit = 250.0;
-        m.test = 250.0;
-        m.level = 12.0;
-        m.raysPerArea = 1e5;
-        m.zone = 500.0;
-        m.ref = 1000.0;
+        // In units of a slab visit: a test as much, a level a twentieth, the build as the
+        // build's own model charges it (walkModel(), irregular.cpp), 1e5 rays over the screen.
+        const ZoneWalkModel m{.visit = 1.0,
+                              .test = 1.0,
+                              .level = 0.05,
+                              .fill = 0.5,
+                              .raysPerArea = 1e5,
+                              .rays = 0.0,
+                              .zone = 2.0,
+                              .ref = 4.0};
         ScreenBspParams p;
         p.heuristic = BspHeuristic::Balanced;
         p.stopObjects = 1;
