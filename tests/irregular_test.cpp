@@ -986,5 +986,97 @@ TEST(IrregularKnobs, ExplicitMaxObjectsBuildsByTheReportsRule) {
     EXPECT_NE(one, two);
 }
 
+// The zone hint of a projective walk (ProjectiveZones::locate: the zone its last walk located,
+// checked by its rectangle) finds the zone the screen BSP finds, whatever zone the hint holds:
+// for random points, and for the corners and edge midpoints of every zone, which lie on the
+// BSP's lines, where a point belongs to the zone below the line.
+TEST(Irregular, ProjectiveZoneHintLocatesAsTheScreenBsp) {
+    Scene scene = loadScene("builtin:drilled:6");
+    auto accel = buildIrregular(scene, BspHeuristic::Balanced, kAutoObjects);
+    const IrregularSubdivision& s = irregularOf(*accel);
+    std::vector<const ProjectiveZones*> structures{&s.projective()};
+    for (const ProjectiveZones& lz : s.lights())
+        if (lz.zoneCount() > 0) structures.push_back(&lz);
+    ASSERT_GT(structures.size(), 1u);
+    std::mt19937_64 rng(29);
+    TraceContext ctx(scene.prims.size(), scene.tree.depth());
+    size_t checked = 0;
+    for (const ProjectiveZones* pz : structures) {
+        const ScreenBsp& bsp = pz->screen();
+        ASSERT_GT(bsp.zoneCount(), 100u);
+        const glm::dvec2 lo = pz->rectLo(), hi = pz->rectHi();
+        std::vector<glm::dvec2> pts;
+        std::uniform_real_distribution<double> ux(lo.x, hi.x), uy(lo.y, hi.y);
+        for (int i = 0; i < 2000; ++i) pts.push_back({ux(rng), uy(rng)});
+        for (size_t z = 0; z < bsp.zoneCount(); ++z) {
+            const glm::dvec2 a = bsp.zoneLo[z], b = bsp.zoneHi[z];
+            for (glm::dvec2 p :
+                 {a, b, glm::dvec2(a.x, b.y), glm::dvec2(b.x, a.y), 0.5 * (a + b),
+                  glm::dvec2(a.x, 0.5 * (a.y + b.y)), glm::dvec2(0.5 * (a.x + b.x), b.y)})
+                pts.push_back(p);
+        }
+        std::uniform_int_distribution<uint32_t> anyZone(0, uint32_t(bsp.zoneCount()) + 5);
+        for (size_t i = 0; i < pts.size(); ++i) {
+            const glm::dvec2 p = pts[i];
+            const uint32_t want = bsp.locate(p.x, p.y, 0, 0);
+            // The hint as the walk leaves it (the previous point's zone), the zone itself, a
+            // random zone (some beyond the count).
+            for (int k = 0; k < 3; ++k) {
+                for (uint32_t& h : ctx.zoneHint) {
+                    if (k == 1) h = want;
+                    if (k == 2) h = anyZone(rng);
+                }
+                ASSERT_EQ(pz->locate(p.x, p.y, ctx), want)
+                    << "point (" << p.x << ", " << p.y << "), hint " << k;
+                ++checked;
+            }
+        }
+    }
+    std::printf("%zu locations checked\n", checked);
+}
+
+// The walk model (ZoneWalkModel) splits a cell only where the rays through it go on past what
+// it lists: 256 small squares behind an opaque square that covers the whole screen stay in the
+// 16 zones the first levels always make (every ray ends on the front square), the same squares
+// in front of it are split into a zone each. The count model (stepCost) is left out of it.
+TEST(Irregular, WalkModelSplitsOnlyWhereRaysGoOn) {
+    auto build = [](double frontDepth) {
+        std::vector<Box3> rect;
+        std::vector<uint32_t> prims;
+        rect.push_back({{0.0, 0.0, frontDepth}, {1.0, 1.0, frontDepth + 1.0}});
+        prims.push_back(0);
+        for (int i = 0; i < 16; ++i)
+            for (int j = 0; j < 16; ++j) {
+                const double x = (i + 0.25) / 16.0, y = (j + 0.25) / 16.0;
+                rect.push_back({{x, y, 5.0}, {x + 0.5 / 16.0, y + 0.5 / 16.0, 6.0}});
+                prims.push_back(uint32_t(prims.size()));
+            }
+        const std::vector<float> stops(rect.size(), 1.0f);
+        // In units of a slab visit: a test as much, a level a twentieth, the build as the
+        // build's own model charges it (walkModel(), irregular.cpp), 1e5 rays over the screen.
+        const ZoneWalkModel m{.visit = 1.0,
+                              .test = 1.0,
+                              .level = 0.05,
+                              .fill = 0.5,
+                              .raysPerArea = 1e5,
+                              .rays = 0.0,
+                              .zone = 2.0,
+                              .ref = 4.0};
+        ScreenBspParams p;
+        p.heuristic = BspHeuristic::Balanced;
+        p.stopObjects = 1;
+        p.stepCost = 1e9;  // the count model never pays
+        p.walk = &m;
+        p.stops = &stops;
+        return ScreenBsp::build(rect, prims, {0.0, 0.0}, {1.0, 1.0}, p);
+    };
+    const ScreenBsp hidden = build(1.0), seen = build(10.0);
+    std::printf("squares hidden: %zu zones; in front: %zu zones\n", hidden.zoneCount(),
+                seen.zoneCount());
+    EXPECT_LE(hidden.zoneCount(), 16u);
+    EXPECT_GT(hidden.costStops, 0u);
+    EXPECT_GE(seen.zoneCount(), 256u);
+}
+
 }  // namespace
 }  // namespace lancer

@@ -163,7 +163,9 @@ struct IrregularConfig {
     /// estimated tests per ray (false: the report's rule alone, max-objects).
     bool costStop = true;
     /// Cost of the zone a screen split adds, in primitive tests (2, 4 and 8 measured: 4 renders
-    /// balls4 and lattice:12 fastest for their build).
+    /// balls4 and lattice:12 fastest for their build). The camera frame's cost stop; the
+    /// projective structures' follows their walk (ZoneWalkModel) and splits where this one
+    /// pays as well.
     double stepCost = 4.0;
 
     /// The max-objects the screen BSP stops cells at.

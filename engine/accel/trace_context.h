@@ -116,6 +116,11 @@ struct TraceContext {
     std::vector<SpanList> scratch;  ///< two buffers per tree level, reused without allocation
     SpanList result;                ///< spans of the tree evaluated last
     SpanList leafSpans;             ///< the spans of a region's primitives (hitInLeaf's union)
+    /// Zones the irregular scheme's projective walks located last, one per structure (the
+    /// eye's, then its lights'; ProjectiveZones::hintSlot): rays come in pixel order, so the
+    /// next one's zone is most often the same, checked by its rectangle before the screen BSP
+    /// is descended.
+    std::array<uint32_t, 9> zoneHint{};
     uint32_t rayId = 0;
     bool useMailboxes = true;
     Precision precision = Precision::Double;  ///< of the primitives' tests (--precision)

@@ -30,8 +30,18 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
     double aspect = std::max(4.0, double(scene.width) / double(std::max(scene.height, 1)));
     glm::dvec2 limLo(-half * aspect, -half * (1.0 + 1e-6)),
         limHi(half * aspect, half * (1.0 + 1e-6));
+    // The walk model's rays: a pixel's each, over the image's rectangle in (u, v).
+    ScreenBspParams eyeSp = sp;
+    ZoneWalkModel eyeWalk;
+    if (sp.walk) {
+        eyeWalk = *sp.walk;
+        const double w = std::max(scene.width, 1), h = std::max(scene.height, 1);
+        eyeWalk.raysPerArea = w * h / (4.0 * half * half * w / h);
+        eyeWalk.rays = 0.0;
+        eyeSp.walk = &eyeWalk;
+    }
     ProjectiveZones s =
-        buildCentred(scene, frame, limLo, limHi, false, box, live, sp, maxSlabBytes, maxRegions);
+        buildCentred(scene, frame, limLo, limHi, false, box, live, eyeSp, maxSlabBytes, maxRegions);
     if (s.zones_ == 0) return s;
     extra["projective_zones"] = s.zones_;
     extra["projective_slabs"] = s.slabRoot_.size();
@@ -111,6 +121,13 @@ ProjectiveZones ProjectiveZones::buildCentred(const Scene& scene, const CameraFr
     s.zFar_ = zFar;
     ScreenBspParams eyeParams = sp;
     eyeParams.column = ZoneColumn::FromEye;
+    ZoneWalkModel walk;
+    if (sp.walk && sp.walk->rays > 0.0) {
+        // Rays spread evenly over the zones' rectangle (a light's shadow rays).
+        walk = *sp.walk;
+        walk.raysPerArea = walk.rays / ((hi.x - lo.x) * (hi.y - lo.y));
+        eyeParams.walk = &walk;
+    }
     s.bsp_ = ScreenBsp::build(pbox, inside, lo, hi, eyeParams);
     const std::vector<glm::dvec2> depth =
         sp.hulls

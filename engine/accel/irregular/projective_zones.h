@@ -70,6 +70,27 @@ class ProjectiveZones {
     bool intersect(const Ray& ray, const Ray& rc, double u, double v, double tmin, double tmax,
                    uint32_t firstId, TraceContext& ctx, Obs& obs, Hit& hit) const;
 
+    /// The zone holding (u, v), inside the zones' rectangle, as bsp_.locate(u, v, 0, 0) finds
+    /// it: first the zone this structure's last walk in `ctx` located (a point on a line
+    /// belongs to the zone below it, so the rectangle test is exact: lo < u <= hi on each axis,
+    /// lo <= u on the rectangle's low border).
+    uint32_t locate(double u, double v, TraceContext& ctx) const {
+        uint32_t& hint = ctx.zoneHint[hintSlot_];
+        const uint32_t z = hint;
+        if (z < bsp_.zoneCount()) {
+            const glm::dvec2 zl = bsp_.zoneLo[z], zh = bsp_.zoneHi[z];
+            if ((u > zl.x || zl.x == lo_.x) && u <= zh.x && (v > zl.y || zl.y == lo_.y) &&
+                v <= zh.y)
+                return z;
+        }
+        hint = bsp_.locate(u, v, 0, 0);
+        return hint;
+    }
+    /// The slot of ctx.zoneHint this structure's walks keep their last zone in.
+    void setHintSlot(uint32_t slot) {
+        hintSlot_ = slot % uint32_t(std::tuple_size_v<decltype(TraceContext::zoneHint)>);
+    }
+
     size_t regionCount() const { return zones_ == 0 ? 0 : slabRoot_.size() + 1; }
     /// Walk over `scene`'s primitives from now on: a copy of the scene it was built over
     /// (the same Scene::preparedId), for a structure another build lends (BuildControl::previous).
@@ -145,7 +166,8 @@ class ProjectiveZones {
     std::vector<uint32_t> nearPrims_;
     std::vector<uint32_t> enterFirst_, enterPrims_;  ///< slab i's entering list (slabEntering)
     bool unionOnly_ = false;
-    bool inward_ = false;  ///< a light's structure (coversFromCentre)
+    bool inward_ = false;    ///< a light's structure (coversFromCentre)
+    uint32_t hintSlot_ = 0;  ///< its slot of TraceContext::zoneHint
     size_t emptySlabs_ = 0, mergedZones_ = 0, coarseZones_ = 0;
 };
 
@@ -201,7 +223,7 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
     };
     double t = tmin;
     ctx.beginLeafWalk();
-    const uint32_t zone = bsp_.locate(u, v, 0, 0);
+    const uint32_t zone = locate(u, v, ctx);
     const uint32_t first = zoneFirst_[zone], last = zoneFirst_[zone + 1];
     if (!inward_) {
         if (hasNearRegion()) {

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cstring>
+#include <span>
 #include <stdexcept>
 #include <string>
 
 #include "engine/accel/accelerator.h"
 #include "engine/accel/build_guard.h"
+#include "engine/accel/irregular/camera_frame.h"
 #include "engine/accel/irregular/primitive_hulls.h"
+#include "engine/scene/scene.h"
 
 namespace lancer {
 
@@ -35,6 +38,9 @@ struct Cell {
     int depth;
     Split split{};
     size_t primsBelow = 0, primsAbove = 0;  ///< the split's children's primitive counts
+    /// The walk's cost of a ray through the cell (walkCost; < 0: not known yet), and of its
+    /// split's children.
+    double walk = -1.0, walkBelow = 0.0, walkAbove = 0.0;
 };
 
 /// A cell waiting in the best-first queue: the larger gain first, then the older cell.
@@ -161,6 +167,68 @@ Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h, const BuildG
     return best;
 }
 
+/// Cells of at most this many primitives take their depth ranges from the hulls (walkCost).
+constexpr size_t kNarrowedCellPrims = 64;
+
+/// What the walk model sees along depth (walkCost): a slab cut (`cut`, where a primitive's
+/// range starts or ends), the test of a primitive whose range starts there (`weight`), and the
+/// share of the rays still going that end there (`kill`).
+struct DepthEvent {
+    double z;
+    double weight, kill;
+    bool cut;
+};
+
+/// The expected cost of a ray through the cell [lo, hi] that lists `prims` (ZoneWalkModel),
+/// walking the cell's slabs front to back: every slab costs a visit and every primitive a
+/// test, each times the share of the rays still going there. A primitive ends the rays that
+/// meet its filled share of the cell (its stop share times the share of the cell its
+/// rectangle covers) between its nearest depth and the middle of its range, half at each:
+/// its front surface lies there (a sphere's up to its centre), and the slabs cut in between
+/// are visited by the rays that meet it further on.
+double walkCost(const std::vector<uint32_t>& prims, glm::dvec2 lo, glm::dvec2 hi,
+                const std::vector<Box3>& rect, const ScreenBspParams& params,
+                std::vector<DepthEvent>& events) {
+    const ZoneWalkModel& model = *params.walk;
+    const double area = (hi.x - lo.x) * (hi.y - lo.y);
+    if (!(area > 0.0)) return model.visit;
+    events.clear();
+    // Small cells take each primitive's depth range over their column from its hull, as the
+    // slabs will (narrowZones): a large turned box is shallow over a small cell.
+    const bool narrow = params.hulls && prims.size() <= kNarrowedCellPrims;
+    for (uint32_t p : prims) {
+        const Box3& r = rect[p];
+        const double cx = std::min(r.hi.x, hi.x) - std::max(r.lo.x, lo.x);
+        const double cy = std::min(r.hi.y, hi.y) - std::max(r.lo.y, lo.y);
+        const double cover = std::clamp(cx * cy / area, 0.0, 1.0);
+        const double w = params.weights ? double((*params.weights)[p]) : 1.0;
+        glm::dvec2 z(r.lo.z, r.hi.z);
+        if (narrow) {
+            z = params.hulls->depthIn(p, params.column, lo, hi, r.lo.z, z);
+            if (z.x > z.y) continue;  // its bound misses the column
+        }
+        const double stop = (params.stops ? double((*params.stops)[p]) : model.fill) * cover;
+        events.push_back({z.x, w, 0.5 * stop, true});
+        events.push_back(
+            {0.5 * (z.x + z.y), 0.0, stop < 1.0 ? 0.5 * stop / (1.0 - 0.5 * stop) : 1.0, false});
+        events.push_back({z.y, 0.0, 0.0, true});
+    }
+    std::sort(events.begin(), events.end(),
+              [](const DepthEvent& a, const DepthEvent& b) { return a.z < b.z; });
+    double alive = 1.0, cost = model.visit;  // the slab in front of the first cut
+    double lastCut = -kInf;
+    for (size_t i = 0; i < events.size() && alive > 1e-6; ++i) {
+        const DepthEvent& e = events[i];
+        if (e.cut && e.z != lastCut) {
+            cost += alive * model.visit;
+            lastCut = e.z;
+        }
+        cost += alive * model.test * e.weight;
+        alive *= 1.0 - e.kill;
+    }
+    return cost;
+}
+
 /// The rectangle's interior meets the cell's. A rectangle that only touches the cell is left
 /// out: boxes are padded far beyond rounding (irregular.cpp), so its primitive has no point
 /// and no hit within the cell; including it would add every neighbour across an edge.
@@ -263,6 +331,8 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
     std::vector<Waiting> queue;       // a max-heap of the waiting cells by gain
     uint64_t order = 0;
     SplitScratch scratch;
+    std::vector<uint32_t> listBelow, listAbove;  // a cell's children's lists, for the walk model
+    std::vector<DepthEvent> events;
     // Which child of each node was split first in depth-first order (the one with fewer
     // segments, the upper one on a tie): the final numbering follows it (see below).
     std::vector<uint8_t> firstSide;
@@ -318,6 +388,8 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         // The tests of each side and of the cell, each weighing what it costs (sums of
         // quarters, exact in any order).
         double wBelow = 0.0, wAbove = 0.0, wCell = 0.0;
+        listBelow.clear();
+        listAbove.clear();
         for (uint32_t p : cell.prims) {
             if (params.guard && (++polled & 32767) == 0) params.guard->poll();
             const double w = params.weights ? double((*params.weights)[p]) : 1.0;
@@ -327,6 +399,8 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
             wBelow += b ? w : 0.0;
             wAbove += a ? w : 0.0;
             wCell += w;
+            if (params.walk && b) listBelow.push_back(p);
+            if (params.walk && a) listAbove.push_back(p);
         }
         // A ray through the cell (the area of a side is its share of the rays) tests its
         // rectangles; split, it crosses one more zone and tests one side's. The gain is the
@@ -335,13 +409,37 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         const double aBelow = (bHi.x - cell.lo.x) * (bHi.y - cell.lo.y);
         const double aAbove = (cell.hi.x - aLo.x) * (cell.hi.y - aLo.y);
         const double split = params.stepCost + (aBelow * wBelow + aAbove * wAbove) / area;
-        const double gain = area > 0.0 ? area * (wCell - split) : 0.0;
+        double gain = area > 0.0 ? area * (wCell - split) : 0.0;
+        bool pays = split < wCell;
+        if (params.walk && area > 0.0) {
+            // The walk model: the instructions the rays expected through the cell save by
+            // walking its children (one level deeper to locate), less what building the split
+            // adds (a zone, and a reference for each primitive it cuts in two).
+            const ZoneWalkModel& m = *params.walk;
+            if (cell.walk < 0.0)
+                cell.walk = walkCost(cell.prims, cell.lo, cell.hi, rect, params, events);
+            cell.walkBelow = walkCost(listBelow, cell.lo, bHi, rect, params, events);
+            cell.walkAbove = walkCost(listAbove, aLo, cell.hi, rect, params, events);
+            const double saved =
+                cell.walk - (aBelow * cell.walkBelow + aAbove * cell.walkAbove) / area - m.level;
+            const double built =
+                m.zone + m.ref * (double(nBelow + nAbove) - double(cell.prims.size()));
+            // Where the count model (stepCost) pays and the walk model does not, the split is
+            // made all the same (its gain in instructions: the tests it saves): the walk model
+            // misjudges where rays end on many faces at once (gears2's eye zones, alone: 9.8
+            // slabs a primary ray against 5.2 with the count model, 3.2 with both).
+            const double countGain = gain * m.raysPerArea * m.test;
+            gain = area * m.raysPerArea * saved - built;
+            if (pays && countGain > gain) gain = countGain;
+            pays = gain > 0.0;
+        }
         cell.primsBelow = nBelow;
         cell.primsAbove = nAbove;
         // The first levels always split (at most 16 cells): with a handful of primitives the
         // estimate would leave one zone, and the scheme would have no screen structure at all.
         const bool always = cell.depth < kAlwaysSplitLevels;
-        if (params.stepCost > 0.0 && !always && area > 0.0 && !(split < wCell)) {
+        const bool costStop = params.stepCost > 0.0 || params.walk;
+        if (costStop && !always && area > 0.0 && !pays) {
             ++bsp.costStops;
             makeZone(cell);
             return;
@@ -412,6 +510,10 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         (cell.parent < 0 ? bsp.root : bsp.nodes[cell.parent].child[cell.side]) = node;
         bsp.nodes.push_back({sp.axis, sp.c, {0, 0}});
         below.parent = above.parent = node;
+        if (params.walk) {
+            below.walk = cell.walkBelow;
+            above.walk = cell.walkAbove;
+        }
         for (const Segment& s : cell.segs) {
             if (params.guard && (++polled & 32767) == 0) params.guard->poll();
             if (s.axis == sp.axis) {
@@ -436,6 +538,68 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
     }
     renumber(bsp, firstSide, params.guard);
     return bsp;
+}
+
+std::vector<float> stopShares(const Scene& scene, const CameraFrame& frame) {
+    std::vector<float> share(scene.prims.size(), 0.0f);
+    const CsgTree& tree = scene.tree;
+    if (tree.empty()) return share;
+    // The share of their rectangle that vertices projected from the origin enclose (shoelace),
+    // or `none` when one lies behind it.
+    auto projected = [&](std::span<const Vec3> pts, float none) {
+        glm::dvec2 lo(kInf), hi(-kInf);
+        double twice = 0.0;
+        std::vector<glm::dvec2> q;
+        for (const Vec3& p : pts) {
+            const Vec3 c = frame.point(p);
+            if (!(c.z > 0.0)) return none;
+            q.push_back({c.x / c.z, c.y / c.z});
+            lo = glm::min(lo, q.back());
+            hi = glm::max(hi, q.back());
+        }
+        for (size_t i = 0; i < q.size(); ++i) {
+            const glm::dvec2 a = q[i], b = q[(i + 1) % q.size()];
+            twice += a.x * b.y - a.y * b.x;
+        }
+        const double rect = (hi.x - lo.x) * (hi.y - lo.y);
+        return rect > 0.0 ? float(std::clamp(0.5 * std::abs(twice) / rect, 0.0, 1.0)) : 0.0f;
+    };
+    // What each shape fills of its bounding rectangle, seen from about any side.
+    auto fill = [&](const Primitive& prim) {
+        const Shape& s = prim.shape;
+        if (std::holds_alternative<Sphere>(s)) return 0.785f;
+        if (std::holds_alternative<Block>(s)) return 0.9f;
+        if (const Triangle* t = std::get_if<Triangle>(&s))
+            return prim.hasXf ? 0.5f : projected(t->p, 0.5f);
+        if (const Polygon* pg = std::get_if<Polygon>(&s))
+            return prim.hasXf ? 0.7f : projected(pg->p, 0.7f);
+        if (std::holds_alternative<Torus>(s)) return 0.5f;
+        return 0.7f;  // cones and cylinders, polytopes
+    };
+    std::vector<std::pair<int, float>> stack{{tree.root, 1.0f}};
+    while (!stack.empty()) {
+        const auto [n, f] = stack.back();
+        stack.pop_back();
+        const CsgNode& node = tree.nodes[size_t(n)];
+        switch (node.op) {
+            case Op::Primitive:
+                share[node.prim] = std::max(share[node.prim], f * fill(scene.prims[node.prim]));
+                break;
+            case Op::Union:
+                stack.push_back({node.left, f});
+                stack.push_back({node.right, f});
+                break;
+            case Op::Intersection:
+                stack.push_back({node.left, 0.5f * f});
+                stack.push_back({node.right, 0.5f * f});
+                break;
+            case Op::Difference:
+                stack.push_back({node.left, f});
+                stack.push_back({node.right, 0.0f});
+                break;
+        }
+    }
+    return share;
 }
 
 uint32_t ScreenBsp::locate(double x, double y, int sx, int sy) const {

@@ -15,6 +15,28 @@ enum class BspHeuristic : uint8_t;  // build_params.h
 class BuildGuard;                   // build_guard.h
 class PrimitiveHulls;               // primitive_hulls.h
 enum class ZoneColumn : uint8_t;    // primitive_hulls.h
+struct Scene;                       // scene.h
+struct CameraFrame;                 // camera_frame.h
+
+/// The cost of a ray in a zone it walks in depth (the projective zones: the zone located once,
+/// then its slabs front to back until the first hit), in instructions of the render, and what
+/// a zone costs to build. With it the screen BSP splits a cell where the rays expected through
+/// it save, walking its children instead, more than the split adds to the build
+/// (docs/irregular.md, "A cost estimate that follows the walk").
+struct ZoneWalkModel {
+    double visit = 0.0;  ///< a slab visited
+    double test = 0.0;   ///< a primitive test of weight 1 (ScreenBspParams::weights)
+    double level = 0.0;  ///< a level of the BSP descended to locate the zone
+    /// The share of a primitive's rectangle where a ray ends on it, for primitives without a
+    /// share of their own (ScreenBspParams::stops).
+    double fill = 0.0;
+    double raysPerArea = 0.0;  ///< rays expected per unit area of the screen rectangle
+    /// Rays expected over the zones' whole rectangle, spread evenly (0: raysPerArea as given);
+    /// a light's structure, whose shadow rays start where the primary rays hit.
+    double rays = 0.0;
+    double zone = 0.0;  ///< building a zone
+    double ref = 0.0;   ///< building a zone's reference to a primitive (its depth range, slabs)
+};
 
 struct ScreenBspParams {
     BspHeuristic heuristic{};  ///< the choice of splitting line
@@ -39,7 +61,21 @@ struct ScreenBspParams {
     /// What testing each primitive costs, in sphere tests (testWeights(): a polygon weighs
     /// 1 + vertices / 4), for the cost stop's counts (null: every test alike).
     const std::vector<float>* weights = nullptr;
+    /// The walk's cost model (null: the count model of stepCost). Rectangles then carry each
+    /// primitive's depth range in z.
+    const ZoneWalkModel* walk = nullptr;
+    /// Per primitive, the share of its rectangle where a ray ends on it, for the walk model
+    /// (stopShares(); null: walk->fill for every one).
+    const std::vector<float>* stops = nullptr;
 };
+
+/// Per primitive of `scene`, the share of its screen rectangle where a ray from `frame`'s origin
+/// ends on it, as the walk model takes it: the share its shape fills of its bounding rectangle
+/// (a sphere pi/4; a triangle or polygon in world coordinates, the area of its vertices
+/// projected from the origin over their rectangle's, so a face seen edge-on stops nothing),
+/// halved under each intersection (the ray ends only where the other side holds too), none
+/// for what a difference takes away (a ray goes on through it).
+std::vector<float> stopShares(const Scene& scene, const CameraFrame& frame);
 
 /// The screen BSP and its leaves, the zones, each with the primitives whose rectangle it touches.
 struct ScreenBsp {
@@ -55,7 +91,7 @@ struct ScreenBsp {
     std::vector<uint32_t> zonePrims;
     size_t segments = 0;   ///< rectangle edges fed to the BSP
     size_t cuts = 0;       ///< segments cut in two by a splitting line
-    size_t costStops = 0;  ///< cells left whole because no split paid (stepCost)
+    size_t costStops = 0;  ///< cells left whole because no split paid (stepCost, walk)
     /// Zones by why their cell was not split, besides costStops: at most stopObjects
     /// rectangles; no segment left (the cell inside all its rectangles); the zone or byte limit.
     /// The four add up to the zones.
