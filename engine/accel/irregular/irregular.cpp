@@ -305,7 +305,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     // They do not depend on the camera: a structure built over the same prepared scene with the
     // same key lends its own (copied, about a millisecond a megabyte, where balls4's three
     // lights take 0.9 s of CPU to build).
-    s.lightKey_ = {scene.preparedId, params, share, maxRegions};
+    s.lightKey_ = {scene.preparedId, params, share, maxRegions, pixels};
     const bool lend = previous && scene.preparedId != 0 && previous->lightKey_ == s.lightKey_ &&
                       previous->lights_.size() == scene.lights.size();
     s.lightsInside_ = lend ? previous->lightsInside_ : lights.inside;

@@ -133,6 +133,7 @@ class IrregularSubdivision {
         IrregularConfig config;
         size_t share = 0;       ///< each structure's share of the budget
         size_t maxRegions = 0;  ///< the slabs' region bound (it follows the image size)
+        size_t pixels = 0;      ///< the image's: the cost stop's rays toward each light
         bool operator==(const LightKey&) const = default;
     };
     /// p is below region r on axis a (or on its low face, going down).
