@@ -14,6 +14,7 @@
 #include "engine/accel/irregular/screen_bsp.h"
 #include "engine/accel/regular/grid_frame.h"
 #include "engine/model/restriction.h"
+#include "engine/scene/json_reader.h"
 #include "engine/scene/loader.h"
 #include "tests/support/differential.h"
 
@@ -1033,6 +1034,61 @@ TEST(Irregular, ProjectiveZoneHintLocatesAsTheScreenBsp) {
         }
     }
     std::printf("%zu locations checked\n", checked);
+}
+
+// A ray from the eye whose (u, v) lies outside the zones' rectangle (the union of the projected
+// boxes of every primitive beyond zNear) can meet only the near region's primitives: the
+// projective walk answers it there, in no region at all when the near region is empty, instead
+// of handing it to the camera-frame walk (whose regions it used to cross: two thirds of the
+// turned sponge's primary rays at 128x128). Its hit is brute force's, and inside the rectangle
+// nothing changes.
+TEST(Irregular, EyeRaysOutsideEveryProjectedBoxVisitOnlyTheNearRegion) {
+    // The bracket with a ball behind the eye, which puts a primitive in the near region.
+    const std::string bracket = R"({
+      "camera": {"from": [70, -50, 60], "at": [20, 10, 5], "up": [0, 0, 1], "fov": 35},
+      "scene": {"union": [
+        {"difference": [
+          {"box": {"min": [0, 0, 0], "max": [40, 20, 10]}},
+          {"cylinder": {"radius": 4, "height": 12}, "transform": [{"translate": [10, 10, -1]}]}
+        ]},
+        {"sphere": {"radius": 2}, "transform": [{"translate": [95, -80, 87.5]}]}
+      ]}})";
+    std::vector<std::pair<std::string, Scene>> scenes;
+    scenes.emplace_back("builtin:sponge:3", loadScene("builtin:sponge:3"));
+    scenes.emplace_back("bracket", readJsonScene(SourceText("bracket.json", bracket)));
+    for (const auto& [name, scene] : scenes) {
+        auto accel = buildIrregular(scene);
+        const IrregularSubdivision& s = irregularOf(*accel);
+        const ProjectiveZones& pz = s.projective();
+        ASSERT_GT(pz.zoneCount(), 0u) << name;
+        EXPECT_EQ(pz.hasNearRegion(), name == "bracket");
+        const std::vector<Ray> rays = test::pixelRays(scene, 48, 48);
+        expectSame(scene, *accel, rays, name.c_str());
+        TraceContext ctx(scene.prims.size(), scene.tree.depth());
+        ctx.useMailboxes = accel->usesMailboxes();
+        const uint32_t nearId = uint32_t(s.regions().size()) + uint32_t(pz.zoneFirst().back());
+        size_t outside = 0, inside = 0, nearVisits = 0;
+        for (const Ray& ray : rays) {
+            const Ray rc = pz.frame().ray(ray);
+            double u, v;
+            ASSERT_TRUE(pz.covers(ray, rc, u, v)) << name << ": every pixel's ray is answered";
+            const RecordingObserver obs = test::recordWalk(*accel, ray, ctx);
+            if (pz.inZones(u, v)) {
+                ++inside;
+                continue;
+            }
+            ++outside;
+            for (const WalkEvent& e : obs.events) {
+                if (e.kind() != WalkEvent::Region) continue;
+                ASSERT_TRUE(pz.hasNearRegion()) << name << ": a region visited, none to visit";
+                EXPECT_EQ(std::get<walk::Region>(e.data).region, nearId) << name;
+                ++nearVisits;
+            }
+        }
+        EXPECT_GT(outside, rays.size() / 10) << name;
+        EXPECT_GT(inside, rays.size() / 10) << name;
+        EXPECT_EQ(nearVisits, pz.hasNearRegion() ? outside : 0u) << name;
+    }
 }
 
 // The walk model (ZoneWalkModel) splits a cell only where the rays through it go on past what

@@ -75,6 +75,8 @@ ProjectiveZones ProjectiveZones::buildCentred(const Scene& scene, const CameraFr
     s.frame_ = frame;
     s.eyePoint_ = frame.origin;
     s.inward_ = inward;
+    s.limLo_ = limLo;
+    s.limHi_ = limHi;
 
     // zNear: the nearest box wholly in front of the centre.
     double zNear = kInf, zFar = 0.0;

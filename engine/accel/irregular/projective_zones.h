@@ -46,20 +46,27 @@ class ProjectiveZones {
                                          size_t maxRegions = 0);
 
     /// This structure answers the ray: it starts exactly at the eye and its (u, v) is inside the
-    /// screen rectangle. `rc` is the ray in the camera frame.
+    /// rectangle the build projected the scene's boxes over (limLo_, limHi_; outside the zones'
+    /// rectangle such a ray can meet only the near region's primitives). `rc` is the ray in the
+    /// camera frame.
     bool covers(const Ray& world, const Ray& rc, double& u, double& v) const {
         if (zones_ == 0 || inward_ || world.o != eyePoint_ || !(rc.d.z > 0.0)) return false;
         u = rc.d.x / rc.d.z;
         v = rc.d.y / rc.d.z;
-        return u >= lo_.x && u <= hi_.x && v >= lo_.y && v <= hi_.y;
+        return u >= limLo_.x && u <= limHi_.x && v >= limLo_.y && v <= limHi_.y;
     }
     /// A light's structure answers the ray `rc` (in its frame) that heads for the centre from in
-    /// front of it, its origin's (u, v) inside the zones' rectangle: the caller's shadow ray
-    /// toward this light, whose line passes through the centre to rounding.
+    /// front of it: the caller's shadow ray toward this light, whose line passes through the
+    /// centre to rounding. Every direction from the light was projected, so every such ray is.
     bool coversFromCentre(const Ray& rc, double& u, double& v) const {
         if (zones_ == 0 || !inward_ || !(rc.o.z > 0.0) || !(rc.d.z < 0.0)) return false;
         u = rc.o.x / rc.o.z;
         v = rc.o.y / rc.o.z;
+        return u >= limLo_.x && u <= limHi_.x && v >= limLo_.y && v <= limHi_.y;
+    }
+    /// (u, v) lies in the zones' rectangle: the union of the projected boxes of every primitive
+    /// reaching beyond zNear, so a covered ray outside it meets the near region's alone.
+    bool inZones(double u, double v) const {
         return u >= lo_.x && u <= hi_.x && v >= lo_.y && v <= hi_.y;
     }
 
@@ -151,8 +158,9 @@ class ProjectiveZones {
     const Scene* scene_ = nullptr;
     CameraFrame frame_;  ///< the camera frame the walk's events are told in the world from
     Vec3 eyePoint_{0.0};
-    glm::dvec2 lo_{0.0}, hi_{0.0};     ///< the screen rectangle in (u, v)
-    double zNear_ = 0.0, zFar_ = 0.0;  ///< depth range of the slabs
+    glm::dvec2 lo_{0.0}, hi_{0.0};        ///< the zones' rectangle in (u, v)
+    glm::dvec2 limLo_{0.0}, limHi_{0.0};  ///< the rectangle the boxes were projected over
+    double zNear_ = 0.0, zFar_ = 0.0;     ///< depth range of the slabs
     int nearRoot_ = -1;  ///< restricted tree of the primitives reaching in front of zNear
     size_t zones_ = 0;
     ScreenBsp bsp_;
@@ -223,6 +231,14 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
     };
     double t = tmin;
     ctx.beginLeafWalk();
+    if (!inZones(u, v)) {
+        // Outside every projected box beyond zNear: only the near region's primitives remain,
+        // met before zNear from the eye, after it toward a light.
+        if (!hasNearRegion()) return false;
+        const double t0 = inward_ ? std::max(tAt(zNear_), t) : t;
+        const double t1 = inward_ ? tmax : std::min(tAt(zNear_), tmax);
+        return t0 <= t1 && nearRegion(t0, t1);
+    }
     const uint32_t zone = locate(u, v, ctx);
     const uint32_t first = zoneFirst_[zone], last = zoneFirst_[zone + 1];
     if (!inward_) {
