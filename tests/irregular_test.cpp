@@ -401,6 +401,71 @@ TEST(Irregular, ScreenBspStoppedByItsBudgetSpendsItEvenly) {
     EXPECT_NEAR(area, (hi.x - lo.x) * (hi.y - lo.y), 1e-9 * (hi.x - lo.x) * (hi.y - lo.y));
 }
 
+// A waiting cell keeps, in its references' top bits, the sides of its split that the cost
+// estimate found each primitive on, and the split sorts them by those bits: every zone lists
+// exactly the primitives whose rectangle's interior and hull outline meet it, in the order of
+// `live`, none with a side bit left, whether the BSP ran to its end, stopped on its byte limit
+// (the cells waiting then become zones with their bits cleared), or followed the walk model.
+TEST(Irregular, ScreenBspZonesListWhatMeetsThemAfterTheSplitsSideBits) {
+    size_t zones = 0, stopped = 0;
+    for (const char* name : {"builtin:sponge:2", "builtin:balls:3"}) {
+        Scene scene = loadScene(name);
+        const FrameChoice turned = chooseGridFrame(scene);
+        const CameraFrame frame = CameraFrame::of(scene.camera);
+        const std::vector<uint32_t> live = scene.livePrimitives();
+        const double pad = 1e-9 * scene.scale();
+        const PrimitiveHulls hulls = PrimitiveHulls::make(scene, frame, turned, live, pad);
+        std::vector<Box3> rect(scene.prims.size());
+        for (uint32_t p : live) rect[p] = frame.box(scene.minBox[p]);
+        const Box3 cam = frame.box(scene.bounds);
+        const glm::dvec2 lo(cam.lo), hi(cam.hi);
+        const std::vector<float> stops = stopShares(scene, frame);
+        ZoneWalkModel walk;
+        walk.visit = walk.test = 250.0;
+        walk.level = 12.0;
+        walk.fill = 0.5;
+        walk.zone = 500.0;
+        walk.ref = 1000.0;
+        walk.raysPerArea = 4096.0 / ((hi.x - lo.x) * (hi.y - lo.y));
+        size_t freeBytes = 0;  // what the unbounded build's zones cost
+        for (int mode = 0; mode < 3; ++mode) {
+            ScreenBspParams p;
+            p.heuristic = BspHeuristic::Balanced;
+            p.stopObjects = 1;
+            p.stepCost = 4.0;
+            p.zoneBytes = 64;
+            p.refBytes = 40;
+            p.hulls = &hulls;
+            p.column = ZoneColumn::Parallel;
+            if (mode == 1) p.maxBytes = freeBytes / 5;
+            if (mode == 2) {
+                p.walk = &walk;
+                p.stops = &stops;
+            }
+            const ScreenBsp bsp = ScreenBsp::build(rect, live, lo, hi, p);
+            if (mode == 0)
+                freeBytes = bsp.zoneCount() * p.zoneBytes + bsp.zonePrims.size() * p.refBytes;
+            stopped += bsp.stopped;
+            zones += bsp.zoneCount();
+            for (size_t z = 0; z < bsp.zoneCount(); ++z) {
+                const glm::dvec2 zl = bsp.zoneLo[z], zh = bsp.zoneHi[z];
+                std::vector<uint32_t> want;
+                for (uint32_t q : live) {
+                    const Box3& r = rect[q];
+                    if (r.lo.x < zh.x && zl.x < r.hi.x && r.lo.y < zh.y && zl.y < r.hi.y &&
+                        hulls.touches(q, ZoneColumn::Parallel, zl, zh))
+                        want.push_back(q);
+                }
+                const std::vector<uint32_t> got(bsp.zonePrims.begin() + bsp.zoneFirst[z],
+                                                bsp.zonePrims.begin() + bsp.zoneFirst[z + 1]);
+                ASSERT_EQ(got, want) << name << " mode " << mode << " zone " << z;
+            }
+        }
+    }
+    EXPECT_GT(zones, 300u);
+    EXPECT_EQ(stopped, 2u);  // the byte limit stopped each scene's second build
+}
+
 // The walk reported to the observer: regions in ray order with contiguous intervals, the
 // corner pointers followed between them, mailbox hits for primitives shared by regions.
 TEST(Irregular, ObserverSeesRegionsPointersAndMailboxes) {
