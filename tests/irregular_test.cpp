@@ -347,6 +347,18 @@ ZoneCost zoneCost(const ScreenBsp& bsp, glm::dvec2 lo, glm::dvec2 hi) {
     return c;
 }
 
+/// Screen BSP parameters of the count model (stepCost 4), stopping at `stopObjects`, charging
+/// 64 bytes a zone and 40 a reference.
+ScreenBspParams countModelParams(int stopObjects) {
+    ScreenBspParams p;
+    p.heuristic = BspHeuristic::Balanced;
+    p.stopObjects = stopObjects;
+    p.stepCost = 4.0;
+    p.zoneBytes = 64;
+    p.refBytes = 40;
+    return p;
+}
+
 // A screen BSP stopped by its byte limit has spent it across the whole screen: its cells are
 // split in order of the cost estimate's gain, so no zone is left much coarser than the others.
 // Stopped at a fifth of its unbounded bytes, this scene's BSP has 386 zones (3,488 unbounded)
@@ -362,12 +374,7 @@ TEST(Irregular, ScreenBspStoppedByItsBudgetSpendsItEvenly) {
     const std::vector<uint32_t> live = scene.livePrimitives();
     for (uint32_t p : live) rect[p] = s.frame().box(scene.minBox[p]);
     const glm::dvec2 lo(s.bounds().lo), hi(s.bounds().hi);
-    ScreenBspParams p;
-    p.heuristic = BspHeuristic::Balanced;
-    p.stopObjects = 4;
-    p.stepCost = 4.0;
-    p.zoneBytes = 64;
-    p.refBytes = 40;
+    ScreenBspParams p = countModelParams(4);
     const ScreenBsp free = ScreenBsp::build(rect, live, lo, hi, p);
     ASSERT_FALSE(free.stopped);
     const ZoneCost full = zoneCost(free, lo, hi);
@@ -429,12 +436,7 @@ TEST(Irregular, ScreenBspZonesListWhatMeetsThemAfterTheSplitsSideBits) {
         walk.raysPerArea = 4096.0 / ((hi.x - lo.x) * (hi.y - lo.y));
         size_t freeBytes = 0;  // what the unbounded build's zones cost
         for (int mode = 0; mode < 3; ++mode) {
-            ScreenBspParams p;
-            p.heuristic = BspHeuristic::Balanced;
-            p.stopObjects = 1;
-            p.stepCost = 4.0;
-            p.zoneBytes = 64;
-            p.refBytes = 40;
+            ScreenBspParams p = countModelParams(1);
             p.hulls = &hulls;
             p.column = ZoneColumn::Parallel;
             if (mode == 1) p.maxBytes = freeBytes / 5;
