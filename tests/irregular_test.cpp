@@ -1084,7 +1084,8 @@ glm::dvec2 keptFacesRange(const KeptFacesBox& world, const KeptFacesBox* turned,
 // those planes from its pre-check and skips a plane that a polygon lies wholly on one side of:
 // the ranges are those of the plain clipping, bit for bit (the slabs cut at them), on turned
 // bars (two boxes each), balls seen from a turned camera (the world box alone) and gears1's
-// polygons (a box along each one's plane off the world's axes, kept faces against none kept).
+// polygons (a box along each one's plane off the world's axes), with all, some or none of the
+// faces kept.
 TEST(PrimitiveHulls, KeptFacesGiveThePlainClippingsRangesBitForBit) {
     size_t compared = 0, twoBoxes = 0, cut = 0;
     auto compare = [&](const Scene& s, bool reference) {
@@ -1096,6 +1097,14 @@ TEST(PrimitiveHulls, KeptFacesGiveThePlainClippingsRangesBitForBit) {
         const PrimitiveHulls none = PrimitiveHulls::make(s, frame, turned, live, pad, nullptr, 0);
         EXPECT_EQ(none.keptFaces(), 0u);
         EXPECT_EQ(none.faceBytes(), 0u);
+        // At the bytes that all the faces take, the doubling counted, about half are kept.
+        const PrimitiveHulls some =
+            PrimitiveHulls::make(s, frame, turned, live, pad, nullptr, hulls.faceBytes());
+        EXPECT_LE(2 * some.faceBytes(), hulls.faceBytes());
+        if (hulls.keptFaces() > 1) {
+            EXPECT_GT(some.keptFaces(), 0u);
+            EXPECT_LT(some.keptFaces(), hulls.keptFaces());
+        }
         twoBoxes += hulls.keptFaces();
         std::mt19937_64 rng(live.size());
         std::uniform_real_distribution<double> u01(0.0, 1.0);
@@ -1121,8 +1130,11 @@ TEST(PrimitiveHulls, KeptFacesGiveThePlainClippingsRangesBitForBit) {
                         lo - 0.5 * e + glm::dvec2(u01(rng), u01(rng)) * (hi - lo);
                     const glm::dvec2 d = hulls.depthIn(p, column, zlo, zlo + e, zNear, whole);
                     const glm::dvec2 o = none.depthIn(p, column, zlo, zlo + e, zNear, whole);
+                    const glm::dvec2 h = some.depthIn(p, column, zlo, zlo + e, zNear, whole);
                     EXPECT_EQ(d.x, o.x) << "p" << p;
                     EXPECT_EQ(d.y, o.y) << "p" << p;
+                    EXPECT_EQ(d.x, h.x) << "p" << p;
+                    EXPECT_EQ(d.y, h.y) << "p" << p;
                     if (reference) {
                         const glm::dvec2 r = keptFacesRange(world, own ? &*own : nullptr, column,
                                                             zlo, zlo + e, zNear, whole);

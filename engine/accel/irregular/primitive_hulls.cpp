@@ -189,24 +189,27 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
             }
         }
         // Two boxes: each face of one clipped by the other is the same for every zone (depthIn
-        // clips it by the zone's column after), so it is clipped once here, while the faces kept
-        // stay within maxFaceBytes (the vector's doubling counted).
+        // clips it by the zone's column after), so it is clipped once here, and kept while the
+        // kept faces stay within maxFaceBytes (checked before they are added, the vector's
+        // doubling counted).
         if (!hull.single && keep) {
-            const size_t at = h.faceVerts_.size();
-            Poly a, b;
+            Poly face[12], spare;
+            size_t count = 0;
             for (int f = 0; f < 12; ++f) {
-                const Solid& me = f < 6 ? hull.world : hull.turned;
-                boxFace(me.corner, f % 6, a);
-                const Poly* in = clipByBox(f < 6 ? hull.turned : hull.world, &a, &b);
-                hull.faceSize[size_t(f)] = uint8_t(in->n);
-                for (int i = 0; i < in->n; ++i) h.faceVerts_.push_back({in->v[i], in->corner[i]});
+                boxFace((f < 6 ? hull.world : hull.turned).corner, f % 6, face[f]);
+                const Poly* r = clipByBox(f < 6 ? hull.turned : hull.world, &face[f], &spare);
+                if (r != &face[f]) face[f] = *r;
+                count += size_t(face[f].n);
             }
-            if (2 * h.faceVerts_.size() * sizeof(FaceVertex) <= maxFaceBytes) {
-                hull.faceFirst = uint32_t(at);
+            if (2 * (h.faceVerts_.size() + count) * sizeof(FaceVertex) <= maxFaceBytes) {
+                hull.faceFirst = uint32_t(h.faceVerts_.size());
+                for (int f = 0; f < 12; ++f) {
+                    hull.faceSize[size_t(f)] = uint8_t(face[f].n);
+                    for (int i = 0; i < face[f].n; ++i)
+                        h.faceVerts_.push_back({face[f].v[size_t(i)], face[f].corner[size_t(i)]});
+                }
                 ++h.keptFaces_;
             } else {
-                h.faceVerts_.resize(at);
-                hull.faceSize = {};
                 keep = false;
             }
         }
