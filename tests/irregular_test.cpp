@@ -348,6 +348,18 @@ ZoneCost zoneCost(const ScreenBsp& bsp, glm::dvec2 lo, glm::dvec2 hi) {
     return c;
 }
 
+/// Screen BSP parameters of the count model (stepCost 4), stopping at `stopObjects`, charging
+/// 64 bytes a zone and 40 a reference.
+ScreenBspParams countModelParams(int stopObjects) {
+    ScreenBspParams p;
+    p.heuristic = BspHeuristic::Balanced;
+    p.stopObjects = stopObjects;
+    p.stepCost = 4.0;
+    p.zoneBytes = 64;
+    p.refBytes = 40;
+    return p;
+}
+
 // A screen BSP stopped by its byte limit has spent it across the whole screen: its cells are
 // split in order of the cost estimate's gain, so no zone is left much coarser than the others.
 // Stopped at a fifth of its unbounded bytes, this scene's BSP has 386 zones (3,488 unbounded)
@@ -363,12 +375,7 @@ TEST(Irregular, ScreenBspStoppedByItsBudgetSpendsItEvenly) {
     const std::vector<uint32_t> live = scene.livePrimitives();
     for (uint32_t p : live) rect[p] = s.frame().box(scene.minBox[p]);
     const glm::dvec2 lo(s.bounds().lo), hi(s.bounds().hi);
-    ScreenBspParams p;
-    p.heuristic = BspHeuristic::Balanced;
-    p.stopObjects = 4;
-    p.stepCost = 4.0;
-    p.zoneBytes = 64;
-    p.refBytes = 40;
+    ScreenBspParams p = countModelParams(4);
     const ScreenBsp free = ScreenBsp::build(rect, live, lo, hi, p);
     ASSERT_FALSE(free.stopped);
     const ZoneCost full = zoneCost(free, lo, hi);
@@ -400,6 +407,66 @@ TEST(Irregular, ScreenBspStoppedByItsBudgetSpendsItEvenly) {
         }
     }
     EXPECT_NEAR(area, (hi.x - lo.x) * (hi.y - lo.y), 1e-9 * (hi.x - lo.x) * (hi.y - lo.y));
+}
+
+// A waiting cell keeps, in its references' top bits, the sides of its split that the cost
+// estimate found each primitive on, and the split sorts them by those bits: every zone lists
+// exactly the primitives whose rectangle's interior and hull outline meet it, in the order of
+// `live`, none with a side bit left, whether the BSP ran to its end, stopped on its byte limit
+// (the cells waiting then become zones with their bits cleared), or followed the walk model.
+TEST(Irregular, ScreenBspZonesListWhatMeetsThemAfterTheSplitsSideBits) {
+    size_t zones = 0, stopped = 0;
+    for (const char* name : {"builtin:sponge:2", "builtin:balls:3"}) {
+        Scene scene = loadScene(name);
+        const FrameChoice turned = chooseGridFrame(scene);
+        const CameraFrame frame = CameraFrame::of(scene.camera);
+        const std::vector<uint32_t> live = scene.livePrimitives();
+        const double pad = 1e-9 * scene.scale();
+        const PrimitiveHulls hulls = PrimitiveHulls::make(scene, frame, turned, live, pad);
+        std::vector<Box3> rect(scene.prims.size());
+        for (uint32_t p : live) rect[p] = frame.box(scene.minBox[p]);
+        const Box3 cam = frame.box(scene.bounds);
+        const glm::dvec2 lo(cam.lo), hi(cam.hi);
+        const std::vector<float> stops = stopShares(scene, frame);
+        ZoneWalkModel walk;
+        walk.visit = walk.test = 250.0;
+        walk.level = 12.0;
+        walk.fill = 0.5;
+        walk.zone = 500.0;
+        walk.ref = 1000.0;
+        walk.raysPerArea = 4096.0 / ((hi.x - lo.x) * (hi.y - lo.y));
+        size_t freeBytes = 0;  // what the unbounded build's zones cost
+        for (int mode = 0; mode < 3; ++mode) {
+            ScreenBspParams p = countModelParams(1);
+            p.hulls = &hulls;
+            p.column = ZoneColumn::Parallel;
+            if (mode == 1) p.maxBytes = freeBytes / 5;
+            if (mode == 2) {
+                p.walk = &walk;
+                p.stops = &stops;
+            }
+            const ScreenBsp bsp = ScreenBsp::build(rect, live, lo, hi, p);
+            if (mode == 0)
+                freeBytes = bsp.zoneCount() * p.zoneBytes + bsp.zonePrims.size() * p.refBytes;
+            stopped += bsp.stopped;
+            zones += bsp.zoneCount();
+            for (size_t z = 0; z < bsp.zoneCount(); ++z) {
+                const glm::dvec2 zl = bsp.zoneLo[z], zh = bsp.zoneHi[z];
+                std::vector<uint32_t> want;
+                for (uint32_t q : live) {
+                    const Box3& r = rect[q];
+                    if (r.lo.x < zh.x && zl.x < r.hi.x && r.lo.y < zh.y && zl.y < r.hi.y &&
+                        hulls.touches(q, ZoneColumn::Parallel, zl, zh))
+                        want.push_back(q);
+                }
+                const std::vector<uint32_t> got(bsp.zonePrims.begin() + bsp.zoneFirst[z],
+                                                bsp.zonePrims.begin() + bsp.zoneFirst[z + 1]);
+                ASSERT_EQ(got, want) << name << " mode " << mode << " zone " << z;
+            }
+        }
+    }
+    EXPECT_GT(zones, 300u);
+    EXPECT_EQ(stopped, 2u);  // the byte limit stopped each scene's second build
 }
 
 // The walk reported to the observer: regions in ray order with contiguous intervals, the
@@ -914,6 +981,179 @@ TEST(PrimitiveHulls, FlatAndWorldBoxesHoldThePolygonsPoints) {
     EXPECT_GE(polygons, 20u);
     EXPECT_GT(samples, 800u);
     EXPECT_GT(tighter, pairs / 4) << tighter << " of " << pairs;
+}
+
+/// A box of the camera frame along the world-frame axes `axes`, as PrimitiveHulls makes it:
+/// corners and planes (axis . x between lo and hi).
+struct KeptFacesBox {
+    std::array<Vec3, 8> corner;
+    std::array<Vec3, 3> axis;
+    Vec3 lo, hi;
+};
+
+KeptFacesBox keptFacesBox(const CameraFrame& frame, const Box3& b, const Mat3& axes, double pad) {
+    KeptFacesBox s;
+    const Box3 w{b.lo - Vec3(pad), b.hi + Vec3(pad)};
+    for (int a = 0; a < 3; ++a) {
+        s.axis[size_t(a)] = frame.vector(axes[a]);
+        const double o = glm::dot(axes[a], frame.origin);
+        s.lo[a] = w.lo[a] - o;
+        s.hi[a] = w.hi[a] - o;
+    }
+    for (int c = 0; c < 8; ++c) s.corner[size_t(c)] = frame.point(axes * boxCorner(w, c));
+    return s;
+}
+
+/// The part of `in` where n . x <= d, one Sutherland-Hodgman pass.
+std::vector<Vec3> keptFacesClip(const std::vector<Vec3>& in, const Vec3& n, double d) {
+    std::vector<Vec3> out;
+    for (size_t i = 0; i < in.size(); ++i) {
+        const Vec3& a = in[i];
+        const Vec3& b = in[(i + 1) % in.size()];
+        const double da = glm::dot(n, a) - d, db = glm::dot(n, b) - d;
+        if (da <= 0.0) out.push_back(a);
+        if ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
+            const double s = da / (da - db);
+            out.push_back(a + s * (b - a));
+        }
+    }
+    return out;
+}
+
+/// The depth range of the world box and the turned box (null: the world box alone) within the
+/// column over [lo, hi], computed the plain way: each face of each box clipped by the other box,
+/// then by every column plane that cuts a corner off either box, pass after pass.
+glm::dvec2 keptFacesRange(const KeptFacesBox& world, const KeptFacesBox* turned, ZoneColumn column,
+                          glm::dvec2 lo, glm::dvec2 hi, double zNear, glm::dvec2 whole) {
+    std::vector<Vec3> cn;
+    std::vector<double> cd;
+    if (column == ZoneColumn::Parallel) {
+        cn = {Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, -1, 0), Vec3(0, 1, 0)};
+        cd = {-lo.x, hi.x, -lo.y, hi.y};
+    } else {
+        cn = {Vec3(-1, 0, lo.x), Vec3(1, 0, -hi.x), Vec3(0, -1, lo.y), Vec3(0, 1, -hi.y),
+              Vec3(0, 0, -1)};
+        cd = {0.0, 0.0, 0.0, 0.0, -zNear};
+    }
+    const KeptFacesBox* boxes[2] = {&world, turned};
+    const int n = turned ? 2 : 1;
+    std::vector<bool> cuts(cn.size(), false);
+    for (size_t k = 0; k < cn.size(); ++k) {
+        for (int s = 0; s < n; ++s) {
+            int beyond = 0;
+            for (const Vec3& c : boxes[s]->corner) beyond += glm::dot(cn[k], c) > cd[k];
+            if (beyond == 8) return {whole.x, -kInf};
+            cuts[k] = cuts[k] || beyond > 0;
+        }
+    }
+    glm::dvec2 range(kInf, -kInf);
+    for (int s = 0; s < n; ++s) {
+        const KeptFacesBox& me = *boxes[s];
+        for (int axis = 0; axis < 3; ++axis) {
+            const int u = 1 << ((axis + 1) % 3), v = 1 << ((axis + 2) % 3);
+            for (int side = 0; side < 2; ++side) {
+                const int base = side << axis;
+                std::vector<Vec3> f = {me.corner[size_t(base)], me.corner[size_t(base | u)],
+                                       me.corner[size_t(base | u | v)],
+                                       me.corner[size_t(base | v)]};
+                if (turned) {
+                    const KeptFacesBox& other = *boxes[1 - s];
+                    for (size_t k = 0; k < 3 && !f.empty(); ++k) {
+                        f = keptFacesClip(f, other.axis[k], other.hi[int(k)]);
+                        if (f.empty()) break;
+                        f = keptFacesClip(f, -other.axis[k], -other.lo[int(k)]);
+                    }
+                }
+                for (size_t k = 0; k < cn.size() && !f.empty(); ++k)
+                    if (cuts[k]) f = keptFacesClip(f, cn[k], cd[k]);
+                for (const Vec3& q : f) {
+                    range.x = std::min(range.x, q.z);
+                    range.y = std::max(range.y, q.z);
+                }
+            }
+        }
+    }
+    if (column == ZoneColumn::FromEye && range.x <= range.y)
+        for (int s = 0; s < n; ++s)
+            for (const Vec3& c : boxes[s]->corner)
+                if (c.z < zNear) range.x = zNear;
+    return {std::max(range.x, whole.x), std::min(range.y, whole.y)};
+}
+
+// depthIn keeps each face of a hull's two boxes clipped by the other box (they do not depend on
+// the zone), clips only by the column planes at each zone, takes the corners' distances to
+// those planes from its pre-check and skips a plane that a polygon lies wholly on one side of:
+// the ranges are those of the plain clipping, bit for bit (the slabs cut at them), on turned
+// bars (two boxes each), balls seen from a turned camera (the world box alone) and gears1's
+// polygons (a box along each one's plane off the world's axes), with all, some or none of the
+// faces kept.
+TEST(PrimitiveHulls, KeptFacesGiveThePlainClippingsRangesBitForBit) {
+    size_t compared = 0, twoBoxes = 0, cut = 0;
+    auto compare = [&](const Scene& s, bool reference) {
+        const FrameChoice turned = chooseGridFrame(s);
+        const CameraFrame frame = CameraFrame::of(s.camera);
+        const std::vector<uint32_t> live = s.livePrimitives();
+        const double pad = 1e-9 * s.scale();
+        const PrimitiveHulls hulls = PrimitiveHulls::make(s, frame, turned, live, pad);
+        const PrimitiveHulls none = PrimitiveHulls::make(s, frame, turned, live, pad, nullptr, 0);
+        EXPECT_EQ(none.keptFaces(), 0u);
+        EXPECT_EQ(none.faceBytes(), 0u);
+        // At the bytes that all the faces take, the doubling counted, about half are kept.
+        const PrimitiveHulls some =
+            PrimitiveHulls::make(s, frame, turned, live, pad, nullptr, hulls.faceBytes());
+        EXPECT_LE(2 * some.faceBytes(), hulls.faceBytes());
+        if (hulls.keptFaces() > 1) {
+            EXPECT_GT(some.keptFaces(), 0u);
+            EXPECT_LT(some.keptFaces(), hulls.keptFaces());
+        }
+        twoBoxes += hulls.keptFaces();
+        std::mt19937_64 rng(live.size());
+        std::uniform_real_distribution<double> u01(0.0, 1.0);
+        const double zNear = 1e-3 * s.scale();
+        for (uint32_t p : live) {
+            const Box3 cam = frame.box(s.minBox[p]);
+            const glm::dvec2 whole(cam.lo.z, cam.hi.z);
+            const KeptFacesBox world = keptFacesBox(frame, s.minBox[p], Mat3(1.0), pad);
+            std::optional<KeptFacesBox> own;
+            if (turned.frame.turned && !turned.boxes[p].isEmpty())
+                own = keptFacesBox(frame, turned.boxes[p], turned.frame.axes, pad);
+            for (ZoneColumn column : {ZoneColumn::Parallel, ZoneColumn::FromEye}) {
+                glm::dvec2 lo(cam.lo.x, cam.lo.y), hi(cam.hi.x, cam.hi.y);
+                if (column == ZoneColumn::FromEye) {
+                    if (!(cam.lo.z > 0.0)) continue;
+                    lo = glm::min(lo / cam.lo.z, lo / cam.hi.z);
+                    hi = glm::max(hi / cam.lo.z, hi / cam.hi.z);
+                }
+                // Zones from a twentieth to the whole of the rectangle across, most cutting it.
+                for (int k = 0; k < 12; ++k) {
+                    const glm::dvec2 e = (0.05 + 0.95 * u01(rng)) * (hi - lo);
+                    const glm::dvec2 zlo =
+                        lo - 0.5 * e + glm::dvec2(u01(rng), u01(rng)) * (hi - lo);
+                    const glm::dvec2 d = hulls.depthIn(p, column, zlo, zlo + e, zNear, whole);
+                    const glm::dvec2 o = none.depthIn(p, column, zlo, zlo + e, zNear, whole);
+                    const glm::dvec2 h = some.depthIn(p, column, zlo, zlo + e, zNear, whole);
+                    EXPECT_EQ(d.x, o.x) << "p" << p;
+                    EXPECT_EQ(d.y, o.y) << "p" << p;
+                    EXPECT_EQ(d.x, h.x) << "p" << p;
+                    EXPECT_EQ(d.y, h.y) << "p" << p;
+                    if (reference) {
+                        const glm::dvec2 r = keptFacesRange(world, own ? &*own : nullptr, column,
+                                                            zlo, zlo + e, zNear, whole);
+                        EXPECT_EQ(d.x, r.x) << "p" << p;
+                        EXPECT_EQ(d.y, r.y) << "p" << p;
+                    }
+                    ++compared;
+                    cut += d.x <= d.y && (d.x > whole.x || d.y < whole.y);
+                }
+            }
+        }
+    };
+    for (uint64_t seed = 1; seed <= 3; ++seed) compare(test::turnedBars(seed * 29 + 1, 16), true);
+    compare(loadScene("builtin:balls:2"), true);
+    compare(loadScene(std::string(LANCER_SOURCE_DIR) + "/assets/spd/gears1.nff"), false);
+    EXPECT_GT(twoBoxes, 40u);
+    EXPECT_GT(compared, 5000u);
+    EXPECT_GT(cut, compared / 4) << cut << " of " << compared;
 }
 
 TEST(Irregular, SparseRestrictionEqualsRestrictTree) {

@@ -154,11 +154,12 @@ ProjectiveZones buildLightZones(const Scene& scene, const CameraFrame& f, const 
     const std::vector<Box3> box = frameBoxes(scene, f, turned, live, eps);
     // The hulls are scratch: within a sixteenth of the light's share, as each frame's within a
     // sixteenth of the budget, so the tasks running at once stay within it.
-    const bool hullsFit =
-        PrimitiveHulls::bytesFor(live.size(), scene.prims.size()) <= share / kHullShare;
+    const size_t hullBytes = PrimitiveHulls::bytesFor(live.size(), scene.prims.size());
     const PrimitiveHulls hulls =
-        hullsFit ? PrimitiveHulls::make(scene, f, turned, live, eps, frameSp.guard)
-                 : PrimitiveHulls{};
+        hullBytes <= share / kHullShare
+            ? PrimitiveHulls::make(scene, f, turned, live, eps, frameSp.guard,
+                                   share / kHullShare - hullBytes)
+            : PrimitiveHulls{};
     ScreenBspParams sp = frameSp;
     ZoneWalkModel walk;
     std::vector<float> stops;
@@ -259,11 +260,13 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     // each zone (primitive_hulls.h).
     // They are the build's scratch, made only when they take at most a sixteenth of the budget
     // (a tighter budget builds on the boxes alone, as it did before them).
-    const bool hullsFit =
-        PrimitiveHulls::bytesFor(live.size(), scene.prims.size()) <= guard.budget() / kHullShare;
+    // Their faces clipped by each other box are kept within what is left of that sixteenth.
+    const size_t hullBytes = PrimitiveHulls::bytesFor(live.size(), scene.prims.size());
     const PrimitiveHulls hulls =
-        hullsFit ? PrimitiveHulls::make(scene, s.frame_, turned, live, eps, &guard)
-                 : PrimitiveHulls{};
+        hullBytes <= guard.budget() / kHullShare
+            ? PrimitiveHulls::make(scene, s.frame_, turned, live, eps, &guard,
+                                   guard.budget() / kHullShare - hullBytes)
+            : PrimitiveHulls{};
     if (!hulls.empty()) sp.hulls = &hulls;
     sp.column = ZoneColumn::Parallel;
     sp.hullPad = eps;

@@ -11,25 +11,75 @@ namespace lancer {
 
 namespace {
 
-/// A convex polygon being clipped: a quad cut by at most 15 planes has at most 19 vertices.
+/// A convex polygon being clipped, each vertex with the corner of its box it is (-1: a point
+/// clipping made): a quad cut by at most 15 planes has at most 19 vertices.
 struct Poly {
     std::array<Vec3, 24> v;
+    std::array<int, 24> corner;
     int n = 0;
 };
 
-/// Keeps the part of `in` where n . x <= d (Sutherland-Hodgman).
-void clip(const Poly& in, const Vec3& n, double d, Poly& out) {
-    out.n = 0;
-    for (int i = 0; i < in.n; ++i) {
-        const Vec3& a = in.v[i];
-        const Vec3& b = in.v[(i + 1) % in.n];
-        const double da = glm::dot(n, a) - d, db = glm::dot(n, b) - d;
-        if (da <= 0.0) out.v[out.n++] = a;
+/// Keeps the part of `in` where n . x <= d (Sutherland-Hodgman), in `out` or, when it keeps every
+/// vertex, in `in` itself: the polygon returned holds the result. Each vertex's n . x - d is
+/// computed once, a corner's taken from cornerDist (null: computed), and a polygon wholly within
+/// or wholly beyond the plane is not walked: the same vertices, in the same order, as the walk.
+Poly* clip(Poly* in, Poly* out, const Vec3& n, double d, const double* cornerDist) {
+    double dist[24];
+    int within = 0, beyond = 0;
+    for (int i = 0; i < in->n; ++i) {
+        dist[i] = cornerDist && in->corner[i] >= 0 ? cornerDist[in->corner[i]]
+                                                   : glm::dot(n, in->v[i]) - d;
+        within += dist[i] <= 0.0;
+        beyond += dist[i] > 0.0;
+    }
+    if (within == in->n) return in;
+    out->n = 0;
+    if (beyond == in->n) return out;
+    for (int i = 0; i < in->n; ++i) {
+        const int j = i + 1 == in->n ? 0 : i + 1;
+        const double da = dist[i], db = dist[j];
+        if (da <= 0.0) {
+            out->v[out->n] = in->v[i];
+            out->corner[out->n++] = in->corner[i];
+        }
         if ((da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0)) {
             const double s = da / (da - db);
-            out.v[out.n++] = a + s * (b - a);
+            out->v[out->n] = in->v[i] + s * (in->v[j] - in->v[i]);
+            out->corner[out->n++] = -1;
         }
     }
+    return out;
+}
+
+/// Face f of a box with corners `corner` (f / 2 its axis, the high side when f is odd), its
+/// vertices counterclockwise from its lowest corner as seen from outside.
+template <class Corners>
+void boxFace(const Corners& corner, int f, Poly& out) {
+    const int axis = f / 2;
+    const int u = 1 << ((axis + 1) % 3), v = 1 << ((axis + 2) % 3);
+    const int base = (f % 2) << axis;
+    const int c[4] = {base, base | u, base | u | v, base | v};
+    out.n = 4;
+    for (int i = 0; i < 4; ++i) {
+        out.v[i] = corner[c[i]];
+        out.corner[i] = c[i];
+    }
+}
+
+/// Clips `in` by the box `other`'s planes, along each axis its high one then its low one (`spare`:
+/// scratch); returns the polygon holding the result.
+template <class Solid>
+Poly* clipByBox(const Solid& other, Poly* in, Poly* spare) {
+    auto by = [&](const Vec3& n, double d) {
+        Poly* r = clip(in, spare, n, d, nullptr);
+        if (r != in) spare = in, in = r;
+    };
+    for (int k = 0; k < 3 && in->n; ++k) {
+        by(other.axis[k], other.hi[k]);
+        if (!in->n) break;
+        by(-other.axis[k], -other.lo[k]);
+    }
+    return in;
 }
 
 /// The frame of a flat primitive (a triangle or a polygon) whose plane is turned off the
@@ -63,7 +113,7 @@ std::optional<GridFrame> flatFrame(const Primitive& prim) {
 
 PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame,
                                     const FrameChoice& turned, const std::vector<uint32_t>& live,
-                                    double pad, const BuildGuard* guard) {
+                                    double pad, const BuildGuard* guard, size_t maxFaceBytes) {
     PrimitiveHulls h;
     // A box along the world-frame axes `axes` (columns) in the camera frame: a rotation keeps it
     // a box, its planes along the camera images of those axes, offset by the eye's position.
@@ -89,6 +139,7 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
     const bool alongWorld = worldAxis(frame.x) && worldAxis(frame.y) && worldAxis(frame.z);
     h.index_.assign(scene.prims.size(), -1);
     size_t made = 0;
+    bool keep = maxFaceBytes > 0;  // faces clipped by the other box are still kept
     for (uint32_t p : live) {
         // About a microsecond a primitive: balls:5's 66,430 took a cancellation past 100 ms.
         if (guard && (made++ & 1023) == 0) guard->poll();
@@ -137,9 +188,35 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
                 hull.outlineHi[c] = glm::max(hull.outlineHi[c], q);
             }
         }
+        // Two boxes: each face of one clipped by the other is the same for every zone (depthIn
+        // clips it by the zone's column after), so it is clipped once here, and kept while the
+        // kept faces stay within maxFaceBytes (checked before they are added, the vector's
+        // doubling counted).
+        if (!hull.single && keep) {
+            Poly face[12], spare;
+            size_t count = 0;
+            for (int f = 0; f < 12; ++f) {
+                boxFace((f < 6 ? hull.world : hull.turned).corner, f % 6, face[f]);
+                const Poly* r = clipByBox(f < 6 ? hull.turned : hull.world, &face[f], &spare);
+                if (r != &face[f]) face[f] = *r;
+                count += size_t(face[f].n);
+            }
+            if (2 * (h.faceVerts_.size() + count) * sizeof(FaceVertex) <= maxFaceBytes) {
+                hull.faceFirst = uint32_t(h.faceVerts_.size());
+                for (int f = 0; f < 12; ++f) {
+                    hull.faceSize[size_t(f)] = uint8_t(face[f].n);
+                    for (int i = 0; i < face[f].n; ++i)
+                        h.faceVerts_.push_back({face[f].v[size_t(i)], face[f].corner[size_t(i)]});
+                }
+                ++h.keptFaces_;
+            } else {
+                keep = false;
+            }
+        }
         h.index_[p] = int32_t(h.hulls_.size());
         h.hulls_.push_back(std::move(hull));
     }
+    h.faceVerts_.shrink_to_fit();
     return h;
 }
 
@@ -216,61 +293,61 @@ glm::dvec2 PrimitiveHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo,
         planes = 5;
     }
     // A column plane that every corner of a box lies within cuts nothing from it; one that
-    // every corner lies beyond leaves nothing (both boxes are convex).
+    // every corner lies beyond leaves nothing (both boxes are convex). The corners' n . x - d
+    // are kept for the clipping below.
+    const int solids = h.single ? 1 : 2;
+    const Solid* solid[2] = {&h.world, &h.turned};
     std::array<bool, 5> cuts{};
+    double cornerDist[2][5][8];
     for (int k = 0; k < planes; ++k) {
-        for (int s = 0; s < (h.single ? 1 : 2); ++s) {
-            const Solid& box = s == 0 ? h.world : h.turned;
+        for (int s = 0; s < solids; ++s) {
             int beyond = 0;
-            for (const Vec3& c : box.corner) beyond += glm::dot(cn[k], c) > cd[k];
+            for (int c = 0; c < 8; ++c) {
+                cornerDist[s][k][c] = glm::dot(cn[k], solid[s]->corner[size_t(c)]) - cd[k];
+                beyond += cornerDist[s][k][c] > 0.0;
+            }
             if (beyond == 8) return {whole.x, -kInf};
             cuts[k] = cuts[k] || beyond > 0;
         }
     }
     // The extremes in depth of the solid (both boxes and the column) lie on a face of one of
     // the boxes: the column is unbounded in depth (beyond zNear, handled below), so its sides
-    // alone hold no extreme. Each face is clipped by the other box and the column.
+    // alone hold no extreme. Each face is clipped by the other box (kept from make, or here)
+    // and the column.
     glm::dvec2 range(kInf, -kInf);
-    const Solid* solids[2] = {&h.world, &h.turned};
     Poly a, b;
-    for (int s = 0; s < (h.single ? 1 : 2); ++s) {
-        const Solid& me = *solids[s];
-        const Solid& other = *solids[1 - s];
-        for (int axis = 0; axis < 3; ++axis) {
-            const int u = 1 << ((axis + 1) % 3), v = 1 << ((axis + 2) % 3);
-            for (int side = 0; side < 2; ++side) {
-                const int base = side << axis;
-                a.n = 4;
-                a.v[0] = me.corner[base];
-                a.v[1] = me.corner[base | u];
-                a.v[2] = me.corner[base | u | v];
-                a.v[3] = me.corner[base | v];
-                Poly* in = &a;
-                Poly* out = &b;
-                for (int k = 0; k < 3 && in->n && !h.single; ++k) {
-                    clip(*in, other.axis[k], other.hi[k], *out);
-                    std::swap(in, out);
-                    if (!in->n) break;
-                    clip(*in, -other.axis[k], -other.lo[k], *out);
-                    std::swap(in, out);
+    const FaceVertex* kept = h.faceFirst == UINT32_MAX ? nullptr : faceVerts_.data() + h.faceFirst;
+    for (int s = 0; s < solids; ++s) {
+        for (int f = 0; f < 6; ++f) {
+            Poly* in = &a;
+            Poly* spare = &b;
+            if (kept) {
+                a.n = h.faceSize[size_t(6 * s + f)];
+                for (int i = 0; i < a.n; ++i, ++kept) {
+                    a.v[size_t(i)] = kept->p;
+                    a.corner[size_t(i)] = kept->corner;
                 }
-                for (int k = 0; k < planes && in->n; ++k) {
-                    if (!cuts[k]) continue;
-                    clip(*in, cn[k], cd[k], *out);
-                    std::swap(in, out);
-                }
-                for (int i = 0; i < in->n; ++i) {
-                    range.x = std::min(range.x, in->v[i].z);
-                    range.y = std::max(range.y, in->v[i].z);
-                }
+            } else {
+                boxFace(solid[s]->corner, f, a);
+                if (!h.single) in = clipByBox(*solid[1 - s], &a, &b);
+                spare = in == &a ? &b : &a;
+            }
+            for (int k = 0; k < planes && in->n; ++k) {
+                if (!cuts[k]) continue;
+                Poly* r = clip(in, spare, cn[k], cd[k], cornerDist[s][k]);
+                if (r != in) spare = in, in = r;
+            }
+            for (int i = 0; i < in->n; ++i) {
+                range.x = std::min(range.x, in->v[size_t(i)].z);
+                range.y = std::max(range.y, in->v[size_t(i)].z);
             }
         }
     }
     // From the eye, the plane z = zNear closes the column: where the boxes reach in front of
     // it, the solid's nearest points may lie on that plane, inside both boxes.
     if (column == ZoneColumn::FromEye && range.x <= range.y) {
-        for (int s = 0; s < (h.single ? 1 : 2); ++s)
-            for (const Vec3& c : solids[s]->corner)
+        for (int s = 0; s < solids; ++s)
+            for (const Vec3& c : solid[s]->corner)
                 if (c.z < zNear) range.x = zNear;
     }
     return {std::max(range.x, whole.x), std::min(range.y, whole.y)};

@@ -34,9 +34,13 @@ class PrimitiveHulls {
     /// turned frame of `turned` (chooseGridFrame) when it has one, else along its own plane for
     /// a triangle or polygon off the world's axes; each widened by `pad` on every side.
     /// `guard` (null: none) is polled for cancellation.
+    /// Each hull with two boxes also keeps its faces clipped by the other box (they do not
+    /// depend on the zone), within `maxFaceBytes` bytes in all (0: none); the hulls beyond
+    /// clip them at each depthIn, to the same ranges.
     static PrimitiveHulls make(const Scene& scene, const CameraFrame& frame,
                                const FrameChoice& turned, const std::vector<uint32_t>& live,
-                               double pad, const BuildGuard* guard = nullptr);
+                               double pad, const BuildGuard* guard = nullptr,
+                               size_t maxFaceBytes = SIZE_MAX);
 
     /// Bytes the hulls of `prims` primitives take in a scene of `total` (the build's scratch,
     /// which the memory budget leaves room for before they are made).
@@ -45,6 +49,10 @@ class PrimitiveHulls {
     }
     /// No primitive has a hull: the zones keep their rectangles' lists.
     bool empty() const { return hulls_.empty(); }
+    /// Hulls of two boxes whose faces clipped by the other box are kept (make's maxFaceBytes).
+    size_t keptFaces() const { return keptFaces_; }
+    /// Bytes of the kept faces.
+    size_t faceBytes() const { return faceVerts_.capacity() * sizeof(FaceVertex); }
     /// Primitive p's own box (its world box when it has none), seen along `column`, meets the
     /// screen rectangle [lo, hi] (a primitive without a hull always does; so does one reaching
     /// behind the eye, `FromEye`).
@@ -77,6 +85,16 @@ class PrimitiveHulls {
         std::array<glm::dvec2, 8> outline[2];
         int outlineSize[2] = {0, 0};
         glm::dvec2 outlineLo[2], outlineHi[2];
+        /// Not `single`: its twelve faces (the world box's six, then the turned box's) clipped by
+        /// the other box, at faceVerts_[faceFirst ..], faceSize[f] vertices each (faceFirst
+        /// UINT32_MAX: not kept, clipped at each depthIn).
+        uint32_t faceFirst = UINT32_MAX;
+        std::array<uint8_t, 12> faceSize{};
+    };
+    /// A vertex of a clipped face: which corner of its box it is (-1: a point clipping made).
+    struct FaceVertex {
+        Vec3 p;
+        int corner;
     };
     /// The depth range of an `aligned` hull's box within the column over [lo, hi] at
     /// z >= zNear (lo > hi: it misses the column).
@@ -85,6 +103,8 @@ class PrimitiveHulls {
 
     std::vector<int32_t> index_;  ///< per primitive: its hull, or -1
     std::vector<Hull> hulls_;
+    std::vector<FaceVertex> faceVerts_;  ///< the kept faces' vertices (Hull::faceFirst)
+    size_t keptFaces_ = 0;
 };
 
 /// Narrows the zones of `bsp` to what the hulls hold: drops from each zone the primitives whose

@@ -53,6 +53,10 @@ struct Waiting {
     }
 };
 
+/// A waiting cell's primitive references carry in their top bits the sides of its split they
+/// belong to (meets, decided when the split is chosen), so the split does not decide it again.
+constexpr uint32_t kBelowBit = 1u << 31, kAboveBit = 1u << 30, kPrimMask = kAboveBit - 1;
+
 /// Levels of the screen BSP split whatever the cost estimate says.
 constexpr int kAlwaysSplitLevels = 4;
 
@@ -298,6 +302,9 @@ size_t ScreenBsp::rootBytes(size_t prims) {
 
 ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint32_t>& prims,
                            glm::dvec2 lo, glm::dvec2 hi, const ScreenBspParams& params) {
+    if (rect.size() > kPrimMask)
+        throw std::invalid_argument("the screen BSP takes at most " + std::to_string(kPrimMask) +
+                                    " primitives");
     ScreenBsp bsp;
     bsp.zoneFirst.push_back(0);
     Cell top{lo, hi, {}, {}, -1, 0, 0};
@@ -364,7 +371,11 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         slot = ~int32_t(bsp.zoneLo.size());
         bsp.zoneLo.push_back(cell.lo);
         bsp.zoneHi.push_back(cell.hi);
+        // Inserted as a range (the vector grows as it did: the byte limit counts its capacity),
+        // then cleared of the split's side bits.
+        const size_t at = bsp.zonePrims.size();
         bsp.zonePrims.insert(bsp.zonePrims.end(), cell.prims.begin(), cell.prims.end());
+        for (size_t i = at; i < bsp.zonePrims.size(); ++i) bsp.zonePrims[i] &= kPrimMask;
         bsp.zoneFirst.push_back(uint32_t(bsp.zonePrims.size()));
     };
     // A new cell: a zone now when nothing splits it or no split pays, else it waits with its
@@ -390,10 +401,16 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         double wBelow = 0.0, wAbove = 0.0, wCell = 0.0;
         listBelow.clear();
         listAbove.clear();
-        for (uint32_t p : cell.prims) {
+        const double cellArea = (cell.hi.x - cell.lo.x) * (cell.hi.y - cell.lo.y);
+        if (params.walk && cellArea > 0.0 && cell.walk < 0.0)
+            cell.walk = walkCost(cell.prims, cell.lo, cell.hi, rect, params, events);
+        for (uint32_t& ref : cell.prims) {
             if (params.guard && (++polled & 32767) == 0) params.guard->poll();
+            const uint32_t p = ref;
             const double w = params.weights ? double((*params.weights)[p]) : 1.0;
             const bool b = meets(p, cell.lo, bHi), a = meets(p, aLo, cell.hi);
+            // Kept for the split, which sorts the primitives to the same sides.
+            ref = p | (b ? kBelowBit : 0u) | (a ? kAboveBit : 0u);
             nBelow += b;
             nAbove += a;
             wBelow += b ? w : 0.0;
@@ -416,8 +433,6 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
             // walking its children (one level deeper to locate), less what building the split
             // adds (a zone, and a reference for each primitive it cuts in two).
             const ZoneWalkModel& m = *params.walk;
-            if (cell.walk < 0.0)
-                cell.walk = walkCost(cell.prims, cell.lo, cell.hi, rect, params, events);
             cell.walkBelow = walkCost(listBelow, cell.lo, bHi, rect, params, events);
             cell.walkAbove = walkCost(listAbove, aLo, cell.hi, rect, params, events);
             const double saved =
@@ -501,10 +516,9 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         above.segs.reserve(segsAbove);
         below.prims.reserve(cell.primsBelow);
         above.prims.reserve(cell.primsAbove);
-        for (uint32_t p : cell.prims) {
-            if (params.guard && (++polled & 32767) == 0) params.guard->poll();
-            if (meets(p, below.lo, below.hi)) below.prims.push_back(p);
-            if (meets(p, above.lo, above.hi)) above.prims.push_back(p);
+        for (uint32_t ref : cell.prims) {
+            if (ref & kBelowBit) below.prims.push_back(ref & kPrimMask);
+            if (ref & kAboveBit) above.prims.push_back(ref & kPrimMask);
         }
         int32_t node = int32_t(bsp.nodes.size());
         (cell.parent < 0 ? bsp.root : bsp.nodes[cell.parent].child[cell.side]) = node;
