@@ -260,6 +260,10 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     prepareOverlays(imageW, imageH);
     const bool layerChanged = overlays_->layerVersion() != layerVersion;
     phases_.mark("overlays");
+    // A new view held off the screen is composited in parts as its rows come, within the
+    // budget (the steps after it keep what the layer keeps for them), so that its release
+    // only copies it.
+    if (state_.holdImage()) view_->composeHeld(budget_, kLayerReserveMs);
     glViewport(0, 0, fbWidth, fbHeight);
     glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
     std::vector<PixelRect> views;
