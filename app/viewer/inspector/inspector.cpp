@@ -66,6 +66,21 @@ Inspector::Inspector(std::function<void()> wake) {
     glBindTexture(GL_TEXTURE_2D, 0);
     glGenRenderbuffers(1, &depthRb_);
     glGenVertexArrays(1, &vao_);
+    // The picture's framebuffer of one pixel until render() gives it the view's size, its
+    // drawing states readied now, before any frame.
+    glBindTexture(GL_TEXTURE_2D, colorTex_);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glBindRenderbuffer(GL_RENDERBUFFER, depthRb_);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, 1, 1);
+    glBindRenderbuffer(GL_RENDERBUFFER, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colorTex_, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depthRb_);
+    fboW_ = fboH_ = vw_ = vh_ = 1;
+    warmUp();
+    vw_ = vh_ = 0;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 Inspector::~Inspector() {
@@ -311,7 +326,6 @@ void Inspector::render() {
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colorTex_, 0);
         glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depthRb_);
-        warmUp();
     }
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, vw_, vh_);
@@ -383,12 +397,11 @@ void Inspector::render() {
 
 void Inspector::warmUp() {
     // One line of no length at the far corner, with and without the depth test, then cleared
-    // by render(): the driver readies what drawing lines into this framebuffer needs now, in
-    // the frame that makes it (before a structure), not with the picture's first part.
+    // by render(): the driver readies what drawing lines into this framebuffer needs now,
+    // before any frame, not with the picture's first part.
     gl::Batch dot;
     const glm::vec3 corner(1.0f, 1.0f, 1.0f);  // clip space (toClip below is the identity)
     dot.line(corner, corner, gl::Rgba8{});
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, vw_, vh_);
     gl::DrawOptions o;
     for (bool depth : {false, true}) {

@@ -122,8 +122,8 @@ class Inspector {
 
   private:
     void rebuildModel();
-    /// Draw nothing visible into the picture's framebuffer with each of its states (render()
-    /// clears it next): readies the driver for them in the frame that makes the framebuffer.
+    /// Draw nothing visible into the picture's framebuffer (bound, of vw_ x vh_) with each of
+    /// its states: readies the driver for them (the constructor, before any frame).
     void warmUp();
     /// The main camera's frustum again (frustum_), for the picture.
     void rebuildFrustum();
