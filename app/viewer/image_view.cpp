@@ -7,6 +7,7 @@
 
 #include "app/viewer/gl.h"
 #include "app/viewer/gl/program.h"
+#include "app/viewer/timing/frame_budget.h"
 #include "app/viewer/timing/frame_times.h"
 
 namespace lancer::viewer {
@@ -175,7 +176,7 @@ bool ImageView::layerAtImageSize() const {
     return !overlayRgba_.empty() && overlayWidth_ == width_ && overlayHeight_ == height_;
 }
 
-void ImageView::compose(int rowBegin, int rowEnd) const {
+void ImageView::compose(int rowBegin, int rowEnd, bool upload) const {
     // Image row r is FBO row height - 1 - r: rows [b, e) are FBO rows [h - e, h - b), written
     // bottom row first. The layer is premultiplied (blendTexel); a layer of another size is
     // sampled at the nearest texel, as the heat maps' shader samples it.
@@ -208,13 +209,39 @@ void ImageView::compose(int rowBegin, int rowEnd) const {
     } else {
         composedLayer_.clear();
     }
+    if (!upload) return;
+    uploadComposed(rowBegin, rowEnd);
+    lastShade_.rows += rows;
+}
+
+void ImageView::uploadComposed(int rowBegin, int rowEnd) const {
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
     glBindTexture(GL_TEXTURE_2D, shadedTex_);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, height_ - rowEnd, width_, rows, GL_RGBA, GL_UNSIGNED_BYTE,
-                    composed_.data() + size_t(height_ - rowEnd) * w * 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, height_ - rowEnd, width_, rowEnd - rowBegin, GL_RGBA,
+                    GL_UNSIGNED_BYTE,
+                    composed_.data() + size_t(height_ - rowEnd) * size_t(width_) * 4);
     glBindTexture(GL_TEXTURE_2D, 0);
-    lastShade_.rows += rows;
+}
+
+int ImageView::composeHeld(FrameBudget& budget, double reserveMs) {
+    // Only rows that the release would composite one by one: a colour picture shaded at the
+    // image's size (anything else is shaded whole when the hold ends).
+    if (!hold_ || !shadedValid_ || shadedMode_ != ViewMode::Color || shadedWidth_ != width_ ||
+        shadedHeight_ != height_ || composed_.size() != size_t(width_) * size_t(height_) * 4)
+        return 0;
+    constexpr int kRows = 48;
+    int done = 0;
+    while (!dirty_.empty()) {
+        const int end = std::min(dirty_.end, dirty_.begin + kRows);
+        if (!budget.fits(msPerRow_ * (end - dirty_.begin), reserveMs)) break;
+        compose(dirty_.begin, end, false);
+        precomposed_.add(dirty_.begin, end);
+        done += end - dirty_.begin;
+        dirty_.begin = end;
+    }
+    if (dirty_.empty()) dirty_.clear();
+    return done;
 }
 
 void ImageView::composeLayerChanges(int skipBegin, int skipEnd) const {
@@ -316,7 +343,7 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     if (!held) lastShade_ = {};
     if (!held && whole)
         shade(mode, scale, logScale, diverging, 0, height_);
-    else if (!held && (!dirty_.empty() || layerChanged_))
+    else if (!held && (!dirty_.empty() || layerChanged_ || !precomposed_.empty()))
         shade(mode, scale, logScale, diverging, dirty_.begin, dirty_.end);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
@@ -370,6 +397,9 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
         rowEnd = height_;
     }
     if (mode == ViewMode::Color) {
+        // Rows composited while held are copied now (those composited again below after).
+        if (!precomposed_.empty() && (rowBegin > precomposed_.begin || rowEnd < precomposed_.end))
+            uploadComposed(precomposed_.begin, precomposed_.end);
         const double start = threadCpuMs();
         compose(rowBegin, rowEnd);
         if (rowEnd - rowBegin >= 64)  // the running mean of the time a row takes
@@ -383,6 +413,7 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
     }
     layerChanged_ = false;
     dirty_.clear();
+    precomposed_.clear();
     shadedValid_ = true;
     shadedWidth_ = width_;
     shadedHeight_ = height_;

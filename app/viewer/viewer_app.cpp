@@ -41,14 +41,15 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
     inspector_->buildInBackground(std::move(wake));
     inspector_->drawInParts(1000, 4.0);
     // One budget for the frame (FrameBudget): each step that may leave work for the next
-    // frame keeps back what the steps after it take in a frame that runs them all (balls4's
-    // slabs with the inspector, the slow-frame lines of --log-timings, 2026-12-06): after the
-    // layer, the image's changed texels (3-5 ms), a band of the inspector's picture (about
-    // 4 ms) and the panel layer; after the inspector, the panel layer (its copies about 3 ms,
-    // a changed panel about 1 ms more) and the swap; after a panel, the copies of the panels
-    // and the swap.
+    // frame starts a part only when the part's learned cost fits in what is left, less what
+    // the steps after it take in a frame that runs them all (balls4's slabs with the
+    // inspector, the slow-frame lines of --log-timings, 2026-12-06): after the layer, the
+    // image's changed texels (3-5 ms), the flush of the frame's drawing before the
+    // inspector's picture (the image's copy and the layer, about 6 ms) and the panel layer;
+    // after the inspector, the panel layer (its copies about 3 ms, a changed panel about 1 ms
+    // more) and the swap; after a panel, the copies of the panels and the swap.
     overlays_->setFrameBudget(&budget_, kLayerReserveMs);
-    inspector_->setFrameBudget(&budget_, 8.0);
+    inspector_->setFrameBudget(&budget_, 5.0);
     panels_.setFrameBudget(&budget_, 5.0);
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
     // drawn at all, and each is copied from a layer where it is redrawn only when it changes
@@ -247,9 +248,22 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // new view released whole took 8-16 ms of the image step (balls4, 2026-12-06), so the
     // layer keeps that back too.
     view_->setHold(state_.holdImage());
-    overlays_->setFrameBudget(&budget_, kLayerReserveMs + view_->shadeEstimateMs(s.mode));
+    // The composite of the texels a new drawing of the layer changes comes after the layer
+    // too: its learned cost (a moving camera's layer changes most of its texels, 8-11 ms of
+    // the image step on balls4's slabs, a part at rest few) is kept back as well.
+    const bool moving = cameraMoving();
+    const bool layerDraws = overlays_->options.any() && (moving || overlays_->layerPending());
+    StepCost& composite = layerCompositeCost_[moving ? 1 : 0];
+    overlays_->setFrameBudget(&budget_, kLayerReserveMs + view_->shadeEstimateMs(s.mode) +
+                                            (layerDraws ? composite.estimateMs(1) : 0.0));
+    const uint64_t layerVersion = overlays_->layerVersion();
     prepareOverlays(imageW, imageH);
+    const bool layerChanged = overlays_->layerVersion() != layerVersion;
     phases_.mark("overlays");
+    // A new view held off the screen is composited in parts as its rows come, within the
+    // budget (the steps after it keep what the layer keeps for them), so that its release
+    // only copies it.
+    if (state_.holdImage()) view_->composeHeld(budget_, kLayerReserveMs);
     glViewport(0, 0, fbWidth, fbHeight);
     glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
     std::vector<PixelRect> views;
@@ -266,8 +280,12 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         if (r.x0 < area.x1 && area.x0 < r.x1 && r.y0 < area.y1 && area.y0 < r.y1)
             covered.push_back(r);
     view_->setViewport(area);
+    const double imageStart = budget_.spentMs();
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale,
                 state_.heatDiverging());
+    // What compositing the layer's changes took (the rows of a pass aside), learned.
+    if (layerChanged && view_->lastShade().texels > 0 && view_->lastShade().rows == 0)
+        composite.record(1, budget_.spentMs() - imageStart);
     phases_.mark("image");
 
     // 4b. The 3D inspector beside the image (the image is not copied under it), with the

@@ -194,6 +194,10 @@ class ViewerApp {
     Clock::time_point lastFrame_ = Clock::now();
     FramePhases phases_;                  ///< the last frame's CPU time by step
     FrameBudget budget_{kFrameBudgetMs};  ///< begun at each frame()
+    /// The image step's cost when the layer changed (its changed texels composited again), at
+    /// rest [0] and while the camera moves [1]: kept back from the layer's budget. 8.6 ms (a
+    /// whole 1280x720 composite) to begin with.
+    StepCost layerCompositeCost_[2] = {StepCost(8.6), StepCost(8.6)};
     /// The region the playback selected last (-1: none), so a click elsewhere is not undone.
     int64_t playedRegion_ = -1;
     gl::Batch inspectorRay_;     ///< the lines last handed to the inspector

@@ -220,6 +220,26 @@ TEST(InspectorGl, BuiltInTheBackgroundAndDrawnInPartsTheModelEndsAsTheDirectOne)
     EXPECT_EQ(f.gl.read(), direct);
 }
 
+/// `parts` shows `f`'s model, drawn in parts of `lines` for `ms` a draw under `budget`,
+/// keeping `reserveMs` of it.
+void startInParts(Inspector& parts, Fixture& f, size_t lines, double ms, FrameBudget& budget,
+                  double reserveMs) {
+    parts.options() = f.insp->options();
+    parts.drawInParts(lines, ms);
+    parts.setFrameBudget(&budget, reserveMs);
+    parts.changed();
+    parts.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+}
+
+/// One frame of `parts` under `budget`, whose earlier steps took `spentMs` (`now`: the
+/// budget's clock).
+void budgetFrame(Fixture& f, Inspector& parts, FrameBudget& budget, double& now, double spentMs) {
+    budget.begin();
+    now += spentMs;
+    f.gl.clear(0.0f, 0.0f, 0.0f);
+    parts.draw(kW, kH);
+}
+
 TEST(InspectorGl, WithTheFramesBudgetSpentThePictureWaitsAndEndsAsTheDirectOne) {
     Fixture f;
     ASSERT_TRUE(f.gl.ok());
@@ -228,19 +248,12 @@ TEST(InspectorGl, WithTheFramesBudgetSpentThePictureWaitsAndEndsAsTheDirectOne) 
     ASSERT_GT(lines, 10u);
     // Parts of a fifth, as many a draw as the frame's budget allows; `now += 30` stands for
     // the frame's earlier steps (the clock moves 6 ms a reading otherwise).
-    Inspector parts;
-    parts.options() = f.insp->options();
-    parts.drawInParts(lines / 5 + 1, 1e9);
     double now = 0.0;
     FrameBudget budget(33.0, [&] { return now += 6.0; });
-    parts.setFrameBudget(&budget, 8.0);
-    parts.changed();
-    parts.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    Inspector parts;
+    startInParts(parts, f, lines / 5 + 1, 1e9, budget, 8.0);
     // Spent before it: nothing drawn (the window shows what it had), the picture pending.
-    budget.begin();
-    now += 30.0;
-    f.gl.clear(0.0f, 0.0f, 0.0f);
-    parts.draw(kW, kH);
+    budgetFrame(f, parts, budget, now, 30.0);
     EXPECT_EQ(parts.picturedLines(), 0u);
     EXPECT_TRUE(parts.picturePending());
     EXPECT_FALSE(parts.settled());
@@ -249,10 +262,7 @@ TEST(InspectorGl, WithTheFramesBudgetSpentThePictureWaitsAndEndsAsTheDirectOne) 
     int frames = 0;
     size_t before = 0;
     do {
-        budget.begin();
-        if (frames % 2 == 1) now += 30.0;
-        f.gl.clear(0.0f, 0.0f, 0.0f);
-        parts.draw(kW, kH);
+        budgetFrame(f, parts, budget, now, frames % 2 == 1 ? 30.0 : 0.0);
         if (frames % 2 == 1) {
             EXPECT_EQ(parts.picturedLines(), before) << "frame " << frames;
         } else {
@@ -268,6 +278,49 @@ TEST(InspectorGl, WithTheFramesBudgetSpentThePictureWaitsAndEndsAsTheDirectOne) 
     EXPECT_EQ(f.gl.read(), direct);
 }
 
+TEST(InspectorGl, APieceStartsOnlyWhenItsLearnedCostFitsInWhatTheBudgetLeaves) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    const std::vector<uint8_t> direct = f.draw();
+    const size_t lines = f.insp->model().lines.lineCount();
+    ASSERT_GT(lines, 30u);
+    // One part of a 15th a draw; a clock only the test moves, so each piece measured costs
+    // nothing and the learned costs shrink a quarter at each piece.
+    double now = 0.0;
+    FrameBudget budget(33.0, [&] { return now; });
+    Inspector parts;
+    startInParts(parts, f, lines / 15 + 1, 0.0, budget, 5.0);
+    // 1 ms left beyond the reserve: some budget is left, but not a new picture's first piece
+    // (its clear, 2 ms, and a part of lines, 4 ms, until measured): nothing drawn.
+    budgetFrame(f, parts, budget, now, 27.0);
+    EXPECT_EQ(parts.picturedLines(), 0u);
+    EXPECT_TRUE(parts.picturePending());
+    EXPECT_GE(budget.deferred(), 1);
+    // Frames with room and frames with 1 ms left, in turn: a part costs 4 ms until measured,
+    // then a quarter less each time (4 x 0.75^5 < 1 after five parts); frames with 1 ms left
+    // draw nothing until then, a part after.
+    int frames = 0, tightDeferred = 0, tightDrawn = 0;
+    do {
+        const bool tight = frames % 2 == 1;
+        const size_t before = parts.picturedLines();
+        budgetFrame(f, parts, budget, now, tight ? 27.0 : 0.0);
+        if (!tight) {
+            EXPECT_GT(parts.picturedLines(), before) << "frame " << frames;
+        } else if (parts.picturedLines() == before) {
+            ++tightDeferred;
+            EXPECT_EQ(tightDrawn, 0) << "once learned cheap, a part fits in 1 ms";
+        } else {
+            ++tightDrawn;
+        }
+        ++frames;
+    } while (!parts.settled() && frames < 100);
+    EXPECT_GE(tightDeferred, 3) << "4, 3 and 2.25 ms do not fit in 1";
+    EXPECT_GE(tightDrawn, 1);
+    EXPECT_TRUE(parts.settled());
+    EXPECT_EQ(parts.picturedLines(), lines);
+    EXPECT_EQ(f.gl.read(), direct);
+}
+
 TEST(InspectorGl, WithItsSurfacesThePictureInPartsEqualsTheOneDrawnAtOnce) {
     Fixture f;
     ASSERT_TRUE(f.gl.ok());
@@ -276,19 +329,24 @@ TEST(InspectorGl, WithItsSurfacesThePictureInPartsEqualsTheOneDrawnAtOnce) {
     f.insp->update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
     ASSERT_TRUE(f.insp->waitSurfaces(60000));
     const std::vector<uint8_t> direct = f.draw();
-    // Drawn in parts, one a draw: the surfaces in six bands of rows, then the lines.
+    // Drawn in parts, one a draw: the surfaces in bands of a 24th of the rows (rounded up),
+    // then the lines in two parts.
     Inspector parts;
     parts.options() = f.insp->options();
     parts.drawInParts(f.insp->model().lines.lineCount() / 2 + 1, 0.0);
     parts.changed();
     parts.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
     ASSERT_TRUE(parts.waitSurfaces(60000));
+    int surfaceDraws = 0;
     const int draws = drawUntilSettled(f, parts, [&](int n) {
-        if (n <= 5) {
-            EXPECT_EQ(parts.picturedLines(), 0u) << "surfaces first";
+        if (parts.picturedLines() == 0) {
+            EXPECT_EQ(surfaceDraws, n - 1) << "surfaces first";
+            surfaceDraws = n;
         }
     });
-    EXPECT_EQ(draws, 7);
+    EXPECT_GE(surfaceDraws, 20) << "narrow bands";
+    EXPECT_LE(surfaceDraws, 24);
+    EXPECT_EQ(draws, surfaceDraws + 2);
     EXPECT_EQ(f.gl.read(), direct);
 }
 

@@ -673,80 +673,152 @@ TEST(Overlays, ALargeLayerIsDrawnInPartsLongestFirstWithinAFramesBudget) {
     EXPECT_EQ(ov.layerDrawn(), 2 * ov.look.restLines);
 }
 
+/// twoBoxes' leaves (max level 8) in opaque lines, in two overlays: `ov` under test, `free`
+/// drawn without a budget.
+struct LeavesInParts {
+    std::shared_ptr<SceneBuild> s = twoBoxes(SchemeKind::Regular, 8);
+    const Camera& cam = s->scene->camera;
+    OffscreenGl gl{kW, kH};  // before the overlays: they need its context
+    Overlays free, ov;
+    LeavesInParts() {
+        if (!gl.ok()) return;
+        for (Overlays* o : {&free, &ov}) {
+            o->options.leaves = true;
+            o->look.lineOpacity = 1.0f;
+            o->update(s, cam, kW, kH);
+        }
+    }
+};
+
+/// A black image with `o`'s layer for `cam` composited over it, as drawn.
+std::vector<uint8_t> overBlack(const OffscreenGl& gl, ImageView& view, Overlays& o,
+                               const Camera& cam) {
+    if (view.width() == 0) view.upload(Image(kW, kH), ViewMode::Color);
+    view.setOverlay(o.layerTexture(cam, kW, kH), o.layerVersion());
+    gl.clear(0, 0, 0);
+    view.draw(kW, kH, ViewMode::Color, 1.0f);
+    return gl.read();
+}
+
 TEST(Overlays, WithTheFramesBudgetSpentTheLayerWaitsAndEndsAsTheOneDrawnWithoutIt) {
     // The same layer drawn in parts without a budget and with one that earlier steps of the
     // frame spent in some frames.
-    auto s = twoBoxes(SchemeKind::Regular, 8);
-    const Camera& cam = s->scene->camera;
-    OffscreenGl gl(kW, kH);
-    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
-    Overlays free, ov;
-    for (Overlays* o : {&free, &ov}) {
-        o->options.leaves = true;
-        o->look.lineOpacity = 1.0f;
-        o->update(s, cam, kW, kH);
-    }
-    const size_t total = ov.layerLines();
+    LeavesInParts t;
+    ASSERT_TRUE(t.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    const size_t total = t.ov.layerLines();
     ASSERT_GT(total, 12u);
-    for (Overlays* o : {&free, &ov}) {
+    for (Overlays* o : {&t.free, &t.ov}) {
         o->look.restLines = total / 4 + 1;  // four parts
         o->look.restMs = 1e9;               // each as many parts as the frame allows
     }
-    free.look.restMs = 0.0;  // one part a call
+    t.free.look.restMs = 0.0;  // one part a call
     // The clock: 6 ms a reading, so a frame of 33 ms keeping 10 for later steps has room for
     // three parts of the four; `now += 30` stands for the frame's earlier steps.
     double now = 0.0;
     FrameBudget budget(33.0, [&] { return now += 6.0; });
-    ov.setFrameBudget(&budget, 10.0);
-    Image black(kW, kH);
+    t.ov.setFrameBudget(&budget, 10.0);
     ImageView view;
-    view.upload(black, ViewMode::Color);
-    auto composited = [&](Overlays& o) {
-        view.setOverlay(o.layerTexture(cam, kW, kH), o.layerVersion());
-        gl.clear(0, 0, 0);
-        view.draw(kW, kH, ViewMode::Color, 1.0f);
-        return gl.read();
-    };
     // A frame whose earlier steps spent the budget: no part, nothing drawn, the layer pending
     // (the window stays eager).
     budget.begin();
     now += 30.0;
-    ov.layerTexture(cam, kW, kH);
-    EXPECT_EQ(ov.layerDrawn(), 0u);
-    EXPECT_EQ(ov.layerVersion(), 0u) << "nothing drawn";
-    EXPECT_TRUE(ov.layerPending()) << "deferred: pending";
+    t.ov.layerTexture(t.cam, kW, kH);
+    EXPECT_EQ(t.ov.layerDrawn(), 0u);
+    EXPECT_EQ(t.ov.layerVersion(), 0u) << "nothing drawn";
+    EXPECT_TRUE(t.ov.layerPending()) << "deferred: pending";
     EXPECT_GE(budget.deferred(), 1);
     // A frame with room: parts until the budget less the reserve is spent, not the whole.
     budget.begin();
-    ov.layerTexture(cam, kW, kH);
-    const size_t first = ov.layerDrawn();
-    EXPECT_GE(first, ov.look.restLines);
+    t.ov.layerTexture(t.cam, kW, kH);
+    const size_t first = t.ov.layerDrawn();
+    EXPECT_GE(first, t.ov.look.restLines);
     EXPECT_LT(first, total) << "stopped by the frame's budget, not by restMs";
     int frames = 1;
-    while (ov.layerPending() && frames < 100) {
+    while (t.ov.layerPending() && frames < 100) {
         budget.begin();
         if (frames % 2 == 1) now += 30.0;  // every other frame spent before the layer
-        const size_t before = ov.layerDrawn();
-        ov.layerTexture(cam, kW, kH);
+        const size_t before = t.ov.layerDrawn();
+        t.ov.layerTexture(t.cam, kW, kH);
         if (frames % 2 == 1) {
-            EXPECT_EQ(ov.layerDrawn(), before) << "frame " << frames;
+            EXPECT_EQ(t.ov.layerDrawn(), before) << "frame " << frames;
         }
         ++frames;
     }
-    EXPECT_FALSE(ov.layerPending());
-    EXPECT_EQ(ov.layerDrawn(), total);
+    EXPECT_FALSE(t.ov.layerPending());
+    EXPECT_EQ(t.ov.layerDrawn(), total);
     // The same picture as the layer drawn in parts without a budget.
-    while (free.layerPending() || free.layerVersion() == 0) free.layerTexture(cam, kW, kH);
-    EXPECT_EQ(composited(ov), composited(free));
+    while (t.free.layerPending() || t.free.layerVersion() == 0) t.free.layerTexture(t.cam, kW, kH);
+    EXPECT_EQ(overBlack(t.gl, view, t.ov, t.cam), overBlack(t.gl, view, t.free, t.cam));
     // A moving camera's layer draws its first part whatever the budget.
-    Camera moved = cam;
+    Camera moved = t.cam;
     moved.from.x += 0.5;
-    ov.look.movingLines = total;
+    t.ov.look.movingLines = total;
     budget.begin();
     now += 100.0;
-    ov.layerTexture(moved, kW, kH, true);
-    EXPECT_EQ(ov.layerDrawn(), ov.look.restLines);
-    ov.setFrameBudget(nullptr, 0.0);
+    t.ov.layerTexture(moved, kW, kH, true);
+    EXPECT_EQ(t.ov.layerDrawn(), t.ov.look.restLines);
+    t.ov.setFrameBudget(nullptr, 0.0);
+}
+
+TEST(Overlays, APartStartsOnlyWhenItsLearnedCostFitsAndAMovingFirstPartIsSizedToTheBudget) {
+    LeavesInParts t;
+    ASSERT_TRUE(t.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    const size_t total = t.ov.layerLines();
+    ASSERT_GT(total, 40u);
+    t.ov.look.movingLines = total;
+    t.ov.look.movingMs = 1e9;
+    t.ov.look.movingMinLines = 10;
+    // A clock only the test moves: each part measured costs nothing, so the learned costs
+    // shrink a quarter at each part.
+    double now = 0.0;
+    FrameBudget budget(33.0, [&] { return now; });
+    t.ov.setFrameBudget(&budget, 10.0);
+    Camera moved = t.cam;
+    moved.from.x += 0.5;
+    // A moving camera with 0.1 ms left beyond the reserve: at 7 ms per 1,000 lines (the
+    // estimate until measured) 14 lines fit; the first part holds them, not restLines.
+    t.ov.look.restLines = total;
+    budget.begin();
+    now += 22.9;
+    t.ov.layerTexture(moved, kW, kH, true);
+    EXPECT_EQ(t.ov.layerDrawn(), 14u);
+    // With the budget spent, the least part (the longest lines) whatever the budget.
+    budget.begin();
+    now += 100.0;
+    moved.from.x += 0.5;
+    t.ov.layerTexture(moved, kW, kH, true);
+    EXPECT_EQ(t.ov.layerDrawn(), 10u);
+    // With room, the whole cap.
+    budget.begin();
+    moved.from.x += 0.5;
+    t.ov.layerTexture(moved, kW, kH, true);
+    EXPECT_EQ(t.ov.layerDrawn(), total);
+    // At rest, in parts of a quarter (5 ms per 500 lines until measured): with 0.01 ms left
+    // beyond the reserve no part starts (some budget is left, but not a part's cost), and the
+    // layer waits.
+    t.ov.look.restLines = total / 4 + 1;
+    t.ov.look.restMs = 1e9;
+    budget.begin();
+    now += 22.99;
+    const double partMs = double(t.ov.look.restLines) * 5.0 / 500.0;
+    ASSERT_GT(partMs, 0.01);
+    const uint64_t version = t.ov.layerVersion();
+    t.ov.layerTexture(t.cam, kW, kH);
+    EXPECT_EQ(t.ov.layerVersion(), version) << "nothing drawn";
+    EXPECT_TRUE(t.ov.layerPending());
+    EXPECT_GE(budget.deferred(), 1);
+    // A frame with room draws every part (they cost nothing measured); then the layer drawn
+    // without a budget.
+    budget.begin();
+    t.ov.layerTexture(t.cam, kW, kH);
+    EXPECT_FALSE(t.ov.layerPending());
+    EXPECT_EQ(t.ov.layerDrawn(), total);
+    t.free.look = t.ov.look;
+    t.free.look.restMs = 0.0;
+    while (t.free.layerPending() || t.free.layerVersion() == 0) t.free.layerTexture(t.cam, kW, kH);
+    ImageView view;
+    EXPECT_EQ(overBlack(t.gl, view, t.ov, t.cam), overBlack(t.gl, view, t.free, t.cam));
+    t.ov.setFrameBudget(nullptr, 0.0);
 }
 
 TEST(Overlays, BatchesBuiltInTheBackgroundAreCopiedInPartsAndTheLayerFollowsThem) {

@@ -17,6 +17,7 @@
 #include "app/viewer/camera_control.h"
 #include "app/viewer/image_view.h"
 #include "app/viewer/panel_cache.h"
+#include "app/viewer/timing/frame_budget.h"
 #include "app/viewer/viewer_app.h"
 #include "engine/scene/loader.h"
 #include "tests/gl/offscreen_gl.h"
@@ -198,6 +199,20 @@ unsigned layerTextureOf(int w, int h, const std::vector<uint8_t>& texels) {
     return tex;
 }
 
+/// The picture a view shows of `img` with `layer` (texels at its size) composited whole: a
+/// view that never saw another.
+std::vector<uint8_t> wholeComposite(const OffscreenGl& gl, const Image& img,
+                                    const std::vector<uint8_t>& layer) {
+    const unsigned t = layerTextureOf(img.width, img.height, layer);
+    ImageView fresh;
+    fresh.upload(img, ViewMode::Color);
+    fresh.setOverlay(t, 1);
+    gl.clear(0, 0, 0);
+    fresh.draw(img.width, img.height, ViewMode::Color, 1.0f);
+    glDeleteTextures(1, &t);
+    return gl.read();
+}
+
 TEST(ViewerGl, ANewLayerCompositesOnlyTheTexelsItChangedAndEqualsTheWholeComposite) {
     const int w = 160, h = 96;
     OffscreenGl gl(w, h);
@@ -215,17 +230,7 @@ TEST(ViewerGl, ANewLayerCompositesOnlyTheTexelsItChangedAndEqualsTheWholeComposi
     };
     for (int i = 0; i < w * h; i += 37) put(i % w, i / w, 120, 200);
     const unsigned tex = layerTextureOf(w, h, texels);
-    // The picture a view shows with `layer` composited whole (a view that never saw another).
-    auto whole = [&](const std::vector<uint8_t>& layer) {
-        const unsigned t = layerTextureOf(w, h, layer);
-        ImageView fresh;
-        fresh.upload(img, ViewMode::Color);
-        fresh.setOverlay(t, 1);
-        gl.clear(0, 0, 0);
-        fresh.draw(w, h, ViewMode::Color, 1.0f);
-        glDeleteTextures(1, &t);
-        return gl.read();
-    };
+    auto whole = [&](const std::vector<uint8_t>& layer) { return wholeComposite(gl, img, layer); };
     ImageView view;
     view.upload(img, ViewMode::Color);
     // The layer's texels as they stand now, as version `version` of the texture, drawn.
@@ -281,6 +286,79 @@ TEST(ViewerGl, ANewLayerCompositesOnlyTheTexelsItChangedAndEqualsTheWholeComposi
     view.draw(w, h, ViewMode::Color, 1.0f);
     EXPECT_EQ(view.lastShade().texels, size_t(w - 1)) << "row 80's span, x 0 to w - 2";
     EXPECT_EQ(gl.read(), whole(texels));
+    glDeleteTextures(1, &tex);
+}
+
+TEST(ViewerGl, AHeldViewCompositedInPartsWithinTheBudgetEndsAsTheWholeComposite) {
+    const int w = 160, h = 96;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    // Two views of many colours and a layer of scattered premultiplied texels.
+    Image a(w, h), b(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            a.color[a.index(x, y)] = glm::vec3(float(x) / w, float(y) / h, 0.3f);
+            b.color[b.index(x, y)] = glm::vec3(0.2f, float((x * 5 + y) % 13) / 13.0f, float(y) / h);
+        }
+    std::vector<uint8_t> texels(size_t(w) * h * 4, 0);
+    for (size_t i = 0; i < texels.size() / 4; i += 29) {
+        texels[i * 4 + 0] = 150;
+        texels[i * 4 + 3] = 190;
+    }
+    const unsigned tex = layerTextureOf(w, h, texels);
+    ImageView view;
+    view.upload(a, ViewMode::Color);
+    view.setOverlay(tex, 1);
+    gl.clear(0, 0, 0);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    const std::vector<uint8_t> shownA = gl.read();
+    // A clock only the test moves: a frame with room, or one its earlier steps spent.
+    double now = 0.0;
+    FrameBudget budget(33.0, [&] { return now; });
+    auto frame = [&](bool spent) {
+        budget.begin();
+        if (spent) now += 100.0;
+        return view.composeHeld(budget, 5.0);
+    };
+    // View b comes in three parts while held: composited as it comes when the frame has room,
+    // not when it is spent; the screen shows view a meanwhile.
+    view.setHold(true);
+    view.upload(b, ViewMode::Color, 0, 32);
+    EXPECT_EQ(frame(false), 32);
+    gl.clear(0, 0, 0);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    EXPECT_EQ(gl.read(), shownA) << "held: the view before";
+    view.upload(b, ViewMode::Color, 32, 64);
+    EXPECT_EQ(frame(true), 0);
+    EXPECT_GE(budget.deferred(), 1);
+    view.upload(b, ViewMode::Color, 64, 96);
+    EXPECT_EQ(frame(false), 64) << "the rows of the spent frame too";
+    // A new layer while held (a texel in a composited row changes), then the release: no row
+    // composited there, only the layer's changed texel, and the whole composite's picture.
+    texels[(size_t(10) * w + 7) * 4 + 1] = 220;
+    texels[(size_t(10) * w + 7) * 4 + 3] = 230;
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, texels.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
+    view.setOverlay(tex, 2);
+    view.setHold(false);
+    gl.clear(0, 0, 0);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    EXPECT_EQ(view.lastShade().rows, 0) << "composited while held";
+    EXPECT_EQ(view.lastShade().texels, 1u);
+    EXPECT_EQ(gl.read(), wholeComposite(gl, b, texels));
+    // View a again, held, every frame spent: the release composites all its rows.
+    view.setHold(true);
+    view.upload(a, ViewMode::Color);
+    EXPECT_EQ(frame(true), 0);
+    view.setHold(false);
+    gl.clear(0, 0, 0);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    EXPECT_EQ(view.lastShade().rows, h);
+    EXPECT_EQ(gl.read(), wholeComposite(gl, a, texels));
+    // Nothing composites while not held.
+    view.upload(b, ViewMode::Color, 0, 10);
+    EXPECT_EQ(frame(false), 0);
     glDeleteTextures(1, &tex);
 }
 

@@ -66,6 +66,21 @@ Inspector::Inspector(std::function<void()> wake) {
     glBindTexture(GL_TEXTURE_2D, 0);
     glGenRenderbuffers(1, &depthRb_);
     glGenVertexArrays(1, &vao_);
+    // The picture's framebuffer of one pixel until render() gives it the view's size, its
+    // drawing states readied now, before any frame.
+    glBindTexture(GL_TEXTURE_2D, colorTex_);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glBindRenderbuffer(GL_RENDERBUFFER, depthRb_);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, 1, 1);
+    glBindRenderbuffer(GL_RENDERBUFFER, 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colorTex_, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depthRb_);
+    fboW_ = fboH_ = vw_ = vh_ = 1;
+    warmUp();
+    vw_ = vh_ = 0;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 Inspector::~Inspector() {
@@ -298,6 +313,7 @@ bool Inspector::waitSurfaces(int ms) {
 
 void Inspector::render() {
     dirtyPicture_ = false;
+    const double start = budget_ ? budget_->spentMs() : 0.0;
     if (fboW_ != vw_ || fboH_ != vh_) {
         fboW_ = vw_;
         fboH_ = vh_;
@@ -318,6 +334,10 @@ void Inspector::render() {
     glClearColor(kBackground.x, kBackground.y, kBackground.z, 1.0f);
     glClearDepth(1.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    if (budget_ && partLines_ > 0) {
+        glFinish();  // timed: the clear is done
+        startCost_.record(1, budget_->spentMs() - start);
+    }
     double near, far;
     depthBounds(near, far);
     const bool surfaces = surfacesShown();
@@ -326,6 +346,7 @@ void Inspector::render() {
     if (surfaces) {
         const Image& img = surfaces_->image;
         if (!surfUploaded_) {
+            const double copyStart = budget_ ? budget_->spentMs() : 0.0;
             surfW_ = img.width;
             surfH_ = img.height;
             std::vector<uint8_t> rgba(size_t(img.width) * size_t(img.height) * 4);
@@ -359,6 +380,7 @@ void Inspector::render() {
                          depth.data());
             glBindTexture(GL_TEXTURE_2D, 0);
             surfUploaded_ = true;
+            if (budget_) surfaceCopyCost_.record(1, budget_->spentMs() - copyStart);
         }
     }
     pictureNear_ = near;
@@ -371,6 +393,33 @@ void Inspector::render() {
     }
     picturedLines_ = 0;
     renderMore();
+}
+
+void Inspector::warmUp() {
+    // One line of no length at the far corner, with and without the depth test, then cleared
+    // by render(): the driver readies what drawing lines into this framebuffer needs now,
+    // before any frame, not with the picture's first part.
+    gl::Batch dot;
+    const glm::vec3 corner(1.0f, 1.0f, 1.0f);  // clip space (toClip below is the identity)
+    dot.line(corner, corner, gl::Rgba8{});
+    glViewport(0, 0, vw_, vh_);
+    gl::DrawOptions o;
+    for (bool depth : {false, true}) {
+        o.depthTest = depth;
+        batches_->drawNow(dot, glm::mat4(1.0f), o);
+    }
+    // The surfaces' textures of their formats (one texel until the trace comes: the driver's
+    // program depends on them; the first band of balls4's surfaces took 29 ms without this).
+    if (!surfUploaded_) {
+        const uint8_t texel[4] = {0, 0, 0, 0};
+        const float depth = -1.0f;
+        glBindTexture(GL_TEXTURE_2D, surfColorTex_);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, texel);
+        glBindTexture(GL_TEXTURE_2D, surfDepthTex_);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, 1, 1, 0, GL_RED, GL_FLOAT, &depth);
+        glBindTexture(GL_TEXTURE_2D, 0);
+    }
+    drawSurfaceRows(0, 1);
 }
 
 void Inspector::drawSurfaceRows(int rowBegin, int rowEnd) {
@@ -406,24 +455,59 @@ void Inspector::drawSurfaceRows(int rowBegin, int rowEnd) {
     glDisable(GL_SCISSOR_TEST);
 }
 
+int Inspector::nextBandRows() const {
+    const bool surfaces = dirtyPicture_ ? surfacesShown() : surfaceRows_ < vh_;
+    if (!surfaces) return 0;
+    const int from = dirtyPicture_ ? 0 : surfaceRows_;
+    const int band = partLines_ > 0 ? std::max(1, (vh_ + kSurfaceBands - 1) / kSurfaceBands) : vh_;
+    return std::min(band, vh_ - from);
+}
+
+double Inspector::nextPieceMs() const {
+    const int rows = nextBandRows();
+    double ms = rows > 0 ? rowCost_.estimateMs(rows) : partCost_.estimateMs(1);
+    // A new picture is cleared first, and new surfaces are converted and copied to GL.
+    if (dirtyPicture_) ms += startCost_.estimateMs(1);
+    if (dirtyPicture_ && surfacesShown() && !surfUploaded_) ms += surfaceCopyCost_.estimateMs(1);
+    return ms;
+}
+
 void Inspector::renderMore() {
     const auto t0 = std::chrono::steady_clock::now();
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, vw_, vh_);
     glDisable(GL_SCISSOR_TEST);
-    // The surfaces first (the lines are tested against their depth), in bands of a sixth of
-    // the rows a part, about the part's time: a quad over the whole viewport took llvmpipe
-    // 23-29 ms (2026-12-06).
+    // The frame's CPU time so far (the budget's clock), to learn what a piece costs.
+    auto spent = [this] { return budget_ ? budget_->spentMs() : 0.0; };
+    auto overTime = [&] {
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                   .count() >= partMs_;
+    };
+    // The first piece of a draw() was let in by draw() (nextPieceMs()); each further one
+    // starts only when its learned cost fits in what the frame's budget leaves.
+    bool first = true;
+    auto fits = [&](double ms) {
+        if (first || partLines_ == 0 || !budget_) return true;
+        return budget_->fits(ms, budgetReserveMs_);
+    };
+    // The surfaces first (the lines are tested against their depth), in bands.
     while (surfaceRows_ < vh_) {
-        const int band = partLines_ > 0 ? std::max(1, (vh_ + 5) / 6) : vh_;
-        const int end = std::min(vh_, surfaceRows_ + band);
+        const int end = surfaceRows_ + nextBandRows();
+        if (!fits(rowCost_.estimateMs(end - surfaceRows_))) {
+            picturePending_ = true;
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            return;
+        }
+        first = false;
+        const double start = spent();
         drawSurfaceRows(surfaceRows_, end);
+        if (partLines_ > 0) {
+            glFinish();  // timed: the band is drawn
+            rowCost_.record(end - surfaceRows_, spent() - start);
+        }
         surfaceRows_ = end;
         if (partLines_ == 0 || surfaceRows_ >= vh_) break;
-        glFinish();  // timed: the band is drawn
-        if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                    .count() >= partMs_ ||
-            (budget_ && !budget_->allows(budgetReserveMs_))) {
+        if (overTime()) {
             picturePending_ = true;
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
             return;
@@ -435,19 +519,22 @@ void Inspector::renderMore() {
     // picture is the one drawing them at once would give.
     const size_t part = partLines_ > 0 ? partLines_ : SIZE_MAX;
     for (;;) {
+        if (!fits(partCost_.estimateMs(1))) break;
+        first = false;
+        const double start = spent();
         if (!lines_->uploaded()) lines_->uploadMore(partLines_ > 0 ? kPartBytes : SIZE_MAX);
         gl::DrawOptions range = o;
         range.firstLine = picturedLines_;
         range.lineLimit = std::min(part, lines_->lineCount() - picturedLines_);
         batches_->draw(*lines_, pictureToClip_, range);
         picturedLines_ += range.lineLimit;
+        if (partLines_ > 0) {
+            glFinish();  // timed: the part is drawn
+            partCost_.record(1, spent() - start);
+        }
         if (lines_->uploaded() && picturedLines_ >= lines_->lineCount()) break;
         if (partLines_ == 0) continue;
-        glFinish();  // timed: the part is drawn
-        if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                    .count() >= partMs_ ||
-            (budget_ && !budget_->allows(budgetReserveMs_)))
-            break;
+        if (overTime()) break;
     }
     picturePending_ = !lines_->uploaded() || picturedLines_ < lines_->lineCount();
     // Over the lines drawn so far (again after each part: the same pixels once whole).
@@ -478,9 +565,10 @@ void Inspector::draw(int fbWidth, int fbHeight) {
     // screen stays as it is (dirtyPicture_ or picturePending_ kept) and is drawn later.
     const bool work = dirtyPicture_ || picturePending_;
     // The frame's GL work so far finished first, so the budget sees what it cost (llvmpipe
-    // draws at a flush; the first part's flush took 11-23 ms of such work, 2026-12-06).
+    // draws at a flush; the first part's flush took 11-23 ms of such work, 2026-12-06); then
+    // the first piece starts only if its learned cost fits in what is left.
     if (work && budget_) glFinish();
-    const bool deferred = work && budget_ && !budget_->allows(budgetReserveMs_);
+    const bool deferred = work && budget_ && !budget_->fits(nextPieceMs(), budgetReserveMs_);
     pictureDeferred_ = deferred;
     if (!deferred && dirtyPicture_)
         render();

@@ -101,10 +101,11 @@ class Inspector {
     /// (the default). balls4's inspector picture (20,000 regions, 240,000 lines) took
     /// llvmpipe 50-75 ms in one frame (2026-12-06).
     void drawInParts(size_t lines, double ms);
-    /// Share a frame's budget from now on (null: none): draw() starts or goes on with the
-    /// picture only while more than `reserveMs` of the frame's budget is left, and stops its
-    /// parts once no more is; the picture on screen stays until then. The budget must outlive
-    /// the inspector or be unset.
+    /// Share a frame's budget from now on (null: none): draw() starts each piece of the
+    /// picture (a band of its surfaces' rows, a part of its lines) only when the piece's
+    /// learned cost fits in the frame's budget less `reserveMs`, and leaves the rest to later
+    /// draws; the picture on screen stays until then. The budget must outlive the inspector or
+    /// be unset.
     void setFrameBudget(FrameBudget* budget, double reserveMs) {
         budget_ = budget;
         budgetReserveMs_ = reserveMs;
@@ -121,6 +122,9 @@ class Inspector {
 
   private:
     void rebuildModel();
+    /// Draw nothing visible into the picture's framebuffer (bound, of vw_ x vh_) with each of
+    /// its states: readies the driver for them (the constructor, before any frame).
+    void warmUp();
     /// The main camera's frustum again (frustum_), for the picture.
     void rebuildFrustum();
     void requestSurfaces();
@@ -182,7 +186,24 @@ class Inspector {
     bool picturePending_ = false;
     bool pictureSurfaces_ = false;
     double pictureNear_ = 0.0, pictureFar_ = 1.0;
-    int surfaceRows_ = 0;            ///< rows of the surfaces in the picture so far
+    int surfaceRows_ = 0;  ///< rows of the surfaces in the picture so far
+    /// The traced surfaces are drawn in bands of a 24th of the rows when in parts: a band of a
+    /// sixth of balls4's rows took llvmpipe 4-7 ms (2026-12-06), too much to start late in a
+    /// frame.
+    static constexpr int kSurfaceBands = 24;
+    /// The next piece of the picture: rows of the surfaces' next band (0: the lines are next).
+    int nextBandRows() const;
+    /// The next piece's estimated cost, in ms (the budget asks it before the piece starts).
+    double nextPieceMs() const;
+    /// Learned costs (FrameBudget's clock): a row of surfaces, a part of lines (its copy to GL
+    /// and its drawing, with the frustum and selection drawn over it); about 4 ms a band of
+    /// 120 rows and 4 ms a part to begin with (balls4, 2026-12-06).
+    StepCost rowCost_{4.0 / 120.0};
+    StepCost partCost_{4.0};
+    /// A new picture's start (its clear, about 2 ms) and new surfaces' conversion and copy to
+    /// GL (1-5 ms), also learned.
+    StepCost startCost_{2.0};
+    StepCost surfaceCopyCost_{3.0};
     FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
     double budgetReserveMs_ = 0.0;
     bool pictureDeferred_ = false;  ///< the last draw() left the picture for the budget

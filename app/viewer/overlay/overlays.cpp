@@ -181,16 +181,24 @@ void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms) 
 void Overlays::uploadMore() {
     // With the frame's budget: once a frame (update() runs twice in one), and only while the
     // budget is not spent; the copy goes on in the next frames.
+    // Each part starts only when its learned cost fits in what the budget leaves.
+    const auto fits = [this] {
+        return !budget_ || budget_->fits(uploadCost_.estimateMs(1), budgetReserveMs_);
+    };
     if (budget_ && !uploaded()) {
-        if (budget_->frame() == uploadFrame_ || !budget_->allows(budgetReserveMs_)) return;
+        if (budget_->frame() == uploadFrame_ || !fits()) return;
         uploadFrame_ = budget_->frame();
     }
     const auto t0 = std::chrono::steady_clock::now();
+    bool first = true;  // let in above
     for (gl::GpuBatch* b : {cuts_.get(), fills_.get(), wiresLongestFirst_.get(), wires_.get()})
         while (!b->uploaded()) {
-            if (budget_ && !budget_->allows(budgetReserveMs_)) return;
+            if (!first && !fits()) return;
+            first = false;
+            const double start = budget_ ? budget_->spentMs() : 0.0;
             b->uploadMore(look.uploadBytes);
             glFinish();  // timed: the copy is done
+            if (budget_) uploadCost_.record(1, budget_->spentMs() - start);
             if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count() >= look.uploadMs)
                 return;
@@ -312,10 +320,19 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         return layerTex_;
     }
-    // At rest the layer is optional work: with the frame's budget spent the texture stays as
-    // it is (the last one, whole or in part) and is drawn in a later frame. A moving camera's
-    // layer draws its first part in any case (it follows the view), its others within budget.
-    layerDeferred_ = !moving && budget_ && !budget_->allows(budgetReserveMs_);
+    // At rest the layer is optional work: when its first part's learned cost does not fit in
+    // what the frame's budget leaves, the texture stays as it is (the last one, whole or in
+    // part) and is drawn in a later frame. A moving camera's layer draws a first part in any
+    // case (it follows the view), as many lines as fit (OverlayLook::movingMinLines at least),
+    // its others when they fit.
+    const size_t partLines = std::max<size_t>(look.restLines, 1);
+    StepCost& cost = moving ? movingLineCost_ : restLineCost_;
+    const size_t from = resume ? layerDrawn_ : 0;
+    layerDeferred_ =
+        !moving && budget_ &&
+        !budget_->fits(cost.estimateMs(double(
+                           std::min(inParts ? partLines : total, ready - std::min(ready, from)))),
+                       budgetReserveMs_);
     if (layerDeferred_) {
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         return layerTex_;
@@ -330,15 +347,25 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
         // first; while moving, up to the cap.
         const size_t end = moving ? std::min(look.movingLines, ready) : ready;
         const double budget = moving ? look.movingMs : look.restMs;
-        do {
-            const size_t part = std::min(std::max<size_t>(look.restLines, 1), end - layerDrawn_);
+        for (bool first = true;; first = false) {
+            size_t part = std::min(partLines, end - layerDrawn_);
+            if (first && moving && budget_) {
+                const double fit = cost.unitsIn(budget_->leftMs(budgetReserveMs_));
+                part = std::min(part, std::max(look.movingMinLines, size_t(std::min(fit, 1e9))));
+            } else if (!first && budget_ &&
+                       !budget_->fits(cost.estimateMs(double(part)), budgetReserveMs_)) {
+                break;
+            }
+            const double start = budget_ ? budget_->spentMs() : 0.0;
             drawLayerRange(view, width, height, layerDrawn_, part, true);
             layerDrawn_ += part;
             glFinish();
-        } while (layerDrawn_ < end &&
-                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                         .count() < budget &&
-                 (!budget_ || budget_->allows(budgetReserveMs_)));
+            if (budget_) cost.record(double(part), budget_->spentMs() - start);
+            if (layerDrawn_ >= end ||
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                        .count() >= budget)
+                break;
+        }
     } else {  // whole in one frame, the wireframe in its own order
         drawLayers(view, width, height, SIZE_MAX);
         layerDrawn_ = total;

@@ -31,6 +31,10 @@ struct OverlayLook {
     /// fills capped alike), in parts of restLines until movingMs have passed: the whole layer
     /// is drawn again when it rests. 0: none while it moves.
     size_t movingLines = 2000;
+    /// With a frame's budget (Overlays::setFrameBudget()) a moving camera's first part holds
+    /// as many lines as the budget leaves room for, at their learned cost, but at least this
+    /// many, whatever the budget: the longest, the view's outline.
+    size_t movingMinLines = 100;
     /// Milliseconds of a frame while the camera moves given to drawing the layer (0: one part).
     /// balls4's 2,000 longest slab lines took llvmpipe 14-20 ms a frame (2026-12-06).
     double movingMs = 6.0;
@@ -122,11 +126,12 @@ class Overlays {
     bool layerPending() const {
         return (layerDeferred_ || (layerPartial_ && !layerMoving_)) && options.any() && view_;
     }
-    /// Share a frame's budget from now on (null: none, each step only its own share): the
-    /// batches' copy to GL (once a frame) and the layer's parts stop while no more than
-    /// `reserveMs` of the frame's budget is left (kept for the steps after them), and go on in
-    /// the next frames. At rest no part is drawn then; a moving camera's layer draws its first
-    /// part in any case. The budget must outlive the overlays or be unset.
+    /// Share a frame's budget from now on (null: none, each step only its own share): each
+    /// part of the batches' copy to GL (once a frame) and of the layer starts only when its
+    /// learned cost fits in the frame's budget less `reserveMs` (kept for the steps after
+    /// them); the rest goes on in the next frames. At rest no part is drawn then; a moving
+    /// camera's layer draws a first part in any case, of as many lines as fit
+    /// (OverlayLook::movingMinLines at least). The budget must outlive the overlays or be unset.
     void setFrameBudget(FrameBudget* budget, double reserveMs) {
         budget_ = budget;
         budgetReserveMs_ = reserveMs;
@@ -246,6 +251,13 @@ class Overlays {
     FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
     double budgetReserveMs_ = 0.0;
     unsigned long uploadFrame_ = 0;  ///< the budget's frame the batches were last copied in
+    /// Learned costs (the budget's clock): a part of the batches' copy (uploadBytes), a line of
+    /// a moving camera's layer and of a layer at rest (the longest lines, drawn while moving,
+    /// cost more each). To begin with: 4 ms a part, 7 ms per 1,000 moving lines, 5 ms per 500
+    /// lines at rest (balls4's slabs, 2026-12-06).
+    StepCost uploadCost_{4.0};
+    StepCost movingLineCost_{7.0 / 1000.0};
+    StepCost restLineCost_{5.0 / 500.0};
     Camera layerCamera_;
     OverlayLook layerLook_;
     std::optional<Selection> selection_;

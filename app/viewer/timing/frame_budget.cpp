@@ -1,5 +1,7 @@
 #include "app/viewer/timing/frame_budget.h"
 
+#include <cmath>
+#include <limits>
 #include <utility>
 
 #include "app/viewer/timing/frame_times.h"
@@ -23,6 +25,23 @@ bool FrameBudget::allows(double reserveMs) {
     if (leftMs(reserveMs) > 0.0) return true;
     ++deferred_;
     return false;
+}
+
+bool FrameBudget::fits(double estimateMs, double reserveMs) {
+    if (leftMs(reserveMs) >= estimateMs) return true;
+    ++deferred_;
+    return false;
+}
+
+double StepCost::unitsIn(double ms) const {
+    if (ms <= 0.0) return 0.0;
+    if (msPerUnit_ <= 0.0) return std::numeric_limits<double>::infinity();
+    return std::floor(ms / msPerUnit_);
+}
+
+void StepCost::record(double units, double ms) {
+    if (units <= 0.0 || !(ms >= 0.0)) return;
+    msPerUnit_ += 0.25 * (ms / units - msPerUnit_);
 }
 
 }  // namespace lancer::viewer

@@ -5,7 +5,10 @@
 // 2026-12-06). The steps draw from the budget in the frame's order, which is their priority:
 // a new view's image parts (taken in any case), then the layer, then the inspector, then the
 // panels; a step stops its optional work once the frame's budget, less what it leaves to the
-// steps after it, is spent, and goes on in the next frame.
+// steps after it, is spent, and goes on in the next frame. A step whose work comes in parts
+// learns what a part costs (StepCost) and starts one only when that cost fits in what is left
+// (fits()): a part begun with a little budget left once ran over by its whole cost (frames of
+// 33-41 ms on balls4's slabs with the inspector, 2026-12-06).
 #pragma once
 
 #include <functional>
@@ -31,6 +34,10 @@ class FrameBudget {
     /// Optional work of a step may go on: more than `reserveMs` of the budget is left. A step
     /// that stops here is counted (deferred()).
     bool allows(double reserveMs = 0.0);
+    /// A part of optional work estimated at `estimateMs` may start: it fits in what is left
+    /// when `reserveMs` are kept for later steps. A step that stops here is counted
+    /// (deferred()).
+    bool fits(double estimateMs, double reserveMs = 0.0);
     /// Steps that stopped for the budget since begin().
     int deferred() const { return deferred_; }
     /// The budget per frame, in ms.
@@ -44,6 +51,29 @@ class FrameBudget {
     double start_ = 0.0;
     int deferred_ = 0;
     unsigned long frame_ = 0;
+};
+
+/// What a step's work costs per unit (a row, a line, a byte), learned from the parts it ran:
+/// a running mean of the measured cost per unit, so that a part starts only when its
+/// estimate fits in the frame's budget (FrameBudget::fits()) and a part's size follows what
+/// the machine takes now.
+class StepCost {
+  public:
+    /// `msPerUnit` until a part is measured.
+    explicit StepCost(double msPerUnit) : msPerUnit_(msPerUnit) {}
+    /// The estimated cost of `units`, in ms.
+    double estimateMs(double units) const { return msPerUnit_ * units; }
+    /// How many whole units fit in `ms` (0 if none does).
+    double unitsIn(double ms) const;
+    /// A part of `units` took `ms`: the running mean moves a quarter of the way to it (one slow
+    /// part, e.g. the machine's load, does not stop the step for long; a lasting change is
+    /// followed within a few parts).
+    void record(double units, double ms);
+    /// The current cost per unit, in ms.
+    double msPerUnit() const { return msPerUnit_; }
+
+  private:
+    double msPerUnit_;
 };
 
 }  // namespace lancer::viewer

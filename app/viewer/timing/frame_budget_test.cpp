@@ -30,6 +30,38 @@ TEST(FrameBudget, StepsDrawFromOneBudgetAndStopOnceItIsSpentLessTheirReserve) {
     EXPECT_EQ(b.budgetMs(), 33.0);
 }
 
+TEST(FrameBudget, APartStartsOnlyWhenItsLearnedCostFitsInWhatIsLeft) {
+    double now = 0.0;
+    FrameBudget b(33.0, [&] { return now; });
+    b.begin();
+    now += 20.0;
+    // 13 ms left, 5 kept for later steps: a part of 8 ms fits, one of 8.5 does not.
+    EXPECT_TRUE(b.fits(8.0, 5.0));
+    EXPECT_FALSE(b.fits(8.5, 5.0));
+    EXPECT_EQ(b.deferred(), 1);
+    // allows() would let the 8.5 ms part start (some budget is left) and overrun by 0.5 ms.
+    EXPECT_TRUE(b.allows(5.0));
+
+    StepCost band(1.0);  // 1 ms a row until measured
+    EXPECT_EQ(band.estimateMs(30), 30.0);
+    EXPECT_EQ(band.unitsIn(7.5), 7.0);
+    EXPECT_EQ(band.unitsIn(0.0), 0.0);
+    EXPECT_EQ(band.unitsIn(-2.0), 0.0);
+    band.record(30, 6.0);  // measured 0.2 ms a row: a quarter of the way from 1.0
+    EXPECT_DOUBLE_EQ(band.msPerUnit(), 0.8);
+    for (int i = 0; i < 40; ++i) band.record(30, 6.0);
+    EXPECT_NEAR(band.msPerUnit(), 0.2, 1e-4) << "a lasting cost is followed";
+    EXPECT_NEAR(band.unitsIn(8.0), 40.0, 1.0);
+    band.record(30, 30.0);  // one slow part (the machine's load) moves it only partly
+    EXPECT_NEAR(band.msPerUnit(), 0.4, 1e-3);
+    band.record(0, 5.0);  // nothing done: nothing learned
+    EXPECT_NEAR(band.msPerUnit(), 0.4, 1e-3);
+    // A step asks its part's estimate: with 5 ms left beyond its reserve, 12 rows at 0.4 ms.
+    now = 28.0;
+    EXPECT_TRUE(b.fits(band.estimateMs(10), 0.0));
+    EXPECT_FALSE(b.fits(band.estimateMs(13), 0.0));
+}
+
 TEST(FrameBudget, ByDefaultTheUiThreadsCpuTime) {
     FrameBudget b(33.0);
     b.begin();
