@@ -266,7 +266,7 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         ++ctx.counters.regionVisits;
         obs.region(r, t, t1);
         if (hitInIrregularRegion(*scene_, unionOnly_, primitives(r), pool_, R.root, ray, tmin, t,
-                                 t1, ctx, obs, hit))
+                                 t1, ctx, obs, hit, true))
             return true;
         if (te >= tend) return false;
         if constexpr (Obs::kActive) obs.regionExit(te, frame_.toWorld(p), axis, ties);

@@ -212,7 +212,7 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         ++ctx.counters.regionVisits;
         obs.region(id, t0, t1);
         return hitInIrregularRegion(scene, unionOnly_, nearPrims_, pool_, nearRoot_, ray, tmin, t0,
-                                    t1, ctx, obs, hit);
+                                    t1, ctx, obs, hit, false);
     };
     // The first slab walked fetches its whole list, each later one what it adds, unless the
     // slab before it was evaluated lazily (hitInLeaf), fetching only part.
@@ -225,7 +225,7 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         if (heldBefore) tests = slabEntering(i);
         const bool found =
             hitInIrregularRegion(scene, unionOnly_, slabPrimitives(i), pool_, slabRoot_[i], ray,
-                                 tmin, t0, t1, ctx, obs, hit, tests);
+                                 tmin, t0, t1, ctx, obs, hit, false, tests);
         heldBefore = ctx.pending.tested;
         return found;
     };
