@@ -234,7 +234,7 @@ int ImageView::composeHeld(FrameBudget& budget, double reserveMs) {
     int done = 0;
     while (!dirty_.empty()) {
         const int end = std::min(dirty_.end, dirty_.begin + kRows);
-        if (!budget.fits(msPerRow_ * (end - dirty_.begin), reserveMs)) break;
+        if (!budget.fits(rowCost_.estimateMs(end - dirty_.begin), reserveMs)) break;
         compose(dirty_.begin, end, false);
         precomposed_.add(dirty_.begin, end);
         done += end - dirty_.begin;
@@ -372,7 +372,7 @@ double ImageView::shadeEstimateMs(ViewMode mode) const {
     const bool whole =
         !shadedValid_ || mode != shadedMode_ || shadedWidth_ != width_ || shadedHeight_ != height_;
     const int rows = whole ? height_ : dirty_.end - dirty_.begin;
-    return msPerRow_ * std::max(rows, 0);
+    return rowCost_.estimateMs(std::max(rows, 0));
 }
 
 PixelRect ImageView::viewport(int fbWidth, int fbHeight) const {
@@ -403,7 +403,7 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
         const double start = threadCpuMs();
         compose(rowBegin, rowEnd);
         if (rowEnd - rowBegin >= 64)  // the running mean of the time a row takes
-            msPerRow_ += 0.25 * ((threadCpuMs() - start) / (rowEnd - rowBegin) - msPerRow_);
+            rowCost_.record(rowEnd - rowBegin, threadCpuMs() - start);
         const bool wholeRows = rowBegin <= 0 && rowEnd >= height_;
         if (layerChanged_ && !wholeRows && layerAtImageSize() &&
             composedLayer_.size() == overlayRgba_.size())

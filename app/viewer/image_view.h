@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "app/viewer/colormap.h"
+#include "app/viewer/timing/frame_budget.h"
 #include "engine/render/image.h"
 
 namespace lancer::viewer {
@@ -13,7 +14,6 @@ namespace lancer::viewer {
 namespace gl {
 class Program;
 }
-class FrameBudget;
 
 /// A rectangle of framebuffer pixels, [x0, x1) x [y0, y1), row 0 at the top (as ImGui has it).
 struct PixelRect {
@@ -132,10 +132,10 @@ class ImageView {
     mutable std::vector<uint8_t> composedLayer_;
     mutable bool layerChanged_ = false;  ///< a new layer since the last shade()
     mutable ShadeCount lastShade_;
-    /// Milliseconds of the UI thread's CPU per row composited and uploaded (a running mean of
+    /// The UI thread's CPU per row composited and uploaded (a running mean of
     /// the composites of 64 rows or more); 8.6 ms for a 720-row image to begin with (the
     /// composite of balls4 at 1280x720, 2026-12-06).
-    mutable double msPerRow_ = 8.6 / 720.0;
+    mutable StepCost rowCost_{8.6 / 720.0};
     mutable bool shadedValid_ = false;
     mutable ViewMode shadedMode_ = ViewMode::Color;
     mutable float shadedScale_ = 0.0f;
