@@ -101,6 +101,12 @@ class PrimitiveHulls {
     static glm::dvec2 alignedDepth(const Box3& b, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi,
                                    double zNear);
 
+    /// depthIn for a `single` hull (its world box `b`), from its corners' distances to the
+    /// column's planes (`dist`, the fifth z = zNear from the eye) and which planes cut it.
+    static glm::dvec2 singleBoxDepth(const Solid& b, ZoneColumn column, glm::dvec2 lo,
+                                     glm::dvec2 hi, double zNear, const double (&dist)[5][8],
+                                     const std::array<bool, 5>& cuts, glm::dvec2 whole);
+
     std::vector<int32_t> index_;  ///< per primitive: its hull, or -1
     std::vector<Hull> hulls_;
     std::vector<FaceVertex> faceVerts_;  ///< the kept faces' vertices (Hull::faceFirst)
