@@ -166,6 +166,22 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
             hull.aligned = true;
             for (const Vec3& q : hull.world.corner) hull.box.expand(q);
         }
+        // A box of its own within the world box (a turned scene's bar, whose world box is its
+        // bound) is the hull alone: the two boxes' common part is it, up to the padding, by
+        // which its corners may leave the world box (padded along other axes); taken alone,
+        // its ranges are wider than the common part's by at most that.
+        if (!hull.single) {
+            bool within = true;
+            for (const Vec3& q : hull.turned.corner)
+                for (int a = 0; a < 3 && within; ++a) {
+                    const double x = glm::dot(hull.world.axis[size_t(a)], q);
+                    within = x >= hull.world.lo[a] - 2.0 * pad && x <= hull.world.hi[a] + 2.0 * pad;
+                }
+            if (within) {
+                hull.world = hull.turned;
+                hull.single = true;
+            }
+        }
         // An aligned hull's outline is its box's, tested in closed form (touches).
         std::vector<glm::dvec2> flat, eye;
         bool front = !hull.aligned;
