@@ -18,6 +18,7 @@
 // the ray without gap.
 #pragma once
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <span>
 
@@ -265,8 +266,13 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
     // Toward the light: depth falls as t grows. Skip the slabs wholly before tmin (those beyond
     // the origin's depth), then walk down to the zone's first slab and the near region, whose
     // interval runs to tmax (the ray ends at the light, where only near primitives can lie).
-    uint32_t i = last - 1;
-    while (i > first && tAt(slabLo_[i]) < t) --i;
+    // The slab's start is crossed later the nearer the slab: a binary search for the last slab
+    // whose start is not crossed before t (a shadow ray from deep in a zone of many slabs).
+    const uint32_t i0 =
+        uint32_t(std::partition_point(slabLo_.begin() + first + 1, slabLo_.begin() + last,
+                                      [&](double z) { return !(tAt(z) < t); }) -
+                 slabLo_.begin());
+    uint32_t i = i0 - 1;
     for (;; --i) {
         const double z1 = i + 1 < last ? slabLo_[i + 1] : zFar_;
         const double t0 = std::max(tAt(z1), t);
