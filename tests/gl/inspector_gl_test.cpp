@@ -278,18 +278,28 @@ TEST(InspectorGl, WithTheFramesBudgetSpentThePictureWaitsAndEndsAsTheDirectOne) 
     EXPECT_EQ(f.gl.read(), direct);
 }
 
+/// `f`'s model drawn in parts of a 15th of its lines, one a draw, under a budget of 33 ms
+/// keeping 5, on a clock only the test moves (`now`): every piece and copy measured costs
+/// nothing, so the learned costs shrink a quarter at each measure.
+struct FrozenClockParts {
+    explicit FrozenClockParts(Fixture& f) {
+        startInParts(parts, f, f.insp->model().lines.lineCount() / 15 + 1, 0.0, budget, 5.0);
+    }
+    double now = 0.0;
+    FrameBudget budget{33.0, [this] { return now; }};
+    Inspector parts;
+};
+
 TEST(InspectorGl, APieceStartsOnlyWhenItsLearnedCostFitsInWhatTheBudgetLeaves) {
     Fixture f;
     ASSERT_TRUE(f.gl.ok());
     const std::vector<uint8_t> direct = f.draw();
     const size_t lines = f.insp->model().lines.lineCount();
     ASSERT_GT(lines, 30u);
-    // One part of a 15th a draw; a clock only the test moves, so each piece measured costs
-    // nothing and the learned costs shrink a quarter at each piece.
-    double now = 0.0;
-    FrameBudget budget(33.0, [&] { return now; });
-    Inspector parts;
-    startInParts(parts, f, lines / 15 + 1, 0.0, budget, 5.0);
+    FrozenClockParts t(f);
+    Inspector& parts = t.parts;
+    FrameBudget& budget = t.budget;
+    double& now = t.now;
     // 1 ms left beyond the reserve: some budget is left, but not a new picture's first piece
     // (its clear, 2 ms, and a part of lines, 4 ms, until measured): nothing drawn.
     budgetFrame(f, parts, budget, now, 27.0);
@@ -316,6 +326,48 @@ TEST(InspectorGl, APieceStartsOnlyWhenItsLearnedCostFitsInWhatTheBudgetLeaves) {
     } while (!parts.settled() && frames < 100);
     EXPECT_GE(tightDeferred, 3) << "4, 3 and 2.25 ms do not fit in 1";
     EXPECT_GE(tightDrawn, 1);
+    EXPECT_TRUE(parts.settled());
+    EXPECT_EQ(parts.picturedLines(), lines);
+    EXPECT_EQ(f.gl.read(), direct);
+}
+
+// The picture's copy to the window follows its pieces in every draw: its learned cost is kept
+// back beside the reserve given, so a piece that fits in what the reserve leaves still waits
+// when the copy after it would not fit.
+TEST(InspectorGl, APieceWaitsWhenThePicturesCopyToTheWindowWouldNotFitAfterIt) {
+    Fixture f;
+    ASSERT_TRUE(f.gl.ok());
+    const std::vector<uint8_t> direct = f.draw();
+    const size_t lines = f.insp->model().lines.lineCount();
+    ASSERT_GT(lines, 30u);
+    FrozenClockParts t(f);
+    Inspector& parts = t.parts;
+    FrameBudget& budget = t.budget;
+    double& now = t.now;
+    EXPECT_DOUBLE_EQ(parts.showEstimateMs(), 5.0) << "the copy's figure until measured";
+    // 20 ms spent: 8 left beyond the reserve, room for a new picture's first piece (its clear,
+    // 2 ms, and a part of lines, 4 ms) but not for the copy after it too (5 ms): nothing drawn.
+    budgetFrame(f, parts, budget, now, 20.0);
+    EXPECT_EQ(parts.picturedLines(), 0u);
+    EXPECT_TRUE(parts.picturePending());
+    EXPECT_GE(budget.deferred(), 1);
+    EXPECT_LT(parts.showEstimateMs(), 5.0) << "the copy is measured in each draw";
+    // The same frames: the copy, learned cheaper at each draw, fits beside the first piece
+    // within a few frames (5 x 0.75^n + 6 <= 8 from n = 4); then the picture is completed and
+    // ends as the direct one.
+    int frames = 0, waited = 1;
+    do {
+        const size_t before = parts.picturedLines();
+        const double copyMs = parts.showEstimateMs();
+        budgetFrame(f, parts, budget, now, 20.0);
+        if (parts.picturedLines() == before && parts.picturedLines() == 0) {
+            ++waited;
+            EXPECT_GT(copyMs + 6.0, 8.0) << "frame " << frames << ": the piece and the copy fit";
+        }
+        ++frames;
+    } while (!parts.settled() && frames < 100);
+    EXPECT_GE(waited, 3);
+    EXPECT_LE(waited, 6) << "the deferred picture starts within a few frames";
     EXPECT_TRUE(parts.settled());
     EXPECT_EQ(parts.picturedLines(), lines);
     EXPECT_EQ(f.gl.read(), direct);
