@@ -33,6 +33,11 @@ uint64_t hashList(uint64_t h, const ImDrawList& l) {
 
 bool empty(const PixelRect& r) { return r.x1 <= r.x0 || r.y1 <= r.y0; }
 
+/// `r`'s pixels (0 when empty).
+double area(const PixelRect& r) {
+    return empty(r) ? 0.0 : double(r.x1 - r.x0) * double(r.y1 - r.y0);
+}
+
 bool overlap(const PixelRect& a, const PixelRect& b) {
     return a.x0 < b.x1 && b.x0 < a.x1 && a.y0 < b.y1 && b.y0 < a.y1;
 }
@@ -153,15 +158,15 @@ double PanelCache::estimateMs() const {
     // they overlap.
     const Plan p = plan();
     std::vector<char> drawn(panels_.size(), 0);
-    double count = 0.0;
+    double pixels = 0.0;
     for (size_t i = 0; i < panels_.size(); ++i) {
         if (p.need[i] == kMust) drawn[i] = 1;
         if (!drawn[i]) continue;
-        count += 1.0;
+        pixels += area(panels_[i].rect);
         for (size_t j = i + 1; j < panels_.size(); ++j)
             if (overlap(panels_[i].rect, panels_[j].rect)) drawn[j] = 1;
     }
-    return copyCost_.estimateMs(1) + redrawCost_.estimateMs(count);
+    return copyCost_.estimateMs(1) + redrawCost_.estimateMs(pixels);
 }
 
 void PanelCache::render() {
@@ -206,7 +211,8 @@ void PanelCache::render() {
     std::vector<unsigned> stillInvalid;
     for (size_t i = 0; i < panels_.size(); ++i) {
         if (need[i] == kContent && !dirty[i] && budget_ &&
-            !budget_->fits(redrawCost_.estimateMs(1), budgetReserveMs_ + copyCost_.estimateMs(1))) {
+            !budget_->fits(redrawEstimateMs(area(panels_[i].rect)),
+                           budgetReserveMs_ + copyCost_.estimateMs(1))) {
             ++deferred_;
             if (std::find(invalid_.begin(), invalid_.end(), panels_[i].id) != invalid_.end())
                 stillInvalid.push_back(panels_[i].id);
@@ -243,7 +249,7 @@ void PanelCache::render() {
             if (budget_) {
                 glFinish();
                 const double ms = budget_->spentMs() - redrawStart;
-                redrawCost_.record(1, ms);
+                redrawCost_.record(area(q), ms);
                 redrawMs += ms;
             }
         }

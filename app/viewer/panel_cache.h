@@ -57,8 +57,8 @@ class PanelCache {
     /// uncovered) and of the copies. The steps before it keep that much back: a new
     /// structure's first frame redraws five panels, 9-11 ms (balls4, 2026-12-06).
     double estimateMs() const;
-    /// The learned cost of drawing one panel again, in ms.
-    double redrawEstimateMs() const { return redrawCost_.estimateMs(1); }
+    /// The learned cost of drawing a panel of `pixels` again, in ms.
+    double redrawEstimateMs(double pixels) const { return redrawCost_.estimateMs(pixels); }
     /// The learned cost of a render() that draws no panel again (the copies), in ms.
     double copyEstimateMs() const { return copyCost_.estimateMs(1); }
 
@@ -102,9 +102,10 @@ class PanelCache {
     int deferred_ = 0;
     FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
     double budgetReserveMs_ = 0.0;
-    /// Learned (FrameBudget's clock): a panel drawn again (1-2 ms under llvmpipe at first), and
-    /// a render()'s copies and direct lists (about 3 ms, 2026-12-06).
-    StepCost redrawCost_{2.0};
+    /// Learned (FrameBudget's clock): a panel drawn again, by its pixels (at first 1.5 ms for a
+    /// panel of 100,000, as llvmpipe takes for the viewer's at 1280x720: a new structure's five
+    /// took 9-11 ms, 2026-12-06), and a render()'s copies and direct lists (about 3 ms).
+    StepCost redrawCost_{1.5e-5};
     StepCost copyCost_{3.0};
 };
 
