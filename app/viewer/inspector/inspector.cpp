@@ -565,9 +565,10 @@ void Inspector::draw(int fbWidth, int fbHeight) {
     // screen stays as it is (dirtyPicture_ or picturePending_ kept) and is drawn later.
     const bool work = dirtyPicture_ || picturePending_;
     // The frame's GL work so far finished first, so the budget sees what it cost (llvmpipe
-    // draws at a flush; the first part's flush took 11-23 ms of such work, 2026-12-06); then
-    // the first piece starts only if its learned cost fits in what is left.
-    if (work && budget_) glFinish();
+    // draws at a flush: 3-7 ms on balls4's slabs, 2026-12-07); then the first piece starts only
+    // if its learned cost fits in what is left. Finished with nothing to draw too, so that the
+    // picture's copy is learned apart from that work.
+    if (budget_) glFinish();
     const bool deferred = work && budget_ && !budget_->fits(nextPieceMs(), reserveMs());
     pictureDeferred_ = deferred;
     if (!deferred && dirtyPicture_)
