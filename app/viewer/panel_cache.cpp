@@ -33,6 +33,11 @@ uint64_t hashList(uint64_t h, const ImDrawList& l) {
 
 bool empty(const PixelRect& r) { return r.x1 <= r.x0 || r.y1 <= r.y0; }
 
+/// `r`'s pixels (0 when empty).
+double area(const PixelRect& r) {
+    return empty(r) ? 0.0 : double(r.x1 - r.x0) * double(r.y1 - r.y0);
+}
+
 bool overlap(const PixelRect& a, const PixelRect& b) {
     return a.x0 < b.x1 && b.x0 < a.x1 && a.y0 < b.y1 && b.y0 < a.y1;
 }
@@ -102,19 +107,89 @@ const std::vector<PixelRect>& PanelCache::layout(ImDrawData* dd, int fbWidth, in
     return covered_;
 }
 
+PanelCache::Plan PanelCache::plan() const {
+    // The layer must hold, under every panel's rectangle, the topmost panel there as it is
+    // now. A panel is drawn again when it is new, moved or resized (its rectangle in the layer
+    // is stale), when a panel of the last frame that vanished or moved overlapped it (that
+    // panel's pixels are left in the layer), when a panel drawn again below it overlaps it
+    // (drawing that one covers its pixels), and when its content changed. Only the last is
+    // optional: with the frame's budget spent it waits for a later frame, the layer showing
+    // its last content meanwhile. A change of the panels' order, or of the layer's size,
+    // redraws them all.
+    Plan p;
+    bool redrawAll = w_ != fbWidth_ || h_ != fbHeight_;
+    p.need.assign(panels_.size(), redrawAll ? kMust : kNone);
+    p.lastOf.assign(panels_.size(), SIZE_MAX);
+    std::vector<char> matched(last_.size(), 0);
+    for (size_t i = 0; !redrawAll && i < panels_.size(); ++i) {
+        for (size_t j = 0; j < last_.size(); ++j)
+            if (last_[j].id == panels_[i].id) p.lastOf[i] = j;
+        if (p.lastOf[i] == SIZE_MAX) {
+            p.need[i] = kMust;
+            continue;
+        }
+        const Panel& was = last_[p.lastOf[i]];
+        if (!(was.rect == panels_[i].rect)) {
+            p.need[i] = kMust;
+            continue;
+        }
+        matched[p.lastOf[i]] = 1;
+        if (was.hash != panels_[i].hash ||
+            std::find(invalid_.begin(), invalid_.end(), panels_[i].id) != invalid_.end())
+            p.need[i] = kContent;
+    }
+    for (size_t i = 1; !redrawAll && i < panels_.size(); ++i)  // the order kept
+        for (size_t k = 0; k < i; ++k)
+            if (p.lastOf[i] != SIZE_MAX && p.lastOf[k] != SIZE_MAX && p.lastOf[k] > p.lastOf[i])
+                redrawAll = true;
+    if (redrawAll) std::fill(p.need.begin(), p.need.end(), char(kMust));
+    for (size_t j = 0; j < last_.size(); ++j) {  // vanished or moved: its old place is stale
+        if (matched[j]) continue;
+        for (size_t i = 0; i < panels_.size(); ++i)
+            if (overlap(last_[j].rect, panels_[i].rect)) p.need[i] = kMust;
+    }
+    return p;
+}
+
+double PanelCache::estimateMs() const {
+    if (!dd_) return 0.0;
+    if (direct_) return copyCost_.estimateMs(1);
+    // The panels drawn whatever the budget: those that must be, and those above them that
+    // they overlap.
+    const Plan p = plan();
+    std::vector<char> drawn(panels_.size(), 0);
+    double pixels = 0.0;
+    for (size_t i = 0; i < panels_.size(); ++i) {
+        if (p.need[i] == kMust) drawn[i] = 1;
+        if (!drawn[i]) continue;
+        pixels += area(panels_[i].rect);
+        for (size_t j = i + 1; j < panels_.size(); ++j)
+            if (overlap(panels_[i].rect, panels_[j].rect)) drawn[j] = 1;
+    }
+    return copyCost_.estimateMs(1) + redrawCost_.estimateMs(pixels);
+}
+
 void PanelCache::render() {
     redrawn_ = 0;
     deferred_ = 0;
     if (!dd_) return;
+    const double start = budget_ ? budget_->spentMs() : 0.0;
+    double redrawMs = 0.0;  // of the panels drawn again, learned apart from the copies
     if (direct_) {
         last_.clear();
         invalid_.clear();
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         ImGui_ImplOpenGL3_RenderDrawData(dd_);
+        if (budget_) {
+            glFinish();  // timed: the panels are drawn
+            copyCost_.record(1, budget_->spentMs() - start);
+        }
         return;
     }
     const int fbWidth = fbWidth_, fbHeight = fbHeight_;
-    bool redrawAll = false;
+    Plan p = plan();
+    std::vector<char>& need = p.need;
+    const std::vector<size_t>& lastOf = p.lastOf;
     if (w_ != fbWidth || h_ != fbHeight) {
         if (!tex_) {
             glGenTextures(1, &tex_);
@@ -129,52 +204,15 @@ void PanelCache::render() {
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex_, 0);
         w_ = fbWidth, h_ = fbHeight;
-        redrawAll = true;
-    }
-    // The layer must hold, under every panel's rectangle, the topmost panel there as it is
-    // now. A panel is drawn again when it is new, moved or resized (its rectangle in the layer
-    // is stale), when a panel of the last frame that vanished or moved overlapped it (that
-    // panel's pixels are left in the layer), when a panel drawn again below it overlaps it
-    // (drawing that one covers its pixels), and when its content changed. Only the last is
-    // optional: with the frame's budget spent it waits for a later frame, the layer showing
-    // its last content meanwhile. A change of the panels' order redraws them all.
-    enum Need : char { kNone, kContent, kMust };
-    std::vector<char> need(panels_.size(), redrawAll ? kMust : kNone);
-    std::vector<char> matched(last_.size(), 0);
-    std::vector<size_t> lastOf(panels_.size(), SIZE_MAX);
-    for (size_t i = 0; !redrawAll && i < panels_.size(); ++i) {
-        for (size_t j = 0; j < last_.size(); ++j)
-            if (last_[j].id == panels_[i].id) lastOf[i] = j;
-        if (lastOf[i] == SIZE_MAX) {
-            need[i] = kMust;
-            continue;
-        }
-        const Panel& was = last_[lastOf[i]];
-        if (!(was.rect == panels_[i].rect)) {
-            need[i] = kMust;
-            continue;
-        }
-        matched[lastOf[i]] = 1;
-        if (was.hash != panels_[i].hash ||
-            std::find(invalid_.begin(), invalid_.end(), panels_[i].id) != invalid_.end())
-            need[i] = kContent;
-    }
-    for (size_t i = 1; !redrawAll && i < panels_.size(); ++i)  // the order kept
-        for (size_t k = 0; k < i; ++k)
-            if (lastOf[i] != SIZE_MAX && lastOf[k] != SIZE_MAX && lastOf[k] > lastOf[i])
-                redrawAll = true;
-    if (redrawAll) std::fill(need.begin(), need.end(), char(kMust));
-    for (size_t j = 0; j < last_.size(); ++j) {  // vanished or moved: its old place is stale
-        if (matched[j]) continue;
-        for (size_t i = 0; i < panels_.size(); ++i)
-            if (overlap(last_[j].rect, panels_[i].rect)) need[i] = kMust;
     }
     // Which are drawn: bottom to top, a content change within the budget; each drawn panel
     // makes the ones above it that it overlaps drawn too.
     std::vector<char> dirty(panels_.size(), 0);
     std::vector<unsigned> stillInvalid;
     for (size_t i = 0; i < panels_.size(); ++i) {
-        if (need[i] == kContent && !dirty[i] && budget_ && !budget_->allows(budgetReserveMs_)) {
+        if (need[i] == kContent && !dirty[i] && budget_ &&
+            !budget_->fits(redrawEstimateMs(area(panels_[i].rect)),
+                           budgetReserveMs_ + copyCost_.estimateMs(1))) {
             ++deferred_;
             if (std::find(invalid_.begin(), invalid_.end(), panels_[i].id) != invalid_.end())
                 stillInvalid.push_back(panels_[i].id);
@@ -204,10 +242,16 @@ void PanelCache::render() {
             glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
             glClear(GL_COLOR_BUFFER_BIT);
             glDisable(GL_SCISSOR_TEST);
+            const double redrawStart = budget_ ? budget_->spentMs() : 0.0;
             drawLists(*dd_, r.lists);
             ++redrawn_;
             // Drawn now (the blit below reads it), so the budget sees what the redraw cost.
-            if (budget_) glFinish();
+            if (budget_) {
+                glFinish();
+                const double ms = budget_->spentMs() - redrawStart;
+                redrawCost_.record(area(q), ms);
+                redrawMs += ms;
+            }
         }
         glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
@@ -217,6 +261,10 @@ void PanelCache::render() {
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
+    if (budget_) {
+        glFinish();  // timed: the copies are done
+        copyCost_.record(1, budget_->spentMs() - start - redrawMs);
+    }
     last_ = panels_;
     invalid_ = std::move(stillInvalid);
 }

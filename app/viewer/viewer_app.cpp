@@ -20,9 +20,15 @@ namespace lancer::viewer {
 
 namespace {
 
-/// What the overlays' optional work keeps back of the frame's budget for the steps after it
-/// (the image's rows to composite are added each frame): see the constructor.
-constexpr double kLayerReserveMs = 12.0;
+/// What the overlays' optional work keeps back of the frame's budget beside the learned costs
+/// of the steps after it (the image's rows to composite, the composite of the layer's changes,
+/// the inspector's copy to the window, the panel layer and the swap, added each frame): the
+/// flush of the frame's drawing before the inspector (about 6 ms) and room for the inspector's
+/// pieces. See the constructor.
+constexpr double kLayerReserveMs = 9.0;
+/// What the inspector's and the panels' optional work keeps back for the swap and what follows
+/// the frame's steps (0.1-0.5 ms, 2026-12-07).
+constexpr double kSwapReserveMs = 1.0;
 
 bool sameCamera(const Camera& a, const Camera& b) {
     return a.from == b.from && a.at == b.at && a.up == b.up && a.fov == b.fov &&
@@ -43,14 +49,17 @@ ViewerApp::ViewerApp(ViewerSettings& settings, bool logTimings, std::function<vo
     // One budget for the frame (FrameBudget): each step that may leave work for the next
     // frame starts a part only when the part's learned cost fits in what is left, less what
     // the steps after it take in a frame that runs them all (balls4's slabs with the
-    // inspector, the slow-frame lines of --log-timings, 2026-12-06): after the layer, the
+    // inspector, the slow-frame lines of --log-timings, 2026-12-06/07): after the layer, the
     // image's changed texels (3-5 ms), the flush of the frame's drawing before the
-    // inspector's picture (the image's copy and the layer, about 6 ms) and the panel layer;
-    // after the inspector, the panel layer (its copies about 3 ms, a changed panel about 1 ms
-    // more) and the swap; after a panel, the copies of the panels and the swap.
+    // inspector's picture (the image's copy and the layer, about 6 ms), the inspector's copy
+    // to the window (4-5 ms) and the panel layer; after the inspector, the panel layer (its
+    // copies about 3 ms, the panels it must draw again 1-2 ms each) and the swap; after a
+    // panel, the copies of the panels and the swap. What the panel layer and the inspector's
+    // copy take is learned (PanelCache::estimateMs(), the inspector's own) and set each
+    // frame (frame()).
     overlays_->setFrameBudget(&budget_, kLayerReserveMs);
-    inspector_->setFrameBudget(&budget_, 5.0);
-    panels_.setFrameBudget(&budget_, 5.0);
+    inspector_->setFrameBudget(&budget_, kSwapReserveMs);
+    panels_.setFrameBudget(&budget_, kSwapReserveMs);
     // Opaque panels (ImGui's dark style has them 94% opaque): the image under them is not
     // drawn at all, and each is copied from a layer where it is redrawn only when it changes
     // (frame(), PanelCache).
@@ -254,7 +263,16 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     const bool moving = cameraMoving();
     const bool layerDraws = overlays_->options.any() && (moving || overlays_->layerPending());
     StepCost& composite = layerCompositeCost_[moving ? 1 : 0];
-    overlays_->setFrameBudget(&budget_, kLayerReserveMs + view_->shadeEstimateMs(s.mode) +
+    // The panel layer's learned cost in this frame: the panels it must draw again (a new
+    // structure's first frame redraws five) are kept back by the steps before it.
+    std::vector<PixelRect> covered;  // a menu or a tooltip over the image
+    for (const PixelRect& r : panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight))
+        if (r.x0 < area.x1 && area.x0 < r.x1 && r.y0 < area.y1 && area.y0 < r.y1)
+            covered.push_back(r);
+    const double panelsMs = panels_.estimateMs() + kSwapReserveMs;
+    inspector_->setFrameBudget(&budget_, panelsMs);
+    overlays_->setFrameBudget(&budget_, kLayerReserveMs + panelsMs + inspector_->showEstimateMs() +
+                                            view_->shadeEstimateMs(s.mode) +
                                             (layerDraws ? composite.estimateMs(1) : 0.0));
     const uint64_t layerVersion = overlays_->layerVersion();
     prepareOverlays(imageW, imageH);
@@ -275,10 +293,6 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
         glClear(GL_COLOR_BUFFER_BIT);
     }
     glDisable(GL_SCISSOR_TEST);
-    std::vector<PixelRect> covered;  // a menu or a tooltip over the image
-    for (const PixelRect& r : panels_.layout(ImGui::GetDrawData(), fbWidth, fbHeight))
-        if (r.x0 < area.x1 && area.x0 < r.x1 && r.y0 < area.y1 && area.y0 < r.y1)
-            covered.push_back(r);
     view_->setViewport(area);
     const double imageStart = budget_.spentMs();
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale,

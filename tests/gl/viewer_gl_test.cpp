@@ -611,9 +611,40 @@ TEST(ViewerGl, PanelsFromTheirTexturesMatchImGuisOwnDrawingAndRedrawOnlyWhenChan
         EXPECT_EQ(cache.redrawn(), 1);
         EXPECT_EQ(cache.deferred(), 0);
         EXPECT_TRUE(near(caught.cached, caught.direct));
+        // A changed panel is drawn again only when its learned cost fits beside the copies'
+        // (the test's clock stands still in both, so they were learned cheaper than their
+        // first figures): with less left than that, though some is, it waits for a frame that
+        // has room, then is ImGui's own pixels again.
+        const double redrawMs = cache.redrawEstimateMs(200 * 150);  // the first panel's
+        const double copyMs = cache.copyEstimateMs();
+        ASSERT_GT(redrawMs, 0.0);
+        budget.begin();
+        now += 33.0 - 5.0 - copyMs - redrawMs / 2;
+        EXPECT_GT(budget.leftMs(5.0), 0.0) << "some budget is left beyond the reserve";
+        frame(3);
+        const Drawn tight = drawBoth();
+        EXPECT_EQ(cache.redrawn(), 0);
+        EXPECT_EQ(cache.deferred(), 1);
+        EXPECT_TRUE(near(tight.cached, caught.direct)) << "the counter's last content";
+        budget.begin();
+        frame(3);
+        const Drawn roomy = drawBoth();
+        EXPECT_EQ(cache.redrawn(), 1);
+        EXPECT_TRUE(near(roomy.cached, roomy.direct));
+        // What a frame's render() takes in any case, for the steps before it: the copies when no
+        // panel must be drawn, and the redraw of the pixels of a panel that appears.
+        cache.layout(ImGui::GetDrawData(), w, h);
+        EXPECT_DOUBLE_EQ(cache.estimateMs(), cache.copyEstimateMs());
+        for (int warm = 0; warm < 2; ++warm) frame(3, &tipAt);
+        cache.layout(ImGui::GetDrawData(), w, h);
+        EXPECT_DOUBLE_EQ(cache.estimateMs(),
+                         cache.copyEstimateMs() + cache.redrawEstimateMs(90 * 50));
+        cache.render();
+        frame(2);
+        drawBoth();
         // A panel that must be drawn (moved, new) is drawn whatever the budget.
         budget.begin();
-        now = 100.0;
+        now = 1000.0;
         for (int warm = 0; warm < 2; ++warm) frame(2, &tipAt);
         const Drawn must = drawBoth();
         EXPECT_EQ(cache.redrawn(), 1) << "the new tip";

@@ -488,7 +488,7 @@ void Inspector::renderMore() {
     bool first = true;
     auto fits = [&](double ms) {
         if (first || partLines_ == 0 || !budget_) return true;
-        return budget_->fits(ms, budgetReserveMs_);
+        return budget_->fits(ms, reserveMs());
     };
     // The surfaces first (the lines are tested against their depth), in bands.
     while (surfaceRows_ < vh_) {
@@ -565,24 +565,32 @@ void Inspector::draw(int fbWidth, int fbHeight) {
     // screen stays as it is (dirtyPicture_ or picturePending_ kept) and is drawn later.
     const bool work = dirtyPicture_ || picturePending_;
     // The frame's GL work so far finished first, so the budget sees what it cost (llvmpipe
-    // draws at a flush; the first part's flush took 11-23 ms of such work, 2026-12-06); then
-    // the first piece starts only if its learned cost fits in what is left.
-    if (work && budget_) glFinish();
-    const bool deferred = work && budget_ && !budget_->fits(nextPieceMs(), budgetReserveMs_);
+    // draws at a flush: 3-7 ms on balls4's slabs, 2026-12-07); then the first piece starts only
+    // if its learned cost fits in what is left. Finished with nothing to draw too, so that the
+    // picture's copy is learned apart from that work.
+    if (budget_) glFinish();
+    const bool deferred = work && budget_ && !budget_->fits(nextPieceMs(), reserveMs());
     pictureDeferred_ = deferred;
     if (!deferred && dirtyPicture_)
         render();
     else if (!deferred && picturePending_)
         renderMore();
     const PixelRect v = area(fbWidth, fbHeight);
+    const double showStart = budget_ ? budget_->spentMs() : 0.0;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
     glBlitFramebuffer(0, 0, fboW_, fboH_, v.x0, fbHeight - v.y1, v.x1, fbHeight - v.y0,
                       GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    if (budget_) {
+        glFinish();  // timed: the copy is done
+        showCost_.record(1, budget_->spentMs() - showStart);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
 }
+
+double Inspector::reserveMs() const { return budgetReserveMs_ + showCost_.estimateMs(1); }
 
 void Inspector::panel(bool* open) {
     if (!ImGui::Begin("Inspector", open)) {

@@ -103,13 +103,17 @@ class Inspector {
     void drawInParts(size_t lines, double ms);
     /// Share a frame's budget from now on (null: none): draw() starts each piece of the
     /// picture (a band of its surfaces' rows, a part of its lines) only when the piece's
-    /// learned cost fits in the frame's budget less `reserveMs`, and leaves the rest to later
+    /// learned cost fits in the frame's budget less `reserveMs` and the learned cost of
+    /// copying the picture to the window after it, and leaves the rest to later
     /// draws; the picture on screen stays until then. The budget must outlive the inspector or
     /// be unset.
     void setFrameBudget(FrameBudget* budget, double reserveMs) {
         budget_ = budget;
         budgetReserveMs_ = reserveMs;
     }
+    /// The learned cost of the picture's copy to the window that each draw() makes while it is
+    /// shown (0 when hidden), in ms: the steps before it keep it back.
+    double showEstimateMs() const { return opt_.show ? showCost_.estimateMs(1) : 0.0; }
     /// The last draw() left the picture to be completed, or drawn again (the budget), by
     /// later draws.
     bool picturePending() const { return opt_.show && (picturePending_ || pictureDeferred_); }
@@ -204,6 +208,13 @@ class Inspector {
     /// GL (1-5 ms), also learned.
     StepCost startCost_{2.0};
     StepCost surfaceCopyCost_{3.0};
+    /// The picture's copy to the window, which draw() makes after its pieces in every frame
+    /// (4-5 ms of llvmpipe's time for balls4's inspector at 1280x720, 2026-12-07): learned,
+    /// and kept back beside the reserve, so that the last piece does not push it over the
+    /// frame's budget.
+    StepCost showCost_{5.0};
+    /// What a piece leaves of the frame's budget: the reserve given and the picture's copy.
+    double reserveMs() const;
     FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
     double budgetReserveMs_ = 0.0;
     bool pictureDeferred_ = false;  ///< the last draw() left the picture for the budget
