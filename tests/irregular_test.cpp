@@ -44,9 +44,9 @@ std::unique_ptr<Accelerator> buildIrregular(const Scene& scene,
 std::vector<Vec3> regionPoints(const IrregularSubdivision& s, size_t maxRegions, uint64_t seed) {
     std::mt19937_64 rng(seed);
     std::vector<Vec3> pts;
-    const auto& regions = s.regions();
-    for (size_t k = 0; k < maxRegions && !regions.empty(); ++k) {
-        const Box3& b = regions[rng() % regions.size()].box;
+    const size_t regions = s.regions().size();
+    for (size_t k = 0; k < maxRegions && regions > 0; ++k) {
+        const Box3 b = s.regionBox(uint32_t(rng() % regions));
         for (int i = 0; i < 27; i += 2) {  // corners, edge midpoints, face centres, centre
             Vec3 c;
             for (int a = 0, j = i; a < 3; ++a, j /= 3)
@@ -229,7 +229,7 @@ TEST(Irregular, WalkReachesTheRegionHoldingAPoint) {
             pts.push_back(B.lo + Vec3(u(rng), u(rng), u(rng)) * B.extent());
         // Corners, edge midpoints and face centres of regions, exactly (camera coordinates).
         for (int i = 0; i < 200; ++i) {
-            const Box3& b = R[rng() % R.size()].box;
+            const Box3 b = s.regionBox(uint32_t(rng() % R.size()));
             Vec3 c;
             for (int a = 0; a < 3; ++a) {
                 int k = int(rng() % 3);
@@ -240,7 +240,7 @@ TEST(Irregular, WalkReachesTheRegionHoldingAPoint) {
         for (Vec3 p : pts) {
             p = glm::clamp(p, B.lo, B.hi);  // corners mapped to the world and back may round out
             uint32_t from = uint32_t(rng() % R.size());
-            Vec3 d = p - R[from].box.center();
+            Vec3 d = p - s.regionBox(from).center();
             int64_t got = s.walkTo(from, p);
             ASSERT_GE(got, 0) << "walk error from region " << from << " to " << toString(p);
             std::vector<uint32_t> holding;
@@ -250,8 +250,8 @@ TEST(Irregular, WalkReachesTheRegionHoldingAPoint) {
             if (holding.size() == 1)
                 EXPECT_EQ(uint32_t(got), holding[0])
                     << "point " << toString(p) << " from " << from << " dir " << toString(d)
-                    << "\n  got " << R[got].box.toString() << "\n  want "
-                    << R[holding[0]].box.toString() << "\n  bounds " << B.toString();
+                    << "\n  got " << s.regionBox(uint32_t(got)).toString() << "\n  want "
+                    << s.regionBox(holding[0]).toString() << "\n  bounds " << B.toString();
             else
                 EXPECT_TRUE(s.holds(uint32_t(got), p, d)) << toString(p);
         }
@@ -260,15 +260,15 @@ TEST(Irregular, WalkReachesTheRegionHoldingAPoint) {
         for (uint32_t r = 0; r < R.size(); ++r) {
             for (int a = 0; a < 3; ++a) {
                 for (int high = 0; high < 2; ++high) {
-                    int32_t n = high ? R[r].hi[a] : R[r].lo[a];
-                    Vec3 c = high ? R[r].box.hi : R[r].box.lo;
+                    int32_t n = s.pointer(r, a, high);
+                    Vec3 c = high ? s.regionBox(r).hi : s.regionBox(r).lo;
                     bool border = high ? c[a] == B.hi[a] : c[a] == B.lo[a];
                     if (border) {
                         EXPECT_EQ(n, -1);
                         continue;
                     }
                     ASSERT_GE(n, 0) << "region " << r << " axis " << a;
-                    const Box3& nb = R[n].box;
+                    const Box3 nb = s.regionBox(uint32_t(n));
                     EXPECT_TRUE(nb.contains(c))
                         << "pointer " << r << " -> " << n << " misses its corner";
                     EXPECT_EQ(high ? nb.lo[a] : nb.hi[a], c[a]) << "not across the face";
@@ -294,7 +294,7 @@ TEST(Irregular, RegionsTileTheBoundsAndListTheirPrimitives) {
     const Box3& B = s.bounds();
     double volume = 0.0;
     for (uint32_t r = 0; r < s.regions().size(); ++r) {
-        const Box3& b = s.regions()[r].box;
+        const Box3 b = s.regionBox(r);
         Vec3 e = b.extent();
         EXPECT_GT(e.x, 0.0);
         EXPECT_GT(e.y, 0.0);
@@ -328,6 +328,34 @@ TEST(Irregular, RegionsTileTheBoundsAndListTheirPrimitives) {
               s.regions().size() + s.projective().regionCount() + lightRegions);
     EXPECT_GT(s.projective().regionCount(), 0u);
     EXPECT_TRUE(accel->usesMailboxes());
+}
+
+// Issue 29's memory bar: on balls4 the irregular scheme (camera frame, the eye's and the
+// lights' projective structures) takes at most four times the regular scheme's memory. The
+// camera frame's regions keep their depth range and screen pointers alone (region.h): with the
+// full box and six pointers a region took 88 bytes and balls4 4.7 times the regular scheme's.
+TEST(Irregular, Balls4TakesAtMostFourTimesTheRegularSchemesMemory) {
+    Scene scene = loadScene(std::string(LANCER_SPD_DIR) + "/balls4.nff");
+    scene.width = scene.height = 128;
+    BuildParams p;  // each scheme's defaults, as `lancer render` builds it
+    p.scheme = SchemeKind::Irregular;
+    auto irregular = buildAccelerator(scene, p);
+    p.scheme = SchemeKind::Regular;
+    auto regular = buildAccelerator(scene, p);
+    const IrregularSubdivision& s = irregularOf(*irregular);
+    ASSERT_GT(s.regions().size(), 50'000u);
+    EXPECT_LE(irregular->info().memoryBytes, 4 * regular->info().memoryBytes)
+        << s.regions().size() << " camera-frame regions";
+    // Each region's box is its zone's rectangle times its depth range, and its depth pointers
+    // are the slabs beside it in its zone's column.
+    for (uint32_t z = 0; z < s.screen().zoneCount(); ++z) {
+        const uint32_t first = s.zoneFirstRegion()[z], last = s.zoneFirstRegion()[z + 1];
+        for (uint32_t r = first; r < last; ++r) {
+            EXPECT_EQ(s.regions()[r].zone, z);
+            EXPECT_EQ(s.pointer(r, 2, false), r > first ? int32_t(r - 1) : -1);
+            EXPECT_EQ(s.pointer(r, 2, true), r + 1 < last ? int32_t(r + 1) : -1);
+        }
+    }
 }
 
 /// What a screen BSP costs a ray through the screen rectangle by its own estimate: the

@@ -709,7 +709,7 @@ TEST(RayTree, RaysEnteringAtACameraFrameRegionCorner) {
             ctx.useMailboxes = accel->usesMailboxes();
             std::vector<Ray> all;
             for (uint32_t id = 0; id < s->regions().size(); ++id) {
-                const Box3& b = s->regions()[id].box;
+                const Box3 b = s->regionBox(id);
                 const Vec3 e = b.extent();
                 const bool sliver = std::min({e.x, e.y, e.z}) < 1e-6 * scale;
                 const std::array<Vec3, 8> c = view.regionCorners(id);
@@ -754,7 +754,7 @@ TEST(RayTree, RaysEnteringAtACameraFrameRegionCorner) {
                                 << ev.toString() << " " << ray.toString();
                             const walk::Region* g = ev.get<walk::Region>();
                             if (!g || !(g->t1 > g->t0)) continue;
-                            const Vec3 x = s->regions()[g->region].box.extent();
+                            const Vec3 x = s->regionBox(g->region).extent();
                             sliverStretches += std::min({x.x, x.y, x.z}) < 1e-6 * scale;
                         }
                         all.push_back(ray);

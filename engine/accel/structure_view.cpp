@@ -151,8 +151,8 @@ std::vector<SlabInfo> ZoneFrameView::slabs(uint32_t z) const {
     if (kind_ == ZoneFrameKind::Camera) {
         const std::vector<uint32_t>& first = s_->zoneFirstRegion();
         for (uint32_t r = first[z]; r < first[z + 1]; ++r) {
-            const Box3& b = s_->regions()[r].box;
-            out.push_back({r, b.lo.z, b.hi.z, s_->primitives(r)});
+            const IrregularRegion& R = s_->regions()[r];
+            out.push_back({r, R.zlo, R.zhi, s_->primitives(r)});
         }
     } else {
         const ProjectiveZones& pz = s_->projective();
@@ -393,15 +393,15 @@ RegionInfo StructureView::region(uint32_t id) const {
     if (id < base) {
         const IrregularRegion& R = s->regions()[id];
         r.kind = RegionKind::Slab;
-        r.frameBox = R.box;
+        r.frameBox = s->regionBox(uint32_t(id));
         r.zone = R.zone;
         r.slab = id - s->zoneFirstRegion()[R.zone];
         r.prims = s->primitives(id);
         r.pool = &s->treePool();
         r.root = R.root;
         for (int a = 0; a < 3; ++a) {
-            r.lo[a] = R.lo[a];
-            r.hi[a] = R.hi[a];
+            r.lo[a] = s->pointer(uint32_t(id), a, false);
+            r.hi[a] = s->pointer(uint32_t(id), a, true);
         }
         return r;
     }

@@ -12,7 +12,7 @@ uint32_t slabAt(const std::vector<IrregularRegion>& regions,
     // The first slab whose top is above z (s > 0) or at or above z (s <= 0).
     auto it = std::partition_point(
         regions.begin() + first, regions.begin() + last,
-        [&](const IrregularRegion& r) { return s > 0 ? r.box.hi.z <= z : r.box.hi.z < z; });
+        [&](const IrregularRegion& r) { return s > 0 ? r.zhi <= z : r.zhi < z; });
     uint32_t i = uint32_t(it - regions.begin());
     return std::min(i, last - 1);
 }
@@ -35,19 +35,16 @@ void linkCorners(const ScreenBsp& bsp, const Box3& bounds, DepthSlabs& slabs,
             // High corner: just below its zhi in the neighbour; low corner: just above its zlo.
             r.hi[0] = hx < 0 ? -1
                              : int32_t(slabAt(slabs.regions, slabs.zoneFirstRegion, uint32_t(hx),
-                                              r.box.hi.z, -1));
+                                              r.zhi, -1));
             r.hi[1] = hy < 0 ? -1
                              : int32_t(slabAt(slabs.regions, slabs.zoneFirstRegion, uint32_t(hy),
-                                              r.box.hi.z, -1));
+                                              r.zhi, -1));
             r.lo[0] = lx < 0 ? -1
                              : int32_t(slabAt(slabs.regions, slabs.zoneFirstRegion, uint32_t(lx),
-                                              r.box.lo.z, +1));
+                                              r.zlo, +1));
             r.lo[1] = ly < 0 ? -1
                              : int32_t(slabAt(slabs.regions, slabs.zoneFirstRegion, uint32_t(ly),
-                                              r.box.lo.z, +1));
-            // Along depth the neighbour is the next slab of the same zone: same footprint.
-            r.lo[2] = i > first ? int32_t(i - 1) : -1;
-            r.hi[2] = i + 1 < last ? int32_t(i + 1) : -1;
+                                              r.zlo, +1));
         }
     }
 }

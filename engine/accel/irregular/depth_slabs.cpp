@@ -105,8 +105,8 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
         if (guard) guard->poll("depth slabs", now, out.regions.size());
         IrregularRegion r;
         r.zone = z;
-        r.box.lo = Vec3(bsp.zoneLo[z], zlo);
-        r.box.hi = Vec3(bsp.zoneHi[z], zhi);
+        r.zlo = zlo;
+        r.zhi = zhi;
         if (first == last) {  // an empty zone: one empty region through the whole depth
             ++out.emptyZones;
             out.regions.push_back(r);
@@ -178,8 +178,8 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
             // A zone of a thousand boxes makes two thousand slabs, each restricted and shared
             // (balls:5: half a second): a cancellation must not wait for the zone's end.
             if (guard && (i & 63) == 63) guard->poll();
-            r.box.lo.z = cuts[i];
-            r.box.hi.z = cuts[i + 1];
+            r.zlo = cuts[i];
+            r.zhi = cuts[i + 1];
             inSlab.assign(slabPrims.begin() + slabFirst[i], slabPrims.begin() + slabFirst[i + 1]);
             if (inSlab.empty()) ++out.emptySlabs;
             share(inSlab, r);

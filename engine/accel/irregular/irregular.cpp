@@ -446,14 +446,16 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
 
 double IrregularSubdivision::exitOf(const IrregularRegion& r, const Ray& rc, double t, int& axis,
                                     int& ties, Vec3& p) const {
+    // The box from the zone's rectangle and the region's depth range (region.h).
+    const Vec3 lo(bsp_.zoneLo[r.zone], r.zlo), hi(bsp_.zoneHi[r.zone], r.zhi);
     double ta[3];
     double te = kInf;
     axis = 0;
     for (int a = 0; a < 3; ++a) {
         if (rc.d[a] > 0.0)
-            ta[a] = (r.box.hi[a] - rc.o[a]) / rc.d[a];
+            ta[a] = (hi[a] - rc.o[a]) / rc.d[a];
         else if (rc.d[a] < 0.0)
-            ta[a] = (r.box.lo[a] - rc.o[a]) / rc.d[a];
+            ta[a] = (lo[a] - rc.o[a]) / rc.d[a];
         else
             ta[a] = kInf;
         if (ta[a] < te) {
@@ -466,9 +468,9 @@ double IrregularSubdivision::exitOf(const IrregularRegion& r, const Ray& rc, dou
     for (int a = 0; a < 3; ++a) {
         if (ta[a] == te) ties |= 1 << a;
         if (ta[a] == te)
-            p[a] = rc.d[a] > 0.0 ? r.box.hi[a] : r.box.lo[a];
+            p[a] = rc.d[a] > 0.0 ? hi[a] : lo[a];
         else
-            p[a] = std::clamp(rc.o[a] + tc * rc.d[a], r.box.lo[a], r.box.hi[a]);
+            p[a] = std::clamp(rc.o[a] + tc * rc.d[a], lo[a], hi[a]);
     }
     return tc;
 }
@@ -479,7 +481,8 @@ uint32_t IrregularSubdivision::locate(const Vec3& p, const Vec3& d) const {
 }
 
 int64_t IrregularSubdivision::walkTo(uint32_t from, const Vec3& p) const {
-    Ray rc{regions_[from].box.center(), p - regions_[from].box.center()};
+    const Vec3 c = regionBox(from).center();
+    Ray rc{c, p - c};
     uint32_t r = from;
     double t = 0.0;
     size_t budget = budget_;

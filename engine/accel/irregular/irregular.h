@@ -105,6 +105,20 @@ class IrregularSubdivision {
         uint32_t l = regions_[region].list;
         return {listPrims_.data() + listFirst_[l], listPrims_.data() + listFirst_[l + 1]};
     }
+    /// Region r's box in the camera frame: its zone's rectangle times its depth range.
+    Box3 regionBox(uint32_t r) const {
+        const IrregularRegion& R = regions_[r];
+        return {Vec3(bsp_.zoneLo[R.zone], R.zlo), Vec3(bsp_.zoneHi[R.zone], R.zhi)};
+    }
+    /// Region r's corner pointer across its face on axis a, at its high corner (`high`) or its
+    /// low one (region.h): stored on the screen axes, the next or previous slab of its zone in
+    /// depth; -1 where that face is the structure's border.
+    int32_t pointer(uint32_t r, int a, bool high) const {
+        const IrregularRegion& R = regions_[r];
+        if (a < 2) return high ? R.hi[a] : R.lo[a];
+        if (high) return R.zhi < bounds_.hi.z ? int32_t(r + 1) : -1;
+        return R.zlo > bounds_.lo.z ? int32_t(r - 1) : -1;
+    }
     /// Does region r hold camera point p, on the side of direction d where p lies on a cut?
     bool holds(uint32_t r, const Vec3& p, const Vec3& d) const {
         for (int a = 0; a < 3; ++a)
@@ -136,14 +150,21 @@ class IrregularSubdivision {
         size_t pixels = 0;      ///< the image's: the cost stop's rays toward each light
         bool operator==(const LightKey&) const = default;
     };
+    /// Region R's low and high bounds on axis a: its zone's on the screen axes, its own in depth.
+    double lowOf(const IrregularRegion& R, int a) const {
+        return a < 2 ? bsp_.zoneLo[R.zone][a] : R.zlo;
+    }
+    double highOf(const IrregularRegion& R, int a) const {
+        return a < 2 ? bsp_.zoneHi[R.zone][a] : R.zhi;
+    }
     /// p is below region r on axis a (or on its low face, going down).
     bool below(uint32_t r, int a, const Vec3& p, const Vec3& d) const {
-        const Box3& b = regions_[r].box;
-        return p[a] < b.lo[a] || (p[a] == b.lo[a] && d[a] < 0.0 && b.lo[a] > bounds_.lo[a]);
+        const double lo = lowOf(regions_[r], a);
+        return p[a] < lo || (p[a] == lo && d[a] < 0.0 && lo > bounds_.lo[a]);
     }
     bool above(uint32_t r, int a, const Vec3& p, const Vec3& d) const {
-        const Box3& b = regions_[r].box;
-        return p[a] > b.hi[a] || (p[a] == b.hi[a] && d[a] > 0.0 && b.hi[a] < bounds_.hi[a]);
+        const double hi = highOf(regions_[r], a);
+        return p[a] > hi || (p[a] == hi && d[a] > 0.0 && hi < bounds_.hi[a]);
     }
     /// Where the ray leaves region r after t: the exit parameter, the axis crossed (the first
     /// of the tied ones), the tied axes (a bit mask), and the exit point, exactly on every tied
@@ -152,7 +173,7 @@ class IrregularSubdivision {
                   Vec3& p) const;
     /// The face of r that a ray going along d leaves through on axis a is the structure's border.
     bool onBorder(const IrregularRegion& r, int a, const Vec3& d) const {
-        return d[a] > 0.0 ? r.box.hi[a] == bounds_.hi[a] : r.box.lo[a] == bounds_.lo[a];
+        return d[a] > 0.0 ? highOf(r, a) == bounds_.hi[a] : lowOf(r, a) == bounds_.lo[a];
     }
     /// The region beyond region r's face on `axis` that holds p, by corner pointers.
     template <class Obs>
@@ -190,7 +211,7 @@ int64_t IrregularSubdivision::cross(uint32_t r, int axis, const Vec3& p, const V
         return true;
     };
     bool up = d[axis] > 0.0;
-    int32_t n = up ? regions_[r].hi[axis] : regions_[r].lo[axis];
+    int32_t n = pointer(r, axis, up);
     if (!follow(r, n, up ? kHighCorner : kLowCorner)) return -1;
     if (axis < 2) {
         // Along the face: down from the high corner's neighbour, up from the low corner's.
@@ -211,12 +232,12 @@ int64_t IrregularSubdivision::cross(uint32_t r, int axis, const Vec3& p, const V
     }
     // In depth, inside the zone's column: its slabs share its footprint, so both ways are open.
     while (below(uint32_t(n), 2, p, d)) {
-        int32_t m = regions_[n].lo[2];
+        int32_t m = pointer(uint32_t(n), 2, false);
         if (!follow(uint32_t(n), m, kLowCorner)) return -1;
         n = m;
     }
     while (above(uint32_t(n), 2, p, d)) {
-        int32_t m = regions_[n].hi[2];
+        int32_t m = pointer(uint32_t(n), 2, true);
         if (!follow(uint32_t(n), m, kHighCorner)) return -1;
         n = m;
     }

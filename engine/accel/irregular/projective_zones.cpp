@@ -145,7 +145,7 @@ ProjectiveZones ProjectiveZones::buildCentred(const Scene& scene, const CameraFr
     s.slabList_.reserve(slabs.regions.size());
     if (sp.guard) sp.guard->poll();
     for (const IrregularRegion& r : slabs.regions) {
-        s.slabLo_.push_back(r.box.lo.z);
+        s.slabLo_.push_back(r.zlo);
         s.slabRoot_.push_back(r.root);
         s.slabList_.push_back(r.list);
     }
