@@ -446,8 +446,8 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
 
 double IrregularSubdivision::exitOf(const IrregularRegion& r, const Ray& rc, double t, int& axis,
                                     int& ties, Vec3& p) const {
-    // The box from the zone's rectangle and the region's depth range (region.h).
-    const Vec3 lo(bsp_.zoneLo[r.zone], r.zlo), hi(bsp_.zoneHi[r.zone], r.zhi);
+    const Box3 box = boxOf(r);
+    const Vec3 &lo = box.lo, &hi = box.hi;
     double ta[3];
     double te = kInf;
     axis = 0;

@@ -106,10 +106,7 @@ class IrregularSubdivision {
         return {listPrims_.data() + listFirst_[l], listPrims_.data() + listFirst_[l + 1]};
     }
     /// Region r's box in the camera frame: its zone's rectangle times its depth range.
-    Box3 regionBox(uint32_t r) const {
-        const IrregularRegion& R = regions_[r];
-        return {Vec3(bsp_.zoneLo[R.zone], R.zlo), Vec3(bsp_.zoneHi[R.zone], R.zhi)};
-    }
+    Box3 regionBox(uint32_t r) const { return boxOf(regions_[r]); }
     /// Region r's corner pointer across its face on axis a, at its high corner (`high`) or its
     /// low one (region.h): stored on the screen axes, the next or previous slab of its zone in
     /// depth; -1 where that face is the structure's border.
@@ -150,6 +147,10 @@ class IrregularSubdivision {
         size_t pixels = 0;      ///< the image's: the cost stop's rays toward each light
         bool operator==(const LightKey&) const = default;
     };
+    /// Region R's box: its zone's rectangle times its depth range (region.h).
+    Box3 boxOf(const IrregularRegion& R) const {
+        return {Vec3(bsp_.zoneLo[R.zone], R.zlo), Vec3(bsp_.zoneHi[R.zone], R.zhi)};
+    }
     /// Region R's low and high bounds on axis a: its zone's on the screen axes, its own in depth.
     double lowOf(const IrregularRegion& R, int a) const {
         return a < 2 ? bsp_.zoneLo[R.zone][a] : R.zlo;

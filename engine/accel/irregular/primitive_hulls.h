@@ -72,14 +72,17 @@ class PrimitiveHulls {
         Vec3 lo, hi;
     };
     struct Hull {
+        /// The box along its own axes, and the world box; when `single`, `world` holds the
+        /// hull's one box: the world box, or its own box where that lies within the world box
+        /// (make).
         Solid turned, world;
-        bool single = false;  ///< no box of its own axes: the world box alone (`turned` unset)
+        bool single = false;  ///< one box: `world` alone (`turned` unused)
         /// `single`, in a frame whose axes are the world's (a light's, lightFrame): the world box
         /// is `box` there, and its outline and depths over a column come in closed form
         /// (alignedDepth) instead of by clipping its faces.
         bool aligned = false;
         Box3 box;
-        /// The turned box's outline (the world box's when `single`), a convex polygon
+        /// The turned box's outline (`world`'s when `single`), a convex polygon
         /// counterclockwise, along each column (`FromEye`: none when a corner is not in front
         /// of the eye), and its bounding rectangle.
         std::array<glm::dvec2, 8> outline[2];
@@ -101,7 +104,7 @@ class PrimitiveHulls {
     static glm::dvec2 alignedDepth(const Box3& b, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi,
                                    double zNear);
 
-    /// depthIn for a `single` hull (its world box `b`), from its corners' distances to the
+    /// depthIn for a `single` hull (its one box `b`), from its corners' distances to the
     /// column's planes (`dist`, the fifth z = zNear from the eye) and which planes cut it.
     static glm::dvec2 singleBoxDepth(const Solid& b, ZoneColumn column, glm::dvec2 lo,
                                      glm::dvec2 hi, double zNear, const double (&dist)[5][8],
