@@ -437,6 +437,40 @@ TEST(Irregular, ScreenBspStoppedByItsBudgetSpendsItEvenly) {
     EXPECT_NEAR(area, (hi.x - lo.x) * (hi.y - lo.y), 1e-9 * (hi.x - lo.x) * (hi.y - lo.y));
 }
 
+/// A scene's camera-frame rectangles, hulls and stop shares for the screen BSP, and a walk model
+/// of the build's charges with `rays` rays over the rectangle.
+struct BspInputs {
+    Scene scene;
+    std::vector<uint32_t> live;
+    PrimitiveHulls hulls;
+    std::vector<Box3> rect;
+    glm::dvec2 lo, hi;
+    std::vector<float> stops;
+    ZoneWalkModel walk;
+};
+
+BspInputs bspInputs(const char* name, double rays) {
+    BspInputs in{loadScene(name), {}, {}, {}, {}, {}, {}, {}};
+    const Scene& scene = in.scene;
+    const FrameChoice turned = chooseGridFrame(scene);
+    const CameraFrame frame = CameraFrame::of(scene.camera);
+    in.live = scene.livePrimitives();
+    in.hulls = PrimitiveHulls::make(scene, frame, turned, in.live, 1e-9 * scene.scale());
+    in.rect.resize(scene.prims.size());
+    for (uint32_t p : in.live) in.rect[p] = frame.box(scene.minBox[p]);
+    const Box3 cam = frame.box(scene.bounds);
+    in.lo = glm::dvec2(cam.lo);
+    in.hi = glm::dvec2(cam.hi);
+    in.stops = stopShares(scene, frame);
+    in.walk.visit = in.walk.test = 250.0;
+    in.walk.level = 12.0;
+    in.walk.fill = 0.5;
+    in.walk.zone = 500.0;
+    in.walk.ref = 1000.0;
+    in.walk.raysPerArea = rays / ((in.hi.x - in.lo.x) * (in.hi.y - in.lo.y));
+    return in;
+}
+
 // A waiting cell keeps, in its references' top bits, the sides of its split that the cost
 // estimate found each primitive on, and the split sorts them by those bits: every zone lists
 // exactly the primitives whose rectangle's interior and hull outline meet it, in the order of
@@ -445,33 +479,19 @@ TEST(Irregular, ScreenBspStoppedByItsBudgetSpendsItEvenly) {
 TEST(Irregular, ScreenBspZonesListWhatMeetsThemAfterTheSplitsSideBits) {
     size_t zones = 0, stopped = 0;
     for (const char* name : {"builtin:sponge:2", "builtin:balls:3"}) {
-        Scene scene = loadScene(name);
-        const FrameChoice turned = chooseGridFrame(scene);
-        const CameraFrame frame = CameraFrame::of(scene.camera);
-        const std::vector<uint32_t> live = scene.livePrimitives();
-        const double pad = 1e-9 * scene.scale();
-        const PrimitiveHulls hulls = PrimitiveHulls::make(scene, frame, turned, live, pad);
-        std::vector<Box3> rect(scene.prims.size());
-        for (uint32_t p : live) rect[p] = frame.box(scene.minBox[p]);
-        const Box3 cam = frame.box(scene.bounds);
-        const glm::dvec2 lo(cam.lo), hi(cam.hi);
-        const std::vector<float> stops = stopShares(scene, frame);
-        ZoneWalkModel walk;
-        walk.visit = walk.test = 250.0;
-        walk.level = 12.0;
-        walk.fill = 0.5;
-        walk.zone = 500.0;
-        walk.ref = 1000.0;
-        walk.raysPerArea = 4096.0 / ((hi.x - lo.x) * (hi.y - lo.y));
+        const BspInputs in = bspInputs(name, 4096.0);
+        const std::vector<uint32_t>& live = in.live;
+        const std::vector<Box3>& rect = in.rect;
+        const glm::dvec2 lo = in.lo, hi = in.hi;
         size_t freeBytes = 0;  // what the unbounded build's zones cost
         for (int mode = 0; mode < 3; ++mode) {
             ScreenBspParams p = countModelParams(1);
-            p.hulls = &hulls;
+            p.hulls = &in.hulls;
             p.column = ZoneColumn::Parallel;
             if (mode == 1) p.maxBytes = freeBytes / 5;
             if (mode == 2) {
-                p.walk = &walk;
-                p.stops = &stops;
+                p.walk = &in.walk;
+                p.stops = &in.stops;
             }
             const ScreenBsp bsp = ScreenBsp::build(rect, live, lo, hi, p);
             if (mode == 0)
@@ -484,7 +504,7 @@ TEST(Irregular, ScreenBspZonesListWhatMeetsThemAfterTheSplitsSideBits) {
                 for (uint32_t q : live) {
                     const Box3& r = rect[q];
                     if (r.lo.x < zh.x && zl.x < r.hi.x && r.lo.y < zh.y && zl.y < r.hi.y &&
-                        hulls.touches(q, ZoneColumn::Parallel, zl, zh))
+                        in.hulls.touches(q, ZoneColumn::Parallel, zl, zh))
                         want.push_back(q);
                 }
                 const std::vector<uint32_t> got(bsp.zonePrims.begin() + bsp.zoneFirst[z],
@@ -495,6 +515,69 @@ TEST(Irregular, ScreenBspZonesListWhatMeetsThemAfterTheSplitsSideBits) {
     }
     EXPECT_GT(zones, 300u);
     EXPECT_EQ(stopped, 2u);  // the byte limit stopped each scene's second build
+}
+
+// Cells keep their segments presorted from cell to cell (by axis and line, and by each end
+// along the other axis), each split filtering its orders into its children's, the cut pieces'
+// new ends moved to the end of the lower piece's order and the start of the upper one's. At
+// every presorted cell the orders read what a fresh sort of the cell's segments gives
+// (checkOrders throws otherwise), and the BSP is the one built sorting every cell: the same
+// lines, zones, lists and counts, with the count model and the walk model, both heuristics that
+// score lines, without a byte limit, with one that leaves the orders out of some cells (an
+// eighth of it for them), and with one that stops the BSP.
+TEST(Irregular, ScreenBspPresortedSegmentsSplitAsAFreshSortAndBuildTheSameBsp) {
+    size_t checked = 0;
+    for (const char* name : {"builtin:balls:3", "builtin:sponge:2", "builtin:drilled:3"}) {
+        const BspInputs in = bspInputs(name, 65536.0);
+        const std::vector<uint32_t>& live = in.live;
+        const std::vector<Box3>& rect = in.rect;
+        const glm::dvec2 lo = in.lo, hi = in.hi;
+        size_t freeBytes = 0;  // what the walk model's unbounded zones cost
+        for (int mode = 0; mode < 6; ++mode) {
+            ScreenBspParams p = countModelParams(mode == 1 ? 0 : 4);
+            if (mode == 2) p.heuristic = BspHeuristic::FewestCuts;
+            if (mode >= 3) {
+                p.hulls = &in.hulls;
+                p.column = ZoneColumn::Parallel;
+                p.walk = &in.walk;
+                p.stops = &in.stops;
+                p.stopObjects = 1;
+            }
+            // The unbounded BSP's bytes (the orders then fit in an eighth of them only while
+            // the cells waiting are few), then a fifth of them, which stops it.
+            if (mode == 4) p.maxBytes = freeBytes;
+            if (mode == 5) p.maxBytes = freeBytes / 5;
+            p.presorted = false;
+            const ScreenBsp want = ScreenBsp::build(rect, live, lo, hi, p);
+            p.presorted = true;
+            p.checkOrders = true;
+            const ScreenBsp got = ScreenBsp::build(rect, live, lo, hi, p);
+            const std::string what = std::string(name) + " mode " + std::to_string(mode);
+            if (mode == 3)
+                freeBytes = got.zoneCount() * p.zoneBytes + got.zonePrims.size() * p.refBytes;
+            ASSERT_EQ(got.nodes.size(), want.nodes.size()) << what;
+            for (size_t n = 0; n < got.nodes.size(); ++n) {
+                ASSERT_EQ(got.nodes[n].axis, want.nodes[n].axis) << what << " node " << n;
+                ASSERT_EQ(got.nodes[n].value, want.nodes[n].value) << what << " node " << n;
+                ASSERT_EQ(got.nodes[n].child[0], want.nodes[n].child[0]) << what << " node " << n;
+                ASSERT_EQ(got.nodes[n].child[1], want.nodes[n].child[1]) << what << " node " << n;
+            }
+            EXPECT_EQ(got.root, want.root) << what;
+            EXPECT_EQ(got.zoneLo, want.zoneLo) << what;
+            EXPECT_EQ(got.zoneHi, want.zoneHi) << what;
+            EXPECT_EQ(got.zoneFirst, want.zoneFirst) << what;
+            EXPECT_EQ(got.zonePrims, want.zonePrims) << what;
+            EXPECT_EQ(got.cuts, want.cuts) << what;
+            EXPECT_EQ(got.costStops, want.costStops) << what;
+            EXPECT_EQ(got.limitStops, want.limitStops) << what;
+            EXPECT_EQ(got.stopped, want.stopped) << what;
+            if (mode != 4) {
+                EXPECT_EQ(got.stopped, mode == 5) << what;
+            }
+            checked += got.nodes.size();
+        }
+    }
+    EXPECT_GT(checked, 1000u);
 }
 
 // The walk reported to the observer: regions in ray order with contiguous intervals, the

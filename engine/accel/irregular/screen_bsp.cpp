@@ -1,6 +1,7 @@
 #include "engine/accel/irregular/screen_bsp.h"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <span>
 #include <stdexcept>
@@ -27,6 +28,34 @@ struct Split {
     double c;
 };
 
+/// A cell's segments kept in the orders its split choice reads, so that no cell sorts them
+/// (docs/irregular.md, "Build speed"): the cell's `segs` holds the segments of axis 0 then
+/// those of axis 1, each run by increasing c, and lo(a) (hi(a)) the indices in `segs` of the
+/// segments of axis 1 - a by increasing lo (hi), their extent along a. A split keeps every
+/// order by filtering it, the cut pieces' new ends (the line's c) going to the end of the lower
+/// piece's hi order and the start of the upper piece's lo order (splitOrders). Empty: not
+/// presorted.
+struct SegmentOrders {
+    /// lo(0), hi(0), lo(1), hi(1), in one allocation.
+    std::vector<uint32_t> index;
+    uint32_t n0 = 0, n1 = 0;  ///< the cell's segments of axis 0, of axis 1
+
+    bool empty() const { return index.empty(); }
+    size_t bytes() const { return index.capacity() * sizeof(uint32_t); }
+    /// The segments an order along a holds: those of the other axis.
+    size_t along(int a) const { return a == 0 ? n1 : n0; }
+    const uint32_t* lo(int a) const { return index.data() + (a == 0 ? 0 : 2 * size_t(n1)); }
+    const uint32_t* hi(int a) const { return lo(a) + along(a); }
+    uint32_t* lo(int a) { return index.data() + (a == 0 ? 0 : 2 * size_t(n1)); }
+    uint32_t* hi(int a) { return lo(a) + along(a); }
+    /// Sized for n0 and n1 segments, the orders to be written.
+    void resize(uint32_t axis0, uint32_t axis1) {
+        n0 = axis0;
+        n1 = axis1;
+        index.resize(2 * (size_t(n0) + n1));
+    }
+};
+
 /// A cell still to be split: its rectangle, the segments strictly inside it and the primitives
 /// whose rectangle touches it, and once it waits, the line it is to be split on.
 struct Cell {
@@ -41,6 +70,8 @@ struct Cell {
     /// The walk's cost of a ray through the cell (walkCost; < 0: not known yet), and of its
     /// split's children.
     double walk = -1.0, walkBelow = 0.0, walkAbove = 0.0;
+    /// Empty, or `segs` is presorted (SegmentOrders) and these are its orders.
+    SegmentOrders orders{};
 };
 
 /// A cell waiting in the best-first queue: the larger gain first, then the older cell.
@@ -106,16 +137,64 @@ struct SplitScratch {
     std::vector<uint64_t> key, tmp;
 };
 
+/// Scores the lines of axis a, line(i) for i < lines in increasing order, against the ends
+/// along a of the segments of the other axis, lo(k) and hi(k) for k < others each in increasing
+/// order, and keeps the best in `best` (chooseSplit's costs; the first line wins a tie). Each
+/// count comes from a pointer that only moves forward: the end of the run of lines at c, the
+/// segments ending at or before c, those starting before c.
+template <class Line, class Lo, class Hi>
+void scoreLines(uint8_t a, size_t lines, Line line, size_t others, Lo lo, Hi hi, BspHeuristic h,
+                const BuildGuard* guard, Split& best, size_t& bestMain, size_t& bestTie) {
+    size_t next = 0, ending = 0, starting = 0;
+    for (size_t i = 0, polled = 0; i < lines; i = next) {
+        if (guard && (++polled & 8191) == 0) guard->poll();
+        const double c = line(i);
+        while (next < lines && line(next) == c) ++next;
+        while (ending < others && hi(ending) <= c) ++ending;
+        while (starting < others && lo(starting) < c) ++starting;
+        size_t below = i;
+        size_t above = lines - next;
+        size_t crossLow = ending;
+        size_t crossHigh = others - starting;
+        size_t cut = others - crossLow - crossHigh;
+        size_t larger = std::max(below + crossLow, above + crossHigh) + cut;
+        size_t mainCost = h == BspHeuristic::Balanced ? larger : cut;
+        size_t tieCost = h == BspHeuristic::Balanced ? cut : larger;
+        if (mainCost < bestMain || (mainCost == bestMain && tieCost < bestTie)) {
+            bestMain = mainCost;
+            bestTie = tieCost;
+            best = {a, c};
+        }
+    }
+}
+
 /// The line to split on. `first`: the first segment's line (the report's "on choisit un
 /// segment", read literally). `balanced`: the line that minimizes the larger side (segments on
 /// it plus the pieces cut), then the cuts. `fewest-cuts`: the line that cuts fewest segments,
-/// then the larger side. Each axis is scored in O(n log n) from sorted endpoints, a cell of
-/// 2 kSplitSample segments or more from a sample of them.
-Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h, const BuildGuard* guard,
-                  SplitScratch& scratch) {
+/// then the larger side. Each axis is scored from its endpoints in increasing order: a
+/// presorted cell's (`orders` not empty) read in O(n), the others' sorted in O(n log n), a cell
+/// of 2 kSplitSample segments or more from a sample of them. The scores depend on the sorted
+/// values alone, so both give the same line.
+Split chooseSplit(const std::vector<Segment>& segs, const SegmentOrders& orders, BspHeuristic h,
+                  const BuildGuard* guard, SplitScratch& scratch) {
     if (h == BspHeuristic::First) return {segs[0].axis, segs[0].c};
     Split best{segs[0].axis, segs[0].c};
     size_t bestMain = SIZE_MAX, bestTie = SIZE_MAX;
+    if (!orders.empty()) {
+        for (uint8_t a = 0; a < 2; ++a) {
+            // segs[0, n0) are the lines of axis 0 by c, segs[n0, ..) those of axis 1.
+            const Segment* line = segs.data() + (a == 0 ? 0 : orders.n0);
+            const size_t lines = a == 0 ? orders.n0 : orders.n1;
+            if (lines == 0) continue;
+            const uint32_t* lo = orders.lo(a);
+            const uint32_t* hi = orders.hi(a);
+            scoreLines(
+                a, lines, [&](size_t i) { return line[i].c; }, orders.along(a),
+                [&](size_t k) { return segs[lo[k]].lo; }, [&](size_t k) { return segs[hi[k]].hi; },
+                h, guard, best, bestMain, bestTie);
+        }
+        return best;
+    }
     auto& [lines, lo, hi, key, tmp] = scratch;
     // A cell of 2 kSplitSample segments or more is scored on every stride-th of them (between
     // kSplitSample and 2 kSplitSample of them): the line is then about as good (the counts are
@@ -143,32 +222,124 @@ Split chooseSplit(const std::vector<Segment>& segs, BspHeuristic h, const BuildG
         if (guard) guard->poll();
         sortValues(hi, key, tmp);
         if (guard) guard->poll();
-        // The lines in increasing order, each count by a pointer that only moves forward: the
-        // end of the run of lines at c, the segments ending at or before c, those starting
-        // before c.
-        size_t next = 0, ending = 0, starting = 0;
-        for (size_t i = 0, polled = 0; i < lines.size(); i = next) {
-            if (guard && (++polled & 8191) == 0) guard->poll();
-            const double c = lines[i];
-            while (next < lines.size() && lines[next] == c) ++next;
-            while (ending < hi.size() && hi[ending] <= c) ++ending;
-            while (starting < lo.size() && lo[starting] < c) ++starting;
-            size_t below = i;
-            size_t above = lines.size() - next;
-            size_t crossLow = ending;
-            size_t crossHigh = lo.size() - starting;
-            size_t cut = lo.size() - crossLow - crossHigh;
-            size_t larger = std::max(below + crossLow, above + crossHigh) + cut;
-            size_t mainCost = h == BspHeuristic::Balanced ? larger : cut;
-            size_t tieCost = h == BspHeuristic::Balanced ? cut : larger;
-            if (mainCost < bestMain || (mainCost == bestMain && tieCost < bestTie)) {
-                bestMain = mainCost;
-                bestTie = tieCost;
-                best = {a, c};
-            }
-        }
+        scoreLines(
+            a, lines.size(), [&](size_t i) { return lines[i]; }, lo.size(),
+            [&](size_t k) { return lo[k]; }, [&](size_t k) { return hi[k]; }, h, guard, best,
+            bestMain, bestTie);
     }
     return best;
+}
+
+/// Presorts a cell's segments in place (SegmentOrders): by axis, then c, and the orders of
+/// their ends along the other axis.
+void presort(std::vector<Segment>& segs, SegmentOrders& orders) {
+    std::sort(segs.begin(), segs.end(), [](const Segment& x, const Segment& y) {
+        return x.axis < y.axis || (x.axis == y.axis && x.c < y.c);
+    });
+    const uint32_t n0 =
+        uint32_t(std::partition_point(segs.begin(), segs.end(),
+                                      [](const Segment& x) { return x.axis == 0; }) -
+                 segs.begin());
+    orders.resize(n0, uint32_t(segs.size()) - n0);
+    for (uint8_t a = 0; a < 2; ++a) {
+        // Along a, the segments of the other axis: segs[n0, ..) for a = 0.
+        uint32_t* lo = orders.lo(a);
+        uint32_t* hi = orders.hi(a);
+        const uint32_t first = a == 0 ? n0 : 0;
+        for (uint32_t k = 0; k < orders.along(a); ++k) lo[k] = hi[k] = first + k;
+        std::sort(lo, lo + orders.along(a),
+                  [&](uint32_t x, uint32_t y) { return segs[x].lo < segs[y].lo; });
+        std::sort(hi, hi + orders.along(a),
+                  [&](uint32_t x, uint32_t y) { return segs[x].hi < segs[y].hi; });
+    }
+}
+
+/// Throws std::logic_error unless `orders` are those of the presorted `segs` (SegmentOrders):
+/// the segments by axis then c, and each order every segment of its axis once, by its end,
+/// so that it reads the values a fresh sort gives (ScreenBspParams::checkOrders).
+void checkOrders(const std::vector<Segment>& segs, const SegmentOrders& orders) {
+    auto fail = [](const char* what) {
+        throw std::logic_error(std::string("screen BSP: presorted segments: ") + what);
+    };
+    for (size_t i = 1; i < segs.size(); ++i)
+        if (segs[i].axis < segs[i - 1].axis ||
+            (segs[i].axis == segs[i - 1].axis && segs[i].c < segs[i - 1].c))
+            fail("segments not by axis then line");
+    if (size_t(orders.n0) + orders.n1 != segs.size() || orders.index.size() != 2 * segs.size() ||
+        (orders.n0 > 0 && segs[orders.n0 - 1].axis != 0) ||
+        (orders.n0 < segs.size() && segs[orders.n0].axis != 1))
+        fail("counts differ from the segments'");
+    for (uint8_t a = 0; a < 2; ++a) {
+        for (int k = 0; k < 2; ++k) {
+            const uint32_t* order = k == 0 ? orders.lo(a) : orders.hi(a);
+            std::vector<double> fresh, read;
+            for (const Segment& x : segs)
+                if (x.axis != a) fresh.push_back(k == 0 ? x.lo : x.hi);
+            std::sort(fresh.begin(), fresh.end());
+            std::vector<uint8_t> seen(segs.size(), 0);
+            for (size_t j = 0; j < orders.along(a); ++j) {
+                const uint32_t i = order[j];
+                if (i >= segs.size() || segs[i].axis == a || seen[i]++) fail("not a permutation");
+                read.push_back(k == 0 ? segs[i].lo : segs[i].hi);
+            }
+            if (read != fresh) fail("an order differs from a fresh sort");
+        }
+    }
+}
+
+/// The orders of a presorted cell's child on `side` (0 below the line `sp`, 1 above): the
+/// child's segments `child` are the parent's in its order, `cuts` of them cut in two by the
+/// line, segment i at index at[i] of the child where it goes there.
+void splitOrders(const std::vector<Segment>& segs, const SegmentOrders& orders, Split sp, int side,
+                 const std::vector<uint32_t>& at, size_t cuts, const std::vector<Segment>& child,
+                 SegmentOrders& out) {
+    const uint8_t a = sp.axis, b = uint8_t(1 - a);
+    const double c = sp.c;
+    const uint32_t n0 =
+        uint32_t(std::partition_point(child.begin(), child.end(),
+                                      [](const Segment& x) { return x.axis == 0; }) -
+                 child.begin());
+    out.resize(n0, uint32_t(child.size()) - n0);
+    // Along a, the segments of axis b: the lower child takes those starting before c (the cut
+    // ones now ending at c, after every other end), the upper one those ending after c (the
+    // cut ones now starting at c, before every other start).
+    const uint32_t* lo = orders.lo(a);
+    const uint32_t* hi = orders.hi(a);
+    const size_t n = orders.along(a), m = out.along(a);
+    uint32_t* toLo = out.lo(a);
+    uint32_t* toHi = out.hi(a);
+    if (side == 0) {
+        for (size_t k = 0; k < m; ++k) toLo[k] = at[lo[k]];  // the first m start before c
+        uint32_t* whole = toHi;
+        uint32_t* cut = toHi + (m - cuts);
+        for (size_t k = 0; k < n; ++k) {
+            const Segment& x = segs[hi[k]];
+            if (x.hi <= c)
+                *whole++ = at[hi[k]];
+            else if (x.lo < c)
+                *cut++ = at[hi[k]];
+        }
+    } else {
+        uint32_t* cut = toLo;
+        uint32_t* whole = toLo + cuts;
+        for (size_t k = 0; k < n; ++k) {
+            const Segment& x = segs[lo[k]];
+            if (x.lo >= c)
+                *whole++ = at[lo[k]];
+            else if (x.hi > c)
+                *cut++ = at[lo[k]];
+        }
+        for (size_t k = n - m; k < n; ++k) toHi[k - (n - m)] = at[hi[k]];  // the last m end after c
+    }
+    // Along b, the lines of axis a: each child takes those on its side, the line's own used up.
+    for (int k = 0; k < 2; ++k) {
+        const uint32_t* from = k == 0 ? orders.lo(b) : orders.hi(b);
+        uint32_t* to = k == 0 ? out.lo(b) : out.hi(b);
+        for (size_t j = 0; j < orders.along(b); ++j) {
+            const double x = segs[from[j]].c;
+            if (side == 0 ? x < c : x > c) *to++ = at[from[j]];
+        }
+    }
 }
 
 /// Cells of at most this many primitives take their depth ranges from the hulls (walkCost).
@@ -339,6 +510,25 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
     uint64_t order = 0;
     SplitScratch scratch;
     std::vector<uint32_t> listBelow, listAbove;  // a cell's children's lists, for the walk model
+    // Presorted cells (SegmentOrders): where each segment of the cell being split goes in its
+    // children, and the bytes of the waiting cells' orders. The orders take 8 bytes a segment
+    // and are kept while they take at most an eighth of the byte limit beside it (uncharged, as
+    // the sorts' scratch they replace was, so the limit stops the BSP where it did); past it, or
+    // for a cell sampled (2 kSplitSample segments or more) or split on its first segment, the
+    // cell sorts its endpoints.
+    std::vector<uint32_t> atBelow, atAbove;
+    size_t orderBytes = 0;
+    auto presortable = [&](const std::vector<Segment>& segs) {
+        return params.presorted && params.heuristic != BspHeuristic::First &&
+               segs.size() < 2 * kSplitSample &&
+               (!params.maxBytes ||
+                orderBytes + 2 * segs.size() * sizeof(uint32_t) <= params.maxBytes / 8);
+    };
+    // A cell that add() makes a zone at once: nothing splits it, or few enough primitives.
+    auto settled = [&](const Cell& c) {
+        return c.segs.empty() ||
+               (params.stopObjects > 0 && c.prims.size() <= size_t(params.stopObjects));
+    };
     std::vector<DepthEvent> events;
     // Which child of each node was split first in depth-first order (the one with fewer
     // segments, the upper one on a tie): the final numbering follows it (see below).
@@ -382,8 +572,7 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
     // split and the split's gain.
     auto add = [&](Cell&& cell) {
         bsp.depth = std::max(bsp.depth, cell.depth);
-        if (cell.segs.empty() ||
-            (params.stopObjects > 0 && cell.prims.size() <= size_t(params.stopObjects))) {
+        if (settled(cell)) {
             // At most max-objects rectangles (an empty cell holds at most any), else no edge
             // crosses the cell: it lies inside all its rectangles.
             ++(cell.prims.size() <= size_t(std::max(params.stopObjects, 0)) ? bsp.objectStops
@@ -391,7 +580,9 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
             makeZone(cell);
             return;
         }
-        cell.split = chooseSplit(cell.segs, params.heuristic, params.guard, scratch);
+        if (cell.orders.empty() && presortable(cell.segs)) presort(cell.segs, cell.orders);
+        if (params.checkOrders && !cell.orders.empty()) checkOrders(cell.segs, cell.orders);
+        cell.split = chooseSplit(cell.segs, cell.orders, params.heuristic, params.guard, scratch);
         glm::dvec2 bHi = cell.hi, aLo = cell.lo;
         bHi[cell.split.axis] = cell.split.c;
         aLo[cell.split.axis] = cell.split.c;
@@ -469,6 +660,7 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         }
         waiting += cellBytes(cell);
         waitingRefs += cell.prims.size();
+        orderBytes += cell.orders.bytes();
         cells[slot] = std::move(cell);
         queue.push_back({always ? kInf : gain, order++, slot});
         std::push_heap(queue.begin(), queue.end());
@@ -485,6 +677,7 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         freeSlots.push_back(slot);
         waiting -= cellBytes(cell);
         waitingRefs -= cell.prims.size();
+        orderBytes -= cell.orders.bytes();
         // Over a limit, the BSP stops: this cell and every one still waiting become zones.
         if ((params.maxZones && bsp.zoneLo.size() + queue.size() + 1 >= params.maxZones) ||
             (params.maxBytes && bytes + waiting >= params.maxBytes)) {
@@ -528,8 +721,21 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
             below.walk = cell.walkBelow;
             above.walk = cell.walkAbove;
         }
-        for (const Segment& s : cell.segs) {
+        // A presorted cell's children keep its order: where each segment goes is noted for
+        // their orders.
+        const bool sorted = !cell.orders.empty();
+        const size_t cutsBefore = bsp.cuts;
+        if (sorted) {
+            atBelow.resize(cell.segs.size());
+            atAbove.resize(cell.segs.size());
+        }
+        for (size_t i = 0; i < cell.segs.size(); ++i) {
             if (params.guard && (++polled & 32767) == 0) params.guard->poll();
+            const Segment& s = cell.segs[i];
+            if (sorted) {
+                atBelow[i] = uint32_t(below.segs.size());
+                atAbove[i] = uint32_t(above.segs.size());
+            }
             if (s.axis == sp.axis) {
                 if (s.c < sp.c)
                     below.segs.push_back(s);
@@ -543,6 +749,14 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
                 ++bsp.cuts;
                 below.segs.push_back({s.c, s.lo, sp.c, s.axis});
                 above.segs.push_back({s.c, sp.c, s.hi, s.axis});
+            }
+        }
+        if (sorted) {
+            for (Cell* child : {&below, &above}) {
+                if (settled(*child) || !presortable(child->segs)) continue;
+                const int side = child == &below ? 0 : 1;
+                splitOrders(cell.segs, cell.orders, sp, side, side == 0 ? atBelow : atAbove,
+                            bsp.cuts - cutsBefore, child->segs, child->orders);
             }
         }
         cell = Cell{};  // free the parent's lists

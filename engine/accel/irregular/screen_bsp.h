@@ -67,6 +67,13 @@ struct ScreenBspParams {
     /// Per primitive, the share of its rectangle where a ray ends on it, for the walk model
     /// (stopShares(); null: walk->fill for every one).
     const std::vector<float>* stops = nullptr;
+    /// Cells keep their segments presorted from cell to cell instead of sorting their
+    /// endpoints at each split: the same lines, in O(n) a cell (docs/irregular.md, "Build
+    /// speed"). false: every cell sorts, as a check of the presorted build.
+    bool presorted = true;
+    /// Check every presorted cell's orders against a fresh sort of its segments (tests); a
+    /// mismatch throws std::logic_error.
+    bool checkOrders = false;
 };
 
 /// Per primitive of `scene`, the share of its screen rectangle where a ray from `frame`'s origin
