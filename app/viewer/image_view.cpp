@@ -341,10 +341,18 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
         (mode != ViewMode::Color &&
          (scale != shadedScale_ || logScale != shadedLog_ || diverging != shadedDiverging_));
     if (!held) lastShade_ = {};
-    if (!held && whole)
+    if (!held && whole) {
         shade(mode, scale, logScale, diverging, 0, height_);
-    else if (!held && (!dirty_.empty() || layerChanged_ || !precomposed_.empty()))
-        shade(mode, scale, logScale, diverging, dirty_.begin, dirty_.end);
+    } else if (!held && (!dirty_.empty() || layerChanged_ || !precomposed_.empty())) {
+        // A finer pass of the view on screen already shows in parts: its rows may wait for
+        // the next frames. A released view's may not.
+        const int end =
+            drawnHeld_ || !precomposed_.empty() || mode != ViewMode::Color || dirty_.empty()
+                ? dirty_.end
+                : budgetedRowsEnd();
+        shade(mode, scale, logScale, diverging, dirty_.begin, end);
+    }
+    drawnHeld_ = held;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glDisable(GL_SCISSOR_TEST);
@@ -365,6 +373,18 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(0, 0, fbWidth, fbHeight);
+}
+
+int ImageView::budgetedRowsEnd() const {
+    if (!budget_) return dirty_.end;
+    // Parts of kRows from the first pending row, the first in any case (never starved).
+    constexpr int kRows = 48;
+    int end = std::min(dirty_.end, dirty_.begin + kRows);
+    while (end < dirty_.end &&
+           budget_->fits(rowCost_.estimateMs(std::min(dirty_.end, end + kRows) - dirty_.begin),
+                         budgetReserveMs_))
+        end = std::min(dirty_.end, end + kRows);
+    return end;
 }
 
 double ImageView::shadeEstimateMs(ViewMode mode) const {
@@ -412,7 +432,11 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
         shadeHeat(scale, logScale, diverging, rowBegin, rowEnd);
     }
     layerChanged_ = false;
-    dirty_.clear();
+    // Rows left for the next draws (budgetedRowsEnd()) stay pending.
+    if (rowEnd < dirty_.end && rowBegin <= dirty_.begin && !dirty_.empty())
+        dirty_.begin = std::max(dirty_.begin, rowEnd);
+    else
+        dirty_.clear();
     precomposed_.clear();
     shadedValid_ = true;
     shadedWidth_ = width_;

@@ -80,6 +80,21 @@ class ImageView {
     /// 16-25 ms of the image step in one frame (balls4 at 1280x720, 2026-12-06). Returns the
     /// rows composited; none unless a colour picture of the image's size is shown.
     int composeHeld(FrameBudget& budget, double reserveMs);
+    /// Share a frame's budget from now on (null: none): draw() composites the rows of the
+    /// view on screen uploaded since the last draw (a finer pass's part) in parts of 48 rows,
+    /// each only when its learned cost fits in `budget` less `reserveMs`, at least one part a
+    /// draw; the rest stay pending for the next draws. The rows of a view released from a
+    /// hold, and a whole shade, are composited at once (two views never share the screen). A
+    /// pass's part with the image step took 10-12 ms of a frame beside its poll and upload
+    /// (balls4's slabs with the inspector, 2026-12-07). The budget must outlive the view or
+    /// be unset.
+    void setFrameBudget(FrameBudget* budget, double reserveMs) {
+        budget_ = budget;
+        budgetReserveMs_ = reserveMs;
+    }
+    /// Image rows uploaded and not yet composited into the picture (draw() left them for the
+    /// budget, or a hold).
+    int pendingRows() const { return dirty_.empty() ? 0 : dirty_.end - dirty_.begin; }
     /// draw() draws a picture: something was uploaded, and it is not held before a first one.
     bool showsPicture() const { return width_ > 0 && (!hold_ || shadedWidth_ > 0); }
     /// What the last draw() that shaded composited: image rows composited whole, texels
@@ -117,6 +132,9 @@ class ImageView {
     void composeLayerChanges(int skipBegin, int skipEnd) const;
     /// The layer's pixels are one per image pixel (the viewer draws it at the image's size).
     bool layerAtImageSize() const;
+    /// One past the last pending row draw() composites now: parts of 48 rows while their
+    /// learned cost fits in the frame's budget (setFrameBudget()), the first in any case.
+    int budgetedRowsEnd() const;
     /// The heat map's rows [rowBegin, rowEnd) through the colour-map shader.
     void shadeHeat(float scale, bool logScale, bool diverging, int rowBegin, int rowEnd) const;
 
@@ -150,6 +168,11 @@ class ImageView {
     int width_ = 0, height_ = 0;
     mutable int shadedWidth_ = 0, shadedHeight_ = 0;  ///< the size the FBO was last shaded at
     bool hold_ = false;
+    /// The last draw() was held: the next unheld one composites all pending rows (the view
+    /// released must show whole).
+    mutable bool drawnHeld_ = false;
+    FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
+    double budgetReserveMs_ = 0.0;
     PixelRect viewport_;
     unsigned overlayTex_ = 0;
     uint64_t overlayVersion_ = 0;

@@ -167,7 +167,11 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     const int imageW = area.x1 - area.x0, imageH = area.y1 - area.y0;
     // Counts that arrived in the poll: the overlays take them before the keys read them.
     overlays_->setCosts(state_.costs());
-    overlays_->update(state_.sceneBuild(), state_.camera(), imageW, imageH, cameraMoving());
+    // The batches' copy to GL waits for prepareOverlays(), once the steps after the layer have
+    // said what they take in this frame: copied here, with the last frame's reserve, a part
+    // took 6-7 ms before any budgeted step (a new structure's batches, balls4's slabs,
+    // 2026-12-07).
+    overlays_->update(state_.sceneBuild(), state_.camera(), imageW, imageH, cameraMoving(), false);
     inspector_->setShown(s.showInspector);
     phases_.mark("overlay update");
     inspector_->update(state_.sceneBuild(),
@@ -294,6 +298,9 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     }
     glDisable(GL_SCISSOR_TEST);
     view_->setViewport(area);
+    // A finer pass's rows composite within what the steps after the image keep (as the layer
+    // keeps for them, less the image's own estimate): the rest waits for the next frames.
+    view_->setFrameBudget(&budget_, kLayerReserveMs + panelsMs + inspector_->showEstimateMs());
     const double imageStart = budget_.spentMs();
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale,
                 state_.heatDiverging());
@@ -364,7 +371,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     }
     settled_ = state_.settledSince() && inspector_->settled() && !overlays_->building() &&
                !overlays_->layerPending() && !player_.pending() && !player_.playback().playing() &&
-               panels_.deferred() == 0;
+               panels_.deferred() == 0 && view_->pendingRows() == 0;
     keepSettings();
 }
 

@@ -56,10 +56,11 @@ class ViewerApp {
     /// the render of the latest change has shown nothing yet, a pass finer than the one on
     /// screen has begun to show, or the render is complete. Otherwise the render is only
     /// refining the pass on screen band by band, and a window may show its bands at a lower
-    /// rate. Also while the overlays' layer is drawn over several frames.
+    /// rate. Also while the overlays' layer is drawn over several frames, or image rows wait
+    /// for the frame's budget.
     bool eager() const {
         return state_.eager(settled_) || overlays_->layerPending() ||
-               inspector_->picturePending() || panels_.deferred() > 0;
+               inspector_->picturePending() || panels_.deferred() > 0 || view_->pendingRows() > 0;
     }
     /// The frame drawn by the last frame() is on screen (after the window's swap): logs, with
     /// --log-timings, the passes it shows for the first time, with their latency.

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <condition_variable>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <set>
@@ -821,26 +822,42 @@ TEST(Overlays, APartStartsOnlyWhenItsLearnedCostFitsAndAMovingFirstPartIsSizedTo
     t.ov.setFrameBudget(nullptr, 0.0);
 }
 
-TEST(Overlays, BatchesBuiltInTheBackgroundAreCopiedInPartsAndTheLayerFollowsThem) {
-    OffscreenGl gl(kW, kH);
-    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
-    auto s = twoBoxes(SchemeKind::Regular, 8);
+/// Two boxes' regular leaves built at once (direct) and on a worker (ov).
+struct LeavesInTheBackground {
+    OffscreenGl gl{kW, kH};
+    std::shared_ptr<SceneBuild> s = twoBoxes(SchemeKind::Regular, 8);
     const Camera& cam = s->scene->camera;
-    // The leaves built at once, and on a worker copied to GL in parts.
     Overlays direct, ov;
-    direct.options.leaves = ov.options.leaves = true;
-    direct.update(s, cam, kW, kH);
-    ov.buildInBackground({});
+    LeavesInTheBackground() {
+        direct.options.leaves = ov.options.leaves = true;
+        if (gl.ok()) direct.update(s, cam, kW, kH);
+        ov.buildInBackground({});
+    }
+    /// Frames of `frame()` then ov's update (`copy`) until the worker's build is taken.
+    void untilTaken(bool copy, const std::function<void()>& frame = {}) {
+        const auto start = std::chrono::steady_clock::now();
+        while (ov.rebuilds() == 0 &&
+               std::chrono::steady_clock::now() - start < std::chrono::seconds(30)) {
+            if (frame) frame();
+            ov.update(s, cam, kW, kH, false, copy);
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
+    }
+};
+
+TEST(Overlays, BatchesBuiltInTheBackgroundAreCopiedInPartsAndTheLayerFollowsThem) {
+    LeavesInTheBackground t;
+    ASSERT_TRUE(t.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    OffscreenGl& gl = t.gl;
+    auto& s = t.s;
+    const Camera& cam = t.cam;
+    Overlays &direct = t.direct, &ov = t.ov;
+    // The leaves built at once, and on a worker copied to GL in parts.
     ov.look.uploadBytes = 16 * sizeof(gl::BatchVertex);  // 8 lines a part
     ov.look.uploadMs = 0.0;                              // one part a frame
     ov.look.restMs = 0.0;
     ov.look.restLines = 4;
-    const auto start = std::chrono::steady_clock::now();
-    while (ov.rebuilds() == 0 &&
-           std::chrono::steady_clock::now() - start < std::chrono::seconds(30)) {
-        ov.update(s, cam, kW, kH);
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
+    t.untilTaken(true);
     ASSERT_EQ(ov.rebuilds(), 1u);
     const size_t total = ov.layerLines();
     ASSERT_GT(total, 24u);
@@ -884,6 +901,29 @@ TEST(Overlays, BatchesBuiltInTheBackgroundAreCopiedInPartsAndTheLayerFollowsThem
         }
     EXPECT_GT(lits, 0u);
     EXPECT_EQ(differ, 0u);
+}
+
+TEST(Overlays, TheFramesFirstUpdateTakesTheBatchesAndLeavesTheirCopyToTheBudgetedUpdate) {
+    LeavesInTheBackground t;
+    ASSERT_TRUE(t.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    auto& s = t.s;
+    const Camera& cam = t.cam;
+    Overlays& ov = t.ov;
+    ov.look.uploadMs = 1000.0;  // a copy that fits copies everything
+    double now = 0.0;           // a clock only the test moves: each frame has room
+    FrameBudget budget(33.0, [&] { return now; });
+    ov.setFrameBudget(&budget, 0.0);
+    // The viewer's frame: an update without the copy (before the steps after the layer have
+    // said what they take), then one with it.
+    t.untilTaken(false, [&] { budget.begin(); });
+    ASSERT_EQ(ov.rebuilds(), 1u);
+    EXPECT_FALSE(ov.uploaded()) << "taken, nothing copied";
+    EXPECT_EQ(ov.layerReady(), 0u);
+    ov.update(s, cam, kW, kH, false, false);
+    EXPECT_FALSE(ov.uploaded());
+    ov.update(s, cam, kW, kH);
+    EXPECT_TRUE(ov.uploaded()) << "copied by the frame's update with the copy";
+    EXPECT_EQ(drawn(t.gl, ov, cam), drawn(t.gl, t.direct, cam));
 }
 
 TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShows) {

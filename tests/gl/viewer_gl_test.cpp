@@ -13,6 +13,7 @@
 #include <chrono>
 #include <set>
 #include <thread>
+#include <utility>
 
 #include "app/viewer/camera_control.h"
 #include "app/viewer/image_view.h"
@@ -289,22 +290,36 @@ TEST(ViewerGl, ANewLayerCompositesOnlyTheTexelsItChangedAndEqualsTheWholeComposi
     glDeleteTextures(1, &tex);
 }
 
-TEST(ViewerGl, AHeldViewCompositedInPartsWithinTheBudgetEndsAsTheWholeComposite) {
-    const int w = 160, h = 96;
-    OffscreenGl gl(w, h);
-    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
-    // Two views of many colours and a layer of scattered premultiplied texels.
+/// Two views of many colours, w x h.
+std::pair<Image, Image> twoViews(int w, int h) {
     Image a(w, h), b(w, h);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             a.color[a.index(x, y)] = glm::vec3(float(x) / w, float(y) / h, 0.3f);
             b.color[b.index(x, y)] = glm::vec3(0.2f, float((x * 5 + y) % 13) / 13.0f, float(y) / h);
         }
+    return {std::move(a), std::move(b)};
+}
+
+/// A w x h layer of premultiplied texels, every `step`-th one lit: `channel` at `value`, alpha
+/// `alpha`.
+std::vector<uint8_t> scatteredLayer(int w, int h, size_t step, int channel, uint8_t value,
+                                    uint8_t alpha) {
     std::vector<uint8_t> texels(size_t(w) * h * 4, 0);
-    for (size_t i = 0; i < texels.size() / 4; i += 29) {
-        texels[i * 4 + 0] = 150;
-        texels[i * 4 + 3] = 190;
+    for (size_t i = 0; i < texels.size() / 4; i += step) {
+        texels[i * 4 + size_t(channel)] = value;
+        texels[i * 4 + 3] = alpha;
     }
+    return texels;
+}
+
+TEST(ViewerGl, AHeldViewCompositedInPartsWithinTheBudgetEndsAsTheWholeComposite) {
+    const int w = 160, h = 96;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    // Two views of many colours and a layer of scattered premultiplied texels.
+    const auto [a, b] = twoViews(w, h);
+    std::vector<uint8_t> texels = scatteredLayer(w, h, 29, 0, 150, 190);
     const unsigned tex = layerTextureOf(w, h, texels);
     ImageView view;
     view.upload(a, ViewMode::Color);
@@ -359,6 +374,61 @@ TEST(ViewerGl, AHeldViewCompositedInPartsWithinTheBudgetEndsAsTheWholeComposite)
     // Nothing composites while not held.
     view.upload(b, ViewMode::Color, 0, 10);
     EXPECT_EQ(frame(false), 0);
+    glDeleteTextures(1, &tex);
+}
+
+TEST(ViewerGl, AFinerPassesRowsCompositeWithinTheBudgetAPartAtLeastAndEndAsTheWholeComposite) {
+    double now = 0.0;  // a clock only the test moves
+    FrameBudget budget(33.0, [&] { return now; });
+    const int w = 160, h = 200;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    ImageView view;
+    view.setFrameBudget(&budget, 5.0);
+    // A coarse pass and a finer one of the same view (as two views' colours differ), and a
+    // layer of scattered texels.
+    const auto [coarse, fine] = twoViews(w, h);
+    std::vector<uint8_t> texels = scatteredLayer(w, h, 37, 2, 120, 160);
+    const unsigned tex = layerTextureOf(w, h, texels);
+    auto draw = [&](bool spent) {
+        budget.begin();
+        if (spent) now += 100.0;
+        gl.clear(0, 0, 0);
+        view.draw(w, h, ViewMode::Color, 1.0f);
+        return view.lastShade().rows;
+    };
+    view.upload(coarse, ViewMode::Color);
+    view.setOverlay(tex, 1);
+    EXPECT_EQ(draw(true), h) << "a first picture is shaded whole";
+    // The finer pass's rows, the frame spent by the steps before: one part of 48 rows a frame,
+    // the rest left for the next frames.
+    view.upload(fine, ViewMode::Color);
+    EXPECT_EQ(draw(true), 48);
+    EXPECT_EQ(view.pendingRows(), h - 48);
+    EXPECT_GE(budget.deferred(), 1);
+    // A new layer meanwhile (a texel in a composited row, one in a pending row).
+    for (int row : {5, 150}) {
+        const size_t at = (size_t(h - 1 - row) * w + 9) * 4;  // the layer's rows go up
+        texels[at + 0] = 200;
+        texels[at + 3] = 210;
+    }
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, texels.data());
+    glBindTexture(GL_TEXTURE_2D, 0);
+    view.setOverlay(tex, 2);
+    EXPECT_EQ(draw(true), 48);
+    EXPECT_EQ(view.pendingRows(), h - 96);
+    // A frame with room composites the rest; the picture is the finer pass's whole composite.
+    EXPECT_EQ(draw(false), h - 96);
+    EXPECT_EQ(view.pendingRows(), 0);
+    EXPECT_EQ(gl.read(), wholeComposite(gl, fine, texels));
+    // A view released from a hold shows whole, whatever the budget.
+    view.setHold(true);
+    view.upload(coarse, ViewMode::Color);
+    draw(true);
+    view.setHold(false);
+    EXPECT_EQ(draw(true), h);
+    EXPECT_EQ(gl.read(), wholeComposite(gl, coarse, texels));
     glDeleteTextures(1, &tex);
 }
 

@@ -96,7 +96,7 @@ bool Overlays::select(uint32_t id) {
 }
 
 void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const Camera& view,
-                      int width, int height, bool moving) {
+                      int width, int height, bool moving, bool copy) {
     if (structure && structure != structure_) {
         // The new structure replaces the old one only now that it is ready: until then the old
         // overlays stayed on screen. Region ids of the old one mean nothing in the new one.
@@ -109,13 +109,14 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
         }
     }
     if (!view_) return;
-    uploadMore();
+    if (copy) uploadMore();
     if (job_.pending()) {  // a build under way: the batches on screen stay until it is done
         std::optional<OverlayGeometry> g = job_.poll();
         if (!g) return;
         take(std::move(*g), jobInputs_,
              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - jobStart_)
-                 .count());
+                 .count(),
+             copy);
     }
     // The counts a cost colouring reads: the last complete image's, on this structure.
     std::shared_ptr<const ImageCosts> costs;
@@ -135,7 +136,8 @@ void Overlays::update(const std::shared_ptr<const SceneBuild>& structure, const 
         OverlayGeometry g = build(in);
         take(std::move(g), in,
              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                 .count());
+                 .count(),
+             true);
         return;
     }
     // On the worker: balls4's slabs (1.2 M lines) took the UI thread 0.83 s a structure
@@ -156,14 +158,14 @@ OverlayGeometry Overlays::build(const BuildInputs& in) {
                                 in.costs ? &in.costs->costs : nullptr);
 }
 
-void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms) {
+void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms, bool copy) {
     geometry_ = std::move(geometry);
     cuts_->beginUpload(geometry_.cuts);
     fills_->beginUpload(geometry_.fills);
     wiresLongestFirst_->beginUpload(geometry_.wiresLongestFirst);
     wires_->beginUpload(geometry_.wires);
     if (background_) {
-        uploadMore();  // the rest in the next frames
+        if (copy) uploadMore();  // the rest in the next frames
     } else {
         for (gl::GpuBatch* b : {cuts_.get(), fills_.get(), wiresLongestFirst_.get(), wires_.get()})
             b->uploadMore(SIZE_MAX);

@@ -80,9 +80,12 @@ class Overlays {
     /// Take the structure on screen (null: none yet) and rebuild the batches if the structure,
     /// the camera they depend on, the size or the options changed. Until a new structure
     /// arrives the previous one's overlays stay. While the camera is `moving` (a drag), batches
-    /// culled for an earlier view are kept: they are culled again once it rests.
+    /// culled for an earlier view are kept: they are culled again once it rests. Without
+    /// `copy` no part of the batches is copied to GL (the frame's first update, before the
+    /// steps after the layer have said what they take: a later update with `copy` in the same
+    /// frame copies within the budget then).
     void update(const std::shared_ptr<const SceneBuild>& structure, const Camera& view, int width,
-                int height, bool moving = false);
+                int height, bool moving = false, bool copy = true);
     /// Draw the layers and the selection into the current framebuffer (width x height, the
     /// image filling it), as seen by `view`.
     void draw(const Camera& view, int width, int height) {
@@ -219,7 +222,7 @@ class Overlays {
     static OverlayGeometry build(const BuildInputs& in);
     /// The built geometry into the GL batches (in parts, from a worker's build), and what it
     /// was built for.
-    void take(OverlayGeometry geometry, const BuildInputs& in, double ms);
+    void take(OverlayGeometry geometry, const BuildInputs& in, double ms, bool copy);
     /// Copy more of the batches taken, for look.uploadMs: cut lines, fills and the longest-
     /// first wireframe first (what the layer's parts draw), the wireframe in its own order last.
     void uploadMore();
