@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -1115,6 +1116,19 @@ KeptFacesBox keptFacesBox(const CameraFrame& frame, const Box3& b, const Mat3& a
     return s;
 }
 
+/// The rectangle of the camera-frame box `cam` seen along `column` (false: from the eye, the
+/// box is not wholly in front of it).
+bool hullColumnRect(const Box3& cam, ZoneColumn column, glm::dvec2& lo, glm::dvec2& hi) {
+    lo = {cam.lo.x, cam.lo.y};
+    hi = {cam.hi.x, cam.hi.y};
+    if (column == ZoneColumn::Parallel) return true;
+    if (!(cam.lo.z > 0.0)) return false;
+    const glm::dvec2 l = lo, h = hi;
+    lo = glm::min(l / cam.lo.z, l / cam.hi.z);
+    hi = glm::max(h / cam.lo.z, h / cam.hi.z);
+    return true;
+}
+
 /// The part of `in` where n . x <= d, one Sutherland-Hodgman pass.
 std::vector<Vec3> keptFacesClip(const std::vector<Vec3>& in, const Vec3& n, double d) {
     std::vector<Vec3> out;
@@ -1240,12 +1254,8 @@ TEST(PrimitiveHulls, KeptFacesGiveThePlainClippingsRangesBitForBit) {
                         x >= world.lo[int(a)] - 2.0 * pad && x <= world.hi[int(a)] + 2.0 * pad;
                 }
             for (ZoneColumn column : {ZoneColumn::Parallel, ZoneColumn::FromEye}) {
-                glm::dvec2 lo(cam.lo.x, cam.lo.y), hi(cam.hi.x, cam.hi.y);
-                if (column == ZoneColumn::FromEye) {
-                    if (!(cam.lo.z > 0.0)) continue;
-                    lo = glm::min(lo / cam.lo.z, lo / cam.hi.z);
-                    hi = glm::max(hi / cam.lo.z, hi / cam.hi.z);
-                }
+                glm::dvec2 lo, hi;
+                if (!hullColumnRect(cam, column, lo, hi)) continue;
                 // Zones from a twentieth to the whole of the rectangle across, most cutting it.
                 for (int k = 0; k < 12; ++k) {
                     const glm::dvec2 e = (0.05 + 0.95 * u01(rng)) * (hi - lo);
@@ -1312,6 +1322,87 @@ TEST(PrimitiveHulls, KeptFacesGiveThePlainClippingsRangesBitForBit) {
     EXPECT_GT(cut, compared / 4) << cut << " of " << compared;
     EXPECT_GT(single, 1000u);
     EXPECT_LT(worst, 1.0);
+}
+
+// depthIn writes the column planes' distances to the boxes' corners out (lo.x - x, x - hi.x ..,
+// or from the eye lo.x z - x ..) instead of glm::dot's products by 0 and 1: the ranges are
+// glm::dot's bit for bit (withDotPlanes), sign of zero included. Checked on hulls of every kind
+// (turned bars of two boxes, balls seen turned, sponge:1's cubes, gears1's polygons off the
+// world's axes, balls under a light's frame along the world's axes, whose closed form is left
+// to depthIn's planes behind the eye) in both columns, over zones across the primitive's
+// rectangle, grazing it (a side at its rectangle's side, a few ulps and a millionth off), of
+// no width, and zNear in front of, at and behind the eye.
+TEST(PrimitiveHulls, WrittenOutPlaneDistancesGiveGlmDotsRangesBitForBit) {
+    size_t compared = 0, grazing = 0, cutRanges = 0, misses = 0, flat = 0;
+    auto bits = [](double v) { return std::bit_cast<uint64_t>(v); };
+    auto check = [&](const Scene& s, const CameraFrame& frame, const FrameChoice& turned) {
+        const std::vector<uint32_t> live = s.livePrimitives();
+        const double pad = 1e-9 * s.scale();
+        const PrimitiveHulls hulls = PrimitiveHulls::make(s, frame, turned, live, pad);
+        const PrimitiveHulls dot = hulls.withDotPlanes();
+        std::mt19937_64 rng(live.size() * 7 + 1);
+        std::uniform_real_distribution<double> u01(0.0, 1.0);
+        for (uint32_t p : live) {
+            const Box3 cam = frame.box(s.minBox[p]);
+            const glm::dvec2 whole(cam.lo.z, cam.hi.z);
+            for (ZoneColumn column : {ZoneColumn::Parallel, ZoneColumn::FromEye}) {
+                glm::dvec2 lo, hi;
+                if (!hullColumnRect(cam, column, lo, hi)) continue;
+                const glm::dvec2 ext = hi - lo;
+                for (int k = 0; k < 16; ++k) {
+                    // A zone from nothing to twice the rectangle across.
+                    glm::dvec2 e = 2.0 * u01(rng) * ext;
+                    if (k % 8 == 7) e[k % 2] = 0.0;
+                    glm::dvec2 zlo = lo - 0.5 * e + glm::dvec2(u01(rng), u01(rng)) * ext;
+                    glm::dvec2 zhi = zlo + e;
+                    // Or one side grazing the rectangle's (its corners' extreme).
+                    const int how = int(rng() % 4);
+                    if (how > 0) {
+                        const int axis = int(rng() % 2);
+                        const bool high = rng() % 2;
+                        double c = rng() % 2 ? lo[axis] : hi[axis];
+                        if (how == 2)
+                            for (int i = int(rng() % 4); i > 0; --i)
+                                c = std::nextafter(c, rng() % 2 ? kInf : -kInf);
+                        if (how == 3) c += (rng() % 2 ? 1e-6 : -1e-6) * ext[axis];
+                        (high ? zhi : zlo)[axis] = c;
+                        if (!(zlo[axis] <= zhi[axis])) std::swap(zlo[axis], zhi[axis]);
+                        ++grazing;
+                    }
+                    const double zNears[4] = {0.5 * cam.lo.z, cam.lo.z, 0.0, -0.5 * s.scale()};
+                    const double zNear = zNears[k % 4];
+                    const glm::dvec2 a = hulls.depthIn(p, column, zlo, zhi, zNear, whole);
+                    const glm::dvec2 b = dot.depthIn(p, column, zlo, zhi, zNear, whole);
+                    EXPECT_EQ(bits(a.x), bits(b.x)) << "p" << p << " " << a.x << " " << b.x;
+                    EXPECT_EQ(bits(a.y), bits(b.y)) << "p" << p << " " << a.y << " " << b.y;
+                    ++compared;
+                    misses += !(a.x <= a.y);
+                    flat += zlo.x == zhi.x || zlo.y == zhi.y;
+                    cutRanges += a.x <= a.y && (a.x > whole.x || a.y < whole.y);
+                }
+            }
+        }
+    };
+    auto eye = [&](const Scene& s) { check(s, CameraFrame::of(s.camera), chooseGridFrame(s)); };
+    for (uint64_t seed = 1; seed <= 3; ++seed) eye(test::turnedBars(seed * 31 + 5, 16));
+    eye(loadScene("builtin:balls:2"));
+    eye(loadScene("builtin:sponge:1"));
+    eye(loadScene(std::string(LANCER_SOURCE_DIR) + "/assets/spd/gears1.nff"));
+    {
+        const Scene s = loadScene("builtin:balls:2");
+        CameraFrame f;
+        f.origin = s.bounds.center();
+        f.origin.z = s.bounds.hi.z + 0.7 * s.bounds.extent().z;
+        f.z = Vec3(0, 0, -1), f.x = Vec3(1, 0, 0), f.y = Vec3(0, 1, 0);
+        check(s, f, FrameChoice{});
+    }
+    // Enough ranges cut by the zones, missing them, grazing and flat, for the check to mean
+    // something.
+    EXPECT_GT(compared, 20000u) << compared;
+    EXPECT_GT(cutRanges, compared / 4) << cutRanges << " of " << compared;
+    EXPECT_GT(misses, compared / 20) << misses << " of " << compared;
+    EXPECT_GT(grazing, compared / 2) << grazing << " of " << compared;
+    EXPECT_GT(flat, compared / 20) << flat << " of " << compared;
 }
 
 TEST(Irregular, SparseRestrictionEqualsRestrictTree) {

@@ -109,6 +109,22 @@ std::optional<GridFrame> flatFrame(const Primitive& prim) {
     return GridFrame::fromAxes(Mat3(u, glm::cross(n, u), n));
 }
 
+/// The column's planes n . x <= d (depthIn): the rectangle [lo, hi] swept along z (its four
+/// sides, x >= lo.x, x <= hi.x, y >= lo.y, y <= hi.y), or the rays from the eye through it
+/// (u0 <= x / z <= u1 .. for z > 0) and z >= zNear. Returns how many (4 or 5).
+int columnPlanes(ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi, double zNear,
+                 std::array<Vec3, 5>& cn, std::array<double, 5>& cd) {
+    if (column == ZoneColumn::Parallel) {
+        cn = {Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, -1, 0), Vec3(0, 1, 0), Vec3(0)};
+        cd = {-lo.x, hi.x, -lo.y, hi.y, 0.0};
+        return 4;
+    }
+    cn = {Vec3(-1, 0, lo.x), Vec3(1, 0, -hi.x), Vec3(0, -1, lo.y), Vec3(0, 1, -hi.y),
+          Vec3(0, 0, -1)};
+    cd = {0.0, 0.0, 0.0, 0.0, -zNear};
+    return 5;
+}
+
 }  // namespace
 
 PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame,
@@ -233,6 +249,11 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
         h.hulls_.push_back(std::move(hull));
     }
     h.faceVerts_.shrink_to_fit();
+    for (const Hull& hull : h.hulls_)
+        for (int s = 0; s < (hull.single ? 1 : 2); ++s)
+            for (const Vec3& q : (s == 0 ? hull.world : hull.turned).corner)
+                h.finite_ =
+                    h.finite_ && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z);
     return h;
 }
 
@@ -294,20 +315,9 @@ glm::dvec2 PrimitiveHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo,
         const glm::dvec2 d = alignedDepth(h.box, column, lo, hi, zNear);
         return {std::max(d.x, whole.x), std::min(d.y, whole.y)};
     }
-    // The column's planes n . x <= d: the rectangle swept along z, or the rays from the eye
-    // through it (u0 <= x / z <= u1 .. for z > 0) and z >= zNear.
     std::array<Vec3, 5> cn;
     std::array<double, 5> cd;
-    int planes = 4;
-    if (column == ZoneColumn::Parallel) {
-        cn = {Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, -1, 0), Vec3(0, 1, 0), Vec3(0)};
-        cd = {-lo.x, hi.x, -lo.y, hi.y, 0.0};
-    } else {
-        cn = {Vec3(-1, 0, lo.x), Vec3(1, 0, -hi.x), Vec3(0, -1, lo.y), Vec3(0, 1, -hi.y),
-              Vec3(0, 0, -1)};
-        cd = {0.0, 0.0, 0.0, 0.0, -zNear};
-        planes = 5;
-    }
+    const int planes = columnPlanes(column, lo, hi, zNear, cn, cd);
     // A column plane that every corner of a box lies within cuts nothing from it; one that
     // every corner lies beyond leaves nothing (both boxes are convex). The corners' n . x - d
     // are kept for the clipping below.
@@ -315,15 +325,41 @@ glm::dvec2 PrimitiveHulls::depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo,
     const Solid* solid[2] = {&h.world, &h.turned};
     std::array<bool, 5> cuts{};
     double cornerDist[2][5][8];
+    int beyond[2][5] = {};
+    for (int s = 0; s < solids; ++s) {
+        const std::array<Vec3, 8>& corner = solid[s]->corner;
+        if (!finite_) {
+            for (int k = 0; k < planes; ++k)
+                for (int c = 0; c < 8; ++c)
+                    cornerDist[s][k][c] = glm::dot(cn[k], corner[size_t(c)]) - cd[k];
+        } else if (column == ZoneColumn::Parallel) {
+            // The planes' products by 0 and 1 written out: glm::dot's sums are these numbers
+            // (their signs of zero aside, which only the comparisons below and the clipping's
+            // interpolation between distances of opposite signs read), a third of its work.
+            for (int c = 0; c < 8; ++c) {
+                const Vec3& q = corner[size_t(c)];
+                cornerDist[s][0][c] = lo.x - q.x;
+                cornerDist[s][1][c] = q.x - hi.x;
+                cornerDist[s][2][c] = lo.y - q.y;
+                cornerDist[s][3][c] = q.y - hi.y;
+            }
+        } else {
+            for (int c = 0; c < 8; ++c) {
+                const Vec3& q = corner[size_t(c)];
+                cornerDist[s][0][c] = lo.x * q.z - q.x;
+                cornerDist[s][1][c] = q.x - hi.x * q.z;
+                cornerDist[s][2][c] = lo.y * q.z - q.y;
+                cornerDist[s][3][c] = q.y - hi.y * q.z;
+                cornerDist[s][4][c] = zNear - q.z;
+            }
+        }
+        for (int k = 0; k < planes; ++k)
+            for (int c = 0; c < 8; ++c) beyond[s][k] += cornerDist[s][k][c] > 0.0;
+    }
     for (int k = 0; k < planes; ++k) {
         for (int s = 0; s < solids; ++s) {
-            int beyond = 0;
-            for (int c = 0; c < 8; ++c) {
-                cornerDist[s][k][c] = glm::dot(cn[k], solid[s]->corner[size_t(c)]) - cd[k];
-                beyond += cornerDist[s][k][c] > 0.0;
-            }
-            if (beyond == 8) return {whole.x, -kInf};
-            cuts[k] = cuts[k] || beyond > 0;
+            if (beyond[s][k] == 8) return {whole.x, -kInf};
+            cuts[k] = cuts[k] || beyond[s][k] > 0;
         }
     }
     if (h.single) return singleBoxDepth(h.world, column, lo, hi, zNear, cornerDist[0], cuts, whole);

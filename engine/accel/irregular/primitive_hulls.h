@@ -63,6 +63,14 @@ class PrimitiveHulls {
     glm::dvec2 depthIn(uint32_t p, ZoneColumn column, glm::dvec2 lo, glm::dvec2 hi, double zNear,
                        glm::dvec2 whole) const;
 
+    /// A copy whose depthIn computes the column planes' distances by glm::dot, as for hulls with
+    /// a corner not finite (tests: the reference of the distances written out).
+    PrimitiveHulls withDotPlanes() const {
+        PrimitiveHulls h = *this;
+        h.finite_ = false;
+        return h;
+    }
+
   private:
     /// A box of the camera frame along axes of its own: its eight corners (bit 0 the high
     /// side of the first axis, ..) and its planes, axis[a] . x between lo[a] and hi[a].
@@ -114,6 +122,9 @@ class PrimitiveHulls {
     std::vector<Hull> hulls_;
     std::vector<FaceVertex> faceVerts_;  ///< the kept faces' vertices (Hull::faceFirst)
     size_t keptFaces_ = 0;
+    /// Every corner is finite: depthIn writes the column planes' distances out (a product by
+    /// 0 of an infinite coordinate would be NaN in glm::dot).
+    bool finite_ = true;
 };
 
 /// Narrows the zones of `bsp` to what the hulls hold: drops from each zone the primitives whose
