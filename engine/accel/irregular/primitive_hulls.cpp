@@ -431,9 +431,8 @@ glm::dvec2 PrimitiveHulls::singleBoxDepth(const Solid& b, ZoneColumn column, glm
     if (anyCut) {
         // A crossing point within another side up to the rounding of its distance (a vertex on
         // two sides at once is also a column edge's, found below).
-        double tol[4] = {};  // read for the sides that cut alone
+        double tol[4];
         for (int k = 0; k < 4; ++k) {
-            if (!cuts[k]) continue;
             double m = 0.0;
             for (int c = 0; c < 8; ++c) m = std::max(m, std::abs(dist[k][c]));
             tol[k] = 1e-12 * m;
@@ -460,17 +459,13 @@ glm::dvec2 PrimitiveHulls::singleBoxDepth(const Solid& b, ZoneColumn column, glm
         // The column's four edges: parallel to z through the rectangle's corners, or from the
         // eye through them; z is the line's parameter either way.
         const bool parallel = column == ZoneColumn::Parallel;
-        // Parallel, every edge has the direction z: its products with the box's axes, once.
-        double alongZ[3];
-        for (int a = 0; a < 3 && parallel; ++a)
-            alongZ[a] = glm::dot(b.axis[size_t(a)], Vec3(0.0, 0.0, 1.0));
         for (int i = 0; i < 4; ++i) {
             const double u = i & 1 ? hi.x : lo.x, v = i & 2 ? hi.y : lo.y;
             const Vec3 base = parallel ? Vec3(u, v, 0.0) : Vec3(0.0);
             const Vec3 dir = parallel ? Vec3(0.0, 0.0, 1.0) : Vec3(u, v, 1.0);
             double t0 = parallel ? -kInf : 0.0, t1 = kInf;
             for (int a = 0; a < 3 && t0 <= t1; ++a) {
-                const double an = parallel ? alongZ[a] : glm::dot(b.axis[size_t(a)], dir);
+                const double an = glm::dot(b.axis[size_t(a)], dir);
                 const double ab = glm::dot(b.axis[size_t(a)], base);
                 if (an == 0.0) {
                     if (ab < b.lo[a] || ab > b.hi[a]) t0 = kInf;
