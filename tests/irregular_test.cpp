@@ -1349,7 +1349,7 @@ TEST(PrimitiveHulls, WrittenOutPlaneDistancesGiveGlmDotsRangesBitForBit) {
                 glm::dvec2 lo, hi;
                 if (!hullColumnRect(cam, column, lo, hi)) continue;
                 const glm::dvec2 ext = hi - lo;
-                for (int k = 0; k < 16; ++k) {
+                for (int k = 0; k < 40; ++k) {
                     // A zone from nothing to twice the rectangle across.
                     glm::dvec2 e = 2.0 * u01(rng) * ext;
                     if (k % 8 == 7) e[k % 2] = 0.0;
