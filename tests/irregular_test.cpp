@@ -678,6 +678,96 @@ TEST(Irregular, UnionOnlyRegionsKeepListsNotTrees) {
     EXPECT_GT(withTrees->info().extra["distinct_trees"].get<size_t>(), 0u);
 }
 
+// In a union-only scene a primitive whose camera-frame box covers a large share of the
+// structure's screen rectangle (balls2's floor, a ball that holds the others) is in no
+// camera-frame list: every camera-frame region merges it, fetched once a walk. Every ray is
+// walked in the camera frame here (--irregular-frame camera). The hits are brute force's for
+// rays that meet the floor behind the balls (from above them) and in front of them (from under
+// the floor), along it, from the hits of the pixels' rays, and for rays that start inside the
+// large ball and leave it through a small one jutting out of it: the union's stretch ends on the
+// small ball, not where the large one ends.
+TEST(Irregular, LargePrimitivesOfAUnionAreSharedNotListed) {
+    auto listsNone = [](const IrregularSubdivision& s, uint32_t p) {
+        for (uint32_t r = 0; r < s.regions().size(); ++r) {
+            const auto prims = s.primitives(r);
+            if (std::find(prims.begin(), prims.end(), p) != prims.end()) return false;
+        }
+        return true;
+    };
+    Scene balls = loadScene(std::string(LANCER_SPD_DIR) + "/balls2.nff");
+    ASSERT_TRUE(balls.tree.unionOnly());
+    const std::vector<uint32_t> live = balls.livePrimitives();
+    const uint32_t floor = *std::max_element(live.begin(), live.end(), [&](uint32_t a, uint32_t b) {
+        return balls.minBox[a].extent().x < balls.minBox[b].extent().x;
+    });
+    auto accel = buildIrregular(balls, BspHeuristic::Balanced, 0, IrregularFrame::Camera);
+    const IrregularSubdivision& s = irregularOf(*accel);
+    ASSERT_EQ(s.shared().size(), 1u);
+    EXPECT_EQ(s.shared()[0], floor);
+    EXPECT_EQ(accel->info().extra["shared_primitives"].get<size_t>(), 1u);
+    EXPECT_TRUE(listsNone(s, floor));
+    std::vector<Ray> rays = test::pixelRays(balls, 40, 40);
+    for (const Ray& r : secondaryRays(balls, rays, 5)) rays.push_back(r);
+    const Box3& fb = balls.minBox[floor];
+    for (uint32_t p : live) {
+        if (p == floor) continue;
+        const Vec3 c = balls.minBox[p].center();
+        rays.push_back({c + Vec3(0, 0, 3), {0, 0, -1}});           // the ball, then the floor
+        rays.push_back({Vec3(c.x, c.y, fb.lo.z - 3), {0, 0, 1}});  // the floor, then the ball
+        rays.push_back({c + Vec3(0.3, 0.2, 2), glm::normalize(Vec3(0.2, -0.1, -1))});
+        rays.push_back({Vec3(c.x, c.y, fb.center().z), glm::normalize(Vec3(1, 0.3, 0))});
+    }
+    expectSame(balls, *accel, rays, "balls2, the floor shared");
+    // Past the box of the listed primitives (occupied()) the walk goes on only toward a boundary
+    // of a shared primitive: rays going up from the balls, away from the floor, enter no region
+    // beyond it, though the structure reaches far beyond it.
+    TraceContext ctx(balls.prims.size(), balls.tree.depth());
+    ctx.useMailboxes = accel->usesMailboxes();
+    size_t beyond = 0;
+    for (uint32_t p : live) {
+        if (p == floor) continue;
+        const Ray up{balls.minBox[p].center(), {0, 0, 1}};
+        const Ray rc = s.frame().ray(up);
+        double o0, o1, b0, b1;
+        ASSERT_TRUE(clipLine(rc, s.occupied(), o0, o1));
+        ASSERT_TRUE(clipLine(rc, s.bounds(), b0, b1));
+        beyond += b1 > o1 + 0.5;
+        for (const WalkEvent& e : test::recordWalk(*accel, up, ctx).events)
+            if (const walk::Region* r = e.get<walk::Region>()) {
+                EXPECT_LE(r->t0, o1) << "p" << p << ": region " << r->region;
+            }
+    }
+    EXPECT_GT(beyond, live.size() / 2);
+
+    const std::string nested = R"({
+      "camera": {"from": [30, -40, 25], "at": [0, 0, 0], "up": [0, 0, 1], "fov": 40},
+      "scene": {"union": [
+        {"sphere": {"radius": 10}},
+        {"sphere": {"radius": 1.5}, "transform": [{"translate": [10, 0, 0]}]},
+        {"sphere": {"radius": 1}, "transform": [{"translate": [0, 0, 10.5]}]},
+        {"sphere": {"radius": 1}, "transform": [{"translate": [-4, 3, 2]}]},
+        {"sphere": {"radius": 2}, "transform": [{"translate": [0, -11, 0]}]}
+      ]}})";
+    Scene ball = readJsonScene(SourceText("nested.json", nested));
+    ASSERT_TRUE(ball.tree.unionOnly());
+    auto big = buildIrregular(ball, BspHeuristic::Balanced, 0, IrregularFrame::Camera);
+    const IrregularSubdivision& t = irregularOf(*big);
+    ASSERT_EQ(t.shared().size(), 1u);
+    EXPECT_GT(ball.minBox[t.shared()[0]].extent().x, 19.0);
+    EXPECT_TRUE(listsNone(t, t.shared()[0]));
+    std::vector<Ray> inside = test::pixelRays(ball, 32, 32);
+    std::mt19937_64 rng(29);
+    std::normal_distribution<double> g;
+    for (int i = 0; i < 400; ++i) {
+        const Vec3 o(0.5 * g(rng), 0.5 * g(rng), 0.5 * g(rng));
+        inside.push_back({o, glm::normalize(Vec3(g(rng), g(rng), g(rng)))});
+    }
+    for (const Vec3& at : {Vec3(10, 0, 0), Vec3(0, 0, 10.5), Vec3(0, -11, 0)})
+        for (int i = 0; i < 30; ++i)
+            inside.push_back({Vec3(0.0), glm::normalize(at + Vec3(g(rng), g(rng), g(rng)) * 0.3)});
+    expectSame(ball, *big, inside, "a ball holding others, shared");
+}
+
 /// A union-only cloud of overlapping spheres around an eye inside one of them, written as an NFF
 /// file: every primary ray starts inside the union, and so do rays from the spheres' centres.
 Scene overlappingSpheres(uint64_t seed, int count) {

@@ -152,7 +152,7 @@ std::vector<SlabInfo> ZoneFrameView::slabs(uint32_t z) const {
         const std::vector<uint32_t>& first = s_->zoneFirstRegion();
         for (uint32_t r = first[z]; r < first[z + 1]; ++r) {
             const IrregularRegion& R = s_->regions()[r];
-            out.push_back({r, R.zlo, R.zhi, s_->primitives(r)});
+            out.push_back({r, R.zlo, R.zhi, s_->heldPrimitives(r)});
         }
     } else {
         const ProjectiveZones& pz = s_->projective();
@@ -396,7 +396,7 @@ RegionInfo StructureView::region(uint32_t id) const {
         r.frameBox = s->regionBox(uint32_t(id));
         r.zone = R.zone;
         r.slab = id - s->zoneFirstRegion()[R.zone];
-        r.prims = s->primitives(id);
+        r.prims = s->heldPrimitives(uint32_t(id));
         r.pool = &s->treePool();
         r.root = R.root;
         for (int a = 0; a < 3; ++a) {

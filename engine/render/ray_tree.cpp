@@ -458,7 +458,11 @@ std::vector<StepReason> explainSteps(const TracedRay& r, const StructureView& vi
                 s += "the ray reaches its light at t = " + num6(reg.t1) +
                      " inside this region: nothing blocks it";
             } else if (std::isfinite(reg.t1) && reg.t1 < r.tmax) {
-                s += "the ray leaves the structure's box at t = " + num6(reg.t1) + ": nothing hit";
+                // The irregular camera-frame walk also ends where the ray leaves the box of its
+                // listed primitives with no boundary of a shared one ahead (shared()).
+                s += "the ray leaves the structure's box, or the box of the primitives it lists "
+                     "with no shared one's boundary ahead, at t = " +
+                     num6(reg.t1) + ": nothing hit";
             } else {
                 s += "the ray's interval ends inside this region: nothing hit";
             }

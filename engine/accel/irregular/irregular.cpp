@@ -70,6 +70,33 @@ constexpr double kLightRays = 0.5;
 /// What a light's zone and reference cost to build, as a share of the eye's (walkModel).
 constexpr double kLightBuild = 2.0;
 
+/// In a union-only scene, a primitive whose camera-frame box covers at least this share of the
+/// structure's screen rectangle is kept out of the camera frame's lists and tested by every
+/// camera-frame walk (IrregularSubdivision::shared): listed, it cuts a slab at each end of its
+/// depth range in every zone under it, and its edges split the screen, so a secondary ray
+/// crosses regions that hold only it (docs/irregular.md, "Secondary rays in the camera frame").
+constexpr double kSharedArea = 0.25;
+/// At most this many are shared, the largest first: each costs every camera-frame walk a test.
+constexpr size_t kMaxShared = 4;
+
+/// The primitives of `live` to share (kSharedArea, kMaxShared), by decreasing area; none when
+/// they would be every primitive.
+std::vector<uint32_t> sharedPrimitives(const std::vector<Box3>& box,
+                                       const std::vector<uint32_t>& live, const Box3& bounds) {
+    const double screen = (bounds.hi.x - bounds.lo.x) * (bounds.hi.y - bounds.lo.y);
+    auto area = [&](uint32_t p) {
+        return (box[p].hi.x - box[p].lo.x) * (box[p].hi.y - box[p].lo.y);
+    };
+    std::vector<uint32_t> big;
+    for (uint32_t p : live)
+        if (area(p) >= kSharedArea * screen) big.push_back(p);
+    std::stable_sort(big.begin(), big.end(),
+                     [&](uint32_t a, uint32_t b) { return area(a) > area(b); });
+    if (big.size() > kMaxShared) big.resize(kMaxShared);
+    if (big.size() == live.size()) big.clear();
+    return big;
+}
+
 /// Lights beyond this many (outside the bounds) get no structure of their own: each costs about
 /// as much to build as the eye's zones.
 constexpr size_t kMaxLightStructures = 8;
@@ -343,8 +370,19 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     }
     double bspMs = 0.0, slabMs = 0.0, linkMs = 0.0;
     DepthSlabs slabs;
+    // The camera frame's lists leave the shared primitives out (union-only scenes only: a CSG
+    // region's restricted tree needs every primitive it meets).
+    if (scene.tree.unionOnly()) s.shared_ = sharedPrimitives(box, live, s.bounds_);
+    std::vector<uint32_t> listed = live;
+    if (!s.shared_.empty())
+        std::erase_if(listed, [&](uint32_t p) {
+            return std::find(s.shared_.begin(), s.shared_.end(), p) != s.shared_.end();
+        });
+    // Padded once more than the boxes: a boundary of a listed primitive lies inside its box.
+    for (uint32_t p : listed) s.occupied_.expand(box[p]);
+    s.occupied_ = {s.occupied_.lo - eps, s.occupied_.hi + eps};
     try {
-        s.bsp_ = ScreenBsp::build(box, live, {s.bounds_.lo.x, s.bounds_.lo.y},
+        s.bsp_ = ScreenBsp::build(box, listed, {s.bounds_.lo.x, s.bounds_.lo.y},
                                   {s.bounds_.hi.x, s.bounds_.hi.y}, sp);
         bspMs = ms(t0);
 
@@ -391,6 +429,20 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     s.pool_ = std::move(slabs.pool);
     s.listFirst_ = std::move(slabs.listFirst);
     s.listPrims_ = std::move(slabs.listPrims);
+    if (!s.shared_.empty()) {
+        // Each list followed by the shared primitives, which the walk merges in every region.
+        const size_t lists = s.listFirst_.size() - 1, n = s.shared_.size();
+        std::vector<uint32_t> prims;
+        prims.reserve(s.listPrims_.size() + lists * n);
+        for (size_t l = 0; l < lists; ++l) {
+            const uint32_t from = s.listFirst_[l], to = s.listFirst_[l + 1];
+            s.listFirst_[l] = uint32_t(prims.size());
+            prims.insert(prims.end(), s.listPrims_.begin() + from, s.listPrims_.begin() + to);
+            prims.insert(prims.end(), s.shared_.begin(), s.shared_.end());
+        }
+        s.listFirst_[lists] = uint32_t(prims.size());
+        s.listPrims_ = std::move(prims);
+    }
     s.unionOnly_ = slabs.unionOnly;
     s.budget_ = 16 * s.regions_.size() + 1024;
     s.finishLights(lightMs, extra);
@@ -429,6 +481,7 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     // Union-only scenes: regions hold their primitive lists alone (no tree, distinct_trees 0).
     extra["flat_regions"] = s.unionOnly_;
     extra["distinct_lists"] = s.listFirst_.size() - 1;
+    extra["shared_primitives"] = s.shared_.size();
     extra["distinct_trees"] = s.unionOnly_ ? 0 : s.listFirst_.size() - 1;
     extra["pool_nodes"] = s.pool_.nodes.size();
     extra["prims_per_region"] = double(refs) / double(s.regions_.size());
@@ -512,8 +565,8 @@ int64_t IrregularSubdivision::walkTo(uint32_t from, const Vec3& p) const {
 size_t IrregularSubdivision::memoryBytes() const {
     return sizeof(*this) + regions_.size() * sizeof(IrregularRegion) + bsp_.memoryBytes() +
            zoneFirstRegion_.size() * sizeof(uint32_t) + pool_.nodes.size() * sizeof(CsgNode) +
-           (listFirst_.size() + listPrims_.size()) * sizeof(uint32_t) + projective_.memoryBytes() +
-           lightBytes();
+           (listFirst_.size() + listPrims_.size() + shared_.size()) * sizeof(uint32_t) +
+           projective_.memoryBytes() + lightBytes();
 }
 
 size_t IrregularSubdivision::lightBytes() const {

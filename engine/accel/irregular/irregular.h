@@ -29,6 +29,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <span>
 
 #include "engine/accel/build_params.h"
@@ -100,11 +101,26 @@ class IrregularSubdivision {
     /// The scene is union-only: regions keep their primitive lists and no tree (root -1); the
     /// walk merges the listed primitives' spans (hitInLeaf, flatUnion).
     bool unionOnly() const { return unionOnly_; }
-    /// Primitives of a region.
+    /// Primitives of a region (the shared ones, shared(), are not among them).
     std::span<const uint32_t> primitives(uint32_t region) const {
-        uint32_t l = regions_[region].list;
+        const uint32_t l = regions_[region].list;
+        return {listPrims_.data() + listFirst_[l],
+                listPrims_.data() + listFirst_[l + 1] - shared_.size()};
+    }
+    /// The primitives the walk merges in region r: its list, then shared() (the structure view
+    /// and dump show these as the region's).
+    std::span<const uint32_t> heldPrimitives(uint32_t region) const {
+        const uint32_t l = regions_[region].list;
         return {listPrims_.data() + listFirst_[l], listPrims_.data() + listFirst_[l + 1]};
     }
+    /// The primitives that no camera-frame list holds and that every camera-frame region
+    /// tests (union-only scenes: those whose projected box covers a large share of the
+    /// structure's screen rectangle, such as a floor; docs/irregular.md, "Secondary rays in the
+    /// camera frame"). Empty in a CSG scene.
+    std::span<const uint32_t> shared() const { return shared_; }
+    /// The bound of the listed primitives' camera-frame boxes, padded: with shared primitives,
+    /// a walk past it goes on only while one of theirs has a boundary ahead.
+    const Box3& occupied() const { return occupied_; }
     /// Region r's box in the camera frame: its zone's rectangle times its depth range.
     Box3 regionBox(uint32_t r) const { return boxOf(regions_[r]); }
     /// Region r's corner pointer across its face on axis a, at its high corner (`high`) or its
@@ -172,6 +188,16 @@ class IrregularSubdivision {
     /// plane.
     double exitOf(const IrregularRegion& r, const Ray& rc, double t, int& axis, int& ties,
                   Vec3& p) const;
+    /// A boundary of a shared primitive (fetched by this walk) lies in [t0, t1] after tmin.
+    bool sharedAhead(double tmin, double t0, double t1, TraceContext& ctx) const {
+        for (uint32_t p : shared_) {
+            const Mailbox* m = ctx.heldMailbox(p);
+            for (int k = 0; m && k < m->count; ++k)
+                for (const Boundary& b : {m->spans[k].in, m->spans[k].out})
+                    if (b.t >= t0 && b.t <= t1 && b.t > tmin) return true;
+        }
+        return false;
+    }
     /// The face of r that a ray going along d leaves through on axis a is the structure's border.
     bool onBorder(const IrregularRegion& r, int a, const Vec3& d) const {
         return d[a] > 0.0 ? highOf(r, a) == bounds_.hi[a] : lowOf(r, a) == bounds_.lo[a];
@@ -184,6 +210,7 @@ class IrregularSubdivision {
     const Scene* scene_ = nullptr;
     CameraFrame frame_;
     Box3 bounds_;
+    Box3 occupied_;  ///< occupied()
     ScreenBsp bsp_;
     ProjectiveZones projective_;              ///< primary rays (region ids from regions_.size() on)
     std::vector<ProjectiveZones> lights_;     ///< per scene light: shadow rays toward it
@@ -196,8 +223,11 @@ class IrregularSubdivision {
     std::vector<IrregularRegion> regions_;
     std::vector<uint32_t> zoneFirstRegion_;  ///< zone z: regions [zoneFirstRegion_[z], [z + 1])
     CsgTree pool_;
+    /// List l's own primitives are listPrims_[listFirst_[l] .. [l + 1] - shared_.size()), the
+    /// shared ones follow them: a region's walk merges both without copying.
     std::vector<uint32_t> listFirst_, listPrims_;
-    size_t budget_ = 0;  ///< steps allowed to one walk
+    std::vector<uint32_t> shared_;  ///< shared(): in no list, tested by every camera-frame walk
+    size_t budget_ = 0;             ///< steps allowed to one walk
     bool unionOnly_ = false;
 };
 
@@ -274,11 +304,16 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
     if (!clipLine(rc, bounds_, tw0, tw1)) return false;
     double t = std::max(tw0, tmin), tend = std::min(tw1, tmax);
     if (!(t <= tend)) return false;
+    // No listed primitive has a boundary beyond the box of their boxes (occupied()): past
+    // where the ray leaves it, only the shared primitives can be met (below).
+    double tOut = tend;
+    if (double o0, o1; !shared_.empty()) tOut = clipLine(rc, occupied_, o0, o1) ? o1 : -kInf;
     uint32_t r = locate(glm::clamp(rc.at(t), bounds_.lo, bounds_.hi), rc.d);
     if constexpr (Obs::kActive)
         obs.locate(frame_.toWorld(glm::clamp(rc.at(t), bounds_.lo, bounds_.hi)), r);
     size_t budget = budget_;
     ctx.beginLeafWalk();
+    bool first = true;
     for (;;) {
         const IrregularRegion& R = regions_[r];
         int axis, ties;
@@ -287,10 +322,19 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         double t1 = std::min(te, tend);
         ++ctx.counters.regionVisits;
         obs.region(r, t, t1);
-        if (hitInIrregularRegion(*scene_, unionOnly_, primitives(r), pool_, R.root, ray, tmin, t,
-                                 t1, ctx, obs, hit, true))
+        // The shared primitives are merged in every region, fetched in the first one; after it
+        // only the region's own list is fetched (the others are in their mailboxes).
+        const std::span<const uint32_t> all = heldPrimitives(r);
+        std::optional<std::span<const uint32_t>> fetch;
+        if (!shared_.empty() && !first) fetch = all.first(all.size() - shared_.size());
+        first = false;
+        if (hitInIrregularRegion(*scene_, unionOnly_, all, pool_, R.root, ray, tmin, t, t1, ctx,
+                                 obs, hit, true, fetch))
             return true;
         if (te >= tend) return false;
+        // Beyond the listed primitives' box only the shared ones can be met: with none of
+        // their boundaries ahead, the ray meets nothing more.
+        if (te >= tOut && !sharedAhead(tmin, te, tend, ctx)) return false;
         if constexpr (Obs::kActive) obs.regionExit(te, frame_.toWorld(p), axis, ties);
         // Out through the structure's border (a face, or an edge or corner touching it).
         for (int a = 0; a < 3; ++a)
