@@ -447,12 +447,20 @@ TEST(ViewerGl, AFinerPassesRowsCompositeWithinTheBudgetAPartAtLeastAndEndAsTheWh
     glDeleteTextures(1, &tex);
 }
 
+/// An OSMesa context of w x h and a frame budget of 33 ms on a clock only the test moves.
+struct GlWithBudget {
+    OffscreenGl gl;
+    double now = 0.0;
+    FrameBudget budget{33.0, [this] { return now; }};
+    GlWithBudget(int w, int h) : gl(w, h) {}
+};
+
 TEST(ViewerGl, AFirstPictureComesOffTheScreenInPartsAndShowsOnlyWhenWhole) {
-    double now = 0.0;  // a clock only the test moves
-    FrameBudget budget(33.0, [&] { return now; });
     const int w = 160, h = 200;
-    OffscreenGl gl(w, h);
-    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    GlWithBudget set(w, h);
+    ASSERT_TRUE(set.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    const OffscreenGl& gl = set.gl;
+    FrameBudget& budget = set.budget;
     const auto [a, b] = twoViews(w, h);
     const std::vector<uint8_t> texels = scatteredLayer(w, h, 31, 1, 140, 170);
     const unsigned tex = layerTextureOf(w, h, texels);
@@ -461,7 +469,7 @@ TEST(ViewerGl, AFirstPictureComesOffTheScreenInPartsAndShowsOnlyWhenWhole) {
     view.setOverlay(tex, 1);
     const auto begin = [&](bool spent) {
         budget.begin();
-        if (spent) now += 100.0;
+        if (spent) set.now += 100.0;
     };
     // Nothing drawn over the framebuffer's blue before the picture is whole.
     auto draw = [&] {
