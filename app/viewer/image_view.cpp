@@ -35,10 +35,10 @@ void setupTexture(GLuint tex) {
 
 }  // namespace
 
-ZeroedBytes::~ZeroedBytes() { clear(); }
+void ZeroedBytes::Unmap::operator()(uint8_t* p) const { munmap(p, size); }
 
 void ZeroedBytes::resize(size_t n) {
-    if (n != size_) assignZeroed(n);
+    if (n != size()) assignZeroed(n);
 }
 
 void ZeroedBytes::assignZeroed(size_t n) {
@@ -48,14 +48,7 @@ void ZeroedBytes::assignZeroed(size_t n) {
     // calloc then clears them all at once).
     void* p = mmap(nullptr, n, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (p == MAP_FAILED) throw std::bad_alloc();
-    data_ = static_cast<uint8_t*>(p);
-    size_ = n;
-}
-
-void ZeroedBytes::clear() {
-    if (data_) munmap(data_, size_);
-    data_ = nullptr;
-    size_ = 0;
+    data_ = std::unique_ptr<uint8_t, Unmap>(static_cast<uint8_t*>(p), Unmap{n});
 }
 
 ImageView::ImageView() {

@@ -30,26 +30,26 @@ std::vector<PixelRect> uncovered(int width, int height, const std::vector<PixelR
 /// loaded 2-core machine, 2026-12-07).
 class ZeroedBytes {
   public:
-    ZeroedBytes() = default;
-    ~ZeroedBytes();
-    ZeroedBytes(const ZeroedBytes&) = delete;
-    ZeroedBytes& operator=(const ZeroedBytes&) = delete;
     /// `n` zero bytes (the old ones dropped), unless it holds `n` already (kept as they are).
     void resize(size_t n);
     /// `n` zero bytes, whatever it held.
     void assignZeroed(size_t n);
     /// Holds nothing.
-    void clear();
+    void clear() { data_.reset(); }
     /// The bytes (null when empty).
-    uint8_t* data() const { return data_; }
+    uint8_t* data() const { return data_.get(); }
     /// How many bytes it holds.
-    size_t size() const { return size_; }
+    size_t size() const { return data_ ? data_.get_deleter().size : 0; }
     /// Holds nothing.
-    bool empty() const { return size_ == 0; }
+    bool empty() const { return size() == 0; }
 
   private:
-    uint8_t* data_ = nullptr;
-    size_t size_ = 0;
+    /// Unmaps the mapping, whose length it keeps.
+    struct Unmap {
+        size_t size = 0;
+        void operator()(uint8_t* p) const;
+    };
+    std::unique_ptr<uint8_t, Unmap> data_;
 };
 
 class ImageView {
