@@ -1,7 +1,10 @@
 #include "app/viewer/image_view.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <cstring>
+#include <new>
 #include <stdexcept>
 #include <string>
 
@@ -31,6 +34,22 @@ void setupTexture(GLuint tex) {
 }
 
 }  // namespace
+
+void ZeroedBytes::Unmap::operator()(uint8_t* p) const { munmap(p, size); }
+
+void ZeroedBytes::resize(size_t n) {
+    if (n != size()) assignZeroed(n);
+}
+
+void ZeroedBytes::assignZeroed(size_t n) {
+    clear();
+    if (n == 0) return;
+    // Anonymous pages are zero and mapped only when first written (malloc may reuse pages and
+    // calloc then clears them all at once).
+    void* p = mmap(nullptr, n, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    data_ = std::unique_ptr<uint8_t, Unmap>(static_cast<uint8_t*>(p), Unmap{n});
+}
 
 ImageView::ImageView() {
     program_ = std::make_unique<gl::Program>("image.vert", "image.frag");
@@ -71,10 +90,19 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
     height_ = img.height;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    if (resized) {  // the counters' texture at the new size; the shaded one when it is shaded
+    if (resized) {  // the shaded texture is made when it is shaded, the counters' below
+        colorRgba_.assignZeroed(size_t(width_) * size_t(height_) * 4);
+        newSize_ = true;
+        dirty_.clear();
+        precomposed_.clear();
+    }
+    uploadMode_ = mode;
+    if (mode != ViewMode::Color && (heatWidth_ != width_ || heatHeight_ != height_)) {
+        // Only for a heat map: a colour image never reads it.
         glBindTexture(GL_TEXTURE_2D, heatTex_);
         glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, width_, height_, 0, GL_RED, GL_FLOAT, nullptr);
-        colorRgba_.assign(size_t(width_) * size_t(height_) * 4, 0);
+        heatWidth_ = width_;
+        heatHeight_ = height_;
     }
     if (rows > 0) {
         // 8 bits per channel, quantised as the PNG writer does: the screen shows what `render`
@@ -96,10 +124,7 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
         }
     }
     glBindTexture(GL_TEXTURE_2D, 0);
-    if (resized)
-        shadedValid_ = false;
-    else
-        dirty_.add(rowBegin, rowEnd);
+    dirty_.add(rowBegin, rowEnd);
 }
 
 void ImageView::setOverlay(unsigned texture, uint64_t version) {
@@ -183,8 +208,17 @@ void ImageView::compose(int rowBegin, int rowEnd, bool upload) const {
     const int rows = rowEnd - rowBegin;
     if (rows <= 0) return;
     const size_t w = size_t(width_);
-    composed_.resize(w * size_t(height_) * 4);
     const bool layer = !overlayRgba_.empty();
+    if (composed_.size() != w * size_t(height_) * 4) {
+        // A new size: the layer each row is composited with is kept from its first row on, so
+        // that a picture composited in parts takes a new layer's changes as one composited
+        // whole does.
+        composed_.assignZeroed(w * size_t(height_) * 4);
+        if (layerAtImageSize())
+            composedLayer_.assignZeroed(overlayRgba_.size());
+        else
+            composedLayer_.clear();
+    }
     std::vector<size_t> column;
     if (layer)
         for (size_t x = 0; x < w; ++x)
@@ -224,17 +258,27 @@ void ImageView::uploadComposed(int rowBegin, int rowEnd) const {
     glBindTexture(GL_TEXTURE_2D, 0);
 }
 
+bool ImageView::composesOffScreen() const {
+    // Anything else is shaded whole when the view is shown.
+    if (uploadMode_ != ViewMode::Color) return false;
+    if (newSize_) return true;
+    return shadedValid_ && shadedMode_ == ViewMode::Color && shadedWidth_ == width_ &&
+           shadedHeight_ == height_;
+}
+
 int ImageView::composeHeld(FrameBudget& budget, double reserveMs) {
-    // Only rows that the release would composite one by one: a colour picture shaded at the
-    // image's size (anything else is shaded whole when the hold ends).
-    if (!hold_ || !shadedValid_ || shadedMode_ != ViewMode::Color || shadedWidth_ != width_ ||
-        shadedHeight_ != height_ || composed_.size() != size_t(width_) * size_t(height_) * 4)
-        return 0;
+    if (!hold_ || !composesOffScreen()) return 0;
+    return composeParts(budget, reserveMs, false);
+}
+
+int ImageView::composeParts(FrameBudget& budget, double reserveMs, bool atLeastOne) const {
     constexpr int kRows = 48;
     int done = 0;
     while (!dirty_.empty()) {
         const int end = std::min(dirty_.end, dirty_.begin + kRows);
-        if (!budget.fits(rowCost_.estimateMs(end - dirty_.begin), reserveMs)) break;
+        if ((!atLeastOne || done > 0) &&
+            !budget.fits(rowCost_.estimateMs(end - dirty_.begin), reserveMs))
+            break;
         compose(dirty_.begin, end, false);
         precomposed_.add(dirty_.begin, end);
         done += end - dirty_.begin;
@@ -242,6 +286,28 @@ int ImageView::composeHeld(FrameBudget& budget, double reserveMs) {
     }
     if (dirty_.empty()) dirty_.clear();
     return done;
+}
+
+void ImageView::finishOffScreen(ViewMode mode) const {
+    if (budget_ && mode == ViewMode::Color && composesOffScreen()) {
+        const bool composing = !dirty_.empty();
+        composeParts(*budget_, budgetReserveMs_, true);
+        if (!dirty_.empty()) return;  // the next draws go on; the picture before meanwhile
+        // Showing it copies its rows (and makes the texture at a new size: 30-40 ms of the
+        // image step with the last parts in one frame, balls4 at 1280x720 under load,
+        // 2026-12-07): after parts in this draw only if its learned cost fits, else in the
+        // next draw whatever the budget.
+        if (composing && !budget_->fits(showEstimateMs(), budgetReserveMs_)) return;
+    }
+    offScreen_ = false;
+}
+
+double ImageView::showEstimateMs() const {
+    double ms =
+        showRowCost_.estimateMs(precomposed_.empty() ? 0 : precomposed_.end - precomposed_.begin);
+    if (shadedWidth_ != width_ || shadedHeight_ != height_)
+        ms += textureCost_.estimateMs(double(width_) * double(height_));
+    return ms;
 }
 
 void ImageView::composeLayerChanges(int skipBegin, int skipEnd) const {
@@ -328,18 +394,27 @@ void ImageView::draw(int fbWidth, int fbHeight, ViewMode mode, float scale,
     if (width_ == 0) return;
     scale = scale > 0.0f ? scale : 1.0f;
     diverging = diverging && mode != ViewMode::Color;
+    // A view released from a hold is composited off the screen until all its rows are in.
+    if (!hold_ && offScreen_) finishOffScreen(mode);
     // Held (setHold): drawn as shaded before, whatever its size; nothing before a first
     // picture (showsPicture()).
     if (!showsPicture()) return;
-    const bool held = hold_;
+    const bool held = hold_ || offScreen_;
     // A new layer composites only its changed texels over a colour image already composited
     // with the layer before it, at the image's size; anything else shades the whole image.
     const bool layerInPlace = mode == ViewMode::Color && layerAtImageSize() &&
                               composedLayer_.size() == overlayRgba_.size();
+    // Every row of a colour view composited off the screen, with the layer or one whose
+    // changes composite in place: copied as it is, even at a new size.
+    const bool offScreenWhole = mode == ViewMode::Color && uploadMode_ == ViewMode::Color &&
+                                dirty_.empty() && precomposed_.begin <= 0 &&
+                                precomposed_.end >= height_ && (!layerChanged_ || layerInPlace);
     const bool whole =
-        !shadedValid_ || mode != shadedMode_ || (layerChanged_ && !layerInPlace) ||
-        (mode != ViewMode::Color &&
-         (scale != shadedScale_ || logScale != shadedLog_ || diverging != shadedDiverging_));
+        newSize_ || !shadedValid_
+            ? !offScreenWhole
+            : mode != shadedMode_ || (layerChanged_ && !layerInPlace) ||
+                  (mode != ViewMode::Color && (scale != shadedScale_ || logScale != shadedLog_ ||
+                                               diverging != shadedDiverging_));
     if (!held) lastShade_ = {};
     if (!held && whole) {
         shade(mode, scale, logScale, diverging, 0, height_);
@@ -389,6 +464,8 @@ int ImageView::budgetedRowsEnd() const {
 
 double ImageView::shadeEstimateMs(ViewMode mode) const {
     if (width_ == 0 || hold_ || mode != ViewMode::Color) return 0.0;
+    // A released view still off the screen: a part at least (finishOffScreen()).
+    if (offScreen_) return rowCost_.estimateMs(std::min(pendingRows(), 48));
     const bool whole =
         !shadedValid_ || mode != shadedMode_ || shadedWidth_ != width_ || shadedHeight_ != height_;
     const int rows = whole ? height_ : dirty_.end - dirty_.begin;
@@ -404,6 +481,7 @@ PixelRect ImageView::viewport(int fbWidth, int fbHeight) const {
 void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging, int rowBegin,
                       int rowEnd) const {
     if (shadedWidth_ != width_ || shadedHeight_ != height_) {
+        const double made = threadCpuMs();
         // The shaded texture at the new size (made only now: until then a hold drew the last
         // picture), the FBO on it; shaded whole.
         glBindTexture(GL_TEXTURE_2D, shadedTex_);
@@ -413,13 +491,21 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
         glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, shadedTex_, 0);
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        rowBegin = 0;
-        rowEnd = height_;
+        textureCost_.record(double(width_) * double(height_), threadCpuMs() - made);
+        // Shaded whole, unless every row was composited off the screen (copied below).
+        if (mode != ViewMode::Color || precomposed_.begin > 0 || precomposed_.end < height_) {
+            rowBegin = 0;
+            rowEnd = height_;
+        }
     }
     if (mode == ViewMode::Color) {
         // Rows composited while held are copied now (those composited again below after).
-        if (!precomposed_.empty() && (rowBegin > precomposed_.begin || rowEnd < precomposed_.end))
+        if (!precomposed_.empty() && (rowBegin > precomposed_.begin || rowEnd < precomposed_.end)) {
+            const double copied = threadCpuMs();
             uploadComposed(precomposed_.begin, precomposed_.end);
+            if (precomposed_.end - precomposed_.begin >= 64)
+                showRowCost_.record(precomposed_.end - precomposed_.begin, threadCpuMs() - copied);
+        }
         const double start = threadCpuMs();
         compose(rowBegin, rowEnd);
         if (rowEnd - rowBegin >= 64)  // the running mean of the time a row takes
@@ -438,6 +524,7 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
     else
         dirty_.clear();
     precomposed_.clear();
+    newSize_ = false;
     shadedValid_ = true;
     shadedWidth_ = width_;
     shadedHeight_ = height_;

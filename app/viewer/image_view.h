@@ -24,6 +24,34 @@ struct PixelRect {
 /// (bands of rows, each cut into the runs between covering rectangles).
 std::vector<PixelRect> uncovered(int width, int height, const std::vector<PixelRect>& covered);
 
+/// Zeroed bytes whose pages are mapped only when first written: a buffer of a new image size
+/// costs nothing until its rows are written, and then per row, in the parts the rows come in
+/// (writing a new 1280x720 RGBA8 buffer whole took 9-11 ms of page faults in one frame on the
+/// loaded 2-core machine, 2026-12-07).
+class ZeroedBytes {
+  public:
+    /// `n` zero bytes (the old ones dropped), unless it holds `n` already (kept as they are).
+    void resize(size_t n);
+    /// `n` zero bytes, whatever it held.
+    void assignZeroed(size_t n);
+    /// Holds nothing.
+    void clear() { data_.reset(); }
+    /// The bytes (null when empty).
+    uint8_t* data() const { return data_.get(); }
+    /// How many bytes it holds.
+    size_t size() const { return data_ ? data_.get_deleter().size : 0; }
+    /// Holds nothing.
+    bool empty() const { return size() == 0; }
+
+  private:
+    /// Unmaps the mapping, whose length it keeps.
+    struct Unmap {
+        size_t size = 0;
+        void operator()(uint8_t* p) const;
+    };
+    std::unique_ptr<uint8_t, Unmap> data_;
+};
+
 class ImageView {
   public:
     /// Needs a current OpenGL 3.3 core context. Throws std::runtime_error if a shader fails.
@@ -72,19 +100,30 @@ class ImageView {
     /// the rows they changed are shaded once the hold ends (a new view's image coming in parts
     /// is never shown half). A hold keeps a picture of another size (drawn scaled), and before
     /// the first picture draws nothing.
-    void setHold(bool hold) { hold_ = hold; }
+    /// A colour view released from a hold with rows still to composite stays off the screen
+    /// (draw() shows the picture before it) while draw() composites them in parts within the
+    /// frame's budget (setFrameBudget()), at least one part a draw, and is shown once all its
+    /// rows are in: released whole it took 36-44 ms of the image step in one frame (its first
+    /// picture, balls4 at 1280x720, 2026-12-07).
+    /// Without a frame budget a released view is shown at once.
+    void setHold(bool hold) {
+        hold_ = hold;
+        offScreen_ = hold || (offScreen_ && budget_ != nullptr);
+    }
     /// While held, composite the colour image's rows uploaded since the picture was shaded in
     /// parts of 48 rows, each only when its estimated cost (the time per row measured so far)
-    /// fits in `budget` less `reserveMs`; they are copied to the texture when the hold ends,
-    /// which then composites only the rows still pending. A new view released whole took
-    /// 16-25 ms of the image step in one frame (balls4 at 1280x720, 2026-12-06). Returns the
-    /// rows composited; none unless a colour picture of the image's size is shown.
+    /// fits in `budget` less `reserveMs`; they are copied to the texture when the view is shown
+    /// (setHold()). A new view released whole took 16-25 ms of the image step in one frame
+    /// (balls4 at 1280x720, 2026-12-06). Returns the rows composited; none unless colour rows
+    /// come over a colour picture of the image's size, or a first picture, or one of a new
+    /// size (its buffers then come page by page with its rows: ZeroedBytes).
     int composeHeld(FrameBudget& budget, double reserveMs);
     /// Share a frame's budget from now on (null: none): draw() composites the rows of the
     /// view on screen uploaded since the last draw (a finer pass's part) in parts of 48 rows,
     /// each only when its learned cost fits in `budget` less `reserveMs`, at least one part a
-    /// draw; the rest stay pending for the next draws. The rows of a view released from a
-    /// hold, and a whole shade, are composited at once (two views never share the screen). A
+    /// draw; the rest stay pending for the next draws. A view released from a hold is
+    /// composited off the screen in such parts and shown whole (setHold()); a whole shade is
+    /// composited at once (two views never share the screen). A
     /// pass's part with the image step took 10-12 ms of a frame beside its poll and upload
     /// (balls4's slabs with the inspector, 2026-12-07). The budget must outlive the view or
     /// be unset.
@@ -93,10 +132,16 @@ class ImageView {
         budgetReserveMs_ = reserveMs;
     }
     /// Image rows uploaded and not yet composited into the picture (draw() left them for the
-    /// budget, or a hold).
-    int pendingRows() const { return dirty_.empty() ? 0 : dirty_.end - dirty_.begin; }
+    /// budget, or a hold), and those of a released view composited off the screen and not yet
+    /// shown.
+    int pendingRows() const {
+        return (dirty_.empty() ? 0 : dirty_.end - dirty_.begin) +
+               (offScreen_ && !hold_ && !precomposed_.empty()
+                    ? precomposed_.end - precomposed_.begin
+                    : 0);
+    }
     /// draw() draws a picture: something was uploaded, and it is not held before a first one.
-    bool showsPicture() const { return width_ > 0 && (!hold_ || shadedWidth_ > 0); }
+    bool showsPicture() const { return width_ > 0 && (shadedWidth_ > 0 || !(hold_ || offScreen_)); }
     /// What the last draw() that shaded composited: image rows composited whole, texels
     /// composited again for a new layer's changes (in each changed row, the span from its
     /// first to its last changed texel), and the texels those uploaded (for each band of 16
@@ -112,6 +157,9 @@ class ImageView {
     /// (rows uploaded, the whole image after a change), in ms: the rows times the time per row
     /// measured in the colour image's earlier composites; 0 while held.
     double shadeEstimateMs(ViewMode mode) const;
+    /// The counters' texture has storage: only once a heat map is uploaded (its allocation took
+    /// 10 ms of a colour image's first upload, balls4 at 1280x720, 2026-12-07).
+    bool countersAllocated() const { return heatWidth_ > 0; }
     /// Size of the uploaded image (0 x 0 before the first upload).
     int width() const { return width_; }
     int height() const { return height_; }
@@ -135,19 +183,34 @@ class ImageView {
     /// One past the last pending row draw() composites now: parts of 48 rows while their
     /// learned cost fits in the frame's budget (setFrameBudget()), the first in any case.
     int budgetedRowsEnd() const;
+    /// Rows uploaded since the picture may be composited off the screen into composed_, to be
+    /// copied when the view is shown: colour uploads over a colour picture of the image's
+    /// size, or a first picture, or one of a new size.
+    bool composesOffScreen() const;
+    /// Composite pending rows into composed_ (not the texture) in parts of 48 while their
+    /// estimated cost fits in `budget` less `reserveMs`, the first part in any case if
+    /// `atLeastOne`; returns the rows composited.
+    int composeParts(FrameBudget& budget, double reserveMs, bool atLeastOne) const;
+    /// A view released from a hold: its pending rows composited off the screen in parts
+    /// (composeParts(), at least one a draw); offScreen_ ends once none is pending, or at once
+    /// when they cannot be (a heat map, no budget).
+    void finishOffScreen(ViewMode mode) const;
+    /// What showing the view composited off the screen costs, in ms: its rows copied to the
+    /// texture, and the texture made at a new size (learned: showRowCost_, textureCost_).
+    double showEstimateMs() const;
     /// The heat map's rows [rowBegin, rowEnd) through the colour-map shader.
     void shadeHeat(float scale, bool logScale, bool diverging, int rowBegin, int rowEnd) const;
 
     std::unique_ptr<gl::Program> program_;
     unsigned vao_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
-    std::vector<uint8_t> colorRgba_;    ///< the colour image as 8-bit RGBA, row 0 on top
+    ZeroedBytes colorRgba_;             ///< the colour image as 8-bit RGBA, row 0 on top
     std::vector<uint8_t> overlayRgba_;  ///< the layer's pixels (row 0 at the bottom); empty: none
     int overlayWidth_ = 0, overlayHeight_ = 0;
     /// The composited colour image (FBO rows, row 0 at the bottom), as in the FBO's texture.
-    mutable std::vector<uint8_t> composed_;
+    mutable ZeroedBytes composed_;
     /// The layer's pixels composed_ was composited with (empty: a layer of another size or
     /// none; then a new layer composites the whole image).
-    mutable std::vector<uint8_t> composedLayer_;
+    mutable ZeroedBytes composedLayer_;
     mutable bool layerChanged_ = false;  ///< a new layer since the last shade()
     mutable ShadeCount lastShade_;
     /// The UI thread's CPU per row composited and uploaded (a running mean of
@@ -168,6 +231,19 @@ class ImageView {
     int width_ = 0, height_ = 0;
     mutable int shadedWidth_ = 0, shadedHeight_ = 0;  ///< the size the FBO was last shaded at
     bool hold_ = false;
+    /// A view held, or released with rows still to composite off the screen (setHold()).
+    mutable bool offScreen_ = false;
+    /// The image's size changed (or its first upload) since it was last shaded: composited
+    /// whole unless every row was composited off the screen.
+    mutable bool newSize_ = false;
+    ViewMode uploadMode_ = ViewMode::Color;  ///< the mode of the last upload
+    int heatWidth_ = 0, heatHeight_ = 0;     ///< the counters' texture's size (0: none)
+    /// The UI thread's CPU per row copied to the texture when a view composited off the
+    /// screen is shown (parts of 64 rows or more).
+    mutable StepCost showRowCost_{4.0 / 720.0};
+    /// The UI thread's CPU per texel to make the texture at a new size (9.6 ms at 1280x720 on
+    /// the loaded 2-core machine, 2026-12-07).
+    mutable StepCost textureCost_{9.6 / (1280.0 * 720.0)};
     /// The last draw() was held: the next unheld one composites all pending rows (the view
     /// released must show whole).
     mutable bool drawnHeld_ = false;

@@ -8,6 +8,8 @@
 #include <imgui.h>
 #include <imgui_impl_opengl3.h>
 #include <imgui_internal.h>  // FindWindowByName: where the panels are
+#include <sys/mman.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -422,14 +424,115 @@ TEST(ViewerGl, AFinerPassesRowsCompositeWithinTheBudgetAPartAtLeastAndEndAsTheWh
     EXPECT_EQ(draw(false), h - 96);
     EXPECT_EQ(view.pendingRows(), 0);
     EXPECT_EQ(gl.read(), wholeComposite(gl, fine, texels));
-    // A view released from a hold shows whole, whatever the budget.
+    // A view released from a hold with every frame spent: composited off the screen a part of
+    // 48 rows a frame, the view before shown meanwhile, then shown whole at once (two views
+    // never share the screen).
+    const std::vector<uint8_t> before = gl.read();
     view.setHold(true);
     view.upload(coarse, ViewMode::Color);
     draw(true);
+    EXPECT_EQ(gl.read(), before) << "held";
     view.setHold(false);
-    EXPECT_EQ(draw(true), h);
+    int draws = 0;
+    while (view.pendingRows() > 0 && draws < 2 * h) {
+        draw(true);
+        ++draws;
+        if (view.pendingRows() > 0) {
+            EXPECT_EQ(gl.read(), before) << "released, draw " << draws;
+        }
+    }
+    EXPECT_EQ(draws, (h + 47) / 48 + 1) << "a part a frame, and the showing in a frame of its own";
+    EXPECT_EQ(view.lastShade().rows, 0) << "every row composited off the screen";
     EXPECT_EQ(gl.read(), wholeComposite(gl, coarse, texels));
     glDeleteTextures(1, &tex);
+}
+
+/// An OSMesa context of w x h and a frame budget of 33 ms on a clock only the test moves.
+struct GlWithBudget {
+    OffscreenGl gl;
+    double now = 0.0;
+    FrameBudget budget{33.0, [this] { return now; }};
+    GlWithBudget(int w, int h) : gl(w, h) {}
+};
+
+TEST(ViewerGl, AFirstPictureComesOffTheScreenInPartsAndShowsOnlyWhenWhole) {
+    const int w = 160, h = 200;
+    GlWithBudget set(w, h);
+    ASSERT_TRUE(set.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    const OffscreenGl& gl = set.gl;
+    FrameBudget& budget = set.budget;
+    const auto [a, b] = twoViews(w, h);
+    const std::vector<uint8_t> texels = scatteredLayer(w, h, 31, 1, 140, 170);
+    const unsigned tex = layerTextureOf(w, h, texels);
+    ImageView view;
+    view.setFrameBudget(&budget, 5.0);
+    view.setOverlay(tex, 1);
+    const auto begin = [&](bool spent) {
+        budget.begin();
+        if (spent) set.now += 100.0;
+    };
+    // Nothing drawn over the framebuffer's blue before the picture is whole.
+    auto draw = [&] {
+        gl.clear(0, 0, 1);
+        view.draw(w, h, ViewMode::Color, 1.0f);
+        const std::vector<uint8_t> px = gl.read();
+        for (size_t i = 0; i < px.size(); i += 4)
+            if (px[i] != 0 || px[i + 1] != 0 || px[i + 2] != 255) return true;
+        return false;
+    };
+    // Its parts come held: composited as they come when the frame has room.
+    view.setHold(true);
+    view.upload(a, ViewMode::Color, 0, 80);
+    begin(false);
+    EXPECT_EQ(view.composeHeld(budget, 5.0), 80);
+    EXPECT_FALSE(draw()) << "held, no picture yet";
+    view.upload(a, ViewMode::Color, 80, 160);
+    begin(true);
+    EXPECT_EQ(view.composeHeld(budget, 5.0), 0) << "a spent frame";
+    view.upload(a, ViewMode::Color, 160, 200);
+    view.setHold(false);
+    EXPECT_FALSE(view.showsPicture());
+    // Released with every frame spent: a part of 48 rows a draw off the screen, none shown
+    // until the last, then all of it, no row composited whole.
+    int draws = 0;
+    bool drawn = false;
+    while (!drawn && draws < h) {
+        begin(true);
+        drawn = draw();
+        ++draws;
+        if (!drawn) {
+            EXPECT_GT(view.pendingRows(), 0) << draws;
+        }
+    }
+    EXPECT_EQ(draws, 4) << "120 rows left: 48, 48, 24, then the showing in a frame of its own";
+    EXPECT_EQ(view.pendingRows(), 0);
+    EXPECT_EQ(view.lastShade().rows, 0);
+    EXPECT_EQ(gl.read(), wholeComposite(gl, a, texels));
+    // The counters' texture is made only for a heat map.
+    EXPECT_FALSE(view.countersAllocated());
+    view.upload(a, ViewMode::PrimTests);
+    EXPECT_TRUE(view.countersAllocated());
+    glDeleteTextures(1, &tex);
+}
+
+TEST(ViewerGl, ZeroedBytesMapAPageOnlyWhenItIsWritten) {
+    const size_t page = size_t(sysconf(_SC_PAGESIZE)), pages = 64;
+    ZeroedBytes bytes;
+    bytes.assignZeroed(pages * page);
+    auto resident = [&] {
+        std::vector<unsigned char> in(pages);
+        EXPECT_EQ(mincore(bytes.data(), pages * page, in.data()), 0);
+        return size_t(std::count_if(in.begin(), in.end(), [](unsigned char c) { return c & 1; }));
+    };
+    EXPECT_EQ(resident(), 0u) << "none before a write";
+    bytes.data()[5 * page + 7] = 9;
+    EXPECT_EQ(resident(), 1u);
+    EXPECT_EQ(bytes.data()[5 * page + 6], 0);
+    bytes.resize(pages * page);
+    EXPECT_EQ(bytes.data()[5 * page + 7], 9) << "the same size keeps the bytes";
+    bytes.resize(pages * page / 2);
+    EXPECT_EQ(bytes.size(), pages * page / 2);
+    EXPECT_EQ(bytes.data()[5 * page + 7], 0) << "another size: zero again";
 }
 
 TEST(ViewerImage, TheFirstImageAndEachViewOfADragComeInPartsNeverWhole) {
