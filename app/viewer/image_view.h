@@ -46,7 +46,7 @@ class ZeroedBytes {
   private:
     /// Unmaps the mapping, whose length it keeps.
     struct Unmap {
-        size_t size = 0;
+        size_t size;  ///< the mapping's length (no initialiser: unique_ptr value-initialises it)
         void operator()(uint8_t* p) const;
     };
     std::unique_ptr<uint8_t, Unmap> data_;
