@@ -14,6 +14,7 @@
 #include "engine/accel/irregular/primitive_hulls.h"
 #include "engine/accel/irregular/screen_bsp.h"
 #include "engine/accel/regular/grid_frame.h"
+#include "engine/model/csg.h"
 #include "engine/model/restriction.h"
 #include "engine/scene/json_reader.h"
 #include "engine/scene/loader.h"
@@ -890,6 +891,86 @@ TEST(Irregular, UnionOnlyWalkEqualsObservedWalkAndBruteForce) {
     check(ortho, *orthoAccel, orthoRays, 0.0, true, "orthographic");
     EXPECT_GT(merged, 500u);
     EXPECT_GT(compared, 10000u);
+}
+
+// A union-only region's hit without an active observer (hitInLeaf with no tree: the irregular
+// scheme's regions in a union-only scene) against the merge it stands for: random spheres (with
+// duplicates: ties), random rays, lists, windows [t0, t1] and tmin (before, inside and after
+// spans, on their ends). The same hit (t, primitive, part, side) as flatUnion then firstBoundary
+// over the listed primitives' spans in list order, or none; and the spans are merged only when
+// the ray starts the window inside a stretch of their union: a hit that starts a span inside the
+// window leaves ctx.result as it was.
+TEST(Irregular, UnionOnlyRegionMergesOnlyInsideAStretch) {
+    std::mt19937_64 rng(29);
+    std::uniform_real_distribution<double> u(-4.0, 4.0), radius(0.3, 1.5);
+    Scene s;
+    std::vector<int> leaves;
+    for (int i = 0; i < 24; ++i) {
+        Sphere sp{Vec3(u(rng), u(rng), u(rng)), radius(rng)};
+        if (i % 6 == 5) sp = std::get<Sphere>(s.prims.back().shape);  // a duplicate: ties
+        s.prims.push_back(makePrimitive(sp, Transform{}));
+        leaves.push_back(s.tree.leaf(uint32_t(s.prims.size() - 1)));
+    }
+    s.tree.root = s.tree.balanced(Op::Union, leaves);
+    s.prepare();
+    ASSERT_TRUE(s.tree.unionOnly());
+    TraceContext ctx(s.prims.size(), s.tree.depth());
+    NullObserver obs;
+    const Span sentinel{{-1e9, 999, 0, false}, {-1e9 + 1, 999, 1, false}};
+    size_t unmerged = 0, merged = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const Ray ray{Vec3(u(rng), u(rng), u(rng)) * 2.0,
+                      glm::normalize(Vec3(u(rng), u(rng), u(rng)) + 1e-9)};
+        std::vector<uint32_t> keys;
+        for (uint32_t p = 0; p < s.prims.size(); ++p)
+            if (rng() % 3 == 0) keys.push_back(p);
+        std::shuffle(keys.begin(), keys.end(), rng);
+        SpanList listed, want;
+        std::vector<double> ends;
+        for (uint32_t p : keys) {
+            Span sp[2];
+            const int n = s.primSpans(p, ray, sp, Precision::Double);
+            for (int k = 0; k < n; ++k) {
+                listed.push_back(sp[k]);
+                ends.push_back(sp[k].in.t);
+                ends.push_back(sp[k].out.t);
+            }
+        }
+        flatUnion(listed, want);
+        auto pick = [&] {
+            return !ends.empty() && rng() % 3 == 0 ? ends[rng() % ends.size()] : 3.0 * u(rng);
+        };
+        double t0 = pick(), t1 = pick();
+        const double tmin = rng() % 2 ? pick() : -kInf;
+        if (t0 > t1) std::swap(t0, t1);
+        const Boundary* b = firstBoundary(want, tmin, t0, t1);
+        ctx.beginRay();
+        ctx.beginLeafWalk();
+        ctx.result.assign(1, sentinel);
+        Hit hit;
+        const bool got = hitInLeaf(s, nullptr, -1, keys.data(), uint32_t(keys.size()), ray, tmin,
+                                   t0, t1, ctx, obs, hit);
+        ASSERT_EQ(got, b != nullptr) << "trial " << trial;
+        if (!b) continue;
+        ASSERT_EQ(hit.t, b->t) << "trial " << trial;
+        ASSERT_EQ(hit.prim, b->prim) << "trial " << trial;
+        ASSERT_EQ(hit.part, b->part) << "trial " << trial;
+        ASSERT_EQ(hit.flip, b->flip) << "trial " << trial;
+        if (ctx.result.size() == 1 && ctx.result[0].in.prim == 999) {
+            ++unmerged;
+            // Not merged: the hit starts a span inside the window.
+            ASSERT_TRUE(std::any_of(listed.begin(), listed.end(),
+                                    [&](const Span& sp) {
+                                        return sp.in.t == hit.t && sp.in.prim == hit.prim &&
+                                               hit.t >= t0;
+                                    }))
+                << "trial " << trial;
+        } else {
+            ++merged;
+        }
+    }
+    EXPECT_GT(unmerged, 400u);
+    EXPECT_GT(merged, 200u);  // windows starting inside a stretch: the merge's way
 }
 
 // Primary rays on the projective zones: regions in depth order with contiguous intervals, no
