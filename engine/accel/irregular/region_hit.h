@@ -13,7 +13,8 @@ namespace lancer {
 /// The visible hit of a region the ray crosses on [t0, t1] (after tmin), ctx.beginLeafWalk()
 /// called at the walk's start. `prims` are the region's primitives; `root` its restricted tree
 /// in `pool` (-1: an empty region, or, `unionOnly`, none: the scene is union-only and hitInLeaf
-/// merges the listed primitives' spans). Both go through hitInLeaf's pending boundaries: a
+/// takes the first start among the listed primitives' held spans, merging them only when the
+/// ray starts the window inside a stretch of their union). Both go through hitInLeaf's pending boundaries: a
 /// region where no boundary of a primitive this walk has tested lies in the window holds no hit
 /// and is left in one comparison, its tree not evaluated. The irregular walk crosses many thin
 /// regions whose primitives an earlier region tested, so most are left that way (docs/
