@@ -882,6 +882,15 @@ TEST(Overlays, ATextureOfANewSizeIsMadeWhenItsLearnedCostFitsAndDrawnIntoFromThe
     EXPECT_EQ(t.ov.layerTexture(t.cam, w, h / 2), texture);
     EXPECT_EQ(t.ov.layerVersion(), 2u);
     EXPECT_FALSE(t.ov.layerPending());
+    // A texture no frame would hold (a reserve of 30 ms leaves 3, the texture's learned cost
+    // more): made at once, not waited for for ever; the layer drawn into it at the next call.
+    t.ov.setFrameBudget(&budget, 30.0);
+    budget.begin();
+    EXPECT_EQ(t.ov.layerTexture(t.cam, w, h), texture);
+    EXPECT_EQ(t.ov.layerVersion(), 2u);
+    budget.begin();
+    t.ov.layerTexture(t.cam, w, h);
+    EXPECT_EQ(t.ov.layerVersion(), 3u);
     t.ov.setFrameBudget(nullptr, 0.0);
 }
 

@@ -296,9 +296,11 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
     // storage (10 ms at 1280x720, 2026-12-07). Made with the layer's first drawing and its
     // read-back in one frame, whatever the first part's estimate (none for an empty layer),
     // they took balls4's first structure 21-32 ms of the overlays step. Until then the layer
-    // shown stays.
-    if (newSize && !moving && budget_ &&
-        !budget_->fits(textureCost_.estimateMs(texels), budgetReserveMs_)) {
+    // shown stays. A texture that no frame's budget less the reserve would hold is made at
+    // once (never waiting for ever: a larger window's viewer never settled).
+    const double textureMs = textureCost_.estimateMs(texels);
+    if (newSize && !moving && budget_ && textureMs <= budget_->budgetMs() - budgetReserveMs_ &&
+        !budget_->fits(textureMs, budgetReserveMs_)) {
         layerDeferred_ = true;
         return layerVersion_ == 0 ? 0 : layerTex_;
     }
