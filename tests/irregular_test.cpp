@@ -923,41 +923,6 @@ TEST(Irregular, ProjectiveWalkIsADepthRun) {
     EXPECT_EQ(ctx.counters.walkErrors, 0u);
 }
 
-// A camera-frame region that adds one primitive to what the walk holds fetches it and is left by
-// the pending check, its tree not evaluated; one that adds two or more evaluates its tree lazily
-// (hitInLeaf's kLazyNewPrims). The eye looks along z beside a ball X, inside its box, through
-// the box of S (or of S and T, the same box) in X - S (X - (S u T)): the centre pixel's ray first
-// crosses regions listing X alone, which it tests (a miss), then S is the one primitive a region
-// adds and is tested; S and T together are two, and the lazy tree leaves them untested, X being
-// empty along the ray. (With every region holding a new primitive evaluated lazily, X - S made
-// one test.)
-TEST(Irregular, CameraFrameRegionAddingOnePrimitiveFetchesItTwoEvaluateLazily) {
-    auto scene = [](const std::string& cut) {
-        const std::string text = R"({
-          "camera": {"from": [0.75, 0.75, -3], "at": [0.75, 0.75, 1], "up": [0, 1, 0], "fov": 40},
-          "scene": {"difference": [{"sphere": {"radius": 1}}, )" +
-                                 cut + "]}}";
-        Scene s = readJsonScene(SourceText("cut.json", text));
-        s.width = s.height = 9;
-        return s;
-    };
-    const std::string ball = R"({"sphere": {"center": [0.75, 0.75, 0.25], "radius": 0.125}})";
-    const std::string box =
-        R"({"box": {"min": [0.625, 0.625, 0.125], "max": [0.875, 0.875, 0.375]}})";
-    const Scene one = scene(ball);
-    const Scene two = scene(R"({"union": [)" + ball + ", " + box + "]}");
-    // Beside X (0.75 * sqrt(2) from its axis), through S's centre.
-    const Ray ray{Vec3(0.75, 0.75, -3.0), Vec3(0.0, 0.0, 1.0)};
-    for (const Scene* s : {&one, &two}) {
-        auto a = buildIrregular(*s, BspHeuristic::Balanced, kAutoObjects, IrregularFrame::Camera);
-        expectSame(*s, *a, {ray}, "cut ball");
-        const RayCounters c = test::traceCounters(*s, *a, {ray});
-        EXPECT_EQ(c.walkErrors, 0u);
-        EXPECT_GE(c.regionVisits, 2u);
-        EXPECT_EQ(c.primTests, s == &one ? 2u : 1u) << (s == &one ? "X - S" : "X - (S u T)");
-    }
-}
-
 // The sparse restriction used for thousands of slabs builds the same tree as restrictTree.
 // builtin:sponge (OpenSCAD's example024, every bar turned off the world's axes): zones list the
 // bars whose turned box's outline meets them, slabs cut at the depths those boxes take over the

@@ -296,12 +296,6 @@ template <class Obs, class Test>
 /// (docs/irregular.md, "Entering lists"). `prims` must then be a subset of what this walk has
 /// fetched together with `tests`.
 inline constexpr uint32_t kLazyLeafPrims = 16;
-/// `lazyTree`: the region's tree is evaluated lazily when at least this many of the primitives
-/// to fetch are not in a mailbox of this walk. With one new primitive, its test and the pending
-/// check cost less than evaluating the tree, which most regions then skip: a camera-frame walk
-/// steps into the next slab of a column, or a neighbour zone, that adds one primitive to what
-/// it holds (docs/irregular.md, "CSG walks").
-inline constexpr uint32_t kLazyNewPrims = 2;
 
 template <class Obs>
 [[gnu::always_inline]] inline bool hitInLeaf(const Scene& scene, const CsgTree* tree, int root,
@@ -336,10 +330,7 @@ template <class Obs>
     const bool csg = tree && !unionOnly;
     bool lazy = csg && count > kLazyLeafPrims;
     if (csg && lazyTree && !lazy) {
-        uint32_t unheld = 0;
-        for (uint32_t i = 0; i < fetchCount && unheld < kLazyNewPrims; ++i)
-            unheld += !ctx.heldMailbox(fetch[i]);
-        lazy = unheld >= kLazyNewPrims;
+        for (uint32_t i = 0; i < fetchCount && !lazy; ++i) lazy = !ctx.heldMailbox(fetch[i]);
     }
     if (lazy) {
         // The spans the evaluation fetches go to the mailboxes filled after `filled` (in order),

@@ -19,15 +19,15 @@ namespace lancer {
 /// regions whose primitives an earlier region tested, so most are left that way (docs/
 /// irregular.md, "One region test for both walks"). `tests`: the primitives to fetch
 /// (hitInLeaf's `tests`; none: `prims`), the entering list of a slab the walk stepped into
-/// from the slab before it in depth. `lazy`: a CSG region with two or more primitives not yet
-/// fetched by this walk (hitInLeaf's kLazyNewPrims) evaluates its tree lazily (hitInLeaf's
-/// lazyTree), testing only what the tree needs, instead of fetching all for the pending check. The
-/// camera-frame walk crosses from zone to zone into regions whose lists differ, where that saves
-/// tests (the turned sponge in the camera frame: 44% more without it); the projective walk steps
-/// along one zone's slabs, each adding a few primitives, where fetching them lets most slabs be
-/// left without evaluating their tree (docs/irregular.md, "Eager slabs"). The regular walk's path
-/// for union-only leaves (hitInUnionLeaf, which scans the held spans of every listed primitive in
-/// every region) costs more here for the same reason.
+/// from the slab before it in depth. `lazy`: a CSG region with a primitive not yet fetched by
+/// this walk evaluates its tree lazily (hitInLeaf's lazyTree), testing only what the tree needs,
+/// instead of fetching all for the pending check. The camera-frame walk crosses from zone to
+/// zone into regions whose lists differ, where that saves tests (the turned sponge in the camera
+/// frame: 44% more without it); the projective walk steps along one zone's slabs, each adding a
+/// few primitives, where fetching them lets most slabs be left without evaluating their tree
+/// (docs/irregular.md, "Eager slabs"). The regular walk's path for union-only
+/// leaves (hitInUnionLeaf, which scans the held spans of every listed primitive in every
+/// region) costs more here for the same reason.
 template <class Obs>
 [[gnu::always_inline]] inline bool hitInIrregularRegion(
     const Scene& scene, bool unionOnly, std::span<const uint32_t> prims, const CsgTree& pool,
