@@ -14,10 +14,10 @@ namespace lancer {
 /// called at the walk's start. `prims` are the region's primitives; `root` its restricted tree
 /// in `pool` (-1: an empty region, or, `unionOnly`, none: the scene is union-only and hitInLeaf
 /// takes the first start among the listed primitives' held spans, merging them only when the
-/// ray starts the window inside a stretch of their union). Both go through hitInLeaf's pending boundaries: a
-/// region where no boundary of a primitive this walk has tested lies in the window holds no hit
-/// and is left in one comparison, its tree not evaluated. The irregular walk crosses many thin
-/// regions whose primitives an earlier region tested, so most are left that way (docs/
+/// ray starts the window inside a stretch of their union). Both go through hitInLeaf's pending
+/// boundaries: a region where no boundary of a primitive this walk has tested lies in the window
+/// holds no hit and is left in one comparison, its tree not evaluated. The irregular walk crosses
+/// many thin regions whose primitives an earlier region tested, so most are left that way (docs/
 /// irregular.md, "One region test for both walks"). `tests`: the primitives to fetch
 /// (hitInLeaf's `tests`; none: `prims`), the entering list of a slab the walk stepped into
 /// from the slab before it in depth. `lazy`: a CSG region with a primitive not yet fetched by
