@@ -11,6 +11,7 @@
 #include <random>
 
 #include "engine/accel/build_guard.h"
+#include "engine/accel/irregular/depth_slabs.h"
 #include "engine/accel/irregular/primitive_hulls.h"
 #include "engine/accel/irregular/screen_bsp.h"
 #include "engine/accel/regular/grid_frame.h"
@@ -358,6 +359,67 @@ TEST(Irregular, Balls4TakesAtMostFourTimesTheRegularSchemesMemory) {
             EXPECT_EQ(s.pointer(r, 2, true), r + 1 < last ? int32_t(r + 1) : -1);
         }
     }
+}
+
+// The camera-frame walk reads a region's zone rectangle from one 32-byte record and its list's
+// length and entries from one place (region.h): every zone's record is the screen BSP's
+// rectangle, and every region's list read from its `first` is the list its `list` names, its own
+// primitives (sorted, none shared, each with a camera-frame box that meets the region's box)
+// then the shared ones; in a union-only scene with shared primitives (balls2's floor) and in a
+// CSG scene (every list sorted, none shared).
+TEST(Irregular, RegionRecordsReadTheirZoneAndListInOnePlace) {
+    for (const char* spec : {"spd:balls2.nff", "builtin:drilled:4"}) {
+        SCOPED_TRACE(spec);
+        const std::string name(spec);
+        Scene scene = loadScene(
+            name.rfind("spd:", 0) == 0 ? std::string(LANCER_SPD_DIR) + "/" + name.substr(4) : name);
+        auto accel = buildIrregular(scene);
+        const IrregularSubdivision& s = irregularOf(*accel);
+        if (scene.tree.unionOnly()) {
+            EXPECT_FALSE(s.shared().empty());
+        }
+        for (uint32_t z = 0; z < s.screen().zoneCount(); ++z) {
+            EXPECT_EQ(s.zoneRect(z).lo, s.screen().zoneLo[z]);
+            EXPECT_EQ(s.zoneRect(z).hi, s.screen().zoneHi[z]);
+            EXPECT_EQ(reinterpret_cast<uintptr_t>(&s.zoneRect(z)) % 32, 0u);
+        }
+        const auto shared = s.shared();
+        const double pad = 1e-6 * scene.scale();
+        size_t listed = 0;
+        for (uint32_t r = 0; r < s.regions().size(); ++r) {
+            const auto held = s.heldPrimitives(r), named = s.list(s.regions()[r].list);
+            ASSERT_TRUE(std::equal(held.begin(), held.end(), named.begin(), named.end())) << r;
+            ASSERT_GE(held.size(), shared.size());
+            EXPECT_TRUE(std::equal(shared.begin(), shared.end(), held.end() - shared.size()));
+            const auto own = s.primitives(r);
+            EXPECT_TRUE(std::is_sorted(own.begin(), own.end()));
+            const Box3 box = s.regionBox(r);
+            for (uint32_t p : own) {
+                EXPECT_EQ(std::find(shared.begin(), shared.end(), p), shared.end());
+                const Box3 b = s.frame().box(scene.minBox[p]);
+                for (int a = 0; a < 3; ++a) {
+                    EXPECT_LE(b.lo[a], box.hi[a] + pad) << r << " " << p;
+                    EXPECT_GE(b.hi[a], box.lo[a] - pad) << r << " " << p;
+                }
+            }
+            listed += !own.empty();
+        }
+        EXPECT_GT(listed, 0u);
+    }
+}
+
+// headedLists lays each list out after its length and before the common tail, at its head:
+// the empty list too (its length is the tail's), and the last head is the array's size.
+TEST(Irregular, HeadedListsKeepEachListAfterItsLength) {
+    const std::vector<uint32_t> first = {0, 0, 2, 5}, prims = {7, 9, 1, 2, 3};
+    const std::vector<uint32_t> tail = {4};
+    std::vector<uint32_t> heads;
+    EXPECT_EQ(headedLists(first, prims, tail, heads),
+              (std::vector<uint32_t>{1, 4, 3, 7, 9, 4, 4, 1, 2, 3, 4}));
+    EXPECT_EQ(heads, (std::vector<uint32_t>{0, 2, 6, 11}));
+    EXPECT_EQ(headedLists(first, prims, {}, heads),
+              (std::vector<uint32_t>{0, 2, 7, 9, 3, 1, 2, 3}));
+    EXPECT_EQ(heads, (std::vector<uint32_t>{0, 1, 4, 8}));
 }
 
 /// What a screen BSP costs a ray through the screen rectangle by its own estimate: the

@@ -9,6 +9,24 @@
 
 namespace lancer {
 
+std::vector<uint32_t> headedLists(const std::vector<uint32_t>& listFirst,
+                                  const std::vector<uint32_t>& listPrims,
+                                  std::span<const uint32_t> tail, std::vector<uint32_t>& heads) {
+    const size_t lists = listFirst.empty() ? 0 : listFirst.size() - 1;
+    std::vector<uint32_t> out;
+    out.reserve(listPrims.size() + lists * (tail.size() + 1));
+    heads.assign(lists + 1, 0);
+    for (size_t l = 0; l < lists; ++l) {
+        heads[l] = uint32_t(out.size());
+        out.push_back(uint32_t(listFirst[l + 1] - listFirst[l] + tail.size()));
+        out.insert(out.end(), listPrims.begin() + listFirst[l],
+                   listPrims.begin() + listFirst[l + 1]);
+        out.insert(out.end(), tail.begin(), tail.end());
+    }
+    heads[lists] = uint32_t(out.size());
+    return out;
+}
+
 DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
                            const std::vector<glm::dvec2>& depth, double zlo, double zhi,
                            BuildGuard* guard, size_t maxBytes, size_t maxRegions) {

@@ -7,6 +7,7 @@
 // sides of its own zmin and zmax.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "engine/accel/irregular/region.h"
@@ -44,6 +45,15 @@ inline constexpr size_t kUnionOnlyRefBytes = 2 * sizeof(uint32_t);
 inline constexpr size_t mergedRefBytes(bool unionOnly) {
     return unionOnly ? kUnionOnlyRefBytes : kMergedRefBytes;
 }
+
+/// The lists (listFirst, listPrims) laid out for a walk that reads a list from one place: list
+/// l becomes its length, its entries, then `tail`'s (the same for every list), from heads[l] of
+/// the array returned (heads[lists]: its size). A region or slab keeps heads[l] and reads the
+/// length from the line of the first entries, where a table of list starts cost a line of its
+/// own a visit (docs/irregular.md, "Region visits in fewer cache lines").
+std::vector<uint32_t> headedLists(const std::vector<uint32_t>& listFirst,
+                                  const std::vector<uint32_t>& listPrims,
+                                  std::span<const uint32_t> tail, std::vector<uint32_t>& heads);
 
 /// Cut every zone of `bsp` along depth inside [zlo, zhi]; depth[i] is the depth range of the
 /// zone reference bsp.zonePrims[i] (its primitive's camera box's, or narrower: narrowZones).

@@ -427,22 +427,13 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     s.regions_ = std::move(slabs.regions);
     s.zoneFirstRegion_ = std::move(slabs.zoneFirstRegion);
     s.pool_ = std::move(slabs.pool);
-    s.listFirst_ = std::move(slabs.listFirst);
-    s.listPrims_ = std::move(slabs.listPrims);
-    if (!s.shared_.empty()) {
-        // Each list followed by the shared primitives, which the walk merges in every region.
-        const size_t lists = s.listFirst_.size() - 1, n = s.shared_.size();
-        std::vector<uint32_t> prims;
-        prims.reserve(s.listPrims_.size() + lists * n);
-        for (size_t l = 0; l < lists; ++l) {
-            const uint32_t from = s.listFirst_[l], to = s.listFirst_[l + 1];
-            s.listFirst_[l] = uint32_t(prims.size());
-            prims.insert(prims.end(), s.listPrims_.begin() + from, s.listPrims_.begin() + to);
-            prims.insert(prims.end(), s.shared_.begin(), s.shared_.end());
-        }
-        s.listFirst_[lists] = uint32_t(prims.size());
-        s.listPrims_ = std::move(prims);
-    }
+    // Each list after its length and followed by the shared primitives, which the walk merges
+    // in every region.
+    s.listPrims_ = headedLists(slabs.listFirst, slabs.listPrims, s.shared_, s.listFirst_);
+    for (IrregularRegion& R : s.regions_) R.first = s.listFirst_[R.list];
+    s.zoneRect_.resize(s.bsp_.zoneCount());
+    for (uint32_t z = 0; z < s.bsp_.zoneCount(); ++z)
+        s.zoneRect_[z] = {s.bsp_.zoneLo[z], s.bsp_.zoneHi[z]};
     s.unionOnly_ = slabs.unionOnly;
     s.budget_ = 16 * s.regions_.size() + 1024;
     s.finishLights(lightMs, extra);
@@ -564,7 +555,8 @@ int64_t IrregularSubdivision::walkTo(uint32_t from, const Vec3& p) const {
 
 size_t IrregularSubdivision::memoryBytes() const {
     return sizeof(*this) + regions_.size() * sizeof(IrregularRegion) + bsp_.memoryBytes() +
-           zoneFirstRegion_.size() * sizeof(uint32_t) + pool_.nodes.size() * sizeof(CsgNode) +
+           zoneFirstRegion_.size() * sizeof(uint32_t) +
+           zoneRect_.size() * sizeof(IrregularZoneRect) + pool_.nodes.size() * sizeof(CsgNode) +
            (listFirst_.size() + listPrims_.size() + shared_.size()) * sizeof(uint32_t) +
            projective_.memoryBytes() + lightBytes();
 }

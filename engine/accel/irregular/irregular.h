@@ -103,16 +103,19 @@ class IrregularSubdivision {
     bool unionOnly() const { return unionOnly_; }
     /// Primitives of a region (the shared ones, shared(), are not among them).
     std::span<const uint32_t> primitives(uint32_t region) const {
-        const uint32_t l = regions_[region].list;
-        return {listPrims_.data() + listFirst_[l],
-                listPrims_.data() + listFirst_[l + 1] - shared_.size()};
+        const std::span<const uint32_t> all = heldPrimitives(region);
+        return all.first(all.size() - shared_.size());
     }
     /// The primitives the walk merges in region r: its list, then shared() (the structure view
     /// and dump show these as the region's).
     std::span<const uint32_t> heldPrimitives(uint32_t region) const {
-        const uint32_t l = regions_[region].list;
-        return {listPrims_.data() + listFirst_[l], listPrims_.data() + listFirst_[l + 1]};
+        return listAt(regions_[region].first);
     }
+    /// List l as the list table gives it (its own primitives, then shared()): the one each
+    /// region whose `list` is l reads from its `first`.
+    std::span<const uint32_t> list(uint32_t l) const { return listAt(listFirst_[l]); }
+    /// Zone z's rectangle as the walk reads it (region.h): the screen BSP's, in one line.
+    const IrregularZoneRect& zoneRect(uint32_t z) const { return zoneRect_[z]; }
     /// The primitives that no camera-frame list holds and that every camera-frame region
     /// tests (union-only scenes: those whose projected box covers a large share of the
     /// structure's screen rectangle, such as a floor; docs/irregular.md, "Secondary rays in the
@@ -163,16 +166,21 @@ class IrregularSubdivision {
         size_t pixels = 0;      ///< the image's: the cost stop's rays toward each light
         bool operator==(const LightKey&) const = default;
     };
+    /// The list whose length is listPrims_[head], its entries after it.
+    std::span<const uint32_t> listAt(uint32_t head) const {
+        return {listPrims_.data() + head + 1, listPrims_[head]};
+    }
     /// Region R's box: its zone's rectangle times its depth range (region.h).
     Box3 boxOf(const IrregularRegion& R) const {
-        return {Vec3(bsp_.zoneLo[R.zone], R.zlo), Vec3(bsp_.zoneHi[R.zone], R.zhi)};
+        const IrregularZoneRect& z = zoneRect_[R.zone];
+        return {Vec3(z.lo, R.zlo), Vec3(z.hi, R.zhi)};
     }
     /// Region R's low and high bounds on axis a: its zone's on the screen axes, its own in depth.
     double lowOf(const IrregularRegion& R, int a) const {
-        return a < 2 ? bsp_.zoneLo[R.zone][a] : R.zlo;
+        return a < 2 ? zoneRect_[R.zone].lo[a] : R.zlo;
     }
     double highOf(const IrregularRegion& R, int a) const {
-        return a < 2 ? bsp_.zoneHi[R.zone][a] : R.zhi;
+        return a < 2 ? zoneRect_[R.zone].hi[a] : R.zhi;
     }
     /// p is below region r on axis a (or on its low face, going down).
     bool below(uint32_t r, int a, const Vec3& p, const Vec3& d) const {
@@ -221,10 +229,12 @@ class IrregularSubdivision {
     size_t lightsInside_ = 0, lightsOverLimit_ = 0;
     std::vector<char> lightOver_;
     std::vector<IrregularRegion> regions_;
-    std::vector<uint32_t> zoneFirstRegion_;  ///< zone z: regions [zoneFirstRegion_[z], [z + 1])
+    std::vector<uint32_t> zoneFirstRegion_;    ///< zone z: regions [zoneFirstRegion_[z], [z + 1])
+    std::vector<IrregularZoneRect> zoneRect_;  ///< bsp_'s zone rectangles, one line each
     CsgTree pool_;
-    /// List l's own primitives are listPrims_[listFirst_[l] .. [l + 1] - shared_.size()), the
-    /// shared ones follow them: a region's walk merges both without copying.
+    /// List l lies at listFirst_[l] in listPrims_: its length, its own primitives, then the
+    /// shared ones, so a region's walk merges both without copying and reads the length from
+    /// the line that holds the first entries (IrregularRegion::first is listFirst_[list]).
     std::vector<uint32_t> listFirst_, listPrims_;
     std::vector<uint32_t> shared_;  ///< shared(): in no list, tested by every camera-frame walk
     size_t budget_ = 0;             ///< steps allowed to one walk
@@ -324,7 +334,7 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         obs.region(r, t, t1);
         // The shared primitives are merged in every region, fetched in the first one; after it
         // only the region's own list is fetched (the others are in their mailboxes).
-        const std::span<const uint32_t> all = heldPrimitives(r);
+        const std::span<const uint32_t> all = listAt(R.first);
         std::optional<std::span<const uint32_t>> fetch;
         if (!shared_.empty() && !first) fetch = all.first(all.size() - shared_.size());
         first = false;

@@ -142,16 +142,19 @@ ProjectiveZones ProjectiveZones::buildCentred(const Scene& scene, const CameraFr
     s.zoneFirst_ = std::move(slabs.zoneFirstRegion);
     s.slabLo_.reserve(slabs.regions.size());
     s.slabRoot_.reserve(slabs.regions.size());
-    s.slabList_.reserve(slabs.regions.size());
+    s.slabHead_.reserve(slabs.regions.size());
     if (sp.guard) sp.guard->poll();
     for (const IrregularRegion& r : slabs.regions) {
         s.slabLo_.push_back(r.zlo);
         s.slabRoot_.push_back(r.root);
-        s.slabList_.push_back(r.list);
+        s.slabHead_.push_back(r.list);
     }
     s.pool_ = std::move(slabs.pool);
-    s.listFirst_ = std::move(slabs.listFirst);
-    s.listPrims_ = std::move(slabs.listPrims);
+    // Each slab keeps where its list lies (its length, then its entries): the walk reads the
+    // list from one place, no table of list starts kept.
+    std::vector<uint32_t> heads;
+    s.listPrims_ = headedLists(slabs.listFirst, slabs.listPrims, {}, heads);
+    for (uint32_t& h : s.slabHead_) h = heads[h];
     s.unionOnly_ = slabs.unionOnly;
     s.buildEntering();
     std::sort(nearPrims.begin(), nearPrims.end());
@@ -216,8 +219,8 @@ size_t ProjectiveZones::memoryBytes() const {
     return bsp_.memoryBytes() + zoneFirst_.size() * sizeof(uint32_t) +
            slabLo_.size() * sizeof(double) + slabRoot_.size() * sizeof(int32_t) +
            pool_.nodes.size() * sizeof(CsgNode) +
-           (slabList_.size() + listFirst_.size() + listPrims_.size() + nearPrims_.size() +
-            enterFirst_.size() + enterPrims_.size()) *
+           (slabHead_.size() + listPrims_.size() + nearPrims_.size() + enterFirst_.size() +
+            enterPrims_.size()) *
                sizeof(uint32_t);
 }
 

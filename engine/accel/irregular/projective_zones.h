@@ -133,8 +133,8 @@ class ProjectiveZones {
     const CsgTree& treePool() const { return pool_; }
     /// Primitives of slab i (those whose projected box overlaps it).
     std::span<const uint32_t> slabPrimitives(uint32_t i) const {
-        uint32_t l = slabList_[i];
-        return {listPrims_.data() + listFirst_[l], listPrims_.data() + listFirst_[l + 1]};
+        const uint32_t h = slabHead_[i];
+        return {listPrims_.data() + h + 1, listPrims_[h]};
     }
     /// What slab i adds to the slab the walk leaves for it (the one before it in depth, or, in a
     /// light's structure, the one after it; all of the zone's first slab walked): the primitives
@@ -170,8 +170,9 @@ class ProjectiveZones {
     std::vector<int32_t> slabRoot_;    ///< restricted tree of each slab (-1: empty)
     CsgTree pool_;
     // The slabs' primitive lists, which the walk tests (hitInIrregularRegion), and their trees.
-    std::vector<uint32_t> slabList_;  ///< list of each slab
-    std::vector<uint32_t> listFirst_, listPrims_;
+    /// Where each slab's list lies in listPrims_: its length, then its entries (headedLists).
+    std::vector<uint32_t> slabHead_;
+    std::vector<uint32_t> listPrims_;
     std::vector<uint32_t> nearPrims_;
     std::vector<uint32_t> enterFirst_, enterPrims_;  ///< slab i's entering list (slabEntering)
     bool unionOnly_ = false;
