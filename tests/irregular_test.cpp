@@ -8,6 +8,7 @@
 #include <bit>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include "engine/accel/build_guard.h"
@@ -535,6 +536,17 @@ BspInputs bspInputs(const char* name, double rays) {
     return in;
 }
 
+/// The screen BSP's parameters for the walk model over `in`: its hulls' outlines and depth
+/// ranges along the camera frame's depth, its stop shares, cells stopping at one primitive.
+ScreenBspParams walkModelParams(const BspInputs& in) {
+    ScreenBspParams p = countModelParams(1);
+    p.hulls = &in.hulls;
+    p.column = ZoneColumn::Parallel;
+    p.walk = &in.walk;
+    p.stops = &in.stops;
+    return p;
+}
+
 // A waiting cell keeps, in its references' top bits, the sides of its split that the cost
 // estimate found each primitive on, and the split sorts them by those bits: every zone lists
 // exactly the primitives whose rectangle's interior and hull outline meet it, in the order of
@@ -642,6 +654,58 @@ TEST(Irregular, ScreenBspPresortedSegmentsSplitAsAFreshSortAndBuildTheSameBsp) {
         }
     }
     EXPECT_GT(checked, 1000u);
+}
+
+// Two sorts of the build made once or lighter, each giving what the sort it replaces gave:
+// - the walk model sorts each cell's depth events by a key of their depth and index, with the
+//   comparison std::sort of the events themselves takes: the keys' permutation is that sort's,
+//   ties (boxes sharing a depth, a range's middle at another's end) in the same order, so every
+//   cost is the same sum bit for bit (checkOrders throws otherwise; a stable sort of the keys
+//   breaks it), in cells of up to 64 primitives with the hulls' ranges and in larger ones with
+//   their boxes';
+// - the depth slabs keep the cuts each zone's check of the limits sorts (while they take at most
+//   an eighth of the byte limit) and cut the zone at them: the slabs are those of a build that
+//   sorts every zone's cuts once, without that check (no limit), region for region and list for
+//   list, on the zones of that BSP narrowed by the hulls.
+// Scenes of blocks on a grid (sponge:2, lattice:4, drilled:3) and of spheres (balls:3).
+TEST(Irregular, WalkCostsAndSlabsFromTheKeptSortsAreTheFreshSorts) {
+    size_t zones = 0, regions = 0;
+    for (const char* name :
+         {"builtin:sponge:2", "builtin:lattice:4", "builtin:balls:3", "builtin:drilled:3"}) {
+        const BspInputs in = bspInputs(name, 65536.0);
+        ScreenBspParams p = walkModelParams(in);
+        ScreenBsp bsp = ScreenBsp::build(in.rect, in.live, in.lo, in.hi, p);
+        EXPECT_GT(bsp.costStops, 0u) << name;  // the walk model decided
+        zones += bsp.zoneCount();
+        p.checkOrders = true;
+        EXPECT_NO_THROW(ScreenBsp::build(in.rect, in.live, in.lo, in.hi, p)) << name;
+        const CameraFrame frame = CameraFrame::of(in.scene.camera);
+        const Box3 cam = frame.box(in.scene.bounds);
+        const double pad = 1e-9 * in.scene.scale();
+        const std::vector<glm::dvec2> depth =
+            narrowZones(bsp, in.hulls, ZoneColumn::Parallel, in.rect, cam.lo.z, cam.hi.z, pad);
+        const DepthSlabs want = buildDepthSlabs(in.scene, bsp, depth, cam.lo.z, cam.hi.z);
+        const DepthSlabs got = buildDepthSlabs(in.scene, bsp, depth, cam.lo.z, cam.hi.z, nullptr, 0,
+                                               std::numeric_limits<size_t>::max() / 2);
+        ASSERT_EQ(got.regions.size(), want.regions.size()) << name;
+        for (size_t r = 0; r < got.regions.size(); ++r) {
+            const IrregularRegion &a = got.regions[r], &b = want.regions[r];
+            ASSERT_EQ(a.zone, b.zone) << name << " region " << r;
+            ASSERT_EQ(a.zlo, b.zlo) << name << " region " << r;
+            ASSERT_EQ(a.zhi, b.zhi) << name << " region " << r;
+            ASSERT_EQ(a.list, b.list) << name << " region " << r;
+            ASSERT_EQ(a.root, b.root) << name << " region " << r;
+        }
+        EXPECT_EQ(got.zoneFirstRegion, want.zoneFirstRegion) << name;
+        EXPECT_EQ(got.listFirst, want.listFirst) << name;
+        EXPECT_EQ(got.listPrims, want.listPrims) << name;
+        EXPECT_EQ(got.slabs, want.slabs) << name;
+        EXPECT_EQ(got.mergedZones + got.coarseZones, 0u) << name;
+        EXPECT_GT(want.slabs, 2 * bsp.zoneCount()) << name;  // zones cut in depth
+        regions += got.regions.size();
+    }
+    EXPECT_GT(zones, 300u);
+    EXPECT_GT(regions, 1000u);
 }
 
 // The walk reported to the observer: regions in ray order with contiguous intervals, the

@@ -87,6 +87,11 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
     };
     // Whether every zone's full slabs fit (bytes and regions): then no zone is held to its share.
     bool ample = true;
+    // The zones' cuts as the check below makes them, kept for the slabs (zone z's are
+    // keptCuts[keptFirst[z] ..]) while they take at most an eighth of the byte limit (as the
+    // screen BSP's presorted orders, uncharged scratch): the zones past it sort theirs again.
+    std::vector<double> keptCuts;
+    std::vector<size_t> keptFirst{0};
     if (maxBytes || maxRegions) {
         size_t allBytes = 0, allSlabs = 0;
         for (uint32_t z = 0; z < bsp.zoneCount(); ++z) {
@@ -94,6 +99,11 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
             const uint32_t* first = bsp.zonePrims.data() + bsp.zoneFirst[z];
             const uint32_t* last = bsp.zonePrims.data() + bsp.zoneFirst[z + 1];
             zoneCuts(first, last);
+            if (keptFirst.size() == z + 1 &&
+                (!maxBytes || (keptCuts.size() + cuts.size()) * sizeof(double) <= maxBytes / 8)) {
+                keptCuts.insert(keptCuts.end(), cuts.begin(), cuts.end());
+                keptFirst.push_back(keptCuts.size());
+            }
             size_t refs = 0;
             for (const uint32_t* p = first; p != last; ++p) {
                 auto at = [&](double v) {
@@ -131,7 +141,11 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
             out.zoneFirstRegion.push_back(uint32_t(out.regions.size()));
             continue;
         }
-        zoneCuts(first, last);
+        if (z + 1 < keptFirst.size())
+            cuts.assign(keptCuts.begin() + ptrdiff_t(keptFirst[z]),
+                        keptCuts.begin() + ptrdiff_t(keptFirst[z + 1]));
+        else
+            zoneCuts(first, last);
         // Each box spans the slabs from the one holding its zmin to the one holding its zmax
         // (a box overlaps a slab's interior); the lists are filled by those spans (a sweep, not
         // a scan of the zone per slab).

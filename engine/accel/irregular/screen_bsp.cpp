@@ -354,6 +354,19 @@ struct DepthEvent {
     bool cut;
 };
 
+/// An event's depth and its index among walkCost's events: what the sweep's order is sorted on,
+/// half an event's bytes to move.
+struct DepthKey {
+    double z;
+    uint32_t event;
+};
+
+/// walkCost's events and their order, kept from one cell to the next.
+struct DepthEvents {
+    std::vector<DepthEvent> events;
+    std::vector<DepthKey> keys;
+};
+
 /// The expected cost of a ray through the cell [lo, hi] that lists `prims` (ZoneWalkModel),
 /// walking the cell's slabs front to back: every slab costs a visit and every primitive a
 /// test, each times the share of the rays still going there. A primitive ends the rays that
@@ -363,11 +376,19 @@ struct DepthEvent {
 /// are visited by the rays that meet it further on.
 double walkCost(const std::vector<uint32_t>& prims, glm::dvec2 lo, glm::dvec2 hi,
                 const std::vector<Box3>& rect, const ScreenBspParams& params,
-                std::vector<DepthEvent>& events) {
+                DepthEvents& scratch) {
     const ZoneWalkModel& model = *params.walk;
+    std::vector<DepthEvent>& events = scratch.events;
+    std::vector<DepthKey>& keys = scratch.keys;
     const double area = (hi.x - lo.x) * (hi.y - lo.y);
     if (!(area > 0.0)) return model.visit;
-    events.clear();
+    // Three events a primitive at most, written in place (the scratch only grows: a resize
+    // from empty would clear them all again at every cell).
+    if (events.size() < 3 * prims.size()) {
+        events.resize(3 * prims.size());
+        keys.resize(3 * prims.size());
+    }
+    size_t n = 0;  // events written
     // Small cells take each primitive's depth range over their column from its hull, as the
     // slabs will (narrowZones): a large turned box is shallow over a small cell.
     const bool narrow = params.hulls && prims.size() <= kNarrowedCellPrims;
@@ -383,23 +404,48 @@ double walkCost(const std::vector<uint32_t>& prims, glm::dvec2 lo, glm::dvec2 hi
             if (z.x > z.y) continue;  // its bound misses the column
         }
         const double stop = (params.stops ? double((*params.stops)[p]) : model.fill) * cover;
-        events.push_back({z.x, w, 0.5 * stop, true});
-        events.push_back(
-            {0.5 * (z.x + z.y), 0.0, stop < 1.0 ? 0.5 * stop / (1.0 - 0.5 * stop) : 1.0, false});
-        events.push_back({z.y, 0.0, 0.0, true});
+        const double mid = 0.5 * (z.x + z.y);
+        events[n] = {z.x, w, 0.5 * stop, true};
+        events[n + 1] = {mid, 0.0, stop < 1.0 ? 0.5 * stop / (1.0 - 0.5 * stop) : 1.0, false};
+        events[n + 2] = {z.y, 0.0, 0.0, true};
+        keys[n] = {z.x, uint32_t(n)};
+        keys[n + 1] = {mid, uint32_t(n + 1)};
+        keys[n + 2] = {z.y, uint32_t(n + 2)};
+        n += 3;
     }
-    std::sort(events.begin(), events.end(),
-              [](const DepthEvent& a, const DepthEvent& b) { return a.z < b.z; });
-    double alive = 1.0, cost = model.visit;  // the slab in front of the first cut
-    double lastCut = -kInf;
-    for (size_t i = 0; i < events.size() && alive > 1e-6; ++i) {
-        const DepthEvent& e = events[i];
-        if (e.cut && e.z != lastCut) {
-            cost += alive * model.visit;
-            lastCut = e.z;
+    // The sweep's products follow the order among equal depths, so the keys are sorted by
+    // std::sort with the events' comparison: its moves depend on the comparisons alone, so the
+    // keys come out in the permutation sorting the events themselves gives, for half the bytes
+    // moved (ScreenBspParams::checkOrders compares the two).
+    std::sort(keys.begin(), keys.begin() + ptrdiff_t(n),
+              [](const DepthKey& a, const DepthKey& b) { return a.z < b.z; });
+    // The cost of the events in the order event(0), event(1), ..
+    auto sweep = [&](auto event) {
+        double alive = 1.0, cost = model.visit;  // the slab in front of the first cut
+        double lastCut = -kInf;
+        for (size_t i = 0; i < n && alive > 1e-6; ++i) {
+            const DepthEvent& e = event(i);
+            if (e.cut && e.z != lastCut) {
+                cost += alive * model.visit;
+                lastCut = e.z;
+            }
+            cost += alive * model.test * e.weight;
+            alive *= 1.0 - e.kill;
         }
-        cost += alive * model.test * e.weight;
-        alive *= 1.0 - e.kill;
+        return cost;
+    };
+    const double cost = sweep([&](size_t i) -> const DepthEvent& { return events[keys[i].event]; });
+    if (params.checkOrders) {
+        std::vector<DepthEvent> sorted(events.begin(), events.begin() + ptrdiff_t(n));
+        std::sort(sorted.begin(), sorted.end(),
+                  [](const DepthEvent& a, const DepthEvent& b) { return a.z < b.z; });
+        const double plain = sweep([&](size_t i) -> const DepthEvent& { return sorted[i]; });
+        for (size_t i = 0; i < n; ++i) {
+            const DepthEvent &a = events[keys[i].event], &b = sorted[i];
+            if (std::memcmp(&a.z, &b.z, sizeof a.z) != 0 || a.weight != b.weight ||
+                a.kill != b.kill || a.cut != b.cut || std::memcmp(&cost, &plain, sizeof cost))
+                throw std::logic_error("walkCost: the keys' order is not the events' sort's");
+        }
     }
     return cost;
 }
@@ -529,7 +575,7 @@ ScreenBsp ScreenBsp::build(const std::vector<Box3>& rect, const std::vector<uint
         return c.segs.empty() ||
                (params.stopObjects > 0 && c.prims.size() <= size_t(params.stopObjects));
     };
-    std::vector<DepthEvent> events;
+    DepthEvents events;
     // Which child of each node was split first in depth-first order (the one with fewer
     // segments, the upper one on a tie): the final numbering follows it (see below).
     std::vector<uint8_t> firstSide;

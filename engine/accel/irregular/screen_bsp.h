@@ -71,8 +71,9 @@ struct ScreenBspParams {
     /// endpoints at each split: the same lines, in O(n) a cell (docs/irregular.md, "Build
     /// speed"). false: every cell sorts, as a check of the presorted build.
     bool presorted = true;
-    /// Check every presorted cell's orders against a fresh sort of its segments (tests); a
-    /// mismatch throws std::logic_error.
+    /// Check every presorted cell's orders against a fresh sort of its segments, and every walk
+    /// model cost against the sweep of its depth events sorted themselves by std::sort, bit for
+    /// bit (tests); a mismatch throws std::logic_error.
     bool checkOrders = false;
 };
 
