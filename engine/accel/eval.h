@@ -194,8 +194,8 @@ struct UnionFirstStart {
     }
     /// The region's hit, once every primitive of `keys` was added: the first start when it is
     /// inside the window, else the end of the stretch the ray starts in, from the merged spans.
-    // Inlined: called from more than one walk, it was left out of line, which cost the regular
-    // walk 2.8 M instructions of balls4's 91.7 M (callgrind, 2026-12-07).
+    // Inlined by force: with two walks calling it the compiler left it out of line, a call in
+    // every union leaf (docs/irregular.md, "Union-only regions: the hit from the first start").
     [[gnu::always_inline]] bool hit(const uint32_t* keys, uint32_t count, TraceContext& ctx,
                                     Hit& out) const {
         if (!found) return false;

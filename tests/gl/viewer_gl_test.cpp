@@ -1360,6 +1360,19 @@ TEST_F(ViewerFrames, PanelsFitTheirContentAndStayOnScreen) {
     runUntilSettled();
 }
 
+// The image step's GL work is finished and learned in every frame, and the steps before it
+// keep back its learned cost with room for the inspector's pieces when that is more than
+// their fixed 9 ms (with the inspector shown, that flush was 3-7 ms of its step on balls4,
+// which no learned cost covered).
+TEST_F(ViewerFrames, TheImagesFlushIsLearnedAndKeptBackWhenMoreThanTheFixedReserve) {
+    EXPECT_DOUBLE_EQ(app_->imageFlushEstimateMs(), 6.0) << "the figure until measured";
+    app_->frame(kW, kH);
+    EXPECT_NE(app_->imageFlushEstimateMs(), 6.0) << "measured in the frame";
+    EXPECT_DOUBLE_EQ(ViewerApp::layerReserveMs(0.0), 9.0);
+    EXPECT_DOUBLE_EQ(ViewerApp::layerReserveMs(6.0), 9.0);
+    EXPECT_DOUBLE_EQ(ViewerApp::layerReserveMs(10.0), 13.0);
+}
+
 // An error line appearing in Parameters does not move the controls under it.
 TEST_F(ViewerFrames, TheErrorLineIsReservedSoTheControlsStayPut) {
     runUntilSettled();
