@@ -894,6 +894,48 @@ TEST(Overlays, ATextureOfANewSizeIsMadeWhenItsLearnedCostFitsAndDrawnIntoFromThe
     t.ov.setFrameBudget(nullptr, 0.0);
 }
 
+TEST(Overlays, NoStepOfTheLayerWaitsForEverBesideWhatEachFrameSpendsBeforeIt) {
+    // The quiet machine's run that never settled (balls4's slabs with the inspector at
+    // 1280x720, 2026-12-07): the texture's learned cost (10 ms at 1280x720) is within the
+    // budget less the reserve (23 ms), so it is not made at once, yet never fits beside what
+    // each frame spends before the layer. Here each frame spends 24 ms before it: neither the
+    // texture nor any part of the layer ever fits. Each still starts after kPatienceFrames
+    // frames of waiting: the layer is whole within a bounded number of frames, as drawn
+    // without a budget.
+    LeavesInParts t;
+    ASSERT_TRUE(t.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    constexpr int w = 1280, h = 720;
+    const size_t total = t.ov.layerLines();
+    ASSERT_GT(total, 12u);
+    for (Overlays* o : {&t.free, &t.ov}) {
+        o->update(t.s, t.cam, w, h);
+        o->look.restLines = total / 4 + 1;  // four parts
+        o->look.restMs = 1e9;               // as many parts a frame as the budget allows
+    }
+    double now = 0.0;
+    FrameBudget budget(33.0, [&] { return now; });
+    t.ov.setFrameBudget(&budget, 10.0);
+    // The texture's frame, then one frame a part, each after its patience.
+    constexpr int parts = 4;
+    constexpr int bound = (1 + parts) * int(kPatienceFrames + 1);
+    int frames = 0, forced = 0;
+    while ((t.ov.layerVersion() == 0 || t.ov.layerPending()) && frames < 10 * bound) {
+        budget.begin();
+        now += 24.0;
+        t.ov.layerTexture(t.cam, w, h);
+        forced += budget.forced();
+        ++frames;
+    }
+    EXPECT_LE(frames, bound) << "the texture and each part within their patience";
+    EXPECT_EQ(forced, 1 + parts) << "each let in over the budget, once a frame";
+    ASSERT_FALSE(t.ov.layerPending());
+    EXPECT_EQ(t.ov.layerDrawn(), total);
+    const unsigned whole = t.free.layerTexture(t.cam, w, h);
+    ASSERT_FALSE(t.free.layerPending());
+    EXPECT_EQ(texels(t.ov.layerTexture(t.cam, w, h), w, h), texels(whole, w, h));
+    t.ov.setFrameBudget(nullptr, 0.0);
+}
+
 /// Two boxes' regular leaves built at once (direct) and on a worker (ov).
 struct LeavesInTheBackground {
     OffscreenGl gl{kW, kH};

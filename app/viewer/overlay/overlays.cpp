@@ -183,9 +183,11 @@ void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms, 
 void Overlays::uploadMore() {
     // With the frame's budget: once a frame (update() runs twice in one), and only while the
     // budget is not spent; the copy goes on in the next frames.
-    // Each part starts only when its learned cost fits in what the budget leaves.
+    // Each part starts only when its learned cost fits in what the budget leaves (the first of
+    // a frame also after kPatienceFrames frames of waiting).
     const auto fits = [this] {
-        return !budget_ || budget_->fits(uploadCost_.estimateMs(1), budgetReserveMs_);
+        return !budget_ ||
+               budget_->fits(uploadCost_.estimateMs(1), budgetReserveMs_, uploadPatience_);
     };
     if (budget_ && !uploaded()) {
         if (budget_->frame() == uploadFrame_ || !fits()) return;
@@ -297,10 +299,12 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
     // read-back in one frame, whatever the first part's estimate (none for an empty layer),
     // they took balls4's first structure 21-32 ms of the overlays step. Until then the layer
     // shown stays. A texture that no frame's budget less the reserve would hold is made at
-    // once (never waiting for ever: a larger window's viewer never settled).
+    // once (a larger window's viewer never settled), and one that would fit but not beside
+    // what the frames spend before it is made after kPatienceFrames frames of waiting (on a
+    // quiet machine it waited for ever).
     const double textureMs = textureCost_.estimateMs(texels);
     if (newSize && !moving && budget_ && textureMs <= budget_->budgetMs() - budgetReserveMs_ &&
-        !budget_->fits(textureMs, budgetReserveMs_)) {
+        !budget_->fits(textureMs, budgetReserveMs_, texturePatience_)) {
         layerDeferred_ = true;
         return layerVersion_ == 0 ? 0 : layerTex_;
     }
@@ -355,9 +359,9 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
     }
     // At rest the layer is optional work: when its first part's learned cost does not fit in
     // what the frame's budget leaves, the texture stays as it is (the last one, whole or in
-    // part) and is drawn in a later frame. A moving camera's layer draws a first part in any
-    // case (it follows the view), as many lines as fit (OverlayLook::movingMinLines at least),
-    // its others when they fit.
+    // part) and is drawn in a later frame (after kPatienceFrames at most). A moving camera's layer
+    // draws a first part in any case (it follows the view), as many lines as fit
+    // (OverlayLook::movingMinLines at least), its others when they fit.
     const size_t partLines = std::max<size_t>(look.restLines, 1);
     StepCost& cost = moving ? movingLineCost_ : restLineCost_;
     const size_t from = resume ? layerDrawn_ : 0;
@@ -365,7 +369,7 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
         !moving && budget_ &&
         !budget_->fits(cost.estimateMs(double(
                            std::min(inParts ? partLines : total, ready - std::min(ready, from)))),
-                       budgetReserveMs_);
+                       budgetReserveMs_, partPatience_);
     if (layerDeferred_) {
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         return layerVersion_ == 0 ? 0 : layerTex_;  // none before the first drawing
