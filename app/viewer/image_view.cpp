@@ -296,8 +296,9 @@ void ImageView::finishOffScreen(ViewMode mode) const {
         // Showing it copies its rows (and makes the texture at a new size: 30-40 ms of the
         // image step with the last parts in one frame, balls4 at 1280x720 under load,
         // 2026-12-07): after parts in this draw only if its learned cost fits, else in the
-        // next draw whatever the budget.
-        if (composing && !budget_->fits(showEstimateMs(), budgetReserveMs_)) return;
+        // next draw whatever the budget, or, while a finer pass's rows keep coming, after
+        // kPatienceFrames draws.
+        if (composing && !budget_->fits(showEstimateMs(), budgetReserveMs_, showPatience_)) return;
     }
     offScreen_ = false;
 }

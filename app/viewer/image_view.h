@@ -244,6 +244,9 @@ class ImageView {
     /// The UI thread's CPU per texel to make the texture at a new size (9.6 ms at 1280x720 on
     /// the loaded 2-core machine, 2026-12-07).
     mutable StepCost textureCost_{9.6 / (1280.0 * 720.0)};
+    /// The draws in a row a released view, all its rows composited, waited to be shown for
+    /// the budget (finishOffScreen()): shown whatever the budget after kPatienceFrames.
+    mutable Patience showPatience_{"the image's showing"};
     /// The last draw() was held: the next unheld one composites all pending rows (the view
     /// released must show whole).
     mutable bool drawnHeld_ = false;

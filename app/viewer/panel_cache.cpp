@@ -209,10 +209,20 @@ void PanelCache::render() {
     // makes the ones above it that it overlaps drawn too.
     std::vector<char> dirty(panels_.size(), 0);
     std::vector<unsigned> stillInvalid;
+    // Each panel's patience, kept for the frame's panels only (a closed one's is dropped).
+    std::vector<std::pair<unsigned, Patience>> patience;
+    patience.reserve(panels_.size());
+    for (const Panel& panel : panels_) {
+        auto it = std::find_if(patience_.begin(), patience_.end(),
+                               [&](const auto& e) { return e.first == panel.id; });
+        patience.emplace_back(panel.id,
+                              it != patience_.end() ? it->second : Patience("a panel's redraw"));
+    }
+    patience_ = std::move(patience);
     for (size_t i = 0; i < panels_.size(); ++i) {
         if (need[i] == kContent && !dirty[i] && budget_ &&
             !budget_->fits(redrawEstimateMs(area(panels_[i].rect)),
-                           budgetReserveMs_ + copyCost_.estimateMs(1))) {
+                           budgetReserveMs_ + copyCost_.estimateMs(1), patience_[i].second)) {
             ++deferred_;
             if (std::find(invalid_.begin(), invalid_.end(), panels_[i].id) != invalid_.end())
                 stillInvalid.push_back(panels_[i].id);

@@ -13,6 +13,7 @@
 struct ImGuiWindow;  // imgui_internal.h
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "app/viewer/image_view.h"  // PixelRect
@@ -47,7 +48,8 @@ class PanelCache {
     /// nothing else: not moved, not uncovered, nothing redrawn under it) is rasterized again
     /// only when the learned cost of a redraw fits in the frame's budget less `reserveMs` and
     /// the learned cost of the copies; else the layer shows its last content until a later
-    /// frame. The budget must outlive the cache or be unset.
+    /// frame (kPatienceFrames frames at most: the next redraws it whatever the budget). The
+    /// budget must outlive the cache or be unset.
     void setFrameBudget(FrameBudget* budget, double reserveMs) {
         budget_ = budget;
         budgetReserveMs_ = reserveMs;
@@ -100,6 +102,9 @@ class PanelCache {
     int w_ = 0, h_ = 0;  ///< the layer's size
     int redrawn_ = 0;
     int deferred_ = 0;
+    /// By window ID, the frames in a row a panel's new content waited for the budget (never
+    /// starved: redrawn whatever the budget after kPatienceFrames); the frame's panels only.
+    std::vector<std::pair<unsigned, Patience>> patience_;
     FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
     double budgetReserveMs_ = 0.0;
     /// Learned (FrameBudget's clock): a panel drawn again, by its pixels (at first 1.5 ms for a

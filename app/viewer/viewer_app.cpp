@@ -24,8 +24,10 @@ namespace {
 /// of the steps after it (the image's rows to composite, the composite of the layer's changes,
 /// the inspector's copy to the window, the panel layer and the swap, added each frame): the
 /// flush of the frame's drawing before the inspector (about 6 ms) and room for the inspector's
-/// pieces. See the constructor.
+/// pieces, or more (layerReserveMs()). See the constructor.
 constexpr double kLayerReserveMs = 9.0;
+/// Of kLayerReserveMs, the room for the inspector's pieces beside the flush.
+constexpr double kInspectorRoomMs = 3.0;
 /// What the inspector's and the panels' optional work keeps back for the swap and what follows
 /// the frame's steps (0.1-0.5 ms, 2026-12-07).
 constexpr double kSwapReserveMs = 1.0;
@@ -113,6 +115,10 @@ void ViewerApp::keepSettings() {
 }
 
 ViewerApp::~ViewerApp() = default;
+
+double ViewerApp::layerReserveMs(double flushMs) {
+    return std::max(kLayerReserveMs, kInspectorRoomMs + flushMs);
+}
 
 void ViewerApp::pickPixel(int x, int y, int ray, int step) {
     player_.pickScripted({x, y, ray, step});
@@ -275,7 +281,8 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
             covered.push_back(r);
     const double panelsMs = panels_.estimateMs() + kSwapReserveMs;
     inspector_->setFrameBudget(&budget_, panelsMs);
-    overlays_->setFrameBudget(&budget_, kLayerReserveMs + panelsMs + inspector_->showEstimateMs() +
+    const double layerReserve = layerReserveMs(imageFlushCost_.estimateMs(1));
+    overlays_->setFrameBudget(&budget_, layerReserve + panelsMs + inspector_->showEstimateMs() +
                                             view_->shadeEstimateMs(s.mode) +
                                             (layerDraws ? composite.estimateMs(1) : 0.0));
     const uint64_t layerVersion = overlays_->layerVersion();
@@ -285,7 +292,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     // A new view held off the screen is composited in parts as its rows come, within the
     // budget (the steps after it keep what the layer keeps for them), so that its release
     // only copies it.
-    if (state_.holdImage()) view_->composeHeld(budget_, kLayerReserveMs);
+    if (state_.holdImage()) view_->composeHeld(budget_, layerReserve);
     glViewport(0, 0, fbWidth, fbHeight);
     glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
     std::vector<PixelRect> views;
@@ -300,13 +307,20 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     view_->setViewport(area);
     // A finer pass's rows composite within what the steps after the image keep (as the layer
     // keeps for them, less the image's own estimate): the rest waits for the next frames.
-    view_->setFrameBudget(&budget_, kLayerReserveMs + panelsMs + inspector_->showEstimateMs());
+    view_->setFrameBudget(&budget_, layerReserve + panelsMs + inspector_->showEstimateMs());
     const double imageStart = budget_.spentMs();
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale,
                 state_.heatDiverging());
     // What compositing the layer's changes took (the rows of a pass aside), learned.
     if (layerChanged && view_->lastShade().texels > 0 && view_->lastShade().rows == 0)
         composite.record(1, budget_.spentMs() - imageStart);
+    // The frame's GL work so far (the image's copy to the window, the clears around it)
+    // finished and learned here, so that the steps before it keep it back (layerReserveMs()):
+    // with the inspector shown it was its step's flush (3-7 ms), which no learned cost
+    // covered.
+    const double flushStart = budget_.spentMs();
+    glFinish();
+    imageFlushCost_.record(1, budget_.spentMs() - flushStart);
     phases_.mark("image");
 
     // 4b. The 3D inspector beside the image (the image is not copied under it), with the

@@ -156,6 +156,14 @@ class ViewerApp {
     /// Panels the last frame rasterized again (the rest were copied from the panel layer).
     int panelsRedrawn() const { return panels_.redrawn(); }
     const FrameBudget& frameBudget() const { return budget_; }
+    /// What the steps before the image's copy (the layer, a held view's and a finer pass's
+    /// composites) keep back of the frame's budget beside the learned costs of the steps
+    /// after them, in ms: 9 (the flush of the frame's GL work after the image step, about 6
+    /// ms, and room for the inspector's pieces), or, when more, that flush's learned cost
+    /// (`flushMs`) and that room.
+    static double layerReserveMs(double flushMs);
+    /// The learned cost of that flush, in ms (6 until measured).
+    double imageFlushEstimateMs() const { return imageFlushCost_.estimateMs(1); }
 
   private:
     /// Upload rows [rowBegin, rowEnd) (-1: to the last) of the image on screen, with the heat
@@ -195,6 +203,9 @@ class ViewerApp {
     Clock::time_point lastFrame_ = Clock::now();
     FramePhases phases_;                  ///< the last frame's CPU time by step
     FrameBudget budget_{kFrameBudgetMs};  ///< begun at each frame()
+    /// The flush of the frame's GL work after the image step (its copy to the window, the
+    /// clears around it), learned: 6 ms to begin with (balls4's slabs, 2026-12-07).
+    StepCost imageFlushCost_{6.0};
     /// The image step's cost when the layer changed (its changed texels composited again), at
     /// rest [0] and while the camera moves [1]: kept back from the layer's budget. 8.6 ms (a
     /// whole 1280x720 composite) to begin with.

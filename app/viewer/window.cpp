@@ -343,6 +343,15 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                                  app.phases().summary().c_str(), cpuMs - app.phases().totalMs(),
                                  app.panelsRedrawn(), app.frameBudget().deferred());
             }
+            // A step let in over the budget (it had waited its patience) says why it waited.
+            if (v.logTimings)
+                for (const FrameBudget::Forced& f : app.frameBudget().forcedSteps())
+                    std::fprintf(stderr,
+                                 "timing: frame %d: %s let in over the budget after %u frames "
+                                 "of waiting: %.1f ms estimated, %.1f ms left beyond its "
+                                 "reserve of %.1f ms\n",
+                                 frames, f.step, kPatienceFrames, f.estimateMs, f.leftMs,
+                                 f.reserveMs);
             ++statFrames;
             if (v.logTimings && Clock::now() - statStart > std::chrono::seconds(2)) {
                 double secs = std::chrono::duration<double>(Clock::now() - statStart).count();

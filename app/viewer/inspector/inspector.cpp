@@ -569,7 +569,8 @@ void Inspector::draw(int fbWidth, int fbHeight) {
     // if its learned cost fits in what is left. Finished with nothing to draw too, so that the
     // picture's copy is learned apart from that work.
     if (budget_) glFinish();
-    const bool deferred = work && budget_ && !budget_->fits(nextPieceMs(), reserveMs());
+    const bool deferred =
+        work && budget_ && !budget_->fits(nextPieceMs(), reserveMs(), piecePatience_);
     pictureDeferred_ = deferred;
     if (!deferred && dirtyPicture_)
         render();

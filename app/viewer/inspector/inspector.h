@@ -105,7 +105,8 @@ class Inspector {
     /// picture (a band of its surfaces' rows, a part of its lines) only when the piece's
     /// learned cost fits in the frame's budget less `reserveMs` and the learned cost of
     /// copying the picture to the window after it, and leaves the rest to later
-    /// draws; the picture on screen stays until then. The budget must outlive the inspector or
+    /// draws; the picture on screen stays until then (a draw's first piece waits
+    /// kPatienceFrames draws at most). The budget must outlive the inspector or
     /// be unset.
     void setFrameBudget(FrameBudget* budget, double reserveMs) {
         budget_ = budget;
@@ -218,6 +219,9 @@ class Inspector {
     FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
     double budgetReserveMs_ = 0.0;
     bool pictureDeferred_ = false;  ///< the last draw() left the picture for the budget
+    /// The draws in a row the picture's first piece waited for the budget: it starts whatever
+    /// the budget after kPatienceFrames (never starved).
+    Patience piecePatience_{"the inspector's first piece"};
     glm::mat4 pictureToClip_{1.0f};
     BackgroundJob<InspectorModel> job_;  ///< last: its worker joined before the rest is destroyed
 };

@@ -183,9 +183,11 @@ void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms, 
 void Overlays::uploadMore() {
     // With the frame's budget: once a frame (update() runs twice in one), and only while the
     // budget is not spent; the copy goes on in the next frames.
-    // Each part starts only when its learned cost fits in what the budget leaves.
+    // Each part starts only when its learned cost fits in what the budget leaves (the first of
+    // a frame also after kPatienceFrames frames of waiting).
     const auto fits = [this] {
-        return !budget_ || budget_->fits(uploadCost_.estimateMs(1), budgetReserveMs_);
+        return !budget_ ||
+               budget_->fits(uploadCost_.estimateMs(1), budgetReserveMs_, uploadPatience_);
     };
     if (budget_ && !uploaded()) {
         if (budget_->frame() == uploadFrame_ || !fits()) return;
@@ -289,11 +291,29 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
                            layerHeight_ == height && layerLook_ == look &&
                            sameCamera(layerCamera_, view);
     if (moving && layerPartial_ && sameLayer) return layerTex_;  // the capped layer of this view
+    const bool newSize = layerWidth_ != width || layerHeight_ != height;
+    const double texels = double(width) * double(height);
+    // At rest a texture of a new size (the first structure's, a resized window's) is made
+    // only when its learned cost fits in what the frame's budget leaves: llvmpipe zeroes its
+    // storage (10 ms at 1280x720, 2026-12-07). Made with the layer's first drawing and its
+    // read-back in one frame, whatever the first part's estimate (none for an empty layer),
+    // they took balls4's first structure 21-32 ms of the overlays step. Until then the layer
+    // shown stays. A texture that no frame's budget less the reserve would hold is made at
+    // once (a larger window's viewer never settled), and one that would fit but not beside
+    // what the frames spend before it is made after kPatienceFrames frames of waiting (on a
+    // quiet machine it waited for ever).
+    const double textureMs = textureCost_.estimateMs(texels);
+    if (newSize && !moving && budget_ && textureMs <= budget_->budgetMs() - budgetReserveMs_ &&
+        !budget_->fits(textureMs, budgetReserveMs_, texturePatience_)) {
+        layerDeferred_ = true;
+        return layerVersion_ == 0 ? 0 : layerTex_;
+    }
     if (layerTex_ == 0) {
         glGenTextures(1, &layerTex_);
         glGenFramebuffers(1, &layerFbo_);
     }
-    if (layerWidth_ != width || layerHeight_ != height) {
+    if (newSize) {
+        const double madeAt = budget_ ? budget_->spentMs() : 0.0;
         glBindTexture(GL_TEXTURE_2D, layerTex_);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -304,8 +324,23 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
         glBindTexture(GL_TEXTURE_2D, 0);
         glBindFramebuffer(GL_FRAMEBUFFER, layerFbo_);
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, layerTex_, 0);
+        if (budget_) {
+            glFinish();  // timed: the storage is made
+            textureCost_.record(texels, budget_->spentMs() - madeAt);
+        }
         layerWidth_ = width;
         layerHeight_ = height;
+        // Nothing of the layer is in it: its first part starts afresh, at rest in a later
+        // frame, so that the layer's first drawing and its read-back (ImageView::setOverlay,
+        // 10 ms into a new buffer at 1280x720) do not fall in this one too.
+        layerRebuild_ = ~uint64_t(0);
+        layerPartial_ = false;
+        layerDrawn_ = 0;
+        if (!moving && budget_) {
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            layerDeferred_ = true;
+            return layerVersion_ == 0 ? 0 : layerTex_;  // the texture's id is the same
+        }
     }
     const auto t0 = std::chrono::steady_clock::now();
     glBindFramebuffer(GL_FRAMEBUFFER, layerFbo_);
@@ -324,9 +359,9 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
     }
     // At rest the layer is optional work: when its first part's learned cost does not fit in
     // what the frame's budget leaves, the texture stays as it is (the last one, whole or in
-    // part) and is drawn in a later frame. A moving camera's layer draws a first part in any
-    // case (it follows the view), as many lines as fit (OverlayLook::movingMinLines at least),
-    // its others when they fit.
+    // part) and is drawn in a later frame (after kPatienceFrames at most). A moving camera's layer
+    // draws a first part in any case (it follows the view), as many lines as fit
+    // (OverlayLook::movingMinLines at least), its others when they fit.
     const size_t partLines = std::max<size_t>(look.restLines, 1);
     StepCost& cost = moving ? movingLineCost_ : restLineCost_;
     const size_t from = resume ? layerDrawn_ : 0;
@@ -334,10 +369,10 @@ unsigned Overlays::layerTexture(const Camera& view, int width, int height, bool 
         !moving && budget_ &&
         !budget_->fits(cost.estimateMs(double(
                            std::min(inParts ? partLines : total, ready - std::min(ready, from)))),
-                       budgetReserveMs_);
+                       budgetReserveMs_, partPatience_);
     if (layerDeferred_) {
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        return layerTex_;
+        return layerVersion_ == 0 ? 0 : layerTex_;  // none before the first drawing
     }
     if (!resume) {
         glClearColor(0.0f, 0.0f, 0.0f, 0.0f);

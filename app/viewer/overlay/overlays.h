@@ -134,7 +134,11 @@ class Overlays {
     /// learned cost fits in the frame's budget less `reserveMs` (kept for the steps after
     /// them); the rest goes on in the next frames. At rest no part is drawn then; a moving
     /// camera's layer draws a first part in any case, of as many lines as fit
-    /// (OverlayLook::movingMinLines at least). The budget must outlive the overlays or be unset.
+    /// (OverlayLook::movingMinLines at least). At rest the texture of a new size is made only
+    /// when its learned cost fits, and the layer is drawn into it from the next call. None of
+    /// these waits for ever: after kPatienceFrames frames deferred in a row, the first part of
+    /// the next starts whatever the budget (FrameBudget::fits() with a Patience). The budget
+    /// must outlive the overlays or be unset.
     void setFrameBudget(FrameBudget* budget, double reserveMs) {
         budget_ = budget;
         budgetReserveMs_ = reserveMs;
@@ -261,6 +265,15 @@ class Overlays {
     StepCost uploadCost_{4.0};
     StepCost movingLineCost_{7.0 / 1000.0};
     StepCost restLineCost_{5.0 / 500.0};
+    /// A texel of the layer's texture made at a new size (llvmpipe zeroes its storage): 10 ms
+    /// at 1280x720 to begin with (balls4's first structure, 2026-12-07).
+    StepCost textureCost_{10.0 / (1280.0 * 720.0)};
+    /// The frames in a row the batches' copy, the texture of a new size and the layer's first
+    /// part at rest waited for the budget: each starts whatever the budget after
+    /// kPatienceFrames (never starved).
+    Patience uploadPatience_{"the layer's batches copied to GL"};
+    Patience texturePatience_{"the layer's texture of a new size"};
+    Patience partPatience_{"the layer's first part at rest"};
     Camera layerCamera_;
     OverlayLook layerLook_;
     std::optional<Selection> selection_;

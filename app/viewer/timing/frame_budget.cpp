@@ -16,6 +16,7 @@ FrameBudget::FrameBudget(double ms, Clock clock)
 void FrameBudget::begin() {
     start_ = clock_();
     deferred_ = 0;
+    forced_.clear();
     ++frame_;
 }
 
@@ -30,6 +31,25 @@ bool FrameBudget::allows(double reserveMs) {
 bool FrameBudget::fits(double estimateMs, double reserveMs) {
     if (leftMs(reserveMs) >= estimateMs) return true;
     ++deferred_;
+    return false;
+}
+
+bool FrameBudget::fits(double estimateMs, double reserveMs, Patience& patience) {
+    // Only a step's first part of a frame counts: one that started a part in this frame has
+    // made progress, and a frame is counted once however often the step asks in it.
+    const bool firstAsk = patience.startedFrame_ != frame_ && patience.waitedFrame_ != frame_;
+    const bool fitsNow = leftMs(reserveMs) >= estimateMs;
+    if (fitsNow || (firstAsk && patience.waited_ >= kPatienceFrames)) {
+        if (!fitsNow) forced_.push_back({patience.step_, estimateMs, leftMs(reserveMs), reserveMs});
+        patience.startedFrame_ = frame_;
+        patience.waited_ = 0;
+        return true;
+    }
+    ++deferred_;
+    if (firstAsk) {
+        patience.waitedFrame_ = frame_;
+        ++patience.waited_;
+    }
     return false;
 }
 

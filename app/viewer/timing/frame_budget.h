@@ -8,12 +8,43 @@
 // steps after it, is spent, and goes on in the next frame. A step whose work comes in parts
 // learns what a part costs (StepCost) and starts one only when that cost fits in what is left
 // (fits()): a part begun with a little budget left once ran over by its whole cost (frames of
-// 33-41 ms on balls4's slabs with the inspector, 2026-12-06).
+// 33-41 ms on balls4's slabs with the inspector, 2026-12-06). No step starves: one whose work
+// waited kPatienceFrames frames in a row starts its first part of the next frame whatever the
+// budget (fits() with the step's Patience). Without that bound a part that fitted in the
+// budget less its reserve but never beside what the frame had spent before it waited for
+// ever: on a quiet machine the overlay layer's texture of a new size was deferred in every
+// frame of a 10-minute run (balls4's slabs with the inspector at 1280x720, 2026-12-07).
 #pragma once
 
 #include <functional>
+#include <vector>
 
 namespace lancer::viewer {
+
+/// Frames in a row a step's work may wait for the budget: in the next one its first part
+/// starts whatever the budget (FrameBudget::fits() with a Patience).
+inline constexpr unsigned kPatienceFrames = 2;
+
+/// What a step whose work the budget defers keeps from frame to frame, so that it never
+/// starves: the frames in a row its work waited without a part started. One per step (per
+/// kind of part: a texture to make, a layer's part, a panel's redraw), owned by the step.
+class Patience {
+  public:
+    /// A step named `step` (a string literal: --log-timings prints it when the step is let in
+    /// over the budget).
+    explicit Patience(const char* step = "step") : step_(step) {}
+    /// Frames in a row the step's work waited for the budget (none started since).
+    unsigned waited() const { return waited_; }
+    /// The step's name.
+    const char* step() const { return step_; }
+
+  private:
+    friend class FrameBudget;
+    const char* step_;
+    unsigned long startedFrame_ = 0;  ///< the last frame a part of the step started
+    unsigned long waitedFrame_ = 0;   ///< the last frame counted in waited_
+    unsigned waited_ = 0;
+};
 
 class FrameBudget {
   public:
@@ -38,6 +69,23 @@ class FrameBudget {
     /// when `reserveMs` are kept for later steps. A step that stops here is counted
     /// (deferred()).
     bool fits(double estimateMs, double reserveMs = 0.0);
+    /// As fits(), for a step that must not starve: its first part of a frame also starts, over
+    /// the budget, when its work waited kPatienceFrames frames in a row before this one (the
+    /// step's `patience` keeps that count; a part that starts resets it). A part let in over
+    /// the budget is counted (forced()), not deferred.
+    bool fits(double estimateMs, double reserveMs, Patience& patience);
+    /// Parts let in over the budget since begin() (the never-starving bound).
+    int forced() const { return static_cast<int>(forced_.size()); }
+    /// A part let in over the budget: the step, its estimate, and what was left of the
+    /// budget beyond its reserve (negative: over) when it started.
+    struct Forced {
+        const char* step;
+        double estimateMs;
+        double leftMs;
+        double reserveMs;
+    };
+    /// The parts let in over the budget since begin(), in order (--log-timings says why).
+    const std::vector<Forced>& forcedSteps() const { return forced_; }
     /// Steps that stopped for the budget since begin().
     int deferred() const { return deferred_; }
     /// The budget per frame, in ms.
@@ -50,6 +98,7 @@ class FrameBudget {
     Clock clock_;
     double start_ = 0.0;
     int deferred_ = 0;
+    std::vector<Forced> forced_;
     unsigned long frame_ = 0;
 };
 

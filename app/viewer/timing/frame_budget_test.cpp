@@ -62,6 +62,56 @@ TEST(FrameBudget, APartStartsOnlyWhenItsLearnedCostFitsInWhatIsLeft) {
     EXPECT_FALSE(b.fits(band.estimateMs(13), 0.0));
 }
 
+TEST(FrameBudget, AStepThatWaitedItsPatienceStartsItsFirstPartWhateverTheBudget) {
+    // Every frame spent before the step: a part never fits, yet the step starts one after
+    // kPatienceFrames frames of waiting, the first of its frame only, and waits again after.
+    double now = 0.0;
+    FrameBudget b(33.0, [&] { return now; });
+    Patience p;
+    int started = 0, frames = 0;
+    for (; frames < 3 * int(kPatienceFrames + 1); ++frames) {
+        b.begin();
+        now += 40.0;
+        if (b.fits(5.0, 0.0, p)) {
+            ++started;
+            EXPECT_EQ(frames % int(kPatienceFrames + 1), int(kPatienceFrames)) << frames;
+            EXPECT_EQ(b.forced(), 1);
+            EXPECT_EQ(b.deferred(), 0) << "let in over the budget: not deferred";
+            EXPECT_EQ(p.waited(), 0u);
+            EXPECT_FALSE(b.fits(5.0, 0.0, p)) << "a second part of the frame waits";
+            EXPECT_EQ(p.waited(), 0u) << "the step made progress in this frame";
+        } else {
+            EXPECT_EQ(b.forced(), 0);
+            EXPECT_EQ(b.deferred(), 1);
+            EXPECT_FALSE(b.fits(5.0, 0.0, p)) << "asked again in the frame";
+            EXPECT_EQ(p.waited(), unsigned(frames % int(kPatienceFrames + 1)) + 1)
+                << "a frame counted once";
+        }
+    }
+    EXPECT_EQ(started, 3);
+    // A part that fits starts and resets the count, as one let in over the budget does.
+    b.begin();
+    now += 40.0;
+    EXPECT_FALSE(b.fits(5.0, 0.0, p));
+    EXPECT_EQ(p.waited(), 1u);
+    b.begin();
+    EXPECT_TRUE(b.fits(5.0, 0.0, p));
+    EXPECT_EQ(b.forced(), 0);
+    EXPECT_EQ(p.waited(), 0u);
+    // Each step has its own count: one that waited does not let in another.
+    Patience other;
+    for (unsigned i = 0; i < kPatienceFrames; ++i) {
+        b.begin();
+        now += 40.0;
+        EXPECT_FALSE(b.fits(5.0, 0.0, p));
+    }
+    b.begin();
+    now += 40.0;
+    EXPECT_FALSE(b.fits(5.0, 0.0, other)) << "its first frame of waiting";
+    EXPECT_TRUE(b.fits(5.0, 0.0, p)) << "its patience spent";
+    EXPECT_EQ(b.forced(), 1);
+}
+
 TEST(FrameBudget, ByDefaultTheUiThreadsCpuTime) {
     FrameBudget b(33.0);
     b.begin();
