@@ -490,6 +490,61 @@ struct ViewWithBudget : GlWithBudget {
     }
 };
 
+// The rows of a view composited off the screen at the picture's size are copied into the back
+// texture as they are composited, and showing the view swaps that texture in: the frame that
+// shows it copies no row (a released view's 720 rows took 13-19 ms of that frame's image step
+// at 1280x720, over the budget, 2026-12-07). A view composited only in part has the rows
+// around it copied from the picture before. Each picture equals its whole composite.
+TEST(ViewerGl, AViewCompositedOffTheScreenIsShownBySwappingInItsBackTexture) {
+    const int w = 160, h = 120;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    const auto [a, b] = twoViews(w, h);
+    const std::vector<uint8_t> texels = scatteredLayer(w, h, 23, 2, 160, 200);
+    const unsigned tex = layerTextureOf(w, h, texels);
+    ImageView view;
+    view.upload(a, ViewMode::Color);
+    view.setOverlay(tex, 1);
+    gl.clear(0, 0, 0);
+    view.draw(w, h, ViewMode::Color, 1.0f);
+    EXPECT_EQ(view.lastShade().rows, h) << "the first picture: composited whole";
+    double now = 0.0;  // a clock only the test moves: every frame has room
+    FrameBudget budget(33.0, [&] { return now; });
+    auto show = [&] {
+        view.setHold(false);
+        gl.clear(0, 0, 0);
+        view.draw(w, h, ViewMode::Color, 1.0f);
+        return gl.read();
+    };
+    // View b, held and composited whole, then released: no row copied to show it.
+    view.setHold(true);
+    view.upload(b, ViewMode::Color);
+    budget.begin();
+    EXPECT_EQ(view.composeHeld(budget, 5.0), h);
+    EXPECT_EQ(show(), wholeComposite(gl, b, texels));
+    EXPECT_EQ(view.lastShade().rows, 0);
+    EXPECT_EQ(view.lastShade().shownRows, 0) << "the back texture swapped in";
+    // View a's first 40 rows, held and composited, then released: the other rows, b's, copied
+    // beside them.
+    view.setHold(true);
+    view.upload(a, ViewMode::Color, 0, 40);
+    budget.begin();
+    EXPECT_EQ(view.composeHeld(budget, 5.0), 40);
+    Image mixed = b;
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < w; ++x) mixed.color[mixed.index(x, y)] = a.color[a.index(x, y)];
+    EXPECT_EQ(show(), wholeComposite(gl, mixed, texels));
+    EXPECT_EQ(view.lastShade().shownRows, h - 40);
+    // And b whole again, into the texture that was on screen before.
+    view.setHold(true);
+    view.upload(b, ViewMode::Color);
+    budget.begin();
+    EXPECT_EQ(view.composeHeld(budget, 5.0), h);
+    EXPECT_EQ(show(), wholeComposite(gl, b, texels));
+    EXPECT_EQ(view.lastShade().shownRows, 0);
+    glDeleteTextures(1, &tex);
+}
+
 TEST(ViewerGl, AFirstPictureComesOffTheScreenInPartsAndShowsOnlyWhenWhole) {
     ViewWithBudget set(160, 200, scatteredLayer(160, 200, 31, 1, 140, 170));
     ASSERT_TRUE(set.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
