@@ -223,11 +223,16 @@ TEST(InspectorGl, BuiltInTheBackgroundAndDrawnInPartsTheModelEndsAsTheDirectOne)
 }
 
 /// `parts` shows `f`'s model, drawn in parts of `lines` for `ms` a draw under `budget`,
-/// keeping `reserveMs` of it.
+/// keeping `reserveMs` of it; its framebuffer made at the view's size first if `sized`.
 void startInParts(Inspector& parts, Fixture& f, size_t lines, double ms, FrameBudget& budget,
-                  double reserveMs) {
+                  double reserveMs, bool sized = true) {
     parts.options() = f.insp->options();
     parts.drawInParts(lines, ms);
+    if (!sized) {
+        parts.setFrameBudget(&budget, reserveMs);
+        parts.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+        return;
+    }
     // Its framebuffer at the view's size first, in a draw with room for it (the tests here are
     // about the picture's pieces; a framebuffer of a new size is a step of its own before
     // them), on a clock that measures the picture's copy at its figure until measured.
@@ -293,11 +298,12 @@ TEST(InspectorGl, WithTheFramesBudgetSpentThePictureWaitsAndEndsAsTheDirectOne) 
 /// ms keeping 5, on a clock only the test moves (`now`): every piece and copy measured costs
 /// nothing, so the learned costs shrink a quarter at each measure.
 struct FrozenClockParts {
-    FrozenClockParts() {
+    /// `sized`: the picture's framebuffer made at the view's size before the first frame.
+    explicit FrozenClockParts(bool sized = true) {
         if (!f.gl.ok()) return;
         direct = f.draw();
         lines = f.insp->model().lines.lineCount();
-        startInParts(parts, f, lines / 15 + 1, 0.0, budget, 5.0);
+        startInParts(parts, f, lines / 15 + 1, 0.0, budget, 5.0, sized);
     }
     /// One frame whose earlier steps took `spentMs`.
     void frame(double spentMs) { budgetFrame(f, parts, budget, now, spentMs); }
@@ -386,28 +392,20 @@ TEST(InspectorGl, APieceWaitsWhenThePicturesCopyToTheWindowWouldNotFitAfterIt) {
 // first piece starts in a later draw. Made with the clear and the first piece in one draw,
 // balls4's inspector at 1280x720 took 21.6 ms more than that piece's estimate (2026-12-07).
 TEST(InspectorGl, AFramebufferOfANewSizeIsMadeInItsOwnDrawsBeforeThePicture) {
-    Fixture f;
-    ASSERT_TRUE(f.gl.ok());
-    const std::vector<uint8_t> direct = f.draw();
-    const size_t lines = f.insp->model().lines.lineCount();
-    ASSERT_GT(lines, 30u);
-    double now = 0.0;
-    FrameBudget budget(33.0, [&] { return now; });
-    Inspector parts;
-    parts.options() = f.insp->options();
-    parts.drawInParts(lines / 15 + 1, 0.0);
-    parts.setFrameBudget(&budget, 5.0);
-    parts.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    FrozenClockParts t(false);
+    ASSERT_TRUE(t.f.gl.ok());
+    ASSERT_GT(t.lines, 30u);
+    Inspector& parts = t.parts;
     const PixelRect v = parts.area(kW, kH);
     const std::pair<int, int> size(v.x1 - v.x0, v.y1 - v.y0);
     ASSERT_NE(parts.framebufferSize(), size);
     // With room: the two storages in the first draw (each learned at no cost on this clock
     // fits), nothing of the picture; its first piece in the next.
-    budgetFrame(f, parts, budget, now, 0.0);
+    t.frame(0.0);
     EXPECT_EQ(parts.framebufferSize(), size);
     EXPECT_EQ(parts.picturedLines(), 0u) << "no piece with the framebuffer";
     EXPECT_TRUE(parts.picturePending());
-    budgetFrame(f, parts, budget, now, 0.0);
+    t.frame(0.0);
     EXPECT_GT(parts.picturedLines(), 0u);
 
     // A new size in frames with 1 ms left beyond the reserve, less than the picture's copy
@@ -415,14 +413,11 @@ TEST(InspectorGl, AFramebufferOfANewSizeIsMadeInItsOwnDrawsBeforeThePicture) {
     // let in, the depth waits its own patience in the draws after, and the first piece after
     // that.
     Inspector tight;
-    tight.options() = f.insp->options();
-    tight.drawInParts(lines / 15 + 1, 0.0);
-    FrameBudget room(33.0, [&] { return now; });
-    tight.setFrameBudget(&room, 5.0);
-    tight.update(f.st, {f.st->scene->camera, 64, 48}, kW, kH, -1);
+    FrameBudget room(33.0, [&] { return t.now; });
+    startInParts(tight, t.f, t.lines / 15 + 1, 0.0, room, 5.0, false);
     int sized = -1, drawn = -1, forced = 0;
     for (int draw = 1; draw <= 40 && !tight.settled(); ++draw) {
-        budgetFrame(f, tight, room, now, 27.0);
+        budgetFrame(t.f, tight, room, t.now, 27.0);
         for (const FrameBudget::Forced& s : room.forcedSteps())
             forced += std::string(s.step) == "the inspector's framebuffer of a new size";
         if (sized < 0 && tight.framebufferSize() == size) sized = draw;
@@ -433,8 +428,8 @@ TEST(InspectorGl, AFramebufferOfANewSizeIsMadeInItsOwnDrawsBeforeThePicture) {
     EXPECT_EQ(sized, 2 * kWait) << "colour at draw " << kWait << ", depth " << kWait << " later";
     EXPECT_GT(drawn, sized) << "the first piece after the framebuffer";
     EXPECT_TRUE(tight.settled());
-    EXPECT_EQ(tight.picturedLines(), lines);
-    EXPECT_EQ(f.gl.read(), direct);
+    EXPECT_EQ(tight.picturedLines(), t.lines);
+    EXPECT_EQ(t.f.gl.read(), t.direct);
 }
 
 TEST(InspectorGl, WithItsSurfacesThePictureInPartsEqualsTheOneDrawnAtOnce) {

@@ -496,53 +496,37 @@ struct ViewWithBudget : GlWithBudget {
 // at 1280x720, over the budget, 2026-12-07). A view composited only in part has the rows
 // around it copied from the picture before. Each picture equals its whole composite.
 TEST(ViewerGl, AViewCompositedOffTheScreenIsShownBySwappingInItsBackTexture) {
-    const int w = 160, h = 120;
-    OffscreenGl gl(w, h);
-    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
-    const auto [a, b] = twoViews(w, h);
-    const std::vector<uint8_t> texels = scatteredLayer(w, h, 23, 2, 160, 200);
-    const unsigned tex = layerTextureOf(w, h, texels);
-    ImageView view;
+    ViewWithBudget set(160, 120, scatteredLayer(160, 120, 23, 2, 160, 200));
+    ASSERT_TRUE(set.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    ImageView& view = set.view;
+    const Image &a = set.images.first, &b = set.images.second;
+    const int w = set.w, h = set.h;
     view.upload(a, ViewMode::Color);
-    view.setOverlay(tex, 1);
-    gl.clear(0, 0, 0);
-    view.draw(w, h, ViewMode::Color, 1.0f);
+    ASSERT_TRUE(set.draw());
     EXPECT_EQ(view.lastShade().rows, h) << "the first picture: composited whole";
-    double now = 0.0;  // a clock only the test moves: every frame has room
-    FrameBudget budget(33.0, [&] { return now; });
-    auto show = [&] {
+    // Rows [0, rows) of `img` held and composited in a frame with room, then released.
+    auto show = [&](const Image& img, int rows) {
+        view.setHold(true);
+        view.upload(img, ViewMode::Color, 0, rows);
+        set.budget.begin();
+        EXPECT_EQ(view.composeHeld(set.budget, 5.0), rows);
         view.setHold(false);
-        gl.clear(0, 0, 0);
-        view.draw(w, h, ViewMode::Color, 1.0f);
-        return gl.read();
+        set.draw();
+        return set.gl.read();
     };
-    // View b, held and composited whole, then released: no row copied to show it.
-    view.setHold(true);
-    view.upload(b, ViewMode::Color);
-    budget.begin();
-    EXPECT_EQ(view.composeHeld(budget, 5.0), h);
-    EXPECT_EQ(show(), wholeComposite(gl, b, texels));
+    // View b whole: no row copied to show it.
+    EXPECT_EQ(show(b, h), wholeComposite(set.gl, b, set.texels));
     EXPECT_EQ(view.lastShade().rows, 0);
     EXPECT_EQ(view.lastShade().shownRows, 0) << "the back texture swapped in";
-    // View a's first 40 rows, held and composited, then released: the other rows, b's, copied
-    // beside them.
-    view.setHold(true);
-    view.upload(a, ViewMode::Color, 0, 40);
-    budget.begin();
-    EXPECT_EQ(view.composeHeld(budget, 5.0), 40);
+    // View a's first 40 rows: the other rows, b's, copied beside them.
     Image mixed = b;
     for (int y = 0; y < 40; ++y)
         for (int x = 0; x < w; ++x) mixed.color[mixed.index(x, y)] = a.color[a.index(x, y)];
-    EXPECT_EQ(show(), wholeComposite(gl, mixed, texels));
+    EXPECT_EQ(show(a, 40), wholeComposite(set.gl, mixed, set.texels));
     EXPECT_EQ(view.lastShade().shownRows, h - 40);
     // And b whole again, into the texture that was on screen before.
-    view.setHold(true);
-    view.upload(b, ViewMode::Color);
-    budget.begin();
-    EXPECT_EQ(view.composeHeld(budget, 5.0), h);
-    EXPECT_EQ(show(), wholeComposite(gl, b, texels));
+    EXPECT_EQ(show(b, h), wholeComposite(set.gl, b, set.texels));
     EXPECT_EQ(view.lastShade().shownRows, 0);
-    glDeleteTextures(1, &tex);
 }
 
 TEST(ViewerGl, AFirstPictureComesOffTheScreenInPartsAndShowsOnlyWhenWhole) {
