@@ -62,19 +62,19 @@ ImageView::ImageView() {
     locOverlay_ = program_->uniform("overlayTex");
     locHasOverlay_ = program_->uniform("hasOverlay");
     glGenVertexArrays(1, &vao_);  // core profile draws need a bound VAO, even an empty one
-    GLuint tex[2];
-    glGenTextures(2, tex);
+    GLuint tex[3];
+    glGenTextures(3, tex);
     heatTex_ = tex[0];
     shadedTex_ = tex[1];
-    setupTexture(heatTex_);
-    setupTexture(shadedTex_);
+    backTex_ = tex[2];
+    for (GLuint t : tex) setupTexture(t);
     glBindTexture(GL_TEXTURE_2D, 0);
     glGenFramebuffers(1, &fbo_);
 }
 
 ImageView::~ImageView() {
-    GLuint tex[2] = {heatTex_, shadedTex_};
-    glDeleteTextures(2, tex);
+    GLuint tex[3] = {heatTex_, shadedTex_, backTex_};
+    glDeleteTextures(3, tex);
     glDeleteFramebuffers(1, &fbo_);
     glDeleteVertexArrays(1, &vao_);
 }
@@ -248,10 +248,11 @@ void ImageView::compose(int rowBegin, int rowEnd, bool upload) const {
     lastShade_.rows += rows;
 }
 
-void ImageView::uploadComposed(int rowBegin, int rowEnd) const {
+void ImageView::uploadComposed(int rowBegin, int rowEnd, unsigned texture) const {
+    if (rowEnd <= rowBegin) return;
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    glBindTexture(GL_TEXTURE_2D, shadedTex_);
+    glBindTexture(GL_TEXTURE_2D, texture);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, height_ - rowEnd, width_, rowEnd - rowBegin, GL_RGBA,
                     GL_UNSIGNED_BYTE,
                     composed_.data() + size_t(height_ - rowEnd) * size_t(width_) * 4);
@@ -280,6 +281,8 @@ int ImageView::composeParts(FrameBudget& budget, double reserveMs, bool atLeastO
             !budget.fits(rowCost_.estimateMs(end - dirty_.begin), reserveMs))
             break;
         compose(dirty_.begin, end, false);
+        if (precomposed_.empty()) backHoldsPrecomposed_ = backReady(budget, reserveMs);
+        if (backHoldsPrecomposed_) uploadComposed(dirty_.begin, end, backTex_);
         precomposed_.add(dirty_.begin, end);
         done += end - dirty_.begin;
         dirty_.begin = end;
@@ -303,10 +306,44 @@ void ImageView::finishOffScreen(ViewMode mode) const {
     offScreen_ = false;
 }
 
+bool ImageView::frontAtSize() const {
+    return shadedValid_ && shadedMode_ == ViewMode::Color && shadedWidth_ == width_ &&
+           shadedHeight_ == height_ && !newSize_;
+}
+
+bool ImageView::swapsIn() const {
+    return !precomposed_.empty() && backHoldsPrecomposed_ && backWidth_ == width_ &&
+           backHeight_ == height_ &&
+           (frontAtSize() || (precomposed_.begin <= 0 && precomposed_.end >= height_));
+}
+
+bool ImageView::backReady(FrameBudget& budget, double reserveMs) const {
+    if (backWidth_ == width_ && backHeight_ == height_) return true;
+    // Made when its learned cost fits (else this view is shown by copying its rows, and at a
+    // new size by making the picture's texture then, as without it).
+    const double texels = double(width_) * double(height_);
+    if (!budget.fits(textureCost_.estimateMs(texels), reserveMs)) return false;
+    const double made = budget.spentMs();
+    glBindTexture(GL_TEXTURE_2D, backTex_);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width_, height_, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+                 nullptr);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glFinish();  // timed: the storage is made
+    textureCost_.record(texels, budget.spentMs() - made);
+    backWidth_ = width_;
+    backHeight_ = height_;
+    return true;
+}
+
+int ImageView::showRows() const {
+    if (precomposed_.empty()) return 0;
+    const int rows = precomposed_.end - precomposed_.begin;
+    return swapsIn() ? height_ - rows : rows;
+}
+
 double ImageView::showEstimateMs() const {
-    double ms =
-        showRowCost_.estimateMs(precomposed_.empty() ? 0 : precomposed_.end - precomposed_.begin);
-    if (shadedWidth_ != width_ || shadedHeight_ != height_)
+    double ms = showRowCost_.estimateMs(showRows());
+    if (!swapsIn() && (shadedWidth_ != width_ || shadedHeight_ != height_))
         ms += textureCost_.estimateMs(double(width_) * double(height_));
     return ms;
 }
@@ -481,7 +518,12 @@ PixelRect ImageView::viewport(int fbWidth, int fbHeight) const {
 
 void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging, int rowBegin,
                       int rowEnd) const {
-    if (shadedWidth_ != width_ || shadedHeight_ != height_) {
+    // The rows composited off the screen are shown by swapping in the back texture they are
+    // in (at a new size too, when they are all the image's rows).
+    const bool copies =
+        !precomposed_.empty() && (rowBegin > precomposed_.begin || rowEnd < precomposed_.end);
+    const bool swap = mode == ViewMode::Color && copies && swapsIn();
+    if ((shadedWidth_ != width_ || shadedHeight_ != height_) && !swap) {
         const double made = threadCpuMs();
         // The shaded texture at the new size (made only now: until then a hold drew the last
         // picture), the FBO on it; shaded whole.
@@ -501,11 +543,27 @@ void ImageView::shade(ViewMode mode, float scale, bool logScale, bool diverging,
     }
     if (mode == ViewMode::Color) {
         // Rows composited while held are copied now (those composited again below after).
-        if (!precomposed_.empty() && (rowBegin > precomposed_.begin || rowEnd < precomposed_.end)) {
+        if (copies) {
             const double copied = threadCpuMs();
-            uploadComposed(precomposed_.begin, precomposed_.end);
-            if (precomposed_.end - precomposed_.begin >= 64)
-                showRowCost_.record(precomposed_.end - precomposed_.begin, threadCpuMs() - copied);
+            const int rows = showRows();
+            if (swap) {
+                // The back texture holds the rows composited off the screen: the rows around
+                // them (as on screen) join them there, and it becomes the picture; the one on
+                // screen becomes the back texture, of its size.
+                uploadComposed(0, precomposed_.begin, backTex_);
+                uploadComposed(precomposed_.end, height_, backTex_);
+                std::swap(shadedTex_, backTex_);
+                backWidth_ = shadedWidth_;
+                backHeight_ = shadedHeight_;
+                glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+                glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D,
+                                       shadedTex_, 0);
+                glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            } else {
+                uploadComposed(precomposed_.begin, precomposed_.end);
+            }
+            if (rows >= 64) showRowCost_.record(rows, threadCpuMs() - copied);
+            lastShade_.shownRows = rows;
         }
         const double start = threadCpuMs();
         compose(rowBegin, rowEnd);

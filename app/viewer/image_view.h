@@ -144,12 +144,16 @@ class ImageView {
     bool showsPicture() const { return width_ > 0 && (shadedWidth_ > 0 || !(hold_ || offScreen_)); }
     /// What the last draw() that shaded composited: image rows composited whole, texels
     /// composited again for a new layer's changes (in each changed row, the span from its
-    /// first to its last changed texel), and the texels those uploaded (for each band of 16
-    /// rows, the rectangle around its spans).
+    /// first to its last changed texel), the texels those uploaded (for each band of 16
+    /// rows, the rectangle around its spans), and the rows a view composited off the screen
+    /// needed copied to be shown.
     struct ShadeCount {
         int rows = 0;               ///< image rows composited whole
         size_t texels = 0;          ///< texels composited again for a new layer's changes
         size_t uploadedTexels = 0;  ///< texels those uploaded
+        /// Rows copied to show a view composited off the screen (0 when all of them were in
+        /// the back texture swapped in).
+        int shownRows = 0;
     };
     /// What the last draw() that shaded composited (tests: a layer part costs what it changed).
     const ShadeCount& lastShade() const { return lastShade_; }
@@ -172,8 +176,26 @@ class ImageView {
     /// The colour image's rows [rowBegin, rowEnd) with the layer over them, into the FBO's
     /// texture.
     void compose(int rowBegin, int rowEnd, bool upload = true) const;
-    /// Copy the composited rows [rowBegin, rowEnd) (image rows) to the FBO's texture.
-    void uploadComposed(int rowBegin, int rowEnd) const;
+    /// Copy the composited rows [rowBegin, rowEnd) (image rows) to the FBO's texture, or to
+    /// `texture`.
+    void uploadComposed(int rowBegin, int rowEnd) const {
+        uploadComposed(rowBegin, rowEnd, shadedTex_);
+    }
+    void uploadComposed(int rowBegin, int rowEnd, unsigned texture) const;
+    /// The picture on screen is a colour picture of the image's size.
+    bool frontAtSize() const;
+    /// A view composited off the screen is shown by swapping in the back texture: every row
+    /// composited is in it, it is of the image's size, and the rows around them are on screen
+    /// at that size (or there are none).
+    bool swapsIn() const;
+    /// The back texture is of the image's size, made now if it is not and its learned cost
+    /// fits in `budget` less `reserveMs`: rows composited off the screen are copied into it as
+    /// they come (composeParts()).
+    bool backReady(FrameBudget& budget, double reserveMs) const;
+    /// Rows a view composited off the screen needs copied when it is shown: the rows around
+    /// those already in the back texture (it is then swapped in), or else the composited rows
+    /// themselves.
+    int showRows() const;
     /// The texels where the layer differs from the one the picture was composited with, into
     /// the FBO's texture: the other texels are already right. Image rows [skipBegin, skipEnd)
     /// are left out (composited whole by compose()).
@@ -202,7 +224,11 @@ class ImageView {
     void shadeHeat(float scale, bool logScale, bool diverging, int rowBegin, int rowEnd) const;
 
     std::unique_ptr<gl::Program> program_;
-    unsigned vao_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0;
+    /// shadedTex_ is the picture on screen (the FBO's); backTex_, of the same size, takes the
+    /// rows of a view composited off the screen as they come, and is swapped in to show it:
+    /// copying a released view's 720 rows in the frame that shows it took 13-19 ms of the
+    /// image step at 1280x720, over the budget (balls4, 2026-12-07).
+    mutable unsigned vao_ = 0, heatTex_ = 0, shadedTex_ = 0, fbo_ = 0, backTex_ = 0;
     ZeroedBytes colorRgba_;             ///< the colour image as 8-bit RGBA, row 0 on top
     std::vector<uint8_t> overlayRgba_;  ///< the layer's pixels (row 0 at the bottom); empty: none
     int overlayWidth_ = 0, overlayHeight_ = 0;
@@ -228,6 +254,9 @@ class ImageView {
     mutable RowRange dirty_;
     /// Image rows composited while held (composeHeld()) and not yet copied to the texture.
     mutable RowRange precomposed_;
+    /// Every row of precomposed_ is in backTex_ too (each was copied there when composited).
+    mutable bool backHoldsPrecomposed_ = false;
+    mutable int backWidth_ = 0, backHeight_ = 0;  ///< backTex_'s size (0: no storage yet)
     int width_ = 0, height_ = 0;
     mutable int shadedWidth_ = 0, shadedHeight_ = 0;  ///< the size the FBO was last shaded at
     bool hold_ = false;

@@ -1040,6 +1040,48 @@ TEST(Overlays, TheFramesFirstUpdateTakesTheBatchesAndLeavesTheirCopyToTheBudgete
     EXPECT_EQ(drawn(t.gl, ov, cam), drawn(t.gl, t.direct, cam));
 }
 
+// A part of the batches' copy is as large as what the frame's budget leaves holds at its
+// learned cost, uploadBytes at most and a 16th of it at least: a part let in over the budget
+// after its patience is the least one (a whole part there pushed balls4's frames to 33.0-35.8
+// ms of UI CPU, 2026-12-07), and a frame with room copies a whole part.
+TEST(Overlays, APartOfTheCopyFollowsWhatTheBudgetLeavesTheLeastWhenLetInOverIt) {
+    LeavesInTheBackground t;
+    ASSERT_TRUE(t.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    Overlays& ov = t.ov;
+    ov.look.uploadBytes = 64 * sizeof(gl::BatchVertex);  // 32 lines at most, 2 at least
+    ov.look.uploadMs = 0.0;                              // one part a frame
+    double now = 0.0;                                    // a clock only the test moves
+    FrameBudget budget(33.0, [&] { return now; });
+    ov.setFrameBudget(&budget, 0.0);
+    t.untilTaken(false, [&] { budget.begin(); });
+    ASSERT_EQ(ov.rebuilds(), 1u);
+    ASSERT_EQ(ov.copiedBytes(), 0u);
+    ASSERT_GT(ov.layerLines(), 40u);
+    // Vertices copied by a frame whose earlier steps took `spentMs`.
+    size_t copied = 0;
+    auto frame = [&](double spentMs) {
+        budget.begin();
+        now += spentMs;
+        ov.update(t.s, t.cam, kW, kH);
+        const size_t before = copied;
+        copied = ov.copiedBytes() / sizeof(gl::BatchVertex);
+        return copied - before;
+    };
+    // Every frame's budget spent: nothing for kPatienceFrames frames, then the least part (4
+    // vertices: a triangle of the fills, copied whole, counts 3).
+    for (unsigned i = 0; i < kPatienceFrames; ++i) EXPECT_EQ(frame(40.0), 0u) << i;
+    const size_t least = frame(40.0);
+    EXPECT_EQ(budget.forced(), 1);
+    EXPECT_GE(least, 1u);
+    EXPECT_LE(least, 4u) << "the least part, let in over the budget";
+    // A frame with room: a whole part (its learned cost per byte fits many times over).
+    const size_t whole = frame(0.0);
+    EXPECT_EQ(budget.forced(), 0);
+    EXPECT_GE(whole, 62u);
+    EXPECT_LE(whole, 64u);
+    ov.setFrameBudget(nullptr, 0.0);
+}
+
 TEST(Overlays, TheLayerTextureCompositedIntoTheImageShowsWhatDrawingDirectlyShows) {
     OffscreenGl gl(kW, kH);
     ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";

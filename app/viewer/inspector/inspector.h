@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "app/viewer/background_job.h"
 #include "app/viewer/image_view.h"  // PixelRect
@@ -115,9 +116,13 @@ class Inspector {
     /// The learned cost of the picture's copy to the window that each draw() makes while it is
     /// shown (0 when hidden), in ms: the steps before it keep it back.
     double showEstimateMs() const { return opt_.show ? showCost_.estimateMs(1) : 0.0; }
-    /// The last draw() left the picture to be completed, or drawn again (the budget), by
-    /// later draws.
-    bool picturePending() const { return opt_.show && (picturePending_ || pictureDeferred_); }
+    /// A picture is to be drawn (a change since the last draw), completed or drawn again (the
+    /// budget) by later draws.
+    bool picturePending() const {
+        return opt_.show && (dirtyPicture_ || picturePending_ || pictureDeferred_);
+    }
+    /// The size of the picture's framebuffer (the view's once made: makeFramebuffer()).
+    std::pair<int, int> framebufferSize() const { return {fboW_, fboH_}; }
     /// Lines of the model in the picture so far (all of them once it is whole).
     size_t picturedLines() const { return picturedLines_; }
     /// Surfaces of the current camera are on screen (the trace arrived).
@@ -182,6 +187,14 @@ class Inspector {
     std::unique_ptr<gl::Program> surfaceProgram_;
     unsigned fbo_ = 0, colorTex_ = 0, depthRb_ = 0, surfColorTex_ = 0, surfDepthTex_ = 0, vao_ = 0;
     int fboW_ = 0, fboH_ = 0, surfW_ = 0, surfH_ = 0;
+    /// The picture's storage at a new size (nextW_ x nextH_), made beside the one on screen,
+    /// colour and depth each in a draw of its own (makeFramebuffer()).
+    unsigned nextColorTex_ = 0, nextDepthRb_ = 0;
+    int nextW_ = 0, nextH_ = 0;
+    bool nextColorMade_ = false, nextDepthMade_ = false;
+    /// Give the picture's framebuffer the view's size: -1 while a storage waits for the budget
+    /// (the picture on screen stays), 0 if it had it, 1 once made now (its picture is to draw).
+    int makeFramebuffer();
     bool surfUploaded_ = false;
     // The picture in parts (drawInParts()).
     static constexpr size_t kPartBytes = size_t(2) << 20;  ///< copied to GL per part
@@ -214,6 +227,11 @@ class Inspector {
     /// and kept back beside the reserve, so that the last piece does not push it over the
     /// frame's budget.
     StepCost showCost_{5.0};
+    /// A storage of the picture's framebuffer (its colour texture, its depth buffer) per
+    /// texel: llvmpipe clears what it allocates, about 10 ms each at 1280x720 (2026-12-07).
+    StepCost storageCost_{10.0 / (1280.0 * 720.0)};
+    /// The draws in a row a storage of a new size waited for the budget (never starved).
+    Patience storagePatience_{"the inspector's framebuffer of a new size"};
     /// What a piece leaves of the frame's budget: the reserve given and the picture's copy.
     double reserveMs() const;
     FrameBudget* budget_ = nullptr;  ///< setFrameBudget()

@@ -2,6 +2,7 @@
 
 #include <imgui.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <sstream>
@@ -183,11 +184,21 @@ void Overlays::take(OverlayGeometry geometry, const BuildInputs& in, double ms, 
 void Overlays::uploadMore() {
     // With the frame's budget: once a frame (update() runs twice in one), and only while the
     // budget is not spent; the copy goes on in the next frames.
-    // Each part starts only when its learned cost fits in what the budget leaves (the first of
-    // a frame also after kPatienceFrames frames of waiting).
-    const auto fits = [this] {
-        return !budget_ ||
-               budget_->fits(uploadCost_.estimateMs(1), budgetReserveMs_, uploadPatience_);
+    // A part is as large as what the budget leaves holds at its learned cost per byte,
+    // look.uploadBytes at most and a 16th of it at least, and starts when its least fits (the
+    // first of a frame also after kPatienceFrames frames of waiting): a part of uploadBytes let
+    // in over the budget after its patience took frames to 33.0-35.8 ms of UI CPU on balls4's
+    // slabs (2026-12-07), where the least is a fraction of a millisecond.
+    const size_t most = std::max<size_t>(look.uploadBytes, 1),
+                 least = std::max<size_t>(most / 16, 1);
+    const auto fits = [&] {
+        return !budget_ || budget_->fits(uploadCost_.estimateMs(double(least)), budgetReserveMs_,
+                                         uploadPatience_);
+    };
+    const auto partBytes = [&] {
+        if (!budget_) return most;
+        const double fit = uploadCost_.unitsIn(budget_->leftMs(budgetReserveMs_));
+        return std::clamp(size_t(std::min(fit, double(most))), least, most);
     };
     if (budget_ && !uploaded()) {
         if (budget_->frame() == uploadFrame_ || !fits()) return;
@@ -195,23 +206,37 @@ void Overlays::uploadMore() {
     }
     const auto t0 = std::chrono::steady_clock::now();
     bool first = true;  // let in above
-    for (gl::GpuBatch* b : {cuts_.get(), fills_.get(), wiresLongestFirst_.get(), wires_.get()})
+    for (gl::GpuBatch* b : {cuts_.get(), fills_.get(), wiresLongestFirst_.get(), wires_.get()}) {
+        b->uploadMore(0);  // one with nothing left to copy (an empty one) is done, at no cost
         while (!b->uploaded()) {
             if (!first && !fits()) return;
             first = false;
             const double start = budget_ ? budget_->spentMs() : 0.0;
-            b->uploadMore(look.uploadBytes);
+            const size_t before = 2 * b->lineCount() + 3 * b->triangleCount();
+            b->uploadMore(partBytes());
             glFinish();  // timed: the copy is done
-            if (budget_) uploadCost_.record(1, budget_->spentMs() - start);
+            const size_t copied = 2 * b->lineCount() + 3 * b->triangleCount() - before;
+            if (budget_)
+                uploadCost_.record(double(copied * sizeof(gl::BatchVertex)),
+                                   budget_->spentMs() - start);
             if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count() >= look.uploadMs)
                 return;
         }
+    }
 }
 
 bool Overlays::uploaded() const {
     return cuts_->uploaded() && fills_->uploaded() && wiresLongestFirst_->uploaded() &&
            wires_->uploaded();
+}
+
+size_t Overlays::copiedBytes() const {
+    size_t vertices = 0;
+    for (const gl::GpuBatch* b :
+         {cuts_.get(), fills_.get(), wiresLongestFirst_.get(), wires_.get()})
+        vertices += 2 * b->lineCount() + 3 * b->triangleCount();
+    return vertices * sizeof(gl::BatchVertex);
 }
 
 size_t Overlays::layerReady() const {

@@ -191,6 +191,8 @@ class Overlays {
     bool building() const { return job_.pending() || !uploaded(); }
     /// The batches built are all copied to GL.
     bool uploaded() const;
+    /// Bytes of the batches taken that are copied to GL so far (in parts: uploadMore()).
+    size_t copiedBytes() const;
     /// The layer's first lines (in longest-first order) whose wires, cut lines and fills are
     /// all copied to GL: what its parts may draw.
     size_t layerReady() const;
@@ -258,11 +260,11 @@ class Overlays {
     FrameBudget* budget_ = nullptr;  ///< setFrameBudget()
     double budgetReserveMs_ = 0.0;
     unsigned long uploadFrame_ = 0;  ///< the budget's frame the batches were last copied in
-    /// Learned costs (the budget's clock): a part of the batches' copy (uploadBytes), a line of
-    /// a moving camera's layer and of a layer at rest (the longest lines, drawn while moving,
-    /// cost more each). To begin with: 4 ms a part, 7 ms per 1,000 moving lines, 5 ms per 500
-    /// lines at rest (balls4's slabs, 2026-12-06).
-    StepCost uploadCost_{4.0};
+    /// Learned costs (the budget's clock): a byte of the batches' copy, a line of a moving
+    /// camera's layer and of a layer at rest (the longest lines, drawn while moving, cost more
+    /// each). To begin with: 4 ms per 2 MiB, 7 ms per 1,000 moving lines, 5 ms per 500 lines at
+    /// rest (balls4's slabs, 2026-12-06).
+    StepCost uploadCost_{4.0 / double(size_t(2) << 20)};
     StepCost movingLineCost_{7.0 / 1000.0};
     StepCost restLineCost_{5.0 / 500.0};
     /// A texel of the layer's texture made at a new size (llvmpipe zeroes its storage): 10 ms
