@@ -51,9 +51,11 @@ class FrameTimes {
 class FramePhases {
   public:
     /// Start a frame: the phases are cleared, the clock read.
-    void begin() {
+    void begin() { beginAt(threadCpuMs()); }
+    /// Start a frame at CPU time `nowMs` (threadCpuMs(); tests give their own).
+    void beginAt(double nowMs) {
         phases_.clear();
-        last_ = threadCpuMs();
+        last_ = nowMs;
     }
     /// The phase `name` (a string literal) ends now.
     void mark(const char* name) { markAt(name, threadCpuMs()); }
