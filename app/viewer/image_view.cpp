@@ -140,6 +140,7 @@ void ImageView::setOverlay(unsigned texture, uint64_t version) {
     overlayRgba_.clear();
     overlayWidth_ = overlayHeight_ = 0;
     if (texture == 0) return;
+    const double start = threadCpuMs();
     glBindTexture(GL_TEXTURE_2D, texture);
     glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &overlayWidth_);
     glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &overlayHeight_);
@@ -149,6 +150,23 @@ void ImageView::setOverlay(unsigned texture, uint64_t version) {
     if (!overlayRgba_.empty())
         glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_UNSIGNED_BYTE, overlayRgba_.data());
     glBindTexture(GL_TEXTURE_2D, 0);
+    readCost_.record(double(overlayRgba_.size() / 4), threadCpuMs() - start);
+}
+
+bool ImageView::setOverlay(unsigned texture, uint64_t version, FrameBudget& budget,
+                           double reserveMs) {
+    if (texture == overlayTex_ && (texture == 0 || version == overlayVersion_)) return true;
+    if (texture != 0) {
+        GLint w = 0, h = 0;
+        glBindTexture(GL_TEXTURE_2D, texture);
+        glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
+        glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        if (!budget.fits(readCost_.estimateMs(double(w) * double(h)), reserveMs, readPatience_))
+            return false;
+    }
+    setOverlay(texture, version);
+    return true;
 }
 
 namespace {
@@ -267,9 +285,9 @@ bool ImageView::composesOffScreen() const {
            shadedHeight_ == height_;
 }
 
-int ImageView::composeHeld(FrameBudget& budget, double reserveMs) {
-    if (!hold_ || !composesOffScreen()) return 0;
-    return composeParts(budget, reserveMs, false);
+int ImageView::composeHeld() {
+    if (!budget_ || !hold_ || !composesOffScreen()) return 0;
+    return composeParts(*budget_, budgetReserveMs_, false);
 }
 
 int ImageView::composeParts(FrameBudget& budget, double reserveMs, bool atLeastOne) const {

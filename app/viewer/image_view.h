@@ -96,6 +96,14 @@ class ImageView {
     /// whole image before, 8-10 ms at 1280x720); another texture, or a heat map, shades the
     /// whole image again.
     void setOverlay(unsigned texture, uint64_t version);
+    /// As setOverlay(), within a frame's budget: a new version is read back only when the
+    /// read-back's learned cost fits in `budget` less `reserveMs` (or after kPatienceFrames
+    /// frames of waiting, whatever the budget); until then the view keeps the layer it holds
+    /// and the caller asks again with the next frame's version. A read-back is where llvmpipe
+    /// finishes the layer's drawing: unbudgeted, it took 14-22 ms of frames already full
+    /// (balls4 at 1280x720, a new layer texture's first and the irregular zones' filled
+    /// triangles, 2026-12-07). Returns whether the view holds `texture` at `version` now.
+    bool setOverlay(unsigned texture, uint64_t version, FrameBudget& budget, double reserveMs);
     /// While held, draw() shows what it showed before and shades nothing: uploads go on, and
     /// the rows they changed are shaded once the hold ends (a new view's image coming in parts
     /// is never shown half). A hold keeps a picture of another size (drawn scaled), and before
@@ -112,12 +120,15 @@ class ImageView {
     }
     /// While held, composite the colour image's rows uploaded since the picture was shaded in
     /// parts of 48 rows, each only when its estimated cost (the time per row measured so far)
-    /// fits in `budget` less `reserveMs`; they are copied to the texture when the view is shown
-    /// (setHold()). A new view released whole took 16-25 ms of the image step in one frame
-    /// (balls4 at 1280x720, 2026-12-06). Returns the rows composited; none unless colour rows
-    /// come over a colour picture of the image's size, or a first picture, or one of a new
-    /// size (its buffers then come page by page with its rows: ZeroedBytes).
-    int composeHeld(FrameBudget& budget, double reserveMs);
+    /// fits in the frame's budget less the reserve setFrameBudget() gave (the one a pass's
+    /// rows keep: given apart, it once left out the inspector's and the panels' copies, and a
+    /// still frame on balls4 took 34.9 ms, 2026-12-07); they are copied to the texture when
+    /// the view is shown (setHold()). A new view released whole took 16-25 ms of the image
+    /// step in one frame (balls4 at 1280x720, 2026-12-06). Returns the rows composited; none
+    /// without a budget, or unless colour rows come over a colour picture of the image's size,
+    /// or a first picture, or one of a new size (its buffers then come page by page with its
+    /// rows: ZeroedBytes).
+    int composeHeld();
     /// Share a frame's budget from now on (null: none): draw() composites the rows of the
     /// view on screen uploaded since the last draw (a finer pass's part) in parts of 48 rows,
     /// each only when its learned cost fits in `budget` less `reserveMs`, at least one part a
@@ -276,6 +287,10 @@ class ImageView {
     /// The draws in a row a released view, all its rows composited, waited to be shown for
     /// the budget (finishOffScreen()): shown whatever the budget after kPatienceFrames.
     mutable Patience showPatience_{"the image's showing"};
+    /// The UI thread's CPU per texel of a layer's read-back (setOverlay()), learned; until
+    /// measured, a new 1280x720 texture's first, 10.6 ms (balls4, 2026-12-07).
+    StepCost readCost_{10.6 / (1280.0 * 720.0)};
+    Patience readPatience_{"the layer's read-back"};
     /// The last draw() was held: the next unheld one composites all pending rows (the view
     /// released must show whole).
     mutable bool drawnHeld_ = false;

@@ -282,17 +282,20 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     const double panelsMs = panels_.estimateMs() + kSwapReserveMs;
     inspector_->setFrameBudget(&budget_, panelsMs);
     const double layerReserve = layerReserveMs(imageFlushCost_.estimateMs(1));
-    overlays_->setFrameBudget(&budget_, layerReserve + panelsMs + inspector_->showEstimateMs() +
-                                            view_->shadeEstimateMs(s.mode) +
-                                            (layerDraws ? composite.estimateMs(1) : 0.0));
+    const double overlaysReserve = layerReserve + panelsMs + inspector_->showEstimateMs() +
+                                   view_->shadeEstimateMs(s.mode) +
+                                   (layerDraws ? composite.estimateMs(1) : 0.0);
+    overlays_->setFrameBudget(&budget_, overlaysReserve);
     const uint64_t layerVersion = overlays_->layerVersion();
-    prepareOverlays(imageW, imageH);
+    prepareOverlays(imageW, imageH, overlaysReserve);
     const bool layerChanged = overlays_->layerVersion() != layerVersion;
     phases_.mark("overlays");
-    // A new view held off the screen is composited in parts as its rows come, within the
-    // budget (the steps after it keep what the layer keeps for them), so that its release
-    // only copies it.
-    if (state_.holdImage()) view_->composeHeld(budget_, layerReserve);
+    // A new view held off the screen is composited in parts as its rows come, so that its
+    // release only copies it, and a finer pass's rows in parts with the image step: both
+    // within what the steps after the image keep (as the layer keeps for them, less the
+    // image's own estimate); the rest waits for the next frames.
+    view_->setFrameBudget(&budget_, layerReserve + panelsMs + inspector_->showEstimateMs());
+    if (state_.holdImage()) view_->composeHeld();
     glViewport(0, 0, fbWidth, fbHeight);
     glClearColor(0.12f, 0.12f, 0.14f, 1.0f);
     std::vector<PixelRect> views;
@@ -305,9 +308,6 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     }
     glDisable(GL_SCISSOR_TEST);
     view_->setViewport(area);
-    // A finer pass's rows composite within what the steps after the image keep (as the layer
-    // keeps for them, less the image's own estimate): the rest waits for the next frames.
-    view_->setFrameBudget(&budget_, layerReserve + panelsMs + inspector_->showEstimateMs());
     const double imageStart = budget_.spentMs();
     view_->draw(fbWidth, fbHeight, s.mode, state_.heatScale(), covered, s.logScale,
                 state_.heatDiverging());
@@ -385,7 +385,7 @@ void ViewerApp::frame(int fbWidth, int fbHeight) {
     }
     settled_ = state_.settledSince() && inspector_->settled() && !overlays_->building() &&
                !overlays_->layerPending() && !player_.pending() && !player_.playback().playing() &&
-               panels_.deferred() == 0 && view_->pendingRows() == 0;
+               panels_.deferred() == 0 && view_->pendingRows() == 0 && layerRead_;
     keepSettings();
 }
 
@@ -435,7 +435,7 @@ bool ViewerApp::cameraMoving() const {
     return cameraTurning_ || (ImGui::IsAnyMouseDown() && !ImGui::GetIO().WantCaptureMouse);
 }
 
-void ViewerApp::prepareOverlays(int fbWidth, int fbHeight) {
+void ViewerApp::prepareOverlays(int fbWidth, int fbHeight, double reserveMs) {
     const Clock::time_point start = Clock::now();
     const uint64_t version = overlays_->layerVersion();
     const Camera& camera = state_.camera();
@@ -445,7 +445,8 @@ void ViewerApp::prepareOverlays(int fbWidth, int fbHeight) {
     // a quarter of a second. They are drawn whole when the drag ends.
     const bool dragging = cameraMoving() && overlays_->layerStale(camera, fbWidth, fbHeight);
     const unsigned layer = overlays_->layerTexture(camera, fbWidth, fbHeight, dragging);
-    view_->setOverlay(layer, overlays_->layerVersion());
+    // Read back within what the layer's own parts leave (the steps after it keep the same).
+    layerRead_ = view_->setOverlay(layer, overlays_->layerVersion(), budget_, reserveMs);
     if (logTimings_)
         logOverlayTiming(std::chrono::duration<double, std::milli>(Clock::now() - start).count(),
                          overlays_->layerVersion() != version);

@@ -56,11 +56,12 @@ class ViewerApp {
     /// the render of the latest change has shown nothing yet, a pass finer than the one on
     /// screen has begun to show, or the render is complete. Otherwise the render is only
     /// refining the pass on screen band by band, and a window may show its bands at a lower
-    /// rate. Also while the overlays' layer is drawn over several frames, or image rows wait
-    /// for the frame's budget.
+    /// rate. Also while the overlays' layer is drawn over several frames, or image rows or the
+    /// layer's read-back wait for the frame's budget.
     bool eager() const {
         return state_.eager(settled_) || overlays_->layerPending() ||
-               inspector_->picturePending() || panels_.deferred() > 0 || view_->pendingRows() > 0;
+               inspector_->picturePending() || panels_.deferred() > 0 || view_->pendingRows() > 0 ||
+               !layerRead_;
     }
     /// The frame drawn by the last frame() is on screen (after the window's swap): logs, with
     /// --log-timings, the passes it shows for the first time, with their latency.
@@ -155,6 +156,8 @@ class ViewerApp {
     FrameBudget& frameBudget() { return budget_; }
     /// Panels the last frame rasterized again (the rest were copied from the panel layer).
     int panelsRedrawn() const { return panels_.redrawn(); }
+    /// What the last frame's image step composited and copied (--log-timings' slow frames).
+    const ImageView::ShadeCount& imageShade() const { return view_->lastShade(); }
     const FrameBudget& frameBudget() const { return budget_; }
     /// What the steps before the image's copy (the layer, a held view's and a finer pass's
     /// composites) keep back of the frame's budget beside the learned costs of the steps
@@ -173,8 +176,8 @@ class ViewerApp {
     /// ImGui).
     void overlayInput();
     /// Steps 5 of frame(): the overlays' layer (imageW x imageH, the image's size) handed to
-    /// the image view, and its timing.
-    void prepareOverlays(int imageW, int imageH);
+    /// the image view within the frame's budget less `reserveMs`, and its timing.
+    void prepareOverlays(int imageW, int imageH, double reserveMs);
     /// The overlays' and the inspector's options and camera into the settings the ini is
     /// written from (marked to be saved when they changed).
     void keepSettings();
@@ -218,6 +221,8 @@ class ViewerApp {
     PanelLayout layout_;         ///< where this frame's panels, image and inspector go
     KeyReport keys_;             ///< the colour keys drawn this frame
     bool settled_ = false;
+    /// The image view holds the overlays' latest layer (its read-back waits for the budget).
+    bool layerRead_ = true;
 };
 
 }  // namespace lancer::viewer

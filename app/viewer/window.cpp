@@ -338,10 +338,14 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 if (v.logTimings && cpuMs > kFrameBudgetMs)
                     std::fprintf(stderr,
                                  "timing: slow frame %d (%s): %.1f ms, %.1f ms of UI CPU: %s, "
-                                 "swap and rest %.1f; %d panels redrawn, %d steps deferred\n",
+                                 "swap and rest %.1f; %d panels redrawn, %d steps deferred; "
+                                 "image: %d rows composited, %zu texels of layer changes, %d "
+                                 "rows shown\n",
                                  frames, turnDue ? "turning" : "still", workMs, cpuMs,
                                  app.phases().summary().c_str(), cpuMs - app.phases().totalMs(),
-                                 app.panelsRedrawn(), app.frameBudget().deferred());
+                                 app.panelsRedrawn(), app.frameBudget().deferred(),
+                                 app.imageShade().rows, app.imageShade().texels,
+                                 app.imageShade().shownRows);
             }
             // A step let in over the budget (it had waited its patience) says why it waited.
             if (v.logTimings)
