@@ -212,13 +212,11 @@ void Overlays::uploadMore() {
             if (!first && !fits()) return;
             first = false;
             const double start = budget_ ? budget_->spentMs() : 0.0;
-            const size_t before = 2 * b->lineCount() + 3 * b->triangleCount();
+            const size_t before = copiedBytes();
             b->uploadMore(partBytes());
             glFinish();  // timed: the copy is done
-            const size_t copied = 2 * b->lineCount() + 3 * b->triangleCount() - before;
             if (budget_)
-                uploadCost_.record(double(copied * sizeof(gl::BatchVertex)),
-                                   budget_->spentMs() - start);
+                uploadCost_.record(double(copiedBytes() - before), budget_->spentMs() - start);
             if (std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count() >= look.uploadMs)
                 return;
