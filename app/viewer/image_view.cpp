@@ -95,6 +95,11 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
         newSize_ = true;
         dirty_.clear();
         precomposed_.clear();
+        // Held or not, a picture of a new size (a first one) comes off the screen in parts
+        // within the budget: uploaded whole without a hold, it was composited and its texture
+        // made in one frame (41-55 ms of the image step, balls4's first irregular picture after
+        // a turn, 2026-12-07).
+        offScreen_ = offScreen_ || budget_ != nullptr;
     }
     uploadMode_ = mode;
     if (mode != ViewMode::Color && (heatWidth_ != width_ || heatHeight_ != height_)) {
