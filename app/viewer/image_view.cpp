@@ -155,7 +155,18 @@ void ImageView::setOverlay(unsigned texture, uint64_t version) {
     if (!overlayRgba_.empty())
         glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_UNSIGNED_BYTE, overlayRgba_.data());
     glBindTexture(GL_TEXTURE_2D, 0);
-    readCost_.record(double(overlayRgba_.size() / 4), threadCpuMs() - start);
+    const bool first =
+        texture != readTex_ || overlayWidth_ != readWidth_ || overlayHeight_ != readHeight_;
+    (first ? firstReadCost_ : readCost_)
+        .record(double(overlayRgba_.size() / 4), threadCpuMs() - start);
+    readTex_ = texture;
+    readWidth_ = overlayWidth_;
+    readHeight_ = overlayHeight_;
+}
+
+double ImageView::readEstimateMs(unsigned texture, int width, int height) const {
+    const bool first = texture != readTex_ || width != readWidth_ || height != readHeight_;
+    return (first ? firstReadCost_ : readCost_).estimateMs(double(width) * double(height));
 }
 
 bool ImageView::setOverlay(unsigned texture, uint64_t version, FrameBudget& budget,
@@ -167,8 +178,7 @@ bool ImageView::setOverlay(unsigned texture, uint64_t version, FrameBudget& budg
         glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
         glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
         glBindTexture(GL_TEXTURE_2D, 0);
-        if (!budget.fits(readCost_.estimateMs(double(w) * double(h)), reserveMs, readPatience_))
-            return false;
+        if (!budget.fits(readEstimateMs(texture, w, h), reserveMs, readPatience_)) return false;
     }
     setOverlay(texture, version);
     return true;

@@ -104,6 +104,9 @@ class ImageView {
     /// (balls4 at 1280x720, a new layer texture's first and the irregular zones' filled
     /// triangles, 2026-12-07). Returns whether the view holds `texture` at `version` now.
     bool setOverlay(unsigned texture, uint64_t version, FrameBudget& budget, double reserveMs);
+    /// The learned cost of reading back a `width` x `height` version of `texture`, in ms: its
+    /// first at that size costs more than the later ones.
+    double readEstimateMs(unsigned texture, int width, int height) const;
     /// While held, draw() shows what it showed before and shades nothing: uploads go on, and
     /// the rows they changed are shaded once the hold ends (a new view's image coming in parts
     /// is never shown half). A hold keeps a picture of another size (drawn scaled), and before
@@ -287,10 +290,16 @@ class ImageView {
     /// The draws in a row a released view, all its rows composited, waited to be shown for
     /// the budget (finishOffScreen()): shown whatever the budget after kPatienceFrames.
     mutable Patience showPatience_{"the image's showing"};
-    /// The UI thread's CPU per texel of a layer's read-back (setOverlay()), learned; until
-    /// measured, a new 1280x720 texture's first, 10.6 ms (balls4, 2026-12-07).
-    StepCost readCost_{10.6 / (1280.0 * 720.0)};
+    /// The UI thread's CPU per texel of a layer's read-back (setOverlay()), learned apart for a
+    /// texture's first at its size and for its later versions: a new 1280x720 texture's first
+    /// took 10-14 ms, a later one 0.3-2 ms while the camera turns (balls4, 2026-12-07); one
+    /// mean of both kept the later read-backs waiting their patience for 20-30 frames after
+    /// each first one.
+    StepCost firstReadCost_{10.6 / (1280.0 * 720.0)}, readCost_{1.0 / (1280.0 * 720.0)};
     Patience readPatience_{"the layer's read-back"};
+    /// The texture and size last read back (readEstimateMs()).
+    unsigned readTex_ = 0;
+    int readWidth_ = 0, readHeight_ = 0;
     /// The last draw() was held: the next unheld one composites all pending rows (the view
     /// released must show whole).
     mutable bool drawnHeld_ = false;

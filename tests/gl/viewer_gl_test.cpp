@@ -618,6 +618,35 @@ TEST(ViewerGl, ALayersReadBackWaitsForTheBudgetAndThePictureKeepsTheLayerBefore)
 // A first picture uploaded whole without a hold (the irregular scheme's first after a turn,
 // its structure rebuilt) comes off the screen in parts too: composited whole with its texture
 // made in one frame, it took 41-55 ms of the image step (balls4 at 1280x720, 2026-12-07).
+// A texture's first read-back at its size (10-14 ms for a new 1280x720 layer) is learned apart
+// from its later versions' (0.3-2 ms while the camera turns): one mean of both kept the later
+// read-backs waiting their patience for 20-30 frames after each first one (balls4, 2026-12-07).
+TEST(ViewerGl, ATexturesFirstReadBackIsLearnedApartFromItsLaterOnes) {
+    const int w = 160, h = 120;
+    OffscreenGl gl(w, h);
+    ASSERT_TRUE(gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
+    const std::vector<uint8_t> texels = scatteredLayer(w, h, 11, 1, 90, 140);
+    const unsigned tex = layerTextureOf(w, h, texels), other = layerTextureOf(w, h, texels);
+    ImageView view;
+    const double texelShare = double(w) * double(h) / (1280.0 * 720.0);
+    // Nothing read yet: any texture's next read-back is a first one, at the first's guess.
+    EXPECT_DOUBLE_EQ(view.readEstimateMs(tex, w, h), 10.6 * texelShare);
+    view.setOverlay(tex, 1);
+    // Its first read: the texture's next version is estimated at the later ones' guess, a new
+    // texture or a new size at what the first one learned.
+    const double later = view.readEstimateMs(tex, w, h);
+    EXPECT_DOUBLE_EQ(later, 1.0 * texelShare);
+    const double firstLearned = view.readEstimateMs(other, w, h);
+    EXPECT_NE(firstLearned, 10.6 * texelShare) << "the first read-back's measure is learned";
+    EXPECT_DOUBLE_EQ(view.readEstimateMs(tex, w, 2 * h), 2.0 * firstLearned);
+    // A later version's read-back moves the later ones' cost only.
+    view.setOverlay(tex, 2);
+    EXPECT_NE(view.readEstimateMs(tex, w, h), later);
+    EXPECT_DOUBLE_EQ(view.readEstimateMs(other, w, h), firstLearned);
+    const unsigned both[2] = {tex, other};
+    glDeleteTextures(2, both);
+}
+
 TEST(ViewerGl, AFirstPictureUploadedWithoutAHoldComesOffTheScreenInParts) {
     ViewWithBudget set(160, 200, scatteredLayer(160, 200, 13, 0, 110, 150));
     ASSERT_TRUE(set.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
