@@ -485,6 +485,11 @@ struct ViewWithBudget : GlWithBudget {
     }
     ViewWithBudget(const ViewWithBudget&) = delete;
     ViewWithBudget& operator=(const ViewWithBudget&) = delete;
+    /// The first image uploaded whole (no hold); the view to draw it.
+    ImageView& uploadFirst() {
+        view.upload(images.first, ViewMode::Color);
+        return view;
+    }
     /// A draw over the framebuffer's blue: whether anything was drawn.
     bool draw() {
         gl.clear(0, 0, 1);
@@ -568,9 +573,8 @@ TEST(ViewerGl, AHeldViewsPartsKeepTheReserveOfTheViewsBudget) {
 TEST(ViewerGl, ALayersReadBackWaitsForTheBudgetAndThePictureKeepsTheLayerBefore) {
     ViewWithBudget set(160, 120, scatteredLayer(160, 120, 17, 1, 130, 170));
     ASSERT_TRUE(set.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
-    ImageView& view = set.view;
+    ImageView& view = set.uploadFirst();
     const Image& a = set.images.first;
-    view.upload(a, ViewMode::Color);
     ASSERT_TRUE(set.draw());
     const std::vector<uint8_t> before = set.gl.read();
     ASSERT_EQ(before, wholeComposite(set.gl, a, set.texels));
@@ -615,9 +619,6 @@ TEST(ViewerGl, ALayersReadBackWaitsForTheBudgetAndThePictureKeepsTheLayerBefore)
     EXPECT_EQ(set.gl.read(), before);
 }
 
-// A first picture uploaded whole without a hold (the irregular scheme's first after a turn,
-// its structure rebuilt) comes off the screen in parts too: composited whole with its texture
-// made in one frame, it took 41-55 ms of the image step (balls4 at 1280x720, 2026-12-07).
 // A texture's first read-back at its size (10-14 ms for a new 1280x720 layer) is learned apart
 // from its later versions' (0.3-2 ms while the camera turns): one mean of both kept the later
 // read-backs waiting their patience for 20-30 frames after each first one (balls4, 2026-12-07).
@@ -647,12 +648,14 @@ TEST(ViewerGl, ATexturesFirstReadBackIsLearnedApartFromItsLaterOnes) {
     glDeleteTextures(2, both);
 }
 
+// A first picture uploaded whole without a hold (the irregular scheme's first after a turn,
+// its structure rebuilt) comes off the screen in parts too: composited whole with its texture
+// made in one frame, it took 41-55 ms of the image step (balls4 at 1280x720, 2026-12-07).
 TEST(ViewerGl, AFirstPictureUploadedWithoutAHoldComesOffTheScreenInParts) {
     ViewWithBudget set(160, 200, scatteredLayer(160, 200, 13, 0, 110, 150));
     ASSERT_TRUE(set.gl.ok()) << "OSMesa could not create an OpenGL 3.3 core context";
-    ImageView& view = set.view;
+    ImageView& view = set.uploadFirst();
     const Image& a = set.images.first;
-    view.upload(a, ViewMode::Color);
     // Every frame spent: a part of 48 rows a draw, nothing shown before the last.
     int draws = 0;
     bool drawn = false;
