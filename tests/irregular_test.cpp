@@ -362,6 +362,12 @@ TEST(Irregular, Balls4TakesAtMostFourTimesTheRegularSchemesMemory) {
     }
 }
 
+/// The scene `spec` names: "spd:FILE" one of assets/spd, else a scene name loadScene takes.
+Scene irregularSpecScene(const std::string& spec) {
+    return loadScene(spec.rfind("spd:", 0) == 0 ? std::string(LANCER_SPD_DIR) + "/" + spec.substr(4)
+                                                : spec);
+}
+
 // The camera-frame walk reads a region's zone rectangle from one 32-byte record and its list's
 // length and entries from one place (region.h): every zone's record is the screen BSP's
 // rectangle, and every region's list read from its `first` is the list its `list` names, its own
@@ -371,9 +377,7 @@ TEST(Irregular, Balls4TakesAtMostFourTimesTheRegularSchemesMemory) {
 TEST(Irregular, RegionRecordsReadTheirZoneAndListInOnePlace) {
     for (const char* spec : {"spd:balls2.nff", "builtin:drilled:4"}) {
         SCOPED_TRACE(spec);
-        const std::string name(spec);
-        Scene scene = loadScene(
-            name.rfind("spd:", 0) == 0 ? std::string(LANCER_SPD_DIR) + "/" + name.substr(4) : name);
+        Scene scene = irregularSpecScene(spec);
         auto accel = buildIrregular(scene);
         const IrregularSubdivision& s = irregularOf(*accel);
         if (scene.tree.unionOnly()) {
@@ -406,6 +410,48 @@ TEST(Irregular, RegionRecordsReadTheirZoneAndListInOnePlace) {
             listed += !own.empty();
         }
         EXPECT_GT(listed, 0u);
+    }
+}
+
+// A projective slab's record (the eye's structure and each light's) holds where it starts in
+// depth, where its list lies and, in a union-only scene, its list's length, in 16 bytes aligned
+// to 16, so the walk reads all three from one cache line and leaves a slab whose pending check
+// fails without reading its list's line; in a CSG scene it holds the slab's tree there.
+TEST(Irregular, ProjectiveSlabRecordsHoldDepthListAndLengthInOneLine) {
+    for (const char* spec : {"spd:balls2.nff", "builtin:drilled:4"}) {
+        SCOPED_TRACE(spec);
+        Scene scene = irregularSpecScene(spec);
+        auto accel = buildIrregular(scene);
+        const IrregularSubdivision& s = irregularOf(*accel);
+        std::vector<const ProjectiveZones*> structures{&s.projective()};
+        for (const ProjectiveZones& l : s.lights()) structures.push_back(&l);
+        size_t slabs = 0, lights = 0;
+        for (const ProjectiveZones* pz : structures) {
+            if (pz->zoneCount() == 0) continue;
+            lights += pz->inward();
+            const std::span<const uint32_t> lists = pz->lists();
+            const uint32_t n = pz->zoneFirst().back();
+            for (uint32_t i = 0; i < n; ++i, ++slabs) {
+                const ProjectiveZones::Slab& r = pz->slab(i);
+                const uintptr_t at = reinterpret_cast<uintptr_t>(&r);
+                ASSERT_EQ(at % 16, 0u) << i;
+                ASSERT_EQ(at / 64, (at + sizeof r - 1) / 64) << i;
+                EXPECT_EQ(r.lo, pz->slabLo(i));
+                ASSERT_LT(r.head, lists.size());
+                const std::span<const uint32_t> prims = pz->slabPrimitives(i);
+                EXPECT_EQ(prims.data(), lists.data() + r.head + 1) << i;
+                EXPECT_EQ(prims.size(), lists[r.head]) << i;
+                if (pz->unionOnly()) {
+                    EXPECT_EQ(r.rootOrLength, int32_t(lists[r.head])) << i;
+                    EXPECT_EQ(pz->slabRoot(i), -1) << i;
+                } else {
+                    EXPECT_EQ(pz->slabRoot(i), r.rootOrLength) << i;
+                    EXPECT_EQ(r.rootOrLength < 0, prims.empty()) << i;
+                }
+            }
+        }
+        EXPECT_GT(slabs, 0u);
+        EXPECT_GT(lights, 0u);
     }
 }
 
