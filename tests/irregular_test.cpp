@@ -362,10 +362,17 @@ TEST(Irregular, Balls4TakesAtMostFourTimesTheRegularSchemesMemory) {
     }
 }
 
-/// The scene `spec` names: "spd:FILE" one of assets/spd, else a scene name loadScene takes.
-Scene irregularSpecScene(const std::string& spec) {
-    return loadScene(spec.rfind("spd:", 0) == 0 ? std::string(LANCER_SPD_DIR) + "/" + spec.substr(4)
-                                                : spec);
+/// `check(scene, structure)` on balls2 (union-only, a shared floor, lights outside its bounds)
+/// and builtin:drilled:4 (CSG), each built with the default knobs.
+template <class Check>
+void onBalls2AndDrilled4(Check check) {
+    for (const std::string& spec :
+         {std::string(LANCER_SPD_DIR) + "/balls2.nff", std::string("builtin:drilled:4")}) {
+        SCOPED_TRACE(spec);
+        Scene scene = loadScene(spec);
+        auto accel = buildIrregular(scene);
+        check(scene, irregularOf(*accel));
+    }
 }
 
 // The camera-frame walk reads a region's zone rectangle from one 32-byte record and its list's
@@ -375,11 +382,7 @@ Scene irregularSpecScene(const std::string& spec) {
 // then the shared ones; in a union-only scene with shared primitives (balls2's floor) and in a
 // CSG scene (every list sorted, none shared).
 TEST(Irregular, RegionRecordsReadTheirZoneAndListInOnePlace) {
-    for (const char* spec : {"spd:balls2.nff", "builtin:drilled:4"}) {
-        SCOPED_TRACE(spec);
-        Scene scene = irregularSpecScene(spec);
-        auto accel = buildIrregular(scene);
-        const IrregularSubdivision& s = irregularOf(*accel);
+    onBalls2AndDrilled4([](const Scene& scene, const IrregularSubdivision& s) {
         if (scene.tree.unionOnly()) {
             EXPECT_FALSE(s.shared().empty());
         }
@@ -410,7 +413,7 @@ TEST(Irregular, RegionRecordsReadTheirZoneAndListInOnePlace) {
             listed += !own.empty();
         }
         EXPECT_GT(listed, 0u);
-    }
+    });
 }
 
 // A projective slab's record (the eye's structure and each light's) holds where it starts in
@@ -418,11 +421,7 @@ TEST(Irregular, RegionRecordsReadTheirZoneAndListInOnePlace) {
 // to 16, so the walk reads all three from one cache line and leaves a slab whose pending check
 // fails without reading its list's line; in a CSG scene it holds the slab's tree there.
 TEST(Irregular, ProjectiveSlabRecordsHoldDepthListAndLengthInOneLine) {
-    for (const char* spec : {"spd:balls2.nff", "builtin:drilled:4"}) {
-        SCOPED_TRACE(spec);
-        Scene scene = irregularSpecScene(spec);
-        auto accel = buildIrregular(scene);
-        const IrregularSubdivision& s = irregularOf(*accel);
+    onBalls2AndDrilled4([](const Scene&, const IrregularSubdivision& s) {
         std::vector<const ProjectiveZones*> structures{&s.projective()};
         for (const ProjectiveZones& l : s.lights()) structures.push_back(&l);
         size_t slabs = 0, lights = 0;
@@ -452,7 +451,7 @@ TEST(Irregular, ProjectiveSlabRecordsHoldDepthListAndLengthInOneLine) {
         }
         EXPECT_GT(slabs, 0u);
         EXPECT_GT(lights, 0u);
-    }
+    });
 }
 
 // headedLists lays each list out after its length and before the common tail, at its head:
