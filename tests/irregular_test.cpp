@@ -362,6 +362,19 @@ TEST(Irregular, Balls4TakesAtMostFourTimesTheRegularSchemesMemory) {
     }
 }
 
+/// `check(scene, structure)` on balls2 (union-only, a shared floor, lights outside its bounds)
+/// and builtin:drilled:4 (CSG), each built with the default knobs.
+template <class Check>
+void onBalls2AndDrilled4(Check check) {
+    for (const std::string& spec :
+         {std::string(LANCER_SPD_DIR) + "/balls2.nff", std::string("builtin:drilled:4")}) {
+        SCOPED_TRACE(spec);
+        Scene scene = loadScene(spec);
+        auto accel = buildIrregular(scene);
+        check(scene, irregularOf(*accel));
+    }
+}
+
 // The camera-frame walk reads a region's zone rectangle from one 32-byte record and its list's
 // length and entries from one place (region.h): every zone's record is the screen BSP's
 // rectangle, and every region's list read from its `first` is the list its `list` names, its own
@@ -369,13 +382,7 @@ TEST(Irregular, Balls4TakesAtMostFourTimesTheRegularSchemesMemory) {
 // then the shared ones; in a union-only scene with shared primitives (balls2's floor) and in a
 // CSG scene (every list sorted, none shared).
 TEST(Irregular, RegionRecordsReadTheirZoneAndListInOnePlace) {
-    for (const char* spec : {"spd:balls2.nff", "builtin:drilled:4"}) {
-        SCOPED_TRACE(spec);
-        const std::string name(spec);
-        Scene scene = loadScene(
-            name.rfind("spd:", 0) == 0 ? std::string(LANCER_SPD_DIR) + "/" + name.substr(4) : name);
-        auto accel = buildIrregular(scene);
-        const IrregularSubdivision& s = irregularOf(*accel);
+    onBalls2AndDrilled4([](const Scene& scene, const IrregularSubdivision& s) {
         if (scene.tree.unionOnly()) {
             EXPECT_FALSE(s.shared().empty());
         }
@@ -406,7 +413,47 @@ TEST(Irregular, RegionRecordsReadTheirZoneAndListInOnePlace) {
             listed += !own.empty();
         }
         EXPECT_GT(listed, 0u);
-    }
+    });
+}
+
+// A projective slab's record (the eye's structure and each light's) holds where it starts in
+// depth, where its list lies and, in a union-only scene, its list's length, in 16 bytes aligned
+// to 16, so the walk reads all three from one cache line and leaves a slab whose pending check
+// fails without reading its list's line; in a CSG scene it holds the slab's tree there.
+TEST(Irregular, ProjectiveSlabRecordsHoldDepthListAndLengthInOneLine) {
+    onBalls2AndDrilled4([](const Scene&, const IrregularSubdivision& s) {
+        std::vector<const ProjectiveZones*> structures{&s.projective()};
+        for (const ProjectiveZones& l : s.lights()) structures.push_back(&l);
+        size_t slabs = 0, lights = 0;
+        for (const ProjectiveZones* pz : structures) {
+            if (pz->zoneCount() == 0) continue;
+            lights += pz->inward();
+            const std::span<const uint32_t> lists = pz->lists();
+            const uint32_t n = pz->zoneFirst().back();
+            for (uint32_t i = 0; i < n; ++i, ++slabs) {
+                const ProjectiveZones::Slab& r = pz->slab(i);
+                const uintptr_t at = reinterpret_cast<uintptr_t>(&r);
+                ASSERT_EQ(at % 16, 0u) << i;
+                ASSERT_EQ(at / 64, (at + sizeof r - 1) / 64) << i;
+                EXPECT_EQ(r.lo, pz->slabLo(i));
+                ASSERT_LT(r.head, lists.size());
+                const std::span<const uint32_t> prims = pz->slabPrimitives(i);
+                EXPECT_EQ(prims.data(), lists.data() + r.head + 1) << i;
+                EXPECT_EQ(prims.size(), lists[r.head]) << i;
+                if (pz->unionOnly()) {
+                    EXPECT_EQ(r.rootOrLength, int32_t(lists[r.head])) << i;
+                    EXPECT_EQ(pz->slabRoot(i), -1) << i;
+                } else {
+                    EXPECT_EQ(pz->slabRoot(i), r.rootOrLength) << i;
+                    if (prims.empty()) {
+                        EXPECT_LT(r.rootOrLength, 0) << i;
+                    }
+                }
+            }
+        }
+        EXPECT_GT(slabs, 0u);
+        EXPECT_GT(lights, 0u);
+    });
 }
 
 // headedLists lays each list out after its length and before the common tail, at its head:

@@ -44,7 +44,7 @@ ProjectiveZones ProjectiveZones::build(const Scene& scene, const CameraFrame& fr
         buildCentred(scene, frame, limLo, limHi, false, box, live, eyeSp, maxSlabBytes, maxRegions);
     if (s.zones_ == 0) return s;
     extra["projective_zones"] = s.zones_;
-    extra["projective_slabs"] = s.slabRoot_.size();
+    extra["projective_slabs"] = s.slabCount();
     extra["projective_empty_slabs"] = s.emptySlabs_;
     extra["projective_bsp_stopped"] = s.bsp_.stopped;
     extra["projective_merged_zones"] = s.mergedZones_;
@@ -140,22 +140,19 @@ ProjectiveZones ProjectiveZones::buildCentred(const Scene& scene, const CameraFr
         buildDepthSlabs(scene, s.bsp_, depth, zNear, zFar, sp.guard, maxSlabBytes, maxRegions);
     s.zones_ = s.bsp_.zoneCount();
     s.zoneFirst_ = std::move(slabs.zoneFirstRegion);
-    s.slabLo_.reserve(slabs.regions.size());
-    s.slabRoot_.reserve(slabs.regions.size());
-    s.slabHead_.reserve(slabs.regions.size());
     if (sp.guard) sp.guard->poll();
-    for (const IrregularRegion& r : slabs.regions) {
-        s.slabLo_.push_back(r.zlo);
-        s.slabRoot_.push_back(r.root);
-        s.slabHead_.push_back(r.list);
-    }
     s.pool_ = std::move(slabs.pool);
+    s.unionOnly_ = slabs.unionOnly;
     // Each slab keeps where its list lies (its length, then its entries): the walk reads the
-    // list from one place, no table of list starts kept.
+    // list from one place, no table of list starts kept. A union-only scene's slab has no
+    // tree: its record keeps the list's length there instead.
     std::vector<uint32_t> heads;
     s.listPrims_ = headedLists(slabs.listFirst, slabs.listPrims, {}, heads);
-    for (uint32_t& h : s.slabHead_) h = heads[h];
-    s.unionOnly_ = slabs.unionOnly;
+    s.slabs_.reserve(slabs.regions.size());
+    for (const IrregularRegion& r : slabs.regions) {
+        const uint32_t h = heads[r.list];
+        s.slabs_.push_back({r.zlo, h, s.unionOnly_ ? int32_t(s.listPrims_[h]) : r.root});
+    }
     s.buildEntering();
     std::sort(nearPrims.begin(), nearPrims.end());
     if (!nearPrims.empty() && !s.unionOnly_)
@@ -175,7 +172,7 @@ void ProjectiveZones::buildEntering() {
             std::span<const uint32_t> l = slabPrimitives(i);
             out.assign(l.begin(), l.end());
         } else {
-            out = pool_.primitives(slabRoot_[i]);
+            out = pool_.primitives(slabRoot(i));
             std::sort(out.begin(), out.end());
             out.erase(std::unique(out.begin(), out.end()), out.end());
         }
@@ -217,10 +214,8 @@ void ProjectiveZones::buildEntering() {
 
 size_t ProjectiveZones::memoryBytes() const {
     return bsp_.memoryBytes() + zoneFirst_.size() * sizeof(uint32_t) +
-           slabLo_.size() * sizeof(double) + slabRoot_.size() * sizeof(int32_t) +
-           pool_.nodes.size() * sizeof(CsgNode) +
-           (slabHead_.size() + listPrims_.size() + nearPrims_.size() + enterFirst_.size() +
-            enterPrims_.size()) *
+           slabs_.size() * sizeof(Slab) + pool_.nodes.size() * sizeof(CsgNode) +
+           (listPrims_.size() + nearPrims_.size() + enterFirst_.size() + enterPrims_.size()) *
                sizeof(uint32_t);
 }
 

@@ -31,6 +31,17 @@ namespace lancer {
 
 class ProjectiveZones {
   public:
+    /// A slab as the walk reads it: where it starts in depth, where its list lies, and its tree
+    /// or, in a union-only scene (no trees), its list's length. 16 bytes aligned to 16, so one
+    /// line holds all three, the line the search for the walk's first slab ends on
+    /// (docs/irregular.md, "Cache misses at 3 bounces").
+    struct alignas(16) Slab {
+        double lo = 0.0;    ///< depth where the slab starts
+        uint32_t head = 0;  ///< where its list (its length, then its entries) lies in the lists
+        /// Its restricted tree (-1: empty); the list's length when the scene is union-only.
+        int32_t rootOrLength = -1;
+    };
+
     /// Build over the camera-frame boxes `box` (padded) of the primitives `live`; empty when no
     /// box reaches in front of the eye. Figures go to `extra`.
     static ProjectiveZones build(const Scene& scene, const CameraFrame& frame,
@@ -99,7 +110,7 @@ class ProjectiveZones {
         hintSlot_ = slot % uint32_t(std::tuple_size_v<decltype(TraceContext::zoneHint)>);
     }
 
-    size_t regionCount() const { return zones_ == 0 ? 0 : slabRoot_.size() + 1; }
+    size_t regionCount() const { return zones_ == 0 ? 0 : slabCount() + 1; }
     /// Walk over `scene`'s primitives from now on: a copy of the scene it was built over
     /// (the same Scene::preparedId), for a structure another build lends (BuildControl::previous).
     void rebind(const Scene& scene) { scene_ = &scene; }
@@ -127,14 +138,21 @@ class ProjectiveZones {
     /// Zone z's slabs are [zoneFirst()[z], zoneFirst()[z + 1]).
     const std::vector<uint32_t>& zoneFirst() const { return zoneFirst_; }
     /// Depth where slab i starts; it ends where slab i + 1 of its zone starts, or at zFar().
-    double slabLo(uint32_t i) const { return slabLo_[i]; }
-    int32_t slabRoot(uint32_t i) const { return slabRoot_[i]; }
+    double slabLo(uint32_t i) const { return slabs_[i].lo; }
+    int32_t slabRoot(uint32_t i) const { return unionOnly_ ? -1 : slabs_[i].rootOrLength; }
+    /// Slab i's record, as the walk reads it.
+    const Slab& slab(uint32_t i) const { return slabs_[i]; }
+    /// The slabs' lists, each its length then its entries, at the slabs' heads (Slab::head).
+    std::span<const uint32_t> lists() const { return listPrims_; }
     int nearRoot() const { return nearRoot_; }
     const CsgTree& treePool() const { return pool_; }
     /// Primitives of slab i (those whose projected box overlaps it).
     std::span<const uint32_t> slabPrimitives(uint32_t i) const {
-        const uint32_t h = slabHead_[i];
-        return {listPrims_.data() + h + 1, listPrims_[h]};
+        const Slab& s = slabs_[i];
+        // Union-only: the length from the record, so a slab left by the pending check (most
+        // of a shadow ray's) never reads its list's line.
+        return {listPrims_.data() + s.head + 1,
+                unionOnly_ ? uint32_t(s.rootOrLength) : listPrims_[s.head]};
     }
     /// What slab i adds to the slab the walk leaves for it (the one before it in depth, or, in a
     /// light's structure, the one after it; all of the zone's first slab walked): the primitives
@@ -166,12 +184,12 @@ class ProjectiveZones {
     size_t zones_ = 0;
     ScreenBsp bsp_;
     std::vector<uint32_t> zoneFirst_;  ///< zone z: slabs [zoneFirst_[z], zoneFirst_[z + 1])
-    std::vector<double> slabLo_;       ///< depth where each slab starts; the last one ends at zFar_
-    std::vector<int32_t> slabRoot_;    ///< restricted tree of each slab (-1: empty)
+    /// The slabs, zone by zone in depth; the last one of a zone ends at zFar_.
+    std::vector<Slab> slabs_;
+    size_t slabCount() const { return slabs_.size(); }
     CsgTree pool_;
     // The slabs' primitive lists, which the walk tests (hitInIrregularRegion), and their trees.
-    /// Where each slab's list lies in listPrims_: its length, then its entries (headedLists).
-    std::vector<uint32_t> slabHead_;
+    /// The slabs' lists (Slab::head): each its length, then its entries (headedLists).
     std::vector<uint32_t> listPrims_;
     std::vector<uint32_t> nearPrims_;
     std::vector<uint32_t> enterFirst_, enterPrims_;  ///< slab i's entering list (slabEntering)
@@ -209,7 +227,7 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         }
     };
     auto nearRegion = [&](double t0, double t1) {
-        const uint32_t id = firstId + uint32_t(slabRoot_.size());
+        const uint32_t id = firstId + uint32_t(slabCount());
         enter(id, t0);
         ++ctx.counters.regionVisits;
         obs.region(id, t0, t1);
@@ -225,9 +243,16 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         obs.region(firstId + i, t0, t1);
         std::optional<std::span<const uint32_t>> tests;
         if (heldBefore) tests = slabEntering(i);
+        // The list's length from the record in a union-only scene (slabPrimitives), told apart
+        // once here, so each inlined test keeps one path.
+        const Slab& s = slabs_[i];
+        const uint32_t* list = listPrims_.data() + s.head;
         const bool found =
-            hitInIrregularRegion(scene, unionOnly_, slabPrimitives(i), pool_, slabRoot_[i], ray,
-                                 tmin, t0, t1, ctx, obs, hit, false, tests);
+            unionOnly_
+                ? hitInIrregularRegion(scene, true, {list + 1, uint32_t(s.rootOrLength)}, pool_, -1,
+                                       ray, tmin, t0, t1, ctx, obs, hit, false, tests)
+                : hitInIrregularRegion(scene, false, {list + 1, list[0]}, pool_, s.rootOrLength,
+                                       ray, tmin, t0, t1, ctx, obs, hit, false, tests);
         heldBefore = ctx.pending.tested;
         return found;
     };
@@ -253,10 +278,10 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
         }
         uint32_t i = first;
         // Skip the slabs wholly before tmin (a primary ray has tmin = 0: none).
-        while (i + 1 < last && tAt(slabLo_[i + 1]) < t) ++i;
+        while (i + 1 < last && tAt(slabs_[i + 1].lo) < t) ++i;
         for (; i < last; ++i) {
-            const double t0 = std::max(tAt(slabLo_[i]), t);
-            const double z1 = i + 1 < last ? slabLo_[i + 1] : zFar_;
+            const double t0 = std::max(tAt(slabs_[i].lo), t);
+            const double z1 = i + 1 < last ? slabs_[i + 1].lo : zFar_;
             const double t1 = std::min(tAt(z1), tmax);
             if (t0 > tmax) return false;
             if (slab(i, t0, t1)) return true;
@@ -270,21 +295,24 @@ bool ProjectiveZones::intersect(const Ray& ray, const Ray& rc, double u, double 
     // The slab's start is crossed later the nearer the slab: a binary search for the last slab
     // whose start is not crossed before t (a shadow ray from deep in a zone of many slabs).
     const uint32_t i0 =
-        uint32_t(std::partition_point(slabLo_.begin() + first + 1, slabLo_.begin() + last,
-                                      [&](double z) { return !(tAt(z) < t); }) -
-                 slabLo_.begin());
+        uint32_t(std::partition_point(slabs_.begin() + first + 1, slabs_.begin() + last,
+                                      [&](const Slab& s) { return !(tAt(s.lo) < t); }) -
+                 slabs_.begin());
     uint32_t i = i0 - 1;
+    // Slab i ends where slab i + 1 starts: that depth is the one the step before read.
+    double z1 = i0 < last ? slabs_[i0].lo : zFar_;
     for (;; --i) {
-        const double z1 = i + 1 < last ? slabLo_[i + 1] : zFar_;
+        const double z0 = slabs_[i].lo;
         const double t0 = std::max(tAt(z1), t);
         const bool lastSlab = i == first && !hasNearRegion();
-        const double t1 = lastSlab ? tmax : std::min(tAt(slabLo_[i]), tmax);
+        const double t1 = lastSlab ? tmax : std::min(tAt(z0), tmax);
         if (t0 > tmax) return false;
         if (t0 <= t1) {
             if (slab(i, t0, t1)) return true;
-            if (!lastSlab) leave(slabLo_[i]);
+            if (!lastSlab) leave(z0);
         }
         if (i == first) break;
+        z1 = z0;
     }
     if (!hasNearRegion()) return false;
     const double t0 = std::max(tAt(zNear_), t);
