@@ -322,7 +322,11 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 break;
             }
             auto beforeSwap = Clock::now();
+            // The swap's own CPU apart: llvmpipe rasterizes there what was drawn since the
+            // last finish (the inspector's and the panel layer's draws).
+            const double swapCpuStart = threadCpuMs();
             glfwSwapBuffers(window);
+            const double swapCpuMs = threadCpuMs() - swapCpuStart;
             app.presented();
             lastDrawn = Clock::now();
             statSwapMs +=
@@ -338,11 +342,12 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                 if (v.logTimings && cpuMs > kFrameBudgetMs)
                     std::fprintf(stderr,
                                  "timing: slow frame %d (%s): %.1f ms, %.1f ms of UI CPU: %s, "
-                                 "swap and rest %.1f; %d panels redrawn, %d steps deferred; "
+                                 "swap %.1f, rest %.1f; %d panels redrawn, %d steps deferred; "
                                  "image: %d rows composited, %zu texels of layer changes, %d "
                                  "rows shown\n",
                                  frames, turnDue ? "turning" : "still", workMs, cpuMs,
-                                 app.phases().summary().c_str(), cpuMs - app.phases().totalMs(),
+                                 app.phases().summary().c_str(), swapCpuMs,
+                                 cpuMs - app.phases().totalMs() - swapCpuMs,
                                  app.panelsRedrawn(), app.frameBudget().deferred(),
                                  app.imageShade().rows, app.imageShade().texels,
                                  app.imageShade().shownRows);
