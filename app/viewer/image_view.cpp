@@ -7,6 +7,8 @@
 #include <new>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include "app/viewer/gl.h"
 #include "app/viewer/gl/program.h"
@@ -92,6 +94,8 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
     if (resized) {  // the shaded texture is made when it is shaded, the counters' below
         colorRgba_.assignZeroed(size_t(width_) * size_t(height_) * 4);
+        // The layer's read-back buffer of the image's size, made ahead (setOverlay()).
+        if (overlayRgba_.capacity() < colorRgba_.size()) readBuffer_.prepare(colorRgba_.size());
         newSize_ = true;
         dirty_.clear();
         precomposed_.clear();
@@ -132,6 +136,20 @@ void ImageView::upload(const Image& img, ViewMode mode, int rowBegin, int rowEnd
     dirty_.add(rowBegin, rowEnd);
 }
 
+namespace {
+
+/// A 2D texture's level 0 size (its width, its height).
+std::pair<int, int> textureSize(unsigned texture) {
+    GLint w = 0, h = 0;
+    glBindTexture(GL_TEXTURE_2D, texture);
+    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
+    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    return {int(w), int(h)};
+}
+
+}  // namespace
+
 void ImageView::setOverlay(unsigned texture, uint64_t version) {
     if (texture == overlayTex_ && (texture == 0 || version == overlayVersion_)) return;
     // A new version of the same texture: the colour image composites again only the texels
@@ -146,39 +164,44 @@ void ImageView::setOverlay(unsigned texture, uint64_t version) {
     overlayWidth_ = overlayHeight_ = 0;
     if (texture == 0) return;
     const double start = threadCpuMs();
+    std::tie(overlayWidth_, overlayHeight_) = textureSize(texture);
     glBindTexture(GL_TEXTURE_2D, texture);
-    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &overlayWidth_);
-    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &overlayHeight_);
-    overlayRgba_.resize(size_t(std::max(overlayWidth_, 0)) * size_t(std::max(overlayHeight_, 0)) *
-                        4);
+    const size_t bytes =
+        size_t(std::max(overlayWidth_, 0)) * size_t(std::max(overlayHeight_, 0)) * 4;
+    const bool fresh = readNeedsFreshMemory(overlayWidth_, overlayHeight_);
+    if (overlayRgba_.capacity() < bytes)
+        if (std::vector<uint8_t> prepared = readBuffer_.take(bytes); !prepared.empty())
+            overlayRgba_ = std::move(prepared);
+    overlayRgba_.resize(bytes);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     if (!overlayRgba_.empty())
         glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_UNSIGNED_BYTE, overlayRgba_.data());
     glBindTexture(GL_TEXTURE_2D, 0);
-    const bool first =
-        texture != readTex_ || overlayWidth_ != readWidth_ || overlayHeight_ != readHeight_;
-    (first ? firstReadCost_ : readCost_)
-        .record(double(overlayRgba_.size() / 4), threadCpuMs() - start);
-    readTex_ = texture;
-    readWidth_ = overlayWidth_;
-    readHeight_ = overlayHeight_;
+    (fresh ? freshReadCost_ : readCost_).record(double(bytes / 4), threadCpuMs() - start);
 }
 
-double ImageView::readEstimateMs(unsigned texture, int width, int height) const {
-    const bool first = texture != readTex_ || width != readWidth_ || height != readHeight_;
-    return (first ? firstReadCost_ : readCost_).estimateMs(double(width) * double(height));
+bool ImageView::readNeedsFreshMemory(int width, int height) const {
+    const size_t bytes = size_t(std::max(width, 0)) * size_t(std::max(height, 0)) * 4;
+    return overlayRgba_.capacity() < bytes && !readBuffer_.ready(bytes);
+}
+
+double ImageView::readEstimateMs(int width, int height) const {
+    return (readNeedsFreshMemory(width, height) ? freshReadCost_ : readCost_)
+        .estimateMs(double(width) * double(height));
 }
 
 bool ImageView::setOverlay(unsigned texture, uint64_t version, FrameBudget& budget,
                            double reserveMs) {
     if (texture == overlayTex_ && (texture == 0 || version == overlayVersion_)) return true;
     if (texture != 0) {
-        GLint w = 0, h = 0;
-        glBindTexture(GL_TEXTURE_2D, texture);
-        glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
-        glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
-        glBindTexture(GL_TEXTURE_2D, 0);
-        if (!budget.fits(readEstimateMs(texture, w, h), reserveMs, readPatience_)) return false;
+        const auto [w, h] = textureSize(texture);
+        if (readNeedsFreshMemory(w, h)) {
+            // Its buffer is made on a worker first: written in the frame, its fresh pages
+            // took 10-12 ms of the 1280x720 read-back (2026-12-07). The layer held stays.
+            readBuffer_.prepare(size_t(std::max(w, 0)) * size_t(std::max(h, 0)) * 4);
+            if (readNeedsFreshMemory(w, h)) return false;
+        }
+        if (!budget.fits(readEstimateMs(w, h), reserveMs, readPatience_)) return false;
     }
     setOverlay(texture, version);
     return true;

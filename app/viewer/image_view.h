@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "app/viewer/colormap.h"
+#include "app/viewer/memory/fresh_memory.h"
 #include "app/viewer/timing/frame_budget.h"
 #include "engine/render/image.h"
 
@@ -102,11 +103,16 @@ class ImageView {
     /// and the caller asks again with the next frame's version. A read-back is where llvmpipe
     /// finishes the layer's drawing: unbudgeted, it took 14-22 ms of frames already full
     /// (balls4 at 1280x720, a new layer texture's first and the irregular zones' filled
-    /// triangles, 2026-12-07). Returns whether the view holds `texture` at `version` now.
+    /// triangles, 2026-12-07). A read-back that would need fresh memory first waits for its
+    /// buffer, made on a worker (its page faults were 10-12 ms of a 1280x720 read-back).
+    /// Returns whether the view holds `texture` at `version` now.
     bool setOverlay(unsigned texture, uint64_t version, FrameBudget& budget, double reserveMs);
-    /// The learned cost of reading back a `width` x `height` version of `texture`, in ms: its
-    /// first at that size costs more than the later ones.
-    double readEstimateMs(unsigned texture, int width, int height) const;
+    /// The learned cost of reading back a `width` x `height` layer, in ms: into fresh memory
+    /// (no buffer of that size kept or prepared) it costs more than into a buffer kept.
+    double readEstimateMs(int width, int height) const;
+    /// Whether a read-back of a `width` x `height` layer needs fresh memory: the buffer kept is
+    /// smaller and none of that size is prepared (upload() prepares one of the image's size).
+    bool readNeedsFreshMemory(int width, int height) const;
     /// While held, draw() shows what it showed before and shades nothing: uploads go on, and
     /// the rows they changed are shaded once the hold ends (a new view's image coming in parts
     /// is never shown half). A hold keeps a picture of another size (drawn scaled), and before
@@ -291,15 +297,16 @@ class ImageView {
     /// the budget (finishOffScreen()): shown whatever the budget after kPatienceFrames.
     mutable Patience showPatience_{"the image's showing"};
     /// The UI thread's CPU per texel of a layer's read-back (setOverlay()), learned apart for a
-    /// texture's first at its size and for its later versions: a new 1280x720 texture's first
-    /// took 10-14 ms, a later one 0.3-2 ms while the camera turns (balls4, 2026-12-07); one
-    /// mean of both kept the later read-backs waiting their patience for 20-30 frames after
-    /// each first one.
-    StepCost firstReadCost_{10.6 / (1280.0 * 720.0)}, readCost_{1.0 / (1280.0 * 720.0)};
+    /// read into fresh memory and into a buffer kept: the first into a new 1280x720 buffer took
+    /// 10-14 ms, nearly all of it the buffer's page faults, a later one 0.3-2 ms while the
+    /// camera turns (balls4, 2026-12-07); one mean of both kept the later read-backs waiting
+    /// their patience for 20-30 frames after each first one.
+    StepCost freshReadCost_{10.6 / (1280.0 * 720.0)}, readCost_{1.0 / (1280.0 * 720.0)};
     Patience readPatience_{"the layer's read-back"};
-    /// The texture and size last read back (readEstimateMs()).
-    unsigned readTex_ = 0;
-    int readWidth_ = 0, readHeight_ = 0;
+    /// The read-back's buffer of the image's size, made on a worker when the image's size
+    /// changes, so that the first read-back at a size (a new structure's first layer) writes
+    /// into mapped pages.
+    PreparedBytes readBuffer_;
     /// The last draw() was held: the next unheld one composites all pending rows (the view
     /// released must show whole).
     mutable bool drawnHeld_ = false;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "app/viewer/camera_control.h"
+#include "app/viewer/memory/fresh_memory.h"
 #include "app/viewer/panels/panels.h"
 #include "app/viewer/timing/frame_times.h"
 #include "app/viewer/viewer_app.h"
@@ -74,6 +75,8 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
     // the ones that matter for speed; other drivers ignore the variable. A value the user set
     // stays.
     setenv("LP_NUM_THREADS", "0", 0);
+    // Freed buffers (images, batches, llvmpipe's textures) reused, not mapped afresh.
+    keepFreedMemory();
     glfwSetErrorCallback(
         [](int code, const char* text) { std::cerr << "glfw: " << text << " (" << code << ")\n"; });
     if (!glfwInit()) {
@@ -347,10 +350,9 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
                                  "rows shown\n",
                                  frames, turnDue ? "turning" : "still", workMs, cpuMs,
                                  app.phases().summary().c_str(), swapCpuMs,
-                                 cpuMs - app.phases().totalMs() - swapCpuMs,
-                                 app.panelsRedrawn(), app.frameBudget().deferred(),
-                                 app.imageShade().rows, app.imageShade().texels,
-                                 app.imageShade().shownRows);
+                                 cpuMs - app.phases().totalMs() - swapCpuMs, app.panelsRedrawn(),
+                                 app.frameBudget().deferred(), app.imageShade().rows,
+                                 app.imageShade().texels, app.imageShade().shownRows);
             }
             // A step let in over the budget (it had waited its patience) says why it waited.
             if (v.logTimings)
