@@ -9,6 +9,7 @@
 #include "engine/accel/build_guard.h"
 #include "engine/scene/builtin_scenes.h"
 #include "engine/scene/loader.h"
+#include "engine/util/kept_memory.h"
 #ifdef LANCER_WITH_VIEWER
 #include "app/viewer/compare/rebuild_diff.h"
 #include "app/viewer/overlay/overlays.h"
@@ -23,6 +24,9 @@ constexpr const char* kSceneHelp =
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Freed blocks (a bench's repeated builds, the viewer's images and textures) reused, not
+    // mapped afresh: each fresh page is a page fault (engine/util/kept_memory.h).
+    keepFreedMemory();
     CLI::App app{
         "lancer: see and measure how space subdivision accelerates ray tracing of CSG solids"};
     app.require_subcommand(0, 1);

@@ -20,7 +20,6 @@
 #include <vector>
 
 #include "app/viewer/camera_control.h"
-#include "app/viewer/memory/fresh_memory.h"
 #include "app/viewer/panels/panels.h"
 #include "app/viewer/timing/frame_times.h"
 #include "app/viewer/viewer_app.h"
@@ -75,8 +74,6 @@ int runViewer(const cli::CommonOptions& o, const ViewOptions& v,
     // the ones that matter for speed; other drivers ignore the variable. A value the user set
     // stays.
     setenv("LP_NUM_THREADS", "0", 0);
-    // Freed buffers (images, batches, llvmpipe's textures) reused, not mapped afresh.
-    keepFreedMemory();
     glfwSetErrorCallback(
         [](int code, const char* text) { std::cerr << "glfw: " << text << " (" << code << ")\n"; });
     if (!glfwInit()) {

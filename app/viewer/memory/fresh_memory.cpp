@@ -1,17 +1,8 @@
 #include "app/viewer/memory/fresh_memory.h"
 
-#include <malloc.h>
-
-#include <algorithm>
 #include <chrono>
 
 namespace lancer::viewer {
-
-bool keepFreedMemory(size_t trimBytes) {
-    // A fixed mmap threshold also stops glibc from moving it block by block.
-    return mallopt(M_MMAP_THRESHOLD, int(kKeptBlockBytes)) == 1 &&
-           mallopt(M_TRIM_THRESHOLD, int(std::min<size_t>(trimBytes, size_t(1) << 30))) == 1;
-}
 
 PreparedBytes::~PreparedBytes() {
     if (making_.valid()) making_.wait();

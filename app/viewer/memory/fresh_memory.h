@@ -2,9 +2,7 @@
 // about 3 ms a MiB of the writing thread's time (a 1280x720 RGBA buffer 10-12 ms, against
 // 0.2 ms to write the same buffer again; docs/viewer.md, "Fresh memory"). A buffer the UI
 // thread needs whole in one frame (the layer's read-back) is therefore made ahead on a worker
-// (PreparedBytes), and freed blocks stay in the process's heaps for reuse (keepFreedMemory()):
-// glibc returns a freed block over its mmap threshold (128 KiB at first) to the system, so
-// each new image, batch or llvmpipe texture of a size freed before paid for its pages again.
+// (PreparedBytes); freed blocks are kept for reuse process-wide (engine/util/kept_memory.h).
 #pragma once
 
 #include <cstddef>
@@ -13,14 +11,6 @@
 #include <vector>
 
 namespace lancer::viewer {
-
-/// The largest block keepFreedMemory() has come from the heaps (and stay there once freed):
-/// glibc's largest mmap threshold on 64 bits.
-inline constexpr size_t kKeptBlockBytes = size_t(32) << 20;
-
-/// Sets malloc's mmap threshold to kKeptBlockBytes and its trim threshold to `trimBytes`, for
-/// the whole process; false where the C library refuses them (a sanitizer's allocator).
-bool keepFreedMemory(size_t trimBytes = size_t(256) << 20);
 
 /// Bytes of a size known ahead, allocated and written on a worker thread, so that the thread
 /// taking them finds their pages mapped.

@@ -11,6 +11,8 @@
 #include <thread>
 #include <vector>
 
+#include "engine/util/kept_memory.h"
+
 namespace lancer::viewer {
 namespace {
 
@@ -67,7 +69,8 @@ TEST(FreshMemory, PreparedBytesComeZeroWithTheirPagesMapped) {
 }
 
 // A block over glibc's first mmap threshold, written and freed, comes back with its pages:
-// without keepFreedMemory() glibc returns it to the system and the next one is mapped afresh.
+// without keepFreedMemory() (engine/util/kept_memory.h, which `lancer` sets at its start)
+// glibc returns it to the system and the next one is mapped afresh.
 TEST(FreshMemory, FreedBlocksAreKeptForTheNextAllocation) {
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
     GTEST_SKIP() << "a sanitizer's allocator takes no glibc thresholds";

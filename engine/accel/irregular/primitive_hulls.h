@@ -53,6 +53,9 @@ class PrimitiveHulls {
     size_t keptFaces() const { return keptFaces_; }
     /// Bytes of the kept faces.
     size_t faceBytes() const { return faceVerts_.capacity() * sizeof(FaceVertex); }
+    /// Bytes of the hulls' buffer (one hull a live primitive, reserved once: what bytesFor()
+    /// charges the budget for them).
+    size_t hullBytes() const { return hulls_.capacity() * sizeof(Hull); }
     /// Primitive p's own box (its world box when it has none), seen along `column`, meets the
     /// screen rectangle [lo, hi] (a primitive without a hull always does; so does one reaching
     /// behind the eye, `FromEye`).
