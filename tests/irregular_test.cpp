@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <optional>
 #include <random>
 
 #include "engine/accel/build_guard.h"
@@ -396,7 +395,7 @@ TEST(Irregular, RegionRecordsReadTheirZoneAndListInOnePlace) {
         const double pad = 1e-6 * scene.scale();
         size_t listed = 0;
         for (uint32_t r = 0; r < s.regions().size(); ++r) {
-            const auto held = s.heldPrimitives(r), named = s.list(s.regionList(r));
+            const auto held = s.heldPrimitives(r), named = s.list(s.regions()[r].list);
             ASSERT_TRUE(std::equal(held.begin(), held.end(), named.begin(), named.end())) << r;
             ASSERT_GE(held.size(), shared.size());
             EXPECT_TRUE(std::equal(shared.begin(), shared.end(), held.end() - shared.size()));
@@ -414,56 +413,6 @@ TEST(Irregular, RegionRecordsReadTheirZoneAndListInOnePlace) {
             listed += !own.empty();
         }
         EXPECT_GT(listed, 0u);
-    });
-}
-
-// The camera-frame record is 32 bytes aligned to 32 in its array, two to a cache line, none
-// across two (region.h): it keeps its start depth alone, so each region's end is the next
-// record's start in its zone's column, or the structure's far face on the column's last slab,
-// the very doubles the depth step cut at (the slabs rebuilt here); the tree and list read
-// through the list's header are the ones the build made for the region's primitive set.
-TEST(Irregular, RegionRecordsTakeHalfALineAndEndWhereTheNextStarts) {
-    onBalls2AndDrilled4([](const Scene& scene, const IrregularSubdivision& s) {
-        static_assert(sizeof(IrregularRegion) == 32 && alignof(IrregularRegion) == 32);
-        ASSERT_FALSE(s.regions().empty());
-        EXPECT_EQ(reinterpret_cast<uintptr_t>(s.regions().data()) % 32, 0u);
-        const double zfar = s.bounds().hi.z;
-        std::optional<TreeRestrictor> restrictor;
-        if (!scene.tree.unionOnly()) restrictor.emplace(scene.tree);
-        size_t ends = 0, rooted = 0;
-        for (uint32_t z = 0; z < s.screen().zoneCount(); ++z) {
-            const uint32_t first = s.zoneFirstRegion()[z], last = s.zoneFirstRegion()[z + 1];
-            for (uint32_t r = first; r < last; ++r) {
-                const IrregularRegion& R = s.regions()[r];
-                ASSERT_EQ(reinterpret_cast<uintptr_t>(&R) % 32, 0u) << r;
-                EXPECT_EQ(R.zone, z) << r;
-                EXPECT_EQ(R.lastSlab(), r + 1 == last) << r;
-                const double end = r + 1 < last ? s.regions()[r + 1].zlo : zfar;
-                ASSERT_EQ(s.regionEnd(r), end) << r;
-                ASSERT_EQ(s.regionBox(r).hi.z, end) << r;
-                ASSERT_LT(R.zlo, end) << r;
-                ends += r + 1 < last;
-                // The header's tree and list are those of the region's primitive set.
-                const uint32_t l = s.regionList(r);
-                const auto held = s.heldPrimitives(r), named = s.list(l);
-                ASSERT_TRUE(std::equal(held.begin(), held.end(), named.begin(), named.end()));
-                const int32_t root = s.regionRoot(r);
-                if (!restrictor) {
-                    EXPECT_EQ(root, -1) << r;
-                    continue;
-                }
-                const auto own = s.primitives(r);
-                CsgTree want;
-                const int wantRoot =
-                    restrictor->restrict(std::vector<uint32_t>(own.begin(), own.end()), want);
-                ASSERT_EQ(root >= 0, wantRoot >= 0) << r;
-                if (root < 0) continue;
-                ++rooted;
-                EXPECT_EQ(s.treePool().primitives(root), want.primitives(wantRoot)) << r;
-            }
-        }
-        EXPECT_GT(ends, 0u);
-        EXPECT_EQ(rooted > 0, !s.unionOnly());
     });
 }
 
@@ -519,13 +468,6 @@ TEST(Irregular, HeadedListsKeepEachListAfterItsLength) {
     EXPECT_EQ(headedLists(first, prims, {}, heads),
               (std::vector<uint32_t>{0, 2, 7, 9, 3, 1, 2, 3}));
     EXPECT_EQ(heads, (std::vector<uint32_t>{0, 1, 4, 8}));
-    // With a tree a list, each tree after its list's length (-1 read back as unsigned).
-    const std::vector<int32_t> roots = {-1, 5, 8};
-    EXPECT_EQ(headedLists(first, prims, tail, heads, roots),
-              (std::vector<uint32_t>{1, uint32_t(-1), 4, 3, 5, 7, 9, 4, 4, 8, 1, 2, 3, 4}));
-    EXPECT_EQ(heads, (std::vector<uint32_t>{0, 3, 8, 14}));
-    EXPECT_THROW(headedLists(first, prims, tail, heads, std::span(roots).first(2)),
-                 std::invalid_argument);
 }
 
 /// What a screen BSP costs a ray through the screen rectangle by its own estimate: the
@@ -794,7 +736,7 @@ TEST(Irregular, WalkCostsAndSlabsFromTheKeptSortsAreTheFreshSorts) {
                                                std::numeric_limits<size_t>::max() / 2);
         ASSERT_EQ(got.regions.size(), want.regions.size()) << name;
         for (size_t r = 0; r < got.regions.size(); ++r) {
-            const IrregularSlab &a = got.regions[r], &b = want.regions[r];
+            const IrregularRegion &a = got.regions[r], &b = want.regions[r];
             ASSERT_EQ(a.zone, b.zone) << name << " region " << r;
             ASSERT_EQ(a.zlo, b.zlo) << name << " region " << r;
             ASSERT_EQ(a.zhi, b.zhi) << name << " region " << r;
@@ -866,7 +808,7 @@ TEST(Irregular, UnionOnlyRegionsKeepListsNotTrees) {
     EXPECT_EQ(accel->info().extra["distinct_trees"].get<size_t>(), 0u);
     size_t listed = 0;
     for (uint32_t r = 0; r < s.regions().size(); ++r) {
-        EXPECT_EQ(s.regionRoot(r), -1);
+        EXPECT_EQ(s.regions()[r].root, -1);
         listed += s.primitives(r).empty() ? 0 : 1;
     }
     EXPECT_GT(listed, 0u);
@@ -905,9 +847,8 @@ TEST(Irregular, UnionOnlyRegionsKeepListsNotTrees) {
     const IrregularSubdivision& t = irregularOf(*withTrees);
     EXPECT_FALSE(t.unionOnly());
     EXPECT_FALSE(t.treePool().nodes.empty());
-    bool rooted = false;
-    for (uint32_t r = 0; r < t.regions().size(); ++r) rooted |= t.regionRoot(r) >= 0;
-    EXPECT_TRUE(rooted);
+    EXPECT_TRUE(std::any_of(t.regions().begin(), t.regions().end(),
+                            [](const IrregularRegion& r) { return r.root >= 0; }));
     EXPECT_GT(withTrees->info().extra["distinct_trees"].get<size_t>(), 0u);
 }
 

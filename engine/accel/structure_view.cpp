@@ -151,7 +151,8 @@ std::vector<SlabInfo> ZoneFrameView::slabs(uint32_t z) const {
     if (kind_ == ZoneFrameKind::Camera) {
         const std::vector<uint32_t>& first = s_->zoneFirstRegion();
         for (uint32_t r = first[z]; r < first[z + 1]; ++r) {
-            out.push_back({r, s_->regions()[r].zlo, s_->regionEnd(r), s_->heldPrimitives(r)});
+            const IrregularRegion& R = s_->regions()[r];
+            out.push_back({r, R.zlo, R.zhi, s_->heldPrimitives(r)});
         }
     } else {
         const ProjectiveZones& pz = s_->projective();
@@ -397,7 +398,7 @@ RegionInfo StructureView::region(uint32_t id) const {
         r.slab = id - s->zoneFirstRegion()[R.zone];
         r.prims = s->heldPrimitives(uint32_t(id));
         r.pool = &s->treePool();
-        r.root = s->regionRoot(uint32_t(id));
+        r.root = R.root;
         for (int a = 0; a < 3; ++a) {
             r.lo[a] = s->pointer(uint32_t(id), a, false);
             r.hi[a] = s->pointer(uint32_t(id), a, true);

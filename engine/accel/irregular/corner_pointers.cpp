@@ -6,13 +6,13 @@
 
 namespace lancer {
 
-uint32_t slabAt(const std::vector<IrregularSlab>& regions,
+uint32_t slabAt(const std::vector<IrregularRegion>& regions,
                 const std::vector<uint32_t>& zoneFirstRegion, uint32_t zone, double z, int s) {
     uint32_t first = zoneFirstRegion[zone], last = zoneFirstRegion[zone + 1];
     // The first slab whose top is above z (s > 0) or at or above z (s <= 0).
     auto it = std::partition_point(
         regions.begin() + first, regions.begin() + last,
-        [&](const IrregularSlab& r) { return s > 0 ? r.zhi <= z : r.zhi < z; });
+        [&](const IrregularRegion& r) { return s > 0 ? r.zhi <= z : r.zhi < z; });
     uint32_t i = uint32_t(it - regions.begin());
     return std::min(i, last - 1);
 }
@@ -31,7 +31,7 @@ void linkCorners(const ScreenBsp& bsp, const Box3& bounds, DepthSlabs& slabs,
         int64_t ly = lo.y > bounds.lo.y ? int64_t(bsp.locate(lo.x, lo.y, +1, -1)) : -1;
         uint32_t first = slabs.zoneFirstRegion[zone], last = slabs.zoneFirstRegion[zone + 1];
         for (uint32_t i = first; i < last; ++i) {
-            IrregularSlab& r = slabs.regions[i];
+            IrregularRegion& r = slabs.regions[i];
             // High corner: just below its zhi in the neighbour; low corner: just above its zlo.
             r.hi[0] = hx < 0 ? -1
                              : int32_t(slabAt(slabs.regions, slabs.zoneFirstRegion, uint32_t(hx),

@@ -15,7 +15,7 @@ void linkCorners(const ScreenBsp& bsp, const Box3& bounds, DepthSlabs& slabs,
                  const BuildGuard* guard = nullptr);
 
 /// The slab of zone `zone` holding depth z, on the side `s` of a cut (+1 above, -1 below).
-uint32_t slabAt(const std::vector<IrregularSlab>& regions,
+uint32_t slabAt(const std::vector<IrregularRegion>& regions,
                 const std::vector<uint32_t>& zoneFirstRegion, uint32_t zone, double z, int s);
 
 }  // namespace lancer

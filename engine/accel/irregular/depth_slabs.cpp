@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
-#include <stdexcept>
 
 #include "engine/accel/build_guard.h"
 #include "engine/model/restriction.h"
@@ -12,18 +11,14 @@ namespace lancer {
 
 std::vector<uint32_t> headedLists(const std::vector<uint32_t>& listFirst,
                                   const std::vector<uint32_t>& listPrims,
-                                  std::span<const uint32_t> tail, std::vector<uint32_t>& heads,
-                                  std::span<const int32_t> roots) {
+                                  std::span<const uint32_t> tail, std::vector<uint32_t>& heads) {
     const size_t lists = listFirst.empty() ? 0 : listFirst.size() - 1;
-    if (!roots.empty() && roots.size() != lists)
-        throw std::invalid_argument("headedLists: one root a list, or none");
     std::vector<uint32_t> out;
-    out.reserve(listPrims.size() + lists * (tail.size() + 1 + (roots.empty() ? 0 : 1)));
+    out.reserve(listPrims.size() + lists * (tail.size() + 1));
     heads.assign(lists + 1, 0);
     for (size_t l = 0; l < lists; ++l) {
         heads[l] = uint32_t(out.size());
         out.push_back(uint32_t(listFirst[l + 1] - listFirst[l] + tail.size()));
-        if (!roots.empty()) out.push_back(uint32_t(roots[l]));
         out.insert(out.end(), listPrims.begin() + listFirst[l],
                    listPrims.begin() + listFirst[l + 1]);
         out.insert(out.end(), tail.begin(), tail.end());
@@ -48,7 +43,7 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
     if (!out.unionOnly) restrictor.emplace(scene.tree);
     // One tree and one list per distinct primitive set; list 0 is the empty set.
     RestrictedTreePool pool;
-    auto share = [&](std::vector<uint32_t>& prims, IrregularSlab& r) {
+    auto share = [&](std::vector<uint32_t>& prims, IrregularRegion& r) {
         std::sort(prims.begin(), prims.end());
         const RestrictedTreePool::Entry e = pool.share(prims, [&](CsgTree& dst) {
             return restrictor ? restrictor->restrict(prims, dst) : -1;
@@ -59,7 +54,7 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
 
     // What the slabs hold so far: vectors by capacity, and the pool.
     auto bytes = [&] {
-        return out.regions.capacity() * sizeof(IrregularSlab) +
+        return out.regions.capacity() * sizeof(IrregularRegion) +
                out.zoneFirstRegion.capacity() * sizeof(uint32_t) + pool.bytes();
     };
     // What the zones not cut yet cost at least (merged): kept free for them.
@@ -136,7 +131,7 @@ DepthSlabs buildDepthSlabs(const Scene& scene, const ScreenBsp& bsp,
         reserve -= kMergedZoneBytes + k * refBytes;
         --regionsLeft;
         if (guard) guard->poll("depth slabs", now, out.regions.size());
-        IrregularSlab r;
+        IrregularRegion r;
         r.zone = z;
         r.zlo = zlo;
         r.zhi = zhi;

@@ -18,7 +18,7 @@
 namespace lancer {
 
 struct DepthSlabs {
-    std::vector<IrregularSlab> regions;     ///< zone by zone, slabs by increasing depth
+    std::vector<IrregularRegion> regions;   ///< zone by zone, slabs by increasing depth
     std::vector<uint32_t> zoneFirstRegion;  ///< zone z: regions [zoneFirstRegion[z], [z + 1])
     CsgTree pool;                           ///< the restricted trees (none when unionOnly)
     /// The scene is union-only: regions keep their primitive lists alone, no restricted tree
@@ -38,7 +38,8 @@ class BuildGuard;  // build_guard.h
 /// Bytes a zone's slabs cost at least, merged into one: a region, a pool entry, and per primitive
 /// its list entry (kept twice: the list and the pool's index) and, unless the scene is union-only
 /// (`unionOnly`: no tree is made), about two tree nodes.
-inline constexpr size_t kMergedZoneBytes = sizeof(IrregularSlab) + RestrictedTreePool::kEntryBytes;
+inline constexpr size_t kMergedZoneBytes =
+    sizeof(IrregularRegion) + RestrictedTreePool::kEntryBytes;
 inline constexpr size_t kMergedRefBytes = 2 * sizeof(uint32_t) + 2 * sizeof(CsgNode);
 inline constexpr size_t kUnionOnlyRefBytes = 2 * sizeof(uint32_t);
 inline constexpr size_t mergedRefBytes(bool unionOnly) {
@@ -49,14 +50,10 @@ inline constexpr size_t mergedRefBytes(bool unionOnly) {
 /// l becomes its length, its entries, then `tail`'s (the same for every list), from heads[l] of
 /// the array returned (heads[lists]: its size). A region or slab keeps heads[l] and reads the
 /// length from the line of the first entries, where a table of list starts cost a line of its
-/// own a visit (docs/irregular.md, "Region visits in fewer cache lines"). With `roots` (one per
-/// list), list l's length is followed by roots[l], its restricted tree, so a record that keeps
-/// heads[l] reads its tree from that line too (region.h); its entries then start at
-/// heads[l] + 2.
+/// own a visit (docs/irregular.md, "Region visits in fewer cache lines").
 std::vector<uint32_t> headedLists(const std::vector<uint32_t>& listFirst,
                                   const std::vector<uint32_t>& listPrims,
-                                  std::span<const uint32_t> tail, std::vector<uint32_t>& heads,
-                                  std::span<const int32_t> roots = {});
+                                  std::span<const uint32_t> tail, std::vector<uint32_t>& heads);
 
 /// Cut every zone of `bsp` along depth inside [zlo, zhi]; depth[i] is the depth range of the
 /// zone reference bsp.zonePrims[i] (its primitive's camera box's, or narrower: narrowZones).

@@ -97,47 +97,6 @@ std::vector<uint32_t> sharedPrimitives(const std::vector<Box3>& box,
     return big;
 }
 
-/// The camera frame's records of `slabs` (region.h), each list's header found in `heads`. A
-/// record keeps no end depth: each slab's must be the next one's start in its zone's column, or
-/// `zhi` (the structure's far face) on the column's last, and a build where it is not is a bug.
-std::vector<IrregularRegion> regionRecords(const DepthSlabs& slabs,
-                                           const std::vector<uint32_t>& heads, double zhi) {
-    // A list's position shares its word with the last-slab flag.
-    if (heads.back() >= IrregularRegion::kLastSlab)
-        throw std::invalid_argument("--scheme irregular: " + std::to_string(heads.back()) +
-                                    " list entries is over the limit of 2^31; stop the 2D step "
-                                    "earlier with --max-objects");
-    std::vector<IrregularRegion> out(slabs.regions.size());
-    for (size_t i = 0; i < out.size(); ++i) {
-        const IrregularSlab& b = slabs.regions[i];
-        const bool last = i + 1 == slabs.zoneFirstRegion[b.zone + 1];
-        if (b.zhi != (last ? zhi : slabs.regions[i + 1].zlo))
-            throw std::logic_error("irregular: the slabs of zone " + std::to_string(b.zone) +
-                                   " do not tile its depth range");
-        IrregularRegion& R = out[i];
-        R.zlo = b.zlo;
-        for (int a = 0; a < 2; ++a) {
-            R.lo[a] = b.lo[a];
-            R.hi[a] = b.hi[a];
-        }
-        R.zone = b.zone;
-        R.firstBits = heads[b.list] | (last ? IrregularRegion::kLastSlab : 0u);
-    }
-    return out;
-}
-
-/// slabAt (corner_pointers.h) over the camera frame's records, each slab's top read as the next
-/// one's start: the slab before the first later one that starts above z (s > 0) or at or above
-/// z (s <= 0).
-uint32_t regionAt(const std::vector<IrregularRegion>& regions,
-                  const std::vector<uint32_t>& zoneFirstRegion, uint32_t zone, double z, int s) {
-    const uint32_t first = zoneFirstRegion[zone], last = zoneFirstRegion[zone + 1];
-    auto it = std::partition_point(
-        regions.begin() + first + 1, regions.begin() + last,
-        [&](const IrregularRegion& r) { return s > 0 ? r.zlo <= z : r.zlo < z; });
-    return uint32_t(it - regions.begin()) - 1;
-}
-
 /// Lights beyond this many (outside the bounds) get no structure of their own: each costs about
 /// as much to build as the eye's zones.
 constexpr size_t kMaxLightStructures = 8;
@@ -465,15 +424,13 @@ IrregularSubdivision IrregularSubdivision::build(const Scene& scene, const Irreg
     fence.acquire();
     if (eyeExtra.is_object()) extra.update(eyeExtra);
 
-    // Each list after its length and its tree, and followed by the shared primitives, which the
-    // walk merges in every region.
-    std::vector<int32_t> roots(slabs.listFirst.empty() ? 0 : slabs.listFirst.size() - 1, -1);
-    for (const IrregularSlab& b : slabs.regions) roots[b.list] = b.root;
-    s.listPrims_ = headedLists(slabs.listFirst, slabs.listPrims, s.shared_, s.listFirst_, roots);
-    s.regions_ = regionRecords(slabs, s.listFirst_, s.bounds_.hi.z);
-    slabs.regions = {};
+    s.regions_ = std::move(slabs.regions);
     s.zoneFirstRegion_ = std::move(slabs.zoneFirstRegion);
     s.pool_ = std::move(slabs.pool);
+    // Each list after its length and followed by the shared primitives, which the walk merges
+    // in every region.
+    s.listPrims_ = headedLists(slabs.listFirst, slabs.listPrims, s.shared_, s.listFirst_);
+    for (IrregularRegion& R : s.regions_) R.first = s.listFirst_[R.list];
     s.zoneRect_.resize(s.bsp_.zoneCount());
     for (uint32_t z = 0; z < s.bsp_.zoneCount(); ++z)
         s.zoneRect_[z] = {s.bsp_.zoneLo[z], s.bsp_.zoneHi[z]};
@@ -564,7 +521,7 @@ double IrregularSubdivision::exitOf(const IrregularRegion& r, const Ray& rc, dou
 
 uint32_t IrregularSubdivision::locate(const Vec3& p, const Vec3& d) const {
     uint32_t zone = bsp_.locate(p.x, p.y, sign(d.x), sign(d.y));
-    return regionAt(regions_, zoneFirstRegion_, zone, p.z, sign(d.z));
+    return slabAt(regions_, zoneFirstRegion_, zone, p.z, sign(d.z));
 }
 
 int64_t IrregularSubdivision::walkTo(uint32_t from, const Vec3& p) const {

@@ -28,7 +28,6 @@
 // ends with a counted walk error.
 #pragma once
 
-#include <algorithm>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
@@ -110,22 +109,11 @@ class IrregularSubdivision {
     /// The primitives the walk merges in region r: its list, then shared() (the structure view
     /// and dump show these as the region's).
     std::span<const uint32_t> heldPrimitives(uint32_t region) const {
-        return listAt(regions_[region].first());
+        return listAt(regions_[region].first);
     }
     /// List l as the list table gives it (its own primitives, then shared()): the one each
-    /// region whose regionList() is l reads from its `first`.
+    /// region whose `list` is l reads from its `first`.
     std::span<const uint32_t> list(uint32_t l) const { return listAt(listFirst_[l]); }
-    /// Region r's list number, found from its first() in the list table (the walk never needs
-    /// it: the record keeps where the list lies, not its number).
-    uint32_t regionList(uint32_t r) const {
-        const auto it = std::upper_bound(listFirst_.begin(), listFirst_.end(), regions_[r].first());
-        return uint32_t(it - listFirst_.begin() - 1);
-    }
-    /// Region r's restricted tree in treePool() (-1: none), kept in its list's header.
-    int32_t regionRoot(uint32_t r) const { return rootAt(regions_[r].first()); }
-    /// Where region r ends in depth: the next slab's start in its zone's column, or the
-    /// structure's far face on the column's last slab (region.h).
-    double regionEnd(uint32_t r) const { return endOf(regions_[r]); }
     /// Zone z's rectangle as the walk reads it (region.h): the screen BSP's, in one line.
     const IrregularZoneRect& zoneRect(uint32_t z) const { return zoneRect_[z]; }
     /// The primitives that no camera-frame list holds and that every camera-frame region
@@ -144,7 +132,7 @@ class IrregularSubdivision {
     int32_t pointer(uint32_t r, int a, bool high) const {
         const IrregularRegion& R = regions_[r];
         if (a < 2) return high ? R.hi[a] : R.lo[a];
-        if (high) return R.lastSlab() ? -1 : int32_t(r + 1);
+        if (high) return R.zhi < bounds_.hi.z ? int32_t(r + 1) : -1;
         return R.zlo > bounds_.lo.z ? int32_t(r - 1) : -1;
     }
     /// Does region r hold camera point p, on the side of direction d where p lies on a cut?
@@ -178,28 +166,21 @@ class IrregularSubdivision {
         size_t pixels = 0;      ///< the image's: the cost stop's rays toward each light
         bool operator==(const LightKey&) const = default;
     };
-    /// The list whose length is listPrims_[head], its tree after it, then its entries.
+    /// The list whose length is listPrims_[head], its entries after it.
     std::span<const uint32_t> listAt(uint32_t head) const {
-        return {listPrims_.data() + head + 2, listPrims_[head]};
-    }
-    /// The tree kept in the header at `head` (headedLists' roots).
-    int32_t rootAt(uint32_t head) const { return int32_t(listPrims_[head + 1]); }
-    /// Region R's end in depth: R is an element of regions_, and unless it is its zone's last
-    /// slab the record after it is the next slab of the same column.
-    double endOf(const IrregularRegion& R) const {
-        return R.lastSlab() ? bounds_.hi.z : (&R + 1)->zlo;
+        return {listPrims_.data() + head + 1, listPrims_[head]};
     }
     /// Region R's box: its zone's rectangle times its depth range (region.h).
     Box3 boxOf(const IrregularRegion& R) const {
         const IrregularZoneRect& z = zoneRect_[R.zone];
-        return {Vec3(z.lo, R.zlo), Vec3(z.hi, endOf(R))};
+        return {Vec3(z.lo, R.zlo), Vec3(z.hi, R.zhi)};
     }
     /// Region R's low and high bounds on axis a: its zone's on the screen axes, its own in depth.
     double lowOf(const IrregularRegion& R, int a) const {
         return a < 2 ? zoneRect_[R.zone].lo[a] : R.zlo;
     }
     double highOf(const IrregularRegion& R, int a) const {
-        return a < 2 ? zoneRect_[R.zone].hi[a] : endOf(R);
+        return a < 2 ? zoneRect_[R.zone].hi[a] : R.zhi;
     }
     /// p is below region r on axis a (or on its low face, going down).
     bool below(uint32_t r, int a, const Vec3& p, const Vec3& d) const {
@@ -251,10 +232,9 @@ class IrregularSubdivision {
     std::vector<uint32_t> zoneFirstRegion_;    ///< zone z: regions [zoneFirstRegion_[z], [z + 1])
     std::vector<IrregularZoneRect> zoneRect_;  ///< bsp_'s zone rectangles, one line each
     CsgTree pool_;
-    /// List l lies at listFirst_[l] in listPrims_: its length, its restricted tree, its own
-    /// primitives, then the shared ones, so a region's walk merges both without copying and
-    /// reads the length and the tree from the line that holds the first entries
-    /// (IrregularRegion::first() is listFirst_[regionList(r)]).
+    /// List l lies at listFirst_[l] in listPrims_: its length, its own primitives, then the
+    /// shared ones, so a region's walk merges both without copying and reads the length from
+    /// the line that holds the first entries (IrregularRegion::first is listFirst_[list]).
     std::vector<uint32_t> listFirst_, listPrims_;
     std::vector<uint32_t> shared_;  ///< shared(): in no list, tested by every camera-frame walk
     size_t budget_ = 0;             ///< steps allowed to one walk
@@ -354,12 +334,12 @@ bool IrregularSubdivision::intersect(const Ray& ray, double tmin, double tmax, T
         obs.region(r, t, t1);
         // The shared primitives are merged in every region, fetched in the first one; after it
         // only the region's own list is fetched (the others are in their mailboxes).
-        const std::span<const uint32_t> all = listAt(R.first());
+        const std::span<const uint32_t> all = listAt(R.first);
         std::optional<std::span<const uint32_t>> fetch;
         if (!shared_.empty() && !first) fetch = all.first(all.size() - shared_.size());
         first = false;
-        if (hitInIrregularRegion(*scene_, unionOnly_, all, pool_, rootAt(R.first()), ray, tmin, t,
-                                 t1, ctx, obs, hit, true, fetch))
+        if (hitInIrregularRegion(*scene_, unionOnly_, all, pool_, R.root, ray, tmin, t, t1, ctx,
+                                 obs, hit, true, fetch))
             return true;
         if (te >= tend) return false;
         // Beyond the listed primitives' box only the shared ones can be met: with none of

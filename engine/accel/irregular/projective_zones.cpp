@@ -149,7 +149,7 @@ ProjectiveZones ProjectiveZones::buildCentred(const Scene& scene, const CameraFr
     std::vector<uint32_t> heads;
     s.listPrims_ = headedLists(slabs.listFirst, slabs.listPrims, {}, heads);
     s.slabs_.reserve(slabs.regions.size());
-    for (const IrregularSlab& r : slabs.regions) {
+    for (const IrregularRegion& r : slabs.regions) {
         const uint32_t h = heads[r.list];
         s.slabs_.push_back({r.zlo, h, s.unionOnly_ ? int32_t(s.listPrims_[h]) : r.root});
     }
