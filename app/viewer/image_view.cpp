@@ -198,8 +198,9 @@ bool ImageView::setOverlay(unsigned texture, uint64_t version, FrameBudget& budg
         if (readNeedsFreshMemory(w, h)) {
             // Its buffer is made on a worker first: written in the frame, its fresh pages
             // took 10-12 ms of the 1280x720 read-back (2026-12-07). The layer held stays.
-            readBuffer_.prepare(size_t(std::max(w, 0)) * size_t(std::max(h, 0)) * 4);
-            if (readNeedsFreshMemory(w, h)) return false;
+            const size_t bytes = size_t(std::max(w, 0)) * size_t(std::max(h, 0)) * 4;
+            readBuffer_.prepare(bytes);
+            if (readBuffer_.making(bytes)) return false;
         }
         if (!budget.fits(readEstimateMs(w, h), reserveMs, readPatience_)) return false;
     }

@@ -1,6 +1,7 @@
 #include "app/viewer/memory/fresh_memory.h"
 
 #include <chrono>
+#include <exception>
 
 namespace lancer::viewer {
 
@@ -23,9 +24,18 @@ bool PreparedBytes::ready(size_t n) const {
     if (n == 0 || n != size_) return false;
     if (making_.valid()) {
         if (making_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
-        made_ = making_.get();
+        try {
+            made_ = making_.get();
+        } catch (const std::exception&) {
+            made_ = {};  // the allocation failed: nothing prepared, the taker allocates
+        }
     }
     return made_.size() == n;
+}
+
+bool PreparedBytes::making(size_t n) const {
+    return n != 0 && n == size_ && making_.valid() &&
+           making_.wait_for(std::chrono::seconds(0)) != std::future_status::ready;
 }
 
 std::vector<uint8_t> PreparedBytes::take(size_t n) {

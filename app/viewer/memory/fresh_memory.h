@@ -25,8 +25,10 @@ class PreparedBytes {
     /// Starts making `n` zero bytes on a worker, unless `n` are ready or being made already
     /// (bytes of another size are dropped).
     void prepare(size_t n);
-    /// True when `n` bytes are made and not yet taken.
+    /// True when `n` bytes are made and not yet taken (false if their allocation failed).
     bool ready(size_t n) const;
+    /// True while a worker is still making `n` bytes.
+    bool making(size_t n) const;
     /// The `n` bytes made, when ready(n); else an empty vector (nothing is waited for).
     std::vector<uint8_t> take(size_t n);
 

@@ -68,6 +68,27 @@ TEST(FreshMemory, PreparedBytesComeZeroWithTheirPagesMapped) {
     EXPECT_EQ(bytes.take(kWindowBuffer / 4).size(), kWindowBuffer / 4);
 }
 
+// An allocation the worker cannot make leaves nothing prepared, throws nothing, and is no
+// longer being made (a read-back waiting for it then allocates as before).
+TEST(FreshMemory, AFailedPreparationLeavesNothingAndThrowsNothing) {
+    PreparedBytes bytes;
+    const size_t huge = size_t(1) << 62;
+    bytes.prepare(huge);
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (bytes.making(huge) && std::chrono::steady_clock::now() < until)
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    EXPECT_FALSE(bytes.making(huge));
+    EXPECT_FALSE(bytes.ready(huge));
+    EXPECT_TRUE(bytes.take(huge).empty());
+    // A size that can be made is made after it.
+    bytes.prepare(kWindowBuffer);
+    EXPECT_TRUE(bytes.making(kWindowBuffer) || bytes.ready(kWindowBuffer));
+    while (!bytes.ready(kWindowBuffer) && std::chrono::steady_clock::now() < until)
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    EXPECT_FALSE(bytes.making(kWindowBuffer));
+    EXPECT_EQ(bytes.take(kWindowBuffer).size(), kWindowBuffer);
+}
+
 // A block over glibc's first mmap threshold, written and freed, comes back with its pages:
 // without keepFreedMemory() (engine/util/kept_memory.h, which `lancer` sets at its start)
 // glibc returns it to the system and the next one is mapped afresh.

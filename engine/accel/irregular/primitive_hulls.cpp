@@ -157,7 +157,7 @@ PrimitiveHulls PrimitiveHulls::make(const Scene& scene, const CameraFrame& frame
     h.index_.assign(scene.prims.size(), -1);
     // One hull a live primitive, in one buffer written once (grown by doubling, each copy was
     // fresh pages: PrimitiveHulls::make took 41% of the irregular build's page faults on
-    // balls4, docs/irregular.md, "Freed memory kept").
+    // balls4; docs/irregular.md, "Freed memory kept, and the hulls in one buffer").
     reserveHuge(h.hulls_, live.size());
     size_t made = 0;
     bool keep = maxFaceBytes > 0;  // faces clipped by the other box are still kept
